@@ -1,0 +1,1306 @@
+//! Name resolution and type checking: [`ast::File`] to [`Program`].
+//!
+//! Every problem found is reported; compilation goes on after an error so
+//! that `subgram check` can list all of them at once.
+
+use std::collections::HashMap;
+
+use crate::syntax::ast::{self, BinOp, ExprKind, Init, Item, Section, UnOp};
+use crate::syntax::span::{Diagnostic, Span};
+
+use super::ir::*;
+use super::modules::{Alphabet, Signature, Sym};
+use super::value::{StructDef, Ty, Value};
+
+pub fn compile(file: &ast::File) -> Result<Program, Vec<Diagnostic>> {
+    let mut c = Compiler {
+        alphabet: Alphabet::new(),
+        structs: Vec::new(),
+        typedefs: HashMap::new(),
+        globals: Vec::new(),
+        global_names: HashMap::new(),
+        diags: Vec::new(),
+    };
+    c.declarations(file);
+    let program = c.rules_and_directives(file);
+    if c.diags.is_empty() {
+        Ok(program)
+    } else {
+        c.diags.sort_by_key(|d| (d.span.file.0, d.span.start));
+        Err(c.diags)
+    }
+}
+
+struct Compiler {
+    alphabet: Alphabet,
+    structs: Vec<StructDef>,
+    typedefs: HashMap<String, Ty>,
+    globals: Vec<GlobalVar>,
+    global_names: HashMap<String, u16>,
+    diags: Vec<Diagnostic>,
+}
+
+/// Local variables of one body, with nested block scopes.
+#[derive(Default)]
+struct Scope {
+    vars: Vec<(String, Ty, u16)>,
+    marks: Vec<usize>,
+    next: u16,
+    max: u16,
+    loops: u32,
+    in_rule: bool,
+}
+
+impl Scope {
+    fn rule() -> Scope {
+        Scope {
+            in_rule: true,
+            ..Scope::default()
+        }
+    }
+
+    fn push(&mut self) {
+        self.marks.push(self.vars.len());
+    }
+
+    fn pop(&mut self) {
+        let m = self.marks.pop().expect("balanced scopes");
+        self.vars.truncate(m);
+    }
+
+    fn declare(&mut self, name: &str, ty: Ty) -> u16 {
+        let slot = self.next;
+        self.next += 1;
+        self.max = self.max.max(self.next);
+        self.vars.push((name.to_string(), ty, slot));
+        slot
+    }
+
+    fn lookup(&self, name: &str) -> Option<(Ty, u16)> {
+        self.vars
+            .iter()
+            .rev()
+            .find(|(n, _, _)| n == name)
+            .map(|(_, t, s)| (*t, *s))
+    }
+}
+
+type Typed = Option<(Ex, Ty)>;
+
+impl Compiler {
+    fn err(&mut self, span: Span, msg: impl Into<String>) {
+        self.diags.push(Diagnostic::new(span, msg));
+    }
+
+    fn type_name(&self, ty: Ty) -> String {
+        match ty {
+            Ty::Int => "int".into(),
+            Ty::Float => "float".into(),
+            Ty::Bool => "bool".into(),
+            Ty::V2 => "V2f".into(),
+            Ty::V3 => "V3f".into(),
+            Ty::Struct(i) => self.structs[i as usize].name.clone(),
+            Ty::Str => "string".into(),
+            Ty::Void => "void".into(),
+        }
+    }
+
+    fn resolve_type(&mut self, t: &ast::TypeRef) -> Option<Ty> {
+        let ty = match t.name.as_str() {
+            "int" | "long" | "unsigned" | "short" => Ty::Int,
+            "float" | "double" => Ty::Float,
+            "bool" => Ty::Bool,
+            "V2f" | "V2d" => Ty::V2,
+            "V3f" | "V3d" => Ty::V3,
+            "void" => Ty::Void,
+            other => {
+                if let Some(t) = self.typedefs.get(other) {
+                    *t
+                } else if let Some(i) = self.structs.iter().position(|s| s.name == other) {
+                    Ty::Struct(i as u16)
+                } else {
+                    self.err(
+                        t.span,
+                        format!("unknown type `{other}`: expected int, float, double, bool, V2f, V3f or a declared struct"),
+                    );
+                    return None;
+                }
+            }
+        };
+        Some(ty)
+    }
+
+    /// First pass: structs, typedefs and modules, so order does not matter.
+    fn declarations(&mut self, file: &ast::File) {
+        for item in &file.items {
+            match item {
+                Item::Struct { name, fields } => {
+                    let mut fs = Vec::new();
+                    for (t, n) in fields {
+                        if let Some(ty) = self.resolve_type(t) {
+                            fs.push((n.text.clone(), ty));
+                        }
+                    }
+                    self.structs.push(StructDef {
+                        name: name.text.clone(),
+                        fields: fs,
+                    });
+                }
+                Item::Typedef { ty, name } => {
+                    if let Some(t) = self.resolve_type(ty) {
+                        self.typedefs.insert(name.text.clone(), t);
+                    }
+                }
+                Item::Module { name, params } => {
+                    if let Some(s) = self.alphabet.lookup(&name.text) {
+                        let what = if self.alphabet.get(s).builtin {
+                            "is a predefined module and cannot be redeclared"
+                        } else {
+                            "is already declared"
+                        };
+                        self.err(name.span, format!("module `{}` {what}", name.text));
+                        continue;
+                    }
+                    let tys: Vec<Ty> = params.iter().filter_map(|p| self.resolve_type(p)).collect();
+                    if tys.len() == params.len() {
+                        self.alphabet.declare(&name.text, tys);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    fn rules_and_directives(&mut self, file: &ast::File) -> Program {
+        let mut program = Program {
+            alphabet: Alphabet::new(),
+            structs: Vec::new(),
+            globals: Vec::new(),
+            axiom: Vec::new(),
+            derivation_length: None,
+            ring: None,
+            decomposition_depth: None,
+            interpretation_depth: None,
+            rules: Vec::new(),
+            control: Vec::new(),
+        };
+        let mut section = Section::Productions;
+        let mut group = 0i64;
+        let mut filter = Filter::All;
+        let mut axiom_seen = false;
+        for item in &file.items {
+            match item {
+                Item::Global(decl) => self.global(decl),
+                Item::Directive { kind, expr, span } => {
+                    let mut scope = Scope::default();
+                    let Some((ex, ty)) = self.expr(expr, &mut scope) else {
+                        continue;
+                    };
+                    if !ty.is_numeric() {
+                        self.err(expr.span, format!("expected a number, found a value of type {}", self.type_name(ty)));
+                        continue;
+                    }
+                    let slot = match kind {
+                        ast::DirectiveKind::DerivationLength => &mut program.derivation_length,
+                        ast::DirectiveKind::Ring => &mut program.ring,
+                        ast::DirectiveKind::MaximumDepth => match section {
+                            Section::Interpretation => &mut program.interpretation_depth,
+                            _ => &mut program.decomposition_depth,
+                        },
+                    };
+                    if slot.is_some() {
+                        self.err(*span, "this directive is given twice");
+                    }
+                    *slot = Some(ex);
+                }
+                Item::Axiom { modules, span } => {
+                    if axiom_seen {
+                        self.err(*span, "the axiom is given twice");
+                    }
+                    axiom_seen = true;
+                    let mut scope = Scope::default();
+                    program.axiom = self.successors(modules, &mut scope);
+                }
+                Item::ContextFilter {
+                    consider, names, ..
+                } => {
+                    let mut syms = Vec::new();
+                    for n in names {
+                        match self.alphabet.lookup(&n.text) {
+                            Some(s) => syms.push(s),
+                            None => self.err(n.span, format!("undeclared module `{}` in the module list; declare it with `module {}(...);`", n.text, n.text)),
+                        }
+                    }
+                    filter = if names.is_empty() {
+                        Filter::All
+                    } else if *consider {
+                        Filter::Consider(syms)
+                    } else {
+                        Filter::Ignore(syms)
+                    };
+                }
+                Item::Section { section: s, .. } => {
+                    section = *s;
+                    group = 0;
+                }
+                Item::Group { id, .. } => group = *id,
+                Item::Control { kind, body, .. } => {
+                    let mut scope = Scope::default();
+                    let stmts = self.block_stmts(&body.stmts, &mut scope);
+                    program.control.push((*kind, stmts, scope.max as usize));
+                }
+                Item::Production(p) => {
+                    if let Some(rule) = self.rule(p, section, group, &filter) {
+                        program.rules.push(rule);
+                    }
+                }
+                Item::Module { .. } | Item::Struct { .. } | Item::Typedef { .. } => {}
+            }
+        }
+        if !axiom_seen {
+            let end = file
+                .items
+                .last()
+                .map(|_| Span::default())
+                .unwrap_or_default();
+            self.err(end, "the program has no axiom: add a line such as `Axiom: A(1);`");
+        }
+        program.alphabet = self.alphabet.clone();
+        program.structs = self.structs.clone();
+        program.globals = std::mem::take(&mut self.globals);
+        program
+    }
+
+    fn global(&mut self, decl: &ast::VarDecl) {
+        let Some(ty) = self.resolve_type(&decl.ty) else {
+            return;
+        };
+        for d in &decl.vars {
+            let mut scope = Scope::default();
+            let init = self.initializer(ty, &d.init, &mut scope);
+            if scope.max > 0 {
+                self.err(d.name.span, "a global initializer cannot declare variables");
+            }
+            if self.global_names.contains_key(&d.name.text) {
+                self.err(d.name.span, format!("`{}` is already declared", d.name.text));
+                continue;
+            }
+            if self.alphabet.lookup(&d.name.text).is_some() {
+                self.err(d.name.span, format!("`{}` is a module name and cannot also name a variable", d.name.text));
+                continue;
+            }
+            self.global_names
+                .insert(d.name.text.clone(), self.globals.len() as u16);
+            self.globals.push(GlobalVar {
+                name: d.name.text.clone(),
+                ty,
+                is_const: decl.is_const,
+                init,
+            });
+        }
+    }
+
+    /// The expression that initialises a variable of type `ty`.
+    fn initializer(&mut self, ty: Ty, init: &Init, scope: &mut Scope) -> Option<Ex> {
+        match init {
+            Init::None => None,
+            Init::Expr(e) => {
+                let (ex, et) = self.expr(e, scope)?;
+                self.coerce(ex, et, ty, e.span)
+            }
+            Init::Ctor(args, span) | Init::List(args, span) => {
+                let mut exs = Vec::new();
+                for a in args {
+                    exs.push(self.expr(a, scope)?);
+                }
+                self.construct(ty, exs, args, *span)
+            }
+        }
+    }
+
+    /// `V2f v(1, 2)`, `V3f(x, y, z)`, `Data d = {1, 0}`, `int n(3)`.
+    fn construct(&mut self, ty: Ty, mut exs: Vec<(Ex, Ty)>, args: &[ast::Expr], span: Span) -> Option<Ex> {
+        let want: Vec<Ty> = match ty {
+            Ty::V2 => vec![Ty::Float; 2],
+            Ty::V3 => vec![Ty::Float; 3],
+            Ty::Struct(i) => self.structs[i as usize].fields.iter().map(|f| f.1).collect(),
+            t => vec![t],
+        };
+        if exs.len() == 1 && exs[0].1 == ty {
+            return Some(exs.pop().expect("one").0);
+        }
+        if exs.len() != want.len() {
+            self.err(
+                span,
+                format!(
+                    "{} takes {} value(s) here, but {} were given",
+                    self.type_name(ty),
+                    want.len(),
+                    exs.len()
+                ),
+            );
+            return None;
+        }
+        let mut parts = Vec::new();
+        for ((ex, et), (w, a)) in exs.into_iter().zip(want.iter().zip(args)) {
+            parts.push(self.coerce(ex, et, *w, a.span)?);
+        }
+        Some(match ty {
+            Ty::V2 => {
+                let mut it = parts.into_iter();
+                Ex::MakeV2(Box::new(it.next()?), Box::new(it.next()?))
+            }
+            Ty::V3 => {
+                let mut it = parts.into_iter();
+                Ex::MakeV3(
+                    Box::new(it.next()?),
+                    Box::new(it.next()?),
+                    Box::new(it.next()?),
+                )
+            }
+            Ty::Struct(_) => Ex::MakeStruct(parts),
+            _ => parts.pop()?,
+        })
+    }
+
+    /// Converts `ex` of type `from` to `to`, or reports a type error.
+    fn coerce(&mut self, ex: Ex, from: Ty, to: Ty, span: Span) -> Option<Ex> {
+        if from == to {
+            return Some(ex);
+        }
+        if from.is_numeric() && to.is_numeric() {
+            return Some(Ex::Convert(to, Box::new(ex)));
+        }
+        self.err(
+            span,
+            format!(
+                "type mismatch: expected {}, found {}",
+                self.type_name(to),
+                self.type_name(from)
+            ),
+        );
+        None
+    }
+
+    fn rule(&mut self, p: &ast::Production, section: Section, group: i64, filter: &Filter) -> Option<Rule> {
+        let mut scope = Scope::rule();
+        let mut ok = true;
+        let mut pats = |c: &mut Compiler, list: &[ast::PatModule], scope: &mut Scope| -> Vec<Pattern> {
+            let mut out = Vec::new();
+            for m in list {
+                match c.pattern(m, scope) {
+                    Some(pat) => out.push(pat),
+                    None => ok = false,
+                }
+            }
+            out
+        };
+        let new_left = pats(self, &p.new_left, &mut scope);
+        let left = pats(self, &p.left, &mut scope);
+        let strict = pats(self, &p.strict, &mut scope);
+        let right = pats(self, &p.right, &mut scope);
+        let new_right = pats(self, &p.new_right, &mut scope);
+        let body = match &p.body {
+            ast::Body::Block(b) => self.block_stmts(&b.stmts, &mut scope),
+            ast::Body::Arrow(succ, _) => {
+                let modules = self.successors(succ, &mut scope);
+                vec![St::Produce {
+                    modules,
+                    last: true,
+                }]
+            }
+        };
+        if !ok {
+            return None;
+        }
+        let label = pattern_label(p);
+        let mut rule = Rule {
+            new_left,
+            left,
+            strict,
+            right,
+            new_right,
+            filter: filter.clone(),
+            body,
+            frame_size: scope.max as usize,
+            section,
+            group,
+            span: p.span,
+            label,
+            stencil: None,
+        };
+        rule.stencil = super::stencil::Stencil::compile(&rule);
+        Some(rule)
+    }
+
+    /// A predecessor module: each parameter becomes a local of the module's type.
+    fn pattern(&mut self, m: &ast::PatModule, scope: &mut Scope) -> Option<Pattern> {
+        let (sym, tys, arity) = self.module_params(&m.name, m.params.len())?;
+        let mut slots = Vec::new();
+        for (n, t) in m.params.iter().zip(tys.iter().copied()) {
+            if scope.vars.iter().any(|(v, _, _)| *v == n.text) {
+                self.err(n.span, format!("the parameter name `{}` is used twice in this predecessor", n.text));
+                return None;
+            }
+            slots.push(scope.declare(&n.text, t));
+        }
+        Some(Pattern {
+            sym,
+            slots,
+            types: tys,
+            arity,
+        })
+    }
+
+    /// The module `name` and its parameter types for `count` parameters.
+    fn module_params(&mut self, name: &ast::Name, count: usize) -> Option<(Sym, Vec<Ty>, Option<usize>)> {
+        let Some(sym) = self.alphabet.lookup(&name.text) else {
+            self.err(
+                name.span,
+                format!(
+                    "undeclared module `{}`: declare it before use, e.g. `module {}({});`",
+                    name.text,
+                    name.text,
+                    vec!["float"; count].join(", ")
+                ),
+            );
+            return None;
+        };
+        match &self.alphabet.get(sym).sig {
+            Signature::Fixed(tys) => {
+                if tys.len() != count {
+                    let decl = tys.iter().map(|t| self.type_name(*t)).collect::<Vec<_>>().join(", ");
+                    self.err(
+                        name.span,
+                        format!(
+                            "module `{}` is declared with {} parameter(s) ({}) but {} are given here",
+                            name.text,
+                            tys.len(),
+                            decl,
+                            count
+                        ),
+                    );
+                    return None;
+                }
+                Some((sym, tys.clone(), None))
+            }
+            Signature::Overloads(ovs) => match ovs.iter().find(|o| o.len() == count) {
+                Some(o) => Some((sym, o.to_vec(), Some(count))),
+                None => {
+                    let counts: Vec<String> = ovs.iter().map(|o| o.len().to_string()).collect();
+                    self.err(
+                        name.span,
+                        format!(
+                            "predefined module `{}` takes {} parameter(s), but {} are given here",
+                            name.text,
+                            counts.join(" or "),
+                            count
+                        ),
+                    );
+                    None
+                }
+            },
+        }
+    }
+
+    fn successors(&mut self, modules: &[ast::ModuleCall], scope: &mut Scope) -> Vec<Succ> {
+        let mut out = Vec::new();
+        for m in modules {
+            let mut args = Vec::new();
+            let mut ok = true;
+            for a in &m.args {
+                match self.expr(a, scope) {
+                    Some(t) => args.push(t),
+                    None => ok = false,
+                }
+            }
+            if !ok {
+                continue;
+            }
+            let Some(sym) = self.alphabet.lookup(&m.name.text) else {
+                let types: Vec<String> = args.iter().map(|(_, t)| self.type_name(*t)).collect();
+                self.err(
+                    m.name.span,
+                    format!(
+                        "undeclared module `{}`: declare it before use, e.g. `module {}({});`",
+                        m.name.text,
+                        m.name.text,
+                        types.join(", ")
+                    ),
+                );
+                continue;
+            };
+            let candidates: Vec<Vec<Ty>> = match &self.alphabet.get(sym).sig {
+                Signature::Fixed(t) => vec![t.clone()],
+                Signature::Overloads(o) => o.iter().map(|v| v.to_vec()).collect(),
+            };
+            let fits = |want: &[Ty]| {
+                want.len() == args.len()
+                    && want.iter().zip(&args).all(|(w, (_, t))| {
+                        w == t || (w.is_numeric() && t.is_numeric())
+                    })
+            };
+            let Some(want) = candidates.iter().find(|w| fits(w)).cloned() else {
+                let same_arity = candidates.iter().find(|w| w.len() == args.len());
+                match same_arity {
+                    Some(want) => {
+                        for ((_, t), (w, a)) in args.iter().zip(want.iter().zip(&m.args)) {
+                            if !(w == t || (w.is_numeric() && t.is_numeric())) {
+                                self.err(
+                                    a.span,
+                                    format!(
+                                        "type mismatch in argument of `{}`: expected {}, found {}",
+                                        m.name.text,
+                                        self.type_name(*w),
+                                        self.type_name(*t)
+                                    ),
+                                );
+                                break;
+                            }
+                        }
+                    }
+                    None => {
+                        let counts: Vec<String> = candidates.iter().map(|c| c.len().to_string()).collect();
+                        self.err(
+                            m.name.span,
+                            format!(
+                                "module `{}` takes {} parameter(s), but {} are given here",
+                                m.name.text,
+                                counts.join(" or "),
+                                args.len()
+                            ),
+                        );
+                    }
+                }
+                continue;
+            };
+            let args = args
+                .into_iter()
+                .zip(&want)
+                .map(|((ex, t), w)| if t == *w { ex } else { Ex::Convert(*w, Box::new(ex)) })
+                .collect();
+            out.push(Succ {
+                sym,
+                args,
+                span: m.name.span,
+            });
+        }
+        out
+    }
+
+    fn block_stmts(&mut self, stmts: &[ast::Stmt], scope: &mut Scope) -> Vec<St> {
+        scope.push();
+        let mut out = Vec::new();
+        for s in stmts {
+            self.stmt(s, scope, &mut out);
+        }
+        scope.pop();
+        out
+    }
+
+    fn stmt(&mut self, s: &ast::Stmt, scope: &mut Scope, out: &mut Vec<St>) {
+        match s {
+            ast::Stmt::Expr(e) => {
+                if let Some((ex, _)) = self.expr(e, scope) {
+                    out.push(St::Expr(ex));
+                }
+            }
+            ast::Stmt::Decl(d) => {
+                let Some(ty) = self.resolve_type(&d.ty) else {
+                    return;
+                };
+                for v in &d.vars {
+                    let init = self.initializer(ty, &v.init, scope);
+                    let slot = scope.declare(&v.name.text, ty);
+                    let value = init.unwrap_or(Ex::Const(Value::zero(ty, &self.structs)));
+                    out.push(St::Init(slot, value));
+                }
+            }
+            ast::Stmt::If { cond, then, els } => {
+                let c = self.condition(cond, scope);
+                let t = self.sub_stmt(then, scope);
+                let e = els.as_ref().map(|e| Box::new(self.sub_stmt(e, scope)));
+                if let Some(c) = c {
+                    out.push(St::If(c, Box::new(t), e));
+                }
+            }
+            ast::Stmt::While { cond, body } => {
+                let c = self.condition(cond, scope);
+                scope.loops += 1;
+                let b = self.sub_stmt(body, scope);
+                scope.loops -= 1;
+                if let Some(c) = c {
+                    out.push(St::Loop {
+                        cond: Some(c),
+                        body: Box::new(b),
+                        step: None,
+                        test_after: false,
+                        span: cond.span,
+                    });
+                }
+            }
+            ast::Stmt::DoWhile { body, cond } => {
+                scope.loops += 1;
+                let b = self.sub_stmt(body, scope);
+                scope.loops -= 1;
+                if let Some(c) = self.condition(cond, scope) {
+                    out.push(St::Loop {
+                        cond: Some(c),
+                        body: Box::new(b),
+                        step: None,
+                        test_after: true,
+                        span: cond.span,
+                    });
+                }
+            }
+            ast::Stmt::For {
+                init,
+                cond,
+                step,
+                body,
+            } => {
+                scope.push();
+                let mut stmts = Vec::new();
+                if let Some(i) = init {
+                    self.stmt(i, scope, &mut stmts);
+                }
+                let c = cond.as_ref().and_then(|c| self.condition(c, scope));
+                let st = step.as_ref().and_then(|e| self.expr(e, scope)).map(|(e, _)| e);
+                scope.loops += 1;
+                let b = self.sub_stmt(body, scope);
+                scope.loops -= 1;
+                scope.pop();
+                let span = cond.as_ref().map(|c| c.span).unwrap_or_default();
+                stmts.push(St::Loop {
+                    cond: c,
+                    body: Box::new(b),
+                    step: st,
+                    test_after: false,
+                    span,
+                });
+                out.push(St::Block(stmts));
+            }
+            ast::Stmt::Block(b) => out.push(St::Block(self.block_stmts(&b.stmts, scope))),
+            ast::Stmt::Produce {
+                modules,
+                last,
+                span,
+            } => {
+                if !scope.in_rule {
+                    let kw = if *last { "produce" } else { "nproduce" };
+                    self.err(*span, format!("`{kw}` is only allowed in the body of a production or rule"));
+                    return;
+                }
+                let modules = self.successors(modules, scope);
+                out.push(St::Produce {
+                    modules,
+                    last: *last,
+                });
+            }
+            ast::Stmt::Return(_) => out.push(St::Return),
+            ast::Stmt::Break(span) | ast::Stmt::Continue(span) => {
+                if scope.loops == 0 {
+                    self.err(*span, "`break` and `continue` are only allowed inside a loop");
+                    return;
+                }
+                out.push(if matches!(s, ast::Stmt::Break(_)) {
+                    St::Break
+                } else {
+                    St::Continue
+                });
+            }
+            ast::Stmt::Empty => {}
+        }
+    }
+
+    fn sub_stmt(&mut self, s: &ast::Stmt, scope: &mut Scope) -> St {
+        scope.push();
+        let mut v = Vec::new();
+        self.stmt(s, scope, &mut v);
+        scope.pop();
+        if v.len() == 1 {
+            v.pop().expect("one")
+        } else {
+            St::Block(v)
+        }
+    }
+
+    fn condition(&mut self, e: &ast::Expr, scope: &mut Scope) -> Option<Ex> {
+        let (ex, ty) = self.expr(e, scope)?;
+        if !ty.is_numeric() {
+            self.err(e.span, format!("expected a condition (a number or bool), found {}", self.type_name(ty)));
+            return None;
+        }
+        Some(ex)
+    }
+
+    fn place(&mut self, e: &ast::Expr, scope: &mut Scope) -> Option<Place> {
+        match &e.kind {
+            ExprKind::Ident(n) => {
+                if let Some((ty, slot)) = scope.lookup(n) {
+                    return Some(Place {
+                        global: false,
+                        slot,
+                        path: Vec::new(),
+                        ty,
+                    });
+                }
+                if let Some(&g) = self.global_names.get(n) {
+                    let gv = &self.globals[g as usize];
+                    if gv.is_const {
+                        self.err(e.span, format!("cannot assign to `{n}`: it is declared const"));
+                        return None;
+                    }
+                    return Some(Place {
+                        global: true,
+                        slot: g,
+                        path: Vec::new(),
+                        ty: gv.ty,
+                    });
+                }
+                self.err(e.span, format!("unknown identifier `{n}`"));
+                None
+            }
+            ExprKind::Field(base, f) => {
+                let mut p = self.place(base, scope)?;
+                let (idx, ty) = self.field_of(p.ty, f)?;
+                p.path.push(idx);
+                p.ty = ty;
+                Some(p)
+            }
+            _ => {
+                self.err(e.span, "expected a variable or a field to assign to");
+                None
+            }
+        }
+    }
+
+    fn field_of(&mut self, ty: Ty, f: &ast::Name) -> Option<(u16, Ty)> {
+        let found = match ty {
+            Ty::V2 => ["x", "y"].iter().position(|c| *c == f.text).map(|i| (i as u16, Ty::Float)),
+            Ty::V3 => ["x", "y", "z"].iter().position(|c| *c == f.text).map(|i| (i as u16, Ty::Float)),
+            Ty::Struct(s) => self.structs[s as usize]
+                .fields
+                .iter()
+                .position(|(n, _)| *n == f.text)
+                .map(|i| (i as u16, self.structs[s as usize].fields[i].1)),
+            _ => None,
+        };
+        if found.is_none() {
+            self.err(f.span, format!("{} has no field `{}`", self.type_name(ty), f.text));
+        }
+        found
+    }
+
+    fn expr(&mut self, e: &ast::Expr, scope: &mut Scope) -> Typed {
+        let span = e.span;
+        match &e.kind {
+            ExprKind::Int(i) => Some((Ex::Const(Value::Int(*i)), Ty::Int)),
+            ExprKind::Float(f) => Some((Ex::Const(Value::Float(*f)), Ty::Float)),
+            ExprKind::Str(s) => Some((Ex::Const(Value::Str(s.as_str().into())), Ty::Str)),
+            ExprKind::Ident(n) => {
+                if let Some((ty, slot)) = scope.lookup(n) {
+                    return Some((Ex::Local(slot), ty));
+                }
+                if let Some(&g) = self.global_names.get(n) {
+                    return Some((Ex::Global(g), self.globals[g as usize].ty));
+                }
+                let c = match n.as_str() {
+                    "true" => Value::Bool(true),
+                    "false" => Value::Bool(false),
+                    "M_PI" | "PI" => Value::Float(std::f64::consts::PI),
+                    "M_PI_2" => Value::Float(std::f64::consts::FRAC_PI_2),
+                    "M_E" => Value::Float(std::f64::consts::E),
+                    "M_SQRT2" => Value::Float(std::f64::consts::SQRT_2),
+                    _ => {
+                        let hint = if self.alphabet.lookup(n).is_some() {
+                            format!(": `{n}` is a module, not a value")
+                        } else {
+                            String::new()
+                        };
+                        self.err(span, format!("unknown identifier `{n}`{hint}"));
+                        return None;
+                    }
+                };
+                let ty = match c {
+                    Value::Bool(_) => Ty::Bool,
+                    _ => Ty::Float,
+                };
+                Some((Ex::Const(c), ty))
+            }
+            ExprKind::Unary(op, a) => {
+                let (x, t) = self.expr(a, scope)?;
+                match op {
+                    UnOp::Plus if t.is_numeric() || t.is_vector() => Some((x, t)),
+                    UnOp::Neg if t.is_numeric() || t.is_vector() => {
+                        let t = if t == Ty::Bool { Ty::Int } else { t };
+                        Some((Ex::Neg(Box::new(x)), t))
+                    }
+                    UnOp::Not if t.is_numeric() => Some((Ex::Not(Box::new(x)), Ty::Bool)),
+                    _ => {
+                        let sym = match op {
+                            UnOp::Neg => "-",
+                            UnOp::Plus => "+",
+                            UnOp::Not => "!",
+                        };
+                        self.err(span, format!("type error: cannot apply unary `{sym}` to {}", self.type_name(t)));
+                        None
+                    }
+                }
+            }
+            ExprKind::Binary(op, a, b) => {
+                let l = self.expr(a, scope);
+                let r = self.expr(b, scope);
+                let ((lx, lt), (rx, rt)) = (l?, r?);
+                let Some(ty) = binary_type(*op, lt, rt) else {
+                    self.err(
+                        span,
+                        format!(
+                            "type error: cannot apply `{}` to {} and {}",
+                            op.symbol(),
+                            self.type_name(lt),
+                            self.type_name(rt)
+                        ),
+                    );
+                    return None;
+                };
+                let ex = match op {
+                    BinOp::And => Ex::Logic(true, Box::new(lx), Box::new(rx)),
+                    BinOp::Or => Ex::Logic(false, Box::new(lx), Box::new(rx)),
+                    _ => Ex::Bin(*op, Box::new(lx), Box::new(rx)),
+                };
+                Some((ex, ty))
+            }
+            ExprKind::Assign(op, lhs, rhs) => {
+                let place = self.place(lhs, scope);
+                let (rx, rt) = self.expr(rhs, scope)?;
+                let place = place?;
+                let rt = match op {
+                    None => rt,
+                    Some(o) => match binary_type(*o, place.ty, rt) {
+                        Some(t) => t,
+                        None => {
+                            self.err(
+                                span,
+                                format!(
+                                    "type error: cannot apply `{}=` to {} and {}",
+                                    o.symbol(),
+                                    self.type_name(place.ty),
+                                    self.type_name(rt)
+                                ),
+                            );
+                            return None;
+                        }
+                    },
+                };
+                if !(rt == place.ty || (rt.is_numeric() && place.ty.is_numeric())) {
+                    self.err(
+                        span,
+                        format!(
+                            "type mismatch in assignment: expected {}, found {}",
+                            self.type_name(place.ty),
+                            self.type_name(rt)
+                        ),
+                    );
+                    return None;
+                }
+                let ty = place.ty;
+                Some((Ex::Assign(place, *op, Box::new(rx), ty), ty))
+            }
+            ExprKind::IncDec {
+                target,
+                delta,
+                prefix,
+            } => {
+                let place = self.place(target, scope)?;
+                if !place.ty.is_numeric() {
+                    self.err(span, format!("type error: `++`/`--` need a number, found {}", self.type_name(place.ty)));
+                    return None;
+                }
+                let ty = place.ty;
+                Some((Ex::IncDec(place, *delta, *prefix), ty))
+            }
+            ExprKind::Cond(c, a, b) => {
+                let c = self.condition(c, scope);
+                let l = self.expr(a, scope);
+                let r = self.expr(b, scope);
+                let (c, (lx, lt), (rx, rt)) = (c?, l?, r?);
+                let ty = if lt == rt {
+                    lt
+                } else if lt.is_numeric() && rt.is_numeric() {
+                    if lt == Ty::Float || rt == Ty::Float {
+                        Ty::Float
+                    } else {
+                        Ty::Int
+                    }
+                } else {
+                    self.err(
+                        span,
+                        format!(
+                            "type error: the branches of `?:` have different types, {} and {}",
+                            self.type_name(lt),
+                            self.type_name(rt)
+                        ),
+                    );
+                    return None;
+                };
+                let lx = if lt == ty { lx } else { Ex::Convert(ty, Box::new(lx)) };
+                let rx = if rt == ty { rx } else { Ex::Convert(ty, Box::new(rx)) };
+                Some((Ex::Cond(Box::new(c), Box::new(lx), Box::new(rx)), ty))
+            }
+            ExprKind::Cast(t, a) => {
+                let ty = self.resolve_type(t);
+                let (x, xt) = self.expr(a, scope)?;
+                let ty = ty?;
+                if xt == ty {
+                    return Some((x, ty));
+                }
+                if !(xt.is_numeric() && ty.is_numeric()) {
+                    self.err(span, format!("cannot cast {} to {}", self.type_name(xt), self.type_name(ty)));
+                    return None;
+                }
+                Some((Ex::Convert(ty, Box::new(x)), ty))
+            }
+            ExprKind::Field(base, f) => {
+                let (x, t) = self.expr(base, scope)?;
+                let (idx, ft) = self.field_of(t, f)?;
+                Some((Ex::Field(Box::new(x), idx), ft))
+            }
+            ExprKind::Method(recv, name, args) => self.method(recv, name, args, span, scope),
+            ExprKind::Call(name, args) => self.call(name, args, span, scope),
+            ExprKind::InContext(kind, pats) => {
+                if !scope.in_rule {
+                    self.err(span, "context tests are only allowed in the body of a production");
+                    return None;
+                }
+                let mut out = Vec::new();
+                let mut all_places = Vec::new();
+                for p in pats {
+                    let (sym, tys, arity) = self.module_params(&p.name, p.params.len())?;
+                    for (n, t) in p.params.iter().zip(tys.iter().copied()) {
+                        let ident = ast::Expr {
+                            kind: ExprKind::Ident(n.text.clone()),
+                            span: n.span,
+                        };
+                        let place = self.place(&ident, scope)?;
+                        if !(place.ty == t || (place.ty.is_numeric() && t.is_numeric())) {
+                            self.err(
+                                n.span,
+                                format!(
+                                    "`{}` has type {} but this parameter of `{}` is {}",
+                                    n.text,
+                                    self.type_name(place.ty),
+                                    p.name.text,
+                                    self.type_name(t)
+                                ),
+                            );
+                            return None;
+                        }
+                        all_places.push(place);
+                    }
+                    out.push(Pattern {
+                        sym,
+                        slots: Vec::new(),
+                        types: tys,
+                        arity,
+                    });
+                }
+                Some((Ex::InContext(*kind, out, all_places), Ty::Bool))
+            }
+        }
+    }
+
+    fn method(&mut self, recv: &ast::Expr, name: &ast::Name, args: &[ast::Expr], span: Span, scope: &mut Scope) -> Typed {
+        let (x, t) = self.expr(recv, scope)?;
+        if !t.is_vector() || !args.is_empty() {
+            self.err(name.span, format!("{} has no method `{}` taking {} argument(s)", self.type_name(t), name.text, args.len()));
+            return None;
+        }
+        match name.text.as_str() {
+            "Length" => Some((Ex::Call(Func::Length, vec![x], span), Ty::Float)),
+            "Normalized" => Some((Ex::Call(Func::Normalized, vec![x], span), t)),
+            "Normalize" => {
+                let place = self.place(recv, scope)?;
+                Some((
+                    Ex::Assign(place, None, Box::new(Ex::Call(Func::Normalized, vec![x], span)), t),
+                    t,
+                ))
+            }
+            _ => {
+                self.err(name.span, format!("unknown method `{}`: vectors have Length(), Normalize() and Normalized()", name.text));
+                None
+            }
+        }
+    }
+
+    fn call(&mut self, name: &ast::Name, args: &[ast::Expr], span: Span, scope: &mut Scope) -> Typed {
+        let mut typed = Vec::new();
+        let mut ok = true;
+        for a in args {
+            match self.expr(a, scope) {
+                Some(t) => typed.push(t),
+                None => ok = false,
+            }
+        }
+        if !ok {
+            return None;
+        }
+        let n = name.text.as_str();
+        let arity_err = |c: &mut Compiler, want: usize| {
+            c.err(span, format!("`{n}` takes {want} argument(s), but {} were given", typed.len()));
+        };
+        if matches!(n, "V2f" | "V2d" | "V3f" | "V3d") {
+            let ty = if n.starts_with("V2") { Ty::V2 } else { Ty::V3 };
+            let ex = self.construct(ty, typed, args, span)?;
+            return Some((ex, ty));
+        }
+        let math1: Option<fn(f64) -> f64> = match n {
+            "sin" => Some(f64::sin),
+            "cos" => Some(f64::cos),
+            "tan" => Some(f64::tan),
+            "asin" => Some(f64::asin),
+            "acos" => Some(f64::acos),
+            "atan" => Some(f64::atan),
+            "sinh" => Some(f64::sinh),
+            "cosh" => Some(f64::cosh),
+            "tanh" => Some(f64::tanh),
+            "sqrt" => Some(f64::sqrt),
+            "cbrt" => Some(f64::cbrt),
+            "exp" => Some(f64::exp),
+            "log" => Some(f64::ln),
+            "log10" => Some(f64::log10),
+            "log2" => Some(f64::log2),
+            "fabs" => Some(f64::abs),
+            "floor" => Some(f64::floor),
+            "ceil" => Some(f64::ceil),
+            "round" => Some(f64::round),
+            "trunc" => Some(f64::trunc),
+            _ => None,
+        };
+        let math2: Option<fn(f64, f64) -> f64> = match n {
+            "atan2" => Some(f64::atan2),
+            "pow" => Some(f64::powf),
+            "fmod" => Some(|a: f64, b: f64| a % b),
+            "hypot" => Some(f64::hypot),
+            "fmin" => Some(f64::min),
+            "fmax" => Some(f64::max),
+            _ => None,
+        };
+        let numeric_args = |c: &mut Compiler, typed: &Vec<(Ex, Ty)>| -> bool {
+            for ((_, t), a) in typed.iter().zip(args) {
+                if !t.is_numeric() {
+                    c.err(a.span, format!("type error: `{n}` expects a number, found {}", c.type_name(*t)));
+                    return false;
+                }
+            }
+            true
+        };
+        if let Some(f) = math1 {
+            if typed.len() != 1 {
+                arity_err(self, 1);
+                return None;
+            }
+            if !numeric_args(self, &typed) {
+                return None;
+            }
+            let a = typed.pop()?.0;
+            return Some((Ex::Call(Func::Math1(f), vec![a], span), Ty::Float));
+        }
+        if let Some(f) = math2 {
+            if typed.len() != 2 {
+                arity_err(self, 2);
+                return None;
+            }
+            if !numeric_args(self, &typed) {
+                return None;
+            }
+            let exs = typed.into_iter().map(|(e, _)| e).collect();
+            return Some((Ex::Call(Func::Math2(f), exs, span), Ty::Float));
+        }
+        match n {
+            "abs" | "min" | "max" => {
+                let want = if n == "abs" { 1 } else { 2 };
+                if typed.len() != want {
+                    arity_err(self, want);
+                    return None;
+                }
+                if !numeric_args(self, &typed) {
+                    return None;
+                }
+                let all_int = typed.iter().all(|(_, t)| *t == Ty::Int);
+                let exs = typed.into_iter().map(|(e, _)| e).collect();
+                let (f, ty) = match (n, all_int) {
+                    ("abs", true) => (Func::AbsInt, Ty::Int),
+                    ("abs", false) => (Func::Math1(f64::abs), Ty::Float),
+                    ("min", true) => (Func::MinInt, Ty::Int),
+                    ("min", false) => (Func::Math2(f64::min), Ty::Float),
+                    ("max", true) => (Func::MaxInt, Ty::Int),
+                    _ => (Func::Math2(f64::max), Ty::Float),
+                };
+                Some((Ex::Call(f, exs, span), ty))
+            }
+            "Normalize" | "Length" => {
+                if typed.len() != 1 || !typed[0].1.is_vector() {
+                    self.err(span, format!("`{n}` takes one vector argument"));
+                    return None;
+                }
+                let (x, t) = typed.pop()?;
+                if n == "Length" {
+                    Some((Ex::Call(Func::Length, vec![x], span), Ty::Float))
+                } else {
+                    Some((Ex::Call(Func::Normalized, vec![x], span), t))
+                }
+            }
+            "Dot" | "Cross" => {
+                if typed.len() != 2 || typed[0].1 != typed[1].1 || !typed[0].1.is_vector() {
+                    self.err(span, format!("`{n}` takes two vectors of the same type"));
+                    return None;
+                }
+                if n == "Cross" && typed[0].1 != Ty::V3 {
+                    self.err(span, "`Cross` takes two V3f vectors");
+                    return None;
+                }
+                let ty = if n == "Dot" { Ty::Float } else { Ty::V3 };
+                let f = if n == "Dot" { Func::Dot } else { Func::Cross };
+                Some((Ex::Call(f, typed.into_iter().map(|(e, _)| e).collect(), span), ty))
+            }
+            "StepNo" | "CurrentGroup" | "Forward" | "Backward" | "IsForward" | "Stop"
+            | "RunSimulation" | "PauseSimulation" | "DisplayFrame" | "Environment"
+            | "NoEnvironment" => {
+                if !typed.is_empty() {
+                    arity_err(self, 0);
+                    return None;
+                }
+                let (f, ty) = match n {
+                    "StepNo" => (Func::StepNo, Ty::Int),
+                    "CurrentGroup" => (Func::CurrentGroup, Ty::Int),
+                    "Forward" => (Func::Forward, Ty::Void),
+                    "Backward" => (Func::Backward, Ty::Void),
+                    "IsForward" => (Func::IsForward, Ty::Bool),
+                    "Stop" => (Func::Stop, Ty::Void),
+                    _ => (Func::NoOp, Ty::Void),
+                };
+                Some((Ex::Call(f, Vec::new(), span), ty))
+            }
+            "UseGroup" => {
+                if typed.len() != 1 {
+                    arity_err(self, 1);
+                    return None;
+                }
+                if !numeric_args(self, &typed) {
+                    return None;
+                }
+                Some((Ex::Call(Func::UseGroup, vec![typed.pop()?.0], span), Ty::Void))
+            }
+            "ran" => {
+                if typed.len() != 1 {
+                    arity_err(self, 1);
+                    return None;
+                }
+                if !numeric_args(self, &typed) {
+                    return None;
+                }
+                Some((Ex::Call(Func::Ran, vec![typed.pop()?.0], span), Ty::Float))
+            }
+            _ => {
+                let hint = if self.alphabet.lookup(n).is_some() {
+                    format!(": `{n}` is a module; modules go after `produce`, not in expressions")
+                } else {
+                    String::new()
+                };
+                self.err(name.span, format!("unknown function `{n}`{hint}"));
+                None
+            }
+        }
+    }
+}
+
+/// The result type of `a op b`, or `None` for a type error.
+pub fn binary_type(op: BinOp, a: Ty, b: Ty) -> Option<Ty> {
+    let num = a.is_numeric() && b.is_numeric();
+    let promote = || {
+        if a == Ty::Float || b == Ty::Float {
+            Ty::Float
+        } else {
+            Ty::Int
+        }
+    };
+    use BinOp::*;
+    match op {
+        Add | Sub => {
+            if num {
+                Some(promote())
+            } else if a == b && a.is_vector() {
+                Some(a)
+            } else {
+                None
+            }
+        }
+        Mul => {
+            if num {
+                Some(promote())
+            } else if a.is_numeric() && b.is_vector() {
+                Some(b)
+            } else if a.is_vector() && b.is_numeric() {
+                Some(a)
+            } else if a == b && a.is_vector() {
+                Some(Ty::Float)
+            } else {
+                None
+            }
+        }
+        Div => {
+            if num {
+                Some(promote())
+            } else if a.is_vector() && b.is_numeric() {
+                Some(a)
+            } else {
+                None
+            }
+        }
+        Rem => {
+            if num {
+                Some(promote())
+            } else if a == Ty::V3 && b == Ty::V3 {
+                Some(Ty::V3)
+            } else {
+                None
+            }
+        }
+        Lt | Le | Gt | Ge => num.then_some(Ty::Bool),
+        Eq | Ne => (num || (a == b && a.is_vector())).then_some(Ty::Bool),
+        And | Or => num.then_some(Ty::Bool),
+        BitAnd | BitOr | BitXor => (a == Ty::Int && b == Ty::Int || num && a != Ty::Float && b != Ty::Float).then_some(Ty::Int),
+    }
+}
+
+fn pattern_label(p: &ast::Production) -> String {
+    let list = |ms: &[ast::PatModule]| -> String {
+        ms.iter()
+            .map(|m| {
+                if m.name.text == "#" {
+                    "#".to_string()
+                } else {
+                    let ps: Vec<&str> = m.params.iter().map(|n| n.text.as_str()).collect();
+                    format!("{}({})", m.name.text, ps.join(","))
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let mut s = String::new();
+    if !p.new_left.is_empty() {
+        s += &format!("{} << ", list(&p.new_left));
+    }
+    if !p.left.is_empty() {
+        s += &format!("{} < ", list(&p.left));
+    }
+    s += &list(&p.strict);
+    if !p.right.is_empty() {
+        s += &format!(" > {}", list(&p.right));
+    }
+    if !p.new_right.is_empty() {
+        s += &format!(" >> {}", list(&p.new_right));
+    }
+    s
+}

@@ -1,0 +1,527 @@
+//! The interpreter for rule bodies, control blocks and initialisers.
+//!
+//! It knows nothing about words: successors go to an [`Emit`] sink and
+//! context tests are answered by a [`Host`], which the rewriting engine (or
+//! a later mesh engine) provides.
+
+use glam::{DVec2, DVec3};
+
+use crate::syntax::ast::{BinOp, ContextKind};
+use crate::syntax::span::Span;
+
+use super::ir::*;
+use super::modules::Sym;
+use super::value::{StructDef, Value};
+
+/// Global state shared by all bodies of one derivation.
+#[derive(Clone, Debug)]
+pub struct Env {
+    pub globals: Vec<Value>,
+    pub step: i64,
+    pub current_group: i64,
+    pub next_group: i64,
+    /// Direction requested for the next step (`Forward()` / `Backward()`).
+    pub forward: bool,
+    pub stop: bool,
+    pub rng: u64,
+}
+
+impl Env {
+    pub fn new(globals: Vec<Value>) -> Env {
+        Env {
+            globals,
+            step: 0,
+            current_group: 0,
+            next_group: 0,
+            forward: true,
+            stop: false,
+            rng: 0x9E37_79B9_7F4A_7C15,
+        }
+    }
+}
+
+/// An error raised while running a body: what and, when known, where.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RuntimeError {
+    pub span: Option<Span>,
+    pub message: String,
+}
+
+impl RuntimeError {
+    pub fn new(span: Option<Span>, message: impl Into<String>) -> RuntimeError {
+        RuntimeError {
+            span,
+            message: message.into(),
+        }
+    }
+}
+
+type R<T> = Result<T, RuntimeError>;
+
+/// Receives successor modules.
+pub trait Emit {
+    fn emit(&mut self, sym: Sym, args: &[Value]);
+}
+
+/// Answers context tests made inside a body (`InLeftContext(...)` ...).
+/// On success it appends the matched modules' parameters to `out`, in order.
+pub trait Host {
+    fn in_context(&mut self, kind: ContextKind, pats: &[Pattern], out: &mut Vec<Value>) -> bool;
+}
+
+/// A host for bodies that have no context (control blocks, initialisers).
+pub struct NoHost;
+
+impl Host for NoHost {
+    fn in_context(&mut self, _: ContextKind, _: &[Pattern], _: &mut Vec<Value>) -> bool {
+        false
+    }
+}
+
+impl Emit for Vec<(Sym, Vec<Value>)> {
+    fn emit(&mut self, sym: Sym, args: &[Value]) {
+        self.push((sym, args.to_vec()));
+    }
+}
+
+/// How a statement ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Flow {
+    Normal,
+    /// A `produce` ran: the successor is complete.
+    Produced,
+    /// `return` (or the end of the body): the rule does not apply.
+    Return,
+    Break,
+    Continue,
+}
+
+/// Loop iterations one body may run before it is stopped.
+pub const LOOP_LIMIT: u64 = 10_000_000;
+
+/// Runs bodies. Holds scratch space reused across calls.
+pub struct Interp<'p> {
+    pub structs: &'p [StructDef],
+    scratch: Vec<Value>,
+    fuel: u64,
+}
+
+impl<'p> Interp<'p> {
+    pub fn new(structs: &'p [StructDef]) -> Interp<'p> {
+        Interp {
+            structs,
+            scratch: Vec::new(),
+            fuel: LOOP_LIMIT,
+        }
+    }
+
+    /// Runs a body. Returns `Flow::Produced` if a `produce` ended it.
+    pub fn run(
+        &mut self,
+        body: &[St],
+        frame: &mut [Value],
+        env: &mut Env,
+        host: &mut dyn Host,
+        sink: &mut dyn Emit,
+    ) -> R<Flow> {
+        self.fuel = LOOP_LIMIT;
+        let mut cx = Cx {
+            frame,
+            env,
+            host,
+            sink,
+        };
+        for s in body {
+            match self.stmt(s, &mut cx)? {
+                Flow::Normal => {}
+                f => return Ok(f),
+            }
+        }
+        Ok(Flow::Return)
+    }
+
+    /// Evaluates an expression with no locals (initialisers, directives).
+    pub fn eval_global(&mut self, e: &Ex, env: &mut Env) -> R<Value> {
+        let mut frame: Vec<Value> = Vec::new();
+        let mut sink: Vec<(Sym, Vec<Value>)> = Vec::new();
+        let mut cx = Cx {
+            frame: &mut frame,
+            env,
+            host: &mut NoHost,
+            sink: &mut sink,
+        };
+        self.expr(e, &mut cx)
+    }
+
+    /// Evaluates successor modules with no locals (the axiom).
+    pub fn eval_modules(&mut self, succ: &[Succ], env: &mut Env, sink: &mut dyn Emit) -> R<()> {
+        let mut frame: Vec<Value> = Vec::new();
+        let mut cx = Cx {
+            frame: &mut frame,
+            env,
+            host: &mut NoHost,
+            sink,
+        };
+        self.produce(succ, &mut cx)
+    }
+
+    fn stmt(&mut self, s: &St, cx: &mut Cx) -> R<Flow> {
+        match s {
+            St::Expr(e) => {
+                self.expr(e, cx)?;
+                Ok(Flow::Normal)
+            }
+            St::Init(slot, e) => {
+                let v = self.expr(e, cx)?;
+                cx.frame[*slot as usize] = v;
+                Ok(Flow::Normal)
+            }
+            St::If(c, t, e) => {
+                if self.expr(c, cx)?.truthy() {
+                    self.stmt(t, cx)
+                } else if let Some(e) = e {
+                    self.stmt(e, cx)
+                } else {
+                    Ok(Flow::Normal)
+                }
+            }
+            St::Loop {
+                cond,
+                body,
+                step,
+                test_after,
+                span,
+            } => {
+                let mut first = true;
+                loop {
+                    if !(first && *test_after) {
+                        if let Some(c) = cond {
+                            if !self.expr(c, cx)?.truthy() {
+                                break;
+                            }
+                        }
+                    }
+                    first = false;
+                    if self.fuel == 0 {
+                        return Err(RuntimeError::new(
+                            Some(*span),
+                            format!("a loop ran more than {LOOP_LIMIT} iterations in one body; is its condition ever false?"),
+                        ));
+                    }
+                    self.fuel -= 1;
+                    match self.stmt(body, cx)? {
+                        Flow::Break => break,
+                        Flow::Normal | Flow::Continue => {}
+                        f => return Ok(f),
+                    }
+                    if let Some(st) = step {
+                        self.expr(st, cx)?;
+                    }
+                }
+                Ok(Flow::Normal)
+            }
+            St::Block(b) => {
+                for s in b {
+                    match self.stmt(s, cx)? {
+                        Flow::Normal => {}
+                        f => return Ok(f),
+                    }
+                }
+                Ok(Flow::Normal)
+            }
+            St::Produce { modules, last } => {
+                self.produce(modules, cx)?;
+                Ok(if *last { Flow::Produced } else { Flow::Normal })
+            }
+            St::Return => Ok(Flow::Return),
+            St::Break => Ok(Flow::Break),
+            St::Continue => Ok(Flow::Continue),
+        }
+    }
+
+    fn produce(&mut self, modules: &[Succ], cx: &mut Cx) -> R<()> {
+        for m in modules {
+            let base = self.scratch.len();
+            for a in &m.args {
+                let v = self.expr(a, cx)?;
+                if v.is_non_finite() {
+                    self.scratch.truncate(base);
+                    return Err(RuntimeError::new(
+                        Some(m.span),
+                        format!("a parameter of this module is {v}: NaN or infinity"),
+                    ));
+                }
+                self.scratch.push(v);
+            }
+            cx.sink.emit(m.sym, &self.scratch[base..]);
+            self.scratch.truncate(base);
+        }
+        Ok(())
+    }
+
+    fn load(&self, place: &Place, cx: &Cx) -> Value {
+        let mut v = if place.global {
+            &cx.env.globals[place.slot as usize]
+        } else {
+            &cx.frame[place.slot as usize]
+        }
+        .clone();
+        for &i in &place.path {
+            v = field(&v, i);
+        }
+        v
+    }
+
+    fn store(&self, place: &Place, value: Value, cx: &mut Cx) {
+        let root = if place.global {
+            &mut cx.env.globals[place.slot as usize]
+        } else {
+            &mut cx.frame[place.slot as usize]
+        };
+        set_path(root, &place.path, value);
+    }
+
+    fn expr(&mut self, e: &Ex, cx: &mut Cx) -> R<Value> {
+        Ok(match e {
+            Ex::Const(v) => v.clone(),
+            Ex::Local(s) => cx.frame[*s as usize].clone(),
+            Ex::Global(s) => cx.env.globals[*s as usize].clone(),
+            Ex::Field(b, i) => field(&self.expr(b, cx)?, *i),
+            Ex::Neg(a) => match self.expr(a, cx)? {
+                Value::Int(i) => Value::Int(i.wrapping_neg()),
+                Value::Float(f) => Value::Float(-f),
+                Value::Bool(b) => Value::Int(-(b as i64)),
+                Value::V2(v) => Value::V2(-v),
+                Value::V3(v) => Value::V3(-v),
+                other => other,
+            },
+            Ex::Not(a) => Value::Bool(!self.expr(a, cx)?.truthy()),
+            Ex::Bin(op, a, b) => {
+                let x = self.expr(a, cx)?;
+                let y = self.expr(b, cx)?;
+                binary(*op, x, y).map_err(|m| RuntimeError::new(None, m))?
+            }
+            Ex::Logic(and, a, b) => {
+                let x = self.expr(a, cx)?.truthy();
+                if *and {
+                    Value::Bool(x && self.expr(b, cx)?.truthy())
+                } else {
+                    Value::Bool(x || self.expr(b, cx)?.truthy())
+                }
+            }
+            Ex::Cond(c, a, b) => {
+                if self.expr(c, cx)?.truthy() {
+                    self.expr(a, cx)?
+                } else {
+                    self.expr(b, cx)?
+                }
+            }
+            Ex::Convert(t, a) => self.expr(a, cx)?.convert(*t),
+            Ex::Assign(place, op, rhs, ty) => {
+                let r = self.expr(rhs, cx)?;
+                let v = match op {
+                    None => r,
+                    Some(op) => {
+                        let cur = self.load(place, cx);
+                        binary(*op, cur, r).map_err(|m| RuntimeError::new(None, m))?
+                    }
+                }
+                .convert(*ty);
+                self.store(place, v.clone(), cx);
+                v
+            }
+            Ex::IncDec(place, d, prefix) => {
+                let cur = self.load(place, cx);
+                let new = binary(BinOp::Add, cur.clone(), Value::Int(*d as i64))
+                    .map_err(|m| RuntimeError::new(None, m))?
+                    .convert(place.ty);
+                self.store(place, new.clone(), cx);
+                if *prefix {
+                    new
+                } else {
+                    cur
+                }
+            }
+            Ex::Call(f, args, span) => self.call(*f, args, *span, cx)?,
+            Ex::MakeV2(x, y) => Value::V2(DVec2::new(self.expr(x, cx)?.as_f64(), self.expr(y, cx)?.as_f64())),
+            Ex::MakeV3(x, y, z) => Value::V3(DVec3::new(
+                self.expr(x, cx)?.as_f64(),
+                self.expr(y, cx)?.as_f64(),
+                self.expr(z, cx)?.as_f64(),
+            )),
+            Ex::MakeStruct(parts) => {
+                let mut vs = Vec::with_capacity(parts.len());
+                for p in parts {
+                    vs.push(self.expr(p, cx)?);
+                }
+                Value::Struct(vs.into_boxed_slice())
+            }
+            Ex::InContext(kind, pats, places) => {
+                let mut vals = Vec::new();
+                if cx.host.in_context(*kind, pats, &mut vals) {
+                    for (place, v) in places.iter().zip(vals) {
+                        self.store(place, v.convert(place.ty), cx);
+                    }
+                    Value::Bool(true)
+                } else {
+                    Value::Bool(false)
+                }
+            }
+        })
+    }
+
+    fn call(&mut self, f: Func, args: &[Ex], span: Span, cx: &mut Cx) -> R<Value> {
+        let mut vals = Vec::with_capacity(args.len());
+        for a in args {
+            vals.push(self.expr(a, cx)?);
+        }
+        let num = |i: usize| vals[i].as_f64();
+        Ok(match f {
+            Func::Math1(g) => Value::Float(g(num(0))),
+            Func::Math2(g) => Value::Float(g(num(0), num(1))),
+            Func::AbsInt => Value::Int(vals[0].as_i64().wrapping_abs()),
+            Func::MinInt => Value::Int(vals[0].as_i64().min(vals[1].as_i64())),
+            Func::MaxInt => Value::Int(vals[0].as_i64().max(vals[1].as_i64())),
+            Func::Length => match &vals[0] {
+                Value::V2(v) => Value::Float(v.length()),
+                Value::V3(v) => Value::Float(v.length()),
+                _ => Value::Float(f64::NAN),
+            },
+            Func::Normalized => match &vals[0] {
+                Value::V2(v) => Value::V2(v.normalize_or_zero()),
+                Value::V3(v) => Value::V3(v.normalize_or_zero()),
+                other => other.clone(),
+            },
+            Func::Dot => match (&vals[0], &vals[1]) {
+                (Value::V2(a), Value::V2(b)) => Value::Float(a.dot(*b)),
+                (Value::V3(a), Value::V3(b)) => Value::Float(a.dot(*b)),
+                _ => Value::Float(f64::NAN),
+            },
+            Func::Cross => match (&vals[0], &vals[1]) {
+                (Value::V3(a), Value::V3(b)) => Value::V3(a.cross(*b)),
+                _ => Value::Void,
+            },
+            Func::StepNo => Value::Int(cx.env.step),
+            Func::UseGroup => {
+                cx.env.next_group = vals[0].as_i64();
+                Value::Void
+            }
+            Func::CurrentGroup => Value::Int(cx.env.current_group),
+            Func::Forward => {
+                cx.env.forward = true;
+                Value::Void
+            }
+            Func::Backward => {
+                cx.env.forward = false;
+                Value::Void
+            }
+            Func::IsForward => Value::Bool(cx.env.forward),
+            Func::Stop => {
+                cx.env.stop = true;
+                Value::Void
+            }
+            Func::Ran => {
+                // xorshift64*: reproducible from run to run.
+                let mut x = cx.env.rng;
+                x ^= x >> 12;
+                x ^= x << 25;
+                x ^= x >> 27;
+                cx.env.rng = x;
+                let u = (x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64;
+                Value::Float(u * num(0))
+            }
+            Func::NoOp => {
+                let _ = span;
+                Value::Void
+            }
+        })
+    }
+}
+
+struct Cx<'a> {
+    frame: &'a mut [Value],
+    env: &'a mut Env,
+    host: &'a mut dyn Host,
+    sink: &'a mut dyn Emit,
+}
+
+fn field(v: &Value, i: u16) -> Value {
+    match v {
+        Value::V2(p) => Value::Float(p[i as usize]),
+        Value::V3(p) => Value::Float(p[i as usize]),
+        Value::Struct(fs) => fs[i as usize].clone(),
+        _ => Value::Void,
+    }
+}
+
+fn set_path(root: &mut Value, path: &[u16], value: Value) {
+    let Some((&first, rest)) = path.split_first() else {
+        *root = value;
+        return;
+    };
+    match root {
+        Value::V2(p) => p[first as usize] = value.as_f64(),
+        Value::V3(p) => p[first as usize] = value.as_f64(),
+        Value::Struct(fs) => set_path(&mut fs[first as usize], rest, value),
+        _ => {}
+    }
+}
+
+/// Applies a binary operator to two values whose types were checked.
+pub fn binary(op: BinOp, x: Value, y: Value) -> Result<Value, String> {
+    use BinOp::*;
+    use Value::*;
+    let x = if let Bool(b) = x { Int(b as i64) } else { x };
+    let y = if let Bool(b) = y { Int(b as i64) } else { y };
+    Ok(match (op, x, y) {
+        (Add, Int(a), Int(b)) => Int(a.wrapping_add(b)),
+        (Sub, Int(a), Int(b)) => Int(a.wrapping_sub(b)),
+        (Mul, Int(a), Int(b)) => Int(a.wrapping_mul(b)),
+        (Div, Int(_), Int(0)) | (Rem, Int(_), Int(0)) => {
+            return Err("integer division by zero".into())
+        }
+        (Div, Int(a), Int(b)) => Int(a.wrapping_div(b)),
+        (Rem, Int(a), Int(b)) => Int(a.wrapping_rem(b)),
+        (BitAnd, Int(a), Int(b)) => Int(a & b),
+        (BitOr, Int(a), Int(b)) => Int(a | b),
+        (BitXor, Int(a), Int(b)) => Int(a ^ b),
+        (Lt, Int(a), Int(b)) => Bool(a < b),
+        (Le, Int(a), Int(b)) => Bool(a <= b),
+        (Gt, Int(a), Int(b)) => Bool(a > b),
+        (Ge, Int(a), Int(b)) => Bool(a >= b),
+        (Eq, Int(a), Int(b)) => Bool(a == b),
+        (Ne, Int(a), Int(b)) => Bool(a != b),
+        (Add, V2(a), V2(b)) => V2(a + b),
+        (Sub, V2(a), V2(b)) => V2(a - b),
+        (Add, V3(a), V3(b)) => V3(a + b),
+        (Sub, V3(a), V3(b)) => V3(a - b),
+        (Mul, V2(a), V2(b)) => Float(a.dot(b)),
+        (Mul, V3(a), V3(b)) => Float(a.dot(b)),
+        (Rem, V3(a), V3(b)) => V3(a.cross(b)),
+        (Eq, V2(a), V2(b)) => Bool(a == b),
+        (Ne, V2(a), V2(b)) => Bool(a != b),
+        (Eq, V3(a), V3(b)) => Bool(a == b),
+        (Ne, V3(a), V3(b)) => Bool(a != b),
+        (Mul, V2(a), s) | (Mul, s, V2(a)) => V2(a * s.as_f64()),
+        (Mul, V3(a), s) | (Mul, s, V3(a)) => V3(a * s.as_f64()),
+        (Div, V2(a), s) => V2(a / s.as_f64()),
+        (Div, V3(a), s) => V3(a / s.as_f64()),
+        (op, a, b) => {
+            let (a, b) = (a.as_f64(), b.as_f64());
+            match op {
+                Add => Float(a + b),
+                Sub => Float(a - b),
+                Mul => Float(a * b),
+                Div => Float(a / b),
+                Rem => Float(a % b),
+                Lt => Bool(a < b),
+                Le => Bool(a <= b),
+                Gt => Bool(a > b),
+                Ge => Bool(a >= b),
+                Eq => Bool(a == b),
+                Ne => Bool(a != b),
+                _ => return Err(format!("operator `{}` does not apply to these values", op.symbol())),
+            }
+        }
+    })
+}

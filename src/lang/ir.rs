@@ -1,0 +1,183 @@
+//! The checked program: names resolved to slots, types known, rules grouped.
+//!
+//! Nothing here knows about strings of modules. A [`Rule`]'s predecessor is a
+//! list of [`Pattern`]s per role; the topology that matches it (a word today,
+//! a mesh later) lives in `rewrite`.
+
+use crate::syntax::ast::{BinOp, ContextKind, ControlKind, Section};
+use crate::syntax::span::Span;
+
+use super::modules::{Alphabet, Sym};
+use super::value::{StructDef, Ty, Value};
+
+#[derive(Clone, Debug)]
+pub enum Ex {
+    Const(Value),
+    Local(u16),
+    Global(u16),
+    /// A vector component or a struct field.
+    Field(Box<Ex>, u16),
+    Neg(Box<Ex>),
+    Not(Box<Ex>),
+    Bin(BinOp, Box<Ex>, Box<Ex>),
+    /// Short-circuit `&&` (`and == true`) and `||`.
+    Logic(bool, Box<Ex>, Box<Ex>),
+    Cond(Box<Ex>, Box<Ex>, Box<Ex>),
+    Convert(Ty, Box<Ex>),
+    Assign(Place, Option<BinOp>, Box<Ex>, Ty),
+    IncDec(Place, i8, bool),
+    Call(Func, Vec<Ex>, Span),
+    MakeV2(Box<Ex>, Box<Ex>),
+    MakeV3(Box<Ex>, Box<Ex>, Box<Ex>),
+    MakeStruct(Vec<Ex>),
+    /// A context test: the modules to match and the places their parameters go.
+    InContext(ContextKind, Vec<Pattern>, Vec<Place>),
+}
+
+/// An assignable location: a variable and a path of field indices.
+#[derive(Clone, Debug)]
+pub struct Place {
+    pub global: bool,
+    pub slot: u16,
+    pub path: Vec<u16>,
+    pub ty: Ty,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub enum Func {
+    Math1(fn(f64) -> f64),
+    Math2(fn(f64, f64) -> f64),
+    AbsInt,
+    MinInt,
+    MaxInt,
+    Length,
+    Normalized,
+    Dot,
+    Cross,
+    StepNo,
+    UseGroup,
+    CurrentGroup,
+    Forward,
+    Backward,
+    IsForward,
+    Stop,
+    Ran,
+    NoOp,
+}
+
+#[derive(Clone, Debug)]
+pub enum St {
+    Expr(Ex),
+    /// Store the value of an expression into a fresh local.
+    Init(u16, Ex),
+    If(Ex, Box<St>, Option<Box<St>>),
+    Loop {
+        cond: Option<Ex>,
+        body: Box<St>,
+        step: Option<Ex>,
+        /// `do { } while`: test after the body.
+        test_after: bool,
+        span: Span,
+    },
+    Block(Vec<St>),
+    Produce {
+        modules: Vec<Succ>,
+        last: bool,
+    },
+    Return,
+    Break,
+    Continue,
+}
+
+/// A successor module: a symbol and argument expressions of its types.
+#[derive(Clone, Debug)]
+pub struct Succ {
+    pub sym: Sym,
+    pub args: Vec<Ex>,
+    pub span: Span,
+}
+
+/// A module pattern in a predecessor: the symbol and the locals it binds.
+#[derive(Clone, Debug)]
+pub struct Pattern {
+    pub sym: Sym,
+    /// One local slot per parameter.
+    pub slots: Vec<u16>,
+    /// The type of each parameter.
+    pub types: Vec<Ty>,
+    /// Predefined modules with overloads match only this many parameters.
+    pub arity: Option<usize>,
+}
+
+/// Which modules context matching looks at (`ignore:` / `consider:`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Filter {
+    #[default]
+    All,
+    Ignore(Vec<Sym>),
+    Consider(Vec<Sym>),
+}
+
+impl Filter {
+    /// True when context matching skips module `s`. SB and EB are never
+    /// skipped; callers check them before asking.
+    pub fn skips(&self, s: Sym) -> bool {
+        match self {
+            Filter::All => false,
+            Filter::Ignore(v) => v.contains(&s),
+            Filter::Consider(v) => !v.contains(&s),
+        }
+    }
+}
+
+/// A production, decomposition rule or interpretation rule.
+#[derive(Clone, Debug)]
+pub struct Rule {
+    pub new_left: Vec<Pattern>,
+    pub left: Vec<Pattern>,
+    pub strict: Vec<Pattern>,
+    pub right: Vec<Pattern>,
+    pub new_right: Vec<Pattern>,
+    pub filter: Filter,
+    pub body: Vec<St>,
+    pub frame_size: usize,
+    pub section: Section,
+    pub group: i64,
+    pub span: Span,
+    /// The rule as written, for messages: `P(vl) < P(v) > P(vr)`.
+    pub label: String,
+    /// Set when the body is a single `produce` of affine combinations.
+    pub stencil: Option<super::stencil::Stencil>,
+}
+
+#[derive(Clone, Debug)]
+pub struct GlobalVar {
+    pub name: String,
+    pub ty: Ty,
+    pub is_const: bool,
+    pub init: Option<Ex>,
+}
+
+/// A checked, executable program.
+#[derive(Clone, Debug)]
+pub struct Program {
+    pub alphabet: Alphabet,
+    pub structs: Vec<StructDef>,
+    pub globals: Vec<GlobalVar>,
+    pub axiom: Vec<Succ>,
+    pub derivation_length: Option<Ex>,
+    pub ring: Option<Ex>,
+    pub decomposition_depth: Option<Ex>,
+    pub interpretation_depth: Option<Ex>,
+    pub rules: Vec<Rule>,
+    pub control: Vec<(ControlKind, Vec<St>, usize)>,
+}
+
+impl Program {
+    pub fn rules_of(&self, section: Section) -> impl Iterator<Item = (usize, &Rule)> {
+        self.rules
+            .iter()
+            .enumerate()
+            .filter(move |(_, r)| r.section == section)
+    }
+}

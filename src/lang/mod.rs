@@ -1,0 +1,13 @@
+//! The language's meaning: types, values, checking and the interpreter.
+
+pub mod compile;
+pub mod eval;
+pub mod ir;
+pub mod modules;
+pub mod stencil;
+pub mod value;
+
+pub use compile::compile;
+pub use ir::Program;
+pub use modules::{Alphabet, Sym};
+pub use value::{Ty, Value};

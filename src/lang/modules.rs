@@ -1,0 +1,192 @@
+//! The module alphabet: lpfg's predefined modules and the user's declarations.
+
+use super::value::Ty;
+
+/// Index of a module kind in [`Alphabet`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Sym(pub u16);
+
+/// The parameter signature of a module kind.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Signature {
+    /// A user module: exactly these types.
+    Fixed(Vec<Ty>),
+    /// A predefined module: any of these overloads (chosen by arity and type).
+    Overloads(&'static [&'static [Ty]]),
+}
+
+#[derive(Clone, Debug)]
+pub struct ModuleKind {
+    pub name: String,
+    pub sig: Signature,
+    pub builtin: bool,
+}
+
+/// All module kinds known to a program. The predefined ones come first.
+#[derive(Clone, Debug)]
+pub struct Alphabet {
+    pub kinds: Vec<ModuleKind>,
+}
+
+use Ty::{Float as F, Int as I, V2, V3};
+
+const NONE: &[&[Ty]] = &[&[]];
+const ONE_F: &[&[Ty]] = &[&[F]];
+const OPT_F: &[&[Ty]] = &[&[F], &[]];
+const ONE_I: &[&[Ty]] = &[&[I]];
+const XYZ: &[&[Ty]] = &[&[F, F, F], &[V2], &[V3], &[F, F]];
+const P2: &[&[Ty]] = &[&[V2]];
+const P3: &[&[Ty]] = &[&[V3]];
+const L2: &[&[Ty]] = &[&[V2, V2]];
+const L3: &[&[Ty]] = &[&[V3, V3]];
+const FF: &[&[Ty]] = &[&[F, F]];
+const AXIS_ANGLE: &[&[Ty]] = &[&[V3, F]];
+const HEAD: &[&[Ty]] = &[&[F, F, F, F, F, F]];
+const FFF: &[&[Ty]] = &[&[F, F, F]];
+const STR: &[&[Ty]] = &[&[Ty::Str]];
+const IF: &[&[Ty]] = &[&[I, F]];
+const IFFF: &[&[Ty]] = &[&[I, F, F, F]];
+const IFF: &[&[Ty]] = &[&[I, F, F]];
+const III: &[&[Ty]] = &[&[I, I, I]];
+
+/// lpfg's predefined modules (`lpfgall.h`), plus `#` and Velho's `LineTo(v)`.
+pub const PREDEFINED: &[(&str, &[&[Ty]])] = &[
+    ("#", NONE),
+    ("F", OPT_F),
+    ("f", OPT_F),
+    ("G", OPT_F),
+    ("g", OPT_F),
+    ("MoveTo", XYZ),
+    ("MoveTo2f", P2),
+    ("MoveTo2d", P2),
+    ("MoveTo3f", P3),
+    ("MoveTo3d", P3),
+    ("MoveRel2f", P2),
+    ("MoveRel2d", P2),
+    ("MoveRel3f", P3),
+    ("MoveRel3d", P3),
+    ("LineTo", XYZ),
+    ("LineTo2f", P2),
+    ("LineTo2d", P2),
+    ("LineTo3f", P3),
+    ("LineTo3d", P3),
+    ("LineRel2f", P2),
+    ("LineRel2d", P2),
+    ("LineRel3f", P3),
+    ("LineRel3d", P3),
+    ("Line2f", L2),
+    ("Line2d", L2),
+    ("Line3f", L3),
+    ("Line3d", L3),
+    ("SetCoordinateSystem", ONE_F),
+    ("Left", OPT_F),
+    ("Right", OPT_F),
+    ("Up", OPT_F),
+    ("Down", OPT_F),
+    ("RollL", OPT_F),
+    ("RollR", OPT_F),
+    ("TurnAround", NONE),
+    ("RollToVert", NONE),
+    ("RotateXYZ", AXIS_ANGLE),
+    ("RotateHLU", AXIS_ANGLE),
+    ("SetHead", HEAD),
+    ("SetHead3f", P3),
+    ("IncColor", NONE),
+    ("DecColor", NONE),
+    ("SetColor", &[&[I], &[I, I, I]]),
+    ("SetWidth", ONE_F),
+    ("SB", NONE),
+    ("EB", NONE),
+    ("Cut", NONE),
+    ("Circle0", NONE),
+    ("CircleFront0", NONE),
+    ("Circle", ONE_F),
+    ("CircleFront", ONE_F),
+    ("CircleB", ONE_F),
+    ("CircleFrontB", ONE_F),
+    ("Sphere0", NONE),
+    ("Sphere", ONE_F),
+    ("SP", NONE),
+    ("PP", NONE),
+    ("EP", NONE),
+    ("Rhombus", FF),
+    ("Triangle", FF),
+    ("Label", STR),
+    ("Surface", IF),
+    ("Surface3", IFFF),
+    ("Mesh", IF),
+    ("Mesh3", IFFF),
+    ("ContourSides", ONE_I),
+    ("CurrentContour", ONE_I),
+    ("BlendedContour", IFF),
+    ("ScaleContour", FF),
+    ("StartGC", NONE),
+    ("PointGC", NONE),
+    ("EndGC", NONE),
+    ("CurrentTexture", ONE_I),
+    ("TextureVCoeff", ONE_F),
+    ("Elasticity", ONE_F),
+    ("GetPos", FFF),
+    ("GetHead", FFF),
+    ("GetLeft", FFF),
+    ("GetUp", FFF),
+    ("E1", ONE_F),
+    ("E2", FF),
+    ("Camera", NONE),
+    ("MouseIns", NONE),
+    ("SetUPrecision", ONE_F),
+    ("SetVPrecision", ONE_F),
+    ("InitSurface", ONE_I),
+    ("SurfacePoint", III),
+    ("DrawSurface", ONE_I),
+];
+
+impl Alphabet {
+    pub fn new() -> Alphabet {
+        Alphabet {
+            kinds: PREDEFINED
+                .iter()
+                .map(|(name, sig)| ModuleKind {
+                    name: (*name).to_string(),
+                    sig: Signature::Overloads(sig),
+                    builtin: true,
+                })
+                .collect(),
+        }
+    }
+
+    pub fn lookup(&self, name: &str) -> Option<Sym> {
+        self.kinds
+            .iter()
+            .position(|k| k.name == name)
+            .map(|i| Sym(i as u16))
+    }
+
+    pub fn get(&self, s: Sym) -> &ModuleKind {
+        &self.kinds[s.0 as usize]
+    }
+
+    pub fn name(&self, s: Sym) -> &str {
+        &self.kinds[s.0 as usize].name
+    }
+
+    /// The symbol of a predefined module; panics if the table lacks it.
+    pub fn builtin(&self, name: &str) -> Sym {
+        self.lookup(name).expect("predefined module")
+    }
+
+    pub fn declare(&mut self, name: &str, params: Vec<Ty>) -> Sym {
+        self.kinds.push(ModuleKind {
+            name: name.to_string(),
+            sig: Signature::Fixed(params),
+            builtin: false,
+        });
+        Sym(self.kinds.len() as u16 - 1)
+    }
+}
+
+impl Default for Alphabet {
+    fn default() -> Self {
+        Alphabet::new()
+    }
+}

@@ -1,0 +1,341 @@
+//! A whole derivation: globals, `Start`, the axiom, the steps with their
+//! `StartEach`/`EndEach` blocks and groups, decomposition after the axiom
+//! and after every step, `End`, and interpretation on request.
+
+use crate::lang::eval::{Env, Interp, NoHost, RuntimeError};
+use crate::lang::ir::{Program, St};
+use crate::lang::{Sym, Value};
+use crate::syntax::ast::{ControlKind, Section};
+use crate::syntax::span::Span;
+
+use super::step::{Rewriter, StepError, StepOptions};
+use super::word::Word;
+
+/// Settings of a derivation. `Default` gives lpfg's behaviour.
+#[derive(Clone, Debug)]
+pub struct DeriveOptions {
+    /// Overrides `derivation length:`.
+    pub steps: Option<u64>,
+    /// A step that makes a longer word fails. Default: 20 million.
+    pub max_modules: usize,
+    /// Where the partition into multi-module strict predecessors starts.
+    pub phase: usize,
+}
+
+impl Default for DeriveOptions {
+    fn default() -> Self {
+        DeriveOptions {
+            steps: None,
+            max_modules: DEFAULT_MAX_MODULES,
+            phase: 0,
+        }
+    }
+}
+
+pub const DEFAULT_MAX_MODULES: usize = 20_000_000;
+/// Derivation lengths beyond this are refused as runaway.
+pub const MAX_STEPS: u64 = 1_000_000;
+
+impl DeriveOptions {
+    pub fn with_steps(mut self, n: u64) -> Self {
+        self.steps = Some(n);
+        self
+    }
+
+    pub fn with_phase(mut self, p: usize) -> Self {
+        self.phase = p;
+        self
+    }
+
+    pub fn with_max_modules(mut self, m: usize) -> Self {
+        self.max_modules = m;
+        self
+    }
+}
+
+/// A failed derivation: the message, where in the program, and at which step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeriveError {
+    pub span: Option<Span>,
+    pub message: String,
+    pub step: u64,
+}
+
+/// The result of a derivation.
+#[derive(Clone, Debug)]
+pub struct Derived {
+    pub word: Word,
+    pub ring: bool,
+    /// The number of steps performed.
+    pub step: u64,
+    /// Global variables after `End`.
+    pub env: Env,
+}
+
+/// Runs a program and keeps the state between steps, so that callers can
+/// look at every intermediate word (`--each`) or stop early.
+pub struct Derivation<'p> {
+    program: &'p Program,
+    rewriter: Rewriter<'p>,
+    pub env: Env,
+    pub word: Word,
+    spare: Word,
+    pub ring: bool,
+    pub length: u64,
+    pub step: u64,
+    opts: DeriveOptions,
+}
+
+impl<'p> Derivation<'p> {
+    /// Initialises globals, evaluates the directives, runs `Start`, sets the
+    /// word to the axiom and decomposes it.
+    pub fn new(program: &'p Program, opts: DeriveOptions) -> Result<Derivation<'p>, DeriveError> {
+        let mut interp = Interp::new(&program.structs);
+        let mut env = Env::new(Vec::new());
+        for g in &program.globals {
+            let v = match &g.init {
+                Some(e) => interp
+                    .eval_global(e, &mut env)
+                    .map_err(|e| runtime(e, None, 0))?
+                    .convert(g.ty),
+                None => Value::zero(g.ty, &program.structs),
+            };
+            env.globals.push(v);
+        }
+        let mut number = |e: &Option<crate::lang::ir::Ex>, env: &mut Env| -> Result<Option<f64>, DeriveError> {
+            match e {
+                Some(e) => Ok(Some(
+                    interp.eval_global(e, env).map_err(|e| runtime(e, None, 0))?.as_f64(),
+                )),
+                None => Ok(None),
+            }
+        };
+        let length = number(&program.derivation_length, &mut env)?.unwrap_or(0.0);
+        let ring = number(&program.ring, &mut env)?.is_some_and(|v| v != 0.0);
+        let length = opts.steps.unwrap_or(if length.is_finite() && length > 0.0 {
+            length as u64
+        } else {
+            0
+        });
+        if length > MAX_STEPS {
+            return Err(DeriveError {
+                span: None,
+                message: format!("a derivation length of {length} steps is beyond the limit of {MAX_STEPS}"),
+                step: 0,
+            });
+        }
+        let mut d = Derivation {
+            program,
+            rewriter: Rewriter::new(program),
+            env,
+            word: Word::new(),
+            spare: Word::new(),
+            ring,
+            length,
+            step: 0,
+            opts,
+        };
+        d.control(ControlKind::Start)?;
+        let mut axiom = Word::new();
+        interp
+            .eval_modules(&program.axiom, &mut d.env, &mut axiom)
+            .map_err(|e| runtime(e, None, 0))?;
+        d.word = axiom;
+        d.decompose()?;
+        Ok(d)
+    }
+
+    fn control(&mut self, kind: ControlKind) -> Result<(), DeriveError> {
+        let mut interp = Interp::new(&self.program.structs);
+        for (k, body, frame) in &self.program.control {
+            if *k == kind {
+                let mut frame = vec![Value::Void; *frame];
+                let mut sink: Vec<(Sym, Vec<Value>)> = Vec::new();
+                run_block(&mut interp, body, &mut frame, &mut self.env, &mut sink)
+                    .map_err(|e| runtime(e, None, self.step))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The rules of `section` usable now: the current group's, then group 0's.
+    fn candidates(&self, section: Section) -> Vec<usize> {
+        let g = self.env.current_group;
+        let mut v: Vec<usize> = self
+            .program
+            .rules_of(section)
+            .filter(|(_, r)| r.group == g)
+            .map(|(i, _)| i)
+            .collect();
+        if g != 0 {
+            v.extend(
+                self.program
+                    .rules_of(section)
+                    .filter(|(_, r)| r.group == 0)
+                    .map(|(i, _)| i),
+            );
+        }
+        v
+    }
+
+    fn step_options(&self) -> StepOptions {
+        StepOptions {
+            ring: self.ring,
+            forward: self.env.forward,
+            phase: self.opts.phase,
+            max_modules: self.opts.max_modules,
+        }
+    }
+
+    /// True while steps remain and `Stop()` has not been called.
+    pub fn has_next(&self) -> bool {
+        self.step < self.length && !self.env.stop
+    }
+
+    /// Performs one derivation step with its control blocks.
+    pub fn next_step(&mut self) -> Result<(), DeriveError> {
+        self.control(ControlKind::StartEach)?;
+        self.env.current_group = self.env.next_group;
+        let rules = self.candidates(Section::Productions);
+        let opts = self.step_options();
+        let mut dst = std::mem::take(&mut self.spare);
+        let step = self.step + 1;
+        let result = self
+            .rewriter
+            .step(&rules, &self.word, &mut dst, &mut self.env, &opts, None, None);
+        if let Err(e) = result {
+            return Err(self.step_error(e, step));
+        }
+        self.spare = std::mem::replace(&mut self.word, dst);
+        self.env.step = step as i64;
+        self.step = step;
+        self.decompose()?;
+        self.control(ControlKind::EndEach)?;
+        Ok(())
+    }
+
+    /// Runs the remaining steps and `End`.
+    pub fn run(mut self) -> Result<Derived, DeriveError> {
+        while self.has_next() {
+            self.next_step()?;
+        }
+        self.control(ControlKind::End)?;
+        Ok(Derived {
+            word: self.word,
+            ring: self.ring,
+            step: self.step,
+            env: self.env,
+        })
+    }
+
+    fn step_error(&self, e: StepError, step: u64) -> DeriveError {
+        match e {
+            StepError::Runtime { rule, error } => {
+                let r = &self.program.rules[rule];
+                let what = match r.section {
+                    Section::Productions => "production",
+                    Section::Decomposition => "decomposition rule",
+                    Section::Interpretation => "interpretation rule",
+                };
+                DeriveError {
+                    span: error.span.or(Some(r.span)),
+                    message: format!("at step {step}, {what} `{}`: {}", r.label, error.message),
+                    step,
+                }
+            }
+            StepError::TooLong { limit } => DeriveError {
+                span: None,
+                message: format!(
+                    "at step {step}, the word grew past {limit} modules; raise the limit with --max-modules or derive fewer steps"
+                ),
+                step,
+            },
+        }
+    }
+
+    /// Applies decomposition rules to the current word, to the maximum depth.
+    fn decompose(&mut self) -> Result<(), DeriveError> {
+        let depth = self.depth(Section::Decomposition)?;
+        let word = std::mem::take(&mut self.word);
+        self.word = self.rewrite_to_depth(Section::Decomposition, word, depth)?;
+        Ok(())
+    }
+
+    fn depth(&mut self, section: Section) -> Result<u64, DeriveError> {
+        let e = match section {
+            Section::Interpretation => &self.program.interpretation_depth,
+            _ => &self.program.decomposition_depth,
+        };
+        let Some(e) = e else { return Ok(1) };
+        let mut interp = Interp::new(&self.program.structs);
+        let v = interp
+            .eval_global(e, &mut self.env)
+            .map_err(|e| runtime(e, None, self.step))?
+            .as_f64();
+        Ok(if v.is_finite() && v > 0.0 { v as u64 } else { 0 })
+    }
+
+    /// Rewrites `word` with the rules of `section` recursively: after the
+    /// first pass only modules that a rule produced are rewritten again.
+    fn rewrite_to_depth(&mut self, section: Section, mut word: Word, depth: u64) -> Result<Word, DeriveError> {
+        let rules = self.candidates(section);
+        if rules.is_empty() {
+            return Ok(word);
+        }
+        let opts = self.step_options();
+        let mut eligible: Option<Vec<bool>> = None;
+        let mut origin = Vec::new();
+        let mut dst = Word::new();
+        for _ in 0..depth {
+            let n = self
+                .rewriter
+                .step(
+                    &rules,
+                    &word,
+                    &mut dst,
+                    &mut self.env,
+                    &opts,
+                    eligible.as_deref(),
+                    Some(&mut origin),
+                )
+                .map_err(|e| self.step_error(e, self.step))?;
+            std::mem::swap(&mut word, &mut dst);
+            if n == 0 {
+                break;
+            }
+            eligible = Some(std::mem::take(&mut origin));
+        }
+        Ok(word)
+    }
+
+    /// The word after interpretation rules: what the turtle draws.
+    pub fn interpret(&mut self) -> Result<Word, DeriveError> {
+        let depth = self.depth(Section::Interpretation)?;
+        let word = self.word.clone();
+        self.rewrite_to_depth(Section::Interpretation, word, depth)
+    }
+}
+
+fn run_block(
+    interp: &mut Interp,
+    body: &[St],
+    frame: &mut [Value],
+    env: &mut Env,
+    sink: &mut Vec<(Sym, Vec<Value>)>,
+) -> Result<(), RuntimeError> {
+    interp.run(body, frame, env, &mut NoHost, sink)?;
+    Ok(())
+}
+
+fn runtime(e: RuntimeError, span: Option<Span>, step: u64) -> DeriveError {
+    DeriveError {
+        span: e.span.or(span),
+        message: e.message,
+        step,
+    }
+}
+
+/// Derives `program` to its derivation length (or `opts.steps`).
+pub fn derive(program: &Program, opts: DeriveOptions) -> Result<Derived, DeriveError> {
+    Derivation::new(program, opts)?.run()
+}

@@ -1,0 +1,11 @@
+//! Rewriting words of modules: storage, context matching, one parallel step,
+//! and whole derivations with decomposition and interpretation.
+
+pub mod context;
+pub mod derive;
+pub mod step;
+pub mod word;
+
+pub use derive::{derive, DeriveError, DeriveOptions, Derivation, Derived};
+pub use step::{Rewriter, StepError, StepOptions};
+pub use word::{Seq, Word};

@@ -1,0 +1,256 @@
+//! The syntax tree of an `.lsys` file: plain data, no geometry, no types
+//! resolved. `lang::compile` turns it into an executable program.
+
+use super::span::Span;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Name {
+    pub text: String,
+    pub span: Span,
+}
+
+/// A type as written: `int`, `float`, `V2f`, or a struct/typedef name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TypeRef {
+    pub name: String,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct File {
+    pub items: Vec<Item>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Item {
+    /// `module P(V2f);`
+    Module { name: Name, params: Vec<TypeRef> },
+    /// `struct Data { float length, area; };`
+    Struct { name: Name, fields: Vec<(TypeRef, Name)> },
+    /// `typedef float real;`
+    Typedef { ty: TypeRef, name: Name },
+    /// `V2f v1(0, 0), v2(0, 1);`, `const int Delay = 2;`
+    Global(VarDecl),
+    /// `derivation length: expr;` and the other `key: expr;` directives.
+    Directive { kind: DirectiveKind, expr: Expr, span: Span },
+    /// `Axiom: P(v1) P(v2);`
+    Axiom { modules: Vec<ModuleCall>, span: Span },
+    /// `ignore: A B;` (`consider == false`) or `consider: A B;`.
+    ContextFilter { consider: bool, names: Vec<Name>, span: Span },
+    /// `production:`, `decomposition:` or `interpretation:`.
+    Section { section: Section, span: Span },
+    /// `group 1:`; `endgroup` is `Group { id: 0 }`.
+    Group { id: i64, span: Span },
+    /// `Start: { ... }` and friends.
+    Control { kind: ControlKind, body: Block, span: Span },
+    Production(Production),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DirectiveKind {
+    DerivationLength,
+    Ring,
+    MaximumDepth,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Section {
+    Productions,
+    Decomposition,
+    Interpretation,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ControlKind {
+    Start,
+    StartEach,
+    EndEach,
+    End,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct VarDecl {
+    pub ty: TypeRef,
+    pub is_const: bool,
+    pub vars: Vec<Declarator>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Declarator {
+    pub name: Name,
+    pub init: Init,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Init {
+    None,
+    /// `= expr`
+    Expr(Expr),
+    /// `v(0, 1)`: constructor arguments.
+    Ctor(Vec<Expr>, Span),
+    /// `= {1, 0}`: an aggregate initializer.
+    List(Vec<Expr>, Span),
+}
+
+/// A module with argument expressions: in an axiom or a successor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModuleCall {
+    pub name: Name,
+    pub args: Vec<Expr>,
+}
+
+/// A module with formal parameter names: in a predecessor or a context test.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatModule {
+    pub name: Name,
+    pub params: Vec<Name>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Production {
+    pub new_left: Vec<PatModule>,
+    pub left: Vec<PatModule>,
+    pub strict: Vec<PatModule>,
+    pub right: Vec<PatModule>,
+    pub new_right: Vec<PatModule>,
+    pub body: Body,
+    /// The predecessor, for messages.
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Body {
+    Block(Block),
+    /// `pred -> succ`: the paper's one-line form, same as `{ produce succ; }`.
+    Arrow(Vec<ModuleCall>, Span),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    pub stmts: Vec<Stmt>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stmt {
+    Expr(Expr),
+    Decl(VarDecl),
+    If {
+        cond: Expr,
+        then: Box<Stmt>,
+        els: Option<Box<Stmt>>,
+    },
+    While {
+        cond: Expr,
+        body: Box<Stmt>,
+    },
+    DoWhile {
+        body: Box<Stmt>,
+        cond: Expr,
+    },
+    For {
+        init: Option<Box<Stmt>>,
+        cond: Option<Expr>,
+        step: Option<Expr>,
+        body: Box<Stmt>,
+    },
+    Block(Block),
+    /// `produce ...;` (`last == true`) or `nproduce ...;`.
+    Produce {
+        modules: Vec<ModuleCall>,
+        last: bool,
+        span: Span,
+    },
+    Return(Span),
+    Break(Span),
+    Continue(Span),
+    Empty,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Rem,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Eq,
+    Ne,
+    And,
+    Or,
+    BitAnd,
+    BitOr,
+    BitXor,
+}
+
+impl BinOp {
+    pub fn symbol(self) -> &'static str {
+        match self {
+            BinOp::Add => "+",
+            BinOp::Sub => "-",
+            BinOp::Mul => "*",
+            BinOp::Div => "/",
+            BinOp::Rem => "%",
+            BinOp::Lt => "<",
+            BinOp::Le => "<=",
+            BinOp::Gt => ">",
+            BinOp::Ge => ">=",
+            BinOp::Eq => "==",
+            BinOp::Ne => "!=",
+            BinOp::And => "&&",
+            BinOp::Or => "||",
+            BinOp::BitAnd => "&",
+            BinOp::BitOr => "|",
+            BinOp::BitXor => "^",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnOp {
+    Neg,
+    Plus,
+    Not,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContextKind {
+    Left,
+    Right,
+    NewLeft,
+    NewRight,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expr {
+    pub kind: ExprKind,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExprKind {
+    Int(i64),
+    Float(f64),
+    Str(String),
+    Ident(String),
+    Unary(UnOp, Box<Expr>),
+    Binary(BinOp, Box<Expr>, Box<Expr>),
+    /// `lhs = rhs` (`op == None`) or `lhs op= rhs`.
+    Assign(Option<BinOp>, Box<Expr>, Box<Expr>),
+    /// `++x` / `--x` (`prefix`) or `x++` / `x--`; `delta` is +1 or -1.
+    IncDec {
+        target: Box<Expr>,
+        delta: i8,
+        prefix: bool,
+    },
+    Cond(Box<Expr>, Box<Expr>, Box<Expr>),
+    Call(Name, Vec<Expr>),
+    Method(Box<Expr>, Name, Vec<Expr>),
+    Field(Box<Expr>, Name),
+    Cast(TypeRef, Box<Expr>),
+    InContext(ContextKind, Vec<PatModule>),
+}

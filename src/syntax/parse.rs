@@ -1,0 +1,1072 @@
+//! Recursive-descent parser from preprocessed tokens to [`ast::File`].
+//!
+//! Every function parses one production of the grammar, shown in its doc
+//! comment. Errors say what was expected and what was found, at the token.
+
+use super::ast::*;
+use super::lex::{Tok, Token};
+use super::span::{Diagnostic, Span};
+
+/// Names that start a declaration in statement or item position.
+const TYPE_KEYWORDS: &[&str] = &[
+    "int", "float", "double", "bool", "V2f", "V2d", "V3f", "V3d", "long", "unsigned", "char",
+];
+
+pub struct Parser<'t> {
+    toks: &'t [Token],
+    pos: usize,
+    /// Struct and typedef names seen so far.
+    type_names: Vec<String>,
+    eof: Span,
+}
+
+type PResult<T> = Result<T, Diagnostic>;
+
+pub fn parse_file(toks: &[Token], eof: Span) -> PResult<File> {
+    let mut p = Parser {
+        toks,
+        pos: 0,
+        type_names: Vec::new(),
+        eof,
+    };
+    let mut items = Vec::new();
+    while !p.at_end() {
+        p.item(&mut items)?;
+    }
+    Ok(File { items })
+}
+
+impl<'t> Parser<'t> {
+    fn at_end(&self) -> bool {
+        self.pos >= self.toks.len()
+    }
+
+    fn peek(&self) -> Option<&'t Token> {
+        self.toks.get(self.pos)
+    }
+
+    fn peek_at(&self, k: usize) -> Option<&'t Token> {
+        self.toks.get(self.pos + k)
+    }
+
+    fn peek_punct(&self, p: &str) -> bool {
+        self.peek().is_some_and(|t| t.tok.is_punct(p))
+    }
+
+    fn peek_ident(&self, s: &str) -> bool {
+        self.peek().is_some_and(|t| t.tok.is_ident(s))
+    }
+
+    fn span_here(&self) -> Span {
+        self.peek().map(|t| t.span).unwrap_or(self.eof)
+    }
+
+    fn prev_span(&self) -> Span {
+        self.pos
+            .checked_sub(1)
+            .and_then(|i| self.toks.get(i))
+            .map(|t| t.span)
+            .unwrap_or(self.eof)
+    }
+
+    fn bump(&mut self) -> &'t Token {
+        let t = &self.toks[self.pos];
+        self.pos += 1;
+        t
+    }
+
+    fn found(&self) -> String {
+        match self.peek() {
+            Some(t) => t.tok.describe(),
+            None => "the end of the file".to_string(),
+        }
+    }
+
+    fn error<T>(&self, expected: &str) -> PResult<T> {
+        Err(Diagnostic::new(
+            self.span_here(),
+            format!("expected {expected}, found {}", self.found()),
+        ))
+    }
+
+    fn eat_punct(&mut self, p: &str) -> bool {
+        if self.peek_punct(p) {
+            self.pos += 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    fn expect_punct(&mut self, p: &str, what: &str) -> PResult<Span> {
+        if self.peek_punct(p) {
+            Ok(self.bump().span)
+        } else {
+            self.error(&format!("`{p}` {what}"))
+        }
+    }
+
+    fn name(&mut self, what: &str) -> PResult<Name> {
+        match self.peek() {
+            Some(Token {
+                tok: Tok::Ident(s),
+                span,
+                ..
+            }) => {
+                self.pos += 1;
+                Ok(Name {
+                    text: s.clone(),
+                    span: *span,
+                })
+            }
+            _ => self.error(what),
+        }
+    }
+
+    fn is_type_name(&self, s: &str) -> bool {
+        TYPE_KEYWORDS.contains(&s) || self.type_names.iter().any(|t| t == s)
+    }
+
+    /// True when the tokens at the cursor begin a declaration:
+    /// `const ...`, `struct Name ...`, `TYPE name`, or `Name name`.
+    fn at_declaration(&self) -> bool {
+        match (self.peek().map(|t| &t.tok), self.peek_at(1).map(|t| &t.tok)) {
+            (Some(Tok::Ident(a)), Some(Tok::Ident(_))) => {
+                !matches!(a.as_str(), "produce" | "nproduce" | "return" | "else" | "if" | "while")
+            }
+            (Some(Tok::Ident(a)), _) => a == "const",
+            _ => false,
+        }
+    }
+
+    // ----- items -------------------------------------------------------
+
+    /// item := module-decl | struct-decl | typedef | global-decl | directive
+    ///       | axiom | ignore | consider | section | group | control | production
+    fn item(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        let t = self.peek().expect("not at end");
+        let start = t.span;
+        if let Tok::Ident(word) = &t.tok {
+            let next_colon = self.peek_at(1).is_some_and(|n| n.tok.is_punct(":"));
+            match word.as_str() {
+                "module" => return self.module_decl(items),
+                "struct" if self.peek_at(2).is_some_and(|n| n.tok.is_punct("{")) => {
+                    return self.struct_decl(items)
+                }
+                "typedef" => return self.typedef(items),
+                "derivation" if self.peek_at(1).is_some_and(|n| n.tok.is_ident("length")) => {
+                    self.pos += 2;
+                    return self.directive(items, DirectiveKind::DerivationLength, start);
+                }
+                "maximum" if self.peek_at(1).is_some_and(|n| n.tok.is_ident("depth")) => {
+                    self.pos += 2;
+                    return self.directive(items, DirectiveKind::MaximumDepth, start);
+                }
+                "ring" if self.peek_at(1).is_some_and(|n| n.tok.is_ident("L")) => {
+                    // ring L-system: expr;
+                    self.pos += 2;
+                    self.expect_punct("-", "in `ring L-system:`")?;
+                    if !self.peek_ident("system") {
+                        return self.error("`system` in `ring L-system:`");
+                    }
+                    self.pos += 1;
+                    return self.directive(items, DirectiveKind::Ring, start);
+                }
+                "Axiom" | "axiom" if next_colon => {
+                    self.pos += 2;
+                    let modules = self.module_calls(&[";"], false)?;
+                    self.expect_punct(";", "after the axiom")?;
+                    items.push(Item::Axiom {
+                        modules,
+                        span: start,
+                    });
+                    return Ok(());
+                }
+                "ignore" | "consider" if next_colon => {
+                    self.pos += 2;
+                    let mut names = Vec::new();
+                    while !self.peek_punct(";") {
+                        if self.at_end() {
+                            return self.error("`;` after the module list");
+                        }
+                        if self.peek_punct("#") {
+                            let t = self.bump();
+                            names.push(Name {
+                                text: "#".into(),
+                                span: t.span,
+                            });
+                        } else {
+                            names.push(self.name("a module name")?);
+                        }
+                    }
+                    self.pos += 1;
+                    items.push(Item::ContextFilter {
+                        consider: word == "consider",
+                        names,
+                        span: start,
+                    });
+                    return Ok(());
+                }
+                "production" | "productions" | "decomposition" | "interpretation"
+                    if next_colon =>
+                {
+                    self.pos += 2;
+                    let section = match word.as_str() {
+                        "decomposition" => Section::Decomposition,
+                        "interpretation" => Section::Interpretation,
+                        _ => Section::Productions,
+                    };
+                    items.push(Item::Section {
+                        section,
+                        span: start,
+                    });
+                    return Ok(());
+                }
+                "group" => {
+                    self.pos += 1;
+                    let id = match self.peek().map(|t| &t.tok) {
+                        Some(Tok::Int(i)) => *i,
+                        _ => return self.error("a group number (an integer constant)"),
+                    };
+                    self.pos += 1;
+                    self.expect_punct(":", "after the group number")?;
+                    items.push(Item::Group { id, span: start });
+                    return Ok(());
+                }
+                "endgroup" => {
+                    self.pos += 1;
+                    self.eat_punct(":");
+                    self.eat_punct(";");
+                    items.push(Item::Group { id: 0, span: start });
+                    return Ok(());
+                }
+                "Start" | "StartEach" | "EndEach" | "End" if next_colon => {
+                    self.pos += 2;
+                    let kind = match word.as_str() {
+                        "Start" => ControlKind::Start,
+                        "StartEach" => ControlKind::StartEach,
+                        "EndEach" => ControlKind::EndEach,
+                        _ => ControlKind::End,
+                    };
+                    let body = self.block()?;
+                    self.eat_punct(";");
+                    items.push(Item::Control {
+                        kind,
+                        body,
+                        span: start,
+                    });
+                    return Ok(());
+                }
+                _ => {}
+            }
+            if self.at_declaration() {
+                // `float f(float x) { ... }` is a function definition.
+                let k = if word == "const" { 2 } else { 1 };
+                if self.peek_at(k + 1).is_some_and(|t| t.tok.is_punct("("))
+                    && self.function_follows(k + 1)
+                {
+                    return Err(Diagnostic::new(
+                        self.peek_at(k).map(|t| t.span).unwrap_or(start),
+                        "function definitions are not supported yet; use a #define macro or write the expression in the production",
+                    ));
+                }
+                let decl = self.var_decl()?;
+                self.expect_punct(";", "after the declaration")?;
+                items.push(Item::Global(decl));
+                return Ok(());
+            }
+        }
+        let prod = self.production()?;
+        items.push(Item::Production(prod));
+        Ok(())
+    }
+
+    /// Looks past a parenthesised list at `k` for a `{` (a function body).
+    fn function_follows(&self, k: usize) -> bool {
+        let mut depth = 0;
+        let mut j = self.pos + k;
+        while let Some(t) = self.toks.get(j) {
+            if t.tok.is_punct("(") {
+                depth += 1;
+            } else if t.tok.is_punct(")") {
+                depth -= 1;
+                if depth == 0 {
+                    return self.toks.get(j + 1).is_some_and(|t| t.tok.is_punct("{"));
+                }
+            }
+            j += 1;
+        }
+        false
+    }
+
+    /// directive := KEY ':' expr ';'
+    fn directive(&mut self, items: &mut Vec<Item>, kind: DirectiveKind, span: Span) -> PResult<()> {
+        self.expect_punct(":", "after the directive name")?;
+        let expr = self.expr()?;
+        self.expect_punct(";", "after the directive's value")?;
+        items.push(Item::Directive {
+            kind,
+            expr,
+            span: span.to(self.prev_span()),
+        });
+        Ok(())
+    }
+
+    /// module-decl := 'module' NAME [ '(' TYPE {',' TYPE} ')' ] ';'   e.g. `module P(V2f);`
+    fn module_decl(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        self.pos += 1;
+        loop {
+            let name = self.name("a module name after `module`")?;
+            let mut params = Vec::new();
+            if self.eat_punct("(") {
+                if !self.eat_punct(")") {
+                    loop {
+                        params.push(self.type_ref()?);
+                        // `module A(int /*id*/)` is fine; `module A(int id)` is not.
+                        if let Some(Token {
+                            tok: Tok::Ident(n),
+                            span,
+                            ..
+                        }) = self.peek()
+                        {
+                            return Err(Diagnostic::new(
+                                *span,
+                                format!("module parameters have types but no names: remove `{n}`"),
+                            ));
+                        }
+                        if self.eat_punct(")") {
+                            break;
+                        }
+                        self.expect_punct(",", "or `)` in the module's parameter types")?;
+                    }
+                }
+            }
+            items.push(Item::Module { name, params });
+            if !self.eat_punct(",") {
+                break;
+            }
+        }
+        self.expect_punct(";", "after the module declaration")?;
+        Ok(())
+    }
+
+    fn type_ref(&mut self) -> PResult<TypeRef> {
+        self.eat_ident("const");
+        self.eat_ident("struct");
+        let n = self.name("a type name")?;
+        let mut name = n.text;
+        // `unsigned int`, `long int`
+        if matches!(name.as_str(), "unsigned" | "long") && self.peek_ident("int") {
+            self.pos += 1;
+            name = "int".into();
+        }
+        Ok(TypeRef { name, span: n.span })
+    }
+
+    fn eat_ident(&mut self, s: &str) -> bool {
+        if self.peek_ident(s) {
+            self.pos += 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// struct-decl := 'struct' NAME '{' { TYPE NAME {',' NAME} ';' } '}' ';'
+    fn struct_decl(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        self.pos += 1;
+        let name = self.name("a struct name")?;
+        self.type_names.push(name.text.clone());
+        self.expect_punct("{", "to open the struct body")?;
+        let mut fields = Vec::new();
+        while !self.eat_punct("}") {
+            if self.at_end() {
+                return self.error("`}` to close the struct");
+            }
+            let ty = self.type_ref()?;
+            loop {
+                let f = self.name("a field name")?;
+                fields.push((ty.clone(), f));
+                if !self.eat_punct(",") {
+                    break;
+                }
+            }
+            self.expect_punct(";", "after the field declaration")?;
+        }
+        self.expect_punct(";", "after the struct declaration")?;
+        items.push(Item::Struct { name, fields });
+        Ok(())
+    }
+
+    /// typedef := 'typedef' TYPE NAME ';'
+    fn typedef(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        self.pos += 1;
+        let ty = self.type_ref()?;
+        let name = self.name("the new type name")?;
+        self.type_names.push(name.text.clone());
+        self.expect_punct(";", "after the typedef")?;
+        items.push(Item::Typedef { ty, name });
+        Ok(())
+    }
+
+    /// var-decl := ['const'] TYPE declarator {',' declarator}
+    /// declarator := NAME [ '(' args ')' | '=' expr | '=' '{' args '}' ]
+    fn var_decl(&mut self) -> PResult<VarDecl> {
+        let is_const = self.eat_ident("const");
+        let ty = self.type_ref()?;
+        let mut vars = Vec::new();
+        loop {
+            let name = self.name("a variable name")?;
+            let init = if self.peek_punct("(") {
+                let open = self.bump().span;
+                let args = self.args(")")?;
+                Init::Ctor(args, open.to(self.prev_span()))
+            } else if self.eat_punct("=") {
+                if self.peek_punct("{") {
+                    let open = self.bump().span;
+                    let args = self.args("}")?;
+                    Init::List(args, open.to(self.prev_span()))
+                } else {
+                    Init::Expr(self.assign_expr()?)
+                }
+            } else {
+                Init::None
+            };
+            vars.push(Declarator { name, init });
+            if !self.eat_punct(",") {
+                break;
+            }
+        }
+        Ok(VarDecl { ty, is_const, vars })
+    }
+
+    /// args := [ expr {',' expr} ] CLOSE   (the opening bracket is consumed)
+    fn args(&mut self, close: &str) -> PResult<Vec<Expr>> {
+        let mut args = Vec::new();
+        if self.eat_punct(close) {
+            return Ok(args);
+        }
+        loop {
+            args.push(self.assign_expr()?);
+            if self.eat_punct(close) {
+                return Ok(args);
+            }
+            if !self.peek_punct(",") {
+                return self.error(&format!("`,` or `{close}` in the argument list"));
+            }
+            self.pos += 1;
+        }
+    }
+
+    // ----- productions --------------------------------------------------
+
+    /// production := predecessor ( ':' block | '->' successor )
+    /// predecessor := [pats '<<'] [pats '<'] pats ['>' pats] ['>>' pats]
+    ///
+    /// e.g. `P(vl) < P(v) > P(vr) : { produce ...; }`
+    fn production(&mut self) -> PResult<Production> {
+        let start = self.span_here();
+        let mut groups: Vec<Vec<PatModule>> = vec![Vec::new()];
+        let mut seps: Vec<(&'static str, Span)> = Vec::new();
+        loop {
+            let Some(t) = self.peek() else {
+                return self.error("`:` after the production's predecessor");
+            };
+            match &t.tok {
+                Tok::Punct(p @ ("<" | ">" | "<<" | ">>")) => {
+                    seps.push((p, t.span));
+                    groups.push(Vec::new());
+                    self.pos += 1;
+                }
+                Tok::Punct(":") | Tok::Punct("->") => break,
+                Tok::Ident(_) | Tok::Punct("#") => {
+                    let m = self.pat_module()?;
+                    groups.last_mut().expect("non-empty").push(m);
+                }
+                _ => {
+                    return self.error(
+                        "a module, `<`, `>`, `<<`, `>>` or `:` in the production's predecessor",
+                    )
+                }
+            }
+        }
+        let pred_span = start.to(self.prev_span());
+        let mut prod = Production {
+            new_left: Vec::new(),
+            left: Vec::new(),
+            strict: Vec::new(),
+            right: Vec::new(),
+            new_right: Vec::new(),
+            body: Body::Arrow(Vec::new(), pred_span),
+            span: pred_span,
+        };
+        // Assign the groups by their separators, in the fixed order
+        // new-left << left < strict > right >> new-right.
+        let order = ["<<", "<", "", ">", ">>"];
+        let mut slot = 0; // index into order of the current group
+        let mut groups = groups.into_iter();
+        let mut current = groups.next().expect("one group");
+        // The first group is strict unless a `<<` or `<` follows it.
+        let first_sep = seps.first().map(|s| s.0);
+        slot = match first_sep {
+            Some("<<") => 0,
+            Some("<") => 1,
+            _ => 2,
+        }
+        .max(slot);
+        for (i, (sep, span)) in seps.iter().enumerate() {
+            let target = match slot {
+                0 => &mut prod.new_left,
+                1 => &mut prod.left,
+                2 => &mut prod.strict,
+                3 => &mut prod.right,
+                _ => &mut prod.new_right,
+            };
+            *target = std::mem::take(&mut current);
+            current = groups.next().expect("one group per separator");
+            let next_slot = match *sep {
+                "<<" => 1,
+                "<" => 2,
+                ">" => 3,
+                ">>" => 4,
+                _ => unreachable!(),
+            };
+            // After `<<`, the next group is left context only if a `<` follows.
+            let next_slot = if *sep == "<<" && seps.get(i + 1).map(|s| s.0) != Some("<") {
+                2
+            } else {
+                next_slot
+            };
+            if next_slot <= slot || (slot < 2 && next_slot > 2) {
+                return Err(Diagnostic::new(
+                    *span,
+                    format!(
+                        "unexpected `{sep}`: the predecessor must read `new-left << left < strict > right >> new-right`, each part optional but the strict predecessor"
+                    ),
+                ));
+            }
+            slot = next_slot;
+        }
+        let _ = order;
+        let target = match slot {
+            0 => &mut prod.new_left,
+            1 => &mut prod.left,
+            2 => &mut prod.strict,
+            3 => &mut prod.right,
+            _ => &mut prod.new_right,
+        };
+        *target = current;
+        if prod.strict.is_empty() {
+            return Err(Diagnostic::new(
+                pred_span,
+                "expected a strict predecessor: at least one module between the contexts",
+            ));
+        }
+        if self.eat_punct("->") {
+            let arrow = self.prev_span();
+            let line_end = self.line_end();
+            let succ = self.module_calls_until(line_end)?;
+            self.eat_punct(";");
+            prod.body = Body::Arrow(succ, arrow);
+        } else {
+            self.expect_punct(":", "after the predecessor")?;
+            prod.body = Body::Block(self.block()?);
+            self.eat_punct(";");
+        }
+        Ok(prod)
+    }
+
+    /// The index of the first token after the current line, at paren depth 0.
+    fn line_end(&self) -> usize {
+        let mut j = self.pos;
+        let mut depth = 0i32;
+        while let Some(t) = self.toks.get(j) {
+            if j > self.pos && t.line_start && depth == 0 {
+                break;
+            }
+            if t.tok.is_punct("(") {
+                depth += 1;
+            } else if t.tok.is_punct(")") {
+                depth -= 1;
+            } else if t.tok.is_punct(";") && depth == 0 {
+                break;
+            }
+            j += 1;
+        }
+        j
+    }
+
+    /// pat-module := NAME [ '(' [NAME {',' NAME}] ')' ] | '#'
+    fn pat_module(&mut self) -> PResult<PatModule> {
+        if self.peek_punct("#") {
+            let t = self.bump();
+            return Ok(PatModule {
+                name: Name {
+                    text: "#".into(),
+                    span: t.span,
+                },
+                params: Vec::new(),
+            });
+        }
+        let name = self.name("a module name")?;
+        let mut params = Vec::new();
+        if self.eat_punct("(") && !self.eat_punct(")") {
+            loop {
+                params.push(self.name("a parameter name in the module pattern")?);
+                if self.eat_punct(")") {
+                    break;
+                }
+                self.expect_punct(",", "or `)` between the pattern's parameters")?;
+            }
+        }
+        Ok(PatModule { name, params })
+    }
+
+    /// A module list up to (not including) one of `stops`.
+    /// module-call := NAME [ '(' args ')' ] | '#'
+    fn module_calls(&mut self, stops: &[&str], allow_close: bool) -> PResult<Vec<ModuleCall>> {
+        let mut out = Vec::new();
+        loop {
+            let Some(t) = self.peek() else {
+                return self.error(&format!("`{}`", stops[0]));
+            };
+            if stops.iter().any(|s| t.tok.is_punct(s)) || (allow_close && t.tok.is_punct("}")) {
+                return Ok(out);
+            }
+            out.push(self.module_call()?);
+        }
+    }
+
+    fn module_calls_until(&mut self, end: usize) -> PResult<Vec<ModuleCall>> {
+        let mut out = Vec::new();
+        while self.pos < end {
+            out.push(self.module_call()?);
+        }
+        Ok(out)
+    }
+
+    fn module_call(&mut self) -> PResult<ModuleCall> {
+        if self.peek_punct("#") {
+            let t = self.bump();
+            return Ok(ModuleCall {
+                name: Name {
+                    text: "#".into(),
+                    span: t.span,
+                },
+                args: Vec::new(),
+            });
+        }
+        if !matches!(self.peek().map(|t| &t.tok), Some(Tok::Ident(_))) {
+            return self.error("a module (a name, optionally with arguments in parentheses)");
+        }
+        let name = self.name("a module name")?;
+        let args = if self.eat_punct("(") {
+            self.args(")")?
+        } else {
+            Vec::new()
+        };
+        Ok(ModuleCall { name, args })
+    }
+
+    // ----- statements ---------------------------------------------------
+
+    /// block := '{' { stmt } '}'
+    fn block(&mut self) -> PResult<Block> {
+        let open = self.expect_punct("{", "to open the block")?;
+        let mut stmts = Vec::new();
+        loop {
+            if self.eat_punct("}") {
+                return Ok(Block {
+                    stmts,
+                    span: open.to(self.prev_span()),
+                });
+            }
+            if self.at_end() {
+                return Err(Diagnostic::new(
+                    open,
+                    "unclosed `{`: expected `}` before the end of the file",
+                ));
+            }
+            stmts.push(self.stmt()?);
+        }
+    }
+
+    fn stmt(&mut self) -> PResult<Stmt> {
+        let t = self.peek().expect("checked by caller");
+        if t.tok.is_punct("{") {
+            return Ok(Stmt::Block(self.block()?));
+        }
+        if t.tok.is_punct(";") {
+            self.pos += 1;
+            return Ok(Stmt::Empty);
+        }
+        if let Tok::Ident(w) = &t.tok {
+            match w.as_str() {
+                "produce" | "nproduce" => {
+                    self.pos += 1;
+                    let last = w == "produce";
+                    let modules = if self.peek_punct("(")
+                        && self.peek_at(1).is_some_and(|t| matches!(t.tok, Tok::Ident(_)))
+                        && self.peek_at(2).is_some_and(|t| t.tok.is_punct("("))
+                    {
+                        // `produce( G(x) );` as in the manual's examples.
+                        self.pos += 1;
+                        let m = self.module_calls(&[")"], false)?;
+                        self.pos += 1;
+                        m
+                    } else {
+                        self.module_calls(&[";"], true)?
+                    };
+                    // Velho's listings omit the `;` before `}`.
+                    if !self.peek_punct("}") {
+                        self.expect_punct(";", "after the successor")?;
+                    }
+                    return Ok(Stmt::Produce {
+                        modules,
+                        last,
+                        span: t.span,
+                    });
+                }
+                "if" => {
+                    self.pos += 1;
+                    let cond = self.expr()?;
+                    let then = Box::new(self.stmt_or_end()?);
+                    let els = if self.eat_ident("else") {
+                        Some(Box::new(self.stmt_or_end()?))
+                    } else {
+                        None
+                    };
+                    return Ok(Stmt::If { cond, then, els });
+                }
+                "while" => {
+                    self.pos += 1;
+                    let cond = self.expr()?;
+                    let body = Box::new(self.stmt_or_end()?);
+                    return Ok(Stmt::While { cond, body });
+                }
+                "do" => {
+                    self.pos += 1;
+                    let body = Box::new(self.stmt_or_end()?);
+                    if !self.eat_ident("while") {
+                        return self.error("`while` after the body of `do`");
+                    }
+                    let cond = self.expr()?;
+                    self.expect_punct(";", "after `do ... while (...)`")?;
+                    return Ok(Stmt::DoWhile { body, cond });
+                }
+                "for" => {
+                    self.pos += 1;
+                    self.expect_punct("(", "after `for`")?;
+                    let init = if self.eat_punct(";") {
+                        None
+                    } else {
+                        let s = if self.at_declaration() {
+                            Stmt::Decl(self.var_decl()?)
+                        } else {
+                            Stmt::Expr(self.expr()?)
+                        };
+                        self.expect_punct(";", "after the loop's initialisation")?;
+                        Some(Box::new(s))
+                    };
+                    let cond = if self.peek_punct(";") {
+                        None
+                    } else {
+                        Some(self.expr()?)
+                    };
+                    self.expect_punct(";", "after the loop condition")?;
+                    let step = if self.peek_punct(")") {
+                        None
+                    } else {
+                        Some(self.expr()?)
+                    };
+                    self.expect_punct(")", "to close the `for` header")?;
+                    let body = Box::new(self.stmt_or_end()?);
+                    return Ok(Stmt::For {
+                        init,
+                        cond,
+                        step,
+                        body,
+                    });
+                }
+                "return" => {
+                    self.pos += 1;
+                    if !self.peek_punct(";") && !self.peek_punct("}") {
+                        self.expr()?;
+                    }
+                    self.eat_punct(";");
+                    return Ok(Stmt::Return(t.span));
+                }
+                "break" | "continue" => {
+                    self.pos += 1;
+                    self.expect_punct(";", &format!("after `{w}`"))?;
+                    return Ok(if w == "break" {
+                        Stmt::Break(t.span)
+                    } else {
+                        Stmt::Continue(t.span)
+                    });
+                }
+                _ => {}
+            }
+            if self.at_declaration() {
+                let d = self.var_decl()?;
+                self.expect_punct(";", "after the declaration")?;
+                return Ok(Stmt::Decl(d));
+            }
+        }
+        let e = self.expr()?;
+        if !self.peek_punct("}") {
+            self.expect_punct(";", "after the expression")?;
+        }
+        Ok(Stmt::Expr(e))
+    }
+
+    fn stmt_or_end(&mut self) -> PResult<Stmt> {
+        if self.at_end() {
+            return self.error("a statement");
+        }
+        self.stmt()
+    }
+
+    // ----- expressions --------------------------------------------------
+
+    pub fn expr(&mut self) -> PResult<Expr> {
+        self.assign_expr()
+    }
+
+    /// assign := cond [ ('=' | '+=' | '-=' | '*=' | '/=' | '%=') assign ]
+    fn assign_expr(&mut self) -> PResult<Expr> {
+        let lhs = self.cond_expr()?;
+        let op = match self.peek().map(|t| &t.tok) {
+            Some(Tok::Punct("=")) => Some(None),
+            Some(Tok::Punct("+=")) => Some(Some(BinOp::Add)),
+            Some(Tok::Punct("-=")) => Some(Some(BinOp::Sub)),
+            Some(Tok::Punct("*=")) => Some(Some(BinOp::Mul)),
+            Some(Tok::Punct("/=")) => Some(Some(BinOp::Div)),
+            Some(Tok::Punct("%=")) => Some(Some(BinOp::Rem)),
+            _ => None,
+        };
+        if let Some(op) = op {
+            self.pos += 1;
+            let rhs = self.assign_expr()?;
+            let span = lhs.span.to(rhs.span);
+            return Ok(Expr {
+                kind: ExprKind::Assign(op, Box::new(lhs), Box::new(rhs)),
+                span,
+            });
+        }
+        Ok(lhs)
+    }
+
+    /// cond := binary(0) [ '?' expr ':' cond ]
+    fn cond_expr(&mut self) -> PResult<Expr> {
+        let c = self.binary(0)?;
+        if self.eat_punct("?") {
+            let a = self.expr()?;
+            self.expect_punct(":", "in the conditional expression `c ? a : b`")?;
+            let b = self.cond_expr()?;
+            let span = c.span.to(b.span);
+            return Ok(Expr {
+                kind: ExprKind::Cond(Box::new(c), Box::new(a), Box::new(b)),
+                span,
+            });
+        }
+        Ok(c)
+    }
+
+    /// Precedence climbing over the C binary operators.
+    fn binary(&mut self, min_prec: u8) -> PResult<Expr> {
+        let mut lhs = self.unary()?;
+        loop {
+            let Some((op, prec)) = self.peek().and_then(|t| binop_of(&t.tok)) else {
+                return Ok(lhs);
+            };
+            if prec < min_prec {
+                return Ok(lhs);
+            }
+            self.pos += 1;
+            let rhs = self.binary(prec + 1)?;
+            let span = lhs.span.to(rhs.span);
+            lhs = Expr {
+                kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+                span,
+            };
+        }
+    }
+
+    /// unary := ('-' | '+' | '!' | '++' | '--') unary | '(' TYPE ')' unary | postfix
+    fn unary(&mut self) -> PResult<Expr> {
+        let Some(t) = self.peek() else {
+            return self.error("an expression");
+        };
+        let start = t.span;
+        let op = match &t.tok {
+            Tok::Punct("-") => Some(UnOp::Neg),
+            Tok::Punct("+") => Some(UnOp::Plus),
+            Tok::Punct("!") => Some(UnOp::Not),
+            _ => None,
+        };
+        if let Some(op) = op {
+            self.pos += 1;
+            let e = self.unary()?;
+            let span = start.to(e.span);
+            return Ok(Expr {
+                kind: ExprKind::Unary(op, Box::new(e)),
+                span,
+            });
+        }
+        if t.tok.is_punct("++") || t.tok.is_punct("--") {
+            self.pos += 1;
+            let e = self.unary()?;
+            let span = start.to(e.span);
+            return Ok(Expr {
+                kind: ExprKind::IncDec {
+                    target: Box::new(e),
+                    delta: if t.tok.is_punct("++") { 1 } else { -1 },
+                    prefix: true,
+                },
+                span,
+            });
+        }
+        // A cast: `(int) expr`
+        if t.tok.is_punct("(") {
+            if let (Some(Token { tok: Tok::Ident(n), .. }), Some(close)) =
+                (self.peek_at(1), self.peek_at(2))
+            {
+                if close.tok.is_punct(")") && self.is_type_name(n) {
+                    self.pos += 1;
+                    let ty = self.type_ref()?;
+                    self.pos += 1;
+                    let e = self.unary()?;
+                    let span = start.to(e.span);
+                    return Ok(Expr {
+                        kind: ExprKind::Cast(ty, Box::new(e)),
+                        span,
+                    });
+                }
+            }
+        }
+        self.postfix()
+    }
+
+    fn postfix(&mut self) -> PResult<Expr> {
+        let mut e = self.primary()?;
+        loop {
+            if self.eat_punct(".") {
+                let name = self.name("a field or method name after `.`")?;
+                if self.eat_punct("(") {
+                    let args = self.args(")")?;
+                    let span = e.span.to(self.prev_span());
+                    e = Expr {
+                        kind: ExprKind::Method(Box::new(e), name, args),
+                        span,
+                    };
+                } else {
+                    let span = e.span.to(name.span);
+                    e = Expr {
+                        kind: ExprKind::Field(Box::new(e), name),
+                        span,
+                    };
+                }
+            } else if self.peek_punct("++") || self.peek_punct("--") {
+                let t = self.bump();
+                let span = e.span.to(t.span);
+                e = Expr {
+                    kind: ExprKind::IncDec {
+                        target: Box::new(e),
+                        delta: if t.tok.is_punct("++") { 1 } else { -1 },
+                        prefix: false,
+                    },
+                    span,
+                };
+            } else {
+                return Ok(e);
+            }
+        }
+    }
+
+    /// primary := NUMBER | STRING | NAME | NAME '(' args ')' | '(' expr ')'
+    ///          | InLeftContext '(' pats ')' | ...
+    fn primary(&mut self) -> PResult<Expr> {
+        let Some(t) = self.peek() else {
+            return self.error("an expression");
+        };
+        let span = t.span;
+        let kind = match &t.tok {
+            Tok::Int(i) => {
+                self.pos += 1;
+                ExprKind::Int(*i)
+            }
+            Tok::Float(f) => {
+                self.pos += 1;
+                ExprKind::Float(*f)
+            }
+            Tok::Str(s) => {
+                self.pos += 1;
+                ExprKind::Str(s.clone())
+            }
+            Tok::Punct("(") => {
+                self.pos += 1;
+                let e = self.expr()?;
+                self.expect_punct(")", "to close the parenthesis")?;
+                return Ok(Expr {
+                    kind: e.kind,
+                    span: span.to(self.prev_span()),
+                });
+            }
+            Tok::Ident(n) => {
+                let name = self.name("a name")?;
+                let ctx = match n.as_str() {
+                    "InLeftContext" => Some(ContextKind::Left),
+                    "InRightContext" => Some(ContextKind::Right),
+                    "InNewLeftContext" => Some(ContextKind::NewLeft),
+                    "InNewRightContext" => Some(ContextKind::NewRight),
+                    _ => None,
+                };
+                if let Some(kind) = ctx {
+                    self.expect_punct("(", "after the context test")?;
+                    let mut pats = Vec::new();
+                    while !self.eat_punct(")") {
+                        if self.at_end() {
+                            return self.error("`)` to close the context test");
+                        }
+                        pats.push(self.pat_module()?);
+                    }
+                    ExprKind::InContext(kind, pats)
+                } else if self.eat_punct("(") {
+                    let args = self.args(")")?;
+                    ExprKind::Call(name, args)
+                } else {
+                    ExprKind::Ident(n.clone())
+                }
+            }
+            _ => return self.error("an expression"),
+        };
+        Ok(Expr {
+            kind,
+            span: span.to(self.prev_span()),
+        })
+    }
+}
+
+fn binop_of(t: &Tok) -> Option<(BinOp, u8)> {
+    let Tok::Punct(p) = t else { return None };
+    Some(match *p {
+        "||" => (BinOp::Or, 1),
+        "&&" => (BinOp::And, 2),
+        "|" => (BinOp::BitOr, 3),
+        "^" => (BinOp::BitXor, 4),
+        "&" => (BinOp::BitAnd, 5),
+        "==" => (BinOp::Eq, 6),
+        "!=" => (BinOp::Ne, 6),
+        "<" => (BinOp::Lt, 7),
+        ">" => (BinOp::Gt, 7),
+        "<=" => (BinOp::Le, 7),
+        ">=" => (BinOp::Ge, 7),
+        "+" => (BinOp::Add, 8),
+        "-" => (BinOp::Sub, 8),
+        "*" => (BinOp::Mul, 9),
+        "/" => (BinOp::Div, 9),
+        "%" => (BinOp::Rem, 9),
+        _ => return None,
+    })
+}
