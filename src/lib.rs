@@ -27,7 +27,7 @@ use std::fmt;
 use std::path::Path;
 
 pub use lang::Program;
-pub use rewrite::{derive, DeriveError, DeriveOptions, Derivation, Derived, Word};
+pub use rewrite::{derive, Derivation, DeriveError, DeriveOptions, Derived, Word};
 pub use syntax::{Diagnostic, SourceMap};
 
 use syntax::{lex, parse, preprocess, SourceFile, Span};

@@ -5,10 +5,14 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use subgram::{output, DeriveOptions, Derivation};
+use subgram::{output, Derivation, DeriveOptions};
 
 #[derive(Parser)]
-#[command(name = "subgram", version, about = "Curves and surfaces from L-systems and grammars")]
+#[command(
+    name = "subgram",
+    version,
+    about = "Curves and surfaces from L-systems and grammars"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -66,12 +70,11 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
     match cli.command {
         Command::Check { file, define } => {
             let loaded = load(&file, &define)?;
-            println!(
+            print_out(&format!(
                 "{file}: ok ({} rules, {} module kinds)",
                 loaded.program.rules.len(),
                 loaded.program.alphabet.kinds.len()
-            );
-            Ok(())
+            ))
         }
         Command::Derive {
             file,
@@ -98,14 +101,11 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
                 d.word.clone()
             };
             let p = &loaded.program;
-            match format {
-                Format::Text => println!("{}", output::word_text(&word, &p.alphabet)),
-                Format::Json => println!(
-                    "{}",
-                    output::word_json(&word, d.ring, d.step, &p.alphabet, &p.structs)
-                ),
-            }
-            Ok(())
+            let text = match format {
+                Format::Text => output::word_text(&word, &p.alphabet),
+                Format::Json => output::word_json(&word, d.ring, d.step, &p.alphabet).to_string(),
+            };
+            print_out(&text)
         }
     }
 }
@@ -118,4 +118,15 @@ fn load(file: &str, define: &[String]) -> Result<subgram::Loaded, (u8, String)> 
         };
         (code, e.render())
     })
+}
+
+/// Writes a line to stdout; a closed pipe (`subgram derive f | head`) is not an error.
+fn print_out(text: &str) -> Result<(), (u8, String)> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match writeln!(out, "{text}").and_then(|_| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err((1, format!("error: cannot write the output: {e}"))),
+    }
 }

@@ -3,7 +3,6 @@
 use serde_json::{json, Value as Json};
 
 use crate::lang::{Alphabet, Value};
-use crate::lang::value::StructDef;
 use crate::rewrite::Word;
 
 /// `P([0, 0.25]) E A(1, 2)`: one module after another, vectors in brackets.
@@ -36,28 +35,29 @@ fn value_text(v: &Value) -> String {
     }
 }
 
+/// A struct parameter is an array of its fields.
 /// `{"ring": bool, "step": N, "modules": [{"symbol": "P", "params": [[0.0, 1.0]]}]}`
-pub fn word_json(word: &Word, ring: bool, step: u64, alphabet: &Alphabet, structs: &[StructDef]) -> Json {
+pub fn word_json(word: &Word, ring: bool, step: u64, alphabet: &Alphabet) -> Json {
     let modules: Vec<Json> = word
         .iter()
         .map(|(sym, params)| {
             json!({
                 "symbol": alphabet.name(sym),
-                "params": params.iter().map(|p| value_json(p, structs)).collect::<Vec<_>>(),
+                "params": params.iter().map(value_json).collect::<Vec<_>>(),
             })
         })
         .collect();
     json!({ "ring": ring, "step": step, "modules": modules })
 }
 
-fn value_json(v: &Value, structs: &[StructDef]) -> Json {
+fn value_json(v: &Value) -> Json {
     match v {
         Value::Int(i) => json!(i),
         Value::Float(f) => json!(f),
         Value::Bool(b) => json!(b),
         Value::V2(p) => json!([p.x, p.y]),
         Value::V3(p) => json!([p.x, p.y, p.z]),
-        Value::Struct(fs) => Json::Array(fs.iter().map(|f| value_json(f, structs)).collect()),
+        Value::Struct(fs) => Json::Array(fs.iter().map(value_json).collect()),
         Value::Str(s) => json!(s.as_ref()),
         Value::Void => Json::Null,
     }

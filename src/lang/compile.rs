@@ -197,7 +197,13 @@ impl Compiler {
                         continue;
                     };
                     if !ty.is_numeric() {
-                        self.err(expr.span, format!("expected a number, found a value of type {}", self.type_name(ty)));
+                        self.err(
+                            expr.span,
+                            format!(
+                                "expected a number, found a value of type {}",
+                                self.type_name(ty)
+                            ),
+                        );
                         continue;
                     }
                     let slot = match kind {
@@ -263,7 +269,10 @@ impl Compiler {
                 .last()
                 .map(|_| Span::default())
                 .unwrap_or_default();
-            self.err(end, "the program has no axiom: add a line such as `Axiom: A(1);`");
+            self.err(
+                end,
+                "the program has no axiom: add a line such as `Axiom: A(1);`",
+            );
         }
         program.alphabet = self.alphabet.clone();
         program.structs = self.structs.clone();
@@ -282,11 +291,20 @@ impl Compiler {
                 self.err(d.name.span, "a global initializer cannot declare variables");
             }
             if self.global_names.contains_key(&d.name.text) {
-                self.err(d.name.span, format!("`{}` is already declared", d.name.text));
+                self.err(
+                    d.name.span,
+                    format!("`{}` is already declared", d.name.text),
+                );
                 continue;
             }
             if self.alphabet.lookup(&d.name.text).is_some() {
-                self.err(d.name.span, format!("`{}` is a module name and cannot also name a variable", d.name.text));
+                self.err(
+                    d.name.span,
+                    format!(
+                        "`{}` is a module name and cannot also name a variable",
+                        d.name.text
+                    ),
+                );
                 continue;
             }
             self.global_names
@@ -319,11 +337,21 @@ impl Compiler {
     }
 
     /// `V2f v(1, 2)`, `V3f(x, y, z)`, `Data d = {1, 0}`, `int n(3)`.
-    fn construct(&mut self, ty: Ty, mut exs: Vec<(Ex, Ty)>, args: &[ast::Expr], span: Span) -> Option<Ex> {
+    fn construct(
+        &mut self,
+        ty: Ty,
+        mut exs: Vec<(Ex, Ty)>,
+        args: &[ast::Expr],
+        span: Span,
+    ) -> Option<Ex> {
         let want: Vec<Ty> = match ty {
             Ty::V2 => vec![Ty::Float; 2],
             Ty::V3 => vec![Ty::Float; 3],
-            Ty::Struct(i) => self.structs[i as usize].fields.iter().map(|f| f.1).collect(),
+            Ty::Struct(i) => self.structs[i as usize]
+                .fields
+                .iter()
+                .map(|f| f.1)
+                .collect(),
             t => vec![t],
         };
         if exs.len() == 1 && exs[0].1 == ty {
@@ -382,24 +410,36 @@ impl Compiler {
         None
     }
 
-    fn rule(&mut self, p: &ast::Production, section: Section, group: i64, filter: &Filter) -> Option<Rule> {
+    fn rule(
+        &mut self,
+        p: &ast::Production,
+        section: Section,
+        group: i64,
+        filter: &Filter,
+    ) -> Option<Rule> {
         let mut scope = Scope::rule();
         let mut ok = true;
-        let mut pats = |c: &mut Compiler, list: &[ast::PatModule], scope: &mut Scope| -> Vec<Pattern> {
-            let mut out = Vec::new();
-            for m in list {
-                match c.pattern(m, scope) {
-                    Some(pat) => out.push(pat),
-                    None => ok = false,
+        let mut pats =
+            |c: &mut Compiler, list: &[ast::PatModule], scope: &mut Scope| -> Vec<Pattern> {
+                let mut out = Vec::new();
+                for m in list {
+                    match c.pattern(m, scope) {
+                        Some(pat) => out.push(pat),
+                        None => ok = false,
+                    }
                 }
-            }
-            out
-        };
+                out
+            };
         let new_left = pats(self, &p.new_left, &mut scope);
         let left = pats(self, &p.left, &mut scope);
         let strict = pats(self, &p.strict, &mut scope);
         let right = pats(self, &p.right, &mut scope);
         let new_right = pats(self, &p.new_right, &mut scope);
+        if !ok {
+            // The body's names depend on the predecessor: checking it now
+            // would only repeat the predecessor's error.
+            return None;
+        }
         let body = match &p.body {
             ast::Body::Block(b) => self.block_stmts(&b.stmts, &mut scope),
             ast::Body::Arrow(succ, _) => {
@@ -410,9 +450,6 @@ impl Compiler {
                 }]
             }
         };
-        if !ok {
-            return None;
-        }
         let label = pattern_label(p);
         let mut rule = Rule {
             new_left,
@@ -439,7 +476,13 @@ impl Compiler {
         let mut slots = Vec::new();
         for (n, t) in m.params.iter().zip(tys.iter().copied()) {
             if scope.vars.iter().any(|(v, _, _)| *v == n.text) {
-                self.err(n.span, format!("the parameter name `{}` is used twice in this predecessor", n.text));
+                self.err(
+                    n.span,
+                    format!(
+                        "the parameter name `{}` is used twice in this predecessor",
+                        n.text
+                    ),
+                );
                 return None;
             }
             slots.push(scope.declare(&n.text, t));
@@ -453,7 +496,11 @@ impl Compiler {
     }
 
     /// The module `name` and its parameter types for `count` parameters.
-    fn module_params(&mut self, name: &ast::Name, count: usize) -> Option<(Sym, Vec<Ty>, Option<usize>)> {
+    fn module_params(
+        &mut self,
+        name: &ast::Name,
+        count: usize,
+    ) -> Option<(Sym, Vec<Ty>, Option<usize>)> {
         let Some(sym) = self.alphabet.lookup(&name.text) else {
             self.err(
                 name.span,
@@ -469,7 +516,11 @@ impl Compiler {
         match &self.alphabet.get(sym).sig {
             Signature::Fixed(tys) => {
                 if tys.len() != count {
-                    let decl = tys.iter().map(|t| self.type_name(*t)).collect::<Vec<_>>().join(", ");
+                    let decl = tys
+                        .iter()
+                        .map(|t| self.type_name(*t))
+                        .collect::<Vec<_>>()
+                        .join(", ");
                     self.err(
                         name.span,
                         format!(
@@ -536,9 +587,10 @@ impl Compiler {
             };
             let fits = |want: &[Ty]| {
                 want.len() == args.len()
-                    && want.iter().zip(&args).all(|(w, (_, t))| {
-                        w == t || (w.is_numeric() && t.is_numeric())
-                    })
+                    && want
+                        .iter()
+                        .zip(&args)
+                        .all(|(w, (_, t))| w == t || (w.is_numeric() && t.is_numeric()))
             };
             let Some(want) = candidates.iter().find(|w| fits(w)).cloned() else {
                 let same_arity = candidates.iter().find(|w| w.len() == args.len());
@@ -560,7 +612,8 @@ impl Compiler {
                         }
                     }
                     None => {
-                        let counts: Vec<String> = candidates.iter().map(|c| c.len().to_string()).collect();
+                        let counts: Vec<String> =
+                            candidates.iter().map(|c| c.len().to_string()).collect();
                         self.err(
                             m.name.span,
                             format!(
@@ -577,7 +630,13 @@ impl Compiler {
             let args = args
                 .into_iter()
                 .zip(&want)
-                .map(|((ex, t), w)| if t == *w { ex } else { Ex::Convert(*w, Box::new(ex)) })
+                .map(|((ex, t), w)| {
+                    if t == *w {
+                        ex
+                    } else {
+                        Ex::Convert(*w, Box::new(ex))
+                    }
+                })
                 .collect();
             out.push(Succ {
                 sym,
@@ -665,7 +724,10 @@ impl Compiler {
                     self.stmt(i, scope, &mut stmts);
                 }
                 let c = cond.as_ref().and_then(|c| self.condition(c, scope));
-                let st = step.as_ref().and_then(|e| self.expr(e, scope)).map(|(e, _)| e);
+                let st = step
+                    .as_ref()
+                    .and_then(|e| self.expr(e, scope))
+                    .map(|(e, _)| e);
                 scope.loops += 1;
                 let b = self.sub_stmt(body, scope);
                 scope.loops -= 1;
@@ -688,7 +750,10 @@ impl Compiler {
             } => {
                 if !scope.in_rule {
                     let kw = if *last { "produce" } else { "nproduce" };
-                    self.err(*span, format!("`{kw}` is only allowed in the body of a production or rule"));
+                    self.err(
+                        *span,
+                        format!("`{kw}` is only allowed in the body of a production or rule"),
+                    );
                     return;
                 }
                 let modules = self.successors(modules, scope);
@@ -700,7 +765,10 @@ impl Compiler {
             ast::Stmt::Return(_) => out.push(St::Return),
             ast::Stmt::Break(span) | ast::Stmt::Continue(span) => {
                 if scope.loops == 0 {
-                    self.err(*span, "`break` and `continue` are only allowed inside a loop");
+                    self.err(
+                        *span,
+                        "`break` and `continue` are only allowed inside a loop",
+                    );
                     return;
                 }
                 out.push(if matches!(s, ast::Stmt::Break(_)) {
@@ -728,7 +796,13 @@ impl Compiler {
     fn condition(&mut self, e: &ast::Expr, scope: &mut Scope) -> Option<Ex> {
         let (ex, ty) = self.expr(e, scope)?;
         if !ty.is_numeric() {
-            self.err(e.span, format!("expected a condition (a number or bool), found {}", self.type_name(ty)));
+            self.err(
+                e.span,
+                format!(
+                    "expected a condition (a number or bool), found {}",
+                    self.type_name(ty)
+                ),
+            );
             return None;
         }
         Some(ex)
@@ -748,7 +822,10 @@ impl Compiler {
                 if let Some(&g) = self.global_names.get(n) {
                     let gv = &self.globals[g as usize];
                     if gv.is_const {
-                        self.err(e.span, format!("cannot assign to `{n}`: it is declared const"));
+                        self.err(
+                            e.span,
+                            format!("cannot assign to `{n}`: it is declared const"),
+                        );
                         return None;
                     }
                     return Some(Place {
@@ -777,8 +854,14 @@ impl Compiler {
 
     fn field_of(&mut self, ty: Ty, f: &ast::Name) -> Option<(u16, Ty)> {
         let found = match ty {
-            Ty::V2 => ["x", "y"].iter().position(|c| *c == f.text).map(|i| (i as u16, Ty::Float)),
-            Ty::V3 => ["x", "y", "z"].iter().position(|c| *c == f.text).map(|i| (i as u16, Ty::Float)),
+            Ty::V2 => ["x", "y"]
+                .iter()
+                .position(|c| *c == f.text)
+                .map(|i| (i as u16, Ty::Float)),
+            Ty::V3 => ["x", "y", "z"]
+                .iter()
+                .position(|c| *c == f.text)
+                .map(|i| (i as u16, Ty::Float)),
             Ty::Struct(s) => self.structs[s as usize]
                 .fields
                 .iter()
@@ -787,7 +870,10 @@ impl Compiler {
             _ => None,
         };
         if found.is_none() {
-            self.err(f.span, format!("{} has no field `{}`", self.type_name(ty), f.text));
+            self.err(
+                f.span,
+                format!("{} has no field `{}`", self.type_name(ty), f.text),
+            );
         }
         found
     }
@@ -843,7 +929,13 @@ impl Compiler {
                             UnOp::Plus => "+",
                             UnOp::Not => "!",
                         };
-                        self.err(span, format!("type error: cannot apply unary `{sym}` to {}", self.type_name(t)));
+                        self.err(
+                            span,
+                            format!(
+                                "type error: cannot apply unary `{sym}` to {}",
+                                self.type_name(t)
+                            ),
+                        );
                         None
                     }
                 }
@@ -914,7 +1006,13 @@ impl Compiler {
             } => {
                 let place = self.place(target, scope)?;
                 if !place.ty.is_numeric() {
-                    self.err(span, format!("type error: `++`/`--` need a number, found {}", self.type_name(place.ty)));
+                    self.err(
+                        span,
+                        format!(
+                            "type error: `++`/`--` need a number, found {}",
+                            self.type_name(place.ty)
+                        ),
+                    );
                     return None;
                 }
                 let ty = place.ty;
@@ -944,8 +1042,16 @@ impl Compiler {
                     );
                     return None;
                 };
-                let lx = if lt == ty { lx } else { Ex::Convert(ty, Box::new(lx)) };
-                let rx = if rt == ty { rx } else { Ex::Convert(ty, Box::new(rx)) };
+                let lx = if lt == ty {
+                    lx
+                } else {
+                    Ex::Convert(ty, Box::new(lx))
+                };
+                let rx = if rt == ty {
+                    rx
+                } else {
+                    Ex::Convert(ty, Box::new(rx))
+                };
                 Some((Ex::Cond(Box::new(c), Box::new(lx), Box::new(rx)), ty))
             }
             ExprKind::Cast(t, a) => {
@@ -956,7 +1062,14 @@ impl Compiler {
                     return Some((x, ty));
                 }
                 if !(xt.is_numeric() && ty.is_numeric()) {
-                    self.err(span, format!("cannot cast {} to {}", self.type_name(xt), self.type_name(ty)));
+                    self.err(
+                        span,
+                        format!(
+                            "cannot cast {} to {}",
+                            self.type_name(xt),
+                            self.type_name(ty)
+                        ),
+                    );
                     return None;
                 }
                 Some((Ex::Convert(ty, Box::new(x)), ty))
@@ -970,7 +1083,10 @@ impl Compiler {
             ExprKind::Call(name, args) => self.call(name, args, span, scope),
             ExprKind::InContext(kind, pats) => {
                 if !scope.in_rule {
-                    self.err(span, "context tests are only allowed in the body of a production");
+                    self.err(
+                        span,
+                        "context tests are only allowed in the body of a production",
+                    );
                     return None;
                 }
                 let mut out = Vec::new();
@@ -1010,10 +1126,25 @@ impl Compiler {
         }
     }
 
-    fn method(&mut self, recv: &ast::Expr, name: &ast::Name, args: &[ast::Expr], span: Span, scope: &mut Scope) -> Typed {
+    fn method(
+        &mut self,
+        recv: &ast::Expr,
+        name: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Typed {
         let (x, t) = self.expr(recv, scope)?;
         if !t.is_vector() || !args.is_empty() {
-            self.err(name.span, format!("{} has no method `{}` taking {} argument(s)", self.type_name(t), name.text, args.len()));
+            self.err(
+                name.span,
+                format!(
+                    "{} has no method `{}` taking {} argument(s)",
+                    self.type_name(t),
+                    name.text,
+                    args.len()
+                ),
+            );
             return None;
         }
         match name.text.as_str() {
@@ -1022,18 +1153,35 @@ impl Compiler {
             "Normalize" => {
                 let place = self.place(recv, scope)?;
                 Some((
-                    Ex::Assign(place, None, Box::new(Ex::Call(Func::Normalized, vec![x], span)), t),
+                    Ex::Assign(
+                        place,
+                        None,
+                        Box::new(Ex::Call(Func::Normalized, vec![x], span)),
+                        t,
+                    ),
                     t,
                 ))
             }
             _ => {
-                self.err(name.span, format!("unknown method `{}`: vectors have Length(), Normalize() and Normalized()", name.text));
+                self.err(
+                    name.span,
+                    format!(
+                        "unknown method `{}`: vectors have Length(), Normalize() and Normalized()",
+                        name.text
+                    ),
+                );
                 None
             }
         }
     }
 
-    fn call(&mut self, name: &ast::Name, args: &[ast::Expr], span: Span, scope: &mut Scope) -> Typed {
+    fn call(
+        &mut self,
+        name: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Typed {
         let mut typed = Vec::new();
         let mut ok = true;
         for a in args {
@@ -1047,7 +1195,13 @@ impl Compiler {
         }
         let n = name.text.as_str();
         let arity_err = |c: &mut Compiler, want: usize| {
-            c.err(span, format!("`{n}` takes {want} argument(s), but {} were given", typed.len()));
+            c.err(
+                span,
+                format!(
+                    "`{n}` takes {want} argument(s), but {} were given",
+                    typed.len()
+                ),
+            );
         };
         if matches!(n, "V2f" | "V2d" | "V3f" | "V3d") {
             let ty = if n.starts_with("V2") { Ty::V2 } else { Ty::V3 };
@@ -1089,7 +1243,13 @@ impl Compiler {
         let numeric_args = |c: &mut Compiler, typed: &Vec<(Ex, Ty)>| -> bool {
             for ((_, t), a) in typed.iter().zip(args) {
                 if !t.is_numeric() {
-                    c.err(a.span, format!("type error: `{n}` expects a number, found {}", c.type_name(*t)));
+                    c.err(
+                        a.span,
+                        format!(
+                            "type error: `{n}` expects a number, found {}",
+                            c.type_name(*t)
+                        ),
+                    );
                     return false;
                 }
             }
@@ -1162,7 +1322,10 @@ impl Compiler {
                 }
                 let ty = if n == "Dot" { Ty::Float } else { Ty::V3 };
                 let f = if n == "Dot" { Func::Dot } else { Func::Cross };
-                Some((Ex::Call(f, typed.into_iter().map(|(e, _)| e).collect(), span), ty))
+                Some((
+                    Ex::Call(f, typed.into_iter().map(|(e, _)| e).collect(), span),
+                    ty,
+                ))
             }
             "StepNo" | "CurrentGroup" | "Forward" | "Backward" | "IsForward" | "Stop"
             | "RunSimulation" | "PauseSimulation" | "DisplayFrame" | "Environment"
@@ -1190,7 +1353,10 @@ impl Compiler {
                 if !numeric_args(self, &typed) {
                     return None;
                 }
-                Some((Ex::Call(Func::UseGroup, vec![typed.pop()?.0], span), Ty::Void))
+                Some((
+                    Ex::Call(Func::UseGroup, vec![typed.pop()?.0], span),
+                    Ty::Void,
+                ))
             }
             "ran" => {
                 if typed.len() != 1 {
@@ -1270,7 +1436,9 @@ pub fn binary_type(op: BinOp, a: Ty, b: Ty) -> Option<Ty> {
         Lt | Le | Gt | Ge => num.then_some(Ty::Bool),
         Eq | Ne => (num || (a == b && a.is_vector())).then_some(Ty::Bool),
         And | Or => num.then_some(Ty::Bool),
-        BitAnd | BitOr | BitXor => (a == Ty::Int && b == Ty::Int || num && a != Ty::Float && b != Ty::Float).then_some(Ty::Int),
+        BitAnd | BitOr | BitXor => (a == Ty::Int && b == Ty::Int
+            || num && a != Ty::Float && b != Ty::Float)
+            .then_some(Ty::Int),
     }
 }
 

@@ -242,13 +242,16 @@ impl<'p> Interp<'p> {
     fn produce(&mut self, modules: &[Succ], cx: &mut Cx) -> R<()> {
         for m in modules {
             let base = self.scratch.len();
-            for a in &m.args {
+            for (k, a) in m.args.iter().enumerate() {
                 let v = self.expr(a, cx)?;
                 if v.is_non_finite() {
                     self.scratch.truncate(base);
                     return Err(RuntimeError::new(
                         Some(m.span),
-                        format!("a parameter of this module is {v}: NaN or infinity"),
+                        format!(
+                            "parameter {} of this successor module is {v}; NaN and infinity are not allowed in a word",
+                            k + 1
+                        ),
                     ));
                 }
                 self.scratch.push(v);
@@ -343,7 +346,10 @@ impl<'p> Interp<'p> {
                 }
             }
             Ex::Call(f, args, span) => self.call(*f, args, *span, cx)?,
-            Ex::MakeV2(x, y) => Value::V2(DVec2::new(self.expr(x, cx)?.as_f64(), self.expr(y, cx)?.as_f64())),
+            Ex::MakeV2(x, y) => Value::V2(DVec2::new(
+                self.expr(x, cx)?.as_f64(),
+                self.expr(y, cx)?.as_f64(),
+            )),
             Ex::MakeV3(x, y, z) => Value::V3(DVec3::new(
                 self.expr(x, cx)?.as_f64(),
                 self.expr(y, cx)?.as_f64(),
@@ -520,7 +526,12 @@ pub fn binary(op: BinOp, x: Value, y: Value) -> Result<Value, String> {
                 Ge => Bool(a >= b),
                 Eq => Bool(a == b),
                 Ne => Bool(a != b),
-                _ => return Err(format!("operator `{}` does not apply to these values", op.symbol())),
+                _ => {
+                    return Err(format!(
+                        "operator `{}` does not apply to these values",
+                        op.symbol()
+                    ))
+                }
             }
         }
     })

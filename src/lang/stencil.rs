@@ -140,15 +140,14 @@ impl Stencil {
                 };
                 let aff = affine(ex, &slot_ty)?;
                 // The result type is the type of its slot terms (all equal).
-                let term_ty = aff
-                    .terms
-                    .iter()
-                    .map(|(s, _)| slot_ty[*s as usize])
-                    .fold(None, |acc: Option<Ty>, t| match acc {
+                let term_ty = aff.terms.iter().map(|(s, _)| slot_ty[*s as usize]).fold(
+                    None,
+                    |acc: Option<Ty>, t| match acc {
                         None => Some(t),
                         Some(a) if a == t => Some(a),
                         Some(_) => Some(Ty::Void),
-                    });
+                    },
+                );
                 let ty = match (term_ty, ty) {
                     (Some(Ty::Void), _) => return None,
                     (Some(t @ (Ty::V2 | Ty::V3)), _) => {

@@ -73,7 +73,12 @@ pub fn match_right<S: Seq + ?Sized>(
 }
 
 /// From a `[` at `pos`, the position after its matching `]`.
-fn skip_branch_forward<S: Seq + ?Sized>(seq: &S, pos: usize, end: usize, r: Rules) -> Option<usize> {
+fn skip_branch_forward<S: Seq + ?Sized>(
+    seq: &S,
+    pos: usize,
+    end: usize,
+    r: Rules,
+) -> Option<usize> {
     let n = seq.len();
     let mut depth = 0usize;
     let mut p = pos;
@@ -163,7 +168,12 @@ pub fn match_left<S: Seq + ?Sized>(
 }
 
 /// From a `]` at `pos`, the position before its matching `[`.
-fn skip_branch_backward<S: Seq + ?Sized>(seq: &S, pos: isize, floor: isize, r: Rules) -> Option<isize> {
+fn skip_branch_backward<S: Seq + ?Sized>(
+    seq: &S,
+    pos: isize,
+    floor: isize,
+    r: Rules,
+) -> Option<isize> {
     let n = seq.len() as isize;
     let mut depth = 0usize;
     let mut p = pos;

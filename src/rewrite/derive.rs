@@ -102,14 +102,18 @@ impl<'p> Derivation<'p> {
             };
             env.globals.push(v);
         }
-        let mut number = |e: &Option<crate::lang::ir::Ex>, env: &mut Env| -> Result<Option<f64>, DeriveError> {
-            match e {
-                Some(e) => Ok(Some(
-                    interp.eval_global(e, env).map_err(|e| runtime(e, None, 0))?.as_f64(),
-                )),
-                None => Ok(None),
-            }
-        };
+        let mut number =
+            |e: &Option<crate::lang::ir::Ex>, env: &mut Env| -> Result<Option<f64>, DeriveError> {
+                match e {
+                    Some(e) => Ok(Some(
+                        interp
+                            .eval_global(e, env)
+                            .map_err(|e| runtime(e, None, 0))?
+                            .as_f64(),
+                    )),
+                    None => Ok(None),
+                }
+            };
         let length = number(&program.derivation_length, &mut env)?.unwrap_or(0.0);
         let ring = number(&program.ring, &mut env)?.is_some_and(|v| v != 0.0);
         let length = opts.steps.unwrap_or(if length.is_finite() && length > 0.0 {
@@ -120,7 +124,9 @@ impl<'p> Derivation<'p> {
         if length > MAX_STEPS {
             return Err(DeriveError {
                 span: None,
-                message: format!("a derivation length of {length} steps is beyond the limit of {MAX_STEPS}"),
+                message: format!(
+                    "a derivation length of {length} steps is beyond the limit of {MAX_STEPS}"
+                ),
                 step: 0,
             });
         }
@@ -200,9 +206,15 @@ impl<'p> Derivation<'p> {
         let opts = self.step_options();
         let mut dst = std::mem::take(&mut self.spare);
         let step = self.step + 1;
-        let result = self
-            .rewriter
-            .step(&rules, &self.word, &mut dst, &mut self.env, &opts, None, None);
+        let result = self.rewriter.step(
+            &rules,
+            &self.word,
+            &mut dst,
+            &mut self.env,
+            &opts,
+            None,
+            None,
+        );
         if let Err(e) = result {
             return Err(self.step_error(e, step));
         }
@@ -272,12 +284,21 @@ impl<'p> Derivation<'p> {
             .eval_global(e, &mut self.env)
             .map_err(|e| runtime(e, None, self.step))?
             .as_f64();
-        Ok(if v.is_finite() && v > 0.0 { v as u64 } else { 0 })
+        Ok(if v.is_finite() && v > 0.0 {
+            v as u64
+        } else {
+            0
+        })
     }
 
     /// Rewrites `word` with the rules of `section` recursively: after the
     /// first pass only modules that a rule produced are rewritten again.
-    fn rewrite_to_depth(&mut self, section: Section, mut word: Word, depth: u64) -> Result<Word, DeriveError> {
+    fn rewrite_to_depth(
+        &mut self,
+        section: Section,
+        mut word: Word,
+        depth: u64,
+    ) -> Result<Word, DeriveError> {
         let rules = self.candidates(section);
         if rules.is_empty() {
             return Ok(word);

@@ -6,6 +6,6 @@ pub mod derive;
 pub mod step;
 pub mod word;
 
-pub use derive::{derive, DeriveError, DeriveOptions, Derivation, Derived};
+pub use derive::{derive, Derivation, DeriveError, DeriveOptions, Derived};
 pub use step::{Rewriter, StepError, StepOptions};
 pub use word::{Seq, Word};

@@ -100,7 +100,6 @@ impl<'p> Rewriter<'p> {
                 (false, false) => n - 1 - k,
             };
             let remaining = n - k;
-            let before = dst.len();
             let mut used = 0;
             if eligible.is_none_or(|e| e[i]) {
                 for &r in rules {
@@ -136,15 +135,10 @@ impl<'p> Rewriter<'p> {
                 rewritten += used;
             } else {
                 used = 1;
-                if opts.forward {
-                    dst.push_from(src, i);
-                } else {
-                    dst.push_from(src, i);
-                }
+                dst.push_from(src, i);
             }
             if let Some(o) = origin.as_deref_mut() {
                 o.resize(dst.len(), produced);
-                let _ = before;
             }
             if dst.len() > opts.max_modules {
                 return Err(StepError::TooLong {
@@ -186,22 +180,35 @@ impl<'p> Rewriter<'p> {
         };
         // Cheap test first: the strict predecessor matches exactly.
         for (j, p) in rule.strict.iter().enumerate() {
-            let idx = if opts.ring { (start + j) % n } else { start + j };
+            let idx = if opts.ring {
+                (start + j) % n
+            } else {
+                start + j
+            };
             if idx >= n || !module_matches(src, idx, p) {
                 return Ok(false);
             }
         }
-        if (!rule.new_left.is_empty() && !opts.forward) || (!rule.new_right.is_empty() && opts.forward) {
+        if (!rule.new_left.is_empty() && !opts.forward)
+            || (!rule.new_right.is_empty() && opts.forward)
+        {
             return Ok(false);
         }
         self.matched.clear();
-        let Some(left_end) = match_left(src, start as isize - 1, &rule.left, ctx, &mut self.matched) else {
+        let Some(left_end) =
+            match_left(src, start as isize - 1, &rule.left, ctx, &mut self.matched)
+        else {
             return Ok(false);
         };
         for j in 0..len {
-            self.matched.push(if opts.ring { (start + j) % n } else { start + j });
+            self.matched.push(if opts.ring {
+                (start + j) % n
+            } else {
+                start + j
+            });
         }
-        let Some(right_end) = match_right(src, start + len, &rule.right, ctx, &mut self.matched) else {
+        let Some(right_end) = match_right(src, start + len, &rule.right, ctx, &mut self.matched)
+        else {
             return Ok(false);
         };
         // New contexts match the part of the new word built so far.
@@ -210,14 +217,26 @@ impl<'p> Rewriter<'p> {
         let mut new_left_end = dst.len() as isize - 1;
         let mut new_right_end = 0;
         if !rule.new_left.is_empty() {
-            match match_left(dst, new_left_end, &rule.new_left, new_ctx, &mut self.new_matched) {
+            match match_left(
+                dst,
+                new_left_end,
+                &rule.new_left,
+                new_ctx,
+                &mut self.new_matched,
+            ) {
                 Some(e) => new_left_end = e,
                 None => return Ok(false),
             }
         }
         let new_left_count = self.new_matched.len();
         if !rule.new_right.is_empty() {
-            match match_right(&Reversed(dst), 0, &rule.new_right, new_ctx, &mut self.new_matched) {
+            match match_right(
+                &Reversed(dst),
+                0,
+                &rule.new_right,
+                new_ctx,
+                &mut self.new_matched,
+            ) {
                 Some(e) => new_right_end = e,
                 None => return Ok(false),
             }
@@ -249,7 +268,11 @@ impl<'p> Rewriter<'p> {
                 frame[*slot as usize] = v.clone();
             }
         };
-        for (p, &idx) in rule.new_left.iter().zip(&self.new_matched[..new_left_count]) {
+        for (p, &idx) in rule
+            .new_left
+            .iter()
+            .zip(&self.new_matched[..new_left_count])
+        {
             bind(&mut self.frame, p, dst.params(idx));
         }
         let old_pats = rule.left.iter().chain(&rule.strict).chain(&rule.right);
@@ -257,7 +280,11 @@ impl<'p> Rewriter<'p> {
             bind(&mut self.frame, p, src.params(idx));
         }
         let rev = Reversed(dst);
-        for (p, &idx) in rule.new_right.iter().zip(&self.new_matched[new_left_count..]) {
+        for (p, &idx) in rule
+            .new_right
+            .iter()
+            .zip(&self.new_matched[new_left_count..])
+        {
             bind(&mut self.frame, p, rev.params(idx));
         }
         let _ = left_count;
@@ -381,7 +408,8 @@ impl Host for WordHost<'_> {
                 }
                 None => false,
             },
-            ContextKind::Right => match match_right(self.src, self.right, pats, self.ctx, &mut idx) {
+            ContextKind::Right => match match_right(self.src, self.right, pats, self.ctx, &mut idx)
+            {
                 Some(p) => {
                     self.right = p;
                     push_params(self.src, &idx, out);

@@ -7,6 +7,9 @@ use crate::lang::{Sym, Value};
 /// Read access to a sequence of modules, used by context matching.
 pub trait Seq {
     fn len(&self) -> usize;
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
     fn sym(&self, i: usize) -> Sym;
     fn params(&self, i: usize) -> &[Value];
 }

@@ -24,25 +24,55 @@ pub struct File {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Item {
     /// `module P(V2f);`
-    Module { name: Name, params: Vec<TypeRef> },
+    Module {
+        name: Name,
+        params: Vec<TypeRef>,
+    },
     /// `struct Data { float length, area; };`
-    Struct { name: Name, fields: Vec<(TypeRef, Name)> },
+    Struct {
+        name: Name,
+        fields: Vec<(TypeRef, Name)>,
+    },
     /// `typedef float real;`
-    Typedef { ty: TypeRef, name: Name },
+    Typedef {
+        ty: TypeRef,
+        name: Name,
+    },
     /// `V2f v1(0, 0), v2(0, 1);`, `const int Delay = 2;`
     Global(VarDecl),
     /// `derivation length: expr;` and the other `key: expr;` directives.
-    Directive { kind: DirectiveKind, expr: Expr, span: Span },
+    Directive {
+        kind: DirectiveKind,
+        expr: Expr,
+        span: Span,
+    },
     /// `Axiom: P(v1) P(v2);`
-    Axiom { modules: Vec<ModuleCall>, span: Span },
+    Axiom {
+        modules: Vec<ModuleCall>,
+        span: Span,
+    },
     /// `ignore: A B;` (`consider == false`) or `consider: A B;`.
-    ContextFilter { consider: bool, names: Vec<Name>, span: Span },
+    ContextFilter {
+        consider: bool,
+        names: Vec<Name>,
+        span: Span,
+    },
     /// `production:`, `decomposition:` or `interpretation:`.
-    Section { section: Section, span: Span },
+    Section {
+        section: Section,
+        span: Span,
+    },
     /// `group 1:`; `endgroup` is `Group { id: 0 }`.
-    Group { id: i64, span: Span },
+    Group {
+        id: i64,
+        span: Span,
+    },
     /// `Start: { ... }` and friends.
-    Control { kind: ControlKind, body: Block, span: Span },
+    Control {
+        kind: ControlKind,
+        body: Block,
+        span: Span,
+    },
     Production(Production),
 }
 

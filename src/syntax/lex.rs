@@ -59,8 +59,8 @@ pub struct Token {
 /// Punctuators, longest first so that `<<` wins over `<`.
 const PUNCTS: &[&str] = &[
     "<<=", ">>=", "...", "->", "<<", ">>", "<=", ">=", "==", "!=", "&&", "||", "++", "--", "+=",
-    "-=", "*=", "/=", "%=", "::", "(", ")", "{", "}", "[", "]", ",", ";", ":", ".", "?", "<",
-    ">", "=", "+", "-", "*", "/", "%", "!", "#", "~", "&", "|", "^", "\\", "@", "$", "'",
+    "-=", "*=", "/=", "%=", "::", "(", ")", "{", "}", "[", "]", ",", ";", ":", ".", "?", "<", ">",
+    "=", "+", "-", "*", "/", "%", "!", "#", "~", "&", "|", "^", "\\", "@", "$", "'",
 ];
 
 fn ident(i: &str) -> IResult<&str, &str> {
@@ -114,7 +114,10 @@ pub fn lex(file: FileId, text: &str) -> Result<Vec<Token>, Diagnostic> {
     loop {
         // Whitespace, comments, and backslash-newline continuations.
         loop {
-            if let Some(r) = rest.strip_prefix("\\\n").or_else(|| rest.strip_prefix("\\\r\n")) {
+            if let Some(r) = rest
+                .strip_prefix("\\\n")
+                .or_else(|| rest.strip_prefix("\\\r\n"))
+            {
                 rest = r;
                 space_before = true;
             } else if let Some(c) = rest.chars().next().filter(|c| c.is_whitespace()) {

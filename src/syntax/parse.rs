@@ -131,9 +131,10 @@ impl<'t> Parser<'t> {
     /// `const ...`, `struct Name ...`, `TYPE name`, or `Name name`.
     fn at_declaration(&self) -> bool {
         match (self.peek().map(|t| &t.tok), self.peek_at(1).map(|t| &t.tok)) {
-            (Some(Tok::Ident(a)), Some(Tok::Ident(_))) => {
-                !matches!(a.as_str(), "produce" | "nproduce" | "return" | "else" | "if" | "while")
-            }
+            (Some(Tok::Ident(a)), Some(Tok::Ident(_))) => !matches!(
+                a.as_str(),
+                "produce" | "nproduce" | "return" | "else" | "if" | "while"
+            ),
             (Some(Tok::Ident(a)), _) => a == "const",
             _ => false,
         }
@@ -174,8 +175,17 @@ impl<'t> Parser<'t> {
                 }
                 "Axiom" | "axiom" if next_colon => {
                     self.pos += 2;
-                    let modules = self.module_calls(&[";"], false)?;
-                    self.expect_punct(";", "after the axiom")?;
+                    let mut modules = Vec::new();
+                    while !self.eat_punct(";") {
+                        let at_module = matches!(
+                            self.peek().map(|t| &t.tok),
+                            Some(Tok::Ident(_)) | Some(Tok::Punct("#"))
+                        );
+                        if !at_module {
+                            return self.error("a module or the `;` that ends the axiom");
+                        }
+                        modules.push(self.module_call()?);
+                    }
                     items.push(Item::Axiom {
                         modules,
                         span: start,
@@ -207,9 +217,7 @@ impl<'t> Parser<'t> {
                     });
                     return Ok(());
                 }
-                "production" | "productions" | "decomposition" | "interpretation"
-                    if next_colon =>
-                {
+                "production" | "productions" | "decomposition" | "interpretation" if next_colon => {
                     self.pos += 2;
                     let section = match word.as_str() {
                         "decomposition" => Section::Decomposition,
@@ -318,8 +326,8 @@ impl<'t> Parser<'t> {
         loop {
             let name = self.name("a module name after `module`")?;
             let mut params = Vec::new();
-            if self.eat_punct("(") {
-                if !self.eat_punct(")") {
+            if self.eat_punct("(") && !self.eat_punct(")") {
+                {
                     loop {
                         params.push(self.type_ref()?);
                         // `module A(int /*id*/)` is fine; `module A(int id)` is not.
@@ -706,7 +714,9 @@ impl<'t> Parser<'t> {
                     self.pos += 1;
                     let last = w == "produce";
                     let modules = if self.peek_punct("(")
-                        && self.peek_at(1).is_some_and(|t| matches!(t.tok, Tok::Ident(_)))
+                        && self
+                            .peek_at(1)
+                            .is_some_and(|t| matches!(t.tok, Tok::Ident(_)))
                         && self.peek_at(2).is_some_and(|t| t.tok.is_punct("("))
                     {
                         // `produce( G(x) );` as in the manual's examples.
@@ -929,8 +939,12 @@ impl<'t> Parser<'t> {
         }
         // A cast: `(int) expr`
         if t.tok.is_punct("(") {
-            if let (Some(Token { tok: Tok::Ident(n), .. }), Some(close)) =
-                (self.peek_at(1), self.peek_at(2))
+            if let (
+                Some(Token {
+                    tok: Tok::Ident(n), ..
+                }),
+                Some(close),
+            ) = (self.peek_at(1), self.peek_at(2))
             {
                 if close.tok.is_punct(")") && self.is_type_name(n) {
                     self.pos += 1;

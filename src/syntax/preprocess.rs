@@ -243,16 +243,9 @@ fn expand_into(
             for b in &m.body {
                 match &b.tok {
                     Tok::Ident(p) if params.contains(p) => {
+                        // Textual substitution, as the C preprocessor does.
                         let k = params.iter().position(|q| q == p).expect("contained");
-                        body.push(Token {
-                            tok: Tok::Punct("("),
-                            ..b.clone()
-                        });
                         body.extend(args[k].iter().cloned());
-                        body.push(Token {
-                            tok: Tok::Punct(")"),
-                            ..b.clone()
-                        });
                     }
                     _ => body.push(b.clone()),
                 }

@@ -1,0 +1,8 @@
+//! The integration tests: one binary, one module per area.
+
+mod cli;
+mod corpus;
+mod curves;
+mod errors;
+mod semantics;
+mod support;
