@@ -102,8 +102,10 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
             };
             let p = &loaded.program;
             let text = match format {
-                Format::Text => output::word_text(&word, &p.alphabet),
-                Format::Json => output::word_json(&word, d.ring, d.step, &p.alphabet).to_string(),
+                Format::Text => output::word_text(&word, &p.alphabet, &p.structs),
+                Format::Json => {
+                    output::word_json(&word, d.ring, d.step, &p.alphabet, &p.structs).to_string()
+                }
             };
             print_out(&text)
         }

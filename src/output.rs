@@ -2,13 +2,14 @@
 
 use serde_json::{json, Value as Json};
 
+use crate::lang::value::StructDef;
 use crate::lang::{Alphabet, Value};
 use crate::rewrite::Word;
 
 /// `P([0, 0.25]) E A(1, 2)`: one module after another, vectors in brackets.
-pub fn word_text(word: &Word, alphabet: &Alphabet) -> String {
+pub fn word_text(word: &Word, alphabet: &Alphabet, structs: &[StructDef]) -> String {
     let mut out = String::new();
-    for (i, (sym, params)) in word.iter().enumerate() {
+    for (i, (sym, params)) in word.modules(alphabet, structs).enumerate() {
         if i > 0 {
             out.push(' ');
         }
@@ -37,9 +38,15 @@ fn value_text(v: &Value) -> String {
 
 /// A struct parameter is an array of its fields.
 /// `{"ring": bool, "step": N, "modules": [{"symbol": "P", "params": [[0.0, 1.0]]}]}`
-pub fn word_json(word: &Word, ring: bool, step: u64, alphabet: &Alphabet) -> Json {
+pub fn word_json(
+    word: &Word,
+    ring: bool,
+    step: u64,
+    alphabet: &Alphabet,
+    structs: &[StructDef],
+) -> Json {
     let modules: Vec<Json> = word
-        .iter()
+        .modules(alphabet, structs)
         .map(|(sym, params)| {
             json!({
                 "symbol": alphabet.name(sym),

@@ -472,7 +472,7 @@ impl Compiler {
 
     /// A predecessor module: each parameter becomes a local of the module's type.
     fn pattern(&mut self, m: &ast::PatModule, scope: &mut Scope) -> Option<Pattern> {
-        let (sym, tys, arity) = self.module_params(&m.name, m.params.len())?;
+        let (sym, tys, width) = self.module_params(&m.name, m.params.len())?;
         let mut slots = Vec::new();
         for (n, t) in m.params.iter().zip(tys.iter().copied()) {
             if scope.vars.iter().any(|(v, _, _)| *v == n.text) {
@@ -491,7 +491,7 @@ impl Compiler {
             sym,
             slots,
             types: tys,
-            arity,
+            width,
         })
     }
 
@@ -536,7 +536,13 @@ impl Compiler {
                 Some((sym, tys.clone(), None))
             }
             Signature::Overloads(ovs) => match ovs.iter().find(|o| o.len() == count) {
-                Some(o) => Some((sym, o.to_vec(), Some(count))),
+                Some(o) => {
+                    let w = o
+                        .iter()
+                        .map(|t| super::value::width(*t, &self.structs))
+                        .sum();
+                    Some((sym, o.to_vec(), Some(w)))
+                }
                 None => {
                     let counts: Vec<String> = ovs.iter().map(|o| o.len().to_string()).collect();
                     self.err(
@@ -1092,7 +1098,7 @@ impl Compiler {
                 let mut out = Vec::new();
                 let mut all_places = Vec::new();
                 for p in pats {
-                    let (sym, tys, arity) = self.module_params(&p.name, p.params.len())?;
+                    let (sym, tys, width) = self.module_params(&p.name, p.params.len())?;
                     for (n, t) in p.params.iter().zip(tys.iter().copied()) {
                         let ident = ast::Expr {
                             kind: ExprKind::Ident(n.text.clone()),
@@ -1118,7 +1124,7 @@ impl Compiler {
                         sym,
                         slots: Vec::new(),
                         types: tys,
-                        arity,
+                        width,
                     });
                 }
                 Some((Ex::InContext(*kind, out, all_places), Ty::Bool))

@@ -105,8 +105,9 @@ pub struct Pattern {
     pub slots: Vec<u16>,
     /// The type of each parameter.
     pub types: Vec<Ty>,
-    /// Predefined modules with overloads match only this many parameters.
-    pub arity: Option<usize>,
+    /// Predefined modules with overloads match only modules whose
+    /// parameters take this many slots.
+    pub width: Option<usize>,
 }
 
 /// Which modules context matching looks at (`ignore:` / `consider:`).

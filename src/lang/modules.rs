@@ -34,7 +34,8 @@ const NONE: &[&[Ty]] = &[&[]];
 const ONE_F: &[&[Ty]] = &[&[F]];
 const OPT_F: &[&[Ty]] = &[&[F], &[]];
 const ONE_I: &[&[Ty]] = &[&[I]];
-const XYZ: &[&[Ty]] = &[&[F, F, F], &[V2], &[V3], &[F, F]];
+/// lpfg's `MoveTo(x, y, z)`, or a point as in Velho's `LineTo(v)`.
+const XYZ: &[&[Ty]] = &[&[F, F, F], &[V2]];
 const P2: &[&[Ty]] = &[&[V2]];
 const P3: &[&[Ty]] = &[&[V3]];
 const L2: &[&[Ty]] = &[&[V2, V2]];
@@ -173,6 +174,24 @@ impl Alphabet {
     /// The symbol of a predefined module; panics if the table lacks it.
     pub fn builtin(&self, name: &str) -> Sym {
         self.lookup(name).expect("predefined module")
+    }
+
+    /// The parameter types of a module of kind `s` whose parameters take
+    /// `width` slots. The overloads of a predefined module differ in width.
+    pub fn layout(&self, s: Sym, width: usize, structs: &[super::value::StructDef]) -> &[Ty] {
+        match &self.kinds[s.0 as usize].sig {
+            Signature::Fixed(t) => t,
+            Signature::Overloads(o) => o
+                .iter()
+                .find(|tys| {
+                    tys.iter()
+                        .map(|t| super::value::width(*t, structs))
+                        .sum::<usize>()
+                        == width
+                })
+                .copied()
+                .unwrap_or(&[]),
+        }
     }
 
     pub fn declare(&mut self, name: &str, params: Vec<Ty>) -> Sym {

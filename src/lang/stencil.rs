@@ -8,20 +8,19 @@ use super::ir::{Ex, Rule, St};
 use super::modules::Sym;
 use super::value::{Ty, Value};
 
-/// One output parameter: `constant + Σ weight · param[source]`.
+/// One output parameter: `constant + Σ weight · (the parameter at slot
+/// offset `off` of matched module `k`)`, componentwise for vectors.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Combination {
-    /// `(index into Stencil::sources, weight)`
-    pub terms: Vec<(u16, f64)>,
+    /// `(k, off, weight)`, with modules counted over left context, strict
+    /// predecessor, right context.
+    pub terms: Vec<(u16, u16, f64)>,
     pub constant: f64,
     pub ty: Ty,
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Stencil {
-    /// Where each local slot comes from: `(matched module k, parameter j)`,
-    /// with modules counted over left context, strict predecessor, right context.
-    pub sources: Vec<(u16, u16)>,
     pub outputs: Vec<(Sym, Vec<Combination>)>,
 }
 
@@ -117,11 +116,19 @@ impl Stencil {
         let mut sources = Vec::new();
         let pats = rule.left.iter().chain(&rule.strict).chain(&rule.right);
         for (k, p) in pats.enumerate() {
-            for (j, slot) in p.slots.iter().enumerate() {
+            let mut off = 0u16;
+            for (slot, ty) in p.slots.iter().zip(&p.types) {
                 if *slot as usize != sources.len() {
                     return None;
                 }
-                sources.push((k as u16, j as u16));
+                sources.push((k as u16, off));
+                off += match ty {
+                    Ty::V2 => 2,
+                    Ty::V3 => 3,
+                    Ty::Int | Ty::Float | Ty::Bool => 1,
+                    // Struct widths need the struct table; keep it simple.
+                    _ => return None,
+                };
             }
         }
         if sources.len() != rule.frame_size {
@@ -159,15 +166,23 @@ impl Stencil {
                     (Some(Ty::Float), Ty::Void | Ty::Float) | (None, Ty::Float) => Ty::Float,
                     _ => return None,
                 };
+                let terms = aff
+                    .terms
+                    .iter()
+                    .map(|&(slot, w)| {
+                        let (k, j) = sources[slot as usize];
+                        (k, j, w)
+                    })
+                    .collect();
                 combos.push(Combination {
-                    terms: aff.terms,
+                    terms,
                     constant: aff.constant,
                     ty,
                 });
             }
             outputs.push((m.sym, combos));
         }
-        Some(Stencil { sources, outputs })
+        Some(Stencil { outputs })
     }
 }
 

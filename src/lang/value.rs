@@ -37,7 +37,7 @@ pub enum Value {
     V2(DVec2),
     V3(DVec3),
     Struct(Box<[Value]>),
-    Str(std::rc::Rc<str>),
+    Str(std::sync::Arc<str>),
     Void,
 }
 
@@ -140,4 +140,86 @@ impl fmt::Display for Value {
 pub struct StructDef {
     pub name: String,
     pub fields: Vec<(String, Ty)>,
+}
+
+/// The number of `f64` slots a value of type `ty` takes in a word.
+pub fn width(ty: Ty, structs: &[StructDef]) -> usize {
+    match ty {
+        Ty::V2 => 2,
+        Ty::V3 => 3,
+        Ty::Struct(id) => structs[id as usize]
+            .fields
+            .iter()
+            .map(|(_, t)| width(*t, structs))
+            .sum(),
+        Ty::Void => 0,
+        _ => 1,
+    }
+}
+
+/// Appends the slots of `v`. Integers keep all their bits; strings are
+/// interned and stored by number.
+pub fn encode(v: &Value, out: &mut Vec<f64>) {
+    match v {
+        Value::Int(i) => out.push(f64::from_bits(*i as u64)),
+        Value::Float(f) => out.push(*f),
+        Value::Bool(b) => out.push(*b as u8 as f64),
+        Value::V2(p) => out.extend_from_slice(&[p.x, p.y]),
+        Value::V3(p) => out.extend_from_slice(&[p.x, p.y, p.z]),
+        Value::Struct(fs) => fs.iter().for_each(|f| encode(f, out)),
+        Value::Str(s) => out.push(f64::from_bits(intern(s) as u64)),
+        Value::Void => {}
+    }
+}
+
+/// Reads a value of type `ty` from the front of `slots`; returns it and the
+/// number of slots it took.
+pub fn decode(ty: Ty, slots: &[f64], structs: &[StructDef]) -> (Value, usize) {
+    let at = |i: usize| slots.get(i).copied().unwrap_or(0.0);
+    match ty {
+        Ty::Int => (Value::Int(at(0).to_bits() as i64), 1),
+        Ty::Float => (Value::Float(at(0)), 1),
+        Ty::Bool => (Value::Bool(at(0) != 0.0), 1),
+        Ty::V2 => (Value::V2(DVec2::new(at(0), at(1))), 2),
+        Ty::V3 => (Value::V3(DVec3::new(at(0), at(1), at(2))), 3),
+        Ty::Struct(id) => {
+            let mut used = 0;
+            let mut fs = Vec::new();
+            for (_, t) in &structs[id as usize].fields {
+                let (v, n) = decode(*t, slots.get(used..).unwrap_or(&[]), structs);
+                fs.push(v);
+                used += n;
+            }
+            (Value::Struct(fs.into_boxed_slice()), used)
+        }
+        Ty::Str => (Value::Str(interned(at(0).to_bits() as usize)), 1),
+        Ty::Void => (Value::Void, 0),
+    }
+}
+
+/// Decodes the parameters of a module whose types are `tys`.
+pub fn decode_all(tys: &[Ty], mut slots: &[f64], structs: &[StructDef]) -> Vec<Value> {
+    let mut out = Vec::with_capacity(tys.len());
+    for t in tys {
+        let (v, n) = decode(*t, slots, structs);
+        out.push(v);
+        slots = slots.get(n..).unwrap_or(&[]);
+    }
+    out
+}
+
+static STRINGS: std::sync::Mutex<Vec<std::sync::Arc<str>>> = std::sync::Mutex::new(Vec::new());
+
+fn intern(s: &std::sync::Arc<str>) -> usize {
+    let mut table = STRINGS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(i) = table.iter().position(|t| **t == **s) {
+        return i;
+    }
+    table.push(s.clone());
+    table.len() - 1
+}
+
+fn interned(i: usize) -> std::sync::Arc<str> {
+    let table = STRINGS.lock().unwrap_or_else(|e| e.into_inner());
+    table.get(i).cloned().unwrap_or_else(|| "".into())
 }

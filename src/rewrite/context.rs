@@ -21,16 +21,27 @@ pub struct Rules<'a> {
     pub ring: bool,
 }
 
+/// `pos % n` for `pos < 2n`, without a division.
+#[inline]
+fn wrap(pos: usize, n: usize) -> usize {
+    if pos >= n {
+        pos - n
+    } else {
+        pos
+    }
+}
+
 /// True when module `i` matches pattern `p` by symbol and, for predefined
-/// modules with several overloads, by parameter count.
+/// modules with several overloads, by the overload (its width in slots).
 #[inline]
 pub fn module_matches<S: Seq + ?Sized>(seq: &S, i: usize, p: &Pattern) -> bool {
-    seq.sym(i) == p.sym && p.arity.is_none_or(|a| seq.params(i).len() == a)
+    seq.sym(i) == p.sym && p.width.is_none_or(|w| seq.data(i).len() == w)
 }
 
 /// Matches `pats` to the right, starting at absolute position `start`.
 /// In a ring, positions wrap, and at most one turn is examined. Pushes the
 /// matched indices and returns the position after the last match.
+#[inline]
 pub fn match_right<S: Seq + ?Sized>(
     seq: &S,
     start: usize,
@@ -49,7 +60,7 @@ pub fn match_right<S: Seq + ?Sized>(
             if pos >= end {
                 return None;
             }
-            let i = pos % n;
+            let i = wrap(pos, n);
             if module_matches(seq, i, p) {
                 out.push(i);
                 pos += 1;
@@ -120,6 +131,7 @@ fn first_unmatched_eb<S: Seq + ?Sized>(seq: &S, pos: usize, end: usize, r: Rules
 /// Matches `pats` to the left, the last pattern at absolute position
 /// `start` (which may be negative in a ring). Pushes the matched indices in
 /// pattern order and returns the position before the first match.
+#[inline]
 pub fn match_left<S: Seq + ?Sized>(
     seq: &S,
     start: isize,
@@ -140,7 +152,7 @@ pub fn match_left<S: Seq + ?Sized>(
                 out.truncate(mark);
                 return None;
             }
-            let i = pos.rem_euclid(n) as usize;
+            let i = if pos < 0 { pos + n } else { pos } as usize;
             if module_matches(seq, i, p) {
                 out.push(i);
                 pos -= 1;

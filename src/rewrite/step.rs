@@ -6,11 +6,10 @@
 //! (pseudo-L-systems) partition the word without overlap, starting at the
 //! phase. `src` is never mutated.
 
-use glam::{DVec2, DVec3};
-
-use crate::lang::eval::{Emit, Env, Flow, Host, Interp, RuntimeError};
+use crate::lang::eval::{Env, Flow, Host, Interp, RuntimeError};
 use crate::lang::ir::{Pattern, Program, Rule};
 use crate::lang::stencil::Stencil;
+use crate::lang::value::{decode, decode_all, StructDef};
 use crate::lang::{Sym, Ty, Value};
 use crate::syntax::ast::ContextKind;
 
@@ -45,6 +44,8 @@ pub struct Rewriter<'p> {
     sb: Sym,
     eb: Sym,
     frame: Vec<Value>,
+    /// The last step's growth (new length / old length), to size buffers.
+    growth: f64,
     matched: Vec<usize>,
     new_matched: Vec<usize>,
     tmp: Word,
@@ -58,6 +59,7 @@ impl<'p> Rewriter<'p> {
             sb: program.alphabet.builtin("SB"),
             eb: program.alphabet.builtin("EB"),
             frame: Vec::new(),
+            growth: 1.0,
             matched: Vec::new(),
             new_matched: Vec::new(),
             tmp: Word::new(),
@@ -88,15 +90,32 @@ impl<'p> Rewriter<'p> {
         if n == 0 {
             return Ok(0);
         }
+        // Size the new word from the last step's growth, so that it is
+        // allocated once instead of doubling its way up.
+        let g = self.growth.clamp(1.0, 64.0);
+        let want = ((n as f64 * g) as usize).min(opts.max_modules + 1);
+        let want_slots =
+            ((src.slot_count() as f64 * g) as usize).min(opts.max_modules.saturating_mul(4));
+        dst.reserve(want, want_slots);
+        if eligible.is_none() && origin.is_none() && opts.forward && self.stencils_only(rules, src)
+        {
+            let rewritten = self.stencil_step(rules, src, dst, opts)?;
+            if Self::all_finite(dst) {
+                self.growth = dst.len() as f64 / n as f64;
+                return Ok(rewritten);
+            }
+            // Redo the step on the general path, which names the production.
+            dst.clear();
+        }
         let phase = opts.phase % n;
         let mut rewritten = 0;
         let mut k = 0;
         while k < n {
             // The scan position; backward steps walk from the right end.
             let i = match (opts.ring, opts.forward) {
-                (true, true) => (phase + k) % n,
+                (true, true) => wrap(phase + k, n),
                 (false, true) => k,
-                (true, false) => (phase + n - 1 - k) % n,
+                (true, false) => wrap(phase + n - 1 - k, n),
                 (false, false) => n - 1 - k,
             };
             let remaining = n - k;
@@ -115,7 +134,7 @@ impl<'p> Rewriter<'p> {
                         }
                         i
                     } else if opts.ring {
-                        (i + n - (len - 1)) % n
+                        wrap(i + n - (len - 1), n)
                     } else if i + 1 < len {
                         continue;
                     } else {
@@ -147,6 +166,7 @@ impl<'p> Rewriter<'p> {
             }
             k += used;
         }
+        self.growth = dst.len() as f64 / n as f64;
         if !opts.forward {
             dst.reverse();
             if let Some(o) = origin {
@@ -154,6 +174,111 @@ impl<'p> Rewriter<'p> {
             }
         }
         Ok(rewritten)
+    }
+
+    /// True when the step can take the compiled fast path: every rule is a
+    /// stencil with a one-module strict predecessor, plain contexts (no
+    /// filter, no overloaded modules) and the word has no branches.
+    fn stencils_only(&self, rules: &[usize], src: &Word) -> bool {
+        let simple = |p: &Pattern| p.width.is_none() && p.sym != self.sb && p.sym != self.eb;
+        let rules_ok = rules.iter().all(|&r| {
+            let rule = &self.program.rules[r];
+            rule.stencil.is_some()
+                && rule.strict.len() == 1
+                && rule.filter == crate::lang::ir::Filter::All
+                && rule
+                    .left
+                    .iter()
+                    .chain(&rule.strict)
+                    .chain(&rule.right)
+                    .all(simple)
+        });
+        rules_ok && !src.syms().iter().any(|&s| s == self.sb || s == self.eb)
+    }
+
+    /// The fast path: contexts are plain neighbours, bodies are stencils.
+    /// Same result as the general path under the conditions of
+    /// `stencils_only`.
+    fn stencil_step(
+        &mut self,
+        rules: &[usize],
+        src: &Word,
+        dst: &mut Word,
+        opts: &StepOptions,
+    ) -> Result<usize, StepError> {
+        let program = self.program;
+        let n = src.len();
+        let syms = src.syms();
+        // Contexts reach at most n modules either way (as in the general
+        // path), so one addition or subtraction wraps a position.
+        let at = |pos: isize| -> Option<usize> {
+            if opts.ring {
+                let n = n as isize;
+                Some(if pos < 0 {
+                    pos + n
+                } else if pos >= n {
+                    pos - n
+                } else {
+                    pos
+                } as usize)
+            } else if pos >= 0 && (pos as usize) < n {
+                Some(pos as usize)
+            } else {
+                None
+            }
+        };
+        let mut matched = [0usize; 16];
+        let mut rewritten = 0;
+        for i in 0..n {
+            let mut done = false;
+            'rules: for &r in rules {
+                let rule = &program.rules[r];
+                if syms[i] != rule.strict[0].sym {
+                    continue;
+                }
+                let nl = rule.left.len();
+                let total = nl + 1 + rule.right.len();
+                if total > matched.len() {
+                    continue;
+                }
+                if opts.ring && (nl > n || rule.right.len() > n) {
+                    continue; // the general path cannot match it either
+                }
+                for (t, p) in rule.left.iter().enumerate() {
+                    match at(i as isize - (nl - t) as isize) {
+                        Some(j) if syms[j] == p.sym => matched[t] = j,
+                        _ => continue 'rules,
+                    }
+                }
+                matched[nl] = i;
+                for (t, p) in rule.right.iter().enumerate() {
+                    match at(i as isize + 1 + t as isize) {
+                        Some(j) if syms[j] == p.sym => matched[nl + 1 + t] = j,
+                        _ => continue 'rules,
+                    }
+                }
+                let st = rule.stencil.as_ref().expect("checked by stencils_only");
+                apply_stencil(st, src, &matched[..total], dst);
+                rewritten += 1;
+                done = true;
+                break;
+            }
+            if !done {
+                dst.push_from(src, i);
+            }
+            if dst.len() > opts.max_modules {
+                return Err(StepError::TooLong {
+                    limit: opts.max_modules,
+                });
+            }
+        }
+        Ok(rewritten)
+    }
+
+    /// The fast path checks for NaN and infinity once, over the whole new
+    /// word; the caller reruns the general path to say where it came from.
+    fn all_finite(dst: &Word) -> bool {
+        dst.all_slots().iter().all(|x| x.is_finite())
     }
 
     /// Tries one rule with its strict predecessor starting at `start`.
@@ -262,10 +387,13 @@ impl<'p> Rewriter<'p> {
         // new-left, left, strict, right, new-right.
         self.frame.clear();
         self.frame.resize(rule.frame_size, Value::Void);
-        let left_count = rule.left.len();
-        let bind = |frame: &mut Vec<Value>, p: &Pattern, params: &[Value]| {
-            for (slot, v) in p.slots.iter().zip(params) {
-                frame[*slot as usize] = v.clone();
+        let program = self.program;
+        let structs = &program.structs[..];
+        let bind = |frame: &mut Vec<Value>, p: &Pattern, mut slots: &[f64]| {
+            for (slot, ty) in p.slots.iter().zip(&p.types) {
+                let (v, used) = decode(*ty, slots, structs);
+                frame[*slot as usize] = v;
+                slots = slots.get(used..).unwrap_or(&[]);
             }
         };
         for (p, &idx) in rule
@@ -273,11 +401,11 @@ impl<'p> Rewriter<'p> {
             .iter()
             .zip(&self.new_matched[..new_left_count])
         {
-            bind(&mut self.frame, p, dst.params(idx));
+            bind(&mut self.frame, p, dst.data(idx));
         }
         let old_pats = rule.left.iter().chain(&rule.strict).chain(&rule.right);
         for (p, &idx) in old_pats.zip(&self.matched) {
-            bind(&mut self.frame, p, src.params(idx));
+            bind(&mut self.frame, p, src.data(idx));
         }
         let rev = Reversed(dst);
         for (p, &idx) in rule
@@ -285,14 +413,14 @@ impl<'p> Rewriter<'p> {
             .iter()
             .zip(&self.new_matched[new_left_count..])
         {
-            bind(&mut self.frame, p, rev.params(idx));
+            bind(&mut self.frame, p, rev.data(idx));
         }
-        let _ = left_count;
 
         self.tmp.clear();
         let mut host = WordHost {
             src,
             dst,
+            structs,
             ctx,
             forward: opts.forward,
             left: left_end,
@@ -320,6 +448,16 @@ impl<'p> Rewriter<'p> {
     }
 }
 
+/// `pos % n` for `pos < 2n`, without a division.
+#[inline]
+fn wrap(pos: usize, n: usize) -> usize {
+    if pos >= n {
+        pos - n
+    } else {
+        pos
+    }
+}
+
 /// Reverses the modules of `w` from `from` on, using `tmp` as scratch.
 fn reverse_tail(w: &mut Word, from: usize, tmp: &mut Word) {
     tmp.clear();
@@ -333,50 +471,56 @@ fn reverse_tail(w: &mut Word, from: usize, tmp: &mut Word) {
 }
 
 /// Evaluates a stencil into `dst`. Returns false if a value is not finite.
+#[inline(always)]
 fn apply_stencil(st: &Stencil, src: &Word, matched: &[usize], dst: &mut Word) -> bool {
-    let mut finite = true;
+    // The slots of the matched modules, looked up once.
+    let mut slices: [&[f64]; 8] = [&[]; 8];
+    let many: Vec<&[f64]>;
+    let sources: &[&[f64]] = if matched.len() <= 8 {
+        for (s, &i) in slices.iter_mut().zip(matched) {
+            *s = src.data(i);
+        }
+        &slices[..matched.len()]
+    } else {
+        many = matched.iter().map(|&i| src.data(i)).collect();
+        &many
+    };
+    let start = dst.slot_count();
     for (sym, combos) in &st.outputs {
-        dst.push_with(*sym, |params| {
+        dst.push_with(*sym, |out| {
             for c in combos {
-                let source = |t: u16| {
-                    let (k, j) = st.sources[t as usize];
-                    &src.params(matched[k as usize])[j as usize]
-                };
-                let v = match c.ty {
+                match c.ty {
                     Ty::V2 => {
-                        let mut acc = DVec2::ZERO;
-                        for &(t, w) in &c.terms {
-                            if let Value::V2(p) = source(t) {
-                                acc += w * *p;
-                            }
+                        let (mut x, mut y) = (0.0, 0.0);
+                        for &(k, off, w) in &c.terms {
+                            let s = &sources[k as usize][off as usize..];
+                            x += w * s[0];
+                            y += w * s[1];
                         }
-                        finite &= acc.is_finite();
-                        Value::V2(acc)
+                        out.extend_from_slice(&[x, y]);
                     }
                     Ty::V3 => {
-                        let mut acc = DVec3::ZERO;
-                        for &(t, w) in &c.terms {
-                            if let Value::V3(p) = source(t) {
-                                acc += w * *p;
-                            }
+                        let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
+                        for &(k, off, w) in &c.terms {
+                            let s = &sources[k as usize][off as usize..];
+                            x += w * s[0];
+                            y += w * s[1];
+                            z += w * s[2];
                         }
-                        finite &= acc.is_finite();
-                        Value::V3(acc)
+                        out.extend_from_slice(&[x, y, z]);
                     }
                     _ => {
                         let mut acc = c.constant;
-                        for &(t, w) in &c.terms {
-                            acc += w * source(t).as_f64();
+                        for &(k, off, w) in &c.terms {
+                            acc += w * sources[k as usize][off as usize];
                         }
-                        finite &= acc.is_finite();
-                        Value::Float(acc)
+                        out.push(acc);
                     }
-                };
-                params.push(v);
+                }
             }
         });
     }
-    finite
+    dst.all_slots()[start..].iter().all(|x| x.is_finite())
 }
 
 /// Answers `InLeftContext` and friends for a body running on a word. Each
@@ -384,6 +528,7 @@ fn apply_stencil(st: &Stencil, src: &Word, matched: &[usize], dst: &mut Word) ->
 struct WordHost<'a> {
     src: &'a Word,
     dst: &'a Word,
+    structs: &'a [StructDef],
     ctx: Rules<'a>,
     forward: bool,
     left: isize,
@@ -403,7 +548,7 @@ impl Host for WordHost<'_> {
             ContextKind::Left => match match_left(self.src, self.left, pats, self.ctx, &mut idx) {
                 Some(p) => {
                     self.left = p;
-                    push_params(self.src, &idx, out);
+                    push_params(self.src, &idx, pats, self.structs, out);
                     true
                 }
                 None => false,
@@ -412,7 +557,7 @@ impl Host for WordHost<'_> {
             {
                 Some(p) => {
                     self.right = p;
-                    push_params(self.src, &idx, out);
+                    push_params(self.src, &idx, pats, self.structs, out);
                     true
                 }
                 None => false,
@@ -421,7 +566,7 @@ impl Host for WordHost<'_> {
                 match match_left(self.dst, self.new_left, pats, new_ctx, &mut idx) {
                     Some(p) => {
                         self.new_left = p;
-                        push_params(self.dst, &idx, out);
+                        push_params(self.dst, &idx, pats, self.structs, out);
                         true
                     }
                     None => false,
@@ -432,7 +577,7 @@ impl Host for WordHost<'_> {
                 match match_right(&rev, self.new_right, pats, new_ctx, &mut idx) {
                     Some(p) => {
                         self.new_right = p;
-                        push_params(&rev, &idx, out);
+                        push_params(&rev, &idx, pats, self.structs, out);
                         true
                     }
                     None => false,
@@ -443,14 +588,15 @@ impl Host for WordHost<'_> {
     }
 }
 
-fn push_params<S: Seq>(seq: &S, idx: &[usize], out: &mut Vec<Value>) {
-    for &i in idx {
-        out.extend_from_slice(seq.params(i));
-    }
-}
-
-impl Emit for &mut Word {
-    fn emit(&mut self, sym: Sym, args: &[Value]) {
-        self.push(sym, args);
+/// Decodes the parameters of the matched modules `idx` (one per pattern).
+fn push_params<S: Seq>(
+    seq: &S,
+    idx: &[usize],
+    pats: &[Pattern],
+    structs: &[StructDef],
+    out: &mut Vec<Value>,
+) {
+    for (&i, p) in idx.iter().zip(pats) {
+        out.extend(decode_all(&p.types, seq.data(i), structs));
     }
 }

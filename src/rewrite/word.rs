@@ -1,8 +1,12 @@
-//! A word: a string of modules, stored flat (symbols, parameter offsets and
-//! one parameter array) so that a derivation step allocates nothing per module.
+//! A word: a string of modules, stored flat. Each module is a symbol and a
+//! run of `f64` slots holding its parameters (a `V2f` takes two slots, a
+//! struct the slots of its fields); the module's kind says how to read them.
+//! A derivation step therefore copies plain numbers and allocates nothing
+//! per module.
 
 use crate::lang::eval::Emit;
-use crate::lang::{Sym, Value};
+use crate::lang::value::{decode_all, encode, StructDef};
+use crate::lang::{Alphabet, Sym, Value};
 
 /// Read access to a sequence of modules, used by context matching.
 pub trait Seq {
@@ -11,15 +15,16 @@ pub trait Seq {
         self.len() == 0
     }
     fn sym(&self, i: usize) -> Sym;
-    fn params(&self, i: usize) -> &[Value];
+    /// The parameter slots of module `i`.
+    fn data(&self, i: usize) -> &[f64];
 }
 
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Word {
     syms: Vec<Sym>,
-    /// `starts[i]..starts[i + 1]` are module `i`'s parameters.
+    /// `starts[i]..starts[i + 1]` are module `i`'s slots.
     starts: Vec<u32>,
-    params: Vec<Value>,
+    data: Vec<f64>,
 }
 
 impl Word {
@@ -27,17 +32,7 @@ impl Word {
         Word {
             syms: Vec::new(),
             starts: vec![0],
-            params: Vec::new(),
-        }
-    }
-
-    pub fn with_capacity(modules: usize, params: usize) -> Word {
-        let mut starts = Vec::with_capacity(modules + 1);
-        starts.push(0);
-        Word {
-            syms: Vec::with_capacity(modules),
-            starts,
-            params: Vec::with_capacity(params),
+            data: Vec::new(),
         }
     }
 
@@ -52,20 +47,50 @@ impl Word {
     pub fn clear(&mut self) {
         self.syms.clear();
         self.starts.truncate(1);
-        self.params.clear();
+        self.data.clear();
     }
 
+    /// Makes room for `modules` more modules with `slots` more slots.
+    pub fn reserve(&mut self, modules: usize, slots: usize) {
+        self.syms.reserve(modules);
+        self.starts.reserve(modules);
+        self.data.reserve(slots);
+    }
+
+    /// The number of parameter slots of all modules together.
+    pub fn slot_count(&self) -> usize {
+        self.data.len()
+    }
+
+    /// Appends a module with parameter values (encoded into slots).
     pub fn push(&mut self, sym: Sym, params: &[Value]) {
         self.syms.push(sym);
-        self.params.extend_from_slice(params);
-        self.starts.push(self.params.len() as u32);
+        for p in params {
+            encode(p, &mut self.data);
+        }
+        self.starts.push(self.data.len() as u32);
     }
 
-    /// Appends a module whose parameters are produced by `fill`.
-    pub fn push_with(&mut self, sym: Sym, fill: impl FnOnce(&mut Vec<Value>)) {
+    /// Appends a module with raw slots.
+    #[inline]
+    pub fn push_raw(&mut self, sym: Sym, slots: &[f64]) {
         self.syms.push(sym);
-        fill(&mut self.params);
-        self.starts.push(self.params.len() as u32);
+        self.data.extend_from_slice(slots);
+        self.starts.push(self.data.len() as u32);
+    }
+
+    /// Appends a module whose slots `fill` writes.
+    #[inline(always)]
+    pub fn push_with(&mut self, sym: Sym, fill: impl FnOnce(&mut Vec<f64>)) {
+        self.syms.push(sym);
+        fill(&mut self.data);
+        self.starts.push(self.data.len() as u32);
+    }
+
+    /// Appends module `i` of `other`.
+    #[inline]
+    pub fn push_from(&mut self, other: &Word, i: usize) {
+        self.push_raw(other.syms[i], other.data(i));
     }
 
     /// Drops modules from the end until `len` remain.
@@ -73,34 +98,52 @@ impl Word {
         if len < self.syms.len() {
             self.syms.truncate(len);
             self.starts.truncate(len + 1);
-            self.params.truncate(self.starts[len] as usize);
+            self.data.truncate(self.starts[len] as usize);
         }
-    }
-
-    pub fn syms(&self) -> &[Sym] {
-        &self.syms
-    }
-
-    /// Appends module `i` of `other`.
-    pub fn push_from(&mut self, other: &Word, i: usize) {
-        self.push(other.syms[i], other.params(i));
     }
 
     /// Reverses the order of the modules (used after a backward step).
     pub fn reverse(&mut self) {
-        let mut out = Word::with_capacity(self.len(), self.params.len());
+        let mut out = Word::new();
+        out.reserve(self.len(), self.data.len());
         for i in (0..self.len()).rev() {
             out.push_from(self, i);
         }
         *self = out;
     }
 
-    pub fn iter(&self) -> impl Iterator<Item = (Sym, &[Value])> {
-        (0..self.len()).map(move |i| (self.syms[i], self.params(i)))
+    pub fn syms(&self) -> &[Sym] {
+        &self.syms
     }
 
-    pub fn params_mut(&mut self) -> &mut Vec<Value> {
-        &mut self.params
+    #[inline]
+    pub fn sym(&self, i: usize) -> Sym {
+        self.syms[i]
+    }
+
+    #[inline(always)]
+    pub fn data(&self, i: usize) -> &[f64] {
+        &self.data[self.starts[i] as usize..self.starts[i + 1] as usize]
+    }
+
+    /// The slots of all modules, in order.
+    pub fn all_slots(&self) -> &[f64] {
+        &self.data
+    }
+
+    /// The parameters of module `i` as values.
+    pub fn values(&self, i: usize, alphabet: &Alphabet, structs: &[StructDef]) -> Vec<Value> {
+        let d = self.data(i);
+        decode_all(alphabet.layout(self.syms[i], d.len(), structs), d, structs)
+    }
+
+    /// Every module with its parameter values, for output and tests.
+    pub fn modules<'a>(
+        &'a self,
+        alphabet: &'a Alphabet,
+        structs: &'a [StructDef],
+    ) -> impl Iterator<Item = (Sym, Vec<Value>)> + 'a {
+        (0..self.len()).map(move |i| (self.syms[i], self.values(i, alphabet, structs)))
     }
 }
 
@@ -115,20 +158,8 @@ impl Seq for Word {
     }
 
     #[inline]
-    fn params(&self, i: usize) -> &[Value] {
-        &self.params[self.starts[i] as usize..self.starts[i + 1] as usize]
-    }
-}
-
-impl Word {
-    #[inline]
-    pub fn params(&self, i: usize) -> &[Value] {
-        Seq::params(self, i)
-    }
-
-    #[inline]
-    pub fn sym(&self, i: usize) -> Sym {
-        self.syms[i]
+    fn data(&self, i: usize) -> &[f64] {
+        Word::data(self, i)
     }
 }
 
@@ -150,7 +181,7 @@ impl Seq for Reversed<'_> {
         self.0.sym(self.0.len() - 1 - i)
     }
 
-    fn params(&self, i: usize) -> &[Value] {
-        self.0.params(self.0.len() - 1 - i)
+    fn data(&self, i: usize) -> &[f64] {
+        self.0.data(self.0.len() - 1 - i)
     }
 }

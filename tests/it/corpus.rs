@@ -105,8 +105,9 @@ fn recursive_interpretation_expands_the_whole_fern() {
         };
     }
     let fs = shown
+        .syms()
         .iter()
-        .filter(|(s, _)| l.program.alphabet.name(*s) == "F")
+        .filter(|s| l.program.alphabet.name(**s) == "F")
         .count();
     assert_eq!(fs, f[8]);
     // Interpretation does not change the derived word itself.

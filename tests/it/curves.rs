@@ -76,8 +76,9 @@ fn open_case(file: &str) {
     // The endmarkers survive at both ends.
     let names: Vec<&str> = d
         .word
+        .syms()
         .iter()
-        .map(|(s, _)| l.program.alphabet.name(s))
+        .map(|s| l.program.alphabet.name(*s))
         .collect();
     assert_eq!(names.first(), Some(&"#"));
     assert_eq!(names.last(), Some(&"#"));

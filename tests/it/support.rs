@@ -44,13 +44,13 @@ pub fn derive(l: &Loaded, opts: DeriveOptions) -> Derived {
 
 /// The word as text, for compact assertions.
 pub fn text(l: &Loaded, d: &Derived) -> String {
-    subgram::output::word_text(&d.word, &l.program.alphabet)
+    subgram::output::word_text(&d.word, &l.program.alphabet, &l.program.structs)
 }
 
 /// The V2 parameters of all modules named `name`, in word order.
 pub fn points(l: &Loaded, d: &Derived, name: &str) -> Vec<DVec2> {
     d.word
-        .iter()
+        .modules(&l.program.alphabet, &l.program.structs)
         .filter(|(s, _)| l.program.alphabet.name(*s) == name)
         .filter_map(|(_, ps)| match ps.first() {
             Some(Value::V2(v)) => Some(*v),
@@ -61,8 +61,9 @@ pub fn points(l: &Loaded, d: &Derived, name: &str) -> Vec<DVec2> {
 
 pub fn count(l: &Loaded, d: &Derived, name: &str) -> usize {
     d.word
+        .syms()
         .iter()
-        .filter(|(s, _)| l.program.alphabet.name(*s) == name)
+        .filter(|s| l.program.alphabet.name(**s) == name)
         .count()
 }
 
