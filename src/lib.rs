@@ -18,8 +18,10 @@
 //! assert_eq!(derived.word.len(), 16); // 4 points, doubled twice
 //! ```
 
+pub mod draw;
 pub mod lang;
 pub mod output;
+pub mod render;
 pub mod rewrite;
 pub mod syntax;
 
@@ -166,3 +168,59 @@ pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Loaded, Lo
 }
 
 fn fix_missing_spans(_program: &mut Program, _main: syntax::FileId) {}
+
+/// Settings of a figure: how far to derive, how to draw, how to render.
+#[derive(Clone, Debug, Default)]
+pub struct FigureOptions {
+    pub derive: DeriveOptions,
+    /// Draw every step 0..=N side by side.
+    pub each: bool,
+    pub draw: draw::DrawOptions,
+    pub render: render::RenderOptions,
+}
+
+/// Why a figure could not be made; `render` gives the message.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FigureError {
+    Derive(DeriveError),
+    Draw(draw::DrawError),
+    Render(render::RenderError),
+}
+
+impl Loaded {
+    /// A figure's message, with a source line and caret where one applies.
+    pub fn render_figure_error(&self, e: &FigureError) -> String {
+        match e {
+            FigureError::Derive(d) => self.render_derive_error(d),
+            FigureError::Draw(d) => format!("error: {}", d.message),
+            FigureError::Render(r) => format!("error: {}", r.message),
+        }
+    }
+
+    /// Derives, interprets and lays out the program's picture.
+    pub fn figure(&self, opts: &FigureOptions) -> Result<render::Scene, FigureError> {
+        let p = &self.program;
+        let mut d = Derivation::new(p, opts.derive.clone()).map_err(FigureError::Derive)?;
+        let mut panels = Vec::new();
+        let mut panel = |d: &mut Derivation| -> Result<(), FigureError> {
+            let word = d.interpret().map_err(FigureError::Derive)?;
+            let events = draw::draw(&word, &p.alphabet, &p.structs, &opts.draw)
+                .map_err(FigureError::Draw)?;
+            panels.push(events);
+            Ok(())
+        };
+        if opts.each {
+            panel(&mut d)?;
+        }
+        while d.has_next() {
+            d.next_step().map_err(FigureError::Derive)?;
+            if opts.each {
+                panel(&mut d)?;
+            }
+        }
+        if !opts.each {
+            panel(&mut d)?;
+        }
+        render::scene(&panels, &opts.render).map_err(FigureError::Render)
+    }
+}

@@ -41,12 +41,69 @@ enum Command {
         #[arg(long)]
         interpreted: bool,
     },
+    /// Render an .lsys file's picture to PNG or SVG.
+    Render {
+        file: String,
+        /// The picture: OUT.png or OUT.svg.
+        #[arg(short = 'o', long = "output")]
+        output: String,
+        #[arg(short = 'n', long = "steps")]
+        steps: Option<u64>,
+        /// Image size in pixels, WIDTHxHEIGHT.
+        #[arg(long, default_value = "800x800", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Draw every step 0..N side by side.
+        #[arg(long)]
+        each: bool,
+        /// white, black, none, #rrggbb.
+        #[arg(long, default_value = "white", value_parser = parse_color)]
+        background: subgram::render::Rgba,
+        /// The projection plane of 3D drawings.
+        #[arg(long, value_enum, default_value_t = ViewArg::Xy)]
+        view: ViewArg,
+        #[arg(short = 'D', value_name = "NAME=VALUE")]
+        define: Vec<String>,
+        #[arg(long, default_value_t = subgram::rewrite::derive::DEFAULT_MAX_MODULES)]
+        max_modules: usize,
+        #[arg(long, default_value_t = 0)]
+        phase: usize,
+    },
     /// Check an .lsys file and report every diagnostic.
     Check {
         file: String,
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
     },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ViewArg {
+    Xy,
+    Xz,
+    Yz,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}` is not WIDTHxHEIGHT, e.g. 800x600"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{w}` is not a width in pixels"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{h}` is not a height in pixels"))?;
+    if w == 0 || h == 0 || w > 20_000 || h > 20_000 {
+        return Err("each side must be 1 to 20000 pixels".into());
+    }
+    Ok((w, h))
+}
+
+fn parse_color(s: &str) -> Result<subgram::render::Rgba, String> {
+    subgram::render::Rgba::parse(s)
+        .ok_or_else(|| format!("`{s}` is not a colour: use white, black, none or #rrggbb"))
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -75,6 +132,56 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
                 loaded.program.rules.len(),
                 loaded.program.alphabet.kinds.len()
             ))
+        }
+        Command::Render {
+            file,
+            output,
+            steps,
+            size,
+            each,
+            background,
+            view,
+            define,
+            max_modules,
+            phase,
+        } => {
+            let lower = output.to_ascii_lowercase();
+            let svg = if lower.ends_with(".svg") {
+                true
+            } else if lower.ends_with(".png") {
+                false
+            } else {
+                return Err((
+                    2,
+                    format!("error: cannot tell the format of `{output}`: name it .png or .svg"),
+                ));
+            };
+            let loaded = load(&file, &define)?;
+            let mut opts = subgram::FigureOptions::default();
+            opts.derive = DeriveOptions::default()
+                .with_max_modules(max_modules)
+                .with_phase(phase);
+            opts.derive.steps = steps;
+            opts.each = each;
+            opts.render.width = size.0;
+            opts.render.height = size.1;
+            opts.render.background = background;
+            opts.render.view = match view {
+                ViewArg::Xy => subgram::render::View::Xy,
+                ViewArg::Xz => subgram::render::View::Xz,
+                ViewArg::Yz => subgram::render::View::Yz,
+            };
+            let scene = loaded
+                .figure(&opts)
+                .map_err(|e| (1, loaded.render_figure_error(&e)))?;
+            let bytes = if svg {
+                subgram::render::svg::render(&scene).into_bytes()
+            } else {
+                subgram::render::png::render(&scene)
+                    .map_err(|e| (1, format!("error: {}", e.message)))?
+            };
+            subgram::render::write_atomic(std::path::Path::new(&output), &bytes)
+                .map_err(|e| (1, format!("error: cannot write `{output}`: {e}")))
         }
         Command::Derive {
             file,

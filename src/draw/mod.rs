@@ -1,0 +1,340 @@
+//! Interpretation of a word as drawing: the turtle walks the modules and
+//! emits renderer-neutral [`Event`]s in 3D. PNG and SVG both draw these
+//! events, so the two always agree.
+
+use glam::DVec3;
+
+use crate::lang::value::StructDef;
+use crate::lang::{Alphabet, Sym, Value};
+use crate::rewrite::Word;
+
+/// The style of a stroke: colour index and width in pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pen {
+    pub color: i64,
+    pub width: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Event {
+    /// A straight segment.
+    Line { a: DVec3, b: DVec3, pen: Pen },
+    /// A filled disc of world radius `r` (`Circle`, `Sphere`).
+    Disc { c: DVec3, r: f64, color: i64 },
+    /// A filled disc whose diameter is the pen width in pixels (`Circle0`).
+    Dot { c: DVec3, pen: Pen },
+    /// A circle outline of world radius `r`, stroked with the pen (`CircleB`).
+    Ring { c: DVec3, r: f64, pen: Pen },
+    /// A filled polygon (`SP() ... PP() ... EP()`).
+    Polygon { points: Vec<DVec3>, color: i64 },
+}
+
+/// What a predefined module does to the turtle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Cmd {
+    None,
+    Forward { draw: bool, record: bool },
+    MoveTo,
+    MoveRel,
+    LineTo,
+    LineRel,
+    Line,
+    Turn(DVec3Axis, f64),
+    TurnAround,
+    SetColor,
+    IncColor,
+    DecColor,
+    SetWidth,
+    Push,
+    Pop,
+    Cut,
+    Disc,
+    Dot,
+    Ring,
+    StartPolygon,
+    PolygonPoint,
+    EndPolygon,
+}
+
+/// The turtle axis a rotation turns about.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum DVec3Axis {
+    Up,
+    Left,
+    Head,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Turtle {
+    pos: DVec3,
+    head: DVec3,
+    left: DVec3,
+    up: DVec3,
+    pen: Pen,
+}
+
+impl Turtle {
+    fn new() -> Turtle {
+        Turtle {
+            pos: DVec3::ZERO,
+            head: DVec3::Y,
+            left: DVec3::NEG_X,
+            up: DVec3::Z,
+            pen: Pen {
+                color: 1,
+                width: 1.0,
+            },
+        }
+    }
+
+    /// Rotates by `deg` degrees about one of the turtle's own axes.
+    fn turn(&mut self, axis: DVec3Axis, deg: f64) {
+        let (s, c) = deg.to_radians().sin_cos();
+        let rot = |a: DVec3, b: DVec3| (a * c + b * s, b * c - a * s);
+        match axis {
+            // Left: heading turns towards the left vector.
+            DVec3Axis::Up => (self.head, self.left) = rot(self.head, self.left),
+            // Up: heading turns towards the up vector.
+            DVec3Axis::Left => (self.head, self.up) = rot(self.head, self.up),
+            // RollR: left turns towards up.
+            DVec3Axis::Head => (self.left, self.up) = rot(self.left, self.up),
+        }
+    }
+}
+
+/// Settings of interpretation.
+#[derive(Clone, Debug)]
+pub struct DrawOptions {
+    /// The angle of `+ - & ^ / \` and of `Left()` without an argument.
+    pub angle: f64,
+    /// Length of `F` without an argument.
+    pub step: f64,
+}
+
+impl Default for DrawOptions {
+    fn default() -> Self {
+        DrawOptions {
+            angle: 90.0,
+            step: 1.0,
+        }
+    }
+}
+
+/// A problem with a word that cannot be drawn.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DrawError {
+    pub message: String,
+}
+
+fn command(name: &str) -> Cmd {
+    use DVec3Axis::*;
+    match name {
+        "F" => Cmd::Forward {
+            draw: true,
+            record: true,
+        },
+        "G" => Cmd::Forward {
+            draw: true,
+            record: false,
+        },
+        "f" => Cmd::Forward {
+            draw: false,
+            record: true,
+        },
+        "g" => Cmd::Forward {
+            draw: false,
+            record: false,
+        },
+        "MoveTo" | "MoveTo2f" | "MoveTo2d" | "MoveTo3f" | "MoveTo3d" => Cmd::MoveTo,
+        "MoveRel2f" | "MoveRel2d" | "MoveRel3f" | "MoveRel3d" => Cmd::MoveRel,
+        "LineTo" | "LineTo2f" | "LineTo2d" | "LineTo3f" | "LineTo3d" => Cmd::LineTo,
+        "LineRel2f" | "LineRel2d" | "LineRel3f" | "LineRel3d" => Cmd::LineRel,
+        "Line2f" | "Line2d" | "Line3f" | "Line3d" => Cmd::Line,
+        "Left" => Cmd::Turn(Up, 1.0),
+        "Right" => Cmd::Turn(Up, -1.0),
+        "Up" => Cmd::Turn(Left, 1.0),
+        "Down" => Cmd::Turn(Left, -1.0),
+        "RollR" => Cmd::Turn(Head, 1.0),
+        "RollL" => Cmd::Turn(Head, -1.0),
+        "TurnAround" => Cmd::TurnAround,
+        "SetColor" => Cmd::SetColor,
+        "IncColor" => Cmd::IncColor,
+        "DecColor" => Cmd::DecColor,
+        "SetWidth" => Cmd::SetWidth,
+        "SB" => Cmd::Push,
+        "EB" => Cmd::Pop,
+        "Cut" => Cmd::Cut,
+        "Circle" | "CircleFront" | "Sphere" => Cmd::Disc,
+        "Circle0" | "CircleFront0" | "Sphere0" => Cmd::Dot,
+        "CircleB" | "CircleFrontB" => Cmd::Ring,
+        "SP" => Cmd::StartPolygon,
+        "PP" => Cmd::PolygonPoint,
+        "EP" => Cmd::EndPolygon,
+        _ => Cmd::None,
+    }
+}
+
+/// Interprets `word` with the turtle and returns the drawing events.
+pub fn draw(
+    word: &Word,
+    alphabet: &Alphabet,
+    structs: &[StructDef],
+    opts: &DrawOptions,
+) -> Result<Vec<Event>, DrawError> {
+    let cmds: Vec<Cmd> = alphabet
+        .kinds
+        .iter()
+        .map(|k| {
+            if k.builtin {
+                command(&k.name)
+            } else {
+                Cmd::None
+            }
+        })
+        .collect();
+    let mut t = Turtle::new();
+    let mut stack: Vec<Turtle> = Vec::new();
+    let mut polygons: Vec<Vec<DVec3>> = Vec::new();
+    let mut out = Vec::new();
+    let mut i = 0;
+    let n = word.len();
+    while i < n {
+        let sym: Sym = word.sym(i);
+        let cmd = cmds[sym.0 as usize];
+        let d = word.data(i);
+        let arg = |k: usize, default: f64| d.get(k).copied().unwrap_or(default);
+        let point = || -> DVec3 {
+            match d.len() {
+                2 => DVec3::new(d[0], d[1], 0.0),
+                3 => DVec3::new(d[0], d[1], d[2]),
+                _ => DVec3::ZERO,
+            }
+        };
+        if d.iter().any(|x| !x.is_finite()) && cmd != Cmd::None {
+            return Err(DrawError {
+                message: format!(
+                    "module {} of the word, `{}`, has a NaN or infinite parameter and cannot be drawn",
+                    i + 1,
+                    alphabet.name(sym)
+                ),
+            });
+        }
+        let int_arg = || match word.values(i, alphabet, structs).first() {
+            Some(Value::Int(v)) => *v,
+            Some(v) => v.as_f64() as i64,
+            None => 0,
+        };
+        match cmd {
+            Cmd::None => {}
+            Cmd::Forward { draw, record } => {
+                let to = t.pos + t.head * arg(0, opts.step);
+                if draw {
+                    out.push(Event::Line {
+                        a: t.pos,
+                        b: to,
+                        pen: t.pen,
+                    });
+                }
+                t.pos = to;
+                if record {
+                    if let Some(p) = polygons.last_mut() {
+                        p.push(to);
+                    }
+                }
+            }
+            Cmd::MoveTo => t.pos = point(),
+            Cmd::MoveRel => t.pos += point(),
+            Cmd::LineTo | Cmd::LineRel => {
+                let to = if cmd == Cmd::LineTo {
+                    point()
+                } else {
+                    t.pos + point()
+                };
+                if t.pos.distance(to) >= 1e-5 {
+                    out.push(Event::Line {
+                        a: t.pos,
+                        b: to,
+                        pen: t.pen,
+                    });
+                }
+                t.pos = to;
+            }
+            Cmd::Line => {
+                let (a, b) = if d.len() == 4 {
+                    (DVec3::new(d[0], d[1], 0.0), DVec3::new(d[2], d[3], 0.0))
+                } else {
+                    (DVec3::new(d[0], d[1], d[2]), DVec3::new(d[3], d[4], d[5]))
+                };
+                if a.distance(b) >= 1e-5 {
+                    out.push(Event::Line { a, b, pen: t.pen });
+                }
+                t.pos = b;
+            }
+            Cmd::Turn(axis, sign) => t.turn(axis, sign * arg(0, opts.angle)),
+            Cmd::TurnAround => t.turn(DVec3Axis::Up, 180.0),
+            Cmd::SetColor => {
+                let c = int_arg();
+                if (1..=255).contains(&c) {
+                    t.pen.color = c;
+                }
+            }
+            Cmd::IncColor => t.pen.color += 1,
+            Cmd::DecColor => t.pen.color -= 1,
+            Cmd::SetWidth => t.pen.width = arg(0, 1.0),
+            Cmd::Push => stack.push(t),
+            Cmd::Pop => {
+                if let Some(s) = stack.pop() {
+                    t = s;
+                }
+            }
+            Cmd::Cut => {
+                // Skip to the end of the current branch.
+                let mut depth = 0;
+                while i + 1 < n {
+                    let name = alphabet.name(word.sym(i + 1));
+                    if name == "SB" {
+                        depth += 1;
+                    } else if name == "EB" {
+                        if depth == 0 {
+                            break;
+                        }
+                        depth -= 1;
+                    }
+                    i += 1;
+                }
+            }
+            Cmd::Disc => out.push(Event::Disc {
+                c: t.pos,
+                r: arg(0, 1.0),
+                color: t.pen.color,
+            }),
+            Cmd::Dot => out.push(Event::Dot {
+                c: t.pos,
+                pen: t.pen,
+            }),
+            Cmd::Ring => out.push(Event::Ring {
+                c: t.pos,
+                r: arg(0, 1.0),
+                pen: t.pen,
+            }),
+            Cmd::StartPolygon => polygons.push(Vec::new()),
+            Cmd::PolygonPoint => {
+                if let Some(p) = polygons.last_mut() {
+                    p.push(t.pos);
+                }
+            }
+            Cmd::EndPolygon => {
+                if let Some(points) = polygons.pop() {
+                    if points.len() >= 3 {
+                        out.push(Event::Polygon {
+                            points,
+                            color: t.pen.color,
+                        });
+                    }
+                }
+            }
+        }
+        i += 1;
+    }
+    Ok(out)
+}

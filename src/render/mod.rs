@@ -1,0 +1,316 @@
+//! From drawing events to pictures: fitting the view, then PNG (tiny-skia)
+//! or SVG (the svg crate) from the same [`Scene`].
+
+pub mod png;
+pub mod svg;
+
+use glam::{DVec2, DVec3};
+
+use crate::draw::Event;
+
+/// The plane the 3D drawing is projected onto, orthographically.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum View {
+    /// Looking down the z axis (the default; 2D drawings live here).
+    #[default]
+    Xy,
+    /// Looking along y: x to the right, z up.
+    Xz,
+    /// Looking along x: y to the right, z up.
+    Yz,
+}
+
+impl View {
+    fn project(self, p: DVec3) -> DVec2 {
+        match self {
+            View::Xy => DVec2::new(p.x, p.y),
+            View::Xz => DVec2::new(p.x, p.z),
+            View::Yz => DVec2::new(p.y, p.z),
+        }
+    }
+}
+
+/// An RGBA colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Rgba(pub u8, pub u8, pub u8, pub u8);
+
+impl Rgba {
+    /// `white`, `black`, `none`/`transparent`, `#rgb`, `#rrggbb` or `#rrggbbaa`.
+    pub fn parse(s: &str) -> Option<Rgba> {
+        let named = match s.to_ascii_lowercase().as_str() {
+            "white" => Some(Rgba(255, 255, 255, 255)),
+            "black" => Some(Rgba(0, 0, 0, 255)),
+            "none" | "transparent" => Some(Rgba(0, 0, 0, 0)),
+            "gray" | "grey" => Some(Rgba(128, 128, 128, 255)),
+            _ => None,
+        };
+        if named.is_some() {
+            return named;
+        }
+        let hex = s.strip_prefix('#')?;
+        let digit = |i: usize, len: usize| u8::from_str_radix(hex.get(i..i + len)?, 16).ok();
+        match hex.len() {
+            3 => Some(Rgba(
+                digit(0, 1)? * 17,
+                digit(1, 1)? * 17,
+                digit(2, 1)? * 17,
+                255,
+            )),
+            6 => Some(Rgba(digit(0, 2)?, digit(2, 2)?, digit(4, 2)?, 255)),
+            8 => Some(Rgba(digit(0, 2)?, digit(2, 2)?, digit(4, 2)?, digit(6, 2)?)),
+            _ => None,
+        }
+    }
+
+    pub fn hex(self) -> String {
+        format!("#{:02x}{:02x}{:02x}", self.0, self.1, self.2)
+    }
+}
+
+/// The default colour map for a white page: index 1 is near-black, then a
+/// run of distinct colours; indices wrap around.
+const PALETTE: [Rgba; 12] = [
+    Rgba(64, 64, 64, 255),
+    Rgba(24, 24, 24, 255),
+    Rgba(214, 39, 40, 255),
+    Rgba(31, 119, 180, 255),
+    Rgba(44, 160, 44, 255),
+    Rgba(255, 127, 14, 255),
+    Rgba(148, 103, 189, 255),
+    Rgba(140, 86, 75, 255),
+    Rgba(227, 119, 194, 255),
+    Rgba(127, 127, 127, 255),
+    Rgba(188, 189, 34, 255),
+    Rgba(23, 190, 207, 255),
+];
+
+/// The colour of index `i` in the default map.
+pub fn palette(i: i64) -> Rgba {
+    PALETTE[i.rem_euclid(PALETTE.len() as i64) as usize]
+}
+
+/// Settings of a picture. `Default` is 800×800 on white, 4% margin, xy view.
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    pub width: u32,
+    pub height: u32,
+    pub background: Rgba,
+    /// Margin on every side, as a fraction of the smaller image side.
+    pub margin: f64,
+    pub view: View,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 800,
+            height: 800,
+            background: Rgba(255, 255, 255, 255),
+            margin: 0.04,
+            view: View::Xy,
+        }
+    }
+}
+
+/// One shape in pixel coordinates (y down).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Item {
+    /// Connected segments with one pen.
+    Polyline {
+        points: Vec<DVec2>,
+        color: Rgba,
+        width: f64,
+    },
+    Disc {
+        c: DVec2,
+        r: f64,
+        color: Rgba,
+    },
+    Ring {
+        c: DVec2,
+        r: f64,
+        color: Rgba,
+        width: f64,
+    },
+    Polygon {
+        points: Vec<DVec2>,
+        color: Rgba,
+    },
+}
+
+/// A picture ready for a backend: size, background and items.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub width: u32,
+    pub height: u32,
+    pub background: Rgba,
+    pub items: Vec<Item>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderError {
+    pub message: String,
+}
+
+impl RenderError {
+    fn new(m: impl Into<String>) -> RenderError {
+        RenderError { message: m.into() }
+    }
+}
+
+/// Lays out panels side by side: each list of events is fitted into its own
+/// cell of equal width. One panel is the usual single picture.
+pub fn scene(panels: &[Vec<Event>], opts: &RenderOptions) -> Result<Scene, RenderError> {
+    if opts.width == 0 || opts.height == 0 || opts.width > 20_000 || opts.height > 20_000 {
+        return Err(RenderError::new(format!(
+            "the image size {}x{} is out of range: each side must be 1 to 20000 pixels",
+            opts.width, opts.height
+        )));
+    }
+    if panels.iter().all(|p| p.is_empty()) {
+        return Err(RenderError::new(
+            "nothing to draw: after interpretation the word has no drawing modules (F, LineTo2f, Circle, ...)",
+        ));
+    }
+    let cell_w = opts.width as f64 / panels.len() as f64;
+    let mut items = Vec::new();
+    for (k, events) in panels.iter().enumerate() {
+        let x0 = k as f64 * cell_w;
+        fit_panel(events, opts, x0, cell_w, &mut items)?;
+    }
+    Ok(Scene {
+        width: opts.width,
+        height: opts.height,
+        background: opts.background,
+        items,
+    })
+}
+
+fn fit_panel(
+    events: &[Event],
+    opts: &RenderOptions,
+    x0: f64,
+    cell_w: f64,
+    items: &mut Vec<Item>,
+) -> Result<(), RenderError> {
+    if events.is_empty() {
+        return Ok(());
+    }
+    let v = opts.view;
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    let mut grow = |p: DVec2, r: f64| {
+        lo = lo.min(p - r);
+        hi = hi.max(p + r);
+    };
+    for e in events {
+        match e {
+            Event::Line { a, b, .. } => {
+                grow(v.project(*a), 0.0);
+                grow(v.project(*b), 0.0);
+            }
+            Event::Disc { c, r, .. } | Event::Ring { c, r, .. } => grow(v.project(*c), r.abs()),
+            Event::Dot { c, .. } => grow(v.project(*c), 0.0),
+            Event::Polygon { points, .. } => points.iter().for_each(|p| grow(v.project(*p), 0.0)),
+        }
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Err(RenderError::new(
+            "the drawing has a NaN or infinite coordinate and cannot be fitted",
+        ));
+    }
+    let margin = opts.margin * cell_w.min(opts.height as f64);
+    let avail =
+        DVec2::new(cell_w - 2.0 * margin, opts.height as f64 - 2.0 * margin).max(DVec2::ONE);
+    let ext = hi - lo;
+    let scale = match (ext.x > 1e-12, ext.y > 1e-12) {
+        (true, true) => (avail.x / ext.x).min(avail.y / ext.y),
+        (true, false) => avail.x / ext.x,
+        (false, true) => avail.y / ext.y,
+        (false, false) => 1.0,
+    };
+    let centre = (lo + hi) * 0.5;
+    let mid = DVec2::new(x0 + cell_w * 0.5, opts.height as f64 * 0.5);
+    let px = |p: DVec3| {
+        let q = (v.project(p) - centre) * scale;
+        DVec2::new(mid.x + q.x, mid.y - q.y)
+    };
+    let mut run: Option<(Vec<DVec2>, Rgba, f64)> = None;
+    let flush = |run: &mut Option<(Vec<DVec2>, Rgba, f64)>, items: &mut Vec<Item>| {
+        if let Some((points, color, width)) = run.take() {
+            items.push(Item::Polyline {
+                points,
+                color,
+                width,
+            });
+        }
+    };
+    for e in events {
+        if let Event::Line { a, b, pen } = e {
+            let (pa, pb) = (px(*a), px(*b));
+            let color = palette(pen.color);
+            let joined = matches!(&run, Some((pts, c, w))
+                if *c == color && *w == pen.width && pts.last().is_some_and(|l| l.distance(pa) < 1e-9));
+            if joined {
+                if let Some((pts, _, _)) = run.as_mut() {
+                    pts.push(pb);
+                }
+            } else {
+                flush(&mut run, items);
+                run = Some((vec![pa, pb], color, pen.width));
+            }
+            continue;
+        }
+        flush(&mut run, items);
+        items.push(match e {
+            Event::Disc { c, r, color } => Item::Disc {
+                c: px(*c),
+                r: r.abs() * scale,
+                color: palette(*color),
+            },
+            Event::Dot { c, pen } => Item::Disc {
+                c: px(*c),
+                r: pen.width * 0.5,
+                color: palette(pen.color),
+            },
+            Event::Ring { c, r, pen } => Item::Ring {
+                c: px(*c),
+                r: r.abs() * scale,
+                color: palette(pen.color),
+                width: pen.width,
+            },
+            Event::Polygon { points, color } => Item::Polygon {
+                points: points.iter().map(|p| px(*p)).collect(),
+                color: palette(*color),
+            },
+            Event::Line { .. } => unreachable!("handled above"),
+        });
+    }
+    flush(&mut run, items);
+    Ok(())
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and
+/// a rename, so that a failure never leaves a truncated file behind.
+pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write;
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}

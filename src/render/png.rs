@@ -1,0 +1,77 @@
+//! PNG output with tiny-skia: antialiased strokes with round caps and joins.
+
+use tiny_skia::{
+    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, Transform,
+};
+
+use super::{Item, RenderError, Rgba, Scene};
+
+fn paint(c: Rgba) -> Paint<'static> {
+    let mut p = Paint::default();
+    p.set_color(Color::from_rgba8(c.0, c.1, c.2, c.3));
+    p.anti_alias = true;
+    p
+}
+
+fn stroke(width: f64) -> Stroke {
+    Stroke {
+        width: width.max(0.0) as f32,
+        line_cap: LineCap::Round,
+        line_join: LineJoin::Round,
+        ..Stroke::default()
+    }
+}
+
+/// Rasterises a scene and encodes it as PNG.
+pub fn render(scene: &Scene) -> Result<Vec<u8>, RenderError> {
+    let mut pm = Pixmap::new(scene.width, scene.height)
+        .ok_or_else(|| RenderError::new("cannot allocate an image of that size"))?;
+    let b = scene.background;
+    pm.fill(Color::from_rgba8(b.0, b.1, b.2, b.3));
+    let id = Transform::identity();
+    for item in &scene.items {
+        match item {
+            Item::Polyline {
+                points,
+                color,
+                width,
+            } => {
+                let mut pb = PathBuilder::new();
+                pb.move_to(points[0].x as f32, points[0].y as f32);
+                for p in &points[1..] {
+                    pb.line_to(p.x as f32, p.y as f32);
+                }
+                if let Some(path) = pb.finish() {
+                    pm.stroke_path(&path, &paint(*color), &stroke(*width), id, None);
+                }
+            }
+            Item::Disc { c, r, color } => {
+                if let Some(path) =
+                    PathBuilder::from_circle(c.x as f32, c.y as f32, (*r as f32).max(0.25))
+                {
+                    pm.fill_path(&path, &paint(*color), FillRule::Winding, id, None);
+                }
+            }
+            Item::Ring { c, r, color, width } => {
+                if let Some(path) =
+                    PathBuilder::from_circle(c.x as f32, c.y as f32, (*r as f32).max(0.25))
+                {
+                    pm.stroke_path(&path, &paint(*color), &stroke(*width), id, None);
+                }
+            }
+            Item::Polygon { points, color } => {
+                let mut pb = PathBuilder::new();
+                pb.move_to(points[0].x as f32, points[0].y as f32);
+                for p in &points[1..] {
+                    pb.line_to(p.x as f32, p.y as f32);
+                }
+                pb.close();
+                if let Some(path) = pb.finish() {
+                    pm.fill_path(&path, &paint(*color), FillRule::EvenOdd, id, None);
+                }
+            }
+        }
+    }
+    pm.encode_png()
+        .map_err(|e| RenderError::new(format!("cannot encode the PNG: {e}")))
+}
