@@ -54,6 +54,7 @@ enum Cmd {
     StartPolygon,
     PolygonPoint,
     EndPolygon,
+    Query(u8),
 }
 
 /// The turtle axis a rotation turns about.
@@ -170,8 +171,17 @@ fn command(name: &str) -> Cmd {
         "SP" => Cmd::StartPolygon,
         "PP" => Cmd::PolygonPoint,
         "EP" => Cmd::EndPolygon,
+        "GetPos" => Cmd::Query(0),
+        "GetHead" => Cmd::Query(1),
+        "GetLeft" => Cmd::Query(2),
+        "GetUp" => Cmd::Query(3),
         _ => Cmd::None,
     }
+}
+
+/// True for lpfg's query modules, which the turtle fills in.
+pub fn is_query(name: &str) -> bool {
+    matches!(name, "GetPos" | "GetHead" | "GetLeft" | "GetUp")
 }
 
 /// Interprets `word` with the turtle and returns the drawing events.
@@ -180,6 +190,18 @@ pub fn draw(
     alphabet: &Alphabet,
     structs: &[StructDef],
     opts: &DrawOptions,
+) -> Result<Vec<Event>, DrawError> {
+    draw_with_queries(word, alphabet, structs, opts, None)
+}
+
+/// Like [`draw`]; also records, for every query module met, the vector it
+/// asks for (`GetPos`: position, `GetHead`/`GetLeft`/`GetUp`: the frame).
+pub fn draw_with_queries(
+    word: &Word,
+    alphabet: &Alphabet,
+    structs: &[StructDef],
+    opts: &DrawOptions,
+    mut queries: Option<&mut Vec<[f64; 3]>>,
 ) -> Result<Vec<Event>, DrawError> {
     let cmds: Vec<Cmd> = alphabet
         .kinds
@@ -210,7 +232,7 @@ pub fn draw(
                 _ => DVec3::ZERO,
             }
         };
-        if d.iter().any(|x| !x.is_finite()) && cmd != Cmd::None {
+        if d.iter().any(|x| !x.is_finite()) && cmd != Cmd::None && !matches!(cmd, Cmd::Query(_)) {
             return Err(DrawError {
                 message: format!(
                     "module {} of the word, `{}`, has a NaN or infinite parameter and cannot be drawn",
@@ -317,6 +339,12 @@ pub fn draw(
                 r: arg(0, 1.0),
                 pen: t.pen,
             }),
+            Cmd::Query(q) => {
+                if let Some(qs) = queries.as_deref_mut() {
+                    let v = [t.pos, t.head, t.left, t.up][q as usize];
+                    qs.push([v.x, v.y, v.z]);
+                }
+            }
             Cmd::StartPolygon => polygons.push(Vec::new()),
             Cmd::PolygonPoint => {
                 if let Some(p) = polygons.last_mut() {

@@ -148,7 +148,79 @@ impl<'p> Derivation<'p> {
             .map_err(|e| runtime(e, None, 0))?;
         d.word = axiom;
         d.decompose()?;
+        d.answer_queries()?;
         Ok(d)
+    }
+
+    /// lpfg's query modules (`GetPos`, `GetHead`, `GetLeft`, `GetUp`): when
+    /// a production's predecessor mentions one, an interpretation step runs
+    /// after the axiom and after every step, and each query module in the
+    /// word receives the turtle's position (or heading, left, up vector)
+    /// at that point. The query modules of the word are matched in order to
+    /// those the turtle meets in the interpreted word, so interpretation
+    /// rules must not create or erase them.
+    fn answer_queries(&mut self) -> Result<(), DeriveError> {
+        let p = self.program;
+        if !self.queries_used() {
+            return Ok(());
+        }
+        let shown = self.interpret()?;
+        let mut answers = Vec::new();
+        crate::draw::draw_with_queries(
+            &shown,
+            &p.alphabet,
+            &p.structs,
+            &crate::draw::DrawOptions::default(),
+            Some(&mut answers),
+        )
+        .map_err(|e| DeriveError {
+            span: None,
+            message: format!("at step {}, the interpretation step for query modules failed: {}", self.step, e.message),
+            step: self.step,
+        })?;
+        let is_query = |s: Sym| crate::draw::is_query(p.alphabet.name(s));
+        let count = self.word.syms().iter().filter(|s| is_query(**s)).count();
+        if count != answers.len() {
+            return Err(DeriveError {
+                span: None,
+                message: format!(
+                    "at step {}, the word has {count} query modules but its interpretation has {}: interpretation rules must not create or erase GetPos, GetHead, GetLeft or GetUp",
+                    self.step,
+                    answers.len()
+                ),
+                step: self.step,
+            });
+        }
+        let mut out = Word::new();
+        out.reserve(self.word.len(), self.word.slot_count());
+        let mut k = 0;
+        for i in 0..self.word.len() {
+            let s = self.word.sym(i);
+            if is_query(s) && self.word.data(i).len() == 3 {
+                out.push_raw(s, &answers[k]);
+                k += 1;
+            } else {
+                if is_query(s) {
+                    k += 1;
+                }
+                out.push_from(&self.word, i);
+            }
+        }
+        self.word = out;
+        Ok(())
+    }
+
+    fn queries_used(&self) -> bool {
+        let p = self.program;
+        p.rules_of(Section::Productions).any(|(_, r)| {
+            r.new_left
+                .iter()
+                .chain(&r.left)
+                .chain(&r.strict)
+                .chain(&r.right)
+                .chain(&r.new_right)
+                .any(|pat| crate::draw::is_query(p.alphabet.name(pat.sym)))
+        })
     }
 
     fn control(&mut self, kind: ControlKind) -> Result<(), DeriveError> {
@@ -222,6 +294,7 @@ impl<'p> Derivation<'p> {
         self.env.step = step as i64;
         self.step = step;
         self.decompose()?;
+        self.answer_queries()?;
         self.control(ControlKind::EndEach)?;
         Ok(())
     }
