@@ -157,19 +157,25 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
                 ));
             };
             let loaded = load(&file, &define)?;
-            let mut opts = subgram::FigureOptions::default();
-            opts.derive = DeriveOptions::default()
+            let mut derive = DeriveOptions::default()
                 .with_max_modules(max_modules)
                 .with_phase(phase);
-            opts.derive.steps = steps;
-            opts.each = each;
-            opts.render.width = size.0;
-            opts.render.height = size.1;
-            opts.render.background = background;
-            opts.render.view = match view {
-                ViewArg::Xy => subgram::render::View::Xy,
-                ViewArg::Xz => subgram::render::View::Xz,
-                ViewArg::Yz => subgram::render::View::Yz,
+            derive.steps = steps;
+            let opts = subgram::FigureOptions {
+                derive,
+                each,
+                draw: Default::default(),
+                render: subgram::render::RenderOptions {
+                    width: size.0,
+                    height: size.1,
+                    background,
+                    view: match view {
+                        ViewArg::Xy => subgram::render::View::Xy,
+                        ViewArg::Xz => subgram::render::View::Xz,
+                        ViewArg::Yz => subgram::render::View::Yz,
+                    },
+                    ..Default::default()
+                },
             };
             let scene = loaded
                 .figure(&opts)

@@ -199,7 +199,9 @@ fn fit_panel(
     let v = opts.view;
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    let mut finite = true;
     let mut grow = |p: DVec2, r: f64| {
+        finite &= p.is_finite() && r.is_finite();
         lo = lo.min(p - r);
         hi = hi.max(p + r);
     };
@@ -214,7 +216,7 @@ fn fit_panel(
             Event::Polygon { points, .. } => points.iter().for_each(|p| grow(v.project(*p), 0.0)),
         }
     }
-    if !(lo.is_finite() && hi.is_finite()) {
+    if !(finite && lo.is_finite() && hi.is_finite()) {
         return Err(RenderError::new(
             "the drawing has a NaN or infinite coordinate and cannot be fitted",
         ));

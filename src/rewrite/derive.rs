@@ -175,7 +175,10 @@ impl<'p> Derivation<'p> {
         )
         .map_err(|e| DeriveError {
             span: None,
-            message: format!("at step {}, the interpretation step for query modules failed: {}", self.step, e.message),
+            message: format!(
+                "at step {}, the interpretation step for query modules failed: {}",
+                self.step, e.message
+            ),
             step: self.step,
         })?;
         let is_query = |s: Sym| crate::draw::is_query(p.alphabet.name(s));

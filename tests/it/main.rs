@@ -4,5 +4,6 @@ mod cli;
 mod corpus;
 mod curves;
 mod errors;
+mod render;
 mod semantics;
 mod support;

@@ -1,0 +1,331 @@
+//! Pictures: the SVG's structure against what the word implies, PNGs
+//! against images that were looked at, fitting, and failures.
+
+use std::path::PathBuf;
+
+use subgram::render::{self, png, svg, Item, RenderOptions, Scene};
+use subgram::{DeriveOptions, FigureOptions};
+
+use crate::support::*;
+
+fn figure(path: &PathBuf, opts: FigureOptions) -> Scene {
+    let l = load(path);
+    l.figure(&opts)
+        .unwrap_or_else(|e| panic!("{}", l.render_figure_error(&e)))
+}
+
+fn sized(w: u32, h: u32) -> FigureOptions {
+    FigureOptions {
+        render: RenderOptions {
+            width: w,
+            height: h,
+            ..RenderOptions::default()
+        },
+        ..FigureOptions::default()
+    }
+}
+
+/// Segments (`L` commands), circles and polygons in an SVG document.
+fn svg_counts(doc: &str) -> (usize, usize, usize) {
+    let mut segments = 0;
+    for part in doc.split(" d=\"").skip(1) {
+        let d = &part[..part.find('"').unwrap()];
+        segments += d.matches('L').count();
+    }
+    (
+        segments,
+        doc.matches("<circle").count(),
+        doc.matches("<polygon").count(),
+    )
+}
+
+#[test]
+fn koch_svg_has_one_segment_per_f() {
+    let s = figure(&corpus("01-quadratic-Koch.l"), FigureOptions::default());
+    let (segments, circles, polygons) = svg_counts(&svg::render(&s));
+    assert_eq!((segments, circles, polygons), (4096, 0, 0));
+}
+
+#[test]
+fn b_spline_svg_has_a_sphere_and_a_line_per_point() {
+    // Interpretation: P -> MoveTo2f Sphere, P < E > P -> Line2f.
+    let s = figure(&corpus("B-spline.l"), FigureOptions::default());
+    let (segments, circles, _) = svg_counts(&svg::render(&s));
+    assert_eq!((segments, circles), (32, 32));
+}
+
+#[test]
+fn paper_program_1_draws_lines_and_circles() {
+    // 32 points: LineTo2f from the origin to the first point, then one
+    // line per point, and one Circle per point.
+    let s = figure(&lsys("paper/000-program1.lsys"), FigureOptions::default());
+    let (segments, circles, _) = svg_counts(&svg::render(&s));
+    assert_eq!((segments, circles), (32, 32));
+}
+
+#[test]
+fn polygons_come_from_sp_pp_ep() {
+    let src = "derivation length: 0;\nAxiom: SP PP F(1) Left(90) PP F(1) Left(90) PP EP \
+               MoveTo(5, 0, 0) SP PP F(1) Left(120) PP F(1) Left(120) PP EP;\n";
+    let l = load_text(src);
+    let s = l.figure(&FigureOptions::default()).unwrap();
+    let (segments, _, polygons) = svg_counts(&svg::render(&s));
+    assert_eq!((segments, polygons), (4, 2));
+}
+
+#[test]
+fn each_draws_every_step_side_by_side() {
+    let opts = FigureOptions {
+        each: true,
+        derive: DeriveOptions::default().with_steps(3),
+        ..sized(1200, 300)
+    };
+    let s = figure(&lsys("curves/chaikin-13.lsys"), opts);
+    // One closed curve per step: 6, 12, 24 and 48 segments.
+    let (segments, _, _) = svg_counts(&svg::render(&s));
+    assert_eq!(segments, 6 + 12 + 24 + 48);
+    // Panel k lies in the k-th quarter of the width.
+    let mut seen = [false; 4];
+    for item in &s.items {
+        if let Item::Polyline { points, .. } = item {
+            let k = (points[0].x / 300.0) as usize;
+            assert!(
+                points.iter().all(|p| (p.x / 300.0) as usize == k),
+                "a curve crosses panels"
+            );
+            seen[k] = true;
+        }
+    }
+    assert_eq!(seen, [true; 4]);
+}
+
+#[test]
+fn the_drawing_is_fitted_inside_the_margin() {
+    for (w, h) in [(800, 800), (800, 300), (300, 800)] {
+        let s = figure(&corpus("03-snowflake.l"), sized(w, h));
+        let m = 0.04 * w.min(h) as f64;
+        let (mut lo, mut hi) = (glam::DVec2::splat(f64::MAX), glam::DVec2::splat(f64::MIN));
+        for item in &s.items {
+            if let Item::Polyline { points, .. } = item {
+                for p in points {
+                    lo = lo.min(*p);
+                    hi = hi.max(*p);
+                }
+            }
+        }
+        let eps = 1e-6;
+        assert!(lo.x >= m - eps && lo.y >= m - eps, "{w}x{h}: {lo}");
+        assert!(
+            hi.x <= w as f64 - m + eps && hi.y <= h as f64 - m + eps,
+            "{w}x{h}: {hi}"
+        );
+        // It fills the available room in one direction, and is centred.
+        let fill_x = (hi.x - lo.x) / (w as f64 - 2.0 * m);
+        let fill_y = (hi.y - lo.y) / (h as f64 - 2.0 * m);
+        assert!(
+            (fill_x.max(fill_y) - 1.0).abs() < 1e-9,
+            "{w}x{h}: {fill_x} {fill_y}"
+        );
+        assert!(((lo.x + hi.x) / 2.0 - w as f64 / 2.0).abs() < 1e-9);
+        assert!(((lo.y + hi.y) / 2.0 - h as f64 / 2.0).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn circles_stay_round_at_any_aspect_ratio() {
+    let s = figure(&lsys("paper/000-program1.lsys"), sized(900, 300));
+    let doc = svg::render(&s);
+    assert!(doc.contains("<circle"));
+    assert!(!doc.contains("<ellipse"));
+    // The PNG disc is as wide as it is tall.
+    let disc = s
+        .items
+        .iter()
+        .find_map(|i| match i {
+            Item::Disc { c, r, .. } => Some((*c, *r)),
+            _ => None,
+        })
+        .unwrap();
+    let one = Scene {
+        items: vec![Item::Disc {
+            c: glam::DVec2::new(50.0, 50.0),
+            r: 20.0,
+            color: render::Rgba(0, 0, 0, 255),
+        }],
+        width: 100,
+        height: 100,
+        background: render::Rgba(255, 255, 255, 255),
+    };
+    let _ = disc;
+    let pm = tiny_skia::Pixmap::decode_png(&png::render(&one).unwrap()).unwrap();
+    let dark = |x: u32, y: u32| pm.pixel(x, y).unwrap().red() < 128;
+    let width = (0..100).filter(|&x| dark(x, 50)).count();
+    let height = (0..100).filter(|&y| dark(50, y)).count();
+    assert_eq!(width, height);
+    assert!((39..=41).contains(&width), "{width}");
+}
+
+#[test]
+fn png_and_svg_draw_the_same_scene() {
+    let s = figure(&lsys("curves/chaikin-13.lsys"), sized(200, 200));
+    let doc = svg::render(&s);
+    let pm = tiny_skia::Pixmap::decode_png(&png::render(&s).unwrap()).unwrap();
+    assert_eq!((pm.width(), pm.height()), (200, 200));
+    assert!(doc.contains("width=\"200\"") && doc.contains("viewBox=\"0 0 200 200\""));
+    // Every circle centre of the SVG is painted in the PNG.
+    for part in doc.split("<circle").skip(1) {
+        let num = |key: &str| -> f64 {
+            let at = part.find(key).unwrap() + key.len();
+            part[at..].split('"').next().unwrap().parse().unwrap()
+        };
+        let (x, y) = (num("cx=\""), num("cy=\""));
+        let p = pm.pixel(x as u32, y as u32).unwrap();
+        assert!(
+            p.red() < 250 || p.green() < 250 || p.blue() < 250,
+            "({x}, {y}) is blank"
+        );
+    }
+}
+
+/// Compares a PNG with a stored one that was looked at and found right.
+/// `UPDATE_GOLDEN=1` rewrites the stored image.
+fn check_golden(name: &str, bytes: &[u8]) {
+    let path = root().join("tests/golden").join(name);
+    if std::env::var_os("UPDATE_GOLDEN").is_some() {
+        std::fs::write(&path, bytes).unwrap();
+        return;
+    }
+    let want = tiny_skia::Pixmap::decode_png(&std::fs::read(&path).unwrap()).unwrap();
+    let got = tiny_skia::Pixmap::decode_png(bytes).unwrap();
+    assert_eq!((got.width(), got.height()), (want.width(), want.height()));
+    let mut total = 0u64;
+    let mut far = 0usize;
+    for (a, b) in got.pixels().iter().zip(want.pixels()) {
+        let d = [
+            a.red().abs_diff(b.red()),
+            a.green().abs_diff(b.green()),
+            a.blue().abs_diff(b.blue()),
+        ];
+        let m = *d.iter().max().unwrap();
+        total += m as u64;
+        if m > 64 {
+            far += 1;
+        }
+    }
+    let n = got.pixels().len();
+    assert!(
+        far * 200 < n,
+        "{name}: {far} of {n} pixels differ by more than 64"
+    );
+    assert!(
+        (total as f64 / n as f64) < 2.0,
+        "{name}: mean difference {}",
+        total as f64 / n as f64
+    );
+}
+
+#[test]
+fn png_matches_the_stored_chaikin_figure() {
+    let s = figure(&lsys("curves/chaikin-13.lsys"), sized(240, 240));
+    check_golden("chaikin-13.png", &png::render(&s).unwrap());
+}
+
+#[test]
+fn png_matches_the_stored_kolam() {
+    let s = figure(&lsys("figures/fig10-kolam.lsys"), sized(240, 240));
+    check_golden("fig10-kolam.png", &png::render(&s).unwrap());
+}
+
+#[test]
+fn png_matches_the_stored_fern() {
+    let s = figure(&corpus("07-fractal-ferns.l"), sized(240, 240));
+    check_golden("07-fractal-ferns.png", &png::render(&s).unwrap());
+}
+
+#[test]
+fn an_empty_drawing_is_an_error() {
+    let l = load_text("module A;\nderivation length: 1;\nAxiom: A;\n");
+    let e = l.figure(&FigureOptions::default()).unwrap_err();
+    assert_eq!(
+        l.render_figure_error(&e),
+        "error: nothing to draw: after interpretation the word has no drawing modules (F, LineTo2f, Circle, ...)"
+    );
+}
+
+#[test]
+fn a_nan_coordinate_is_an_error() {
+    let nan = subgram::draw::Event::Line {
+        a: glam::DVec3::ZERO,
+        b: glam::DVec3::new(f64::NAN, 0.0, 0.0),
+        pen: subgram::draw::Pen {
+            color: 1,
+            width: 1.0,
+        },
+    };
+    let e = render::scene(&[vec![nan]], &RenderOptions::default()).unwrap_err();
+    assert!(
+        e.message.contains("NaN or infinite coordinate"),
+        "{}",
+        e.message
+    );
+}
+
+fn subgram_bin(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn render_writes_png_and_svg_files() {
+    let dir = std::env::temp_dir().join(format!("subgram-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = lsys("curves/chaikin-13.lsys");
+    for ext in ["png", "svg"] {
+        let out = dir.join(format!("c.{ext}"));
+        let o = subgram_bin(&[
+            "render",
+            f.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--size",
+            "300x200",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let bytes = std::fs::read(&out).unwrap();
+        if ext == "png" {
+            let pm = tiny_skia::Pixmap::decode_png(&bytes).unwrap();
+            assert_eq!((pm.width(), pm.height()), (300, 200));
+        } else {
+            assert!(String::from_utf8(bytes).unwrap().starts_with("<svg"));
+        }
+    }
+    // Only the two outputs: no temporary files left behind.
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2);
+}
+
+#[test]
+fn a_failed_render_leaves_no_file() {
+    let dir = std::env::temp_dir().join(format!("subgram-render-fail-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("empty.lsys");
+    std::fs::write(&bad, "module A;\nAxiom: A;\n").unwrap();
+    let out = dir.join("x.png");
+    let o = subgram_bin(&["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("nothing to draw"));
+    assert!(!out.exists());
+    let o = subgram_bin(&[
+        "render",
+        bad.to_str().unwrap(),
+        "-o",
+        dir.join("x.jpg").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        1,
+        "only the input remains"
+    );
+}
