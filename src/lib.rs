@@ -144,7 +144,8 @@ pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Loaded, Lo
         Err(e) => return Err(fail(sources, e)),
     };
     let eof = Span::new(main, text.len(), text.len());
-    let file = match parse::parse_file(&tokens, eof) {
+    let predefined: Vec<&str> = lang::modules::PREDEFINED.iter().map(|(n, _)| *n).collect();
+    let file = match parse::parse_file(&tokens, eof, &predefined) {
         Ok(f) => f,
         Err(e) => return Err(fail(sources, e)),
     };
@@ -201,10 +202,14 @@ impl Loaded {
     pub fn figure(&self, opts: &FigureOptions) -> Result<render::Scene, FigureError> {
         let p = &self.program;
         let mut d = Derivation::new(p, opts.derive.clone()).map_err(FigureError::Derive)?;
+        let mut draw_opts = opts.draw.clone();
+        if let Some(a) = d.angle().map_err(FigureError::Derive)? {
+            draw_opts.angle = a;
+        }
         let mut panels = Vec::new();
         let mut panel = |d: &mut Derivation| -> Result<(), FigureError> {
             let word = d.interpret().map_err(FigureError::Derive)?;
-            let events = draw::draw(&word, &p.alphabet, &p.structs, &opts.draw)
+            let events = draw::draw(&word, &p.alphabet, &p.structs, &draw_opts)
                 .map_err(FigureError::Draw)?;
             panels.push(events);
             Ok(())

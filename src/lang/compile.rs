@@ -22,6 +22,9 @@ pub fn compile(file: &ast::File) -> Result<Program, Vec<Diagnostic>> {
         diags: Vec::new(),
     };
     c.declarations(file);
+    if file.abop {
+        c.declare_from_use(file);
+    }
     let program = c.rules_and_directives(file);
     if c.diags.is_empty() {
         Ok(program)
@@ -171,6 +174,63 @@ impl Compiler {
         }
     }
 
+    /// Turtle mode (The Algorithmic Beauty of Plants): a module used but not
+    /// declared is declared with as many float parameters as its first use.
+    fn declare_from_use(&mut self, file: &ast::File) {
+        fn stmts(ss: &[ast::Stmt], out: &mut Vec<(String, usize)>) {
+            for s in ss {
+                match s {
+                    ast::Stmt::Produce { modules, .. } => {
+                        out.extend(modules.iter().map(|m| (m.name.text.clone(), m.args.len())))
+                    }
+                    ast::Stmt::Block(b) => stmts(&b.stmts, out),
+                    ast::Stmt::If { then, els, .. } => {
+                        stmts(std::slice::from_ref(then), out);
+                        if let Some(e) = els {
+                            stmts(std::slice::from_ref(e), out);
+                        }
+                    }
+                    ast::Stmt::While { body, .. }
+                    | ast::Stmt::DoWhile { body, .. }
+                    | ast::Stmt::For { body, .. } => stmts(std::slice::from_ref(body), out),
+                    _ => {}
+                }
+            }
+        }
+        let mut used: Vec<(String, usize)> = Vec::new();
+        for item in &file.items {
+            match item {
+                Item::Axiom { modules, .. } => {
+                    used.extend(modules.iter().map(|m| (m.name.text.clone(), m.args.len())))
+                }
+                Item::Production(p) => {
+                    for m in p
+                        .new_left
+                        .iter()
+                        .chain(&p.left)
+                        .chain(&p.strict)
+                        .chain(&p.right)
+                        .chain(&p.new_right)
+                    {
+                        used.push((m.name.text.clone(), m.params.len()));
+                    }
+                    match &p.body {
+                        ast::Body::Arrow(succ, _) => {
+                            used.extend(succ.iter().map(|m| (m.name.text.clone(), m.args.len())))
+                        }
+                        ast::Body::Block(b) => stmts(&b.stmts, &mut used),
+                    }
+                }
+                _ => {}
+            }
+        }
+        for (name, arity) in used {
+            if self.alphabet.lookup(&name).is_none() {
+                self.alphabet.declare(&name, vec![Ty::Float; arity]);
+            }
+        }
+    }
+
     fn rules_and_directives(&mut self, file: &ast::File) -> Program {
         let mut program = Program {
             alphabet: Alphabet::new(),
@@ -181,6 +241,7 @@ impl Compiler {
             ring: None,
             decomposition_depth: None,
             interpretation_depth: None,
+            angle: None,
             rules: Vec::new(),
             control: Vec::new(),
         };
@@ -208,6 +269,7 @@ impl Compiler {
                     }
                     let slot = match kind {
                         ast::DirectiveKind::DerivationLength => &mut program.derivation_length,
+                        ast::DirectiveKind::Angle => &mut program.angle,
                         ast::DirectiveKind::Ring => &mut program.ring,
                         ast::DirectiveKind::MaximumDepth => match section {
                             Section::Interpretation => &mut program.interpretation_depth,

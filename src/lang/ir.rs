@@ -170,6 +170,8 @@ pub struct Program {
     pub ring: Option<Ex>,
     pub decomposition_depth: Option<Ex>,
     pub interpretation_depth: Option<Ex>,
+    /// `angle:`: the turn of `+ - & ^ \ /` and of `Left()` without argument.
+    pub angle: Option<Ex>,
     pub rules: Vec<Rule>,
     pub control: Vec<(ControlKind, Vec<St>, usize)>,
 }

@@ -405,6 +405,18 @@ impl<'p> Derivation<'p> {
         Ok(word)
     }
 
+    /// The value of `angle:`, if the program sets it.
+    pub fn angle(&mut self) -> Result<Option<f64>, DeriveError> {
+        let Some(e) = &self.program.angle else {
+            return Ok(None);
+        };
+        let mut interp = Interp::new(&self.program.structs);
+        let v = interp
+            .eval_global(e, &mut self.env)
+            .map_err(|e| runtime(e, None, self.step))?;
+        Ok(Some(v.as_f64()))
+    }
+
     /// The word after interpretation rules: what the turtle draws.
     pub fn interpret(&mut self) -> Result<Word, DeriveError> {
         let depth = self.depth(Section::Interpretation)?;

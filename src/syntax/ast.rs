@@ -19,6 +19,10 @@ pub struct TypeRef {
 #[derive(Clone, Debug, PartialEq)]
 pub struct File {
     pub items: Vec<Item>,
+    /// The file uses the single-character turtle of The Algorithmic Beauty
+    /// of Plants (it has an `angle:` directive): `F+F[-X]` is a module list,
+    /// and undeclared modules are declared from their use.
+    pub abop: bool,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -79,6 +83,8 @@ pub enum Item {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DirectiveKind {
     DerivationLength,
+    /// `angle: 90;`, the turning angle of `+ - & ^ \ /`.
+    Angle,
     Ring,
     MaximumDepth,
 }

@@ -15,6 +15,12 @@ const TYPE_KEYWORDS: &[&str] = &[
 pub struct Parser<'t> {
     toks: &'t [Token],
     pos: usize,
+    /// Single-character turtle mode, switched on by `angle:`.
+    abop: bool,
+    /// Names that are never split into characters in that mode.
+    whole_names: Vec<String>,
+    /// The last character of a split identifier, read in its place.
+    split_last: Option<(usize, Name)>,
     /// Struct and typedef names seen so far.
     type_names: Vec<String>,
     eof: Span,
@@ -22,10 +28,25 @@ pub struct Parser<'t> {
 
 type PResult<T> = Result<T, Diagnostic>;
 
-pub fn parse_file(toks: &[Token], eof: Span) -> PResult<File> {
+pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<File> {
+    // `angle:` anywhere switches on the single-character turtle.
+    let abop = toks
+        .windows(2)
+        .any(|w| w[0].line_start && w[0].tok.is_ident("angle") && w[1].tok.is_punct(":"));
+    let mut whole_names: Vec<String> = predefined.iter().map(|s| s.to_string()).collect();
+    for w in toks.windows(2) {
+        if let (Tok::Ident(m), Tok::Ident(n)) = (&w[0].tok, &w[1].tok) {
+            if m == "module" {
+                whole_names.push(n.clone());
+            }
+        }
+    }
     let mut p = Parser {
         toks,
         pos: 0,
+        abop,
+        whole_names,
+        split_last: None,
         type_names: Vec::new(),
         eof,
     };
@@ -33,7 +54,7 @@ pub fn parse_file(toks: &[Token], eof: Span) -> PResult<File> {
     while !p.at_end() {
         p.item(&mut items)?;
     }
-    Ok(File { items })
+    Ok(File { items, abop })
 }
 
 impl<'t> Parser<'t> {
@@ -107,6 +128,12 @@ impl<'t> Parser<'t> {
     }
 
     fn name(&mut self, what: &str) -> PResult<Name> {
+        if let Some((at, last)) = self.split_last.take() {
+            if at == self.pos {
+                self.pos += 1;
+                return Ok(last);
+            }
+        }
         match self.peek() {
             Some(Token {
                 tok: Tok::Ident(s),
@@ -159,6 +186,10 @@ impl<'t> Parser<'t> {
                     self.pos += 2;
                     return self.directive(items, DirectiveKind::DerivationLength, start);
                 }
+                "angle" if next_colon => {
+                    self.pos += 1;
+                    return self.directive(items, DirectiveKind::Angle, start);
+                }
                 "maximum" if self.peek_at(1).is_some_and(|n| n.tok.is_ident("depth")) => {
                     self.pos += 2;
                     return self.directive(items, DirectiveKind::MaximumDepth, start);
@@ -177,14 +208,10 @@ impl<'t> Parser<'t> {
                     self.pos += 2;
                     let mut modules = Vec::new();
                     while !self.eat_punct(";") {
-                        let at_module = matches!(
-                            self.peek().map(|t| &t.tok),
-                            Some(Tok::Ident(_)) | Some(Tok::Punct("#"))
-                        );
-                        if !at_module {
+                        if !self.at_module() {
                             return self.error("a module or the `;` that ends the axiom");
                         }
-                        modules.push(self.module_call()?);
+                        self.module_call_into(&mut modules)?;
                     }
                     items.push(Item::Axiom {
                         modules,
@@ -488,8 +515,29 @@ impl<'t> Parser<'t> {
                 }
                 Tok::Punct(":") | Tok::Punct("->") => break,
                 Tok::Ident(_) | Tok::Punct("#") => {
+                    let group = groups.last_mut().expect("non-empty");
+                    match self.abop_split() {
+                        Some(names) => group.extend(names.into_iter().map(|name| PatModule {
+                            name,
+                            params: Vec::new(),
+                        })),
+                        None => {}
+                    }
                     let m = self.pat_module()?;
                     groups.last_mut().expect("non-empty").push(m);
+                }
+                Tok::Punct(p) if self.abop && abop_punct(p).is_some() => {
+                    let span = t.span;
+                    self.pos += 1;
+                    for n in abop_punct(p).expect("checked") {
+                        groups.last_mut().expect("non-empty").push(PatModule {
+                            name: Name {
+                                text: n.to_string(),
+                                span,
+                            },
+                            params: Vec::new(),
+                        });
+                    }
                 }
                 _ => {
                     return self.error(
@@ -641,16 +689,91 @@ impl<'t> Parser<'t> {
             if stops.iter().any(|s| t.tok.is_punct(s)) || (allow_close && t.tok.is_punct("}")) {
                 return Ok(out);
             }
-            out.push(self.module_call()?);
+            self.module_call_into(&mut out)?;
         }
     }
 
     fn module_calls_until(&mut self, end: usize) -> PResult<Vec<ModuleCall>> {
         let mut out = Vec::new();
         while self.pos < end {
-            out.push(self.module_call()?);
+            self.module_call_into(&mut out)?;
         }
         Ok(out)
+    }
+
+    fn at_module(&self) -> bool {
+        match self.peek().map(|t| &t.tok) {
+            Some(Tok::Ident(_)) | Some(Tok::Punct("#")) => true,
+            Some(Tok::Punct(p)) => self.abop && abop_punct(p).is_some(),
+            _ => false,
+        }
+    }
+
+    /// In turtle mode, an identifier such as `FX` that names no declared or
+    /// predefined module stands for one module per character. Consumes all
+    /// characters but the last and returns them; the caller parses the last
+    /// one with its arguments.
+    fn abop_split(&mut self) -> Option<Vec<Name>> {
+        if !self.abop {
+            return None;
+        }
+        let t = self.peek()?;
+        let Tok::Ident(s) = &t.tok else { return None };
+        if s.len() < 2 || self.whole_names.iter().any(|w| w == s) || !s.is_ascii() {
+            return None;
+        }
+        let start = t.span.start as usize;
+        let file = t.span.file;
+        let names: Vec<Name> = s
+            .char_indices()
+            .map(|(k, c)| Name {
+                text: c.to_string(),
+                span: Span::new(file, start + k, start + k + 1),
+            })
+            .collect();
+        // Replace the token by its last character, so the usual parsing of
+        // `X(args)` applies to it.
+        let last = names.last().cloned()?;
+        self.split_last = Some((self.pos, last));
+        Some(names[..names.len() - 1].to_vec())
+    }
+
+    /// One module, or in turtle mode possibly several (`FX`, `--`).
+    fn module_call_into(&mut self, out: &mut Vec<ModuleCall>) -> PResult<()> {
+        if self.abop {
+            if let Some(Tok::Punct(p)) = self.peek().map(|t| &t.tok) {
+                if let Some(names) = abop_punct(p) {
+                    let span = self.bump().span;
+                    for (k, n) in names.iter().enumerate() {
+                        let args = if k + 1 == names.len()
+                            && self.peek_punct("(")
+                            && !self.toks[self.pos].space_before
+                        {
+                            self.pos += 1;
+                            self.args(")")?
+                        } else {
+                            Vec::new()
+                        };
+                        out.push(ModuleCall {
+                            name: Name {
+                                text: n.to_string(),
+                                span,
+                            },
+                            args,
+                        });
+                    }
+                    return Ok(());
+                }
+            }
+            if let Some(names) = self.abop_split() {
+                out.extend(names.into_iter().map(|name| ModuleCall {
+                    name,
+                    args: Vec::new(),
+                }));
+            }
+        }
+        out.push(self.module_call()?);
+        Ok(())
     }
 
     fn module_call(&mut self) -> PResult<ModuleCall> {
@@ -1060,6 +1183,27 @@ impl<'t> Parser<'t> {
             span: span.to(self.prev_span()),
         })
     }
+}
+
+/// The turtle modules of The Algorithmic Beauty of Plants' characters.
+/// A doubled operator such as `--` is lexed as one token and means two.
+fn abop_punct(p: &str) -> Option<&'static [&'static str]> {
+    Some(match p {
+        "+" => &["Left"],
+        "-" => &["Right"],
+        "++" => &["Left", "Left"],
+        "--" => &["Right", "Right"],
+        "&" => &["Down"],
+        "&&" => &["Down", "Down"],
+        "^" => &["Up"],
+        "\\" => &["RollL"],
+        "/" => &["RollR"],
+        "|" => &["TurnAround"],
+        "||" => &["TurnAround", "TurnAround"],
+        "[" => &["SB"],
+        "]" => &["EB"],
+        _ => return None,
+    })
 }
 
 fn binop_of(t: &Tok) -> Option<(BinOp, u8)> {
