@@ -114,7 +114,19 @@ enum Format {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli) {
+    // Deep but legal programs recurse deeply in the checker and the
+    // interpreter: give them a large stack rather than a crash.
+    let worker = std::thread::Builder::new()
+        .stack_size(256 << 20)
+        .spawn(move || run(cli));
+    let result = match worker.map(|h| h.join()) {
+        Ok(Ok(r)) => r,
+        _ => Err((
+            1,
+            "error: internal failure (this is a bug in subgram)".to_string(),
+        )),
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err((code, message)) => {
             eprintln!("{message}");
@@ -157,6 +169,7 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
                 ));
             };
             let loaded = load(&file, &define)?;
+            check_steps(steps)?;
             let mut derive = DeriveOptions::default()
                 .with_max_modules(max_modules)
                 .with_phase(phase);
@@ -199,6 +212,7 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
             interpreted,
         } => {
             let loaded = load(&file, &define)?;
+            check_steps(steps)?;
             let mut opts = DeriveOptions::default()
                 .with_max_modules(max_modules)
                 .with_phase(phase);
@@ -243,5 +257,19 @@ fn print_out(text: &str) -> Result<(), (u8, String)> {
         Ok(()) => Ok(()),
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
         Err(e) => Err((1, format!("error: cannot write the output: {e}"))),
+    }
+}
+
+/// `-n` beyond the engine's limit is a usage error.
+fn check_steps(steps: Option<u64>) -> Result<(), (u8, String)> {
+    match steps {
+        Some(n) if n > subgram::rewrite::derive::MAX_STEPS => Err((
+            2,
+            format!(
+                "error: -n {n} is beyond the limit of {} steps",
+                subgram::rewrite::derive::MAX_STEPS
+            ),
+        )),
+        _ => Ok(()),
     }
 }

@@ -279,7 +279,7 @@ impl Compiler {
                     if slot.is_some() {
                         self.err(*span, "this directive is given twice");
                     }
-                    *slot = Some(ex);
+                    *slot = Some((ex, *span));
                 }
                 Item::Axiom { modules, span } => {
                     if axiom_seen {
@@ -709,6 +709,7 @@ impl Compiler {
             out.push(Succ {
                 sym,
                 args,
+                types: want,
                 span: m.name.span,
             });
         }
@@ -751,7 +752,7 @@ impl Compiler {
                     out.push(St::If(c, Box::new(t), e));
                 }
             }
-            ast::Stmt::While { cond, body } => {
+            ast::Stmt::While { cond, body, span } => {
                 let c = self.condition(cond, scope);
                 scope.loops += 1;
                 let b = self.sub_stmt(body, scope);
@@ -762,11 +763,11 @@ impl Compiler {
                         body: Box::new(b),
                         step: None,
                         test_after: false,
-                        span: cond.span,
+                        span: *span,
                     });
                 }
             }
-            ast::Stmt::DoWhile { body, cond } => {
+            ast::Stmt::DoWhile { body, cond, span } => {
                 scope.loops += 1;
                 let b = self.sub_stmt(body, scope);
                 scope.loops -= 1;
@@ -776,7 +777,7 @@ impl Compiler {
                         body: Box::new(b),
                         step: None,
                         test_after: true,
-                        span: cond.span,
+                        span: *span,
                     });
                 }
             }
@@ -785,6 +786,7 @@ impl Compiler {
                 cond,
                 step,
                 body,
+                span,
             } => {
                 scope.push();
                 let mut stmts = Vec::new();
@@ -800,13 +802,12 @@ impl Compiler {
                 let b = self.sub_stmt(body, scope);
                 scope.loops -= 1;
                 scope.pop();
-                let span = cond.as_ref().map(|c| c.span).unwrap_or_default();
                 stmts.push(St::Loop {
                     cond: c,
                     body: Box::new(b),
                     step: st,
                     test_after: false,
-                    span,
+                    span: *span,
                 });
                 out.push(St::Block(stmts));
             }
@@ -1027,7 +1028,7 @@ impl Compiler {
                 let ex = match op {
                     BinOp::And => Ex::Logic(true, Box::new(lx), Box::new(rx)),
                     BinOp::Or => Ex::Logic(false, Box::new(lx), Box::new(rx)),
-                    _ => Ex::Bin(*op, Box::new(lx), Box::new(rx)),
+                    _ => Ex::Bin(*op, Box::new(lx), Box::new(rx), span),
                 };
                 Some((ex, ty))
             }

@@ -299,10 +299,10 @@ impl<'p> Interp<'p> {
                 other => other,
             },
             Ex::Not(a) => Value::Bool(!self.expr(a, cx)?.truthy()),
-            Ex::Bin(op, a, b) => {
+            Ex::Bin(op, a, b, span) => {
                 let x = self.expr(a, cx)?;
                 let y = self.expr(b, cx)?;
-                binary(*op, x, y).map_err(|m| RuntimeError::new(None, m))?
+                binary(*op, x, y).map_err(|m| RuntimeError::new(Some(*span), m))?
             }
             Ex::Logic(and, a, b) => {
                 let x = self.expr(a, cx)?.truthy();

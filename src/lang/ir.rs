@@ -19,7 +19,8 @@ pub enum Ex {
     Field(Box<Ex>, u16),
     Neg(Box<Ex>),
     Not(Box<Ex>),
-    Bin(BinOp, Box<Ex>, Box<Ex>),
+    /// The span locates a division by zero.
+    Bin(BinOp, Box<Ex>, Box<Ex>, Span),
     /// Short-circuit `&&` (`and == true`) and `||`.
     Logic(bool, Box<Ex>, Box<Ex>),
     Cond(Box<Ex>, Box<Ex>, Box<Ex>),
@@ -94,6 +95,8 @@ pub enum St {
 pub struct Succ {
     pub sym: Sym,
     pub args: Vec<Ex>,
+    /// The declared type of each argument (the arguments convert to it).
+    pub types: Vec<Ty>,
     pub span: Span,
 }
 
@@ -166,12 +169,13 @@ pub struct Program {
     pub structs: Vec<StructDef>,
     pub globals: Vec<GlobalVar>,
     pub axiom: Vec<Succ>,
-    pub derivation_length: Option<Ex>,
-    pub ring: Option<Ex>,
-    pub decomposition_depth: Option<Ex>,
-    pub interpretation_depth: Option<Ex>,
+    /// The directives, each with the span of the whole directive.
+    pub derivation_length: Option<(Ex, Span)>,
+    pub ring: Option<(Ex, Span)>,
+    pub decomposition_depth: Option<(Ex, Span)>,
+    pub interpretation_depth: Option<(Ex, Span)>,
     /// `angle:`: the turn of `+ - & ^ \ /` and of `Left()` without argument.
-    pub angle: Option<Ex>,
+    pub angle: Option<(Ex, Span)>,
     pub rules: Vec<Rule>,
     pub control: Vec<(ControlKind, Vec<St>, usize)>,
 }

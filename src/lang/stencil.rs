@@ -8,14 +8,43 @@ use super::ir::{Ex, Rule, St};
 use super::modules::Sym;
 use super::value::{Ty, Value};
 
-/// One output parameter: `constant + Σ weight · (the parameter at slot
-/// offset `off` of matched module `k`)`, componentwise for vectors.
+/// One term of a sum: `w * x`, `x / w`, or the constant `w`, negated when
+/// `negate` (a unary minus), added or subtracted (`sub`) to what precedes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Term {
+    /// `(k, off)`: the parameter at slot offset `off` of matched module `k`,
+    /// modules counted over left context, strict predecessor, right context.
+    /// `None` for a constant.
+    pub source: Option<(u16, u16)>,
+    pub w: f64,
+    pub div: bool,
+    pub negate: bool,
+    pub sub: bool,
+}
+
+impl Term {
+    /// The term's value for one component `x` of its source.
+    #[inline(always)]
+    pub fn apply(&self, x: f64) -> f64 {
+        let v = match (self.source, self.div) {
+            (None, _) => self.w,
+            (Some(_), true) => x / self.w,
+            (Some(_), false) => self.w * x,
+        };
+        if self.negate {
+            -v
+        } else {
+            v
+        }
+    }
+}
+
+/// One output parameter: a sum of terms, evaluated left to right with
+/// exactly the operations the interpreter would perform, so that the fast
+/// path and the interpreter agree to the last bit.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Combination {
-    /// `(k, off, weight)`, with modules counted over left context, strict
-    /// predecessor, right context.
-    pub terms: Vec<(u16, u16, f64)>,
-    pub constant: f64,
+    pub terms: Vec<Term>,
     pub ty: Ty,
 }
 
@@ -24,79 +53,90 @@ pub struct Stencil {
     pub outputs: Vec<(Sym, Vec<Combination>)>,
 }
 
-/// An affine form over local slots, with a scalar constant.
-#[derive(Clone, Debug, Default)]
-struct Affine {
-    terms: Vec<(u16, f64)>,
-    constant: f64,
-}
-
-impl Affine {
-    fn scale(mut self, s: f64) -> Affine {
-        for t in &mut self.terms {
-            t.1 *= s;
-        }
-        self.constant *= s;
-        self
-    }
-
-    fn add(mut self, other: Affine, sign: f64) -> Affine {
-        for (slot, w) in other.terms {
-            match self.terms.iter_mut().find(|t| t.0 == slot) {
-                Some(t) => t.1 += sign * w,
-                None => self.terms.push((slot, sign * w)),
-            }
-        }
-        self.constant += sign * other.constant;
-        self
-    }
-
-    fn constant(&self) -> Option<f64> {
-        self.terms.is_empty().then_some(self.constant)
-    }
-}
-
-fn affine(e: &Ex, slot_ty: &[Ty]) -> Option<Affine> {
+/// The value of a constant expression, computed with the interpreter's own
+/// operations.
+fn constant(e: &Ex) -> Option<Value> {
     match e {
-        Ex::Const(Value::Int(i)) => Some(Affine {
-            terms: vec![],
-            constant: *i as f64,
-        }),
-        Ex::Const(Value::Float(f)) => Some(Affine {
-            terms: vec![],
-            constant: *f,
-        }),
-        Ex::Local(s) => {
-            let ty = *slot_ty.get(*s as usize)?;
-            matches!(ty, Ty::Float | Ty::V2 | Ty::V3).then(|| Affine {
-                terms: vec![(*s, 1.0)],
-                constant: 0.0,
-            })
-        }
-        Ex::Convert(Ty::Float, a) => {
-            let a = affine(a, slot_ty)?;
-            a.constant().map(|c| Affine {
-                terms: vec![],
-                constant: c,
-            })
-        }
-        Ex::Neg(a) => Some(affine(a, slot_ty)?.scale(-1.0)),
-        Ex::Bin(op, a, b) => {
-            let (x, y) = (affine(a, slot_ty)?, affine(b, slot_ty)?);
-            match op {
-                BinOp::Add => Some(x.add(y, 1.0)),
-                BinOp::Sub => Some(x.add(y, -1.0)),
-                BinOp::Mul => match (x.constant(), y.constant()) {
-                    (Some(c), _) => Some(y.scale(c)),
-                    (_, Some(c)) => Some(x.scale(c)),
-                    _ => None,
-                },
-                BinOp::Div => y.constant().filter(|c| *c != 0.0).map(|c| x.scale(1.0 / c)),
-                _ => None,
-            }
+        Ex::Const(v @ (Value::Int(_) | Value::Float(_))) => Some(v.clone()),
+        Ex::Neg(a) => match constant(a)? {
+            Value::Int(i) => Some(Value::Int(i.wrapping_neg())),
+            Value::Float(f) => Some(Value::Float(-f)),
+            _ => None,
+        },
+        Ex::Convert(t @ (Ty::Int | Ty::Float), a) => Some(constant(a)?.convert(*t)),
+        Ex::Bin(op @ (BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div), a, b, _) => {
+            super::eval::binary(*op, constant(a)?, constant(b)?).ok()
         }
         _ => None,
     }
+}
+
+/// A local slot of a float or vector pattern parameter.
+fn slot(e: &Ex, slot_ty: &[Ty]) -> Option<u16> {
+    match e {
+        Ex::Local(s) if matches!(slot_ty.get(*s as usize), Some(Ty::Float | Ty::V2 | Ty::V3)) => {
+            Some(*s)
+        }
+        _ => None,
+    }
+}
+
+/// A slot under any number of unary minuses: `x`, `-x`, `--x`. Negation
+/// commutes exactly with multiplication and division by a constant.
+fn signed_slot(e: &Ex, slot_ty: &[Ty]) -> Option<(u16, bool)> {
+    match e {
+        Ex::Neg(a) => signed_slot(a, slot_ty).map(|(s, n)| (s, !n)),
+        _ => slot(e, slot_ty).map(|s| (s, false)),
+    }
+}
+
+/// A term: `x`, `c*x`, `x*c`, `x/c`, `c`, `-term`. Slots are local slots
+/// here; `compile` maps them to matched modules.
+fn term(e: &Ex, slot_ty: &[Ty]) -> Option<(Option<u16>, f64, bool, bool)> {
+    if let Some(c) = constant(e) {
+        return Some((None, c.as_f64(), false, false));
+    }
+    if let Some(s) = slot(e, slot_ty) {
+        return Some((Some(s), 1.0, false, false));
+    }
+    match e {
+        Ex::Neg(a) => {
+            let (s, w, div, neg) = term(a, slot_ty)?;
+            Some((s, w, div, !neg))
+        }
+        Ex::Bin(BinOp::Mul, a, b, _) => match (
+            constant(a),
+            signed_slot(b, slot_ty),
+            signed_slot(a, slot_ty),
+            constant(b),
+        ) {
+            (Some(c), Some((s, n)), _, _) | (_, _, Some((s, n)), Some(c)) => {
+                Some((Some(s), c.as_f64(), false, n))
+            }
+            _ => None,
+        },
+        Ex::Bin(BinOp::Div, a, b, _) => {
+            let c = constant(b)?.as_f64();
+            let (s, n) = signed_slot(a, slot_ty)?;
+            Some((Some(s), c, true, n))
+        }
+        _ => None,
+    }
+}
+
+/// A sum `term (+|- term)*`, left-associated as the parser builds it.
+fn sum(e: &Ex, slot_ty: &[Ty], out: &mut Vec<(Option<u16>, f64, bool, bool, bool)>) -> Option<()> {
+    if constant(e).is_none() {
+        if let Ex::Bin(op @ (BinOp::Add | BinOp::Sub), a, b, _) = e {
+            sum(a, slot_ty, out)?;
+            let (s, w, div, neg) = term(b, slot_ty)?;
+            out.push((s, w, div, neg, *op == BinOp::Sub));
+            return Some(());
+        }
+    }
+    let (s, w, div, neg) = term(e, slot_ty)?;
+    out.push((s, w, div, neg, false));
+    Some(())
 }
 
 impl Stencil {
@@ -140,45 +180,37 @@ impl Stencil {
         let mut outputs = Vec::new();
         for m in modules {
             let mut combos = Vec::new();
-            for a in &m.args {
-                let (ex, ty) = match a {
-                    Ex::Convert(t, inner) => (inner.as_ref(), *t),
-                    other => (other, Ty::Void),
-                };
-                let aff = affine(ex, &slot_ty)?;
-                // The result type is the type of its slot terms (all equal).
-                let term_ty = aff.terms.iter().map(|(s, _)| slot_ty[*s as usize]).fold(
-                    None,
-                    |acc: Option<Ty>, t| match acc {
-                        None => Some(t),
-                        Some(a) if a == t => Some(a),
-                        Some(_) => Some(Ty::Void),
-                    },
-                );
-                let ty = match (term_ty, ty) {
-                    (Some(Ty::Void), _) => return None,
-                    (Some(t @ (Ty::V2 | Ty::V3)), _) => {
-                        if aff.constant != 0.0 {
-                            return None;
-                        }
-                        t
+            for (a, want) in m.args.iter().zip(&m.types) {
+                let mut raw = Vec::new();
+                sum(a, &slot_ty, &mut raw)?;
+                // The result type: the type of the slots in the sum, all
+                // equal; a vector sum may not add scalar constants.
+                let mut ty = None;
+                for (s, ..) in &raw {
+                    let t = match s {
+                        Some(s) => slot_ty[*s as usize],
+                        None => Ty::Float,
+                    };
+                    if ty.is_some_and(|u| u != t) {
+                        return None;
                     }
-                    (Some(Ty::Float), Ty::Void | Ty::Float) | (None, Ty::Float) => Ty::Float,
-                    _ => return None,
-                };
-                let terms = aff
-                    .terms
+                    ty = Some(t);
+                }
+                let ty = ty?;
+                if ty != *want {
+                    return None;
+                }
+                let terms = raw
                     .iter()
-                    .map(|&(slot, w)| {
-                        let (k, j) = sources[slot as usize];
-                        (k, j, w)
+                    .map(|&(s, w, div, negate, sub)| Term {
+                        source: s.map(|s| sources[s as usize]),
+                        w,
+                        div,
+                        negate,
+                        sub,
                     })
                     .collect();
-                combos.push(Combination {
-                    terms,
-                    constant: aff.constant,
-                    ty,
-                });
+                combos.push(Combination { terms, ty });
             }
             outputs.push((m.sym, combos));
         }

@@ -35,6 +35,8 @@ impl Default for DeriveOptions {
 pub const DEFAULT_MAX_MODULES: usize = 20_000_000;
 /// Derivation lengths beyond this are refused as runaway.
 pub const MAX_STEPS: u64 = 1_000_000;
+/// Decomposition and interpretation depths beyond this are refused.
+pub const MAX_DEPTH: u64 = 10_000;
 
 impl DeriveOptions {
     pub fn with_steps(mut self, n: u64) -> Self {
@@ -102,25 +104,37 @@ impl<'p> Derivation<'p> {
             };
             env.globals.push(v);
         }
+        type Directive = Option<(crate::lang::ir::Ex, Span)>;
         let mut number =
-            |e: &Option<crate::lang::ir::Ex>, env: &mut Env| -> Result<Option<f64>, DeriveError> {
+            |e: &Directive, env: &mut Env| -> Result<Option<(f64, Span)>, DeriveError> {
                 match e {
-                    Some(e) => Ok(Some(
-                        interp
+                    Some((e, span)) => {
+                        let v = interp
                             .eval_global(e, env)
-                            .map_err(|e| runtime(e, None, 0))?
-                            .as_f64(),
-                    )),
+                            .map_err(|e| runtime(e, Some(*span), 0))?;
+                        Ok(Some((v.as_f64(), *span)))
+                    }
                     None => Ok(None),
                 }
             };
-        let length = number(&program.derivation_length, &mut env)?.unwrap_or(0.0);
-        let ring = number(&program.ring, &mut env)?.is_some_and(|v| v != 0.0);
-        let length = opts.steps.unwrap_or(if length.is_finite() && length > 0.0 {
-            length as u64
-        } else {
-            0
-        });
+        let stated = number(&program.derivation_length, &mut env)?;
+        let ring = number(&program.ring, &mut env)?.is_some_and(|(v, _)| v != 0.0);
+        let length = match (opts.steps, stated) {
+            (Some(n), _) => n,
+            (None, None) => 0,
+            (None, Some((v, span))) => {
+                if !v.is_finite() || v > MAX_STEPS as f64 {
+                    return Err(DeriveError {
+                        span: Some(span),
+                        message: format!(
+                            "the derivation length is {v}; it must be a number of steps from 0 to {MAX_STEPS}"
+                        ),
+                        step: 0,
+                    });
+                }
+                v.max(0.0) as u64
+            }
+        };
         if length > MAX_STEPS {
             return Err(DeriveError {
                 span: None,
@@ -354,17 +368,20 @@ impl<'p> Derivation<'p> {
             Section::Interpretation => &self.program.interpretation_depth,
             _ => &self.program.decomposition_depth,
         };
-        let Some(e) = e else { return Ok(1) };
+        let Some((e, span)) = e else { return Ok(1) };
         let mut interp = Interp::new(&self.program.structs);
         let v = interp
             .eval_global(e, &mut self.env)
-            .map_err(|e| runtime(e, None, self.step))?
+            .map_err(|e| runtime(e, Some(*span), self.step))?
             .as_f64();
-        Ok(if v.is_finite() && v > 0.0 {
-            v as u64
-        } else {
-            0
-        })
+        if !v.is_finite() || v > MAX_DEPTH as f64 {
+            return Err(DeriveError {
+                span: Some(*span),
+                message: format!("the maximum depth is {v}; it must be from 0 to {MAX_DEPTH}"),
+                step: self.step,
+            });
+        }
+        Ok(v.max(0.0) as u64)
     }
 
     /// Rewrites `word` with the rules of `section` recursively: after the
@@ -407,13 +424,13 @@ impl<'p> Derivation<'p> {
 
     /// The value of `angle:`, if the program sets it.
     pub fn angle(&mut self) -> Result<Option<f64>, DeriveError> {
-        let Some(e) = &self.program.angle else {
+        let Some((e, span)) = &self.program.angle else {
             return Ok(None);
         };
         let mut interp = Interp::new(&self.program.structs);
         let v = interp
             .eval_global(e, &mut self.env)
-            .map_err(|e| runtime(e, None, self.step))?;
+            .map_err(|e| runtime(e, Some(*span), self.step))?;
         Ok(Some(v.as_f64()))
     }
 

@@ -93,7 +93,7 @@ impl<'p> Rewriter<'p> {
         // Size the new word from the last step's growth, so that it is
         // allocated once instead of doubling its way up.
         let g = self.growth.clamp(1.0, 64.0);
-        let want = ((n as f64 * g) as usize).min(opts.max_modules + 1);
+        let want = ((n as f64 * g) as usize).min(opts.max_modules.saturating_add(1));
         let want_slots =
             ((src.slot_count() as f64 * g) as usize).min(opts.max_modules.saturating_mul(4));
         dst.reserve(want, want_slots);
@@ -470,6 +470,32 @@ fn reverse_tail(w: &mut Word, from: usize, tmp: &mut Word) {
     }
 }
 
+/// One stencil output of `N` components, the terms applied left to right.
+#[inline(always)]
+fn combine<const N: usize>(terms: &[crate::lang::stencil::Term], sources: &[&[f64]]) -> [f64; N] {
+    let mut acc = [0.0; N];
+    for (n, t) in terms.iter().enumerate() {
+        let x: [f64; N] = match t.source {
+            Some((k, off)) => {
+                let s = &sources[k as usize][off as usize..off as usize + N];
+                std::array::from_fn(|i| s[i])
+            }
+            None => [0.0; N],
+        };
+        for i in 0..N {
+            let v = t.apply(x[i]);
+            acc[i] = if n == 0 {
+                v
+            } else if t.sub {
+                acc[i] - v
+            } else {
+                acc[i] + v
+            };
+        }
+    }
+    acc
+}
+
 /// Evaluates a stencil into `dst`. Returns false if a value is not finite.
 #[inline(always)]
 fn apply_stencil(st: &Stencil, src: &Word, matched: &[usize], dst: &mut Word) -> bool {
@@ -490,32 +516,9 @@ fn apply_stencil(st: &Stencil, src: &Word, matched: &[usize], dst: &mut Word) ->
         dst.push_with(*sym, |out| {
             for c in combos {
                 match c.ty {
-                    Ty::V2 => {
-                        let (mut x, mut y) = (0.0, 0.0);
-                        for &(k, off, w) in &c.terms {
-                            let s = &sources[k as usize][off as usize..];
-                            x += w * s[0];
-                            y += w * s[1];
-                        }
-                        out.extend_from_slice(&[x, y]);
-                    }
-                    Ty::V3 => {
-                        let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
-                        for &(k, off, w) in &c.terms {
-                            let s = &sources[k as usize][off as usize..];
-                            x += w * s[0];
-                            y += w * s[1];
-                            z += w * s[2];
-                        }
-                        out.extend_from_slice(&[x, y, z]);
-                    }
-                    _ => {
-                        let mut acc = c.constant;
-                        for &(k, off, w) in &c.terms {
-                            acc += w * sources[k as usize][off as usize];
-                        }
-                        out.push(acc);
-                    }
+                    Ty::V2 => out.extend_from_slice(&combine::<2>(&c.terms, sources)),
+                    Ty::V3 => out.extend_from_slice(&combine::<3>(&c.terms, sources)),
+                    _ => out.push(combine::<1>(&c.terms, sources)[0]),
                 }
             }
         });

@@ -179,16 +179,20 @@ pub enum Stmt {
     While {
         cond: Expr,
         body: Box<Stmt>,
+        /// The `while` keyword.
+        span: Span,
     },
     DoWhile {
         body: Box<Stmt>,
         cond: Expr,
+        span: Span,
     },
     For {
         init: Option<Box<Stmt>>,
         cond: Option<Expr>,
         step: Option<Expr>,
         body: Box<Stmt>,
+        span: Span,
     },
     Block(Block),
     /// `produce ...;` (`last == true`) or `nproduce ...;`.

@@ -21,12 +21,18 @@ pub struct Parser<'t> {
     whole_names: Vec<String>,
     /// The last character of a split identifier, read in its place.
     split_last: Option<(usize, Name)>,
+    /// How deeply expressions and statements are nested right now.
+    depth: usize,
     /// Struct and typedef names seen so far.
     type_names: Vec<String>,
     eof: Span,
 }
 
 type PResult<T> = Result<T, Diagnostic>;
+
+/// How deeply expressions and statements may nest. Deeper programs are
+/// refused with a message rather than overflowing the stack later.
+pub const MAX_NESTING: usize = 200;
 
 pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<File> {
     // `angle:` anywhere switches on the single-character turtle.
@@ -47,6 +53,7 @@ pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<Fil
         abop,
         whole_names,
         split_last: None,
+        depth: 0,
         type_names: Vec::new(),
         eof,
     };
@@ -172,6 +179,9 @@ impl<'t> Parser<'t> {
     /// item := module-decl | struct-decl | typedef | global-decl | directive
     ///       | axiom | ignore | consider | section | group | control | production
     fn item(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        if self.eat_punct(";") {
+            return Ok(()); // a stray `;` between items
+        }
         let t = self.peek().expect("not at end");
         let start = t.span;
         if let Tok::Ident(word) = &t.tok {
@@ -516,12 +526,11 @@ impl<'t> Parser<'t> {
                 Tok::Punct(":") | Tok::Punct("->") => break,
                 Tok::Ident(_) | Tok::Punct("#") => {
                     let group = groups.last_mut().expect("non-empty");
-                    match self.abop_split() {
-                        Some(names) => group.extend(names.into_iter().map(|name| PatModule {
+                    if let Some(names) = self.abop_split() {
+                        group.extend(names.into_iter().map(|name| PatModule {
                             name,
                             params: Vec::new(),
-                        })),
-                        None => {}
+                        }));
                     }
                     let m = self.pat_module()?;
                     groups.last_mut().expect("non-empty").push(m);
@@ -822,7 +831,25 @@ impl<'t> Parser<'t> {
         }
     }
 
+    fn enter(&mut self, extra: usize) -> PResult<()> {
+        if self.depth + extra > MAX_NESTING {
+            return Err(Diagnostic::new(
+                self.span_here(),
+                format!("this is nested more than {MAX_NESTING} levels deep; split it into simpler parts"),
+            ));
+        }
+        Ok(())
+    }
+
     fn stmt(&mut self) -> PResult<Stmt> {
+        self.enter(1)?;
+        self.depth += 1;
+        let r = self.stmt_inner();
+        self.depth -= 1;
+        r
+    }
+
+    fn stmt_inner(&mut self) -> PResult<Stmt> {
         let t = self.peek().expect("checked by caller");
         if t.tok.is_punct("{") {
             return Ok(Stmt::Block(self.block()?));
@@ -875,7 +902,11 @@ impl<'t> Parser<'t> {
                     self.pos += 1;
                     let cond = self.expr()?;
                     let body = Box::new(self.stmt_or_end()?);
-                    return Ok(Stmt::While { cond, body });
+                    return Ok(Stmt::While {
+                        cond,
+                        body,
+                        span: t.span,
+                    });
                 }
                 "do" => {
                     self.pos += 1;
@@ -885,7 +916,11 @@ impl<'t> Parser<'t> {
                     }
                     let cond = self.expr()?;
                     self.expect_punct(";", "after `do ... while (...)`")?;
-                    return Ok(Stmt::DoWhile { body, cond });
+                    return Ok(Stmt::DoWhile {
+                        body,
+                        cond,
+                        span: t.span,
+                    });
                 }
                 "for" => {
                     self.pos += 1;
@@ -919,6 +954,7 @@ impl<'t> Parser<'t> {
                         cond,
                         step,
                         body,
+                        span: t.span,
                     });
                 }
                 "return" => {
@@ -1009,6 +1045,8 @@ impl<'t> Parser<'t> {
     /// Precedence climbing over the C binary operators.
     fn binary(&mut self, min_prec: u8) -> PResult<Expr> {
         let mut lhs = self.unary()?;
+        // Each operator of a chain deepens the tree by one.
+        let mut chain = 0;
         loop {
             let Some((op, prec)) = self.peek().and_then(|t| binop_of(&t.tok)) else {
                 return Ok(lhs);
@@ -1016,8 +1054,13 @@ impl<'t> Parser<'t> {
             if prec < min_prec {
                 return Ok(lhs);
             }
+            chain += 1;
+            self.enter(chain)?;
             self.pos += 1;
-            let rhs = self.binary(prec + 1)?;
+            self.depth += chain;
+            let rhs = self.binary(prec + 1);
+            self.depth -= chain;
+            let rhs = rhs?;
             let span = lhs.span.to(rhs.span);
             lhs = Expr {
                 kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
@@ -1028,6 +1071,14 @@ impl<'t> Parser<'t> {
 
     /// unary := ('-' | '+' | '!' | '++' | '--') unary | '(' TYPE ')' unary | postfix
     fn unary(&mut self) -> PResult<Expr> {
+        self.enter(1)?;
+        self.depth += 1;
+        let r = self.unary_inner();
+        self.depth -= 1;
+        r
+    }
+
+    fn unary_inner(&mut self) -> PResult<Expr> {
         let Some(t) = self.peek() else {
             return self.error("an expression");
         };
@@ -1167,6 +1218,12 @@ impl<'t> Parser<'t> {
                             return self.error("`)` to close the context test");
                         }
                         pats.push(self.pat_module()?);
+                    }
+                    if pats.is_empty() {
+                        return Err(Diagnostic::new(
+                            name.span,
+                            format!("`{n}` needs at least one module to test, e.g. `{n}(A(x))`"),
+                        ));
                     }
                     ExprKind::InContext(kind, pats)
                 } else if self.eat_punct("(") {

@@ -30,6 +30,10 @@ struct Macro {
     body: Vec<Token>,
 }
 
+/// Tokens a file's macro expansions may produce in all, so that a
+/// runaway expansion stops with a message instead of exhausting memory.
+const EXPANSION_BUDGET: usize = 2_000_000;
+
 /// Runs the preprocessor over `tokens`. `overrides` are `-D` definitions,
 /// already lexed; they replace a `#define` of the same name in the file.
 pub fn preprocess(
@@ -48,6 +52,10 @@ pub fn preprocess(
     }
     let overridden: Vec<&str> = overrides.iter().map(|(n, _)| n.as_str()).collect();
     let mut out = Vec::with_capacity(tokens.len());
+    let mut budget = EXPANSION_BUDGET;
+    // Tokens between directives are expanded together, with the macros
+    // defined so far.
+    let mut pending: Vec<Token> = Vec::new();
     let mut i = 0;
     while i < tokens.len() {
         let t = &tokens[i];
@@ -57,9 +65,11 @@ pub fn preprocess(
                 !n.line_start && matches!(&n.tok, Tok::Ident(s) if DIRECTIVES.contains(&s.as_str()))
             });
         if !is_directive {
-            expand_into(&tokens, &mut i, &macros, &mut out, &mut Vec::new())?;
+            pending.push(t.clone());
+            i += 1;
             continue;
         }
+        out.extend(expand(std::mem::take(&mut pending), &macros, &mut budget)?);
         let hash_span = t.span;
         let name_tok = &tokens[i + 1];
         let Tok::Ident(name) = &name_tok.tok else {
@@ -74,64 +84,9 @@ pub fn preprocess(
         match name.as_str() {
             "include" => check_include(hash_span.to(name_tok.span), args)?,
             "define" => {
-                let Some(first) = args.first() else {
-                    return Err(Diagnostic::new(
-                        name_tok.span,
-                        "expected a macro name after `#define`",
-                    ));
-                };
-                let Tok::Ident(mname) = &first.tok else {
-                    return Err(Diagnostic::new(
-                        first.span,
-                        format!("expected a macro name after `#define`, found {}", first.tok.describe()),
-                    ));
-                };
-                let mut body_start = 1;
-                let mut params = None;
-                if args.get(1).is_some_and(|p| p.tok.is_punct("(") && !p.space_before) {
-                    let mut names = Vec::new();
-                    let mut j = 2;
-                    loop {
-                        match args.get(j) {
-                            Some(Token { tok: Tok::Punct(")"), .. }) => {
-                                j += 1;
-                                break;
-                            }
-                            Some(Token { tok: Tok::Ident(p), .. }) => {
-                                names.push(p.clone());
-                                j += 1;
-                                if args.get(j).is_some_and(|c| c.tok.is_punct(",")) {
-                                    j += 1;
-                                }
-                            }
-                            Some(other) => {
-                                return Err(Diagnostic::new(
-                                    other.span,
-                                    format!(
-                                        "expected a parameter name or `)` in the macro's parameter list, found {}",
-                                        other.tok.describe()
-                                    ),
-                                ))
-                            }
-                            None => {
-                                return Err(Diagnostic::new(
-                                    first.span,
-                                    "unterminated macro parameter list: expected `)`",
-                                ))
-                            }
-                        }
-                    }
-                    body_start = j;
-                    params = Some(names);
-                }
+                let (mname, m) = parse_define(name_tok, args)?;
                 if !overridden.contains(&mname.as_str()) {
-                    macros.insert(
-                        mname.clone(),
-                        Macro {
-                            params,
-                            body: args[body_start..].to_vec(),
-                        },
-                    );
+                    macros.insert(mname, m);
                 }
             }
             "undef" => {
@@ -149,7 +104,81 @@ pub fn preprocess(
         }
         i = end;
     }
+    out.extend(expand(pending, &macros, &mut budget)?);
     Ok(out)
+}
+
+/// `#define NAME body` or `#define NAME(a, b) body`.
+fn parse_define(name_tok: &Token, args: &[Token]) -> Result<(String, Macro), Diagnostic> {
+    let Some(first) = args.first() else {
+        return Err(Diagnostic::new(
+            name_tok.span,
+            "expected a macro name after `#define`",
+        ));
+    };
+    let Tok::Ident(mname) = &first.tok else {
+        return Err(Diagnostic::new(
+            first.span,
+            format!(
+                "expected a macro name after `#define`, found {}",
+                first.tok.describe()
+            ),
+        ));
+    };
+    let mut body_start = 1;
+    let mut params = None;
+    if args
+        .get(1)
+        .is_some_and(|p| p.tok.is_punct("(") && !p.space_before)
+    {
+        let mut names = Vec::new();
+        let mut j = 2;
+        loop {
+            match args.get(j) {
+                Some(Token {
+                    tok: Tok::Punct(")"),
+                    ..
+                }) => {
+                    j += 1;
+                    break;
+                }
+                Some(Token {
+                    tok: Tok::Ident(p), ..
+                }) => {
+                    names.push(p.clone());
+                    j += 1;
+                    if args.get(j).is_some_and(|c| c.tok.is_punct(",")) {
+                        j += 1;
+                    }
+                }
+                Some(other) => return Err(Diagnostic::new(
+                    other.span,
+                    format!(
+                        "expected a parameter name or `)` in the macro's parameter list, found {}",
+                        other.tok.describe()
+                    ),
+                )),
+                None => {
+                    return Err(Diagnostic::new(
+                        first.span,
+                        "unterminated macro parameter list: expected `)`",
+                    ))
+                }
+            }
+        }
+        body_start = j;
+        params = Some(names);
+    }
+    let body = args[body_start..].to_vec();
+    for w in body.windows(2) {
+        if w[0].tok.is_punct("#") && w[1].tok.is_punct("#") && !w[1].space_before {
+            return Err(Diagnostic::new(
+                w[0].span.to(w[1].span),
+                "token pasting with `##` is not supported in macros",
+            ));
+        }
+    }
+    Ok((mname.clone(), Macro { params, body }))
 }
 
 fn check_include(span: Span, args: &[Token]) -> Result<(), Diagnostic> {
@@ -175,100 +204,125 @@ fn check_include(span: Span, args: &[Token]) -> Result<(), Diagnostic> {
     }
 }
 
-/// Copies the token at `*i` into `out`, expanding it if it names a macro.
-/// `active` holds the macros being expanded, so a macro never expands itself.
-fn expand_into(
-    tokens: &[Token],
-    i: &mut usize,
+/// The names of the macros whose expansion produced a token: a macro is not
+/// expanded again inside its own expansion.
+type Hide = Vec<String>;
+
+/// Expands macros as the C preprocessor does: an expansion is rescanned
+/// together with the tokens that follow it (so `#define G INC` then
+/// `G(1)` calls `INC`), and the arguments of a function-like macro are
+/// expanded before they are substituted (so `SQ(SQ(2))` works).
+fn expand(
+    tokens: Vec<Token>,
     macros: &HashMap<String, Macro>,
-    out: &mut Vec<Token>,
-    active: &mut Vec<String>,
-) -> Result<(), Diagnostic> {
-    let t = &tokens[*i];
-    *i += 1;
-    let Tok::Ident(name) = &t.tok else {
-        out.push(t.clone());
-        return Ok(());
-    };
-    let Some(m) = macros.get(name).filter(|_| !active.contains(name)) else {
-        out.push(t.clone());
-        return Ok(());
-    };
-    let use_span = t.span;
-    let body: Vec<Token> = match &m.params {
-        None => m.body.clone(),
-        Some(params) => {
-            if !tokens.get(*i).is_some_and(|p| p.tok.is_punct("(")) {
-                // A function-like macro name without arguments is just a name.
-                out.push(t.clone());
-                return Ok(());
-            }
-            *i += 1;
-            let mut args: Vec<Vec<Token>> = vec![Vec::new()];
-            let mut depth = 0;
-            loop {
-                let Some(a) = tokens.get(*i) else {
+    budget: &mut usize,
+) -> Result<Vec<Token>, Diagnostic> {
+    let input = tokens.into_iter().map(|t| (t, Hide::new())).collect();
+    expand_hidden(input, macros, budget)
+}
+
+fn expand_hidden(
+    tokens: Vec<(Token, Hide)>,
+    macros: &HashMap<String, Macro>,
+    budget: &mut usize,
+) -> Result<Vec<Token>, Diagnostic> {
+    if macros.is_empty() {
+        return Ok(tokens.into_iter().map(|(t, _)| t).collect());
+    }
+    // A stack: the next token is at the end.
+    let mut input: Vec<(Token, Hide)> = tokens.into_iter().rev().collect();
+    let mut out = Vec::new();
+    while let Some((t, hide)) = input.pop() {
+        let Tok::Ident(name) = &t.tok else {
+            out.push(t);
+            continue;
+        };
+        let Some(m) = macros.get(name).filter(|_| !hide.contains(name)) else {
+            out.push(t);
+            continue;
+        };
+        let mut inner = hide.clone();
+        inner.push(name.clone());
+        let at_use = |b: &Token| Token {
+            span: t.span,
+            line_start: false,
+            space_before: true,
+            ..b.clone()
+        };
+        let expansion: Vec<(Token, Hide)> = match &m.params {
+            None => m.body.iter().map(|b| (at_use(b), inner.clone())).collect(),
+            Some(params) => {
+                if !input.last().is_some_and(|(n, _)| n.tok.is_punct("(")) {
+                    // A function-like macro's name without arguments.
+                    out.push(t);
+                    continue;
+                }
+                input.pop();
+                let mut args: Vec<Vec<(Token, Hide)>> = vec![Vec::new()];
+                let mut depth = 0;
+                loop {
+                    let Some((a, h)) = input.pop() else {
+                        return Err(Diagnostic::new(
+                            t.span,
+                            format!("unterminated call of macro `{name}`: expected `)`"),
+                        ));
+                    };
+                    match &a.tok {
+                        Tok::Punct("(") => depth += 1,
+                        Tok::Punct(")") if depth == 0 => break,
+                        Tok::Punct(")") => depth -= 1,
+                        Tok::Punct(",") if depth == 0 => {
+                            args.push(Vec::new());
+                            continue;
+                        }
+                        _ => {}
+                    }
+                    args.last_mut().expect("never empty").push((a, h));
+                }
+                if args.len() == 1 && args[0].is_empty() && params.is_empty() {
+                    args.clear();
+                }
+                if args.len() != params.len() {
                     return Err(Diagnostic::new(
-                        use_span,
-                        format!("unterminated call of macro `{name}`: expected `)`"),
+                        t.span,
+                        format!(
+                            "macro `{name}` takes {} argument(s) but {} were given",
+                            params.len(),
+                            args.len()
+                        ),
                     ));
-                };
-                *i += 1;
-                match &a.tok {
-                    Tok::Punct("(") => depth += 1,
-                    Tok::Punct(")") if depth == 0 => break,
-                    Tok::Punct(")") => depth -= 1,
-                    Tok::Punct(",") if depth == 0 => {
-                        args.push(Vec::new());
-                        continue;
-                    }
-                    _ => {}
                 }
-                args.last_mut().expect("never empty").push(a.clone());
-            }
-            if args.len() == 1 && args[0].is_empty() && params.is_empty() {
-                args.clear();
-            }
-            if args.len() != params.len() {
-                return Err(Diagnostic::new(
-                    use_span,
-                    format!(
-                        "macro `{name}` takes {} argument(s) but {} were given",
-                        params.len(),
-                        args.len()
-                    ),
-                ));
-            }
-            let mut body = Vec::new();
-            for b in &m.body {
-                match &b.tok {
-                    Tok::Ident(p) if params.contains(p) => {
-                        // Textual substitution, as the C preprocessor does.
-                        let k = params.iter().position(|q| q == p).expect("contained");
-                        body.extend(args[k].iter().cloned());
-                    }
-                    _ => body.push(b.clone()),
+                let mut expanded = Vec::with_capacity(args.len());
+                for a in args {
+                    expanded.push(expand_hidden(a, macros, budget)?);
                 }
+                let mut body = Vec::new();
+                for b in &m.body {
+                    match &b.tok {
+                        Tok::Ident(p) if params.contains(p) => {
+                            let k = params.iter().position(|q| q == p).expect("contained");
+                            body.extend(expanded[k].iter().map(|a| (a.clone(), inner.clone())));
+                        }
+                        _ => body.push((at_use(b), inner.clone())),
+                    }
+                }
+                body
             }
-            body
+        };
+        if expansion.len() > *budget {
+            return Err(Diagnostic::new(
+                t.span,
+                format!(
+                    "macro expansion produced more than {EXPANSION_BUDGET} tokens; is a macro defined in terms of itself many times over?"
+                ),
+            ));
         }
-    };
-    active.push(name.clone());
-    let mut j = 0;
-    let mut expanded = Vec::new();
-    while j < body.len() {
-        expand_into(&body, &mut j, macros, &mut expanded, active)?;
+        *budget -= expansion.len();
+        let mut items: Vec<(Token, Hide)> = expansion;
+        if let Some((f, _)) = items.first_mut() {
+            f.line_start = t.line_start;
+        }
+        input.extend(items.into_iter().rev());
     }
-    active.pop();
-    let first = out.len();
-    for mut e in expanded {
-        e.span = use_span;
-        e.line_start = false;
-        e.space_before = true;
-        out.push(e);
-    }
-    if let Some(f) = out.get_mut(first) {
-        f.line_start = t.line_start;
-    }
-    Ok(())
+    Ok(out)
 }

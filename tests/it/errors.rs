@@ -161,7 +161,7 @@ fn an_endless_loop_in_a_body_is_stopped() {
         DeriveOptions::default(),
     );
     assert!(
-        got.starts_with("bad.lsys:4:16: error: at step 1, production `A(x)`: a loop ran more than"),
+        got.starts_with("bad.lsys:4:10: error: at step 1, production `A(x)`: a loop ran more than"),
         "{got}"
     );
 }

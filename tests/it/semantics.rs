@@ -270,3 +270,36 @@ fn function_like_macros_expand_with_their_arguments() {
                Axiom: A(1) A(3);\nA(x) < A(y) -> A(MID(x + 1, y))\n";
     assert_eq!(run(src), "A(1) A(3)");
 }
+
+/// The fast path replays the interpreter's operations: results agree to
+/// the last bit, whatever the shape of the affine expression.
+#[test]
+fn stencils_agree_with_the_interpreter_bit_for_bit() {
+    let bodies = [
+        "P(vl/3 + v - 0.1*vr) P(-v/3.0 - (1.0/3)*vl)",
+        "P(0.25*vl + 0.5*v + 0.25*vl) P(v*0.7 - vr*0.1 + v/7)",
+        "P(-(0.3*vl) + 0.9*v) P(v)",
+    ];
+    for body in bodies {
+        let fast = format!(
+            "module P(V2f);\nring L-system: 1;\nderivation length: 6;\n\
+             Axiom: P(V2f(0.1, 0.7)) P(V2f(1.3, 2.9)) P(V2f(4.1, 3.3)) P(V2f(2.2, -1.7));\n\
+             P(vl) < P(v) > P(vr) -> {body}\n"
+        );
+        let slow = fast.replace(
+            &format!("-> {body}"),
+            &format!(": {{ if (1) produce {body}; }}"),
+        );
+        let (a, b) = (load_text(&fast), load_text(&slow));
+        assert!(
+            a.program.rules[0].stencil.is_some(),
+            "{body} is not a stencil"
+        );
+        assert!(b.program.rules[0].stencil.is_none());
+        let (da, db) = (
+            derive(&a, Default::default()),
+            derive(&b, Default::default()),
+        );
+        assert_eq!(da.word, db.word, "{body}");
+    }
+}
