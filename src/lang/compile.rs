@@ -48,6 +48,8 @@ struct Compiler {
 struct Scope {
     vars: Vec<(String, Ty, u16)>,
     marks: Vec<usize>,
+    /// Slots of `const` locals.
+    consts: Vec<u16>,
     next: u16,
     max: u16,
     loops: u32,
@@ -138,8 +140,22 @@ impl Compiler {
         for item in &file.items {
             match item {
                 Item::Struct { name, fields } => {
-                    let mut fs = Vec::new();
+                    if self.structs.iter().any(|s| s.name == name.text) {
+                        self.err(
+                            name.span,
+                            format!("struct `{}` is already declared", name.text),
+                        );
+                        continue;
+                    }
+                    let mut fs: Vec<(String, Ty)> = Vec::new();
                     for (t, n) in fields {
+                        if fs.iter().any(|(f, _)| *f == n.text) {
+                            self.err(
+                                n.span,
+                                format!("struct `{}` already has a field `{}`", name.text, n.text),
+                            );
+                            continue;
+                        }
                         if let Some(ty) = self.resolve_type(t) {
                             fs.push((n.text.clone(), ty));
                         }
@@ -740,6 +756,9 @@ impl Compiler {
                 for v in &d.vars {
                     let init = self.initializer(ty, &v.init, scope);
                     let slot = scope.declare(&v.name.text, ty);
+                    if d.is_const {
+                        scope.consts.push(slot);
+                    }
                     let value = init.unwrap_or(Ex::Const(Value::zero(ty, &self.structs)));
                     out.push(St::Init(slot, value));
                 }
@@ -881,6 +900,13 @@ impl Compiler {
         match &e.kind {
             ExprKind::Ident(n) => {
                 if let Some((ty, slot)) = scope.lookup(n) {
+                    if scope.consts.contains(&slot) {
+                        self.err(
+                            e.span,
+                            format!("cannot assign to `{n}`: it is declared const"),
+                        );
+                        return None;
+                    }
                     return Some(Place {
                         global: false,
                         slot,

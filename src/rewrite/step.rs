@@ -110,6 +110,9 @@ impl<'p> Rewriter<'p> {
         let phase = opts.phase % n;
         let mut rewritten = 0;
         let mut k = 0;
+        // Where, in the new word, the successors of modules scanned after
+        // the scan wrapped from the end of a ring to its start begin.
+        let mut wrapped_at = None;
         while k < n {
             // The scan position; backward steps walk from the right end.
             let i = match (opts.ring, opts.forward) {
@@ -118,6 +121,9 @@ impl<'p> Rewriter<'p> {
                 (true, false) => wrap(phase + n - 1 - k, n),
                 (false, false) => n - 1 - k,
             };
+            if opts.ring && opts.forward && i < phase && wrapped_at.is_none() {
+                wrapped_at = Some(dst.len());
+            }
             let remaining = n - k;
             let mut used = 0;
             if eligible.is_none_or(|e| e[i]) {
@@ -167,6 +173,15 @@ impl<'p> Rewriter<'p> {
             k += used;
         }
         self.growth = dst.len() as f64 / n as f64;
+        if let Some(m) = wrapped_at {
+            // Keep the ring's start where it was: the successors of the
+            // modules before the phase come first, as with phase 0. A
+            // predecessor that wrapped stays at the end.
+            dst.rotate_left(m);
+            if let Some(o) = origin.as_deref_mut() {
+                o.rotate_left(m);
+            }
+        }
         if !opts.forward {
             dst.reverse();
             if let Some(o) = origin {

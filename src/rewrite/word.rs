@@ -102,6 +102,19 @@ impl Word {
         }
     }
 
+    /// Moves the first `k` modules to the end.
+    pub fn rotate_left(&mut self, k: usize) {
+        if k == 0 || k >= self.len() {
+            return;
+        }
+        let mut out = Word::new();
+        out.reserve(self.len(), self.data.len());
+        for i in (k..self.len()).chain(0..k) {
+            out.push_from(self, i);
+        }
+        *self = out;
+    }
+
     /// Reverses the order of the modules (used after a backward step).
     pub fn reverse(&mut self) {
         let mut out = Word::new();

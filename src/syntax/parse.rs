@@ -32,7 +32,7 @@ type PResult<T> = Result<T, Diagnostic>;
 
 /// How deeply expressions and statements may nest. Deeper programs are
 /// refused with a message rather than overflowing the stack later.
-pub const MAX_NESTING: usize = 200;
+pub const MAX_NESTING: usize = 100;
 
 pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<File> {
     // `angle:` anywhere switches on the single-character turtle.

@@ -151,13 +151,15 @@ fn parse_define(name_tok: &Token, args: &[Token]) -> Result<(String, Macro), Dia
                         j += 1;
                     }
                 }
-                Some(other) => return Err(Diagnostic::new(
-                    other.span,
-                    format!(
+                Some(other) => {
+                    return Err(Diagnostic::new(
+                        other.span,
+                        format!(
                         "expected a parameter name or `)` in the macro's parameter list, found {}",
                         other.tok.describe()
                     ),
-                )),
+                    ))
+                }
                 None => {
                     return Err(Diagnostic::new(
                         first.span,

@@ -104,17 +104,40 @@ impl SourceMap {
     pub fn render(&self, span: Span, message: &str) -> String {
         let file = self.get(span.file);
         let (line, col) = file.line_col(span.start as usize);
-        let text = file.line_text(line);
+        let full = file.line_text(line);
+        // A very long line is shown as a window around the column.
+        const WINDOW: usize = 60;
+        let chars: Vec<char> = full
+            .chars()
+            .map(|c| if c.is_control() && c != '\t' { ' ' } else { c })
+            .collect();
+        let (text, shift) = if chars.len() > 2 * WINDOW + 20 {
+            let from = (col - 1).saturating_sub(WINDOW);
+            let to = (col - 1 + WINDOW).min(chars.len());
+            let mut t: String = chars[from..to].iter().collect();
+            let mut shift = from;
+            if from > 0 {
+                t.insert_str(0, "...");
+                shift = from.saturating_sub(3);
+            }
+            if to < chars.len() {
+                t.push_str("...");
+            }
+            (t, shift)
+        } else {
+            (chars.iter().collect::<String>(), 0)
+        };
+        let text = text.as_str();
         let (end_line, end_col) = file.line_col(span.end as usize);
         let width = if end_line == line && end_col > col {
-            end_col - col
+            (end_col - col).min(2 * WINDOW)
         } else {
             1
         };
         let gutter = line.to_string().len();
         let pad: String = text
             .chars()
-            .take(col - 1)
+            .take(col - 1 - shift)
             .map(|c| if c == '\t' { '\t' } else { ' ' })
             .collect();
         format!(

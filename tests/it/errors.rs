@@ -201,3 +201,83 @@ fn unterminated_comment() {
         "{got}"
     );
 }
+
+#[test]
+fn const_locals_and_duplicate_declarations_are_refused() {
+    let got = load_error(
+        "module A(int);\nderivation length: 1;\nAxiom: A(1);\n\
+         A(x) : { const int k = 1; k = 2; produce A(k); }\n",
+    );
+    assert!(
+        got.contains("4:27: error: cannot assign to `k`: it is declared const"),
+        "{got}"
+    );
+    let got = load_error("struct S { float a, a; };\nstruct S { int b; };\nmodule A;\nAxiom: A;\n");
+    assert!(
+        got.contains("1:21: error: struct `S` already has a field `a`"),
+        "{got}"
+    );
+    assert!(
+        got.contains("2:8: error: struct `S` is already declared"),
+        "{got}"
+    );
+}
+
+#[test]
+fn deep_nesting_is_refused_with_a_message() {
+    let deep = format!(
+        "module A(float);\nAxiom: A({}1{});\n",
+        "(".repeat(500),
+        ")".repeat(500)
+    );
+    let got = load_error(&deep);
+    assert!(
+        got.contains("error: this is nested more than 100 levels deep"),
+        "{got}"
+    );
+    // The long line is shown as a window around the column.
+    assert!(got.lines().nth(2).unwrap().len() < 200, "{got}");
+    let sum = format!(
+        "module A(float);\nAxiom: A({});\n",
+        vec!["1"; 1000].join("+")
+    );
+    assert!(load_error(&sum).contains("nested more than 100 levels deep"));
+    // Just below the limit, checking and deriving work, on a test thread's
+    // ordinary stack.
+    let ok = format!(
+        "module A(float);\nderivation length: 2;\nAxiom: A({}1{});\nA(x) -> A({})\n",
+        "(".repeat(95),
+        ")".repeat(95),
+        vec!["x"; 95].join("+")
+    );
+    let l = subgram::load_str("ok.lsys", &ok, &[]).unwrap();
+    let d = subgram::derive(&l.program, DeriveOptions::default()).unwrap();
+    assert_eq!(
+        subgram::output::word_text(&d.word, &l.program.alphabet, &l.program.structs),
+        "A(9025)"
+    );
+}
+
+#[test]
+fn a_non_finite_derivation_length_is_an_error() {
+    let got = derive_error(
+        "module A;\nderivation length: 1e400;\nAxiom: A;\n",
+        DeriveOptions::default(),
+    );
+    assert!(
+        got.starts_with("bad.lsys:2:1: error: the derivation length is inf"),
+        "{got}"
+    );
+}
+
+#[test]
+fn division_by_zero_in_a_control_block_is_located() {
+    let got = derive_error(
+        "module A;\nint n;\nStart: { n = 1 / n; }\nAxiom: A;\n",
+        DeriveOptions::default(),
+    );
+    assert!(
+        got.starts_with("bad.lsys:3:14: error: integer division by zero"),
+        "{got}"
+    );
+}
