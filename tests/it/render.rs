@@ -329,3 +329,49 @@ fn a_failed_render_leaves_no_file() {
         "only the input remains"
     );
 }
+
+/// The 3D turtle: `Up(90)` pitches the heading from +y to +z, so the first
+/// segment runs along z; `--view` chooses the plane it is projected on.
+#[test]
+fn the_view_projects_the_3d_turtle() {
+    let l = load_text("derivation length: 0;\nAxiom: Up(90) F(1) Left(90) F(1);\n");
+    let word = subgram::Derivation::new(&l.program, Default::default())
+        .unwrap()
+        .word
+        .clone();
+    let events = subgram::draw::draw(
+        &word,
+        &l.program.alphabet,
+        &l.program.structs,
+        &Default::default(),
+    )
+    .unwrap();
+    let seg = |e: &subgram::draw::Event| match e {
+        subgram::draw::Event::Line { a, b, .. } => (*a, *b),
+        other => panic!("{other:?}"),
+    };
+    let (a0, b0) = seg(&events[0]);
+    let (a1, b1) = seg(&events[1]);
+    assert!((b0 - a0).abs_diff_eq(glam::DVec3::Z, 1e-12), "{}", b0 - a0);
+    assert!(
+        (b1 - a1).abs_diff_eq(glam::DVec3::NEG_X, 1e-12),
+        "{}",
+        b1 - a1
+    );
+    for (view, first_len) in [(render::View::Xy, 0.0), (render::View::Xz, 1.0)] {
+        let opts = RenderOptions {
+            view,
+            ..RenderOptions::default()
+        };
+        let s = render::scene(std::slice::from_ref(&events), &opts).unwrap();
+        let Item::Polyline { points, .. } = &s.items[0] else {
+            panic!("expected a polyline")
+        };
+        let first = points[0].distance(points[1]);
+        let second = points[1].distance(points[2]);
+        assert!(
+            (first - first_len * second).abs() < 1e-6,
+            "{view:?}: {first} vs {second}"
+        );
+    }
+}
