@@ -22,6 +22,7 @@ pub mod draw;
 pub mod lang;
 pub mod output;
 pub mod render;
+pub mod reverse;
 pub mod rewrite;
 pub mod syntax;
 

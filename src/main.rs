@@ -68,6 +68,50 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         phase: usize,
     },
+    /// Reverse-subdivide a contour into a compact control polygon.
+    Reverse {
+        /// Points (`x y` or CSV), an SVG shape, or a PNG silhouette.
+        input: String,
+        #[arg(short = 'n', long = "steps")]
+        steps: usize,
+        /// The coarse polygon: .csv, .txt or .svg.
+        #[arg(short = 'o', long = "output")]
+        output: String,
+        /// A scheme file (group 1 reverses, group 2 subdivides).
+        #[arg(long)]
+        scheme: Option<String>,
+        /// Which pairing of points: auto (the better), 0 or 1.
+        #[arg(long, default_value = "auto", value_parser = parse_phase)]
+        phase: subgram::reverse::Phase,
+        /// Treat the contour as open (end points kept).
+        #[arg(long)]
+        open: bool,
+        /// Draw input, coarse polygon and reconstruction: .png or .svg.
+        #[arg(long)]
+        figure: Option<String>,
+        /// Print point counts and reconstruction errors.
+        #[arg(long)]
+        report: bool,
+        #[arg(long, value_enum, default_value_t = Format::Text)]
+        format: Format,
+        /// Store the details that restore the input exactly.
+        #[arg(long)]
+        details: Option<String>,
+    },
+    /// Restore a contour from a coarse polygon and its details.
+    Reconstruct {
+        coarse: String,
+        #[arg(long)]
+        details: String,
+        #[arg(short = 'o', long = "output")]
+        output: String,
+        /// Restore only this many levels (default: all).
+        #[arg(long)]
+        level: Option<usize>,
+        /// The scheme the details were made with (default: as recorded).
+        #[arg(long)]
+        scheme: Option<String>,
+    },
     /// Check an .lsys file and report every diagnostic.
     Check {
         file: String,
@@ -81,6 +125,15 @@ enum ViewArg {
     Xy,
     Xz,
     Yz,
+}
+
+fn parse_phase(s: &str) -> Result<subgram::reverse::Phase, String> {
+    match s {
+        "auto" => Ok(subgram::reverse::Phase::Auto),
+        "0" => Ok(subgram::reverse::Phase::Fixed(0)),
+        "1" => Ok(subgram::reverse::Phase::Fixed(1)),
+        _ => Err(format!("`{s}` is not a phase: use auto, 0 or 1")),
+    }
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -145,6 +198,36 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
                 loaded.program.alphabet.kinds.len()
             ))
         }
+        Command::Reverse {
+            input,
+            steps,
+            output,
+            scheme,
+            phase,
+            open,
+            figure,
+            report,
+            format,
+            details,
+        } => reverse_command(ReverseArgs {
+            input,
+            steps,
+            output,
+            scheme,
+            phase,
+            open,
+            figure,
+            report,
+            json: matches!(format, Format::Json),
+            details,
+        }),
+        Command::Reconstruct {
+            coarse,
+            details,
+            output,
+            level,
+            scheme,
+        } => reconstruct_command(&coarse, &details, &output, level, scheme.as_deref()),
         Command::Render {
             file,
             output,
@@ -272,4 +355,156 @@ fn check_steps(steps: Option<u64>) -> Result<(), (u8, String)> {
         )),
         _ => Ok(()),
     }
+}
+
+struct ReverseArgs {
+    input: String,
+    steps: usize,
+    output: String,
+    scheme: Option<String>,
+    phase: subgram::reverse::Phase,
+    open: bool,
+    figure: Option<String>,
+    report: bool,
+    json: bool,
+    details: Option<String>,
+}
+
+fn write_file(path: &str, bytes: &[u8]) -> Result<(), (u8, String)> {
+    subgram::render::write_atomic(std::path::Path::new(path), bytes)
+        .map_err(|e| (1, format!("error: cannot write `{path}`: {e}")))
+}
+
+fn reverse_command(a: ReverseArgs) -> Result<(), (u8, String)> {
+    use subgram::reverse::{self, ReverseOptions, Scheme};
+    let fig_svg = match &a.figure {
+        Some(f) if f.to_ascii_lowercase().ends_with(".svg") => Some(true),
+        Some(f) if f.to_ascii_lowercase().ends_with(".png") => Some(false),
+        Some(f) => {
+            return Err((
+                2,
+                format!("error: cannot tell the format of `{f}`: name it .png or .svg"),
+            ))
+        }
+        None => None,
+    };
+    let mut contour =
+        reverse::input::read(std::path::Path::new(&a.input)).map_err(|e| (1, e.to_string()))?;
+    if a.open {
+        contour.closed = false;
+    }
+    let scheme = match &a.scheme {
+        Some(s) => Scheme::from_file(std::path::Path::new(s), contour.closed),
+        None => Ok(Scheme::builtin(contour.closed)),
+    }
+    .map_err(|e| (1, e.to_string()))?;
+    let opts = ReverseOptions {
+        steps: a.steps,
+        phase: a.phase,
+        details: a.details.is_some(),
+    };
+    let r = reverse::reverse(&scheme, &contour, &opts).map_err(|e| (1, e.to_string()))?;
+    let out = reverse::format_points(&r.coarse, contour.closed, std::path::Path::new(&a.output));
+    write_file(&a.output, out.as_bytes())?;
+    if let (Some(path), Some(d)) = (&a.details, &r.details) {
+        let json = serde_json::to_string(d).map_err(|e| (1, format!("error: {e}")))?;
+        write_file(path, json.as_bytes())?;
+    }
+    if a.report || fig_svg.is_some() {
+        let rep = reverse::report(&scheme, &contour, &r).map_err(|e| (1, e.to_string()))?;
+        if let (Some(svg), Some(path)) = (fig_svg, &a.figure) {
+            let rec = scheme
+                .forward(&r.coarse, a.steps)
+                .map_err(|e| (1, e.to_string()))?;
+            let events = reverse::figure_events(&contour, &r.coarse, &rec);
+            let scene = subgram::render::scene(&[events], &Default::default())
+                .map_err(|e| (1, format!("error: {}", e.message)))?;
+            let bytes = if svg {
+                subgram::render::svg::render(&scene).into_bytes()
+            } else {
+                subgram::render::png::render(&scene)
+                    .map_err(|e| (1, format!("error: {}", e.message)))?
+            };
+            write_file(path, &bytes)?;
+        }
+        if a.report {
+            let text = if a.json {
+                serde_json::to_string_pretty(&rep).map_err(|e| (1, format!("error: {e}")))?
+            } else {
+                report_text(&rep)
+            };
+            print_out(&text)?;
+        }
+    }
+    Ok(())
+}
+
+fn report_text(r: &subgram::reverse::Report) -> String {
+    let mut s = format!(
+        "input: {} points, {} ({})\nscheme: {}\n",
+        r.input_points,
+        if r.closed { "closed" } else { "open" },
+        r.source,
+        r.scheme
+    );
+    for st in &r.steps {
+        s.push_str(&format!(
+            "step {}: {} -> {} points, phase {}{}\n",
+            st.step,
+            st.fine,
+            st.coarse,
+            st.phase,
+            if st.dropped {
+                " (odd: the flattest point was dropped first)"
+            } else {
+                ""
+            }
+        ));
+    }
+    let e = |m: &subgram::reverse::metric::Error| {
+        format!("max {:.6}  mean {:.6}  rms {:.6}", m.max, m.mean, m.rms)
+    };
+    s.push_str(&format!(
+        "reconstruction error, {} points subdivided {} times, against the input:\n  reverse subdivision  {}\n  naive decimation     {}\n",
+        r.coarse_points,
+        r.steps.len(),
+        e(&r.reverse),
+        e(&r.decimation)
+    ));
+    if r.reverse.rms > 0.0 {
+        s.push_str(&format!(
+            "  decimation's rms error is {:.2} times reverse subdivision's",
+            r.decimation.rms / r.reverse.rms
+        ));
+    }
+    s
+}
+
+fn reconstruct_command(
+    coarse: &str,
+    details: &str,
+    output: &str,
+    level: Option<usize>,
+    scheme: Option<&str>,
+) -> Result<(), (u8, String)> {
+    use subgram::reverse::{self, Details, Scheme};
+    let text = std::fs::read_to_string(details)
+        .map_err(|e| (1, format!("{details}: error: cannot read the file: {e}")))?;
+    let d: Details = serde_json::from_str(&text).map_err(|e| {
+        (
+            1,
+            format!("{details}:{}: error: not a details file: {e}", e.line()),
+        )
+    })?;
+    let c = reverse::input::read(std::path::Path::new(coarse)).map_err(|e| (1, e.to_string()))?;
+    let scheme = match scheme {
+        Some(s) => Scheme::from_file(std::path::Path::new(s), d.closed),
+        None if d.scheme.starts_with("builtin:") => Ok(Scheme::builtin(d.closed)),
+        None => Scheme::from_file(std::path::Path::new(&d.scheme), d.closed),
+    }
+    .map_err(|e| (1, e.to_string()))?;
+    let pts =
+        reverse::reconstruct(&scheme, &c.points, &d, level).map_err(|e| (1, e.to_string()))?;
+    let out = reverse::format_points(&pts, d.closed, std::path::Path::new(output));
+    write_file(output, out.as_bytes())
 }

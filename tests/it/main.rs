@@ -5,5 +5,6 @@ mod corpus;
 mod curves;
 mod errors;
 mod render;
+mod reverse;
 mod semantics;
 mod support;

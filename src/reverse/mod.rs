@@ -1,0 +1,577 @@
+//! Reverse subdivision of contours (paper 002, section 7): a scheme file's
+//! group 1 runs through the rewriting engine to halve a contour, its group
+//! 2 (the forward scheme) reconstructs and measures. Details between levels
+//! make the representation lossless, in the spirit of Bartels and
+//! Samavati's multiresolution curves.
+
+pub mod input;
+pub mod metric;
+pub mod trace;
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use crate::lang::Value;
+use crate::rewrite::Word;
+use crate::{Derivation, DeriveOptions, LoadError, Loaded};
+
+pub use input::{Contour, InputError};
+
+/// The scheme files built into the binary (also in `lsystems/reverse/`).
+pub const CLOSED_SCHEME: &str = include_str!("../../lsystems/reverse/chaikin.lsys");
+pub const OPEN_SCHEME: &str = include_str!("../../lsystems/reverse/chaikin-open.lsys");
+
+/// A reverse scheme: group 1 reverses one level, group 2 subdivides one.
+pub struct Scheme {
+    pub loaded: Loaded,
+    /// "builtin:chaikin", "builtin:chaikin-open" or a file path.
+    pub name: String,
+    pub closed: bool,
+}
+
+/// Why reversing failed.
+#[derive(Debug)]
+pub enum ReverseError {
+    Load(LoadError),
+    /// The scheme failed to run (a message with its source location).
+    Scheme(String),
+    /// The contour became too short for another step.
+    TooShort {
+        step: usize,
+        points: usize,
+        needed: usize,
+    },
+    /// A details file does not fit the coarse contour or is malformed.
+    Details(String),
+}
+
+impl std::fmt::Display for ReverseError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ReverseError::Load(e) => f.write_str(&e.render()),
+            ReverseError::Scheme(m) => f.write_str(m),
+            ReverseError::TooShort { step, points, needed } => write!(
+                f,
+                "error: after {} step(s) the contour has {points} points; step {step} needs at least {needed}: ask for fewer steps",
+                step - 1
+            ),
+            ReverseError::Details(m) => write!(f, "error: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for ReverseError {}
+
+impl Scheme {
+    /// The built-in reverse Chaikin scheme, for closed or open contours.
+    pub fn builtin(closed: bool) -> Scheme {
+        let (name, text) = if closed {
+            ("builtin:chaikin", CLOSED_SCHEME)
+        } else {
+            ("builtin:chaikin-open", OPEN_SCHEME)
+        };
+        let loaded = crate::load_str(name, text, &[]).expect("the built-in schemes are valid");
+        Scheme {
+            loaded,
+            name: name.to_string(),
+            closed,
+        }
+    }
+
+    /// A scheme file: module `P(V2f)`, group 1 reverse, group 2 forward.
+    /// Open schemes work between endmarkers `#`.
+    pub fn from_file(path: &std::path::Path, closed: bool) -> Result<Scheme, ReverseError> {
+        let loaded = crate::load_file(path, &[]).map_err(ReverseError::Load)?;
+        let p = loaded.program.alphabet.lookup("P");
+        let ok = p.is_some_and(|s| {
+            matches!(&loaded.program.alphabet.get(s).sig,
+                crate::lang::modules::Signature::Fixed(t) if t == &[crate::lang::Ty::V2])
+        });
+        if !ok {
+            return Err(ReverseError::Scheme(format!(
+                "error: the scheme {} must declare `module P(V2f);` for the contour's points",
+                path.display()
+            )));
+        }
+        Ok(Scheme {
+            loaded,
+            name: path.display().to_string(),
+            closed,
+        })
+    }
+
+    fn word(&self, pts: &[DVec2]) -> Word {
+        let a = &self.loaded.program.alphabet;
+        let p = a.lookup("P").expect("checked");
+        let hash = a.builtin("#");
+        let mut w = Word::new();
+        if !self.closed {
+            w.push(hash, &[]);
+        }
+        for q in pts {
+            w.push(p, &[Value::V2(*q)]);
+        }
+        if !self.closed {
+            w.push(hash, &[]);
+        }
+        w
+    }
+
+    fn points(&self, w: &Word) -> Vec<DVec2> {
+        let p = self.loaded.program.alphabet.lookup("P").expect("checked");
+        (0..w.len())
+            .filter(|&i| w.sym(i) == p)
+            .map(|i| {
+                let d = w.data(i);
+                DVec2::new(d[0], d[1])
+            })
+            .collect()
+    }
+
+    /// Runs `steps` steps of `group` from the given points.
+    fn run(
+        &self,
+        pts: &[DVec2],
+        group: i64,
+        steps: u64,
+        phase: usize,
+    ) -> Result<Vec<DVec2>, ReverseError> {
+        let opts = DeriveOptions::default().with_steps(steps).with_phase(phase);
+        let l = &self.loaded;
+        let fail = |e: crate::DeriveError| ReverseError::Scheme(l.render_derive_error(&e));
+        let mut d = Derivation::new(&l.program, opts).map_err(fail)?;
+        d.word = self.word(pts);
+        d.ring = self.closed;
+        while d.has_next() {
+            d.env.next_group = group;
+            d.next_step().map_err(fail)?;
+        }
+        Ok(self.points(&d.word))
+    }
+
+    /// One reverse step (group 1) with the partition starting at `phase`.
+    pub fn reverse_step(&self, pts: &[DVec2], phase: usize) -> Result<Vec<DVec2>, ReverseError> {
+        self.run(pts, 1, 1, phase)
+    }
+
+    /// `steps` forward steps (group 2).
+    pub fn forward(&self, pts: &[DVec2], steps: usize) -> Result<Vec<DVec2>, ReverseError> {
+        if steps == 0 {
+            return Ok(pts.to_vec());
+        }
+        self.run(pts, 2, steps as u64, 0)
+    }
+
+    /// The fewest points a level needs for one more reverse step.
+    pub fn min_points(&self) -> usize {
+        6
+    }
+}
+
+/// Which partition of a level into pairs to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// Try both at every step and keep the better reconstruction.
+    Auto,
+    Fixed(usize),
+}
+
+/// Settings of `reverse`.
+#[derive(Clone, Debug)]
+pub struct ReverseOptions {
+    pub steps: usize,
+    pub phase: Phase,
+    /// Keep the detail vectors that make the representation lossless.
+    pub details: bool,
+}
+
+/// What happened at one step.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StepReport {
+    pub step: usize,
+    /// Points before the step (after dropping one from an odd level).
+    pub fine: usize,
+    pub coarse: usize,
+    pub phase: usize,
+    /// An odd level lost its flattest point first.
+    pub dropped: bool,
+}
+
+/// The detail of one level: what turns the forward subdivision of the
+/// coarser level back into this level exactly.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LevelDetails {
+    /// The subdivided coarse level, rotated left by `shift`, lines up with
+    /// this level (closed contours only; 0 for open ones).
+    pub shift: usize,
+    /// This level minus the aligned subdivision, one vector per point.
+    pub details: Vec<[f64; 2]>,
+    /// The point an odd level lost before the step: its index and position.
+    pub dropped: Option<(usize, [f64; 2])>,
+}
+
+/// The details file: the levels from the coarsest to the input.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Details {
+    pub format: String,
+    pub version: u32,
+    pub scheme: String,
+    pub closed: bool,
+    pub coarse_points: usize,
+    pub levels: Vec<LevelDetails>,
+}
+
+pub const DETAILS_FORMAT: &str = "subgram-details";
+
+/// The result of `reverse`.
+#[derive(Clone, Debug)]
+pub struct Reversal {
+    pub coarse: Vec<DVec2>,
+    pub steps: Vec<StepReport>,
+    pub details: Option<Details>,
+}
+
+/// The index of the point nearest the chord of its neighbours: removing it
+/// changes the contour least. End points of open contours are kept.
+fn flattest(pts: &[DVec2], closed: bool) -> usize {
+    let n = pts.len();
+    let range = if closed { 0..n } else { 1..n - 1 };
+    range
+        .min_by(|&a, &b| {
+            let dev = |i: usize| {
+                let (l, r) = (pts[(i + n - 1) % n], pts[(i + 1) % n]);
+                metric_point_segment(pts[i], l, r)
+            };
+            dev(a).total_cmp(&dev(b))
+        })
+        .unwrap_or(0)
+}
+
+fn metric_point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    metric::distance(&[p], &[a, b], false).max
+}
+
+/// Reverses `input` by `opts.steps` levels.
+pub fn reverse(
+    scheme: &Scheme,
+    input: &Contour,
+    opts: &ReverseOptions,
+) -> Result<Reversal, ReverseError> {
+    let mut level = input.points.clone();
+    let mut steps = Vec::new();
+    let mut levels = Vec::new();
+    for step in 1..=opts.steps {
+        let even = level.len() - level.len() % 2;
+        if even < scheme.min_points() {
+            return Err(ReverseError::TooShort {
+                step,
+                points: level.len(),
+                needed: scheme.min_points(),
+            });
+        }
+        let mut dropped = None;
+        if level.len() % 2 == 1 {
+            let i = flattest(&level, scheme.closed);
+            let p = level.remove(i);
+            dropped = Some((i, [p.x, p.y]));
+        }
+        let candidates: Vec<usize> = match (opts.phase, scheme.closed) {
+            (_, false) => vec![0],
+            (Phase::Fixed(p), true) => vec![p % 2],
+            (Phase::Auto, true) => vec![0, 1],
+        };
+        let mut best: Option<(f64, usize, Vec<DVec2>)> = None;
+        for ph in candidates {
+            let coarse = scheme.reverse_step(&level, ph)?;
+            let score = if best.is_none() && opts.phase != Phase::Auto {
+                0.0
+            } else {
+                // Reconstruct all the way to the input and compare.
+                let rec = scheme.forward(&coarse, step)?;
+                metric::distance(&input.points, &rec, scheme.closed).rms
+            };
+            if best.as_ref().is_none_or(|(s, _, _)| score < *s) {
+                best = Some((score, ph, coarse));
+            }
+        }
+        let (_, ph, coarse) = best.expect("one candidate at least");
+        if opts.details {
+            let sub = scheme.forward(&coarse, 1)?;
+            if sub.len() != level.len() {
+                return Err(ReverseError::Scheme(format!(
+                    "error: the scheme's forward group turns {} points into {}, not the {} of the finer level, so details cannot be kept",
+                    coarse.len(),
+                    sub.len(),
+                    level.len()
+                )));
+            }
+            let shift = if scheme.closed {
+                (0..level.len())
+                    .min_by(|&a, &b| {
+                        sub[0]
+                            .distance(level[a])
+                            .total_cmp(&sub[0].distance(level[b]))
+                    })
+                    .unwrap_or(0)
+            } else {
+                0
+            };
+            let n = level.len();
+            let details = (0..n)
+                .map(|i| {
+                    let d = level[(i + shift) % n] - sub[i];
+                    [d.x, d.y]
+                })
+                .collect();
+            levels.push(LevelDetails {
+                shift,
+                details,
+                dropped,
+            });
+        }
+        steps.push(StepReport {
+            step,
+            fine: level.len(),
+            coarse: coarse.len(),
+            phase: ph,
+            dropped: dropped.is_some(),
+        });
+        level = coarse;
+    }
+    let details = opts.details.then(|| {
+        levels.reverse();
+        Details {
+            format: DETAILS_FORMAT.to_string(),
+            version: 1,
+            scheme: scheme.name.clone(),
+            closed: scheme.closed,
+            coarse_points: level.len(),
+            levels,
+        }
+    });
+    Ok(Reversal {
+        coarse: level,
+        steps,
+        details,
+    })
+}
+
+/// Restores the contour from a coarse level and details, up to `upto`
+/// levels (all when `None`).
+pub fn reconstruct(
+    scheme: &Scheme,
+    coarse: &[DVec2],
+    details: &Details,
+    upto: Option<usize>,
+) -> Result<Vec<DVec2>, ReverseError> {
+    if details.format != DETAILS_FORMAT || details.version != 1 {
+        return Err(ReverseError::Details(format!(
+            "not a subgram details file (format `{}` version {})",
+            details.format, details.version
+        )));
+    }
+    if coarse.len() != details.coarse_points {
+        return Err(ReverseError::Details(format!(
+            "the details belong to a coarse contour of {} points, but this one has {}",
+            details.coarse_points,
+            coarse.len()
+        )));
+    }
+    let k = upto.unwrap_or(details.levels.len());
+    if k > details.levels.len() {
+        return Err(ReverseError::Details(format!(
+            "level {k} was asked for, but the details have {} levels",
+            details.levels.len()
+        )));
+    }
+    let mut level = coarse.to_vec();
+    for (li, l) in details.levels[..k].iter().enumerate() {
+        let sub = scheme.forward(&level, 1)?;
+        if sub.len() != l.details.len() {
+            return Err(ReverseError::Details(format!(
+                "level {}: the subdivision has {} points but the details have {}",
+                li + 1,
+                sub.len(),
+                l.details.len()
+            )));
+        }
+        let n = sub.len();
+        let mut fine = vec![DVec2::ZERO; n];
+        for i in 0..n {
+            fine[(i + l.shift) % n] = sub[i] + DVec2::from(l.details[i]);
+        }
+        if let Some((i, p)) = l.dropped {
+            if i > fine.len() {
+                return Err(ReverseError::Details(format!(
+                    "level {}: a dropped point's index is out of range",
+                    li + 1
+                )));
+            }
+            fine.insert(i, DVec2::from(p));
+        }
+        level = fine;
+    }
+    Ok(level)
+}
+
+/// Keeps `count` points of `pts` evenly spaced by index (naive decimation).
+pub fn decimate(pts: &[DVec2], count: usize, closed: bool) -> Vec<DVec2> {
+    let n = pts.len();
+    if count >= n {
+        return pts.to_vec();
+    }
+    if closed {
+        (0..count).map(|k| pts[k * n / count]).collect()
+    } else {
+        (0..count)
+            .map(|k| pts[(k * (n - 1) + (count - 1) / 2) / (count - 1).max(1)])
+            .collect()
+    }
+}
+
+/// Reconstruction errors of reverse subdivision and of naive decimation.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    pub input_points: usize,
+    pub closed: bool,
+    pub source: String,
+    pub scheme: String,
+    pub steps: Vec<StepReport>,
+    pub coarse_points: usize,
+    /// Forward scheme applied STEPS times to the coarse polygon, measured
+    /// against the input polyline.
+    pub reverse: metric::Error,
+    /// The same for the input decimated to the same number of points.
+    pub decimation: metric::Error,
+}
+
+/// Measures a reversal.
+pub fn report(scheme: &Scheme, input: &Contour, r: &Reversal) -> Result<Report, ReverseError> {
+    let steps = r.steps.len();
+    let rec = scheme.forward(&r.coarse, steps)?;
+    let dec = decimate(&input.points, r.coarse.len(), scheme.closed);
+    let dec_rec = scheme.forward(&dec, steps)?;
+    Ok(Report {
+        input_points: input.points.len(),
+        closed: scheme.closed,
+        source: input.source.clone(),
+        scheme: scheme.name.clone(),
+        steps: r.steps.clone(),
+        coarse_points: r.coarse.len(),
+        reverse: metric::distance(&input.points, &rec, scheme.closed),
+        decimation: metric::distance(&input.points, &dec_rec, scheme.closed),
+    })
+}
+
+/// Writes points as `x y` lines (`.txt`, `.xy`, anything else), `x,y` CSV
+/// with a header (`.csv`), or an SVG polygon/polyline (`.svg`, y flipped
+/// back to SVG's downward axis).
+pub fn format_points(pts: &[DVec2], closed: bool, path: &std::path::Path) -> String {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "csv" => {
+            let mut s = String::from("x,y\n");
+            for p in pts {
+                s.push_str(&format!("{:?},{:?}\n", p.x, p.y));
+            }
+            s
+        }
+        "svg" => {
+            let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+            for p in pts {
+                let q = DVec2::new(p.x, -p.y);
+                lo = lo.min(q);
+                hi = hi.max(q);
+            }
+            let size = hi - lo;
+            let pad = size.max_element() * 0.02;
+            let coords: Vec<String> = pts
+                .iter()
+                .map(|p| format!("{:?},{:?}", p.x, -p.y))
+                .collect();
+            format!(
+                "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"{:?} {:?} {:?} {:?}\">\n<{} points=\"{}\" fill=\"none\" stroke=\"black\" vector-effect=\"non-scaling-stroke\"/>\n</svg>\n",
+                lo.x - pad,
+                lo.y - pad,
+                size.x + 2.0 * pad,
+                size.y + 2.0 * pad,
+                if closed { "polygon" } else { "polyline" },
+                coords.join(" ")
+            )
+        }
+        _ => {
+            let mut s = String::new();
+            for p in pts {
+                s.push_str(&format!("{:?} {:?}\n", p.x, p.y));
+            }
+            s
+        }
+    }
+}
+
+/// The picture of a reversal: the input thin and grey, the coarse polygon
+/// with its points, the reconstruction in colour.
+pub fn figure_events(
+    input: &Contour,
+    coarse: &[DVec2],
+    reconstruction: &[DVec2],
+) -> Vec<crate::draw::Event> {
+    use crate::draw::{Event, Pen};
+    let v3 = |p: DVec2| glam::DVec3::new(p.x, p.y, 0.0);
+    let mut ev = Vec::new();
+    let poly = |pts: &[DVec2], closed: bool, pen: Pen, ev: &mut Vec<Event>| {
+        let n = pts.len();
+        let last = if closed { n } else { n.saturating_sub(1) };
+        for i in 0..last {
+            ev.push(Event::Line {
+                a: v3(pts[i]),
+                b: v3(pts[(i + 1) % n]),
+                pen,
+            });
+        }
+    };
+    poly(
+        &input.points,
+        input.closed,
+        Pen {
+            color: 9,
+            width: 1.0,
+        },
+        &mut ev,
+    );
+    poly(
+        coarse,
+        input.closed,
+        Pen {
+            color: 0,
+            width: 1.0,
+        },
+        &mut ev,
+    );
+    poly(
+        reconstruction,
+        input.closed,
+        Pen {
+            color: 2,
+            width: 1.5,
+        },
+        &mut ev,
+    );
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in &input.points {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let r = (hi - lo).max_element() * 0.004;
+    for p in coarse {
+        ev.push(Event::Disc {
+            c: v3(*p),
+            r,
+            color: 3,
+        });
+    }
+    ev
+}
