@@ -54,7 +54,7 @@ fn chaikin_loop(start: &[DVec2], steps: usize) -> Vec<DVec2> {
 }
 
 fn main() {
-    let runs = 5;
+    let runs = 10;
     let pts = polygon(1000);
     let steps = 10;
     let axiom: Vec<String> = pts

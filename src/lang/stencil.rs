@@ -53,6 +53,37 @@ pub struct Stencil {
     pub outputs: Vec<(Sym, Vec<Combination>)>,
 }
 
+/// A combination whose terms are all `±c * x`: `Σ w_k · x_k` added left to
+/// right, with the signs folded into the weights. Folding is exact:
+/// `a - c*x` equals `a + (-c)*x` and `-(c*x)` equals `(-c)*x` in IEEE
+/// arithmetic.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlainCombination {
+    pub ty: Ty,
+    /// `(k, off, w)` as in [`Term`].
+    pub terms: Vec<(u16, u16, f64)>,
+}
+
+impl Combination {
+    /// The plain form, when every term is a weighted parameter.
+    pub fn plain(&self) -> Option<PlainCombination> {
+        let mut terms = Vec::with_capacity(self.terms.len());
+        for (n, t) in self.terms.iter().enumerate() {
+            let (k, off) = t.source?;
+            if t.div {
+                return None;
+            }
+            let sign = if t.negate != (t.sub && n > 0) {
+                -1.0
+            } else {
+                1.0
+            };
+            terms.push((k, off, sign * t.w));
+        }
+        Some(PlainCombination { ty: self.ty, terms })
+    }
+}
+
 /// The value of a constant expression, computed with the interpreter's own
 /// operations.
 fn constant(e: &Ex) -> Option<Value> {

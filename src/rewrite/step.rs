@@ -46,6 +46,8 @@ pub struct Rewriter<'p> {
     frame: Vec<Value>,
     /// The last step's growth (new length / old length), to size buffers.
     growth: f64,
+    /// The fast path found every new slot finite while computing it.
+    checked_finite: bool,
     matched: Vec<usize>,
     new_matched: Vec<usize>,
     tmp: Word,
@@ -60,6 +62,7 @@ impl<'p> Rewriter<'p> {
             eb: program.alphabet.builtin("EB"),
             frame: Vec::new(),
             growth: 1.0,
+            checked_finite: false,
             matched: Vec::new(),
             new_matched: Vec::new(),
             tmp: Word::new(),
@@ -96,11 +99,15 @@ impl<'p> Rewriter<'p> {
         let want = ((n as f64 * g) as usize).min(opts.max_modules.saturating_add(1));
         let want_slots =
             ((src.slot_count() as f64 * g) as usize).min(opts.max_modules.saturating_mul(4));
-        dst.reserve(want, want_slots);
+        dst.clear_with_capacity(want, want_slots);
         if eligible.is_none() && origin.is_none() && opts.forward && self.stencils_only(rules, src)
         {
-            let rewritten = self.stencil_step(rules, src, dst, opts)?;
-            if Self::all_finite(dst) {
+            self.checked_finite = false;
+            let rewritten = match self.uniform_rule(rules, src, opts) {
+                Some((r, w)) => self.uniform_step(r, w, src, dst, opts)?,
+                None => self.stencil_step(rules, src, dst, opts)?,
+            };
+            if self.checked_finite || Self::all_finite(dst) {
                 self.growth = dst.len() as f64 / n as f64;
                 return Ok(rewritten);
             }
@@ -211,6 +218,231 @@ impl<'p> Rewriter<'p> {
         rules_ok && !src.syms().iter().any(|&s| s == self.sb || s == self.eb)
     }
 
+    /// On a ring whose modules are all of one kind and one width, the first
+    /// rule whose predecessor is made of that kind rewrites every module.
+    /// Returns that rule and the width, when its body is a stencil.
+    fn uniform_rule(
+        &self,
+        rules: &[usize],
+        src: &Word,
+        opts: &StepOptions,
+    ) -> Option<(usize, usize)> {
+        let n = src.len();
+        if !opts.ring || n == 0 || n > opts.max_modules {
+            return None;
+        }
+        let s = src.sym(0);
+        if src.syms().iter().any(|&t| t != s) || !src.slot_count().is_multiple_of(n) {
+            return None;
+        }
+        let w = src.slot_count() / n;
+        if src.data(0).len() != w {
+            return None;
+        }
+        for &r in rules {
+            let rule = &self.program.rules[r];
+            let all_s = rule
+                .left
+                .iter()
+                .chain(&rule.strict)
+                .chain(&rule.right)
+                .all(|p| p.sym == s);
+            if rule.strict.len() == 1 && all_s && rule.left.len() <= n && rule.right.len() <= n {
+                return rule.stencil.is_some().then_some((r, w));
+            }
+        }
+        None
+    }
+
+    /// The fast path for `uniform_rule`: the same stencil at every module,
+    /// neighbours found by index arithmetic, slots addressed directly.
+    fn uniform_step(
+        &mut self,
+        r: usize,
+        w: usize,
+        src: &Word,
+        dst: &mut Word,
+        opts: &StepOptions,
+    ) -> Result<usize, StepError> {
+        let rule = &self.program.rules[r];
+        let st = rule.stencil.as_ref().expect("checked by uniform_rule");
+        let n = src.len();
+        let (nl, nr) = (rule.left.len(), rule.right.len());
+        let total = nl + 1 + nr;
+        let out_per_module: usize = st.outputs.len();
+        if n.saturating_mul(out_per_module) > opts.max_modules {
+            return Err(StepError::TooLong {
+                limit: opts.max_modules,
+            });
+        }
+        let data = src.all_slots();
+        // The new word's exact size is known: allocate it once.
+        let slots_per_module: usize = st
+            .outputs
+            .iter()
+            .flat_map(|(_, cs)| {
+                cs.iter().map(|c| match c.ty {
+                    Ty::V2 => 2,
+                    Ty::V3 => 3,
+                    _ => 1,
+                })
+            })
+            .sum();
+        dst.clear_with_capacity(n * out_per_module, n * slots_per_module);
+        let (syms, starts, out) = dst.raw_parts_mut();
+        // The common case: every term a weighted parameter.
+        let plain: Option<Vec<(Sym, Vec<crate::lang::stencil::PlainCombination>)>> = st
+            .outputs
+            .iter()
+            .map(|(sym, combos)| {
+                Some((
+                    *sym,
+                    combos
+                        .iter()
+                        .map(|c| c.plain())
+                        .collect::<Option<Vec<_>>>()?,
+                ))
+            })
+            .collect();
+        let mut base = vec![0usize; total];
+        if let Some(plain) = plain {
+            let mut guard = 0.0;
+            // Away from the ring's seam every parameter a term reads sits at
+            // a fixed distance from the module's own slots.
+            let fixed: Vec<FixedOutput> = plain
+                .iter()
+                .map(|(sym, combos)| {
+                    let cs = combos
+                        .iter()
+                        .map(|c| {
+                            let ts = c
+                                .terms
+                                .iter()
+                                .map(|&(k, off, wt)| {
+                                    ((k as isize - nl as isize) * w as isize + off as isize, wt)
+                                })
+                                .collect();
+                            (c.ty, ts)
+                        })
+                        .collect();
+                    (*sym, cs)
+                })
+                .collect();
+            // Symbols and offsets follow a fixed pattern per module: write
+            // them in bulk, and only the parameters in the loops below.
+            let widths: Vec<usize> = plain
+                .iter()
+                .map(|(_, cs)| {
+                    cs.iter()
+                        .map(|c| match c.ty {
+                            Ty::V2 => 2,
+                            Ty::V3 => 3,
+                            _ => 1,
+                        })
+                        .sum()
+                })
+                .collect();
+            let pattern: Vec<Sym> = plain.iter().map(|(s, _)| *s).collect();
+            let mut end = out.len() as u32;
+            for _ in 0..n {
+                syms.extend_from_slice(&pattern);
+                for wd in &widths {
+                    end += *wd as u32;
+                    starts.push(end);
+                }
+            }
+            let seam_module =
+                |i: usize, base: &mut Vec<usize>, out: &mut Vec<f64>, guard: &mut f64| {
+                    for (t, b) in base.iter_mut().enumerate() {
+                        let j = i + n + t - nl;
+                        let j = if j >= 2 * n {
+                            j - 2 * n
+                        } else if j >= n {
+                            j - n
+                        } else {
+                            j
+                        };
+                        *b = j * w;
+                    }
+                    for (_, combos) in &plain {
+                        for c in combos {
+                            match c.ty {
+                                Ty::V2 => plain_eval::<2>(&c.terms, data, base, out, guard),
+                                Ty::V3 => plain_eval::<3>(&c.terms, data, base, out, guard),
+                                _ => plain_eval::<1>(&c.terms, data, base, out, guard),
+                            }
+                        }
+                    }
+                };
+            let first_inner = nl.min(n);
+            let last_inner = n.saturating_sub(nr).max(first_inner);
+            for i in 0..first_inner {
+                seam_module(i, &mut base, out, &mut guard);
+            }
+            // `v * 0` is 0 for a finite v and NaN otherwise: a NaN guard
+            // without a branch per value.
+            let mut g = 0.0;
+            for i in first_inner..last_inner {
+                let at = (i * w) as isize;
+                for (_, combos) in &fixed {
+                    for (ty, terms) in combos {
+                        match ty {
+                            Ty::V2 => {
+                                let a = fixed_eval::<2>(terms, data, at);
+                                g += a[0] * 0.0 + a[1] * 0.0;
+                                out.extend_from_slice(&a);
+                            }
+                            Ty::V3 => {
+                                let a = fixed_eval::<3>(terms, data, at);
+                                g += a[0] * 0.0 + a[1] * 0.0 + a[2] * 0.0;
+                                out.extend_from_slice(&a);
+                            }
+                            _ => {
+                                let a = fixed_eval::<1>(terms, data, at);
+                                g += a[0] * 0.0;
+                                out.push(a[0]);
+                            }
+                        }
+                    }
+                }
+            }
+            guard += g;
+            for i in last_inner..n {
+                seam_module(i, &mut base, out, &mut guard);
+            }
+            debug_assert_eq!(out.len() as u32, end);
+            self.checked_finite = guard == 0.0;
+            return Ok(n);
+        }
+        let mut slices: Vec<&[f64]> = vec![&[]; total];
+        for i in 0..n {
+            for (t, s) in slices.iter_mut().enumerate() {
+                // Position i - nl + t, wrapped once either way.
+                let j = i + n + t - nl;
+                let j = if j >= 2 * n {
+                    j - 2 * n
+                } else if j >= n {
+                    j - n
+                } else {
+                    j
+                };
+                *s = &data[j * w..j * w + w];
+            }
+            for (sym, combos) in &st.outputs {
+                syms.push(*sym);
+                for c in combos {
+                    match c.ty {
+                        Ty::V2 => out.extend_from_slice(&combine::<2>(&c.terms, &slices)),
+                        Ty::V3 => out.extend_from_slice(&combine::<3>(&c.terms, &slices)),
+                        _ => out.push(combine::<1>(&c.terms, &slices)[0]),
+                    }
+                }
+                starts.push(out.len() as u32);
+            }
+        }
+        Ok(n)
+    }
+
     /// The fast path: contexts are plain neighbours, bodies are stencils.
     /// Same result as the general path under the conditions of
     /// `stencils_only`.
@@ -293,7 +525,10 @@ impl<'p> Rewriter<'p> {
     /// The fast path checks for NaN and infinity once, over the whole new
     /// word; the caller reruns the general path to say where it came from.
     fn all_finite(dst: &Word) -> bool {
-        dst.all_slots().iter().all(|x| x.is_finite())
+        // No early exit, so that the loop vectorises.
+        dst.all_slots()
+            .chunks(64)
+            .all(|c| c.iter().fold(true, |ok, x| ok & x.is_finite()))
     }
 
     /// Tries one rule with its strict predecessor starting at `start`.
@@ -482,6 +717,72 @@ fn reverse_tail(w: &mut Word, from: usize, tmp: &mut Word) {
     w.truncate(from);
     for j in (0..tmp.len()).rev() {
         w.push_from(tmp, j);
+    }
+}
+
+/// A stencil output away from the ring's seam: its symbol and, per
+/// parameter, the type and the terms `(slot distance, weight)`.
+type FixedOutput = (Sym, Vec<(Ty, Vec<(isize, f64)>)>);
+
+/// One plain stencil output of `N` components: `Σ w·x` left to right.
+#[inline(always)]
+fn plain_eval<const N: usize>(
+    terms: &[(u16, u16, f64)],
+    data: &[f64],
+    base: &[usize],
+    out: &mut Vec<f64>,
+    guard: &mut f64,
+) {
+    let mut acc = [0.0; N];
+    for (n, &(k, off, w)) in terms.iter().enumerate() {
+        let at = base[k as usize] + off as usize;
+        let x = &data[at..at + N];
+        for i in 0..N {
+            let v = w * x[i];
+            acc[i] = if n == 0 { v } else { acc[i] + v };
+        }
+    }
+    for v in acc {
+        *guard += v * 0.0;
+    }
+    out.extend_from_slice(&acc);
+}
+
+/// `plain_eval` for a module away from the seam: term `t` reads the slots
+/// at `at + delta_t`.
+#[inline(always)]
+fn fixed_eval<const N: usize>(terms: &[(isize, f64)], data: &[f64], at: isize) -> [f64; N] {
+    #[inline(always)]
+    fn load<const N: usize>(data: &[f64], at: isize, delta: isize) -> &[f64; N] {
+        let p = (at + delta) as usize;
+        data[p..p + N].try_into().expect("N slots")
+    }
+    // Two- and three-term sums (every curve scheme of paper 002 but the
+    // four-point one) unrolled; the same operations in the same order.
+    match *terms {
+        [(d0, w0), (d1, w1)] => {
+            let (x0, x1) = (load::<N>(data, at, d0), load::<N>(data, at, d1));
+            std::array::from_fn(|i| w0 * x0[i] + w1 * x1[i])
+        }
+        [(d0, w0), (d1, w1), (d2, w2)] => {
+            let (x0, x1, x2) = (
+                load::<N>(data, at, d0),
+                load::<N>(data, at, d1),
+                load::<N>(data, at, d2),
+            );
+            std::array::from_fn(|i| w0 * x0[i] + w1 * x1[i] + w2 * x2[i])
+        }
+        _ => {
+            let mut acc = [0.0; N];
+            for (n, &(delta, w)) in terms.iter().enumerate() {
+                let x = load::<N>(data, at, delta);
+                for i in 0..N {
+                    let v = w * x[i];
+                    acc[i] = if n == 0 { v } else { acc[i] + v };
+                }
+            }
+            acc
+        }
     }
 }
 

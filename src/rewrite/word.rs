@@ -57,6 +57,22 @@ impl Word {
         self.data.reserve(slots);
     }
 
+    /// Empties the word and makes room for `modules` modules and `slots`
+    /// slots. A buffer too small is replaced rather than grown, so that the
+    /// old contents are not copied.
+    pub fn clear_with_capacity(&mut self, modules: usize, slots: usize) {
+        fn fit<T>(v: &mut Vec<T>, n: usize) {
+            v.clear();
+            if v.capacity() < n {
+                *v = Vec::with_capacity(n);
+            }
+        }
+        fit(&mut self.syms, modules);
+        fit(&mut self.starts, modules + 1);
+        self.starts.push(0);
+        fit(&mut self.data, slots);
+    }
+
     /// The number of parameter slots of all modules together.
     pub fn slot_count(&self) -> usize {
         self.data.len()
@@ -137,6 +153,13 @@ impl Word {
     #[inline(always)]
     pub fn data(&self, i: usize) -> &[f64] {
         &self.data[self.starts[i] as usize..self.starts[i + 1] as usize]
+    }
+
+    /// The storage, for engine fast paths that append many modules at once.
+    /// Callers keep the invariants: one symbol and one offset per module,
+    /// offsets increasing and ending at the slot count.
+    pub(crate) fn raw_parts_mut(&mut self) -> (&mut Vec<Sym>, &mut Vec<u32>, &mut Vec<f64>) {
+        (&mut self.syms, &mut self.starts, &mut self.data)
     }
 
     /// The slots of all modules, in order.

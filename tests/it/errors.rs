@@ -281,3 +281,16 @@ fn division_by_zero_in_a_control_block_is_located() {
         "{got}"
     );
 }
+
+/// The same on a ring of one kind of module, which takes the engine's
+/// uniform fast path.
+#[test]
+fn nan_on_the_uniform_ring_path_is_caught() {
+    let got = derive_error(
+        "module P(V2f);\nring L-system: 1;\nderivation length: 3;\n\
+         Axiom: P(V2f(1e308, 0)) P(V2f(1e308, 0)) P(V2f(1, 1));\nP(a) > P(b) -> P(a + b) P(b)\n",
+        DeriveOptions::default(),
+    );
+    assert!(got.starts_with("bad.lsys:5:1: error: at step 1, production `P(a) > P(b)`"), "{got}");
+    assert!(got.contains("NaN or infinite"), "{got}");
+}
