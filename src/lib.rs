@@ -20,6 +20,7 @@
 
 pub mod draw;
 pub mod lang;
+pub mod mesh;
 pub mod output;
 pub mod render;
 pub mod reverse;

@@ -1,0 +1,1 @@
+//! Pictures of meshes (being written).

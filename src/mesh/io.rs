@@ -1,0 +1,1 @@
+//! Mesh files: OBJ, OFF and PLY (being written).
