@@ -291,6 +291,9 @@ fn nan_on_the_uniform_ring_path_is_caught() {
          Axiom: P(V2f(1e308, 0)) P(V2f(1e308, 0)) P(V2f(1, 1));\nP(a) > P(b) -> P(a + b) P(b)\n",
         DeriveOptions::default(),
     );
-    assert!(got.starts_with("bad.lsys:5:1: error: at step 1, production `P(a) > P(b)`"), "{got}");
+    assert!(
+        got.starts_with("bad.lsys:5:1: error: at step 1, production `P(a) > P(b)`"),
+        "{got}"
+    );
     assert!(got.contains("NaN or infinite"), "{got}");
 }

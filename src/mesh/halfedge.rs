@@ -1,0 +1,517 @@
+//! The half-edge mesh: typed ids, flat arrays of indices, a refinement
+//! level on every vertex, edge and face, and double-buffered positions.
+//!
+//! Half-edges come in pairs: `h` and `h ^ 1` are twins, and edge `e` is the
+//! pair `2e`, `2e + 1`. A boundary half-edge has no face. Every vertex keeps
+//! one outgoing half-edge; a boundary vertex keeps its outgoing boundary
+//! half-edge, so that walks around it start at the boundary.
+
+use std::fmt;
+
+use glam::DVec3;
+
+macro_rules! id {
+    ($(#[$m:meta])* $name:ident) => {
+        $(#[$m])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub struct $name(pub u32);
+
+        impl $name {
+            #[inline]
+            pub fn index(self) -> usize {
+                self.0 as usize
+            }
+        }
+    };
+}
+
+id!(
+    /// A vertex.
+    VertexId
+);
+id!(
+    /// A half-edge; its twin is `HalfEdgeId(h ^ 1)`.
+    HalfEdgeId
+);
+id!(
+    /// An edge: the half-edges `2e` and `2e + 1`.
+    EdgeId
+);
+id!(
+    /// A face (a triangle).
+    FaceId
+);
+
+impl HalfEdgeId {
+    #[inline]
+    pub fn twin(self) -> HalfEdgeId {
+        HalfEdgeId(self.0 ^ 1)
+    }
+
+    #[inline]
+    pub fn edge(self) -> EdgeId {
+        EdgeId(self.0 >> 1)
+    }
+}
+
+impl EdgeId {
+    /// The edge's first half-edge.
+    #[inline]
+    pub fn halfedge(self) -> HalfEdgeId {
+        HalfEdgeId(self.0 << 1)
+    }
+}
+
+/// Why an operation was refused or a mesh is invalid. The mesh is left as
+/// it was.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshError {
+    pub message: String,
+}
+
+impl MeshError {
+    pub fn new(m: impl Into<String>) -> MeshError {
+        MeshError { message: m.into() }
+    }
+}
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+/// A triangle mesh with levels. Storage is structure-of-arrays; removed
+/// elements are marked dead and their slots reused.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    // Vertices.
+    pub(crate) v_out: Vec<Option<HalfEdgeId>>,
+    pub(crate) pos: Vec<DVec3>,
+    pub(crate) next_pos: Vec<DVec3>,
+    pub(crate) v_level: Vec<u32>,
+    pub(crate) v_alive: Vec<bool>,
+    // Half-edges, in twin pairs.
+    pub(crate) he_to: Vec<VertexId>,
+    pub(crate) he_next: Vec<HalfEdgeId>,
+    pub(crate) he_prev: Vec<HalfEdgeId>,
+    pub(crate) he_face: Vec<Option<FaceId>>,
+    // Edges.
+    pub(crate) e_level: Vec<u32>,
+    pub(crate) e_alive: Vec<bool>,
+    /// The internal edge of a basic block of a tri-quad mesh.
+    pub(crate) e_block: Vec<bool>,
+    // Faces.
+    pub(crate) f_he: Vec<HalfEdgeId>,
+    pub(crate) f_level: Vec<u32>,
+    pub(crate) f_alive: Vec<bool>,
+    // Free slots.
+    pub(crate) free_v: Vec<u32>,
+    pub(crate) free_e: Vec<u32>,
+    pub(crate) free_f: Vec<u32>,
+    /// The current level `c` of the subdivision grammar.
+    pub current_level: u32,
+}
+
+impl Mesh {
+    // ----- counts and iteration -------------------------------------
+
+    pub fn vertex_count(&self) -> usize {
+        self.v_alive.len() - self.free_v.len()
+    }
+
+    pub fn edge_count(&self) -> usize {
+        self.e_alive.len() - self.free_e.len()
+    }
+
+    pub fn face_count(&self) -> usize {
+        self.f_alive.len() - self.free_f.len()
+    }
+
+    pub fn vertices(&self) -> impl Iterator<Item = VertexId> + '_ {
+        (0..self.v_alive.len() as u32)
+            .map(VertexId)
+            .filter(|v| self.v_alive[v.index()])
+    }
+
+    pub fn edges(&self) -> impl Iterator<Item = EdgeId> + '_ {
+        (0..self.e_alive.len() as u32)
+            .map(EdgeId)
+            .filter(|e| self.e_alive[e.index()])
+    }
+
+    pub fn faces(&self) -> impl Iterator<Item = FaceId> + '_ {
+        (0..self.f_alive.len() as u32)
+            .map(FaceId)
+            .filter(|f| self.f_alive[f.index()])
+    }
+
+    pub fn is_vertex(&self, v: VertexId) -> bool {
+        self.v_alive.get(v.index()).copied().unwrap_or(false)
+    }
+
+    pub fn is_edge(&self, e: EdgeId) -> bool {
+        self.e_alive.get(e.index()).copied().unwrap_or(false)
+    }
+
+    pub fn is_face(&self, f: FaceId) -> bool {
+        self.f_alive.get(f.index()).copied().unwrap_or(false)
+    }
+
+    /// Bytes of storage per face, for the benchmark's report.
+    pub fn bytes_per_face(&self) -> f64 {
+        let v = self.v_alive.len() * (8 + 24 + 24 + 4 + 1);
+        let h = self.he_to.len() * (4 + 4 + 4 + 8);
+        let e = self.e_alive.len() * (4 + 1 + 1);
+        let f = self.f_alive.len() * (4 + 4 + 1);
+        (v + h + e + f) as f64 / self.face_count().max(1) as f64
+    }
+
+    // ----- element data ----------------------------------------------
+
+    #[inline]
+    pub fn position(&self, v: VertexId) -> DVec3 {
+        self.pos[v.index()]
+    }
+
+    pub fn set_position(&mut self, v: VertexId, p: DVec3) {
+        self.pos[v.index()] = p;
+        self.next_pos[v.index()] = p;
+    }
+
+    /// The next-position buffer of a vertex (smoothing writes here).
+    pub fn next_position(&self, v: VertexId) -> DVec3 {
+        self.next_pos[v.index()]
+    }
+
+    pub fn set_next_position(&mut self, v: VertexId, p: DVec3) {
+        self.next_pos[v.index()] = p;
+    }
+
+    /// Makes the next positions current (paper 000, §7: the buffer is
+    /// swapped after each step). Next positions start equal to current.
+    pub fn swap_positions(&mut self) {
+        std::mem::swap(&mut self.pos, &mut self.next_pos);
+        self.next_pos.copy_from_slice(&self.pos);
+    }
+
+    pub fn vertex_level(&self, v: VertexId) -> u32 {
+        self.v_level[v.index()]
+    }
+
+    pub fn edge_level(&self, e: EdgeId) -> u32 {
+        self.e_level[e.index()]
+    }
+
+    pub fn face_level(&self, f: FaceId) -> u32 {
+        self.f_level[f.index()]
+    }
+
+    pub fn set_vertex_level(&mut self, v: VertexId, l: u32) {
+        self.v_level[v.index()] = l;
+    }
+
+    pub fn set_edge_level(&mut self, e: EdgeId, l: u32) {
+        self.e_level[e.index()] = l;
+    }
+
+    /// True for the internal edge of a basic block (tri-quad meshes).
+    pub fn is_block_edge(&self, e: EdgeId) -> bool {
+        self.e_block[e.index()]
+    }
+
+    // ----- half-edge navigation ------------------------------------
+
+    #[inline]
+    pub fn to(&self, h: HalfEdgeId) -> VertexId {
+        self.he_to[h.index()]
+    }
+
+    #[inline]
+    pub fn from(&self, h: HalfEdgeId) -> VertexId {
+        self.he_to[h.twin().index()]
+    }
+
+    #[inline]
+    pub fn next(&self, h: HalfEdgeId) -> HalfEdgeId {
+        self.he_next[h.index()]
+    }
+
+    #[inline]
+    pub fn prev(&self, h: HalfEdgeId) -> HalfEdgeId {
+        self.he_prev[h.index()]
+    }
+
+    #[inline]
+    pub fn face(&self, h: HalfEdgeId) -> Option<FaceId> {
+        self.he_face[h.index()]
+    }
+
+    pub fn face_halfedge(&self, f: FaceId) -> HalfEdgeId {
+        self.f_he[f.index()]
+    }
+
+    /// An outgoing half-edge of `v` (the boundary one for boundary vertices).
+    pub fn outgoing(&self, v: VertexId) -> Option<HalfEdgeId> {
+        self.v_out[v.index()]
+    }
+
+    pub fn is_boundary_halfedge(&self, h: HalfEdgeId) -> bool {
+        self.he_face[h.index()].is_none()
+    }
+
+    pub fn is_boundary_edge(&self, e: EdgeId) -> bool {
+        let h = e.halfedge();
+        self.is_boundary_halfedge(h) || self.is_boundary_halfedge(h.twin())
+    }
+
+    pub fn is_boundary_vertex(&self, v: VertexId) -> bool {
+        self.v_out[v.index()].is_some_and(|h| self.is_boundary_halfedge(h))
+    }
+
+    /// The two end vertices of an edge.
+    pub fn edge_vertices(&self, e: EdgeId) -> (VertexId, VertexId) {
+        let h = e.halfedge();
+        (self.from(h), self.to(h))
+    }
+
+    /// The half-edge from `a` to `b`, if they are joined.
+    pub fn find_halfedge(&self, a: VertexId, b: VertexId) -> Option<HalfEdgeId> {
+        self.outgoing_halfedges(a).find(|&h| self.to(h) == b)
+    }
+
+    // ----- walkers ----------------------------------------------------
+
+    /// The half-edges leaving `v`, in counter-clockwise order. For a
+    /// boundary vertex the walk crosses faces only: it starts at the edge
+    /// after the boundary gap and ends with the outgoing boundary half-edge.
+    pub fn outgoing_halfedges(&self, v: VertexId) -> OutgoingIter<'_> {
+        let start = self.v_out.get(v.index()).copied().flatten().map(|h| {
+            if self.is_boundary_halfedge(h) {
+                self.prev(h).twin()
+            } else {
+                h
+            }
+        });
+        OutgoingIter {
+            mesh: self,
+            start,
+            cur: start,
+        }
+    }
+
+    /// The one-ring of `v`: its neighbours in counter-clockwise order.
+    pub fn one_ring(&self, v: VertexId) -> impl Iterator<Item = VertexId> + '_ {
+        self.outgoing_halfedges(v).map(move |h| self.to(h))
+    }
+
+    pub fn valence(&self, v: VertexId) -> usize {
+        self.outgoing_halfedges(v).count()
+    }
+
+    /// The faces around `v`, counter-clockwise.
+    pub fn vertex_faces(&self, v: VertexId) -> impl Iterator<Item = FaceId> + '_ {
+        self.outgoing_halfedges(v).filter_map(move |h| self.face(h))
+    }
+
+    /// The half-edges of a face, starting at its recorded one.
+    pub fn face_halfedges(&self, f: FaceId) -> [HalfEdgeId; 3] {
+        let h0 = self.f_he[f.index()];
+        let h1 = self.next(h0);
+        [h0, h1, self.next(h1)]
+    }
+
+    /// The vertices of a face, counter-clockwise.
+    pub fn face_vertices(&self, f: FaceId) -> [VertexId; 3] {
+        self.face_halfedges(f).map(|h| self.to(self.prev(h)))
+    }
+
+    pub fn face_edges(&self, f: FaceId) -> [EdgeId; 3] {
+        self.face_halfedges(f).map(|h| h.edge())
+    }
+
+    /// The faces on either side of an edge (none on a boundary side).
+    pub fn edge_faces(&self, e: EdgeId) -> [Option<FaceId>; 2] {
+        let h = e.halfedge();
+        [self.face(h), self.face(h.twin())]
+    }
+
+    /// The centroid of a face (current positions).
+    pub fn face_centroid(&self, f: FaceId) -> DVec3 {
+        let [a, b, c] = self.face_vertices(f);
+        (self.position(a) + self.position(b) + self.position(c)) / 3.0
+    }
+
+    // ----- allocation ----------------------------------------------------
+
+    /// Makes room for this many more vertices, edges and faces, so that a
+    /// refinement step does not grow its arrays piece by piece.
+    pub fn reserve(&mut self, vertices: usize, edges: usize, faces: usize) {
+        self.v_out.reserve(vertices);
+        self.pos.reserve(vertices);
+        self.next_pos.reserve(vertices);
+        self.v_level.reserve(vertices);
+        self.v_alive.reserve(vertices);
+        for v in [&mut self.he_next, &mut self.he_prev] {
+            v.reserve(2 * edges);
+        }
+        self.he_to.reserve(2 * edges);
+        self.he_face.reserve(2 * edges);
+        self.e_level.reserve(edges);
+        self.e_alive.reserve(edges);
+        self.e_block.reserve(edges);
+        self.f_he.reserve(faces);
+        self.f_level.reserve(faces);
+        self.f_alive.reserve(faces);
+    }
+
+    pub(crate) fn new_vertex(&mut self, p: DVec3, level: u32) -> VertexId {
+        if let Some(i) = self.free_v.pop() {
+            let k = i as usize;
+            self.v_out[k] = None;
+            self.pos[k] = p;
+            self.next_pos[k] = p;
+            self.v_level[k] = level;
+            self.v_alive[k] = true;
+            return VertexId(i);
+        }
+        self.v_out.push(None);
+        self.pos.push(p);
+        self.next_pos.push(p);
+        self.v_level.push(level);
+        self.v_alive.push(true);
+        VertexId(self.v_alive.len() as u32 - 1)
+    }
+
+    /// A new edge from `a` to `b`; returns the half-edge a -> b. Links are
+    /// left for the caller to set.
+    pub(crate) fn new_edge(&mut self, a: VertexId, b: VertexId, level: u32) -> HalfEdgeId {
+        let e = if let Some(i) = self.free_e.pop() {
+            let k = i as usize;
+            self.e_level[k] = level;
+            self.e_alive[k] = true;
+            self.e_block[k] = false;
+            EdgeId(i)
+        } else {
+            self.e_level.push(level);
+            self.e_alive.push(true);
+            self.e_block.push(false);
+            let e = EdgeId(self.e_alive.len() as u32 - 1);
+            let dummy = HalfEdgeId(0);
+            for _ in 0..2 {
+                self.he_to.push(VertexId(0));
+                self.he_next.push(dummy);
+                self.he_prev.push(dummy);
+                self.he_face.push(None);
+            }
+            e
+        };
+        let h = e.halfedge();
+        self.he_to[h.index()] = b;
+        self.he_to[h.twin().index()] = a;
+        self.he_face[h.index()] = None;
+        self.he_face[h.twin().index()] = None;
+        h
+    }
+
+    pub(crate) fn new_face(&mut self, h: HalfEdgeId, level: u32) -> FaceId {
+        if let Some(i) = self.free_f.pop() {
+            self.f_he[i as usize] = h;
+            self.f_level[i as usize] = level;
+            self.f_alive[i as usize] = true;
+            return FaceId(i);
+        }
+        self.f_he.push(h);
+        self.f_level.push(level);
+        self.f_alive.push(true);
+        FaceId(self.f_alive.len() as u32 - 1)
+    }
+
+    pub(crate) fn delete_vertex(&mut self, v: VertexId) {
+        self.v_alive[v.index()] = false;
+        self.v_out[v.index()] = None;
+        self.free_v.push(v.0);
+    }
+
+    pub(crate) fn delete_edge(&mut self, e: EdgeId) {
+        self.e_alive[e.index()] = false;
+        self.free_e.push(e.0);
+    }
+
+    pub(crate) fn delete_face(&mut self, f: FaceId) {
+        self.f_alive[f.index()] = false;
+        self.free_f.push(f.0);
+    }
+
+    #[inline]
+    pub(crate) fn link(&mut self, a: HalfEdgeId, b: HalfEdgeId) {
+        self.he_next[a.index()] = b;
+        self.he_prev[b.index()] = a;
+    }
+
+    /// Makes `h0 -> h1 -> h2` a face cycle of face `f`.
+    pub(crate) fn set_triangle(
+        &mut self,
+        f: FaceId,
+        h0: HalfEdgeId,
+        h1: HalfEdgeId,
+        h2: HalfEdgeId,
+    ) {
+        self.link(h0, h1);
+        self.link(h1, h2);
+        self.link(h2, h0);
+        for h in [h0, h1, h2] {
+            self.he_face[h.index()] = Some(f);
+        }
+        self.f_he[f.index()] = h0;
+    }
+
+    /// The level of a face: one more than its highest vertex (paper 000, §6).
+    pub(crate) fn face_level_from_vertices(&self, vs: [VertexId; 3]) -> u32 {
+        vs.iter()
+            .map(|v| self.v_level[v.index()])
+            .max()
+            .unwrap_or(0)
+            + 1
+    }
+
+    /// Points `v`'s outgoing half-edge at its boundary one, if it has one.
+    pub(crate) fn fix_outgoing(&mut self, v: VertexId) {
+        let Some(start) = self.v_out[v.index()] else {
+            return;
+        };
+        let mut h = start;
+        loop {
+            if self.is_boundary_halfedge(h) {
+                self.v_out[v.index()] = Some(h);
+                return;
+            }
+            h = self.prev(h).twin();
+            if h == start {
+                return;
+            }
+        }
+    }
+}
+
+/// Iterates the half-edges leaving a vertex, counter-clockwise.
+pub struct OutgoingIter<'m> {
+    mesh: &'m Mesh,
+    start: Option<HalfEdgeId>,
+    cur: Option<HalfEdgeId>,
+}
+
+impl Iterator for OutgoingIter<'_> {
+    type Item = HalfEdgeId;
+
+    fn next(&mut self) -> Option<HalfEdgeId> {
+        let h = self.cur?;
+        // Counter-clockwise around the origin: the previous half-edge of
+        // h's face comes into the vertex; its twin leaves it.
+        let n = self.mesh.prev(h).twin();
+        self.cur = if Some(n) == self.start { None } else { Some(n) };
+        Some(h)
+    }
+}

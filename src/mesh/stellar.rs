@@ -1,0 +1,390 @@
+//! The stellar operators of paper 000, §5: face split and weld, edge split
+//! and weld, edge flip. Each checks what it needs first and refuses an
+//! illegal case with an error, leaving the mesh unchanged; levels follow
+//! paper 000, §6.
+
+use glam::DVec3;
+
+use super::halfedge::{EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId};
+
+impl Mesh {
+    /// Face split: a new vertex `v` inside triangle `abc` joined to its
+    /// three corners.
+    ///
+    /// ```text
+    ///        c                 c
+    ///       / \               /|\
+    ///      /   \             / | \
+    ///     /  f  \    ->     /  v  \
+    ///    /       \         / /   \ \
+    ///   a---------b       a---------b
+    /// ```
+    ///
+    /// Levels: `l(v) = max(l(a), l(b), l(c)) + 1`; the three new edges get
+    /// `l(v)`, the level of their common vertex; the faces `l(v) + 1`.
+    pub fn face_split(&mut self, f: FaceId, p: DVec3) -> Result<VertexId, MeshError> {
+        if !self.is_face(f) {
+            return Err(MeshError::new(format!(
+                "face split: face {} does not exist",
+                f.0
+            )));
+        }
+        let [h0, h1, h2] = self.face_halfedges(f);
+        let [a, b, c] = self.face_vertices(f);
+        let lv = self.face_level_from_vertices([a, b, c]);
+        let v = self.new_vertex(p, lv);
+        let va = self.new_edge(v, a, lv);
+        let vb = self.new_edge(v, b, lv);
+        let vc = self.new_edge(v, c, lv);
+        let f1 = self.new_face(h1, 0);
+        let f2 = self.new_face(h2, 0);
+        self.set_triangle(f, h0, vb.twin(), va);
+        self.set_triangle(f1, h1, vc.twin(), vb);
+        self.set_triangle(f2, h2, va.twin(), vc);
+        self.v_out[v.index()] = Some(va);
+        for g in [f, f1, f2] {
+            let vs = self.face_vertices(g);
+            self.f_level[g.index()] = self.face_level_from_vertices(vs);
+        }
+        Ok(v)
+    }
+
+    /// Face weld, the inverse of face split: removes an interior vertex of
+    /// valence 3 and merges its three triangles.
+    ///
+    /// ```text
+    ///        c                 c
+    ///       /|\               / \
+    ///      / | \             /   \
+    ///     /  v  \    ->     /     \
+    ///    / /   \ \         /       \
+    ///   a---------b       a---------b
+    /// ```
+    pub fn face_weld(&mut self, v: VertexId) -> Result<FaceId, MeshError> {
+        if !self.is_vertex(v) {
+            return Err(MeshError::new(format!(
+                "face weld: vertex {} does not exist",
+                v.0
+            )));
+        }
+        if self.is_boundary_vertex(v) {
+            return Err(MeshError::new(format!(
+                "face weld: vertex {} is on the boundary",
+                v.0
+            )));
+        }
+        let out: Vec<HalfEdgeId> = self.outgoing_halfedges(v).collect();
+        if out.len() != 3 {
+            return Err(MeshError::new(format!(
+                "face weld: vertex {} has valence {}, but only a vertex of valence 3 can be welded into a face",
+                v.0,
+                out.len()
+            )));
+        }
+        let outer: Vec<HalfEdgeId> = out.iter().map(|&h| self.next(h)).collect();
+        let across: Vec<Option<FaceId>> = outer.iter().map(|&o| self.face(o.twin())).collect();
+        if across[0].is_some() && across[0] == across[1] && across[1] == across[2] {
+            return Err(MeshError::new(format!(
+                "face weld: welding vertex {} would make a triangle that already exists (a doubled face)",
+                v.0
+            )));
+        }
+        let faces: Vec<FaceId> = out.iter().filter_map(|&h| self.face(h)).collect();
+        let keep = faces[0];
+        for &h in &out {
+            self.delete_edge(h.edge());
+        }
+        for &g in &faces[1..] {
+            self.delete_face(g);
+        }
+        self.delete_vertex(v);
+        self.set_triangle(keep, outer[0], outer[1], outer[2]);
+        for &o in &outer {
+            let a = self.from(o);
+            self.v_out[a.index()] = Some(o);
+            self.fix_outgoing(a);
+        }
+        let vs = self.face_vertices(keep);
+        self.f_level[keep.index()] = self.face_level_from_vertices(vs);
+        Ok(keep)
+    }
+
+    /// Edge split: a new vertex `v` on edge `ab`, joined to the vertices
+    /// opposite the edge (one for a boundary edge).
+    ///
+    /// ```text
+    ///        c                 c
+    ///       / \               /|\
+    ///      /   \             / | \
+    ///     a-----b    ->     a--v--b
+    ///      \   /             \ | /
+    ///       \ /               \|/
+    ///        d                 d
+    /// ```
+    ///
+    /// Levels: `l(v) = max(l(a), l(b)) + 1`; the bisection edges `av`, `vb`
+    /// get `l(ab) + 2`; the transversal edges `vc`, `vd` get `l(c) + 1` and
+    /// `l(d) + 1`.
+    pub fn edge_split(&mut self, e: EdgeId, p: DVec3) -> Result<VertexId, MeshError> {
+        if !self.is_edge(e) {
+            return Err(MeshError::new(format!(
+                "edge split: edge {} does not exist",
+                e.0
+            )));
+        }
+        // h runs a -> b inside a face; t is its twin.
+        let mut h = e.halfedge();
+        if self.face(h).is_none() {
+            h = h.twin();
+        }
+        let t = h.twin();
+        let (a, b) = (self.from(h), self.to(h));
+        let le = self.e_level[e.index()];
+        let lv = self.v_level[a.index()].max(self.v_level[b.index()]) + 1;
+        let (h_bc, h_ca) = (self.next(h), self.prev(h));
+        let c = self.to(h_bc);
+        let f1 = self.face(h).expect("h has a face");
+        let boundary = self.face(t).is_none();
+        let v = self.new_vertex(p, lv);
+        // h becomes a -> v, t becomes v -> a.
+        self.he_to[h.index()] = v;
+        self.he_to[t.index()] = a;
+        self.e_level[e.index()] = le + 2;
+        self.e_block[e.index()] = false;
+        let g = self.new_edge(v, b, le + 2); // v -> b
+        let k = self.new_edge(v, c, self.v_level[c.index()] + 1); // v -> c
+        let f2 = self.new_face(g, 0);
+        self.set_triangle(f1, h, k, h_ca);
+        self.set_triangle(f2, g, h_bc, k.twin());
+        if boundary {
+            // The boundary loop ... -> (b -> a) -> ... becomes
+            // ... -> (b -> v) -> (v -> a) -> ...
+            let (tp, tn) = (self.prev(t), self.next(t));
+            let gt = g.twin();
+            self.he_face[gt.index()] = None;
+            self.he_face[t.index()] = None;
+            self.link(tp, gt);
+            self.link(gt, t);
+            self.link(t, tn);
+            self.v_out[v.index()] = Some(t);
+            if self.v_out[b.index()] == Some(t) {
+                self.v_out[b.index()] = Some(gt);
+            }
+        } else {
+            let f3 = self.face(t).expect("interior edge");
+            let (t_ad, t_db) = (self.next(t), self.prev(t));
+            let d = self.to(t_ad);
+            let m = self.new_edge(v, d, self.v_level[d.index()] + 1); // v -> d
+            let f4 = self.new_face(g.twin(), 0);
+            self.set_triangle(f3, t, t_ad, m.twin());
+            self.set_triangle(f4, g.twin(), m, t_db);
+            self.v_out[v.index()] = Some(g);
+            if self.v_out[b.index()] == Some(t) {
+                self.v_out[b.index()] = Some(g.twin());
+            }
+            let vs = self.face_vertices(f3);
+            self.f_level[f3.index()] = self.face_level_from_vertices(vs);
+            let vs = self.face_vertices(f4);
+            self.f_level[f4.index()] = self.face_level_from_vertices(vs);
+        }
+        for f in [f1, f2] {
+            let vs = self.face_vertices(f);
+            self.f_level[f.index()] = self.face_level_from_vertices(vs);
+        }
+        Ok(v)
+    }
+
+    /// Edge weld, the inverse of edge split: removes `v` (interior of
+    /// valence 4, or boundary of valence 3) and joins `keep` to the
+    /// neighbour opposite it, restoring the split edge with level
+    /// `l(v, keep) - 2`.
+    ///
+    /// ```text
+    ///        c                 c
+    ///       /|\               / \
+    ///      / | \             /   \
+    ///  keep--v--b    ->  keep-----b
+    ///      \ | /             \   /
+    ///       \|/               \ /
+    ///        d                 d
+    /// ```
+    pub fn edge_weld(&mut self, v: VertexId, keep: VertexId) -> Result<EdgeId, MeshError> {
+        if !self.is_vertex(v) {
+            return Err(MeshError::new(format!(
+                "edge weld: vertex {} does not exist",
+                v.0
+            )));
+        }
+        let out: Vec<HalfEdgeId> = self.outgoing_halfedges(v).collect();
+        let boundary = self.is_boundary_vertex(v);
+        let want = if boundary { 3 } else { 4 };
+        if out.len() != want {
+            return Err(MeshError::new(format!(
+                "edge weld: vertex {} has valence {}, but a{} vertex of valence {want} is needed",
+                v.0,
+                out.len(),
+                if boundary { " boundary" } else { "n interior" }
+            )));
+        }
+        let Some(ka) = out.iter().position(|&h| self.to(h) == keep) else {
+            return Err(MeshError::new(format!(
+                "edge weld: vertex {} is not a neighbour of vertex {}",
+                keep.0, v.0
+            )));
+        };
+        if boundary {
+            // Outgoing order: n0 (across the first face), n1, n2 (boundary).
+            if ka == 1 {
+                return Err(MeshError::new(format!(
+                    "edge weld: vertex {} is not on the boundary next to vertex {}",
+                    keep.0, v.0
+                )));
+            }
+            let (n0, n1, n2) = (self.to(out[0]), self.to(out[1]), self.to(out[2]));
+            if self.find_halfedge(n0, n2).is_some() {
+                return Err(MeshError::new(format!(
+                    "edge weld: vertices {} and {} are already joined",
+                    n0.0, n2.0
+                )));
+            }
+            let _ = n1;
+            let (o1, o2) = (self.next(out[0]), self.next(out[1]));
+            let f = self.face(out[0]).expect("first outgoing has a face");
+            let g = self.face(out[1]).expect("second outgoing has a face");
+            // Reuse the edge v-n0: its face side becomes n2 -> n0, its
+            // boundary side n0 -> n2.
+            let x = out[0];
+            let bin = x.twin(); // n0 -> v, boundary
+            let bout = out[2]; // v -> n2, boundary
+            let (bp, bn) = (self.prev(bin), self.next(bout));
+            let le = self.e_level[x.edge().index()].saturating_sub(2);
+            self.delete_edge(out[1].edge());
+            self.delete_edge(out[2].edge());
+            self.delete_face(g);
+            self.delete_vertex(v);
+            self.he_to[x.index()] = n0;
+            self.he_to[bin.index()] = n2;
+            self.e_level[x.edge().index()] = le;
+            self.set_triangle(f, o1, o2, x);
+            self.he_face[bin.index()] = None;
+            self.link(bp, bin);
+            self.link(bin, bn);
+            for w in [n0, n1, n2] {
+                let any = if w == n0 {
+                    bin
+                } else if w == n1 {
+                    o2
+                } else {
+                    x
+                };
+                self.v_out[w.index()] = Some(any);
+                self.fix_outgoing(w);
+            }
+            let vs = self.face_vertices(f);
+            self.f_level[f.index()] = self.face_level_from_vertices(vs);
+            return Ok(x.edge());
+        }
+        // Interior: rotate so that out = [v->a, v->c, v->b, v->d].
+        let o: Vec<HalfEdgeId> = (0..4).map(|i| out[(ka + i) % 4]).collect();
+        let (a, c, b, d) = (self.to(o[0]), self.to(o[1]), self.to(o[2]), self.to(o[3]));
+        if self.find_halfedge(a, b).is_some() {
+            return Err(MeshError::new(format!(
+                "edge weld: vertices {} and {} are already joined",
+                a.0, b.0
+            )));
+        }
+        let _ = (c, d);
+        let (o_ac, o_cb, o_bd, o_da) = (
+            self.next(o[0]),
+            self.next(o[1]),
+            self.next(o[2]),
+            self.next(o[3]),
+        );
+        let faces: Vec<FaceId> = o.iter().map(|&h| self.face(h).expect("interior")).collect();
+        let le = self.e_level[o[0].edge().index()].saturating_sub(2);
+        // Reuse edge v-a: x = a -> b, x' = b -> a.
+        let x = o[0].twin(); // was a -> v
+        self.delete_edge(o[1].edge());
+        self.delete_edge(o[2].edge());
+        self.delete_edge(o[3].edge());
+        self.delete_face(faces[2]);
+        self.delete_face(faces[3]);
+        self.delete_vertex(v);
+        self.he_to[x.index()] = b;
+        self.he_to[x.twin().index()] = a;
+        self.e_level[x.edge().index()] = le;
+        self.set_triangle(faces[0], o_ac, o_cb, x.twin());
+        self.set_triangle(faces[1], o_bd, o_da, x);
+        for (w, h) in [(a, x), (b, x.twin()), (c, o_cb), (d, o_da)] {
+            self.v_out[w.index()] = Some(h);
+            self.fix_outgoing(w);
+        }
+        for f in [faces[0], faces[1]] {
+            let vs = self.face_vertices(f);
+            self.f_level[f.index()] = self.face_level_from_vertices(vs);
+        }
+        Ok(x.edge())
+    }
+
+    /// Edge flip: the diagonal of the quad around an interior edge turns.
+    ///
+    /// ```text
+    ///        c                 c
+    ///       / \               /|\
+    ///      /   \             / | \
+    ///     a-----b    ->     a  |  b
+    ///      \   /             \ | /
+    ///       \ /               \|/
+    ///        d                 d
+    /// ```
+    ///
+    /// Level: the flipped edge gets its parent's level plus one. Refused for
+    /// a boundary edge and when `c` and `d` are already joined.
+    pub fn edge_flip(&mut self, e: EdgeId) -> Result<(), MeshError> {
+        if !self.is_edge(e) {
+            return Err(MeshError::new(format!(
+                "edge flip: edge {} does not exist",
+                e.0
+            )));
+        }
+        if self.is_boundary_edge(e) {
+            return Err(MeshError::new(format!(
+                "edge flip: edge {} is on the boundary and cannot be flipped",
+                e.0
+            )));
+        }
+        let h = e.halfedge();
+        let t = h.twin();
+        let (a, b) = (self.from(h), self.to(h));
+        let (h_bc, h_ca) = (self.next(h), self.prev(h));
+        let (t_ad, t_db) = (self.next(t), self.prev(t));
+        let (c, d) = (self.to(h_bc), self.to(t_ad));
+        if c == d || self.find_halfedge(c, d).is_some() {
+            return Err(MeshError::new(format!(
+                "edge flip: flipping edge {} would duplicate the edge between vertices {} and {}",
+                e.0, c.0, d.0
+            )));
+        }
+        let (f1, f2) = (
+            self.face(h).expect("interior"),
+            self.face(t).expect("interior"),
+        );
+        self.he_to[h.index()] = c; // d -> c
+        self.he_to[t.index()] = d; // c -> d
+        self.set_triangle(f1, t_ad, h, h_ca);
+        self.set_triangle(f2, t_db, h_bc, t);
+        if self.v_out[a.index()] == Some(h) {
+            self.v_out[a.index()] = Some(t_ad);
+        }
+        if self.v_out[b.index()] == Some(t) {
+            self.v_out[b.index()] = Some(h_bc);
+        }
+        self.e_level[e.index()] += 1;
+        self.e_block[e.index()] = false;
+        for f in [f1, f2] {
+            let vs = self.face_vertices(f);
+            self.f_level[f.index()] = self.face_level_from_vertices(vs);
+        }
+        Ok(())
+    }
+}

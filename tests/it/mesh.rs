@@ -1,0 +1,501 @@
+//! The half-edge mesh: building, invariants, the stellar operators with
+//! their levels and inverses, refusals, random sequences, quads and info.
+
+use glam::DVec3;
+use subgram::mesh::shapes;
+use subgram::mesh::{EdgeId, FaceId, Mesh, PolygonSoup, VertexId};
+
+fn soup(positions: &[[f64; 3]], faces: &[&[u32]]) -> PolygonSoup {
+    PolygonSoup {
+        positions: positions.iter().map(|p| DVec3::from_array(*p)).collect(),
+        faces: faces.iter().map(|f| f.to_vec()).collect(),
+        ..Default::default()
+    }
+}
+
+/// Two triangles sharing the edge 0-1: (0,1,2) above, (1,0,3) below.
+fn diamond() -> Mesh {
+    let s = soup(
+        &[[0., 0., 0.], [1., 0., 0.], [0.5, 1., 0.], [0.5, -1., 0.]],
+        &[&[0, 1, 2], &[1, 0, 3]],
+    );
+    Mesh::from_soup(&s).unwrap()
+}
+
+fn tetrahedron() -> Mesh {
+    let s = soup(
+        &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+        &[&[0, 2, 1], &[0, 1, 3], &[1, 2, 3], &[2, 0, 3]],
+    );
+    Mesh::from_soup(&s).unwrap()
+}
+
+fn edge_between(m: &Mesh, a: u32, b: u32) -> EdgeId {
+    m.find_halfedge(VertexId(a), VertexId(b))
+        .expect("joined")
+        .edge()
+}
+
+fn ring(m: &Mesh, v: VertexId) -> Vec<u32> {
+    m.one_ring(v).map(|w| w.0).collect()
+}
+
+#[test]
+fn building_gives_valid_meshes_with_the_right_counts() {
+    for (s, v, e, f) in [
+        (shapes::icosahedron(), 12, 30, 20),
+        (shapes::icosphere(2), 162, 480, 320),
+        (shapes::triangle_grid(3, 2), 12, 23, 12),
+    ] {
+        let m = Mesh::from_soup(&s).unwrap();
+        m.validate().unwrap();
+        assert_eq!(
+            (m.vertex_count(), m.edge_count(), m.face_count()),
+            (v, e, f)
+        );
+    }
+}
+
+#[test]
+fn one_rings_are_ordered_and_boundary_aware() {
+    let m = diamond();
+    // Vertex 0: counter-clockwise from across the first face to the
+    // boundary: 3 then 1 then 2... the walk crosses faces only.
+    let r = ring(&m, VertexId(0));
+    assert_eq!(r.len(), 3);
+    assert!(m.is_boundary_vertex(VertexId(0)));
+    let pos = |v: u32| m.position(VertexId(v));
+    // Consecutive neighbours are counter-clockwise around vertex 0.
+    for w in r.windows(2) {
+        let (a, b) = (pos(w[0]) - pos(0), pos(w[1]) - pos(0));
+        assert!(
+            a.x * b.y - a.y * b.x > 0.0,
+            "{r:?} is not counter-clockwise"
+        );
+    }
+    // Consecutive neighbours share a face.
+    for w in r.windows(2) {
+        assert!(m.find_halfedge(VertexId(w[0]), VertexId(w[1])).is_some());
+    }
+    // An interior vertex of a closed mesh: a full cycle.
+    let t = tetrahedron();
+    assert_eq!(ring(&t, VertexId(3)).len(), 3);
+    assert_eq!(
+        t.edge_faces(edge_between(&t, 0, 1))
+            .iter()
+            .flatten()
+            .count(),
+        2
+    );
+}
+
+#[test]
+fn face_split_counts_rings_and_levels() {
+    let mut m = tetrahedron();
+    let f = FaceId(0);
+    let corners = m.face_vertices(f);
+    let v = m.face_split(f, DVec3::new(0.3, 0.3, 0.0)).unwrap();
+    m.validate().unwrap();
+    assert_eq!(
+        (m.vertex_count(), m.edge_count(), m.face_count()),
+        (5, 9, 6)
+    );
+    assert_eq!(m.vertex_level(v), 1, "max(0, 0, 0) + 1");
+    let mut r = ring(&m, v);
+    r.sort();
+    let mut c: Vec<u32> = corners.iter().map(|c| c.0).collect();
+    c.sort();
+    assert_eq!(r, c);
+    for w in corners {
+        assert_eq!(
+            m.edge_level(edge_between(&m, v.0, w.0)),
+            1,
+            "the level of the common vertex"
+        );
+    }
+    for f in m.vertex_faces(v) {
+        assert_eq!(m.face_level(f), 2);
+    }
+}
+
+#[test]
+fn edge_split_counts_rings_and_levels() {
+    let mut m = diamond();
+    let e = edge_between(&m, 0, 1);
+    m.set_edge_level(e, 3);
+    m.set_vertex_level(VertexId(2), 5);
+    let v = m.edge_split(e, DVec3::new(0.5, 0.0, 0.0)).unwrap();
+    m.validate().unwrap();
+    assert_eq!(
+        (m.vertex_count(), m.edge_count(), m.face_count()),
+        (5, 8, 4)
+    );
+    assert_eq!(m.vertex_level(v), 1);
+    assert_eq!(m.valence(v), 4);
+    assert_eq!(
+        m.edge_level(edge_between(&m, 0, v.0)),
+        5,
+        "bisection: 3 + 2"
+    );
+    assert_eq!(m.edge_level(edge_between(&m, v.0, 1)), 5);
+    assert_eq!(
+        m.edge_level(edge_between(&m, v.0, 2)),
+        6,
+        "transversal: l(2) + 1"
+    );
+    assert_eq!(
+        m.edge_level(edge_between(&m, v.0, 3)),
+        1,
+        "transversal: l(3) + 1"
+    );
+    assert!(m.find_halfedge(VertexId(0), VertexId(1)).is_none());
+}
+
+#[test]
+fn boundary_edge_split_makes_two_triangles_from_one() {
+    let s = soup(&[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], &[&[0, 1, 2]]);
+    let mut m = Mesh::from_soup(&s).unwrap();
+    let v = m
+        .edge_split(edge_between(&m, 0, 1), DVec3::new(0.5, 0.0, 0.0))
+        .unwrap();
+    m.validate().unwrap();
+    assert_eq!(
+        (m.vertex_count(), m.edge_count(), m.face_count()),
+        (4, 5, 2)
+    );
+    assert!(m.is_boundary_vertex(v));
+    assert_eq!(ring(&m, v).len(), 3);
+    assert_eq!(m.edge_level(edge_between(&m, v.0, 2)), 1);
+    assert_eq!(m.info().boundary_loops, 1);
+}
+
+#[test]
+fn edge_flip_turns_the_diagonal_and_raises_its_level() {
+    let mut m = diamond();
+    let e = edge_between(&m, 0, 1);
+    m.edge_flip(e).unwrap();
+    m.validate().unwrap();
+    assert!(m.find_halfedge(VertexId(2), VertexId(3)).is_some());
+    assert!(m.find_halfedge(VertexId(0), VertexId(1)).is_none());
+    assert_eq!(m.edge_level(e), 1);
+    assert_eq!(
+        (m.vertex_count(), m.edge_count(), m.face_count()),
+        (4, 5, 2)
+    );
+}
+
+#[test]
+fn every_operator_followed_by_its_inverse_gives_the_same_mesh() {
+    let base = Mesh::from_soup(&shapes::icosphere(1)).unwrap();
+    let before = base.canonical();
+    // Face split, then face weld.
+    let mut m = base.clone();
+    let v = m.face_split(FaceId(7), DVec3::new(0.1, 0.2, 0.3)).unwrap();
+    m.face_weld(v).unwrap();
+    m.validate().unwrap();
+    assert_eq!(m.canonical(), before);
+    // Edge split, then edge weld.
+    let mut m = base.clone();
+    let e = EdgeId(11);
+    let (a, _) = m.edge_vertices(e);
+    let v = m.edge_split(e, DVec3::ZERO).unwrap();
+    m.edge_weld(v, a).unwrap();
+    m.validate().unwrap();
+    assert_eq!(m.canonical(), before);
+    // A flip twice gives the same connectivity, the level raised twice.
+    let mut m = base.clone();
+    m.edge_flip(EdgeId(5)).unwrap();
+    m.edge_flip(EdgeId(5)).unwrap();
+    m.validate().unwrap();
+    let mut c = m.canonical();
+    for x in &mut c.edges {
+        if Some((x.0, x.1))
+            == Some({
+                let (a, b) = base.edge_vertices(EdgeId(5));
+                (a.0.min(b.0), a.0.max(b.0))
+            })
+        {
+            assert_eq!(x.2, 2);
+            x.2 = 0;
+        }
+    }
+    assert_eq!(c, before);
+    // The boundary versions.
+    let s = shapes::triangle_grid(2, 2);
+    let open = Mesh::from_soup(&s).unwrap();
+    let before = open.canonical();
+    let mut m = open.clone();
+    let e = m.edges().find(|&e| m.is_boundary_edge(e)).unwrap();
+    let (a, b) = m.edge_vertices(e);
+    let v = m.edge_split(e, DVec3::new(9.0, 9.0, 0.0)).unwrap();
+    m.validate().unwrap();
+    m.edge_weld(v, b).unwrap();
+    m.validate().unwrap();
+    assert_eq!(m.canonical(), before, "boundary edge {}-{}", a.0, b.0);
+}
+
+#[test]
+fn refusals_name_the_reason_and_leave_the_mesh_unchanged() {
+    let mut m = diamond();
+    let before = m.canonical();
+    let boundary = edge_between(&m, 0, 2);
+    assert_eq!(
+        m.edge_flip(boundary).unwrap_err().message,
+        format!(
+            "edge flip: edge {} is on the boundary and cannot be flipped",
+            boundary.0
+        )
+    );
+    assert_eq!(
+        m.face_weld(VertexId(0)).unwrap_err().message,
+        "face weld: vertex 0 is on the boundary"
+    );
+    assert_eq!(
+        m.edge_weld(VertexId(2), VertexId(0)).unwrap_err().message,
+        "edge weld: vertex 2 has valence 2, but a boundary vertex of valence 3 is needed"
+    );
+    assert_eq!(m.canonical(), before);
+    let mut t = tetrahedron();
+    let before = t.canonical();
+    let e = edge_between(&t, 0, 1);
+    assert_eq!(
+        t.edge_flip(e).unwrap_err().message,
+        format!(
+            "edge flip: flipping edge {} would duplicate the edge between vertices 2 and 3",
+            e.0
+        )
+    );
+    assert_eq!(
+        t.face_weld(VertexId(3)).unwrap_err().message,
+        "face weld: welding vertex 3 would make a triangle that already exists (a doubled face)"
+    );
+    let ico = Mesh::from_soup(&shapes::icosahedron()).unwrap();
+    let mut i2 = ico.clone();
+    assert_eq!(
+        i2.face_weld(VertexId(0)).unwrap_err().message,
+        "face weld: vertex 0 has valence 5, but only a vertex of valence 3 can be welded into a face"
+    );
+    assert_eq!(
+        i2.edge_weld(VertexId(0), VertexId(1)).unwrap_err().message,
+        "edge weld: vertex 0 has valence 5, but an interior vertex of valence 4 is needed"
+    );
+    assert_eq!(i2.canonical(), ico.canonical());
+    assert_eq!(t.canonical(), before);
+}
+
+#[test]
+fn broken_meshes_are_refused_with_the_element_named() {
+    let p = [
+        [0., 0., 0.],
+        [1., 0., 0.],
+        [0., 1., 0.],
+        [0., 0., 1.],
+        [1., 1., 1.],
+        [2., 0., 0.],
+        [2., 1., 0.],
+    ];
+    let cases: &[(&[&[u32]], &str)] = &[
+        (
+            &[&[0, 1, 2], &[1, 0, 3], &[0, 1, 4]],
+            "face 3 is shared by three or more faces",
+        ),
+        (
+            &[&[0, 1, 2], &[0, 1, 3]],
+            "is used in the same direction by two faces (inconsistent orientation)",
+        ),
+        (&[&[0, 1, 2], &[0, 5, 6]], "vertex 1 is a bow-tie"),
+        (
+            &[&[0, 1, 1]],
+            "face 1 is degenerate: it uses vertex 2 twice",
+        ),
+        (
+            &[&[0, 1, 9]],
+            "face 1 refers to vertex 10, but there are only 7 vertices",
+        ),
+        (&[&[0, 1, 2], &[3, 4]], "face 2 has 2 vertices"),
+    ];
+    for (faces, want) in cases {
+        let e = Mesh::from_soup(&soup(&p, faces)).unwrap_err().message;
+        assert!(e.contains(want), "{e}");
+    }
+    let mut s = soup(&p, &[&[0, 1, 2]]);
+    s.positions[1].y = f64::NAN;
+    s.vertex_lines = vec![3, 4, 5, 6, 7, 8, 9];
+    let e = Mesh::from_soup(&s).unwrap_err().message;
+    assert_eq!(e, "vertex 2 (line 4) has a non-finite coordinate");
+    let mut s = soup(&p, &[&[0, 1, 2], &[0, 1, 3]]);
+    s.face_lines = vec![10, 11];
+    let e = Mesh::from_soup(&s).unwrap_err().message;
+    assert!(
+        e.contains("of face 2 (line 11)") && e.contains("face 1 (line 10)"),
+        "{e}"
+    );
+    let flat = soup(&[[0., 0., 0.], [1., 0., 0.], [2., 0., 0.]], &[&[0, 1, 2]]);
+    assert!(Mesh::from_soup(&flat)
+        .unwrap_err()
+        .message
+        .contains("zero area"));
+}
+
+/// A small deterministic generator for the property test.
+struct Rng(u64);
+
+impl Rng {
+    fn below(&mut self, n: usize) -> usize {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 % n as u64) as usize
+    }
+}
+
+#[test]
+fn random_operator_sequences_keep_every_invariant() {
+    for (seed, s) in [
+        (1u64, shapes::icosphere(1)),
+        (7, shapes::triangle_grid(4, 3)),
+        (99, shapes::quad_grid(3, 3)),
+    ] {
+        let mut m = Mesh::from_soup(&s).unwrap();
+        let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+        let mut applied = 0;
+        for step in 0..400 {
+            let before = m.canonical();
+            let faces: Vec<FaceId> = m.faces().collect();
+            let edges: Vec<EdgeId> = m.edges().collect();
+            let verts: Vec<VertexId> = m.vertices().collect();
+            let r = match rng.below(5) {
+                0 => m
+                    .face_split(faces[rng.below(faces.len())], DVec3::splat(step as f64))
+                    .map(|_| ()),
+                1 => m
+                    .edge_split(edges[rng.below(edges.len())], DVec3::splat(-(step as f64)))
+                    .map(|_| ()),
+                2 => m.edge_flip(edges[rng.below(edges.len())]),
+                3 => m.face_weld(verts[rng.below(verts.len())]).map(|_| ()),
+                _ => {
+                    let v = verts[rng.below(verts.len())];
+                    let n = m.one_ring(v).next().unwrap_or(v);
+                    m.edge_weld(v, n).map(|_| ())
+                }
+            };
+            match r {
+                Ok(()) => applied += 1,
+                Err(_) => assert_eq!(m.canonical(), before, "a refused operator changed the mesh"),
+            }
+            if let Err(e) = m.validate() {
+                panic!("seed {seed}, step {step}: {e}");
+            }
+            let info = m.info();
+            assert_eq!(
+                info.euler_characteristic,
+                Mesh::from_soup(&s).unwrap().info().euler_characteristic
+            );
+        }
+        assert!(applied > 100, "only {applied} operators applied");
+    }
+}
+
+#[test]
+fn quads_become_basic_blocks_and_come_back() {
+    let s = shapes::quad_grid(3, 2);
+    let m = Mesh::from_soup(&s).unwrap();
+    m.validate().unwrap();
+    assert_eq!(m.face_count(), 12);
+    let blocks = m.edges().filter(|&e| m.is_block_edge(e)).count();
+    assert_eq!(blocks, 6);
+    // Levels of paper 000, section 7: internal 0, external 1, vertices 0.
+    for e in m.edges() {
+        assert_eq!(m.edge_level(e), if m.is_block_edge(e) { 0 } else { 1 });
+    }
+    assert!(m.vertices().all(|v| m.vertex_level(v) == 0));
+    let back = m.to_quad_soup();
+    assert_eq!(back.faces.len(), 6);
+    let mut a: Vec<Vec<u32>> = s.faces.iter().map(|f| canonical_cycle(f)).collect();
+    let mut b: Vec<Vec<u32>> = back.faces.iter().map(|f| canonical_cycle(f)).collect();
+    a.sort();
+    b.sort();
+    assert_eq!(a, b);
+    // A pentagon is fanned from its first vertex: three triangles.
+    let pent = soup(
+        &[
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [1.5, 1., 0.],
+            [0.5, 1.5, 0.],
+            [-0.5, 1., 0.],
+        ],
+        &[&[0, 1, 2, 3, 4]],
+    );
+    let m = Mesh::from_soup(&pent).unwrap();
+    assert_eq!(m.face_count(), 3);
+    assert_eq!(m.valence(VertexId(0)), 4);
+}
+
+fn canonical_cycle(f: &[u32]) -> Vec<u32> {
+    let k = (0..f.len()).min_by_key(|&i| f[i]).unwrap();
+    (0..f.len()).map(|i| f[(k + i) % f.len()]).collect()
+}
+
+#[test]
+fn info_reports_topology() {
+    let torus = Mesh::from_soup(&shapes::quad_torus(8, 6)).unwrap();
+    let i = torus.info();
+    assert_eq!(
+        (
+            i.euler_characteristic,
+            i.genus,
+            i.boundary_loops,
+            i.components
+        ),
+        (0, Some(1), 0, 1)
+    );
+    assert_eq!(i.quads, 48);
+    let sphere = Mesh::from_soup(&shapes::icosphere(1)).unwrap().info();
+    assert_eq!((sphere.euler_characteristic, sphere.genus), (2, Some(0)));
+    assert_eq!(sphere.valences.get(&5), Some(&12));
+    assert_eq!(sphere.valences.get(&6), Some(&30));
+    let disc = Mesh::from_soup(&shapes::triangle_grid(2, 2))
+        .unwrap()
+        .info();
+    assert_eq!(
+        (disc.euler_characteristic, disc.genus, disc.boundary_loops),
+        (1, Some(0), 1)
+    );
+}
+
+/// One Loop-style refinement, topology only: split every edge, then flip
+/// the new edges that join an old vertex to a new one... the decomposition
+/// of paper 000, §6: flip the edges whose level is the current level - 1.
+#[test]
+fn split_then_flip_is_quadrisection() {
+    let mut m = Mesh::from_soup(&shapes::icosahedron()).unwrap();
+    let old: Vec<EdgeId> = m.edges().collect();
+    for e in old {
+        let (a, b) = m.edge_vertices(e);
+        let p = (m.position(a) + m.position(b)) * 0.5;
+        m.edge_split(e, p).unwrap();
+    }
+    // After the splits: transversal edges from old vertices (level 0 + 1 = 1)
+    // join a new vertex to an old one across a face, and those are flipped.
+    let flip: Vec<EdgeId> = m
+        .edges()
+        .filter(|&e| {
+            let (a, b) = m.edge_vertices(e);
+            m.edge_level(e) == 1
+                && m.vertex_level(a).min(m.vertex_level(b)) == 0
+                && m.vertex_level(a).max(m.vertex_level(b)) == 1
+        })
+        .collect();
+    for e in flip {
+        m.edge_flip(e).unwrap();
+    }
+    m.validate().unwrap();
+    assert_eq!(
+        (m.vertex_count(), m.edge_count(), m.face_count()),
+        (42, 120, 80)
+    );
+    let i = m.info();
+    assert_eq!(i.valences.get(&5), Some(&12));
+    assert_eq!(i.valences.get(&6), Some(&30));
+}
