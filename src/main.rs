@@ -58,9 +58,13 @@ enum Command {
         /// white, black, none, #rrggbb.
         #[arg(long, default_value = "white", value_parser = parse_color)]
         background: subgram::render::Rgba,
-        /// The projection plane of 3D drawings.
-        #[arg(long, value_enum, default_value_t = ViewArg::Xy)]
-        view: ViewArg,
+        /// The projection of 3D drawings: xy, xz or yz for L-systems;
+        /// iso, front, back, left, right, top or bottom for meshes.
+        #[arg(long)]
+        view: Option<String>,
+        /// Meshes: draw the faces without their edges.
+        #[arg(long)]
+        no_wireframe: bool,
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
         #[arg(long, default_value_t = subgram::rewrite::derive::DEFAULT_MAX_MODULES)]
@@ -112,19 +116,17 @@ enum Command {
         #[arg(long)]
         scheme: Option<String>,
     },
+    /// Meshes: information and conversion.
+    Mesh {
+        #[command(subcommand)]
+        command: MeshCommand,
+    },
     /// Check an .lsys file and report every diagnostic.
     Check {
         file: String,
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
     },
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum ViewArg {
-    Xy,
-    Xz,
-    Yz,
 }
 
 fn parse_phase(s: &str) -> Result<subgram::reverse::Phase, String> {
@@ -157,6 +159,24 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 fn parse_color(s: &str) -> Result<subgram::render::Rgba, String> {
     subgram::render::Rgba::parse(s)
         .ok_or_else(|| format!("`{s}` is not a colour: use white, black, none or #rrggbb"))
+}
+
+#[derive(Subcommand)]
+enum MeshCommand {
+    /// Counts, boundary loops, Euler characteristic, genus, valences, levels.
+    Info {
+        file: String,
+        #[arg(long, value_enum, default_value_t = Format::Text)]
+        format: Format,
+    },
+    /// Check a mesh and write it in another format (.obj, .off, .ply).
+    Convert {
+        input: String,
+        output: String,
+        /// Write the triangles, not the quads of basic blocks.
+        #[arg(long)]
+        triangles: bool,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -221,6 +241,32 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
             json: matches!(format, Format::Json),
             details,
         }),
+        Command::Mesh { command } => match command {
+            MeshCommand::Info { file, format } => {
+                let m = load_mesh(&file)?;
+                let info = m.info();
+                let text = match format {
+                    Format::Text => info.to_string().trim_end().to_string(),
+                    Format::Json => serde_json::to_string_pretty(&info)
+                        .map_err(|e| (1, format!("error: {e}")))?,
+                };
+                print_out(&text)
+            }
+            MeshCommand::Convert {
+                input,
+                output,
+                triangles,
+            } => {
+                let m = load_mesh(&input)?;
+                let soup = if triangles {
+                    m.to_soup()
+                } else {
+                    m.to_quad_soup()
+                };
+                subgram::mesh::io::write(std::path::Path::new(&output), &soup)
+                    .map_err(|e| (1, e.to_string()))
+            }
+        },
         Command::Reconstruct {
             coarse,
             details,
@@ -236,10 +282,32 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
             each,
             background,
             view,
+            no_wireframe,
             define,
             max_modules,
             phase,
         } => {
+            if subgram::mesh::io::Format::from_path(std::path::Path::new(&file)).is_some() {
+                return render_mesh(
+                    &file,
+                    &output,
+                    size,
+                    background,
+                    view.as_deref(),
+                    !no_wireframe,
+                );
+            }
+            let view = match view.as_deref().unwrap_or("xy") {
+                "xy" => subgram::render::View::Xy,
+                "xz" => subgram::render::View::Xz,
+                "yz" => subgram::render::View::Yz,
+                other => return Err((
+                    2,
+                    format!(
+                        "error: `--view {other}` is not a view of an L-system: use xy, xz or yz"
+                    ),
+                )),
+            };
             let lower = output.to_ascii_lowercase();
             let svg = if lower.ends_with(".svg") {
                 true
@@ -265,11 +333,7 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
                     width: size.0,
                     height: size.1,
                     background,
-                    view: match view {
-                        ViewArg::Xy => subgram::render::View::Xy,
-                        ViewArg::Xz => subgram::render::View::Xz,
-                        ViewArg::Yz => subgram::render::View::Yz,
-                    },
+                    view,
                     ..Default::default()
                 },
             };
@@ -507,4 +571,56 @@ fn reconstruct_command(
         reverse::reconstruct(&scheme, &c.points, &d, level).map_err(|e| (1, e.to_string()))?;
     let out = reverse::format_points(&pts, d.closed, std::path::Path::new(output));
     write_file(output, out.as_bytes())
+}
+
+/// Reads a mesh file and builds the half-edge mesh, with the file's name
+/// on every message.
+fn load_mesh(path: &str) -> Result<subgram::mesh::Mesh, (u8, String)> {
+    let soup =
+        subgram::mesh::io::read(std::path::Path::new(path)).map_err(|e| (1, e.to_string()))?;
+    subgram::mesh::Mesh::from_soup(&soup).map_err(|e| (1, format!("{path}: error: {e}")))
+}
+
+fn render_mesh(
+    file: &str,
+    output: &str,
+    size: (u32, u32),
+    background: subgram::render::Rgba,
+    view: Option<&str>,
+    wireframe: bool,
+) -> Result<(), (u8, String)> {
+    use subgram::mesh::draw::{self, MeshView};
+    let lower = output.to_ascii_lowercase();
+    if !lower.ends_with(".png") && !lower.ends_with(".svg") {
+        return Err((
+            2,
+            format!("error: cannot tell the format of `{output}`: name it .png or .svg"),
+        ));
+    }
+    let mut mv = MeshView {
+        width: size.0,
+        height: size.1,
+        background,
+        wireframe,
+        ..MeshView::default()
+    };
+    if let Some(name) = view {
+        let Some((dir, up)) = draw::view_direction(name) else {
+            return Err((
+                2,
+                format!("error: `--view {name}` is not a view of a mesh: use iso, front, back, left, right, top or bottom"),
+            ));
+        };
+        mv.direction = dir;
+        mv.up = up;
+    }
+    let mesh = load_mesh(file)?;
+    let soup = mesh.to_quad_soup();
+    draw::validate(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?;
+    let bytes = if lower.ends_with(".svg") {
+        draw::render_svg(&soup, &mv).into_bytes()
+    } else {
+        draw::render_png(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?
+    };
+    write_file(output, &bytes)
 }

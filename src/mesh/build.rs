@@ -188,9 +188,9 @@ impl Mesh {
         for h in (0..m.he_to.len() as u32).map(HalfEdgeId) {
             degree[m.from(h).index()] += 1;
         }
-        for v in 0..nv {
+        for (v, &deg) in degree.iter().enumerate() {
             let walked = m.outgoing_halfedges(VertexId(v as u32)).count();
-            if walked != degree[v] {
+            if walked != deg {
                 return Err(MeshError::new(format!(
                     "vertex {}{} is non-manifold: its faces form more than one fan",
                     v + 1,

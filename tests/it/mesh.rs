@@ -499,3 +499,77 @@ fn split_then_flip_is_quadrisection() {
     assert_eq!(i.valences.get(&5), Some(&12));
     assert_eq!(i.valences.get(&6), Some(&30));
 }
+
+fn bin(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn mesh_commands_info_convert_and_render() {
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let torus = root.join("lsystems/meshes/torus.obj");
+    let o = bin(&["mesh", "info", torus.to_str().unwrap(), "--format", "json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["genus"], 1);
+    assert_eq!(v["quads"], 96);
+    let o = bin(&["mesh", "info", torus.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("Euler characteristic 0, genus 1"));
+    let dir = std::env::temp_dir().join(format!("subgram-mesh-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for ext in ["off", "ply", "obj"] {
+        let out = dir.join(format!("t.{ext}"));
+        let o = bin(&[
+            "mesh",
+            "convert",
+            torus.to_str().unwrap(),
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let back = subgram::mesh::io::read(&out).unwrap();
+        assert_eq!(back.faces.len(), 96, "{ext}: the quads come back");
+        let m = Mesh::from_soup(&back).unwrap();
+        assert_eq!(m.info().genus, Some(1));
+    }
+    let png = dir.join("t.png");
+    let o = bin(&[
+        "render",
+        torus.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--view",
+        "top",
+        "--size",
+        "200x150",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let pm = tiny_skia::Pixmap::decode_png(&std::fs::read(&png).unwrap()).unwrap();
+    assert_eq!((pm.width(), pm.height()), (200, 150));
+    let o = bin(&[
+        "render",
+        torus.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--view",
+        "xy",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    // A broken mesh names the file, the line and the element.
+    let bad = dir.join("bad.obj");
+    std::fs::write(
+        &bad,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n",
+    )
+    .unwrap();
+    let o = bin(&["mesh", "info", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(
+        err.contains("bad.obj: error: the edge between vertices 1 and 2 of face 2 (line 6)"),
+        "{err}"
+    );
+    assert!(err.contains("inconsistent orientation"), "{err}");
+}
