@@ -25,6 +25,7 @@ pub mod output;
 pub mod render;
 pub mod reverse;
 pub mod rewrite;
+pub mod surface;
 pub mod syntax;
 
 use std::fmt;

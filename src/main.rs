@@ -116,6 +116,23 @@ enum Command {
         #[arg(long)]
         scheme: Option<String>,
     },
+    /// Subdivide a mesh with a surface grammar.
+    Subdivide {
+        /// The base mesh (.obj, .off, .ply); default: the grammar's `mesh:`.
+        mesh: Option<String>,
+        #[arg(long)]
+        grammar: String,
+        #[arg(short = 'n', long = "steps")]
+        steps: Option<usize>,
+        /// .obj, .off, .ply, .png or .svg
+        #[arg(short = 'o', long = "output")]
+        output: String,
+        #[arg(short = 'D', value_name = "NAME=VALUE")]
+        define: Vec<String>,
+        /// For pictures: iso, front, back, left, right, top, bottom.
+        #[arg(long)]
+        view: Option<String>,
+    },
     /// Meshes: information and conversion.
     Mesh {
         #[command(subcommand)]
@@ -241,6 +258,17 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
             json: matches!(format, Format::Json),
             details,
         }),
+        Command::Subdivide {
+            mesh,
+            grammar,
+            steps,
+            output,
+            define,
+            view,
+        } => {
+            let (m, _) = subdivide(mesh.as_deref(), &grammar, steps, &define)?;
+            write_mesh_output(&m, &output, view.as_deref())
+        }
         Command::Mesh { command } => match command {
             MeshCommand::Info { file, format } => {
                 let m = load_mesh(&file)?;
@@ -301,12 +329,14 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
                 "xy" => subgram::render::View::Xy,
                 "xz" => subgram::render::View::Xz,
                 "yz" => subgram::render::View::Yz,
-                other => return Err((
-                    2,
-                    format!(
+                other => {
+                    return Err((
+                        2,
+                        format!(
                         "error: `--view {other}` is not a view of an L-system: use xy, xz or yz"
                     ),
-                )),
+                    ))
+                }
             };
             let lower = output.to_ascii_lowercase();
             let svg = if lower.ends_with(".svg") {
@@ -623,4 +653,79 @@ fn render_mesh(
         draw::render_png(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?
     };
     write_file(output, &bytes)
+}
+
+/// Loads a surface grammar, its base mesh (the argument, else the
+/// grammar's `mesh:` relative to the grammar file), and runs it.
+fn subdivide(
+    mesh: Option<&str>,
+    grammar: &str,
+    steps: Option<usize>,
+    define: &[String],
+) -> Result<(subgram::mesh::Mesh, usize), (u8, String)> {
+    let g = subgram::surface::load_file(std::path::Path::new(grammar), define)
+        .map_err(|e| (1, e.render()))?;
+    let path = match (mesh, &g.mesh) {
+        (Some(m), _) => std::path::PathBuf::from(m),
+        (None, Some((p, _))) => {
+            let rel = std::path::Path::new(grammar).parent().unwrap_or(std::path::Path::new(".")).join(p);
+            if rel.exists() {
+                rel
+            } else {
+                std::path::PathBuf::from(p)
+            }
+        }
+        (None, None) => {
+            return Err((2, format!("error: give a base mesh: `subgram subdivide MESH --grammar {grammar} ...`, or `mesh: \"file.obj\";` in the grammar")))
+        }
+    };
+    let mut m = load_mesh(&path.display().to_string())?;
+    let n = steps.or(g.length.map(|l| l as usize)).unwrap_or(1);
+    if n > 12 {
+        return Err((2, format!("error: {n} steps would multiply the faces by at least 2^{n}; at most 12 are allowed")));
+    }
+    let bar = indicatif::ProgressBar::new(n as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} step {pos}/{len} {msg} [{elapsed}]")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let result = g.run(&mut m, n, |c| {
+        bar.set_position(c.step as u64);
+        bar.set_message(format!(
+            "{} vertices, {} edges, {} faces",
+            c.vertices, c.edges, c.faces
+        ));
+    });
+    bar.finish_and_clear();
+    result.map_err(|e| (1, g.render_error(&e)))?;
+    Ok((m, n))
+}
+
+fn write_mesh_output(
+    m: &subgram::mesh::Mesh,
+    output: &str,
+    view: Option<&str>,
+) -> Result<(), (u8, String)> {
+    let lower = output.to_ascii_lowercase();
+    if lower.ends_with(".png") || lower.ends_with(".svg") {
+        use subgram::mesh::draw::{self, MeshView};
+        let mut mv = MeshView::default();
+        if let Some(name) = view {
+            let Some((dir, up)) = draw::view_direction(name) else {
+                return Err((2, format!("error: `--view {name}` is not a view of a mesh")));
+            };
+            mv.direction = dir;
+            mv.up = up;
+        }
+        let soup = m.to_soup();
+        draw::validate(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?;
+        let bytes = if lower.ends_with(".svg") {
+            draw::render_svg(&soup, &mv).into_bytes()
+        } else {
+            draw::render_png(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?
+        };
+        return write_file(output, &bytes);
+    }
+    subgram::mesh::io::write(std::path::Path::new(output), &m.to_soup())
+        .map_err(|e| (1, e.to_string()))
 }

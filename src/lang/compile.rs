@@ -1175,6 +1175,10 @@ impl Compiler {
                 Some((Ex::Field(Box::new(x), idx), ft))
             }
             ExprKind::Method(recv, name, args) => self.method(recv, name, args, span, scope),
+            ExprKind::Gather { op, .. } => {
+                self.err(op.span, format!("`{}(... in ...)` sums over a mesh neighbourhood and belongs in a surface grammar", op.text));
+                None
+            }
             ExprKind::Call(name, args) => self.call(name, args, span, scope),
             ExprKind::InContext(kind, pats) => {
                 if !scope.in_rule {

@@ -293,4 +293,11 @@ pub enum ExprKind {
     Field(Box<Expr>, Name),
     Cast(TypeRef, Box<Expr>),
     InContext(ContextKind, Vec<PatModule>),
+    /// `sum(w in SET where COND)` (also `avg`, `count`): surface grammars.
+    Gather {
+        op: Name,
+        var: Name,
+        set: Box<Expr>,
+        cond: Option<Box<Expr>>,
+    },
 }

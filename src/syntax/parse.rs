@@ -34,6 +34,23 @@ type PResult<T> = Result<T, Diagnostic>;
 /// refused with a message rather than overflowing the stack later.
 pub const MAX_NESTING: usize = 100;
 
+/// Parses one expression at the start of `toks`; returns it and the number
+/// of tokens it took. Used by the surface-grammar parser.
+pub fn parse_expression(toks: &[Token], eof: Span) -> PResult<(Expr, usize)> {
+    let mut p = Parser {
+        toks,
+        pos: 0,
+        abop: false,
+        whole_names: Vec::new(),
+        split_last: None,
+        depth: 0,
+        type_names: Vec::new(),
+        eof,
+    };
+    let e = p.expr()?;
+    Ok((e, p.pos))
+}
+
 pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<File> {
     // `angle:` anywhere switches on the single-character turtle.
     let abop = toks
@@ -1200,6 +1217,33 @@ impl<'t> Parser<'t> {
                     kind: e.kind,
                     span: span.to(self.prev_span()),
                 });
+            }
+            Tok::Ident(n)
+                if matches!(n.as_str(), "sum" | "avg" | "count")
+                    && self.peek_at(1).is_some_and(|t| t.tok.is_punct("("))
+                    && self
+                        .peek_at(2)
+                        .is_some_and(|t| matches!(t.tok, Tok::Ident(_)))
+                    && self.peek_at(3).is_some_and(|t| t.tok.is_ident("in")) =>
+            {
+                // sum(w in ring(v) where l(w) == c)
+                let op = self.name("sum, avg or count")?;
+                self.pos += 1;
+                let var = self.name("a variable name")?;
+                self.pos += 1;
+                let set = self.expr()?;
+                let cond = if self.eat_ident("where") {
+                    Some(Box::new(self.expr()?))
+                } else {
+                    None
+                };
+                self.expect_punct(")", "to close the sum")?;
+                ExprKind::Gather {
+                    op,
+                    var,
+                    set: Box::new(set),
+                    cond,
+                }
             }
             Tok::Ident(n) => {
                 let name = self.name("a name")?;

@@ -11,3 +11,4 @@ mod render;
 mod reverse;
 mod semantics;
 mod support;
+mod surface;

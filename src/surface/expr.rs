@@ -1,0 +1,627 @@
+//! Expressions of surface grammars: checked and compiled to a small tree
+//! over frame slots, then evaluated against a mesh. Mesh elements are
+//! values; a vertex used in arithmetic stands for its position.
+
+use glam::DVec3;
+
+use crate::mesh::{Mesh, VertexId};
+use crate::syntax::ast::{BinOp, Expr, ExprKind, UnOp};
+use crate::syntax::span::{Diagnostic, Span};
+
+use super::grammar::FunctionDef;
+
+/// Static types.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum T {
+    Num,
+    Vec,
+    Bool,
+    Vertex,
+    Edge,
+    Face,
+    Set,
+}
+
+impl T {
+    fn name(self) -> &'static str {
+        match self {
+            T::Num => "a number",
+            T::Vec => "a point",
+            T::Bool => "a condition",
+            T::Vertex => "a vertex",
+            T::Edge => "an edge",
+            T::Face => "a face",
+            T::Set => "a set of vertices",
+        }
+    }
+}
+
+/// A set of vertices to sum over.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SetKind {
+    /// The one-ring of a vertex.
+    Ring,
+    /// The neighbours along the boundary.
+    BoundaryRing,
+    /// The vertices of an edge or a face.
+    Verts,
+}
+
+#[derive(Clone, Debug)]
+pub enum X {
+    Num(f64),
+    Slot(u16),
+    Current,
+    Level(Box<X>),
+    Pos(Box<X>),
+    Valence(Box<X>),
+    IsBoundary(Box<X>),
+    /// The average position of an edge's or a face's vertices.
+    AvgOf(Box<X>),
+    Set(SetKind, Box<X>),
+    Gather {
+        op: u8,
+        slot: u16,
+        set: Box<X>,
+        cond: Option<Box<X>>,
+    },
+    Bin(BinOp, Box<X>, Box<X>),
+    And(Box<X>, Box<X>),
+    Or(Box<X>, Box<X>),
+    Neg(Box<X>),
+    Not(Box<X>),
+    Cond(Box<X>, Box<X>, Box<X>),
+    Math1(fn(f64) -> f64, Box<X>),
+    Math2(fn(f64, f64) -> f64, Box<X>, Box<X>),
+    Let(u16, Box<X>, Box<X>),
+    MakeVec(Box<X>, Box<X>, Box<X>),
+}
+
+/// A value at run time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Val {
+    N(f64),
+    P(DVec3),
+    B(bool),
+    V(VertexId),
+    /// An edge by its end vertices (captured before a split), level and
+    /// whether it was on the boundary.
+    E(VertexId, VertexId, u32, bool),
+    /// A face by its vertices and level.
+    F([VertexId; 3], u32),
+    /// A set: its kind and the element it belongs to.
+    S(SetKind, SetOf),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SetOf {
+    V(VertexId),
+    E(VertexId, VertexId),
+    F([VertexId; 3]),
+}
+
+/// Compiles expressions; keeps the functions of the grammar.
+pub struct Compiler<'g> {
+    functions: &'g [FunctionDef],
+    scopes: Vec<(String, T, u16)>,
+    next: u16,
+    pub max_slots: u16,
+    depth: usize,
+}
+
+type C = Result<(X, T), Diagnostic>;
+
+fn err<A>(span: Span, m: impl Into<String>) -> Result<A, Diagnostic> {
+    Err(Diagnostic::new(span, m))
+}
+
+impl<'g> Compiler<'g> {
+    pub fn new(functions: &'g [FunctionDef]) -> Compiler<'g> {
+        Compiler {
+            functions,
+            scopes: Vec::new(),
+            next: 0,
+            max_slots: 0,
+            depth: 0,
+        }
+    }
+
+    /// Declares a named slot (a rule's element), returning it.
+    pub fn bind(&mut self, name: &str, t: T) -> u16 {
+        let s = self.next;
+        self.next += 1;
+        self.max_slots = self.max_slots.max(self.next);
+        self.scopes.push((name.to_string(), t, s));
+        s
+    }
+
+    fn unbind(&mut self, n: usize) {
+        for _ in 0..n {
+            self.scopes.pop();
+        }
+    }
+
+    /// Compiles `e` and checks it has type `want`.
+    pub fn compile_as(&mut self, e: &Expr, want: T) -> Result<X, Diagnostic> {
+        let (x, t) = self.compile(e)?;
+        match (t, want) {
+            (a, b) if a == b => Ok(x),
+            (T::Vertex, T::Vec) => Ok(X::Pos(Box::new(x))),
+            _ => err(
+                e.span,
+                format!("expected {}, but this is {}", want.name(), t.name()),
+            ),
+        }
+    }
+
+    /// Converts a vertex to its position for arithmetic.
+    fn arith(x: X, t: T) -> (X, T) {
+        if t == T::Vertex {
+            (X::Pos(Box::new(x)), T::Vec)
+        } else {
+            (x, t)
+        }
+    }
+
+    pub fn compile(&mut self, e: &Expr) -> C {
+        let span = e.span;
+        Ok(match &e.kind {
+            ExprKind::Int(i) => (X::Num(*i as f64), T::Num),
+            ExprKind::Float(f) => (X::Num(*f), T::Num),
+            ExprKind::Ident(n) => {
+                if let Some((_, t, s)) = self.scopes.iter().rev().find(|(m, _, _)| m == n) {
+                    return Ok((X::Slot(*s), *t));
+                }
+                match n.as_str() {
+                    "c" => (X::Current, T::Num),
+                    "PI" | "M_PI" => (X::Num(std::f64::consts::PI), T::Num),
+                    "true" => (X::Num(1.0), T::Bool),
+                    "false" => (X::Num(0.0), T::Bool),
+                    _ => return err(span, format!("unknown identifier `{n}`")),
+                }
+            }
+            ExprKind::Unary(op, a) => {
+                let (x, t) = self.compile(a)?;
+                let (x, t) = Self::arith(x, t);
+                match (op, t) {
+                    (UnOp::Neg, T::Num | T::Vec) => (X::Neg(Box::new(x)), t),
+                    (UnOp::Plus, T::Num | T::Vec) => (x, t),
+                    (UnOp::Not, T::Bool) => (X::Not(Box::new(x)), T::Bool),
+                    _ => {
+                        return err(
+                            span,
+                            format!("type error: this operator does not apply to {}", t.name()),
+                        )
+                    }
+                }
+            }
+            ExprKind::Binary(op, a, b) => {
+                let (xa, ta) = self.compile(a)?;
+                let (xb, tb) = self.compile(b)?;
+                let (xa, ta) = Self::arith(xa, ta);
+                let (xb, tb) = Self::arith(xb, tb);
+                use BinOp::*;
+                let t = match (op, ta, tb) {
+                    (And | Or, T::Bool, T::Bool) => {
+                        let x = if *op == And {
+                            X::And(Box::new(xa), Box::new(xb))
+                        } else {
+                            X::Or(Box::new(xa), Box::new(xb))
+                        };
+                        return Ok((x, T::Bool));
+                    }
+                    (Add | Sub | Mul | Div, T::Num, T::Num) => T::Num,
+                    (Add | Sub, T::Vec, T::Vec) => T::Vec,
+                    (Mul, T::Num, T::Vec) | (Mul, T::Vec, T::Num) | (Div, T::Vec, T::Num) => T::Vec,
+                    (Lt | Le | Gt | Ge | Eq | Ne, T::Num, T::Num) => T::Bool,
+                    _ => {
+                        return err(
+                            span,
+                            format!(
+                                "type error: cannot apply `{}` to {} and {}",
+                                op.symbol(),
+                                ta.name(),
+                                tb.name()
+                            ),
+                        )
+                    }
+                };
+                (X::Bin(*op, Box::new(xa), Box::new(xb)), t)
+            }
+            ExprKind::Cond(c, a, b) => {
+                let xc = self.compile_as(c, T::Bool)?;
+                let (xa, ta) = self.compile(a)?;
+                let (xa, ta) = Self::arith(xa, ta);
+                let xb = self.compile_as(b, ta)?;
+                (X::Cond(Box::new(xc), Box::new(xa), Box::new(xb)), ta)
+            }
+            ExprKind::Gather { op, var, set, cond } => {
+                let xs = self.compile_as(set, T::Set)?;
+                let slot = self.bind(&var.text, T::Vertex);
+                let xc = match cond {
+                    Some(c) => Some(Box::new(self.compile_as(c, T::Bool)?)),
+                    None => None,
+                };
+                self.unbind(1);
+                let code = match op.text.as_str() {
+                    "sum" => 0,
+                    "avg" => 1,
+                    _ => 2,
+                };
+                let t = if code == 2 { T::Num } else { T::Vec };
+                (
+                    X::Gather {
+                        op: code,
+                        slot,
+                        set: Box::new(xs),
+                        cond: xc,
+                    },
+                    t,
+                )
+            }
+            ExprKind::Call(name, args) => return self.call(&name.text, name.span, args, span),
+            _ => {
+                return err(
+                    span,
+                    "this kind of expression is not available in surface grammars",
+                )
+            }
+        })
+    }
+
+    fn call(&mut self, name: &str, nspan: Span, args: &[Expr], span: Span) -> C {
+        let one = |c: &mut Self| -> C {
+            if args.len() != 1 {
+                return err(span, format!("`{name}` takes one argument"));
+            }
+            c.compile(&args[0])
+        };
+        let math1: Option<fn(f64) -> f64> = match name {
+            "cos" => Some(f64::cos),
+            "sin" => Some(f64::sin),
+            "tan" => Some(f64::tan),
+            "sqrt" => Some(f64::sqrt),
+            "exp" => Some(f64::exp),
+            "log" => Some(f64::ln),
+            "fabs" | "abs" => Some(f64::abs),
+            "floor" => Some(f64::floor),
+            "ceil" => Some(f64::ceil),
+            _ => None,
+        };
+        if let Some(f) = math1 {
+            if args.len() != 1 {
+                return err(span, format!("`{name}` takes one argument"));
+            }
+            let x = self.compile_as(&args[0], T::Num)?;
+            return Ok((X::Math1(f, Box::new(x)), T::Num));
+        }
+        let math2: Option<fn(f64, f64) -> f64> = match name {
+            "pow" => Some(f64::powf),
+            "min" => Some(f64::min),
+            "max" => Some(f64::max),
+            "atan2" => Some(f64::atan2),
+            _ => None,
+        };
+        if let Some(f) = math2 {
+            if args.len() != 2 {
+                return err(span, format!("`{name}` takes two arguments"));
+            }
+            let a = self.compile_as(&args[0], T::Num)?;
+            let b = self.compile_as(&args[1], T::Num)?;
+            return Ok((X::Math2(f, Box::new(a), Box::new(b)), T::Num));
+        }
+        match name {
+            "l" => {
+                let (x, t) = one(self)?;
+                if !matches!(t, T::Vertex | T::Edge | T::Face) {
+                    return err(
+                        span,
+                        format!("`l` takes a vertex, an edge or a face, not {}", t.name()),
+                    );
+                }
+                Ok((X::Level(Box::new(x)), T::Num))
+            }
+            "pos" => {
+                let (x, t) = one(self)?;
+                if t != T::Vertex {
+                    return err(span, "`pos` takes a vertex");
+                }
+                Ok((X::Pos(Box::new(x)), T::Vec))
+            }
+            "valence" | "deg" => {
+                let (x, t) = one(self)?;
+                if t != T::Vertex {
+                    return err(span, format!("`{name}` takes a vertex"));
+                }
+                Ok((X::Valence(Box::new(x)), T::Num))
+            }
+            "boundary" => {
+                let (x, t) = one(self)?;
+                if !matches!(t, T::Vertex | T::Edge) {
+                    return err(span, "`boundary` takes a vertex or an edge");
+                }
+                Ok((X::IsBoundary(Box::new(x)), T::Bool))
+            }
+            "ring" | "N1" | "boundary_ring" => {
+                let (x, t) = one(self)?;
+                if t != T::Vertex {
+                    return err(span, format!("`{name}` takes a vertex"));
+                }
+                let k = if name == "boundary_ring" {
+                    SetKind::BoundaryRing
+                } else {
+                    SetKind::Ring
+                };
+                Ok((X::Set(k, Box::new(x)), T::Set))
+            }
+            "verts" => {
+                let (x, t) = one(self)?;
+                if !matches!(t, T::Edge | T::Face) {
+                    return err(span, "`verts` takes an edge or a face");
+                }
+                Ok((X::Set(SetKind::Verts, Box::new(x)), T::Set))
+            }
+            "avg" => {
+                let (x, t) = one(self)?;
+                match t {
+                    T::Edge | T::Face => Ok((X::AvgOf(Box::new(x)), T::Vec)),
+                    T::Set => {
+                        let slot = self.bind("#avg", T::Vertex);
+                        self.unbind(1);
+                        Ok((
+                            X::Gather {
+                                op: 1,
+                                slot,
+                                set: Box::new(x),
+                                cond: None,
+                            },
+                            T::Vec,
+                        ))
+                    }
+                    _ => err(
+                        span,
+                        format!(
+                            "`avg` takes an edge, a face or a set of vertices, not {}",
+                            t.name()
+                        ),
+                    ),
+                }
+            }
+            "V3f" | "point" => {
+                if args.len() != 3 {
+                    return err(span, format!("`{name}` takes three numbers"));
+                }
+                let xs: Vec<X> = args
+                    .iter()
+                    .map(|a| self.compile_as(a, T::Num))
+                    .collect::<Result<_, _>>()?;
+                let mut it = xs.into_iter();
+                let (a, b, c) = (
+                    it.next().expect("3"),
+                    it.next().expect("3"),
+                    it.next().expect("3"),
+                );
+                Ok((X::MakeVec(Box::new(a), Box::new(b), Box::new(c)), T::Vec))
+            }
+            _ => {
+                let Some(f) = self.functions.iter().find(|f| f.name == name) else {
+                    return err(nspan, format!("unknown function `{name}`"));
+                };
+                if f.params.len() != args.len() {
+                    return err(
+                        span,
+                        format!(
+                            "`{name}` takes {} argument(s), but {} were given",
+                            f.params.len(),
+                            args.len()
+                        ),
+                    );
+                }
+                if self.depth > 32 {
+                    return err(
+                        span,
+                        format!("`{name}` calls itself too deeply; functions may not recurse"),
+                    );
+                }
+                // Inline: bind each argument to a fresh slot, then the body.
+                let mut lets = Vec::new();
+                for a in args {
+                    lets.push(self.compile(a)?);
+                }
+                let base = self.scopes.len();
+                let saved: Vec<(String, T, u16)> = std::mem::take(&mut self.scopes);
+                let mut slots = Vec::new();
+                for (p, (_, t)) in f.params.iter().zip(&lets) {
+                    slots.push(self.bind(p, *t));
+                }
+                self.depth += 1;
+                let body = self.compile(&f.body);
+                self.depth -= 1;
+                self.scopes = saved;
+                let _ = base;
+                let (mut x, t) = body.map_err(|d| {
+                    Diagnostic::new(
+                        d.span,
+                        format!("{} (in `{name}`, called at {})", d.message, "this call"),
+                    )
+                })?;
+                for (s, (a, _)) in slots.into_iter().zip(lets).rev() {
+                    x = X::Let(s, Box::new(a), Box::new(x));
+                }
+                Ok((x, t))
+            }
+        }
+    }
+}
+
+/// Evaluates compiled expressions against a mesh.
+pub struct Eval<'m> {
+    pub mesh: &'m Mesh,
+    pub current: u32,
+}
+
+impl Eval<'_> {
+    pub fn eval(&self, x: &X, frame: &mut [Val]) -> Val {
+        match x {
+            X::Num(n) => Val::N(*n),
+            X::Slot(s) => frame[*s as usize],
+            X::Current => Val::N(self.current as f64),
+            X::Level(a) => Val::N(match self.eval(a, frame) {
+                Val::V(v) => self.mesh.vertex_level(v) as f64,
+                Val::E(_, _, l, _) => l as f64,
+                Val::F(_, l) => l as f64,
+                _ => f64::NAN,
+            }),
+            X::Pos(a) => match self.eval(a, frame) {
+                Val::V(v) => Val::P(self.mesh.position(v)),
+                other => other,
+            },
+            X::Valence(a) => match self.eval(a, frame) {
+                Val::V(v) => Val::N(self.mesh.valence(v) as f64),
+                _ => Val::N(f64::NAN),
+            },
+            X::IsBoundary(a) => Val::B(match self.eval(a, frame) {
+                Val::V(v) => self.mesh.is_boundary_vertex(v),
+                Val::E(_, _, _, b) => b,
+                _ => false,
+            }),
+            X::AvgOf(a) => match self.eval(a, frame) {
+                Val::E(p, q, _, _) => Val::P((self.mesh.position(p) + self.mesh.position(q)) * 0.5),
+                Val::F(vs, _) => {
+                    Val::P(vs.iter().map(|v| self.mesh.position(*v)).sum::<DVec3>() / 3.0)
+                }
+                _ => Val::P(DVec3::NAN),
+            },
+            X::Set(k, a) => {
+                let of = match self.eval(a, frame) {
+                    Val::V(v) => SetOf::V(v),
+                    Val::E(p, q, _, _) => SetOf::E(p, q),
+                    Val::F(vs, _) => SetOf::F(vs),
+                    _ => SetOf::V(VertexId(0)),
+                };
+                Val::S(*k, of)
+            }
+            X::Gather {
+                op,
+                slot,
+                set,
+                cond,
+            } => {
+                let Val::S(kind, of) = self.eval(set, frame) else {
+                    return Val::P(DVec3::NAN);
+                };
+                let mut sum = DVec3::ZERO;
+                let mut count = 0usize;
+                let mut visit = |w: VertexId, frame: &mut [Val]| {
+                    frame[*slot as usize] = Val::V(w);
+                    let ok = match cond {
+                        Some(c) => matches!(self.eval(c, frame), Val::B(true)),
+                        None => true,
+                    };
+                    if ok {
+                        sum += self.mesh.position(w);
+                        count += 1;
+                    }
+                };
+                match (kind, of) {
+                    (SetKind::Ring, SetOf::V(v)) => {
+                        for w in self.mesh.one_ring(v) {
+                            visit(w, frame);
+                        }
+                    }
+                    (SetKind::BoundaryRing, SetOf::V(v)) => {
+                        for h in self.mesh.outgoing_halfedges(v) {
+                            if self.mesh.is_boundary_edge(h.edge()) {
+                                visit(self.mesh.to(h), frame);
+                            }
+                        }
+                    }
+                    (_, SetOf::E(p, q)) => {
+                        visit(p, frame);
+                        visit(q, frame);
+                    }
+                    (_, SetOf::F(vs)) => {
+                        for w in vs {
+                            visit(w, frame);
+                        }
+                    }
+                    _ => {}
+                }
+                match op {
+                    0 => Val::P(sum),
+                    1 => Val::P(if count > 0 {
+                        sum / count as f64
+                    } else {
+                        DVec3::NAN
+                    }),
+                    _ => Val::N(count as f64),
+                }
+            }
+            X::Bin(op, a, b) => {
+                let (va, vb) = (self.eval(a, frame), self.eval(b, frame));
+                use BinOp::*;
+                match (va, vb) {
+                    (Val::N(x), Val::N(y)) => match op {
+                        Add => Val::N(x + y),
+                        Sub => Val::N(x - y),
+                        Mul => Val::N(x * y),
+                        Div => Val::N(x / y),
+                        Lt => Val::B(x < y),
+                        Le => Val::B(x <= y),
+                        Gt => Val::B(x > y),
+                        Ge => Val::B(x >= y),
+                        Eq => Val::B(x == y),
+                        Ne => Val::B(x != y),
+                        _ => Val::N(f64::NAN),
+                    },
+                    (Val::P(x), Val::P(y)) => Val::P(if *op == Add { x + y } else { x - y }),
+                    (Val::N(s), Val::P(p)) | (Val::P(p), Val::N(s)) if *op == Mul => Val::P(p * s),
+                    (Val::P(p), Val::N(s)) => Val::P(p / s),
+                    _ => Val::N(f64::NAN),
+                }
+            }
+            X::And(a, b) => Val::B(
+                matches!(self.eval(a, frame), Val::B(true))
+                    && matches!(self.eval(b, frame), Val::B(true)),
+            ),
+            X::Or(a, b) => Val::B(
+                matches!(self.eval(a, frame), Val::B(true))
+                    || matches!(self.eval(b, frame), Val::B(true)),
+            ),
+            X::Neg(a) => match self.eval(a, frame) {
+                Val::N(n) => Val::N(-n),
+                Val::P(p) => Val::P(-p),
+                other => other,
+            },
+            X::Not(a) => Val::B(!matches!(self.eval(a, frame), Val::B(true))),
+            X::Cond(c, a, b) => {
+                if matches!(self.eval(c, frame), Val::B(true)) {
+                    self.eval(a, frame)
+                } else {
+                    self.eval(b, frame)
+                }
+            }
+            X::Math1(f, a) => match self.eval(a, frame) {
+                Val::N(n) => Val::N(f(n)),
+                _ => Val::N(f64::NAN),
+            },
+            X::Math2(f, a, b) => match (self.eval(a, frame), self.eval(b, frame)) {
+                (Val::N(x), Val::N(y)) => Val::N(f(x, y)),
+                _ => Val::N(f64::NAN),
+            },
+            X::Let(s, a, body) => {
+                let v = self.eval(a, frame);
+                frame[*s as usize] = v;
+                self.eval(body, frame)
+            }
+            X::MakeVec(a, b, c) => match (
+                self.eval(a, frame),
+                self.eval(b, frame),
+                self.eval(c, frame),
+            ) {
+                (Val::N(x), Val::N(y), Val::N(z)) => Val::P(DVec3::new(x, y, z)),
+                _ => Val::P(DVec3::NAN),
+            },
+        }
+    }
+}

@@ -1,0 +1,354 @@
+//! Surface grammars: the rule notation of paper 000, §7, in `.lsys` files.
+//!
+//! ```text
+//! mesh: "lsystems/meshes/octahedron.obj";   // the axiom: a base mesh
+//! derivation length: 2;
+//! define loop1(v) = 0.5*v + 0.125*sum(w in ring(v) where l(w) == c);
+//!
+//! F(f) -> V(v = avg(f)) || E^3 F^3                  face split
+//! E(e; l(e) == c) | F^2 -> V(v = avg(e)) || E^4 F^4  interior edge split
+//! E(e) | F -> V(v = avg(e)) || E^3 F^2              boundary edge split
+//! E(e; l(e) < c) | F^2 -> E || F^2                  edge flip
+//! V(v; l(v) < c) | interior -> V(v = loop1(v))      vertex rule
+//! ```
+//!
+//! Expressions are the curve language's, with mesh elements as values and
+//! neighbourhood sums `sum(w in ring(v) where cond)`.
+
+use crate::syntax::ast::Expr;
+use crate::syntax::lex::{Tok, Token};
+use crate::syntax::parse::parse_expression;
+use crate::syntax::span::{Diagnostic, Span};
+
+/// The element type a rule rewrites.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    Face,
+    Edge,
+    Vertex,
+}
+
+/// The stellar operator (or vertex rule) a rule performs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Op {
+    /// `F -> V || E^3 F^3`
+    FaceSplit,
+    /// `E | F^2 -> V || E^4 F^4`
+    EdgeSplit,
+    /// `E | F -> V || E^3 F^2`
+    BoundarySplit,
+    /// `E | F^2 -> E || F^2`
+    Flip,
+    /// `V -> V`
+    Vertex,
+}
+
+/// Which vertices a vertex rule may match.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VertexContext {
+    Any,
+    Boundary,
+    Interior,
+}
+
+#[derive(Clone, Debug)]
+pub struct RuleDef {
+    pub op: Op,
+    /// The predecessor's name (`f`, `e`, `v`).
+    pub name: String,
+    pub cond: Option<Expr>,
+    pub vertex_context: VertexContext,
+    /// The successor vertex's name and assignment, if any.
+    pub assign: Option<(String, Expr)>,
+    pub span: Span,
+    /// The rule as written, for messages.
+    pub text: String,
+}
+
+#[derive(Clone, Debug)]
+pub struct FunctionDef {
+    pub name: String,
+    pub params: Vec<String>,
+    pub body: Expr,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct GrammarFile {
+    pub mesh: Option<(String, Span)>,
+    pub length: Option<Expr>,
+    pub functions: Vec<FunctionDef>,
+    pub rules: Vec<RuleDef>,
+}
+
+type R<T> = Result<T, Diagnostic>;
+
+struct P<'t> {
+    toks: &'t [Token],
+    pos: usize,
+    eof: Span,
+}
+
+impl<'t> P<'t> {
+    fn peek(&self) -> Option<&'t Token> {
+        self.toks.get(self.pos)
+    }
+
+    fn span(&self) -> Span {
+        self.peek().map(|t| t.span).unwrap_or(self.eof)
+    }
+
+    fn found(&self) -> String {
+        self.peek()
+            .map(|t| t.tok.describe())
+            .unwrap_or_else(|| "the end of the file".into())
+    }
+
+    fn err<T>(&self, what: &str) -> R<T> {
+        Err(Diagnostic::new(
+            self.span(),
+            format!("expected {what}, found {}", self.found()),
+        ))
+    }
+
+    fn is(&self, p: &str) -> bool {
+        self.peek().is_some_and(|t| t.tok.is_punct(p))
+    }
+
+    fn is_ident(&self, s: &str) -> bool {
+        self.peek().is_some_and(|t| t.tok.is_ident(s))
+    }
+
+    fn eat(&mut self, p: &str) -> bool {
+        if self.is(p) {
+            self.pos += 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    fn expect(&mut self, p: &str, what: &str) -> R<()> {
+        if self.eat(p) {
+            Ok(())
+        } else {
+            self.err(&format!("`{p}` {what}"))
+        }
+    }
+
+    fn ident(&mut self, what: &str) -> R<String> {
+        match self.peek().map(|t| &t.tok) {
+            Some(Tok::Ident(s)) => {
+                self.pos += 1;
+                Ok(s.clone())
+            }
+            _ => self.err(what),
+        }
+    }
+
+    fn expr(&mut self) -> R<Expr> {
+        let (e, n) = parse_expression(&self.toks[self.pos..], self.eof)?;
+        self.pos += n;
+        Ok(e)
+    }
+
+    /// `^ k` after an element letter; 1 when absent.
+    fn power(&mut self) -> R<i64> {
+        if self.eat("^") {
+            match self.peek().map(|t| &t.tok) {
+                Some(Tok::Int(k)) => {
+                    self.pos += 1;
+                    Ok(*k)
+                }
+                _ => self.err("a count after `^`, as in `F^2`"),
+            }
+        } else {
+            Ok(1)
+        }
+    }
+
+    /// A successor context such as `E^4 F^4`: the counts of E and F.
+    fn counts(&mut self) -> R<(i64, i64)> {
+        let (mut e, mut f) = (0, 0);
+        while self.is_ident("E") || self.is_ident("F") {
+            let which = self.ident("E or F")?;
+            let k = self.power()?;
+            if which == "E" {
+                e += k;
+            } else {
+                f += k;
+            }
+        }
+        Ok((e, f))
+    }
+}
+
+/// True when a token list is a surface grammar: it has `mesh:` at the start
+/// of a line, or a rule whose predecessor is `F(`, `E(` or `V(` with `;` or
+/// `)` followed by `->` and a successor context `||`.
+pub fn is_surface(toks: &[Token]) -> bool {
+    toks.windows(2)
+        .any(|w| w[0].line_start && w[0].tok.is_ident("mesh") && w[1].tok.is_punct(":"))
+}
+
+/// Parses a surface grammar from preprocessed tokens.
+pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<GrammarFile> {
+    let mut p = P { toks, pos: 0, eof };
+    let mut g = GrammarFile::default();
+    while p.pos < toks.len() {
+        if p.eat(";") {
+            continue;
+        }
+        let start = p.span();
+        if p.is_ident("mesh") && toks.get(p.pos + 1).is_some_and(|t| t.tok.is_punct(":")) {
+            p.pos += 2;
+            let path = match p.peek().map(|t| &t.tok) {
+                Some(Tok::Str(s)) => s.clone(),
+                _ => {
+                    return p.err("the base mesh as a quoted file name, e.g. `mesh: \"cube.obj\";`")
+                }
+            };
+            let span = p.span();
+            p.pos += 1;
+            p.eat(";");
+            g.mesh = Some((path, span));
+            continue;
+        }
+        if p.is_ident("derivation")
+            && toks
+                .get(p.pos + 1)
+                .is_some_and(|t| t.tok.is_ident("length"))
+        {
+            p.pos += 2;
+            p.expect(":", "after `derivation length`")?;
+            g.length = Some(p.expr()?);
+            p.expect(";", "after the derivation length")?;
+            continue;
+        }
+        if p.is_ident("define") {
+            p.pos += 1;
+            let name = p.ident("a function name after `define`")?;
+            p.expect("(", "after the function name")?;
+            let mut params = Vec::new();
+            if !p.eat(")") {
+                loop {
+                    params.push(p.ident("a parameter name")?);
+                    if p.eat(")") {
+                        break;
+                    }
+                    p.expect(",", "or `)` between parameters")?;
+                }
+            }
+            p.expect("=", "before the function's expression")?;
+            let body = p.expr()?;
+            p.expect(";", "after the function's expression")?;
+            g.functions.push(FunctionDef {
+                name,
+                params,
+                body,
+                span: start,
+            });
+            continue;
+        }
+        g.rules.push(rule(&mut p, &text_of)?);
+    }
+    Ok(g)
+}
+
+/// rule := KIND '(' name [';' cond] ')' [('|' | '||') context] '->' succ ['||' counts] [';']
+fn rule(p: &mut P, text_of: &impl Fn(Span) -> String) -> R<RuleDef> {
+    let start = p.span();
+    let kind = match p.peek().map(|t| &t.tok) {
+        Some(Tok::Ident(k)) if k == "F" => Kind::Face,
+        Some(Tok::Ident(k)) if k == "E" => Kind::Edge,
+        Some(Tok::Ident(k)) if k == "V" => Kind::Vertex,
+        _ => {
+            return p
+                .err("a rule starting with F, E or V, `define`, `mesh:` or `derivation length:`")
+        }
+    };
+    p.pos += 1;
+    p.expect("(", "after the element type")?;
+    let name = p.ident("the element's name, e.g. `F(f)`")?;
+    let cond = if p.eat(";") { Some(p.expr()?) } else { None };
+    p.expect(")", "to close the predecessor")?;
+    // The predecessor's context.
+    let mut faces = None;
+    let mut vertex_context = VertexContext::Any;
+    if p.eat("|") || p.eat("||") {
+        match kind {
+            Kind::Edge => {
+                if !p.is_ident("F") {
+                    return p.err(
+                        "the faces of the edge, `F` (a boundary edge) or `F^2` (an interior edge)",
+                    );
+                }
+                p.pos += 1;
+                faces = Some(p.power()?);
+            }
+            Kind::Vertex => {
+                let w = p.ident("`boundary` or `interior`")?;
+                vertex_context = match w.as_str() {
+                    "boundary" => VertexContext::Boundary,
+                    "interior" => VertexContext::Interior,
+                    _ => return Err(Diagnostic::new(
+                        p.toks[p.pos - 1].span,
+                        format!(
+                            "expected `boundary` or `interior` as a vertex's context, found `{w}`"
+                        ),
+                    )),
+                };
+            }
+            Kind::Face => return p.err("`->`: a face rule has no context"),
+        }
+    }
+    p.expect("->", "after the predecessor")?;
+    // The successor.
+    let succ_span = p.span();
+    let succ = p.ident("the successor, `V` or `E`")?;
+    let mut assign = None;
+    if p.eat("(") {
+        let v = p.ident("the new vertex's name")?;
+        p.expect("=", "in the assignment `V(v = ...)`")?;
+        let e = p.expr()?;
+        p.expect(")", "to close the assignment")?;
+        assign = Some((v, e));
+    }
+    let counts = if p.eat("||") { Some(p.counts()?) } else { None };
+    let end = p
+        .toks
+        .get(p.pos.saturating_sub(1))
+        .map(|t| t.span)
+        .unwrap_or(start);
+    p.eat(";");
+    let op = match (kind, faces, succ.as_str(), counts) {
+        (Kind::Face, None, "V", Some((3, 3))) => Op::FaceSplit,
+        (Kind::Edge, Some(2), "V", Some((4, 4))) => Op::EdgeSplit,
+        (Kind::Edge, Some(1), "V", Some((3, 2))) => Op::BoundarySplit,
+        (Kind::Edge, Some(2), "E", Some((0, 2))) => Op::Flip,
+        (Kind::Vertex, _, "V", None) => Op::Vertex,
+        _ => {
+            return Err(Diagnostic::new(
+                start.to(end),
+                "this is not one of the rules of paper 000, section 7: expected `F -> V || E^3 F^3`, \
+                 `E | F^2 -> V || E^4 F^4`, `E | F -> V || E^3 F^2`, `E | F^2 -> E || F^2` or `V -> V`",
+            ))
+        }
+    };
+    if op == Op::Flip && assign.is_some() {
+        return Err(Diagnostic::new(
+            succ_span,
+            "an edge flip makes no vertex, so it has no assignment",
+        ));
+    }
+    let span = start.to(end);
+    Ok(RuleDef {
+        op,
+        name,
+        cond,
+        vertex_context,
+        assign,
+        span,
+        text: text_of(span),
+    })
+}

@@ -1,0 +1,357 @@
+//! Running a surface grammar on a mesh (paper 000, §7): rules in file
+//! order; each applies, in parallel, to every element that matches its
+//! type, context and condition when the rule starts; new vertices get their
+//! assignment from the positions before the rule; vertex rules read the
+//! current positions and write the next ones, which become current at the
+//! end of each step.
+//!
+//! The current level `c` is the highest vertex level in the mesh when a
+//! rule starts: the level of the newest vertices. (Paper 000 says that `c`
+//! advances with each rule; read literally, its level rules and its
+//! printed conditions disagree for Loop and Catmull-Clark. This definition
+//! runs √3 exactly as printed; the grammar files note where they differ.)
+
+use glam::DVec3;
+
+use crate::mesh::{Mesh, VertexId};
+use crate::syntax::span::{Diagnostic, SourceMap, Span};
+
+use super::expr::{Compiler, Eval, Val, T, X};
+use super::grammar::{GrammarFile, Op, VertexContext};
+
+/// A compiled rule.
+#[derive(Debug)]
+pub struct Rule {
+    pub op: Op,
+    pub context: VertexContext,
+    pub cond: Option<X>,
+    pub assign: Option<X>,
+    /// Frame slots: the predecessor element and the new vertex.
+    pub elem_slot: u16,
+    pub vertex_slot: Option<u16>,
+    pub frame: usize,
+    pub span: Span,
+    pub text: String,
+}
+
+/// A checked grammar, ready to run.
+#[derive(Debug)]
+pub struct Grammar {
+    pub rules: Vec<Rule>,
+    pub mesh: Option<(String, Span)>,
+    pub length: Option<u64>,
+    pub sources: SourceMap,
+}
+
+/// Compiles a parsed grammar file.
+pub fn compile(
+    file: &GrammarFile,
+    sources: SourceMap,
+) -> Result<Grammar, (SourceMap, Vec<Diagnostic>)> {
+    let mut rules = Vec::new();
+    let mut diags = Vec::new();
+    for r in &file.rules {
+        let mut c = Compiler::new(&file.functions);
+        let elem_t = match r.op {
+            Op::FaceSplit => T::Face,
+            Op::EdgeSplit | Op::BoundarySplit | Op::Flip => T::Edge,
+            Op::Vertex => T::Vertex,
+        };
+        let elem_slot = c.bind(&r.name, elem_t);
+        let cond = match &r.cond {
+            Some(e) => match c.compile_as(e, T::Bool) {
+                Ok(x) => Some(x),
+                Err(d) => {
+                    diags.push(d);
+                    continue;
+                }
+            },
+            None => None,
+        };
+        let (vertex_slot, assign) = match &r.assign {
+            Some((name, e)) => {
+                // In a vertex rule the successor's name is the same vertex.
+                let s = if r.op == Op::Vertex && *name == r.name {
+                    elem_slot
+                } else {
+                    c.bind(name, T::Vertex)
+                };
+                match c.compile_as(e, T::Vec) {
+                    Ok(x) => (Some(s), Some(x)),
+                    Err(d) => {
+                        diags.push(d);
+                        continue;
+                    }
+                }
+            }
+            None => (None, None),
+        };
+        rules.push(Rule {
+            op: r.op,
+            context: r.vertex_context,
+            cond,
+            assign,
+            elem_slot,
+            vertex_slot,
+            frame: c.max_slots as usize + 1,
+            span: r.span,
+            text: r.text.clone(),
+        });
+    }
+    let length = match &file.length {
+        None => None,
+        Some(e) => {
+            let mut c = Compiler::new(&file.functions);
+            match c.compile_as(e, T::Num) {
+                Ok(x) => {
+                    let m = Mesh::default();
+                    let ev = Eval {
+                        mesh: &m,
+                        current: 0,
+                    };
+                    match ev.eval(&x, &mut vec![Val::N(0.0); c.max_slots as usize + 1]) {
+                        Val::N(n) if n.is_finite() && (0.0..=64.0).contains(&n) => Some(n as u64),
+                        _ => {
+                            diags.push(Diagnostic::new(
+                                e.span,
+                                "the derivation length must be a number of steps from 0 to 64",
+                            ));
+                            None
+                        }
+                    }
+                }
+                Err(d) => {
+                    diags.push(d);
+                    None
+                }
+            }
+        }
+    };
+    if !diags.is_empty() {
+        return Err((sources, diags));
+    }
+    Ok(Grammar {
+        rules,
+        mesh: file.mesh.clone(),
+        length,
+        sources,
+    })
+}
+
+/// A failed run: the rule, the step, and what went wrong.
+#[derive(Clone, Debug)]
+pub struct RunError {
+    pub span: Option<Span>,
+    pub message: String,
+}
+
+/// Counts after a step, for progress reports.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StepCounts {
+    pub step: usize,
+    pub vertices: usize,
+    pub edges: usize,
+    pub faces: usize,
+}
+
+impl Grammar {
+    /// Renders a run error with the rule's line and caret.
+    pub fn render_error(&self, e: &RunError) -> String {
+        match e.span {
+            Some(s) => self.sources.render(s, &e.message),
+            None => format!("error: {}", e.message),
+        }
+    }
+
+    /// Runs `steps` steps of the grammar on `mesh`; `progress` hears after
+    /// each step.
+    pub fn run(
+        &self,
+        mesh: &mut Mesh,
+        steps: usize,
+        mut progress: impl FnMut(StepCounts),
+    ) -> Result<(), RunError> {
+        for step in 1..=steps {
+            for rule in &self.rules {
+                self.apply(rule, mesh, step)?;
+            }
+            mesh.swap_positions();
+            progress(StepCounts {
+                step,
+                vertices: mesh.vertex_count(),
+                edges: mesh.edge_count(),
+                faces: mesh.face_count(),
+            });
+        }
+        Ok(())
+    }
+
+    fn apply(&self, rule: &Rule, mesh: &mut Mesh, step: usize) -> Result<(), RunError> {
+        let current = mesh
+            .vertices()
+            .map(|v| mesh.vertex_level(v))
+            .max()
+            .unwrap_or(0);
+        mesh.current_level = current;
+        let fail = |m: String| RunError {
+            span: Some(rule.span),
+            message: format!("at step {step}, rule `{}`: {m}", rule.text),
+        };
+        let mut frame = vec![Val::N(0.0); rule.frame];
+        // What the rule applies to, fixed when it starts.
+        let mut matched: Vec<Val> = Vec::new();
+        {
+            let ev = Eval { mesh, current };
+            let mut consider = |val: Val, frame: &mut Vec<Val>| {
+                frame[rule.elem_slot as usize] = val;
+                let ok = match &rule.cond {
+                    Some(c) => matches!(ev.eval(c, frame), Val::B(true)),
+                    None => true,
+                };
+                if ok {
+                    matched.push(val);
+                }
+            };
+            match rule.op {
+                Op::FaceSplit => {
+                    for f in mesh.faces() {
+                        consider(
+                            Val::F(mesh.face_vertices(f), mesh.face_level(f)),
+                            &mut frame,
+                        );
+                    }
+                }
+                Op::EdgeSplit | Op::BoundarySplit | Op::Flip => {
+                    let want_boundary = rule.op == Op::BoundarySplit;
+                    for e in mesh.edges() {
+                        let b = mesh.is_boundary_edge(e);
+                        if b == want_boundary {
+                            let (p, q) = mesh.edge_vertices(e);
+                            consider(Val::E(p, q, mesh.edge_level(e), b), &mut frame);
+                        }
+                    }
+                }
+                Op::Vertex => {
+                    for v in mesh.vertices() {
+                        let b = mesh.is_boundary_vertex(v);
+                        let ok = match rule.context {
+                            VertexContext::Any => true,
+                            VertexContext::Boundary => b,
+                            VertexContext::Interior => !b,
+                        };
+                        if ok && mesh.outgoing(v).is_some() {
+                            consider(Val::V(v), &mut frame);
+                        }
+                    }
+                }
+            }
+        }
+        match rule.op {
+            Op::Vertex => {
+                let Some(assign) = &rule.assign else {
+                    return Ok(());
+                };
+                let mut out = Vec::with_capacity(matched.len());
+                {
+                    let ev = Eval { mesh, current };
+                    for &val in &matched {
+                        frame[rule.elem_slot as usize] = val;
+                        match ev.eval(assign, &mut frame) {
+                            Val::P(p) if p.is_finite() => out.push(p),
+                            Val::P(p) => {
+                                let Val::V(v) = val else { unreachable!() };
+                                return Err(fail(format!(
+                                    "vertex {} would move to {p}, which is not finite",
+                                    v.0
+                                )));
+                            }
+                            _ => return Err(fail("the assignment did not give a point".into())),
+                        }
+                    }
+                }
+                for (val, p) in matched.iter().zip(out) {
+                    if let Val::V(v) = val {
+                        mesh.set_next_position(*v, p);
+                    }
+                }
+                Ok(())
+            }
+            Op::Flip => {
+                for val in &matched {
+                    let Val::E(p, q, _, _) = *val else { continue };
+                    let Some(h) = mesh.find_halfedge(p, q) else {
+                        return Err(fail(format!(
+                            "the edge between vertices {} and {} is gone",
+                            p.0, q.0
+                        )));
+                    };
+                    mesh.edge_flip(h.edge()).map_err(|e| fail(e.message))?;
+                }
+                Ok(())
+            }
+            Op::FaceSplit | Op::EdgeSplit | Op::BoundarySplit => {
+                let mut made: Vec<(VertexId, Val)> = Vec::with_capacity(matched.len());
+                match rule.op {
+                    Op::FaceSplit => {
+                        mesh.reserve(matched.len(), 3 * matched.len(), 2 * matched.len())
+                    }
+                    _ => mesh.reserve(matched.len(), 3 * matched.len(), 2 * matched.len()),
+                }
+                for &val in &matched {
+                    let v = match val {
+                        Val::F(vs, _) => {
+                            let Some(f) = face_of(mesh, vs) else {
+                                return Err(fail("a face to split is gone".into()));
+                            };
+                            let p = vs.iter().map(|v| mesh.position(*v)).sum::<DVec3>() / 3.0;
+                            mesh.face_split(f, p).map_err(|e| fail(e.message))?
+                        }
+                        Val::E(p, q, _, _) => {
+                            let Some(h) = mesh.find_halfedge(p, q) else {
+                                return Err(fail(format!(
+                                    "the edge between vertices {} and {} is gone",
+                                    p.0, q.0
+                                )));
+                            };
+                            let at = (mesh.position(p) + mesh.position(q)) * 0.5;
+                            mesh.edge_split(h.edge(), at).map_err(|e| fail(e.message))?
+                        }
+                        _ => continue,
+                    };
+                    made.push((v, val));
+                }
+                let Some(assign) = &rule.assign else {
+                    return Ok(());
+                };
+                let vslot = rule.vertex_slot.expect("an assignment names its vertex");
+                let mut out = Vec::with_capacity(made.len());
+                {
+                    let ev = Eval { mesh, current };
+                    for &(v, parent) in &made {
+                        frame[rule.elem_slot as usize] = parent;
+                        frame[vslot as usize] = Val::V(v);
+                        match ev.eval(assign, &mut frame) {
+                            Val::P(p) if p.is_finite() => out.push(p),
+                            Val::P(p) => {
+                                return Err(fail(format!(
+                                    "new vertex {} would be at {p}, which is not finite",
+                                    v.0
+                                )))
+                            }
+                            _ => return Err(fail("the assignment did not give a point".into())),
+                        }
+                    }
+                }
+                for ((v, _), p) in made.iter().zip(out) {
+                    mesh.set_position(*v, p);
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+fn face_of(mesh: &Mesh, vs: [VertexId; 3]) -> Option<crate::mesh::FaceId> {
+    let h = mesh.find_halfedge(vs[0], vs[1])?;
+    mesh.face(h)
+}
