@@ -717,7 +717,7 @@ fn write_mesh_output(
             mv.direction = dir;
             mv.up = up;
         }
-        let soup = m.to_soup();
+        let soup = m.to_quad_soup();
         draw::validate(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?;
         let bytes = if lower.ends_with(".svg") {
             draw::render_svg(&soup, &mv).into_bytes()
@@ -726,6 +726,6 @@ fn write_mesh_output(
         };
         return write_file(output, &bytes);
     }
-    subgram::mesh::io::write(std::path::Path::new(output), &m.to_soup())
+    subgram::mesh::io::write(std::path::Path::new(output), &m.to_quad_soup())
         .map_err(|e| (1, e.to_string()))
 }

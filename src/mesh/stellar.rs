@@ -124,7 +124,8 @@ impl Mesh {
     ///
     /// Levels: `l(v) = max(l(a), l(b)) + 1`; the bisection edges `av`, `vb`
     /// get `l(ab) + 2`; the transversal edges `vc`, `vd` get `l(c) + 1` and
-    /// `l(d) + 1`.
+    /// `l(d) + 1`. Splitting the internal edge of a basic block makes the
+    /// four edges at `v` internal edges of blocks.
     pub fn edge_split(&mut self, e: EdgeId, p: DVec3) -> Result<VertexId, MeshError> {
         if !self.is_edge(e) {
             return Err(MeshError::new(format!(
@@ -140,6 +141,7 @@ impl Mesh {
         let t = h.twin();
         let (a, b) = (self.from(h), self.to(h));
         let le = self.e_level[e.index()];
+        let was_block = self.e_block[e.index()];
         let lv = self.v_level[a.index()].max(self.v_level[b.index()]) + 1;
         let (h_bc, h_ca) = (self.next(h), self.prev(h));
         let c = self.to(h_bc);
@@ -190,6 +192,16 @@ impl Mesh {
         for f in [f1, f2] {
             let vs = self.face_vertices(f);
             self.f_level[f.index()] = self.face_level_from_vertices(vs);
+        }
+        if was_block {
+            // A basic block split at its centre: its four spokes become the
+            // internal edges of the four quads that splitting the block's
+            // external edges completes (primal quadrisection, paper 000,
+            // Fig. 12a).
+            let spokes: Vec<EdgeId> = self.outgoing_halfedges(v).map(|h| h.edge()).collect();
+            for s in spokes {
+                self.e_block[s.index()] = true;
+            }
         }
         Ok(v)
     }

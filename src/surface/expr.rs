@@ -56,6 +56,7 @@ pub enum X {
     Pos(Box<X>),
     Valence(Box<X>),
     IsBoundary(Box<X>),
+    IsBlock(Box<X>),
     /// The average position of an edge's or a face's vertices.
     AvgOf(Box<X>),
     Set(SetKind, Box<X>),
@@ -84,9 +85,10 @@ pub enum Val {
     P(DVec3),
     B(bool),
     V(VertexId),
-    /// An edge by its end vertices (captured before a split), level and
-    /// whether it was on the boundary.
-    E(VertexId, VertexId, u32, bool),
+    /// An edge by its end vertices (captured before a split), level,
+    /// whether it was on the boundary, and whether it was a basic block's
+    /// internal edge.
+    E(VertexId, VertexId, u32, bool, bool),
     /// A face by its vertices and level.
     F([VertexId; 3], u32),
     /// A set: its kind and the element it belongs to.
@@ -342,6 +344,16 @@ impl<'g> Compiler<'g> {
                 }
                 Ok((X::IsBoundary(Box::new(x)), T::Bool))
             }
+            "block" => {
+                let (x, t) = one(self)?;
+                if t != T::Edge {
+                    return err(
+                        span,
+                        "`block` takes an edge: true for the internal edge of a basic block",
+                    );
+                }
+                Ok((X::IsBlock(Box::new(x)), T::Bool))
+            }
             "ring" | "N1" | "boundary_ring" => {
                 let (x, t) = one(self)?;
                 if t != T::Vertex {
@@ -468,7 +480,7 @@ impl Eval<'_> {
             X::Current => Val::N(self.current as f64),
             X::Level(a) => Val::N(match self.eval(a, frame) {
                 Val::V(v) => self.mesh.vertex_level(v) as f64,
-                Val::E(_, _, l, _) => l as f64,
+                Val::E(_, _, l, _, _) => l as f64,
                 Val::F(_, l) => l as f64,
                 _ => f64::NAN,
             }),
@@ -482,11 +494,14 @@ impl Eval<'_> {
             },
             X::IsBoundary(a) => Val::B(match self.eval(a, frame) {
                 Val::V(v) => self.mesh.is_boundary_vertex(v),
-                Val::E(_, _, _, b) => b,
+                Val::E(_, _, _, b, _) => b,
                 _ => false,
             }),
+            X::IsBlock(a) => Val::B(matches!(self.eval(a, frame), Val::E(_, _, _, _, true))),
             X::AvgOf(a) => match self.eval(a, frame) {
-                Val::E(p, q, _, _) => Val::P((self.mesh.position(p) + self.mesh.position(q)) * 0.5),
+                Val::E(p, q, _, _, _) => {
+                    Val::P((self.mesh.position(p) + self.mesh.position(q)) * 0.5)
+                }
                 Val::F(vs, _) => {
                     Val::P(vs.iter().map(|v| self.mesh.position(*v)).sum::<DVec3>() / 3.0)
                 }
@@ -495,7 +510,7 @@ impl Eval<'_> {
             X::Set(k, a) => {
                 let of = match self.eval(a, frame) {
                     Val::V(v) => SetOf::V(v),
-                    Val::E(p, q, _, _) => SetOf::E(p, q),
+                    Val::E(p, q, _, _, _) => SetOf::E(p, q),
                     Val::F(vs, _) => SetOf::F(vs),
                     _ => SetOf::V(VertexId(0)),
                 };

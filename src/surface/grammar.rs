@@ -291,12 +291,14 @@ fn rule(p: &mut P, text_of: &impl Fn(Span) -> String) -> R<RuleDef> {
                 vertex_context = match w.as_str() {
                     "boundary" => VertexContext::Boundary,
                     "interior" => VertexContext::Interior,
-                    _ => return Err(Diagnostic::new(
-                        p.toks[p.pos - 1].span,
-                        format!(
+                    _ => {
+                        return Err(Diagnostic::new(
+                            p.toks[p.pos - 1].span,
+                            format!(
                             "expected `boundary` or `interior` as a vertex's context, found `{w}`"
                         ),
-                    )),
+                        ))
+                    }
                 };
             }
             Kind::Face => return p.err("`->`: a face rule has no context"),

@@ -227,7 +227,10 @@ impl Grammar {
                         let b = mesh.is_boundary_edge(e);
                         if b == want_boundary {
                             let (p, q) = mesh.edge_vertices(e);
-                            consider(Val::E(p, q, mesh.edge_level(e), b), &mut frame);
+                            consider(
+                                Val::E(p, q, mesh.edge_level(e), b, mesh.is_block_edge(e)),
+                                &mut frame,
+                            );
                         }
                     }
                 }
@@ -278,7 +281,9 @@ impl Grammar {
             }
             Op::Flip => {
                 for val in &matched {
-                    let Val::E(p, q, _, _) = *val else { continue };
+                    let Val::E(p, q, _, _, _) = *val else {
+                        continue;
+                    };
                     let Some(h) = mesh.find_halfedge(p, q) else {
                         return Err(fail(format!(
                             "the edge between vertices {} and {} is gone",
@@ -306,7 +311,7 @@ impl Grammar {
                             let p = vs.iter().map(|v| mesh.position(*v)).sum::<DVec3>() / 3.0;
                             mesh.face_split(f, p).map_err(|e| fail(e.message))?
                         }
-                        Val::E(p, q, _, _) => {
+                        Val::E(p, q, _, _, _) => {
                             let Some(h) = mesh.find_halfedge(p, q) else {
                                 return Err(fail(format!(
                                     "the edge between vertices {} and {} is gone",

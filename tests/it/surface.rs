@@ -187,3 +187,142 @@ fn grammar_errors_point_at_the_rule() {
         .render();
     assert!(bad.contains("not one of the rules"), "{bad}");
 }
+
+/// The new vertex whose old neighbours are exactly `parents`.
+fn child_of_exactly(m: &Mesh, parents: &[VertexId], old_count: u32) -> VertexId {
+    let mut want: Vec<u32> = parents.iter().map(|p| p.0).collect();
+    want.sort();
+    m.vertices()
+        .filter(|w| w.0 >= old_count)
+        .find(|&w| {
+            let mut olds: Vec<u32> = m
+                .one_ring(w)
+                .filter(|u| u.0 < old_count)
+                .map(|u| u.0)
+                .collect();
+            olds.sort();
+            olds == want
+        })
+        .expect("a child vertex")
+}
+
+/// Catmull and Clark's rules, computed from the quads of the base mesh:
+/// face points are centroids, edge points average the edge's ends and its
+/// two face points, and a vertex of valence n moves to
+/// (n - 2)/n v + 1/n^2 (sum of edge neighbours + sum of face points);
+/// on the boundary, 3/4 v + 1/8 (a + b) and edge midpoints.
+fn check_catmull_clark(soup: &PolygonSoup) {
+    let base = Mesh::from_soup(soup).unwrap();
+    let old = base.vertex_count() as u32;
+    let m = run("surfaces/catmull-clark.lsys", &base);
+    let p = |i: u32| soup.positions[i as usize];
+    let centroid = |q: &Vec<u32>| q.iter().map(|&i| p(i)).sum::<DVec3>() / 4.0;
+    let quads_of = |v: u32| soup.faces.iter().filter(move |q| q.contains(&v));
+    let boundary = |a: u32, b: u32| quads_of(a).filter(|q| q.contains(&b)).count() == 1;
+    let mut worst: f64 = 0.0;
+    for q in &soup.faces {
+        let fp = child_of_exactly(&m, &q.iter().map(|&i| VertexId(i)).collect::<Vec<_>>(), old);
+        worst = worst.max(m.position(fp).distance(centroid(q)));
+        for k in 0..4 {
+            let (a, b) = (q[k], q[(k + 1) % 4]);
+            let ep = child_of_exactly(&m, &[VertexId(a), VertexId(b)], old);
+            let want = if boundary(a, b) {
+                (p(a) + p(b)) / 2.0
+            } else {
+                let fs: DVec3 = quads_of(a).filter(|g| g.contains(&b)).map(centroid).sum();
+                (p(a) + p(b) + fs) / 4.0
+            };
+            worst = worst.max(m.position(ep).distance(want));
+        }
+    }
+    for v in 0..old {
+        let mut nbrs: Vec<u32> = Vec::new();
+        for q in quads_of(v) {
+            let k = q.iter().position(|&i| i == v).unwrap();
+            for w in [q[(k + 1) % 4], q[(k + 3) % 4]] {
+                if !nbrs.contains(&w) {
+                    nbrs.push(w);
+                }
+            }
+        }
+        let on_boundary: Vec<u32> = nbrs.iter().copied().filter(|&w| boundary(v, w)).collect();
+        let want = if on_boundary.is_empty() {
+            let n = nbrs.len() as f64;
+            let e: DVec3 = nbrs.iter().map(|&w| p(w)).sum();
+            let f: DVec3 = quads_of(v).map(centroid).sum();
+            (n - 2.0) / n * p(v) + (e + f) / (n * n)
+        } else {
+            0.75 * p(v) + 0.125 * (p(on_boundary[0]) + p(on_boundary[1]))
+        };
+        worst = worst.max(m.position(VertexId(v)).distance(want));
+    }
+    assert!(
+        worst < 1e-12,
+        "largest difference from Catmull-Clark: {worst}"
+    );
+    assert_eq!(
+        m.to_quad_soup().faces.len(),
+        4 * soup.faces.len(),
+        "the output is quads"
+    );
+}
+
+#[test]
+fn catmull_clark_grammar_on_regular_quads() {
+    check_catmull_clark(&jitter(shapes::quad_torus(6, 5), 17));
+}
+
+#[test]
+fn catmull_clark_grammar_at_extraordinary_vertices_and_boundaries() {
+    let cube = subgram::mesh::io::read(&lsys("meshes/cube.obj")).unwrap();
+    check_catmull_clark(&jitter(cube, 23));
+    check_catmull_clark(&jitter(shapes::quad_grid(4, 3), 29));
+}
+
+/// The published regular masks, 9/16, 3/32, 1/64 and 3/8, 1/16, read off a
+/// flat regular grid with one vertex moved: the output is linear in it.
+#[test]
+fn catmull_clark_regular_masks_by_impulse() {
+    let mut s = shapes::quad_torus(8, 8);
+    let base_positions = s.positions.clone();
+    let centre = 3 * 8 + 3;
+    s.positions[centre] += DVec3::new(0.0, 0.0, 1.0);
+    let moved = Mesh::from_soup(&s).unwrap();
+    let flat = Mesh::from_soup(&PolygonSoup {
+        positions: base_positions,
+        ..s.clone()
+    })
+    .unwrap();
+    let (a, b) = (
+        run("surfaces/catmull-clark.lsys", &moved),
+        run("surfaces/catmull-clark.lsys", &flat),
+    );
+    let weight = |v: VertexId| (a.position(v) - b.position(v)).z;
+    let c = VertexId(centre as u32);
+    assert!((weight(c) - 9.0 / 16.0).abs() < 1e-12, "{}", weight(c));
+    let old = flat.vertex_count() as u32;
+    for w in flat
+        .one_ring(c)
+        .filter(|w| flat.is_block_edge(flat.find_halfedge(c, *w).unwrap().edge()))
+    {
+        // A diagonal neighbour: it gets 1/64 from the centre.
+        assert!((weight(w) - 1.0 / 64.0).abs() < 1e-12);
+    }
+    for h in flat
+        .outgoing_halfedges(c)
+        .filter(|h| !flat.is_block_edge(h.edge()))
+    {
+        let w = flat.to(h);
+        assert!(
+            (weight(w) - 3.0 / 32.0).abs() < 1e-12,
+            "edge neighbour {}",
+            weight(w)
+        );
+        let ep = child_of_exactly(&a, &[c, w], old);
+        assert!(
+            (weight(ep) - 3.0 / 8.0).abs() < 1e-12,
+            "edge point {}",
+            weight(ep)
+        );
+    }
+}
