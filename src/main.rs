@@ -325,6 +325,17 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
                     !no_wireframe,
                 );
             }
+            if is_surface_file(&file) {
+                let (m, _) = subdivide(None, &file, steps.map(|s| s as usize), &define)?;
+                return write_mesh_picture(
+                    &m,
+                    &output,
+                    size,
+                    background,
+                    view.as_deref(),
+                    !no_wireframe,
+                );
+            }
             let view = match view.as_deref().unwrap_or("xy") {
                 "xy" => subgram::render::View::Xy,
                 "xz" => subgram::render::View::Xz,
@@ -388,6 +399,16 @@ fn run(cli: Cli) -> Result<(), (u8, String)> {
             phase,
             interpreted,
         } => {
+            if is_surface_file(&file) {
+                let (m, n) = subdivide(None, &file, steps.map(|s| s as usize), &define)?;
+                let info = m.info();
+                let text = match format {
+                    Format::Text => format!("after {n} step(s):\n{}", info.to_string().trim_end()),
+                    Format::Json => serde_json::to_string_pretty(&info)
+                        .map_err(|e| (1, format!("error: {e}")))?,
+                };
+                return print_out(&text);
+            }
             let loaded = load(&file, &define)?;
             check_steps(steps)?;
             let mut opts = DeriveOptions::default()
@@ -619,40 +640,8 @@ fn render_mesh(
     view: Option<&str>,
     wireframe: bool,
 ) -> Result<(), (u8, String)> {
-    use subgram::mesh::draw::{self, MeshView};
-    let lower = output.to_ascii_lowercase();
-    if !lower.ends_with(".png") && !lower.ends_with(".svg") {
-        return Err((
-            2,
-            format!("error: cannot tell the format of `{output}`: name it .png or .svg"),
-        ));
-    }
-    let mut mv = MeshView {
-        width: size.0,
-        height: size.1,
-        background,
-        wireframe,
-        ..MeshView::default()
-    };
-    if let Some(name) = view {
-        let Some((dir, up)) = draw::view_direction(name) else {
-            return Err((
-                2,
-                format!("error: `--view {name}` is not a view of a mesh: use iso, front, back, left, right, top or bottom"),
-            ));
-        };
-        mv.direction = dir;
-        mv.up = up;
-    }
     let mesh = load_mesh(file)?;
-    let soup = mesh.to_quad_soup();
-    draw::validate(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?;
-    let bytes = if lower.ends_with(".svg") {
-        draw::render_svg(&soup, &mv).into_bytes()
-    } else {
-        draw::render_png(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?
-    };
-    write_file(output, &bytes)
+    write_mesh_picture(&mesh, output, size, background, view, wireframe)
 }
 
 /// Loads a surface grammar, its base mesh (the argument, else the
@@ -701,6 +690,51 @@ fn subdivide(
     Ok((m, n))
 }
 
+/// True for a surface grammar (its text names a base mesh with `mesh:`).
+fn is_surface_file(path: &str) -> bool {
+    std::fs::read_to_string(path).is_ok_and(|t| subgram::surface::is_surface_text(&t))
+}
+
+fn write_mesh_picture(
+    m: &subgram::mesh::Mesh,
+    output: &str,
+    size: (u32, u32),
+    background: subgram::render::Rgba,
+    view: Option<&str>,
+    wireframe: bool,
+) -> Result<(), (u8, String)> {
+    use subgram::mesh::draw::{self, MeshView};
+    let lower = output.to_ascii_lowercase();
+    if !lower.ends_with(".png") && !lower.ends_with(".svg") {
+        return Err((
+            2,
+            format!("error: cannot tell the format of `{output}`: name it .png or .svg"),
+        ));
+    }
+    let mut mv = MeshView {
+        width: size.0,
+        height: size.1,
+        background,
+        wireframe,
+        ..MeshView::default()
+    };
+    if let Some(name) = view {
+        let Some((dir, up)) = draw::view_direction(name) else {
+            return Err((2, format!("error: `--view {name}` is not a view of a mesh: use iso, front, back, left, right, top or bottom")));
+        };
+        mv.direction = dir;
+        mv.up = up;
+    }
+    let soup = m.to_quad_soup();
+    draw::validate(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?;
+    let bytes = if lower.ends_with(".svg") {
+        draw::render_svg(&soup, &mv).into_bytes()
+    } else {
+        draw::render_png(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?
+    };
+    write_file(output, &bytes)
+}
+
 fn write_mesh_output(
     m: &subgram::mesh::Mesh,
     output: &str,
@@ -708,23 +742,15 @@ fn write_mesh_output(
 ) -> Result<(), (u8, String)> {
     let lower = output.to_ascii_lowercase();
     if lower.ends_with(".png") || lower.ends_with(".svg") {
-        use subgram::mesh::draw::{self, MeshView};
-        let mut mv = MeshView::default();
-        if let Some(name) = view {
-            let Some((dir, up)) = draw::view_direction(name) else {
-                return Err((2, format!("error: `--view {name}` is not a view of a mesh")));
-            };
-            mv.direction = dir;
-            mv.up = up;
-        }
-        let soup = m.to_quad_soup();
-        draw::validate(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?;
-        let bytes = if lower.ends_with(".svg") {
-            draw::render_svg(&soup, &mv).into_bytes()
-        } else {
-            draw::render_png(&soup, &mv).map_err(|e| (1, format!("error: {}", e.message)))?
-        };
-        return write_file(output, &bytes);
+        let d = subgram::mesh::draw::MeshView::default();
+        return write_mesh_picture(
+            m,
+            output,
+            (d.width, d.height),
+            d.background,
+            view,
+            d.wireframe,
+        );
     }
     subgram::mesh::io::write(std::path::Path::new(output), &m.to_quad_soup())
         .map_err(|e| (1, e.to_string()))

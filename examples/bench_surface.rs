@@ -1,0 +1,65 @@
+//! Subdivision through the grammar engine, timed; the peers are timed by
+//! `benches/peers.py` in the same session, on the meshes this program
+//! writes. `cargo run --release --example bench_surface [OUT_DIR]`
+//!
+//! - Loop (lsystems/surfaces/loop.lsys), one level, on an icosphere of
+//!   81,920 triangles;
+//! - Catmull-Clark (lsystems/surfaces/catmull-clark.lsys), one level, on a
+//!   316 x 316 quad torus.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use subgram::mesh::{io, shapes, Mesh};
+
+fn best_of(runs: usize, base: &Mesh, g: &subgram::surface::Grammar) -> (f64, Mesh) {
+    let mut best = f64::MAX;
+    let mut last = None;
+    for _ in 0..runs {
+        let mut m = base.clone();
+        let t = Instant::now();
+        g.run(&mut m, 1, |_| {}).expect("runs");
+        best = best.min(t.elapsed().as_secs_f64());
+        last = Some(m);
+    }
+    (best, last.expect("one run"))
+}
+
+fn main() {
+    let out = PathBuf::from(
+        std::env::args()
+            .nth(1)
+            .unwrap_or_else(|| "/tmp/subgram-bench".into()),
+    );
+    std::fs::create_dir_all(&out).expect("output folder");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let runs = 3;
+
+    let sphere = shapes::icosphere(6);
+    io::write(&out.join("icosphere6.obj"), &sphere).expect("write");
+    let base = Mesh::from_soup(&sphere).expect("valid");
+    let g = subgram::surface::load_file(&root.join("lsystems/surfaces/loop.lsys"), &[])
+        .expect("grammar");
+    let (t, m) = best_of(runs, &base, &g);
+    io::write(&out.join("icosphere6-loop.obj"), &m.to_soup()).expect("write");
+    println!(
+        "Loop grammar: {} -> {} triangles, best of {runs}: {:.1} ms",
+        base.face_count(),
+        m.face_count(),
+        t * 1e3
+    );
+
+    let torus = shapes::quad_torus(316, 316);
+    io::write(&out.join("torus316.obj"), &torus).expect("write");
+    let base = Mesh::from_soup(&torus).expect("valid");
+    let g = subgram::surface::load_file(&root.join("lsystems/surfaces/catmull-clark.lsys"), &[])
+        .expect("grammar");
+    let (t, m) = best_of(runs, &base, &g);
+    io::write(&out.join("torus316-cc.obj"), &m.to_quad_soup()).expect("write");
+    println!(
+        "Catmull-Clark grammar: {} -> {} quads, best of {runs}: {:.1} ms",
+        torus.faces.len(),
+        m.to_quad_soup().faces.len(),
+        t * 1e3
+    );
+}
