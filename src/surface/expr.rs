@@ -67,6 +67,8 @@ pub enum X {
         cond: Option<Box<X>>,
     },
     Bin(BinOp, Box<X>, Box<X>),
+    /// `l(slot) OP c`, the most common condition, evaluated in one step.
+    LevelVsCurrent(BinOp, u16),
     And(Box<X>, Box<X>),
     Or(Box<X>, Box<X>),
     Neg(Box<X>),
@@ -228,6 +230,13 @@ impl<'g> Compiler<'g> {
                         )
                     }
                 };
+                if t == T::Bool {
+                    if let (X::Level(l), X::Current) = (&xa, &xb) {
+                        if let X::Slot(s) = **l {
+                            return Ok((X::LevelVsCurrent(*op, s), T::Bool));
+                        }
+                    }
+                }
                 (X::Bin(*op, Box::new(xa), Box::new(xb)), t)
             }
             ExprKind::Cond(c, a, b) => {
@@ -594,6 +603,24 @@ impl Eval<'_> {
                     (Val::P(p), Val::N(s)) => Val::P(p / s),
                     _ => Val::N(f64::NAN),
                 }
+            }
+            X::LevelVsCurrent(op, s) => {
+                let l = match frame[*s as usize] {
+                    Val::V(v) => self.mesh.vertex_level(v),
+                    Val::E(_, _, l, _, _) => l,
+                    Val::F(_, l) => l,
+                    _ => return Val::B(false),
+                };
+                let c = self.current;
+                Val::B(match op {
+                    BinOp::Lt => l < c,
+                    BinOp::Le => l <= c,
+                    BinOp::Gt => l > c,
+                    BinOp::Ge => l >= c,
+                    BinOp::Eq => l == c,
+                    BinOp::Ne => l != c,
+                    _ => false,
+                })
             }
             X::And(a, b) => Val::B(
                 matches!(self.eval(a, frame), Val::B(true))

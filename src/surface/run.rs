@@ -198,8 +198,11 @@ impl Grammar {
             message: format!("at step {step}, rule `{}`: {m}", rule.text),
         };
         let mut frame = vec![Val::N(0.0); rule.frame];
-        // What the rule applies to, fixed when it starts.
+        // What the rule applies to, fixed when it starts. Edges keep their
+        // ids through the splits and flips of other edges, so the ids
+        // found here stay valid while the rule runs.
         let mut matched: Vec<Val> = Vec::new();
+        let mut edge_ids: Vec<crate::mesh::EdgeId> = Vec::new();
         {
             let ev = Eval { mesh, current };
             let mut consider = |val: Val, frame: &mut Vec<Val>| {
@@ -211,6 +214,7 @@ impl Grammar {
                 if ok {
                     matched.push(val);
                 }
+                ok
             };
             match rule.op {
                 Op::FaceSplit => {
@@ -227,10 +231,12 @@ impl Grammar {
                         let b = mesh.is_boundary_edge(e);
                         if b == want_boundary {
                             let (p, q) = mesh.edge_vertices(e);
-                            consider(
+                            if consider(
                                 Val::E(p, q, mesh.edge_level(e), b, mesh.is_block_edge(e)),
                                 &mut frame,
-                            );
+                            ) {
+                                edge_ids.push(e);
+                            }
                         }
                     }
                 }
@@ -280,17 +286,8 @@ impl Grammar {
                 Ok(())
             }
             Op::Flip => {
-                for val in &matched {
-                    let Val::E(p, q, _, _, _) = *val else {
-                        continue;
-                    };
-                    let Some(h) = mesh.find_halfedge(p, q) else {
-                        return Err(fail(format!(
-                            "the edge between vertices {} and {} is gone",
-                            p.0, q.0
-                        )));
-                    };
-                    mesh.edge_flip(h.edge()).map_err(|e| fail(e.message))?;
+                for &e in &edge_ids {
+                    mesh.edge_flip(e).map_err(|e| fail(e.message))?;
                 }
                 Ok(())
             }
@@ -302,7 +299,7 @@ impl Grammar {
                     }
                     _ => mesh.reserve(matched.len(), 3 * matched.len(), 2 * matched.len()),
                 }
-                for &val in &matched {
+                for (k, &val) in matched.iter().enumerate() {
                     let v = match val {
                         Val::F(vs, _) => {
                             let Some(f) = face_of(mesh, vs) else {
@@ -312,14 +309,13 @@ impl Grammar {
                             mesh.face_split(f, p).map_err(|e| fail(e.message))?
                         }
                         Val::E(p, q, _, _, _) => {
-                            let Some(h) = mesh.find_halfedge(p, q) else {
-                                return Err(fail(format!(
-                                    "the edge between vertices {} and {} is gone",
-                                    p.0, q.0
-                                )));
-                            };
+                            let e = edge_ids[k];
+                            debug_assert!({
+                                let (a, b) = mesh.edge_vertices(e);
+                                (a, b) == (p, q) || (a, b) == (q, p)
+                            });
                             let at = (mesh.position(p) + mesh.position(q)) * 0.5;
-                            mesh.edge_split(h.edge(), at).map_err(|e| fail(e.message))?
+                            mesh.edge_split(e, at).map_err(|e| fail(e.message))?
                         }
                         _ => continue,
                     };
