@@ -354,14 +354,7 @@ impl<'p> Rewriter<'p> {
             let seam_module =
                 |i: usize, base: &mut Vec<usize>, out: &mut Vec<f64>, guard: &mut f64| {
                     for (t, b) in base.iter_mut().enumerate() {
-                        let j = i + n + t - nl;
-                        let j = if j >= 2 * n {
-                            j - 2 * n
-                        } else if j >= n {
-                            j - n
-                        } else {
-                            j
-                        };
+                        let j = ring_index(i, t, nl, n);
                         *b = j * w;
                     }
                     for (_, combos) in &plain {
@@ -417,15 +410,7 @@ impl<'p> Rewriter<'p> {
         let mut slices: Vec<&[f64]> = vec![&[]; total];
         for i in 0..n {
             for (t, s) in slices.iter_mut().enumerate() {
-                // Position i - nl + t, wrapped once either way.
-                let j = i + n + t - nl;
-                let j = if j >= 2 * n {
-                    j - 2 * n
-                } else if j >= n {
-                    j - n
-                } else {
-                    j
-                };
+                let j = ring_index(i, t, nl, n);
                 *s = &data[j * w..j * w + w];
             }
             for (sym, combos) in &st.outputs {
@@ -695,6 +680,20 @@ impl<'p> Rewriter<'p> {
             }
         }
         Ok(true)
+    }
+}
+
+/// The ring position of context slot `t` of module `i`, whose left
+/// context has `nl` modules: `i - nl + t` wrapped once either way.
+#[inline(always)]
+fn ring_index(i: usize, t: usize, nl: usize, n: usize) -> usize {
+    let j = i + n + t - nl;
+    if j >= 2 * n {
+        j - 2 * n
+    } else if j >= n {
+        j - n
+    } else {
+        j
     }
 }
 
