@@ -228,6 +228,14 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<(), (u8, String)> {
     match cli.command {
         Command::Check { file, define } => {
+            if is_surface_file(&file) {
+                let g = subgram::surface::load_file(std::path::Path::new(&file), &define)
+                    .map_err(|e| (1, e.render()))?;
+                return print_out(&format!(
+                    "{file}: ok (a surface grammar of {} rules)",
+                    g.rules.len()
+                ));
+            }
             let loaded = load(&file, &define)?;
             print_out(&format!(
                 "{file}: ok ({} rules, {} module kinds)",

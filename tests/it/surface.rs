@@ -326,3 +326,66 @@ fn catmull_clark_regular_masks_by_impulse() {
         );
     }
 }
+
+#[test]
+fn surface_grammars_run_under_every_command() {
+    let bin = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let loop_file = lsys("surfaces/loop.lsys");
+    let f = loop_file.to_str().unwrap();
+    let o = bin(&["check", f]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("a surface grammar of 6 rules"));
+    // Three Loop steps of the octahedron: 8 * 4^3 faces, valences 4 and 6.
+    let o = bin(&["derive", f, "--format", "json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["faces"], 512);
+    assert_eq!(v["valences"]["4"], 6);
+    let dir = std::env::temp_dir().join(format!("subgram-surface-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("loop.png");
+    let o = bin(&[
+        "render",
+        f,
+        "-o",
+        png.to_str().unwrap(),
+        "-n",
+        "1",
+        "--size",
+        "120x100",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(tiny_skia::Pixmap::decode_png(&std::fs::read(&png).unwrap()).is_ok());
+    let cube = lsys("meshes/cube.obj");
+    let out = dir.join("cc.obj");
+    let cc = lsys("surfaces/catmull-clark.lsys");
+    let o = bin(&[
+        "subdivide",
+        cube.to_str().unwrap(),
+        "--grammar",
+        cc.to_str().unwrap(),
+        "-n",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let back = subgram::mesh::io::read(&out).unwrap();
+    assert_eq!(back.faces.len(), 6 * 16);
+    assert!(
+        back.faces.iter().all(|f| f.len() == 4),
+        "Catmull-Clark gives quads"
+    );
+    // A bad grammar: the message points at the rule.
+    let bad = dir.join("bad.lsys");
+    std::fs::write(&bad, "mesh: \"x.obj\";\nV(v) -> V(v = v * v);\n").unwrap();
+    let o = bin(&["check", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr)
+        .contains("bad.lsys:2:15: error: type error: cannot apply `*` to a point and a point"));
+}
