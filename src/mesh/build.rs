@@ -99,6 +99,29 @@ impl Mesh {
                 tris.push(([f[0], f[i], f[i + 1]], fi, [!first, false, !last]));
             }
         }
+        // Two triangles on the same three vertices close a pocket that no
+        // stellar operator can keep simple (a split would join two vertices
+        // twice).
+        let mut seen: HashMap<[u32; 3], usize> = HashMap::with_capacity(tris.len());
+        for (tri, fi, _) in &tris {
+            let mut key = *tri;
+            key.sort_unstable();
+            if let Some(&other) = seen.get(&key) {
+                if other != *fi {
+                    return Err(MeshError::new(format!(
+                        "faces {}{} and {}{} share the same three vertices {}, {} and {}",
+                        other + 1,
+                        at_line(soup, other),
+                        fi + 1,
+                        at_line(soup, *fi),
+                        key[0] + 1,
+                        key[1] + 1,
+                        key[2] + 1
+                    )));
+                }
+            }
+            seen.insert(key, *fi);
+        }
         let mut m = Mesh::default();
         for p in &soup.positions {
             m.new_vertex(*p, 0);
@@ -208,6 +231,28 @@ impl Mesh {
     /// The mesh as triangles, with dead slots removed.
     pub fn to_soup(&self) -> PolygonSoup {
         self.soup_with(|_| false)
+    }
+
+    /// Reads the mesh as plain triangles: no basic blocks, and, on a base
+    /// mesh (every vertex at level 0), every edge at level 0, as if each
+    /// quad had been given as two triangles. Schemes for triangle meshes
+    /// run on quad input this way.
+    pub fn forget_blocks(&mut self) {
+        let base = self.vertices().all(|v| self.vertex_level(v) == 0);
+        let edges: Vec<EdgeId> = self.edges().collect();
+        for e in edges {
+            self.e_block[e.index()] = false;
+            if base {
+                self.e_level[e.index()] = 0;
+            }
+        }
+    }
+
+    /// The first face that is not half of a basic block, if any: a
+    /// triangle of the input rather than half of a quad.
+    pub fn face_outside_blocks(&self) -> Option<FaceId> {
+        self.faces()
+            .find(|&f| !self.face_edges(f).iter().any(|&e| self.is_block_edge(e)))
     }
 
     /// The mesh with basic blocks merged back into quads.

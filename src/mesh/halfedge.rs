@@ -22,6 +22,14 @@ macro_rules! id {
                 self.0 as usize
             }
         }
+
+        /// Counted from 1, as mesh files count: vertex 1 is the first `v`
+        /// line of an OBJ file.
+        impl std::fmt::Display for $name {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "{}", self.0 as u64 + 1)
+            }
+        }
     };
 }
 
@@ -103,6 +111,9 @@ pub struct Mesh {
     pub(crate) e_alive: Vec<bool>,
     /// The internal edge of a basic block of a tri-quad mesh.
     pub(crate) e_block: Vec<bool>,
+    /// Made by an edge split, joining the new vertex to a vertex opposite
+    /// the split edge, and not flipped since.
+    pub(crate) e_transversal: Vec<bool>,
     // Faces.
     pub(crate) f_he: Vec<HalfEdgeId>,
     pub(crate) f_level: Vec<u32>,
@@ -220,6 +231,12 @@ impl Mesh {
     /// True for the internal edge of a basic block (tri-quad meshes).
     pub fn is_block_edge(&self, e: EdgeId) -> bool {
         self.e_block[e.index()]
+    }
+
+    /// True for an edge that an edge split drew from the new vertex to a
+    /// vertex opposite the split edge, and that no flip has touched since.
+    pub fn is_transversal_edge(&self, e: EdgeId) -> bool {
+        self.e_transversal[e.index()]
     }
 
     // ----- half-edge navigation ------------------------------------
@@ -362,6 +379,7 @@ impl Mesh {
         self.e_level.reserve(edges);
         self.e_alive.reserve(edges);
         self.e_block.reserve(edges);
+        self.e_transversal.reserve(edges);
         self.f_he.reserve(faces);
         self.f_level.reserve(faces);
         self.f_alive.reserve(faces);
@@ -393,11 +411,13 @@ impl Mesh {
             self.e_level[k] = level;
             self.e_alive[k] = true;
             self.e_block[k] = false;
+            self.e_transversal[k] = false;
             EdgeId(i)
         } else {
             self.e_level.push(level);
             self.e_alive.push(true);
             self.e_block.push(false);
+            self.e_transversal.push(false);
             let e = EdgeId(self.e_alive.len() as u32 - 1);
             let dummy = HalfEdgeId(0);
             for _ in 0..2 {

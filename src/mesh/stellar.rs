@@ -26,7 +26,7 @@ impl Mesh {
         if !self.is_face(f) {
             return Err(MeshError::new(format!(
                 "face split: face {} does not exist",
-                f.0
+                f
             )));
         }
         let [h0, h1, h2] = self.face_halfedges(f);
@@ -64,20 +64,20 @@ impl Mesh {
         if !self.is_vertex(v) {
             return Err(MeshError::new(format!(
                 "face weld: vertex {} does not exist",
-                v.0
+                v
             )));
         }
         if self.is_boundary_vertex(v) {
             return Err(MeshError::new(format!(
                 "face weld: vertex {} is on the boundary",
-                v.0
+                v
             )));
         }
         let out: Vec<HalfEdgeId> = self.outgoing_halfedges(v).collect();
         if out.len() != 3 {
             return Err(MeshError::new(format!(
                 "face weld: vertex {} has valence {}, but only a vertex of valence 3 can be welded into a face",
-                v.0,
+                v,
                 out.len()
             )));
         }
@@ -86,7 +86,7 @@ impl Mesh {
         if across[0].is_some() && across[0] == across[1] && across[1] == across[2] {
             return Err(MeshError::new(format!(
                 "face weld: welding vertex {} would make a triangle that already exists (a doubled face)",
-                v.0
+                v
             )));
         }
         let faces: Vec<FaceId> = out.iter().filter_map(|&h| self.face(h)).collect();
@@ -124,13 +124,14 @@ impl Mesh {
     ///
     /// Levels: `l(v) = max(l(a), l(b)) + 1`; the bisection edges `av`, `vb`
     /// get `l(ab) + 2`; the transversal edges `vc`, `vd` get `l(c) + 1` and
-    /// `l(d) + 1`. Splitting the internal edge of a basic block makes the
-    /// four edges at `v` internal edges of blocks.
+    /// `l(d) + 1`, and are marked transversal. Splitting the internal edge
+    /// of a basic block makes the four edges at `v` internal edges of
+    /// blocks.
     pub fn edge_split(&mut self, e: EdgeId, p: DVec3) -> Result<VertexId, MeshError> {
         if !self.is_edge(e) {
             return Err(MeshError::new(format!(
                 "edge split: edge {} does not exist",
-                e.0
+                e
             )));
         }
         // h runs a -> b inside a face; t is its twin.
@@ -147,14 +148,23 @@ impl Mesh {
         let c = self.to(h_bc);
         let f1 = self.face(h).expect("h has a face");
         let boundary = self.face(t).is_none();
+        if !boundary && self.to(self.next(t)) == c {
+            // Both faces are a, b, c: the two spokes would join v to c twice.
+            return Err(MeshError::new(format!(
+                "edge split: both faces of the edge between vertices {} and {} have the same third vertex {}",
+                a, b, c
+            )));
+        }
         let v = self.new_vertex(p, lv);
         // h becomes a -> v, t becomes v -> a.
         self.he_to[h.index()] = v;
         self.he_to[t.index()] = a;
         self.e_level[e.index()] = le + 2;
         self.e_block[e.index()] = false;
+        self.e_transversal[e.index()] = false;
         let g = self.new_edge(v, b, le + 2); // v -> b
         let k = self.new_edge(v, c, self.v_level[c.index()] + 1); // v -> c
+        self.e_transversal[k.edge().index()] = true;
         let f2 = self.new_face(g, 0);
         self.set_triangle(f1, h, k, h_ca);
         self.set_triangle(f2, g, h_bc, k.twin());
@@ -177,6 +187,7 @@ impl Mesh {
             let (t_ad, t_db) = (self.next(t), self.prev(t));
             let d = self.to(t_ad);
             let m = self.new_edge(v, d, self.v_level[d.index()] + 1); // v -> d
+            self.e_transversal[m.edge().index()] = true;
             let f4 = self.new_face(g.twin(), 0);
             self.set_triangle(f3, t, t_ad, m.twin());
             self.set_triangle(f4, g.twin(), m, t_db);
@@ -224,7 +235,7 @@ impl Mesh {
         if !self.is_vertex(v) {
             return Err(MeshError::new(format!(
                 "edge weld: vertex {} does not exist",
-                v.0
+                v
             )));
         }
         let out: Vec<HalfEdgeId> = self.outgoing_halfedges(v).collect();
@@ -233,7 +244,7 @@ impl Mesh {
         if out.len() != want {
             return Err(MeshError::new(format!(
                 "edge weld: vertex {} has valence {}, but a{} vertex of valence {want} is needed",
-                v.0,
+                v,
                 out.len(),
                 if boundary { " boundary" } else { "n interior" }
             )));
@@ -241,7 +252,7 @@ impl Mesh {
         let Some(ka) = out.iter().position(|&h| self.to(h) == keep) else {
             return Err(MeshError::new(format!(
                 "edge weld: vertex {} is not a neighbour of vertex {}",
-                keep.0, v.0
+                keep, v
             )));
         };
         if boundary {
@@ -249,14 +260,14 @@ impl Mesh {
             if ka == 1 {
                 return Err(MeshError::new(format!(
                     "edge weld: vertex {} is not on the boundary next to vertex {}",
-                    keep.0, v.0
+                    keep, v
                 )));
             }
             let (n0, n1, n2) = (self.to(out[0]), self.to(out[1]), self.to(out[2]));
             if self.find_halfedge(n0, n2).is_some() {
                 return Err(MeshError::new(format!(
                     "edge weld: vertices {} and {} are already joined",
-                    n0.0, n2.0
+                    n0, n2
                 )));
             }
             let _ = n1;
@@ -277,6 +288,7 @@ impl Mesh {
             self.he_to[x.index()] = n0;
             self.he_to[bin.index()] = n2;
             self.e_level[x.edge().index()] = le;
+            self.e_transversal[x.edge().index()] = false;
             self.set_triangle(f, o1, o2, x);
             self.he_face[bin.index()] = None;
             self.link(bp, bin);
@@ -302,7 +314,7 @@ impl Mesh {
         if self.find_halfedge(a, b).is_some() {
             return Err(MeshError::new(format!(
                 "edge weld: vertices {} and {} are already joined",
-                a.0, b.0
+                a, b
             )));
         }
         let _ = (c, d);
@@ -325,6 +337,7 @@ impl Mesh {
         self.he_to[x.index()] = b;
         self.he_to[x.twin().index()] = a;
         self.e_level[x.edge().index()] = le;
+        self.e_transversal[x.edge().index()] = false;
         self.set_triangle(faces[0], o_ac, o_cb, x.twin());
         self.set_triangle(faces[1], o_bd, o_da, x);
         for (w, h) in [(a, x), (b, x.twin()), (c, o_cb), (d, o_da)] {
@@ -356,13 +369,13 @@ impl Mesh {
         if !self.is_edge(e) {
             return Err(MeshError::new(format!(
                 "edge flip: edge {} does not exist",
-                e.0
+                e
             )));
         }
         if self.is_boundary_edge(e) {
+            let (a, b) = self.edge_vertices(e);
             return Err(MeshError::new(format!(
-                "edge flip: edge {} is on the boundary and cannot be flipped",
-                e.0
+                "edge flip: the edge between vertices {a} and {b} is on the boundary and cannot be flipped"
             )));
         }
         let h = e.halfedge();
@@ -373,8 +386,8 @@ impl Mesh {
         let (c, d) = (self.to(h_bc), self.to(t_ad));
         if c == d || self.find_halfedge(c, d).is_some() {
             return Err(MeshError::new(format!(
-                "edge flip: flipping edge {} would duplicate the edge between vertices {} and {}",
-                e.0, c.0, d.0
+                "edge flip: flipping the edge between vertices {} and {} would duplicate the edge between vertices {} and {}",
+                a, b, c, d
             )));
         }
         let (f1, f2) = (
@@ -393,6 +406,7 @@ impl Mesh {
         }
         self.e_level[e.index()] += 1;
         self.e_block[e.index()] = false;
+        self.e_transversal[e.index()] = false;
         for f in [f1, f2] {
             let vs = self.face_vertices(f);
             self.f_level[f.index()] = self.face_level_from_vertices(vs);

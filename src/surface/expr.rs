@@ -57,6 +57,7 @@ pub enum X {
     Valence(Box<X>),
     IsBoundary(Box<X>),
     IsBlock(Box<X>),
+    IsTransversal(Box<X>),
     /// The average position of an edge's or a face's vertices.
     AvgOf(Box<X>),
     Set(SetKind, Box<X>),
@@ -88,9 +89,9 @@ pub enum Val {
     B(bool),
     V(VertexId),
     /// An edge by its end vertices (captured before a split), level,
-    /// whether it was on the boundary, and whether it was a basic block's
-    /// internal edge.
-    E(VertexId, VertexId, u32, bool, bool),
+    /// whether it was on the boundary, whether it was a basic block's
+    /// internal edge, and whether it was a transversal edge.
+    E(VertexId, VertexId, u32, bool, bool, bool),
     /// A face by its vertices and level.
     F([VertexId; 3], u32),
     /// A set: its kind and the element it belongs to.
@@ -111,9 +112,17 @@ pub struct Compiler<'g> {
     next: u16,
     pub max_slots: u16,
     depth: usize,
+    /// Function calls inlined so far.
+    inlined: usize,
+    /// Where `block` was first used, if it was.
+    pub block_used_at: Option<Span>,
 }
 
 type C = Result<(X, T), Diagnostic>;
+
+/// Function calls are inlined; past this many in one rule, a grammar whose
+/// functions call each other twice over would take exponential time.
+const MAX_INLINED_CALLS: usize = 10_000;
 
 fn err<A>(span: Span, m: impl Into<String>) -> Result<A, Diagnostic> {
     Err(Diagnostic::new(span, m))
@@ -127,16 +136,31 @@ impl<'g> Compiler<'g> {
             next: 0,
             max_slots: 0,
             depth: 0,
+            inlined: 0,
+            block_used_at: None,
         }
     }
 
     /// Declares a named slot (a rule's element), returning it.
-    pub fn bind(&mut self, name: &str, t: T) -> u16 {
-        let s = self.next;
-        self.next += 1;
-        self.max_slots = self.max_slots.max(self.next);
+    pub fn bind(&mut self, name: &str, t: T, span: Span) -> Result<u16, Diagnostic> {
+        let s = self.reserve(1, span)?;
         self.scopes.push((name.to_string(), t, s));
-        s
+        Ok(s)
+    }
+
+    /// Reserves `n` frame slots, returning the first. Slots are freed in
+    /// stack order: a slot lives while the expression compiled after it is
+    /// evaluated, so later, disjoint expressions reuse it.
+    fn reserve(&mut self, n: usize, span: Span) -> Result<u16, Diagnostic> {
+        let s = self.next;
+        match u16::try_from(s as usize + n) {
+            Ok(next) if next < u16::MAX => {
+                self.next = next;
+                self.max_slots = self.max_slots.max(next);
+                Ok(s)
+            }
+            _ => err(span, "this expression needs too many variables"),
+        }
     }
 
     fn unbind(&mut self, n: usize) {
@@ -248,12 +272,14 @@ impl<'g> Compiler<'g> {
             }
             ExprKind::Gather { op, var, set, cond } => {
                 let xs = self.compile_as(set, T::Set)?;
-                let slot = self.bind(&var.text, T::Vertex);
+                let slot = self.bind(&var.text, T::Vertex, var.span)?;
                 let xc = match cond {
-                    Some(c) => Some(Box::new(self.compile_as(c, T::Bool)?)),
-                    None => None,
+                    Some(c) => self.compile_as(c, T::Bool).map(|x| Some(Box::new(x))),
+                    None => Ok(None),
                 };
                 self.unbind(1);
+                self.next = slot;
+                let xc = xc?;
                 let code = match op.text.as_str() {
                     "sum" => 0,
                     "avg" => 1,
@@ -361,7 +387,18 @@ impl<'g> Compiler<'g> {
                         "`block` takes an edge: true for the internal edge of a basic block",
                     );
                 }
+                self.block_used_at.get_or_insert(span);
                 Ok((X::IsBlock(Box::new(x)), T::Bool))
+            }
+            "transversal" => {
+                let (x, t) = one(self)?;
+                if t != T::Edge {
+                    return err(
+                        span,
+                        "`transversal` takes an edge: true for an edge that an edge split drew to an opposite vertex",
+                    );
+                }
+                Ok((X::IsTransversal(Box::new(x)), T::Bool))
             }
             "ring" | "N1" | "boundary_ring" => {
                 let (x, t) = one(self)?;
@@ -387,8 +424,8 @@ impl<'g> Compiler<'g> {
                 match t {
                     T::Edge | T::Face => Ok((X::AvgOf(Box::new(x)), T::Vec)),
                     T::Set => {
-                        let slot = self.bind("#avg", T::Vertex);
-                        self.unbind(1);
+                        let slot = self.reserve(1, span)?;
+                        self.next = slot;
                         Ok((
                             X::Gather {
                                 op: 1,
@@ -444,34 +481,55 @@ impl<'g> Compiler<'g> {
                         format!("`{name}` calls itself too deeply; functions may not recurse"),
                     );
                 }
-                // Inline: bind each argument to a fresh slot, then the body.
-                let mut lets = Vec::new();
-                for a in args {
-                    lets.push(self.compile(a)?);
+                self.inlined += 1;
+                if self.inlined > MAX_INLINED_CALLS {
+                    return err(
+                        span,
+                        format!(
+                            "the functions called here expand to more than {MAX_INLINED_CALLS} calls; \
+                             name a shared value with a parameter instead of calling a function twice"
+                        ),
+                    );
                 }
-                let base = self.scopes.len();
-                let saved: Vec<(String, T, u16)> = std::mem::take(&mut self.scopes);
-                let mut slots = Vec::new();
-                for (p, (_, t)) in f.params.iter().zip(&lets) {
-                    slots.push(self.bind(p, *t));
-                }
-                self.depth += 1;
-                let body = self.compile(&f.body);
-                self.depth -= 1;
-                self.scopes = saved;
-                let _ = base;
-                let (mut x, t) = body.map_err(|d| {
-                    Diagnostic::new(
-                        d.span,
-                        format!("{} (in `{name}`, called at {})", d.message, "this call"),
-                    )
-                })?;
-                for (s, (a, _)) in slots.into_iter().zip(lets).rev() {
-                    x = X::Let(s, Box::new(a), Box::new(x));
-                }
-                Ok((x, t))
+                // Inline: the parameters get slots reserved before the
+                // arguments are compiled, so no argument's temporaries can
+                // overwrite a parameter set before it; then the body.
+                let first = self.reserve(args.len(), span)?;
+                let result = self.inline(f, args, first);
+                self.next = first;
+                result
             }
         }
+    }
+
+    /// The body of `f` with its parameters, from slot `first` on, bound to
+    /// `args`.
+    fn inline(&mut self, f: &FunctionDef, args: &[Expr], first: u16) -> C {
+        let mut lets = Vec::with_capacity(args.len());
+        for a in args {
+            lets.push(self.compile(a)?);
+        }
+        let saved: Vec<(String, T, u16)> = std::mem::take(&mut self.scopes);
+        for (i, (p, (_, t))) in f.params.iter().zip(&lets).enumerate() {
+            self.scopes.push((p.clone(), *t, first + i as u16));
+        }
+        self.depth += 1;
+        let body = self.compile(&f.body);
+        self.depth -= 1;
+        self.scopes = saved;
+        let (mut x, t) = body.map_err(|d| {
+            // The caret points into the body; name the function once, at
+            // the innermost call.
+            if d.message.contains(" (in `") {
+                d
+            } else {
+                Diagnostic::new(d.span, format!("{} (in `{}`)", d.message, f.name))
+            }
+        })?;
+        for (i, (a, _)) in lets.into_iter().enumerate().rev() {
+            x = X::Let(first + i as u16, Box::new(a), Box::new(x));
+        }
+        Ok((x, t))
     }
 }
 
@@ -489,7 +547,7 @@ impl Eval<'_> {
             X::Current => Val::N(self.current as f64),
             X::Level(a) => Val::N(match self.eval(a, frame) {
                 Val::V(v) => self.mesh.vertex_level(v) as f64,
-                Val::E(_, _, l, _, _) => l as f64,
+                Val::E(_, _, l, _, _, _) => l as f64,
                 Val::F(_, l) => l as f64,
                 _ => f64::NAN,
             }),
@@ -503,12 +561,15 @@ impl Eval<'_> {
             },
             X::IsBoundary(a) => Val::B(match self.eval(a, frame) {
                 Val::V(v) => self.mesh.is_boundary_vertex(v),
-                Val::E(_, _, _, b, _) => b,
+                Val::E(_, _, _, b, _, _) => b,
                 _ => false,
             }),
-            X::IsBlock(a) => Val::B(matches!(self.eval(a, frame), Val::E(_, _, _, _, true))),
+            X::IsBlock(a) => Val::B(matches!(self.eval(a, frame), Val::E(_, _, _, _, true, _))),
+            X::IsTransversal(a) => {
+                Val::B(matches!(self.eval(a, frame), Val::E(_, _, _, _, _, true)))
+            }
             X::AvgOf(a) => match self.eval(a, frame) {
-                Val::E(p, q, _, _, _) => {
+                Val::E(p, q, _, _, _, _) => {
                     Val::P((self.mesh.position(p) + self.mesh.position(q)) * 0.5)
                 }
                 Val::F(vs, _) => {
@@ -519,7 +580,7 @@ impl Eval<'_> {
             X::Set(k, a) => {
                 let of = match self.eval(a, frame) {
                     Val::V(v) => SetOf::V(v),
-                    Val::E(p, q, _, _, _) => SetOf::E(p, q),
+                    Val::E(p, q, _, _, _, _) => SetOf::E(p, q),
                     Val::F(vs, _) => SetOf::F(vs),
                     _ => SetOf::V(VertexId(0)),
                 };
@@ -607,7 +668,7 @@ impl Eval<'_> {
             X::LevelVsCurrent(op, s) => {
                 let l = match frame[*s as usize] {
                     Val::V(v) => self.mesh.vertex_level(v),
-                    Val::E(_, _, l, _, _) => l,
+                    Val::E(_, _, l, _, _, _) => l,
                     Val::F(_, l) => l,
                     _ => return Val::B(false),
                 };

@@ -227,12 +227,29 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
         }
         if p.is_ident("define") {
             p.pos += 1;
+            let name_span = p.span();
             let name = p.ident("a function name after `define`")?;
+            if g.functions.iter().any(|f| f.name == name) {
+                return Err(Diagnostic::new(
+                    name_span,
+                    format!(
+                        "function `{name}` is already defined above; give this one another name"
+                    ),
+                ));
+            }
             p.expect("(", "after the function name")?;
             let mut params = Vec::new();
             if !p.eat(")") {
                 loop {
-                    params.push(p.ident("a parameter name")?);
+                    let at = p.span();
+                    let param = p.ident("a parameter name")?;
+                    if params.contains(&param) {
+                        return Err(Diagnostic::new(
+                            at,
+                            format!("`{name}` already has a parameter `{param}`"),
+                        ));
+                    }
+                    params.push(param);
                     if p.eat(")") {
                         break;
                     }
@@ -251,6 +268,12 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
             continue;
         }
         g.rules.push(rule(&mut p, &text_of)?);
+    }
+    if g.rules.is_empty() {
+        return Err(Diagnostic::new(
+            eof,
+            "expected at least one rule, e.g. `F(f) -> V(v = avg(f)) || E^3 F^3;`",
+        ));
     }
     Ok(g)
 }

@@ -41,7 +41,16 @@ pub struct Grammar {
     pub mesh: Option<(String, Span)>,
     pub length: Option<u64>,
     pub sources: SourceMap,
+    /// Where the grammar first asks `block(e)`: such a grammar is for
+    /// tri-quad meshes. Without it, quads are read as two triangles.
+    pub block_used_at: Option<Span>,
+    /// A rule that would make more faces than this stops the run with an
+    /// error instead of exhausting memory (about 110 bytes a face).
+    pub max_faces: usize,
 }
+
+/// The default face limit: about 5.5 GB of mesh.
+pub const MAX_FACES: usize = 50_000_000;
 
 /// Compiles a parsed grammar file.
 pub fn compile(
@@ -50,6 +59,7 @@ pub fn compile(
 ) -> Result<Grammar, (SourceMap, Vec<Diagnostic>)> {
     let mut rules = Vec::new();
     let mut diags = Vec::new();
+    let mut block_used_at = None;
     for r in &file.rules {
         let mut c = Compiler::new(&file.functions);
         let elem_t = match r.op {
@@ -57,7 +67,13 @@ pub fn compile(
             Op::EdgeSplit | Op::BoundarySplit | Op::Flip => T::Edge,
             Op::Vertex => T::Vertex,
         };
-        let elem_slot = c.bind(&r.name, elem_t);
+        let elem_slot = match c.bind(&r.name, elem_t, r.span) {
+            Ok(s) => s,
+            Err(d) => {
+                diags.push(d);
+                continue;
+            }
+        };
         let cond = match &r.cond {
             Some(e) => match c.compile_as(e, T::Bool) {
                 Ok(x) => Some(x),
@@ -74,7 +90,13 @@ pub fn compile(
                 let s = if r.op == Op::Vertex && *name == r.name {
                     elem_slot
                 } else {
-                    c.bind(name, T::Vertex)
+                    match c.bind(name, T::Vertex, r.span) {
+                        Ok(s) => s,
+                        Err(d) => {
+                            diags.push(d);
+                            continue;
+                        }
+                    }
                 };
                 match c.compile_as(e, T::Vec) {
                     Ok(x) => (Some(s), Some(x)),
@@ -86,6 +108,7 @@ pub fn compile(
             }
             None => (None, None),
         };
+        block_used_at = block_used_at.or(c.block_used_at);
         rules.push(Rule {
             op: r.op,
             context: r.vertex_context,
@@ -110,11 +133,13 @@ pub fn compile(
                         current: 0,
                     };
                     match ev.eval(&x, &mut vec![Val::N(0.0); c.max_slots as usize + 1]) {
-                        Val::N(n) if n.is_finite() && (0.0..=64.0).contains(&n) => Some(n as u64),
+                        Val::N(n) if n.fract() == 0.0 && (0.0..=64.0).contains(&n) => {
+                            Some(n as u64)
+                        }
                         _ => {
                             diags.push(Diagnostic::new(
                                 e.span,
-                                "the derivation length must be a number of steps from 0 to 64",
+                                "the derivation length must be a whole number of steps from 0 to 64",
                             ));
                             None
                         }
@@ -135,6 +160,8 @@ pub fn compile(
         mesh: file.mesh.clone(),
         length,
         sources,
+        block_used_at,
+        max_faces: MAX_FACES,
     })
 }
 
@@ -171,6 +198,21 @@ impl Grammar {
         steps: usize,
         mut progress: impl FnMut(StepCounts),
     ) -> Result<(), RunError> {
+        match self.block_used_at {
+            None => mesh.forget_blocks(),
+            Some(span) => {
+                if let Some(f) = mesh.face_outside_blocks() {
+                    let [a, b, c] = mesh.face_vertices(f).map(|v| v.index() + 1);
+                    return Err(RunError {
+                        span: Some(span),
+                        message: format!(
+                            "this grammar asks `block(e)`, so it needs a mesh of quads, but the triangle \
+                             on vertices {a}, {b} and {c} is not half of a quad"
+                        ),
+                    });
+                }
+            }
+        }
         for step in 1..=steps {
             for rule in &self.rules {
                 self.apply(rule, mesh, step)?;
@@ -232,7 +274,14 @@ impl Grammar {
                         if b == want_boundary {
                             let (p, q) = mesh.edge_vertices(e);
                             if consider(
-                                Val::E(p, q, mesh.edge_level(e), b, mesh.is_block_edge(e)),
+                                Val::E(
+                                    p,
+                                    q,
+                                    mesh.edge_level(e),
+                                    b,
+                                    mesh.is_block_edge(e),
+                                    mesh.is_transversal_edge(e),
+                                ),
                                 &mut frame,
                             ) {
                                 edge_ids.push(e);
@@ -270,8 +319,7 @@ impl Grammar {
                             Val::P(p) => {
                                 let Val::V(v) = val else { unreachable!() };
                                 return Err(fail(format!(
-                                    "vertex {} would move to {p}, which is not finite",
-                                    v.0
+                                    "vertex {v} would move to {p}, which is not finite"
                                 )));
                             }
                             _ => return Err(fail("the assignment did not give a point".into())),
@@ -292,6 +340,15 @@ impl Grammar {
                 Ok(())
             }
             Op::FaceSplit | Op::EdgeSplit | Op::BoundarySplit => {
+                let per = if rule.op == Op::BoundarySplit { 1 } else { 2 };
+                let after = mesh.face_count() + per * matched.len();
+                if after > self.max_faces {
+                    return Err(fail(format!(
+                        "this rule would make {after} faces, past the limit of {}; \
+                         run fewer steps",
+                        self.max_faces
+                    )));
+                }
                 let mut made: Vec<(VertexId, Val)> = Vec::with_capacity(matched.len());
                 match rule.op {
                     Op::FaceSplit => {
@@ -308,7 +365,7 @@ impl Grammar {
                             let p = vs.iter().map(|v| mesh.position(*v)).sum::<DVec3>() / 3.0;
                             mesh.face_split(f, p).map_err(|e| fail(e.message))?
                         }
-                        Val::E(p, q, _, _, _) => {
+                        Val::E(p, q, _, _, _, _) => {
                             let e = edge_ids[k];
                             debug_assert!({
                                 let (a, b) = mesh.edge_vertices(e);
@@ -335,8 +392,7 @@ impl Grammar {
                             Val::P(p) if p.is_finite() => out.push(p),
                             Val::P(p) => {
                                 return Err(fail(format!(
-                                    "new vertex {} would be at {p}, which is not finite",
-                                    v.0
+                                    "new vertex {v} would be at {p}, which is not finite"
                                 )))
                             }
                             _ => return Err(fail("the assignment did not give a point".into())),

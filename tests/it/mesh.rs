@@ -239,45 +239,49 @@ fn refusals_name_the_reason_and_leave_the_mesh_unchanged() {
     let mut m = diamond();
     let before = m.canonical();
     let boundary = edge_between(&m, 0, 2);
-    assert_eq!(
-        m.edge_flip(boundary).unwrap_err().message,
+    assert_eq!(m.edge_flip(boundary).unwrap_err().message, {
+        let (a, b) = m.edge_vertices(boundary);
+        assert_eq!((a.0.min(b.0), a.0.max(b.0)), (0, 2));
+        // Messages count vertices from 1, as mesh files do.
         format!(
-            "edge flip: edge {} is on the boundary and cannot be flipped",
-            boundary.0
-        )
-    );
+                "edge flip: the edge between vertices {} and {} is on the boundary and cannot be flipped",
+                a.0 + 1,
+                b.0 + 1
+            )
+    });
     assert_eq!(
         m.face_weld(VertexId(0)).unwrap_err().message,
-        "face weld: vertex 0 is on the boundary"
+        "face weld: vertex 1 is on the boundary"
     );
     assert_eq!(
         m.edge_weld(VertexId(2), VertexId(0)).unwrap_err().message,
-        "edge weld: vertex 2 has valence 2, but a boundary vertex of valence 3 is needed"
+        "edge weld: vertex 3 has valence 2, but a boundary vertex of valence 3 is needed"
     );
     assert_eq!(m.canonical(), before);
     let mut t = tetrahedron();
     let before = t.canonical();
     let e = edge_between(&t, 0, 1);
-    assert_eq!(
-        t.edge_flip(e).unwrap_err().message,
+    assert_eq!(t.edge_flip(e).unwrap_err().message, {
+        let (a, b) = t.edge_vertices(e);
         format!(
-            "edge flip: flipping edge {} would duplicate the edge between vertices 2 and 3",
-            e.0
-        )
-    );
+                "edge flip: flipping the edge between vertices {} and {} would duplicate the edge between vertices 3 and 4",
+                a.0 + 1,
+                b.0 + 1
+            )
+    });
     assert_eq!(
         t.face_weld(VertexId(3)).unwrap_err().message,
-        "face weld: welding vertex 3 would make a triangle that already exists (a doubled face)"
+        "face weld: welding vertex 4 would make a triangle that already exists (a doubled face)"
     );
     let ico = Mesh::from_soup(&shapes::icosahedron()).unwrap();
     let mut i2 = ico.clone();
     assert_eq!(
         i2.face_weld(VertexId(0)).unwrap_err().message,
-        "face weld: vertex 0 has valence 5, but only a vertex of valence 3 can be welded into a face"
+        "face weld: vertex 1 has valence 5, but only a vertex of valence 3 can be welded into a face"
     );
     assert_eq!(
         i2.edge_weld(VertexId(0), VertexId(1)).unwrap_err().message,
-        "edge weld: vertex 0 has valence 5, but an interior vertex of valence 4 is needed"
+        "edge weld: vertex 1 has valence 5, but an interior vertex of valence 4 is needed"
     );
     assert_eq!(i2.canonical(), ico.canonical());
     assert_eq!(t.canonical(), before);
@@ -313,6 +317,12 @@ fn broken_meshes_are_refused_with_the_element_named() {
             "face 1 refers to vertex 10, but there are only 7 vertices",
         ),
         (&[&[0, 1, 2], &[3, 4]], "face 2 has 2 vertices"),
+        (
+            // A closed pocket of two faces: splitting an edge would join
+            // two vertices twice.
+            &[&[0, 1, 2], &[0, 2, 1]],
+            "faces 1 and 2 share the same three vertices 1, 2 and 3",
+        ),
     ];
     for (faces, want) in cases {
         let e = Mesh::from_soup(&soup(&p, faces)).unwrap_err().message;

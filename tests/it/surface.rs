@@ -389,3 +389,178 @@ fn surface_grammars_run_under_every_command() {
     assert!(String::from_utf8_lossy(&o.stderr)
         .contains("bad.lsys:2:15: error: type error: cannot apply `*` to a point and a point"));
 }
+
+/// Valences and how many vertices have each.
+fn valences(m: &Mesh) -> std::collections::BTreeMap<usize, usize> {
+    let mut h = std::collections::BTreeMap::new();
+    for v in m.vertices() {
+        *h.entry(m.one_ring(v).count()).or_insert(0) += 1;
+    }
+    h
+}
+
+fn run_steps(g: &subgram::surface::Grammar, base: &Mesh, steps: usize) -> Mesh {
+    let mut m = base.clone();
+    g.run(&mut m, steps, |_| {})
+        .unwrap_or_else(|e| panic!("{}", g.render_error(&e)));
+    m.validate().unwrap();
+    m
+}
+
+#[test]
+fn loop_grammar_stays_a_quadrisection_for_six_steps() {
+    // Each Loop step quadrisects every triangle: the base vertices keep
+    // their valence, every new vertex has valence 6, and the counts follow
+    // F' = 4F, E' = 2E + 3F, V' = V + E.
+    let g = grammar("surfaces/loop.lsys");
+    let base = Mesh::from_soup(&jitter(shapes::icosahedron(), 3)).unwrap();
+    let m = run_steps(&g, &base, 6);
+    let (mut v, mut e, mut f) = (12, 30, 20);
+    for _ in 0..6 {
+        (v, e, f) = (v + e, 2 * e + 3 * f, 4 * f);
+    }
+    assert_eq!(
+        (m.vertex_count(), m.edge_count(), m.face_count()),
+        (v, e, f)
+    );
+    let want: std::collections::BTreeMap<usize, usize> = [(5, 12), (6, v - 12)].into();
+    assert_eq!(valences(&m), want);
+}
+
+#[test]
+fn loop_grammar_keeps_a_flat_grid_flat_and_unfolded() {
+    // On a planar grid the limit surface lies in the convex hull of the
+    // control points, the unit square, and no triangle turns over.
+    let g = grammar("surfaces/loop.lsys");
+    for soup in [shapes::triangle_grid(3, 3), shapes::quad_grid(3, 3)] {
+        let m = run_steps(&g, &Mesh::from_soup(&soup).unwrap(), 5);
+        assert_eq!(m.face_count(), 18 * 4usize.pow(5));
+        for v in m.vertices() {
+            let p = m.position(v);
+            assert!(
+                (-1e-12..=1.0 + 1e-12).contains(&p.x) && (-1e-12..=1.0 + 1e-12).contains(&p.y),
+                "vertex {v} at {p} is outside the unit square"
+            );
+        }
+        for f in m.faces() {
+            let [a, b, c] = m.face_vertices(f).map(|v| m.position(v));
+            let z = (b - a).cross(c - a).z;
+            assert!(z > 0.0, "face {f:?} is folded over (signed area {z})");
+        }
+    }
+}
+
+/// The soup with every quad written as the two triangles `from_soup`
+/// would cut it into.
+fn as_triangles(s: &PolygonSoup) -> PolygonSoup {
+    let mut t = s.clone();
+    t.faces = s
+        .faces
+        .iter()
+        .flat_map(|f| (1..f.len() - 1).map(move |i| vec![f[0], f[i], f[i + 1]]))
+        .collect();
+    t
+}
+
+#[test]
+fn triangle_schemes_read_quads_as_two_triangles() {
+    // √3 and Loop are schemes for triangle meshes: a mesh given with quads
+    // must subdivide exactly as the same mesh given as triangles, and Loop
+    // writes only triangles.
+    let torus = jitter(shapes::quad_torus(6, 4), 11);
+    for (file, steps) in [("surfaces/sqrt3.lsys", 2), ("surfaces/loop.lsys", 2)] {
+        let g = grammar(file);
+        let quads = run_steps(&g, &Mesh::from_soup(&torus).unwrap(), steps);
+        let tris = run_steps(&g, &Mesh::from_soup(&as_triangles(&torus)).unwrap(), steps);
+        assert_eq!(quads.canonical(), tris.canonical(), "{file}");
+        assert!(
+            quads.to_quad_soup().faces.iter().all(|f| f.len() == 3),
+            "{file} wrote a quad"
+        );
+    }
+    // A regular torus stays regular under √3.
+    let g = grammar("surfaces/sqrt3.lsys");
+    let m = run_steps(&g, &Mesh::from_soup(&torus).unwrap(), 2);
+    assert_eq!(valences(&m), [(6, m.vertex_count())].into());
+}
+
+#[test]
+fn catmull_clark_refuses_a_mesh_with_triangles() {
+    let g = grammar("surfaces/catmull-clark.lsys");
+    let mut m = Mesh::from_soup(&shapes::icosahedron()).unwrap();
+    let e = g.run(&mut m, 1, |_| {}).unwrap_err();
+    let text = g.render_error(&e);
+    assert!(text.contains("needs a mesh of quads"), "{text}");
+    assert!(text.contains("is not half of a quad"), "{text}");
+    assert!(text.contains("catmull-clark.lsys:"), "{text}");
+}
+
+#[test]
+fn a_run_past_the_face_limit_stops_with_an_error() {
+    let mut g = grammar("surfaces/loop.lsys");
+    g.max_faces = 1000;
+    let mut m = Mesh::from_soup(&shapes::icosahedron()).unwrap();
+    let e = g.run(&mut m, 5, |_| {}).unwrap_err();
+    // 20 · 4^2 = 320 faces; the next step's splits would make 1280.
+    assert!(
+        e.message.contains("at step 3")
+            && e.message
+                .contains("would make 1280 faces, past the limit of 1000"),
+        "{}",
+        e.message
+    );
+}
+
+#[test]
+fn grammar_functions_are_checked() {
+    let load = |text: &str| {
+        subgram::surface::load_str("g.lsys", text, &[])
+            .unwrap_err()
+            .render()
+    };
+    let rule = "V(v) -> V(v = f(v));\n";
+    let bad = load(&format!("define f(x) = f(x);\n{rule}"));
+    assert!(bad.contains("functions may not recurse"), "{bad}");
+    assert_eq!(bad.matches("(in `").count(), 1, "{bad}");
+    // Each function calls the one before twice: 2^20 calls inlined.
+    let mut text = String::from("define f0(x) = x;\n");
+    for i in 1..=20 {
+        text += &format!("define f{i}(x) = f{}(x) + f{}(x);\n", i - 1, i - 1);
+    }
+    text += "V(v) -> V(v = f20(v));\n";
+    let bad = load(&text);
+    assert!(bad.contains("expand to more than 10000 calls"), "{bad}");
+    let bad = load(&format!("define f(x) = x;\ndefine f(y) = y;\n{rule}"));
+    assert!(
+        bad.contains("g.lsys:2:8: error: function `f` is already defined above"),
+        "{bad}"
+    );
+    let bad = load(&format!("define f(x, x) = x;\n{rule}"));
+    assert!(bad.contains("`f` already has a parameter `x`"), "{bad}");
+    let bad = load(&format!("derivation length: 2.5;\n{rule}"));
+    assert!(bad.contains("a whole number of steps"), "{bad}");
+    let bad = load("derivation length: 2;\n");
+    assert!(bad.contains("expected at least one rule"), "{bad}");
+}
+
+#[test]
+fn deep_function_nesting_reuses_frame_slots() {
+    // Sixteen levels of single calls with three parameters each: the
+    // values must pass through intact (v + 16 · (1, 2, 3)).
+    let mut text = String::from("define g0(p, a, b) = p + point(1, 2, 3) * (1 + 0*a*b);\n");
+    for i in 1..=16 {
+        text += &format!(
+            "define g{i}(p, a, b) = g{}(p, a + 1, b) + point(1, 2, 3);\n",
+            i - 1
+        );
+    }
+    text += "V(v) -> V(v = g15(v, 0, 1));\n";
+    let g = subgram::surface::load_str("g.lsys", &text, &[])
+        .unwrap_or_else(|e| panic!("{}", e.render()));
+    let base = Mesh::from_soup(&shapes::icosahedron()).unwrap();
+    let m = run_steps(&g, &base, 1);
+    for v in m.vertices() {
+        let d = m.position(v) - base.position(v);
+        assert!((d - DVec3::new(16.0, 32.0, 48.0)).length() < 1e-12, "{d}");
+    }
+}
