@@ -16,6 +16,10 @@ pub struct MeshInfo {
     pub quads: usize,
     pub boundary_loops: usize,
     pub components: usize,
+    /// Vertices on no edge (an OBJ `v` no face uses). They count in
+    /// `vertices` but not in the Euler characteristic or the genus.
+    pub isolated_vertices: usize,
+    /// `V - E + F` over the vertices that are on a face.
     pub euler_characteristic: i64,
     /// `(2c - χ - b) / 2` summed over components; `None` if not an integer.
     pub genus: Option<i64>,
@@ -68,7 +72,11 @@ impl Mesh {
             }
         }
         let (v, e, f) = (self.vertex_count(), self.edge_count(), self.face_count());
-        let chi = v as i64 - e as i64 + f as i64;
+        let isolated = self
+            .vertices()
+            .filter(|&v| self.outgoing(v).is_none())
+            .count();
+        let chi = (v - isolated) as i64 - e as i64 + f as i64;
         let c = roots.len() as i64;
         let twice = 2 * c - chi - loops as i64;
         let mut valences = BTreeMap::new();
@@ -92,6 +100,7 @@ impl Mesh {
             quads: self.to_quad_soup().faces.len(),
             boundary_loops: loops,
             components: roots.len(),
+            isolated_vertices: isolated,
             euler_characteristic: chi,
             genus: (twice % 2 == 0).then_some(twice / 2),
             valences,
@@ -109,11 +118,19 @@ impl std::fmt::Display for MeshInfo {
             "vertices {}, edges {}, faces {} (triangles; {} after merging basic blocks)",
             self.vertices, self.edges, self.faces, self.quads
         )?;
-        writeln!(
+        write!(
             f,
             "components {}, boundary loops {}",
             self.components, self.boundary_loops
         )?;
+        if self.isolated_vertices > 0 {
+            write!(
+                f,
+                ", isolated vertices {} (on no face; left out of χ)",
+                self.isolated_vertices
+            )?;
+        }
+        writeln!(f)?;
         match self.genus {
             Some(g) => writeln!(
                 f,

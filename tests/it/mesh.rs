@@ -472,6 +472,22 @@ fn info_reports_topology() {
         (disc.euler_characteristic, disc.genus, disc.boundary_loops),
         (1, Some(0), 1)
     );
+    // A stray vertex on no face is reported, not counted as a sphere.
+    let s = soup(
+        &[[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [5., 5., 5.]],
+        &[&[0, 1, 2]],
+    );
+    let i = Mesh::from_soup(&s).unwrap().info();
+    assert_eq!(
+        (
+            i.vertices,
+            i.isolated_vertices,
+            i.components,
+            i.euler_characteristic,
+            i.genus
+        ),
+        (4, 1, 1, 1, Some(0))
+    );
 }
 
 /// One Loop-style refinement, topology only: split every edge, then flip
