@@ -7,22 +7,11 @@
 //! 2. A context-sensitive rewrite without geometry: a signal moving through
 //!    a word of a million modules, in million modules per second.
 
-use std::time::{Duration, Instant};
+mod common;
 
+use common::best_of;
 use glam::DVec2;
 use subgram::DeriveOptions;
-
-fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
-    let mut best = Duration::MAX;
-    let mut last = None;
-    for _ in 0..runs {
-        let t = Instant::now();
-        let r = f();
-        best = best.min(t.elapsed());
-        last = Some(r);
-    }
-    (best, last.expect("at least one run"))
-}
 
 fn polygon(n: usize) -> Vec<DVec2> {
     (0..n)

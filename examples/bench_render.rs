@@ -5,22 +5,13 @@
 //! writing separately, with a reference measured in the same run: tiny-skia
 //! stroking the same points as one path, with no engine around it.
 
-use std::time::{Duration, Instant};
+mod common;
 
+use std::time::Duration;
+
+use common::best_of;
 use subgram::render::{png, svg, Item};
 use subgram::{Derivation, DeriveOptions};
-
-fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
-    let mut best = Duration::MAX;
-    let mut last = None;
-    for _ in 0..runs {
-        let t = Instant::now();
-        let r = f();
-        best = best.min(t.elapsed());
-        last = Some(r);
-    }
-    (best, last.expect("one run"))
-}
 
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3

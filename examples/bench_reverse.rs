@@ -7,22 +7,13 @@
 //! candidates at every step), the report's error measurement, and a
 //! hand-written loop applying production (38) directly, as the reference.
 
-use std::time::{Duration, Instant};
+mod common;
 
+use std::time::Duration;
+
+use common::best_of;
 use glam::DVec2;
 use subgram::reverse::{self, Contour, Phase, ReverseOptions, Scheme};
-
-fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
-    let mut best = Duration::MAX;
-    let mut last = None;
-    for _ in 0..runs {
-        let t = Instant::now();
-        let r = f();
-        best = best.min(t.elapsed());
-        last = Some(r);
-    }
-    (best, last.expect("one run"))
-}
 
 fn reverse_loop(pts: &[DVec2], steps: usize) -> Vec<DVec2> {
     let mut cur = pts.to_vec();
