@@ -13,10 +13,11 @@ use std::fmt::Write;
 use glam::{DVec2, DVec3};
 use svg::node::element::{Polygon, Rectangle};
 use svg::Document;
-use tiny_skia::{Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke};
+use tiny_skia::{Color, FillRule, LineCap, LineJoin, PathBuilder, Pixmap, Stroke};
 
 use super::PolygonSoup;
-use crate::render::{RenderError, Rgba};
+use crate::render::png::paint;
+use crate::render::{fit_scale, RenderError, Rgba};
 
 /// The largest accepted image side, in pixels.
 const MAX_SIDE: u32 = 20_000;
@@ -173,12 +174,7 @@ impl Fit {
         };
         let avail = (size - 2.0 * fraction * size.min_element()).max(DVec2::ONE);
         let ext = hi - lo;
-        let scale = match (ext.x > 1e-12, ext.y > 1e-12) {
-            (true, true) => (avail.x / ext.x).min(avail.y / ext.y),
-            (true, false) => avail.x / ext.x,
-            (false, true) => avail.y / ext.y,
-            (false, false) => 1.0,
-        };
+        let scale = fit_scale(avail, ext);
         Fit {
             scale,
             centre: (lo + hi) * 0.5,
@@ -385,13 +381,6 @@ fn paint_face(pm: &mut Pixmap, face: &Shaded, wireframe: bool, edge_stroke: &Str
     pm.fill_path(&path, &paint(face.fill), FillRule::EvenOdd, id, None);
     let outline = if wireframe { EDGE } else { face.fill };
     pm.stroke_path(&path, &paint(outline), edge_stroke, id, None);
-}
-
-fn paint(c: Rgba) -> Paint<'static> {
-    let mut p = Paint::default();
-    p.set_color(Color::from_rgba8(c.0, c.1, c.2, c.3));
-    p.anti_alias = true;
-    p
 }
 
 fn stroke(width: f64) -> Stroke {

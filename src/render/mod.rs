@@ -225,12 +225,7 @@ fn fit_panel(
     let avail =
         DVec2::new(cell_w - 2.0 * margin, opts.height as f64 - 2.0 * margin).max(DVec2::ONE);
     let ext = hi - lo;
-    let scale = match (ext.x > 1e-12, ext.y > 1e-12) {
-        (true, true) => (avail.x / ext.x).min(avail.y / ext.y),
-        (true, false) => avail.x / ext.x,
-        (false, true) => avail.y / ext.y,
-        (false, false) => 1.0,
-    };
+    let scale = fit_scale(avail, ext);
     let centre = (lo + hi) * 0.5;
     let mid = DVec2::new(x0 + cell_w * 0.5, opts.height as f64 * 0.5);
     let px = |p: DVec3| {
@@ -315,4 +310,16 @@ pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()>
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// The scale that fits a drawing of extent `ext` into `avail`, keeping its
+/// aspect; a flat extent (a line, a point) fits by its other side, or not
+/// at all.
+pub(crate) fn fit_scale(avail: DVec2, ext: DVec2) -> f64 {
+    match (ext.x > 1e-12, ext.y > 1e-12) {
+        (true, true) => (avail.x / ext.x).min(avail.y / ext.y),
+        (true, false) => avail.x / ext.x,
+        (false, true) => avail.y / ext.y,
+        (false, false) => 1.0,
+    }
 }

@@ -6,7 +6,8 @@ use tiny_skia::{
 
 use super::{Item, RenderError, Rgba, Scene};
 
-fn paint(c: Rgba) -> Paint<'static> {
+/// An anti-aliased solid paint.
+pub(crate) fn paint(c: Rgba) -> Paint<'static> {
     let mut p = Paint::default();
     p.set_color(Color::from_rgba8(c.0, c.1, c.2, c.3));
     p.anti_alias = true;
