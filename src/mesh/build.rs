@@ -255,48 +255,138 @@ impl Mesh {
             .find(|&f| !self.face_edges(f).iter().any(|&e| self.is_block_edge(e)))
     }
 
-    /// The mesh with basic blocks merged back into quads.
+    /// The mesh with basic blocks merged back into polygons: quads for
+    /// primal blocks, and for dual blocks the polygon around each centre.
     pub fn to_quad_soup(&self) -> PolygonSoup {
         self.soup_with(|e| self.is_block_edge(e))
     }
 
+    /// The mesh with the faces on either side of each `merge` edge joined
+    /// into polygons. A region of faces joined this way becomes one polygon
+    /// when its border is a single loop through distinct vertices (a
+    /// basic block's two triangles, or a dual block's fan around its
+    /// centre); otherwise its triangles are kept. Vertices inside a
+    /// polygon (a dual block's centre) are left out.
     fn soup_with(&self, merge: impl Fn(EdgeId) -> bool) -> PolygonSoup {
-        let mut index = vec![u32::MAX; self.v_alive.len()];
-        let mut soup = PolygonSoup::default();
-        for v in self.vertices() {
-            index[v.index()] = soup.positions.len() as u32;
-            soup.positions.push(self.position(v));
+        // Regions by union-find over the faces.
+        let mut parent: Vec<u32> = (0..self.f_alive.len() as u32).collect();
+        fn root(parent: &mut [u32], mut f: u32) -> u32 {
+            while parent[f as usize] != f {
+                let g = parent[parent[f as usize] as usize];
+                parent[f as usize] = g;
+                f = g;
+            }
+            f
         }
-        let mut done = vec![false; self.f_alive.len()];
-        for f in self.faces() {
-            if done[f.index()] {
+        for e in self.edges() {
+            if !merge(e) {
                 continue;
             }
-            done[f.index()] = true;
-            let hs = self.face_halfedges(f);
-            let merged = hs.iter().find_map(|&h| {
-                let g = self.face(h.twin())?;
-                (merge(h.edge()) && !done[g.index()]).then_some((h, g))
-            });
-            let verts: Vec<u32> = match merged {
-                Some((h, g)) => {
-                    done[g.index()] = true;
-                    // Quad: from(h), opposite in g, to(h), opposite in f.
-                    let opp_g = self.to(self.next(h.twin()));
-                    let opp_f = self.to(self.next(h));
-                    [self.from(h), opp_g, self.to(h), opp_f]
+            let [Some(f), Some(g)] = self.edge_faces(e) else {
+                continue;
+            };
+            let (a, b) = (root(&mut parent, f.0), root(&mut parent, g.0));
+            if a != b {
+                parent[a.max(b) as usize] = a.min(b);
+            }
+        }
+        let merged_any = parent.iter().enumerate().any(|(i, &p)| p as usize != i);
+        if !merged_any {
+            let mut index = vec![u32::MAX; self.v_alive.len()];
+            let mut soup = PolygonSoup::default();
+            for v in self.vertices() {
+                index[v.index()] = soup.positions.len() as u32;
+                soup.positions.push(self.position(v));
+            }
+            soup.faces = self
+                .faces()
+                .map(|f| {
+                    self.face_vertices(f)
                         .iter()
                         .map(|v| index[v.index()])
                         .collect()
-                }
-                None => self
-                    .face_vertices(f)
-                    .iter()
-                    .map(|v| index[v.index()])
-                    .collect(),
-            };
-            soup.faces.push(verts);
+                })
+                .collect();
+            return soup;
         }
+        let region = |parent: &mut [u32], h: HalfEdgeId| self.face(h).map(|f| root(parent, f.0));
+        let mut polygons: Vec<Vec<VertexId>> = Vec::new();
+        let mut done = vec![false; self.f_alive.len()];
+        let mut members: Vec<Vec<FaceId>> = vec![Vec::new(); self.f_alive.len()];
+        for f in self.faces() {
+            members[root(&mut parent, f.0) as usize].push(f);
+        }
+        for f in self.faces() {
+            let r = root(&mut parent, f.0);
+            if done[r as usize] {
+                continue;
+            }
+            done[r as usize] = true;
+            let faces = &members[r as usize];
+            if faces.len() == 1 {
+                polygons.push(self.face_vertices(f).to_vec());
+                continue;
+            }
+            // The region's border: half-edges whose twin lies outside it.
+            let border: Vec<HalfEdgeId> = faces
+                .iter()
+                .flat_map(|&g| self.face_halfedges(g))
+                .filter(|&h| region(&mut parent, h.twin()) != Some(r))
+                .collect();
+            let mut loop_vs = Vec::with_capacity(border.len());
+            let mut h = border[0];
+            let mut ok = true;
+            for _ in 0..border.len() {
+                loop_vs.push(self.from(h));
+                // The next border half-edge turns about `to(h)` inside
+                // the region.
+                let mut g = self.next(h);
+                let mut turns = 0;
+                while region(&mut parent, g.twin()) == Some(r) {
+                    g = self.next(g.twin());
+                    turns += 1;
+                    if turns > faces.len() {
+                        ok = false;
+                        break;
+                    }
+                }
+                h = g;
+                if !ok {
+                    break;
+                }
+            }
+            let mut sorted = loop_vs.clone();
+            sorted.sort_unstable();
+            sorted.dedup();
+            if ok && h == border[0] && sorted.len() == border.len() {
+                polygons.push(loop_vs);
+            } else {
+                polygons.extend(faces.iter().map(|&g| self.face_vertices(g).to_vec()));
+            }
+        }
+        // Vertices inside a merged polygon are left out; all others stay.
+        let mut index = vec![0u32; self.v_alive.len()];
+        for f in self.faces() {
+            for v in self.face_vertices(f) {
+                index[v.index()] = u32::MAX;
+            }
+        }
+        for p in &polygons {
+            for v in p {
+                index[v.index()] = 0;
+            }
+        }
+        let mut soup = PolygonSoup::default();
+        for v in self.vertices() {
+            if index[v.index()] == 0 {
+                index[v.index()] = soup.positions.len() as u32;
+                soup.positions.push(self.position(v));
+            }
+        }
+        soup.faces = polygons
+            .into_iter()
+            .map(|p| p.iter().map(|v| index[v.index()]).collect())
+            .collect();
         soup
     }
 }

@@ -100,6 +100,8 @@ pub struct Mesh {
     pub(crate) pos: Vec<DVec3>,
     pub(crate) next_pos: Vec<DVec3>,
     pub(crate) v_level: Vec<u32>,
+    /// The step of the grammar run that made the vertex (0: the base mesh).
+    pub(crate) v_step: Vec<u32>,
     pub(crate) v_alive: Vec<bool>,
     // Half-edges, in twin pairs.
     pub(crate) he_to: Vec<VertexId>,
@@ -124,6 +126,23 @@ pub struct Mesh {
     pub(crate) free_f: Vec<u32>,
     /// The current level `c` of the subdivision grammar.
     pub current_level: u32,
+    /// The step a grammar run is in; new vertices record it.
+    pub step: u32,
+    /// What splitting a basic block's internal edge makes of the block.
+    pub block_split: BlockSplit,
+}
+
+/// What splitting the internal edge of a basic block does to the blocks
+/// (paper 000, §6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BlockSplit {
+    /// Primal quadrisection (Fig. 12a): the four edges at the new vertex
+    /// become the internal edges of the next blocks.
+    #[default]
+    Quadrisection,
+    /// √2 bisection on 4-8 meshes (Fig. 8): the block's four external
+    /// edges become the internal edges of the next blocks.
+    Bisection,
 }
 
 impl Mesh {
@@ -173,7 +192,7 @@ impl Mesh {
 
     /// Bytes of storage per face, for the benchmark's report.
     pub fn bytes_per_face(&self) -> f64 {
-        let v = self.v_alive.len() * (8 + 24 + 24 + 4 + 1);
+        let v = self.v_alive.len() * (8 + 24 + 24 + 4 + 4 + 1);
         let h = self.he_to.len() * (4 + 4 + 4 + 8);
         let e = self.e_alive.len() * (4 + 1 + 1);
         let f = self.f_alive.len() * (4 + 4 + 1);
@@ -231,6 +250,24 @@ impl Mesh {
     /// True for the internal edge of a basic block (tri-quad meshes).
     pub fn is_block_edge(&self, e: EdgeId) -> bool {
         self.e_block[e.index()]
+    }
+
+    /// True for a vertex made in the grammar step now running.
+    pub fn is_new_vertex(&self, v: VertexId) -> bool {
+        self.v_step[v.index()] == self.step
+    }
+
+    /// True for the centre of a dual basic block: a vertex all of whose
+    /// edges are internal edges of blocks (paper 000, §6, Fig. 12b).
+    pub fn is_block_centre(&self, v: VertexId) -> bool {
+        let mut any = false;
+        for h in self.outgoing_halfedges(v) {
+            if !self.e_block[h.edge().index()] {
+                return false;
+            }
+            any = true;
+        }
+        any
     }
 
     /// True for an edge that an edge split drew from the new vertex to a
@@ -370,6 +407,7 @@ impl Mesh {
         self.pos.reserve(vertices);
         self.next_pos.reserve(vertices);
         self.v_level.reserve(vertices);
+        self.v_step.reserve(vertices);
         self.v_alive.reserve(vertices);
         for v in [&mut self.he_next, &mut self.he_prev] {
             v.reserve(2 * edges);
@@ -392,6 +430,7 @@ impl Mesh {
             self.pos[k] = p;
             self.next_pos[k] = p;
             self.v_level[k] = level;
+            self.v_step[k] = self.step;
             self.v_alive[k] = true;
             return VertexId(i);
         }
@@ -399,6 +438,7 @@ impl Mesh {
         self.pos.push(p);
         self.next_pos.push(p);
         self.v_level.push(level);
+        self.v_step.push(self.step);
         self.v_alive.push(true);
         VertexId(self.v_alive.len() as u32 - 1)
     }

@@ -11,5 +11,5 @@ pub mod soup;
 pub mod stellar;
 pub mod validate;
 
-pub use halfedge::{EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId};
+pub use halfedge::{BlockSplit, EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId};
 pub use soup::{MeshFileError, PolygonSoup};

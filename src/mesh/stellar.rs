@@ -5,7 +5,7 @@
 
 use glam::DVec3;
 
-use super::halfedge::{EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId};
+use super::halfedge::{BlockSplit, EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId};
 
 impl Mesh {
     /// Face split: a new vertex `v` inside triangle `abc` joined to its
@@ -205,13 +205,30 @@ impl Mesh {
             self.f_level[f.index()] = self.face_level_from_vertices(vs);
         }
         if was_block {
-            // A basic block split at its centre: its four spokes become the
-            // internal edges of the four quads that splitting the block's
-            // external edges completes (primal quadrisection, paper 000,
-            // Fig. 12a).
-            let spokes: Vec<EdgeId> = self.outgoing_halfedges(v).map(|h| h.edge()).collect();
-            for s in spokes {
-                self.e_block[s.index()] = true;
+            match self.block_split {
+                BlockSplit::Quadrisection => {
+                    // A basic block split at its centre: its four spokes
+                    // become the internal edges of the four quads that
+                    // splitting the block's external edges completes
+                    // (primal quadrisection, paper 000, Fig. 12a).
+                    let spokes: Vec<EdgeId> =
+                        self.outgoing_halfedges(v).map(|h| h.edge()).collect();
+                    for s in spokes {
+                        self.e_block[s.index()] = true;
+                    }
+                }
+                BlockSplit::Bisection => {
+                    // The block's external edges, each now opposite the new
+                    // vertex, become the internal edges of the next blocks
+                    // (√2 bisection of 4-8 meshes, Fig. 8).
+                    for f in self.vertex_faces(v).collect::<Vec<_>>() {
+                        for h in self.face_halfedges(f) {
+                            if self.from(h) != v && self.to(h) != v {
+                                self.e_block[h.edge().index()] = true;
+                            }
+                        }
+                    }
+                }
             }
         }
         Ok(v)

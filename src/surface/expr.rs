@@ -58,6 +58,8 @@ pub enum X {
     IsBoundary(Box<X>),
     IsBlock(Box<X>),
     IsTransversal(Box<X>),
+    IsNew(Box<X>),
+    IsCentre(Box<X>),
     /// The average position of an edge's or a face's vertices.
     AvgOf(Box<X>),
     Set(SetKind, Box<X>),
@@ -114,8 +116,10 @@ pub struct Compiler<'g> {
     depth: usize,
     /// Function calls inlined so far.
     inlined: usize,
-    /// Where `block` was first used, if it was.
+    /// Where `block` or `center` was first used, if either was.
     pub block_used_at: Option<Span>,
+    /// Where `center` was first used, if it was.
+    pub centre_used_at: Option<Span>,
 }
 
 type C = Result<(X, T), Diagnostic>;
@@ -138,6 +142,7 @@ impl<'g> Compiler<'g> {
             depth: 0,
             inlined: 0,
             block_used_at: None,
+            centre_used_at: None,
         }
     }
 
@@ -400,6 +405,31 @@ impl<'g> Compiler<'g> {
                 }
                 Ok((X::IsTransversal(Box::new(x)), T::Bool))
             }
+            "new" => {
+                let (x, t) = one(self)?;
+                if t != T::Vertex {
+                    return err(
+                        span,
+                        "`new` takes a vertex: true for a vertex made in this step",
+                    );
+                }
+                Ok((X::IsNew(Box::new(x)), T::Bool))
+            }
+            "center" | "centre" => {
+                let (x, t) = one(self)?;
+                if t != T::Vertex {
+                    return err(
+                        span,
+                        format!(
+                            "`{name}` takes a vertex: true for the centre of a dual block, \
+                             whose edges are all internal edges of blocks"
+                        ),
+                    );
+                }
+                self.block_used_at.get_or_insert(span);
+                self.centre_used_at.get_or_insert(span);
+                Ok((X::IsCentre(Box::new(x)), T::Bool))
+            }
             "ring" | "N1" | "boundary_ring" => {
                 let (x, t) = one(self)?;
                 if t != T::Vertex {
@@ -568,6 +598,14 @@ impl Eval<'_> {
             X::IsTransversal(a) => {
                 Val::B(matches!(self.eval(a, frame), Val::E(_, _, _, _, _, true)))
             }
+            X::IsNew(a) => Val::B(match self.eval(a, frame) {
+                Val::V(v) => self.mesh.is_new_vertex(v),
+                _ => false,
+            }),
+            X::IsCentre(a) => Val::B(match self.eval(a, frame) {
+                Val::V(v) => self.mesh.is_block_centre(v),
+                _ => false,
+            }),
             X::AvgOf(a) => match self.eval(a, frame) {
                 Val::E(p, q, _, _, _, _) => {
                     Val::P((self.mesh.position(p) + self.mesh.position(q)) * 0.5)

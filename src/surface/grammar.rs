@@ -14,7 +14,17 @@
 //!
 //! Expressions are the curve language's, with mesh elements as values and
 //! neighbourhood sums `sum(w in ring(v) where cond)`.
+//!
+//! Quad schemes add `blocks: bisection;` (4-8 meshes: a split block's
+//! external edges become the next internal edges; the default,
+//! `quadrisection`, makes the spokes of the new vertex the next internal
+//! edges) and `init:` before a rule that runs once, before the first step:
+//!
+//! ```text
+//! init: E(e; block(e)) | F^2 -> V(v = avg(ring(v))) || E^4 F^4
+//! ```
 
+use crate::mesh::BlockSplit;
 use crate::syntax::ast::Expr;
 use crate::syntax::lex::{Tok, Token};
 use crate::syntax::parse::parse_expression;
@@ -63,6 +73,8 @@ pub struct RuleDef {
     pub span: Span,
     /// The rule as written, for messages.
     pub text: String,
+    /// Written `init: ...`: runs once, before the first step.
+    pub init: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -79,6 +91,8 @@ pub struct GrammarFile {
     pub length: Option<Expr>,
     pub functions: Vec<FunctionDef>,
     pub rules: Vec<RuleDef>,
+    /// `blocks: bisection;` (4-8 meshes) or `blocks: quadrisection;`.
+    pub block_split: Option<(BlockSplit, Span)>,
 }
 
 type R<T> = Result<T, Diagnostic>;
@@ -225,6 +239,32 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
             p.expect(";", "after the derivation length")?;
             continue;
         }
+        if p.is_ident("blocks") && toks.get(p.pos + 1).is_some_and(|t| t.tok.is_punct(":")) {
+            p.pos += 2;
+            let at = p.span();
+            let how = match p.peek().map(|t| &t.tok) {
+                Some(Tok::Ident(w)) if w == "quadrisection" => BlockSplit::Quadrisection,
+                Some(Tok::Ident(w)) if w == "bisection" => BlockSplit::Bisection,
+                _ => return p.err("`quadrisection` or `bisection` after `blocks:`"),
+            };
+            p.pos += 1;
+            p.expect(";", "after the block refinement")?;
+            g.block_split = Some((how, at));
+            continue;
+        }
+        if p.is_ident("init") && toks.get(p.pos + 1).is_some_and(|t| t.tok.is_punct(":")) {
+            p.pos += 2;
+            let mut r = rule(&mut p, &text_of)?;
+            if g.rules.iter().any(|r| !r.init) {
+                return Err(Diagnostic::new(
+                    start,
+                    "`init:` rules run once before the first step, so they come before the other rules",
+                ));
+            }
+            r.init = true;
+            g.rules.push(r);
+            continue;
+        }
         if p.is_ident("define") {
             p.pos += 1;
             let name_span = p.span();
@@ -286,8 +326,10 @@ fn rule(p: &mut P, text_of: &impl Fn(Span) -> String) -> R<RuleDef> {
         Some(Tok::Ident(k)) if k == "E" => Kind::Edge,
         Some(Tok::Ident(k)) if k == "V" => Kind::Vertex,
         _ => {
-            return p
-                .err("a rule starting with F, E or V, `define`, `mesh:` or `derivation length:`")
+            return p.err(
+                "a rule starting with F, E or V, `init:`, `define`, `mesh:`, `blocks:` or \
+                 `derivation length:`",
+            )
         }
     };
     p.pos += 1;
@@ -375,5 +417,6 @@ fn rule(p: &mut P, text_of: &impl Fn(Span) -> String) -> R<RuleDef> {
         assign,
         span,
         text: text_of(span),
+        init: false,
     })
 }

@@ -13,7 +13,7 @@
 
 use glam::DVec3;
 
-use crate::mesh::{Mesh, VertexId};
+use crate::mesh::{BlockSplit, Mesh, VertexId};
 use crate::syntax::span::{Diagnostic, SourceMap, Span};
 
 use super::expr::{Compiler, Eval, Val, T, X};
@@ -32,6 +32,8 @@ pub struct Rule {
     pub frame: usize,
     pub span: Span,
     pub text: String,
+    /// Runs once, before the first step.
+    pub init: bool,
 }
 
 /// A checked grammar, ready to run.
@@ -44,6 +46,11 @@ pub struct Grammar {
     /// Where the grammar first asks `block(e)`: such a grammar is for
     /// tri-quad meshes. Without it, quads are read as two triangles.
     pub block_used_at: Option<Span>,
+    /// Where the grammar first asks `center(v)`: a dual scheme, which
+    /// needs a closed mesh.
+    pub centre_used_at: Option<Span>,
+    /// What splitting a block's internal edge does (`blocks:`).
+    pub block_split: BlockSplit,
     /// A rule that would make more faces than this stops the run with an
     /// error instead of exhausting memory (about 110 bytes a face).
     pub max_faces: usize,
@@ -60,6 +67,7 @@ pub fn compile(
     let mut rules = Vec::new();
     let mut diags = Vec::new();
     let mut block_used_at = None;
+    let mut centre_used_at = None;
     for r in &file.rules {
         let mut c = Compiler::new(&file.functions);
         let elem_t = match r.op {
@@ -109,6 +117,7 @@ pub fn compile(
             None => (None, None),
         };
         block_used_at = block_used_at.or(c.block_used_at);
+        centre_used_at = centre_used_at.or(c.centre_used_at);
         rules.push(Rule {
             op: r.op,
             context: r.vertex_context,
@@ -119,6 +128,7 @@ pub fn compile(
             frame: c.max_slots as usize + 1,
             span: r.span,
             text: r.text.clone(),
+            init: r.init,
         });
     }
     let length = match &file.length {
@@ -160,9 +170,20 @@ pub fn compile(
         mesh: file.mesh.clone(),
         length,
         sources,
-        block_used_at,
+        block_used_at: block_used_at.or(file.block_split.map(|(_, s)| s)),
+        centre_used_at,
+        block_split: file
+            .block_split
+            .map_or(BlockSplit::Quadrisection, |(b, _)| b),
         max_faces: MAX_FACES,
     })
+}
+
+/// The elements a rule matched when it started.
+struct Matches {
+    current: u32,
+    vals: Vec<Val>,
+    edge_ids: Vec<crate::mesh::EdgeId>,
 }
 
 /// A failed run: the rule, the step, and what went wrong.
@@ -213,10 +234,26 @@ impl Grammar {
                 }
             }
         }
-        for step in 1..=steps {
-            for rule in &self.rules {
-                self.apply(rule, mesh, step)?;
+        if let Some(span) = self.centre_used_at {
+            if let Some(v) = mesh.vertices().find(|&v| mesh.is_boundary_vertex(v)) {
+                return Err(RunError {
+                    span: Some(span),
+                    message: format!(
+                        "this grammar asks `center(v)`, a dual scheme, which runs on closed meshes \
+                         only; vertex {v} is on a boundary"
+                    ),
+                });
             }
+        }
+        mesh.block_split = self.block_split;
+        let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
+        let each: Vec<&Rule> = self.rules.iter().filter(|r| !r.init).collect();
+        self.apply_all(&init, mesh, 0)?;
+        let first = mesh.step;
+        for step in 1..=steps {
+            // Vertices made from here on record this step (`new(v)`).
+            mesh.step = first + step as u32;
+            self.apply_all(&each, mesh, step)?;
             mesh.swap_positions();
             progress(StepCounts {
                 step,
@@ -228,21 +265,18 @@ impl Grammar {
         Ok(())
     }
 
-    fn apply(&self, rule: &Rule, mesh: &mut Mesh, step: usize) -> Result<(), RunError> {
+    /// What `rule` applies to, fixed when it starts: the matched elements
+    /// and, for edge rules, their ids. Edges keep their ids through the
+    /// splits and flips of other edges, so the ids stay valid while the
+    /// rule runs.
+    fn find_matches(&self, rule: &Rule, mesh: &mut Mesh) -> Matches {
         let current = mesh
             .vertices()
             .map(|v| mesh.vertex_level(v))
             .max()
             .unwrap_or(0);
         mesh.current_level = current;
-        let fail = |m: String| RunError {
-            span: Some(rule.span),
-            message: format!("at step {step}, rule `{}`: {m}", rule.text),
-        };
         let mut frame = vec![Val::N(0.0); rule.frame];
-        // What the rule applies to, fixed when it starts. Edges keep their
-        // ids through the splits and flips of other edges, so the ids
-        // found here stay valid while the rule runs.
         let mut matched: Vec<Val> = Vec::new();
         let mut edge_ids: Vec<crate::mesh::EdgeId> = Vec::new();
         {
@@ -304,6 +338,68 @@ impl Grammar {
                 }
             }
         }
+        Matches {
+            current,
+            vals: matched,
+            edge_ids,
+        }
+    }
+
+    /// Applies `rules` in order. An interior and a boundary edge-split rule
+    /// written next to each other are the two contexts of one edge split:
+    /// both match when the first starts, so that what one splits (or marks
+    /// as a block's internal edge) cannot feed the other in the same step.
+    fn apply_all(&self, rules: &[&Rule], mesh: &mut Mesh, step: usize) -> Result<(), RunError> {
+        let mut i = 0;
+        while i < rules.len() {
+            let rule = rules[i];
+            let pair = rules.get(i + 1).filter(|next| {
+                matches!(
+                    (rule.op, next.op),
+                    (Op::EdgeSplit, Op::BoundarySplit) | (Op::BoundarySplit, Op::EdgeSplit)
+                )
+            });
+            match pair {
+                Some(next) => {
+                    let a = self.find_matches(rule, mesh);
+                    let b = self.find_matches(next, mesh);
+                    self.apply_matched(rule, mesh, step, a)?;
+                    self.apply_matched(next, mesh, step, b)?;
+                    i += 2;
+                }
+                None => {
+                    let m = self.find_matches(rule, mesh);
+                    self.apply_matched(rule, mesh, step, m)?;
+                    i += 1;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn apply_matched(
+        &self,
+        rule: &Rule,
+        mesh: &mut Mesh,
+        step: usize,
+        m: Matches,
+    ) -> Result<(), RunError> {
+        let Matches {
+            current,
+            vals: matched,
+            edge_ids,
+        } = m;
+        mesh.current_level = current;
+        let fail = |m: String| RunError {
+            span: Some(rule.span),
+            message: if step == 0 {
+                format!("at initialization, rule `{}`: {m}", rule.text)
+            } else {
+                format!("at step {step}, rule `{}`: {m}", rule.text)
+            },
+        };
+        let mut frame = vec![Val::N(0.0); rule.frame];
+
         match rule.op {
             Op::Vertex => {
                 let Some(assign) = &rule.assign else {

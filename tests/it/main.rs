@@ -12,3 +12,4 @@ mod reverse;
 mod semantics;
 mod support;
 mod surface;
+mod surface_quad;

@@ -1,0 +1,253 @@
+//! The quad schemes of paper 000, §8, built on basic blocks: Doo-Sabin and
+//! Peters (dual blocks), and 4-8 (bisection). Expected positions come from
+//! the published masks, computed here from the input polygons.
+
+use glam::DVec3;
+use subgram::mesh::{shapes, Mesh, PolygonSoup};
+
+use crate::support::*;
+
+fn grammar(file: &str) -> subgram::surface::Grammar {
+    subgram::surface::load_file(&lsys(file), &[]).unwrap_or_else(|e| panic!("{}", e.render()))
+}
+
+fn run(file: &str, soup: &PolygonSoup, steps: usize) -> PolygonSoup {
+    let g = grammar(file);
+    let mut m = Mesh::from_soup(soup).unwrap();
+    g.run(&mut m, steps, |_| {})
+        .unwrap_or_else(|e| panic!("{}", g.render_error(&e)));
+    m.validate().unwrap();
+    m.to_quad_soup()
+}
+
+fn cube() -> PolygonSoup {
+    let mut s = subgram::mesh::io::read(&lsys("meshes/cube.obj")).unwrap();
+    // Move every corner, so that no mask can hide behind symmetry.
+    let mut x = 0x9E37_79B9_7F4A_7C15u64;
+    for p in &mut s.positions {
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        *p += DVec3::new(r(), r(), r()) * 0.3;
+    }
+    s
+}
+
+/// For every corner of every polygon, `rule(polygon positions, corner
+/// index)`: the points a dual scheme makes.
+fn per_corner(s: &PolygonSoup, rule: impl Fn(&[DVec3], usize) -> DVec3) -> Vec<DVec3> {
+    let mut out = Vec::new();
+    for f in &s.faces {
+        let ps: Vec<DVec3> = f.iter().map(|&i| s.positions[i as usize]).collect();
+        for k in 0..ps.len() {
+            out.push(rule(&ps, k));
+        }
+    }
+    out
+}
+
+/// Matches `got` to `want` one to one by position; returns the largest
+/// distance.
+fn match_points(got: &[DVec3], want: &[DVec3]) -> f64 {
+    assert_eq!(got.len(), want.len(), "vertex counts");
+    let mut used = vec![false; got.len()];
+    let mut worst = 0.0f64;
+    for w in want {
+        let (i, d) = got
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !used[*i])
+            .map(|(i, g)| (i, g.distance(*w)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("a point left");
+        used[i] = true;
+        worst = worst.max(d);
+    }
+    worst
+}
+
+/// Doo and Sabin's weights for corner `k` of an n-gon: α0 = 1/4 + 5/(4n),
+/// αj = (3 + 2 cos(2πj/n)) / (4n).
+fn doo_sabin_alpha(ps: &[DVec3], k: usize) -> DVec3 {
+    let n = ps.len();
+    (0..n)
+        .map(|j| {
+            let w = if j == 0 {
+                0.25 + 5.0 / (4.0 * n as f64)
+            } else {
+                (3.0 + 2.0 * (std::f64::consts::TAU * j as f64 / n as f64).cos()) / (4.0 * n as f64)
+            };
+            ps[(k + j) % n] * w
+        })
+        .sum()
+}
+
+/// The averaging form: the corner, the midpoints of its two edges and the
+/// centroid, a quarter each.
+fn doo_sabin_average(ps: &[DVec3], k: usize) -> DVec3 {
+    let n = ps.len();
+    let (a, next, prev) = (ps[k], ps[(k + 1) % n], ps[(k + n - 1) % n]);
+    let centroid = ps.iter().sum::<DVec3>() / n as f64;
+    (a + (a + next) * 0.5 + (a + prev) * 0.5 + centroid) * 0.25
+}
+
+#[test]
+fn doo_sabin_grammar_equals_the_published_quad_mask() {
+    let base = cube();
+    let one = run("surfaces/doo-sabin.lsys", &base, 1);
+    // One face per face, edge and vertex of the cube.
+    assert_eq!(one.faces.len(), 6 + 12 + 8);
+    assert_eq!(one.positions.len(), 24);
+    let want = per_corner(&base, |ps, k| {
+        // 9/16 the corner, 3/16 its two neighbours, 1/16 the opposite one.
+        assert_eq!(ps.len(), 4);
+        ps[k] * (9.0 / 16.0)
+            + (ps[(k + 1) % 4] + ps[(k + 3) % 4]) * (3.0 / 16.0)
+            + ps[(k + 2) % 4] * (1.0 / 16.0)
+    });
+    let d = match_points(&one.positions, &want);
+    assert!(d < 1e-12, "{d}");
+    // On quads the published α weights are the same mask.
+    let alpha = per_corner(&base, doo_sabin_alpha);
+    assert!(match_points(&one.positions, &alpha) < 1e-12);
+}
+
+#[test]
+fn doo_sabin_grammar_on_triangles_is_the_averaging_form() {
+    let base = cube();
+    let one = run("surfaces/doo-sabin.lsys", &base, 1);
+    let two = run("surfaces/doo-sabin.lsys", &base, 2);
+    assert_eq!(two.positions.len(), 4 * 24);
+    // The second step meets the cube's corners as triangles.
+    assert_eq!(one.faces.iter().filter(|f| f.len() == 3).count(), 8);
+    let want = per_corner(&one, doo_sabin_average);
+    let d = match_points(&two.positions, &want);
+    assert!(d < 1e-12, "{d}");
+    // On a triangle the averaging form gives 7/12, 5/24, 5/24, where the
+    // α weights give 2/3, 1/6, 1/6: the points differ by |(b + c)/2 - a| / 12.
+    for f in one.faces.iter().filter(|f| f.len() == 3) {
+        let ps: Vec<DVec3> = f.iter().map(|&i| one.positions[i as usize]).collect();
+        for k in 0..3 {
+            let gap = doo_sabin_average(&ps, k).distance(doo_sabin_alpha(&ps, k));
+            let predicted = ((ps[(k + 1) % 3] + ps[(k + 2) % 3]) * 0.5 - ps[k]).length() / 12.0;
+            assert!((gap - predicted).abs() < 1e-12);
+            assert!(gap > 1e-3, "the two forms differ on triangles");
+        }
+    }
+}
+
+#[test]
+fn peters_grammar_is_two_mid_edge_steps() {
+    let base = cube();
+    let mid_mid = |ps: &[DVec3], k: usize| {
+        let n = ps.len();
+        (ps[(k + n - 1) % n] + ps[k] * 2.0 + ps[(k + 1) % n]) * 0.25
+    };
+    let one = run("surfaces/peters.lsys", &base, 1);
+    assert_eq!(one.faces.len(), 26);
+    let d = match_points(&one.positions, &per_corner(&base, mid_mid));
+    assert!(d < 1e-12, "{d}");
+    let two = run("surfaces/peters.lsys", &base, 2);
+    let d = match_points(&two.positions, &per_corner(&one, mid_mid));
+    assert!(d < 1e-12, "{d}");
+}
+
+#[test]
+fn dual_schemes_refuse_open_meshes() {
+    let g = grammar("surfaces/doo-sabin.lsys");
+    let mut m = Mesh::from_soup(&shapes::quad_grid(3, 3)).unwrap();
+    let e = g.run(&mut m, 1, |_| {}).unwrap_err();
+    let text = g.render_error(&e);
+    assert!(text.contains("runs on closed meshes only"), "{text}");
+    assert!(text.contains("is on a boundary"), "{text}");
+}
+
+/// Paper 004's two-scale coefficients of the C4 four-directional box
+/// spline, over 64.
+const C4: [[f64; 7]; 7] = [
+    [0., 0., 1., 2., 1., 0., 0.],
+    [0., 2., 6., 8., 6., 2., 0.],
+    [1., 6., 14., 18., 14., 6., 1.],
+    [2., 8., 18., 24., 18., 8., 2.],
+    [1., 6., 14., 18., 14., 6., 1.],
+    [0., 2., 6., 8., 6., 2., 0.],
+    [0., 0., 1., 2., 1., 0., 0.],
+];
+
+/// Two bisections on a regular grid: the impulse response of one vertex
+/// (its height) is the C4 box spline's table. The grid's coordinates are
+/// its indices, centred on that vertex, so each output vertex's position
+/// says where it sits on the finer grid (the scheme reproduces linear
+/// functions away from the boundary, which is too far to reach the mask).
+#[test]
+fn four_eight_grammar_gives_the_c4_box_spline() {
+    let n = 16;
+    let mut grid = shapes::quad_grid(n, n);
+    for p in &mut grid.positions {
+        *p = ((*p * n as f64).round() - DVec3::new(8.0, 8.0, 0.0)) * DVec3::new(1.0, 1.0, 0.0);
+    }
+    let centre = 8 * (n + 1) + 8;
+    assert_eq!(grid.positions[centre], DVec3::ZERO);
+    let mut impulse = grid.clone();
+    impulse.positions[centre].z = 1.0;
+    let g = grammar("surfaces/four-eight.lsys");
+    let mut a = Mesh::from_soup(&grid).unwrap();
+    let mut b = Mesh::from_soup(&impulse).unwrap();
+    g.run(&mut a, 2, |_| {}).unwrap();
+    g.run(&mut b, 2, |_| {}).unwrap();
+    a.validate().unwrap();
+    // Two bisections are one quadrisection: four times the vertices.
+    assert_eq!(a.vertex_count(), (2 * n + 1) * (2 * n + 1));
+    assert_eq!(a.to_quad_soup().faces.len(), 4 * n * n);
+    let mut seen = 0;
+    let mut total = 0.0;
+    for v in a.vertices() {
+        let p = a.position(v);
+        let (u, w) = (p.x * 2.0, p.y * 2.0);
+        let weight = b.position(v).z;
+        total += weight;
+        if u.abs() <= 3.0 && w.abs() <= 3.0 {
+            assert!((u - u.round()).abs() < 1e-9 && (w - w.round()).abs() < 1e-9);
+            let want = C4[(u.round() + 3.0) as usize][(w.round() + 3.0) as usize] / 64.0;
+            assert!(
+                (weight - want).abs() < 1e-12,
+                "at ({u}, {w}): {weight} where the table has {want}"
+            );
+            seen += 1;
+        } else {
+            assert!(weight.abs() < 1e-12, "outside the mask at ({u}, {w})");
+        }
+    }
+    assert_eq!(seen, 49);
+    // The table sums to 256/64: four fine points per coarse one.
+    assert!((total - 4.0).abs() < 1e-12);
+}
+
+#[test]
+fn block_rules_are_checked() {
+    let e = subgram::surface::load_str(
+        "g.lsys",
+        "blocks: trisection;\nF(f) -> V(v = avg(f)) || E^3 F^3;\n",
+        &[],
+    )
+    .unwrap_err()
+    .render();
+    assert!(e.contains("g.lsys:1:9"), "{e}");
+    assert!(e.contains("`quadrisection` or `bisection`"), "{e}");
+    let e = subgram::surface::load_str(
+        "g.lsys",
+        "F(f) -> V(v = avg(f)) || E^3 F^3;\ninit: E(e; block(e)) | F^2 -> V(v = avg(e)) || E^4 F^4;\n",
+        &[],
+    )
+    .unwrap_err()
+    .render();
+    assert!(e.contains("g.lsys:2:1"), "{e}");
+    assert!(e.contains("come before the other rules"), "{e}");
+    let e = subgram::surface::load_str("g.lsys", "V(v; center(e)) -> V(v = v);\n", &[])
+        .unwrap_err()
+        .render();
+    assert!(e.contains("unknown identifier `e`"), "{e}");
+}
