@@ -325,6 +325,22 @@ impl Mesh {
         self.v_out[v.index()].is_some_and(|h| self.is_boundary_halfedge(h))
     }
 
+    /// The next (`forward`) or previous vertex along the boundary through
+    /// `v`, in the direction of the faces' half-edges: the boundary edge
+    /// `v -> bnext(v)` and `bprev(v) -> v` run along a face. None off the
+    /// boundary.
+    pub fn boundary_neighbour(&self, v: VertexId, forward: bool) -> Option<VertexId> {
+        let out = self.v_out[v.index()].filter(|&h| self.is_boundary_halfedge(h))?;
+        // `out` runs v -> w with no face, so its twin w -> v runs along a
+        // face: w is the previous vertex. The boundary half-edge before
+        // `out` in the loop runs u -> v; its twin v -> u is along a face.
+        Some(if forward {
+            self.from(self.prev(out))
+        } else {
+            self.to(out)
+        })
+    }
+
     /// The two end vertices of an edge.
     pub fn edge_vertices(&self, e: EdgeId) -> (VertexId, VertexId) {
         let h = e.halfedge();

@@ -52,6 +52,12 @@ pub enum X {
     Num(f64),
     Slot(u16),
     Current,
+    /// The number of the step being run (0 in `init:` rules).
+    Step,
+    /// An edge's first or second vertex (`tail`, `head`).
+    EdgeEnd(bool, Box<X>),
+    /// The next or previous vertex along the boundary (`bnext`, `bprev`).
+    BoundaryStep(bool, Box<X>),
     Level(Box<X>),
     Pos(Box<X>),
     Valence(Box<X>),
@@ -207,6 +213,7 @@ impl<'g> Compiler<'g> {
                 }
                 match n.as_str() {
                     "c" => (X::Current, T::Num),
+                    "step" => (X::Step, T::Num),
                     "PI" | "M_PI" => (X::Num(std::f64::consts::PI), T::Num),
                     "true" => (X::Num(1.0), T::Bool),
                     "false" => (X::Num(0.0), T::Bool),
@@ -243,7 +250,7 @@ impl<'g> Compiler<'g> {
                         };
                         return Ok((x, T::Bool));
                     }
-                    (Add | Sub | Mul | Div, T::Num, T::Num) => T::Num,
+                    (Add | Sub | Mul | Div | Rem, T::Num, T::Num) => T::Num,
                     (Add | Sub, T::Vec, T::Vec) => T::Vec,
                     (Mul, T::Num, T::Vec) | (Mul, T::Vec, T::Num) | (Div, T::Vec, T::Num) => T::Vec,
                     (Lt | Le | Gt | Ge | Eq | Ne, T::Num, T::Num) => T::Bool,
@@ -379,8 +386,8 @@ impl<'g> Compiler<'g> {
             }
             "boundary" => {
                 let (x, t) = one(self)?;
-                if !matches!(t, T::Vertex | T::Edge) {
-                    return err(span, "`boundary` takes a vertex or an edge");
+                if !matches!(t, T::Vertex | T::Edge | T::Face) {
+                    return err(span, "`boundary` takes a vertex, an edge or a face");
                 }
                 Ok((X::IsBoundary(Box::new(x)), T::Bool))
             }
@@ -404,6 +411,20 @@ impl<'g> Compiler<'g> {
                     );
                 }
                 Ok((X::IsTransversal(Box::new(x)), T::Bool))
+            }
+            "tail" | "head" => {
+                let (x, t) = one(self)?;
+                if t != T::Edge {
+                    return err(span, format!("`{name}` takes an edge"));
+                }
+                Ok((X::EdgeEnd(name == "head", Box::new(x)), T::Vertex))
+            }
+            "bnext" | "bprev" => {
+                let (x, t) = one(self)?;
+                if t != T::Vertex {
+                    return err(span, format!("`{name}` takes a boundary vertex"));
+                }
+                Ok((X::BoundaryStep(name == "bnext", Box::new(x)), T::Vertex))
             }
             "new" => {
                 let (x, t) = one(self)?;
@@ -569,12 +590,28 @@ pub struct Eval<'m> {
     pub current: u32,
 }
 
+/// A vertex that does not exist: a position of NaN, which the rule that
+/// asked reports as not finite.
+const NO_VERTEX: Val = Val::N(f64::NAN);
+
 impl Eval<'_> {
     pub fn eval(&self, x: &X, frame: &mut [Val]) -> Val {
         match x {
             X::Num(n) => Val::N(*n),
             X::Slot(s) => frame[*s as usize],
             X::Current => Val::N(self.current as f64),
+            X::Step => Val::N(self.mesh.step as f64),
+            X::EdgeEnd(head, a) => match self.eval(a, frame) {
+                Val::E(p, q, ..) => Val::V(if *head { q } else { p }),
+                _ => NO_VERTEX,
+            },
+            X::BoundaryStep(forward, a) => match self.eval(a, frame) {
+                Val::V(v) => self
+                    .mesh
+                    .boundary_neighbour(v, *forward)
+                    .map_or(NO_VERTEX, Val::V),
+                _ => NO_VERTEX,
+            },
             X::Level(a) => Val::N(match self.eval(a, frame) {
                 Val::V(v) => self.mesh.vertex_level(v) as f64,
                 Val::E(_, _, l, _, _, _) => l as f64,
@@ -592,6 +629,11 @@ impl Eval<'_> {
             X::IsBoundary(a) => Val::B(match self.eval(a, frame) {
                 Val::V(v) => self.mesh.is_boundary_vertex(v),
                 Val::E(_, _, _, b, _, _) => b,
+                Val::F(vs, _) => (0..3).any(|k| {
+                    self.mesh
+                        .find_halfedge(vs[(k + 1) % 3], vs[k])
+                        .is_some_and(|h| self.mesh.face(h).is_none())
+                }),
                 _ => false,
             }),
             X::IsBlock(a) => Val::B(matches!(self.eval(a, frame), Val::E(_, _, _, _, true, _))),
@@ -689,6 +731,7 @@ impl Eval<'_> {
                         Sub => Val::N(x - y),
                         Mul => Val::N(x * y),
                         Div => Val::N(x / y),
+                        Rem => Val::N(x.rem_euclid(y)),
                         Lt => Val::B(x < y),
                         Le => Val::B(x <= y),
                         Gt => Val::B(x > y),

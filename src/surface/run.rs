@@ -306,7 +306,10 @@ impl Grammar {
                     for e in mesh.edges() {
                         let b = mesh.is_boundary_edge(e);
                         if b == want_boundary {
-                            let (p, q) = mesh.edge_vertices(e);
+                            // A boundary edge runs the way its face does.
+                            let h = e.halfedge();
+                            let h = if mesh.face(h).is_none() { h.twin() } else { h };
+                            let (p, q) = (mesh.from(h), mesh.to(h));
                             if consider(
                                 Val::E(
                                     p,

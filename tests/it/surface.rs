@@ -163,6 +163,91 @@ fn sqrt3_grammar_equals_kobbelts_masks() {
 }
 
 #[test]
+fn sqrt3_with_boundary_rules_equals_the_printed_rules_on_closed_meshes() {
+    let base = Mesh::from_soup(&jitter(shapes::icosphere(1), 9)).unwrap();
+    let (g, printed) = (
+        grammar("surfaces/sqrt3.lsys"),
+        grammar("surfaces/sqrt3-printed.lsys"),
+    );
+    let (mut a, mut b) = (base.clone(), base.clone());
+    g.run(&mut a, 3, |_| {}).unwrap();
+    printed.run(&mut b, 3, |_| {}).unwrap();
+    assert_eq!(a.face_count(), 27 * base.face_count());
+    assert_eq!(a.vertex_count(), b.vertex_count());
+    for v in a.vertices() {
+        assert!(a.position(v).distance(b.position(v)) < 1e-12);
+    }
+}
+
+/// The boundary loop from `start`, following the faces' direction.
+fn boundary_loop(m: &Mesh, start: VertexId) -> Vec<VertexId> {
+    let mut out = vec![start];
+    let mut v = m.boundary_neighbour(start, true).unwrap();
+    while v != start {
+        out.push(v);
+        v = m.boundary_neighbour(v, true).unwrap();
+    }
+    out
+}
+
+/// Kobbelt's boundary rule: boundary vertices stay in odd steps; in even
+/// steps each boundary edge is split in three, and the boundary polygon
+/// p_i becomes the ternary cubic B-spline refinement
+/// (4 p_i-1 + 19 p_i + 4 p_i+1)/27, (p_i-1 + 16 p_i + 10 p_i+1)/27,
+/// (10 p_i + 16 p_i+1 + p_i+2)/27.
+#[test]
+fn sqrt3_grammar_follows_kobbelts_boundary_rule() {
+    let base = Mesh::from_soup(&jitter(shapes::triangle_grid(4, 4), 3)).unwrap();
+    let g = grammar("surfaces/sqrt3.lsys");
+    let start = base
+        .vertices()
+        .find(|&v| base.is_boundary_vertex(v))
+        .unwrap();
+    let ring = boundary_loop(&base, start);
+    assert_eq!(ring.len(), 16);
+    let mut one = base.clone();
+    g.run(&mut one, 1, |_| {}).unwrap();
+    one.validate().unwrap();
+    assert_eq!(one.face_count(), 3 * base.face_count());
+    assert_eq!(
+        boundary_loop(&one, start),
+        ring,
+        "odd steps keep the boundary"
+    );
+    for &v in &ring {
+        assert_eq!(one.position(v), base.position(v));
+    }
+    let mut two = base.clone();
+    g.run(&mut two, 2, |_| {}).unwrap();
+    two.validate().unwrap();
+    assert_eq!(two.face_count(), 9 * base.face_count());
+    let fine = boundary_loop(&two, start);
+    assert_eq!(fine.len(), 3 * ring.len());
+    let n = ring.len();
+    let p = |i: usize| base.position(ring[i % n]);
+    for i in 0..n {
+        assert_eq!(
+            fine[3 * i],
+            ring[i],
+            "old vertices keep their place in the loop"
+        );
+        let want = [
+            (p(i + n - 1) * 4.0 + p(i) * 19.0 + p(i + 1) * 4.0) / 27.0,
+            (p(i + n - 1) + p(i) * 16.0 + p(i + 1) * 10.0) / 27.0,
+            (p(i) * 10.0 + p(i + 1) * 16.0 + p(i + 2)) / 27.0,
+        ];
+        for (k, w) in want.iter().enumerate() {
+            let got = two.position(fine[3 * i + k]);
+            assert!(
+                got.distance(*w) < 1e-12,
+                "boundary point {}: {got} vs {w}",
+                3 * i + k
+            );
+        }
+    }
+}
+
+#[test]
 fn grammar_errors_point_at_the_rule() {
     let bad = subgram::surface::load_str("g.lsys", "F(f) -> V(v = avg(f)) || E^4 F^4;\n", &[])
         .unwrap_err()

@@ -251,3 +251,29 @@ fn block_rules_are_checked() {
         .render();
     assert!(e.contains("unknown identifier `e`"), "{e}");
 }
+
+/// Every grammar in lsystems/surfaces runs on the mesh it names, for its
+/// derivation length, and leaves a valid mesh.
+#[test]
+fn every_surface_grammar_runs_on_its_own_mesh() {
+    let dir = lsys("surfaces");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "lsys"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 7, "{files:?}");
+    for path in files {
+        let g =
+            subgram::surface::load_file(&path, &[]).unwrap_or_else(|e| panic!("{}", e.render()));
+        let (mesh, _) = g.mesh.clone().expect("names its base mesh");
+        let soup = subgram::mesh::io::read(&dir.join(mesh)).unwrap();
+        let mut m = Mesh::from_soup(&soup).unwrap();
+        let n = g.length.expect("has a derivation length") as usize;
+        g.run(&mut m, n, |_| {})
+            .unwrap_or_else(|e| panic!("{}: {}", path.display(), g.render_error(&e)));
+        m.validate().unwrap();
+        assert!(m.face_count() > soup.faces.len(), "{}", path.display());
+    }
+}
