@@ -419,24 +419,23 @@ impl Mesh {
     /// Makes room for this many more vertices, edges and faces, so that a
     /// refinement step does not grow its arrays piece by piece.
     pub fn reserve(&mut self, vertices: usize, edges: usize, faces: usize) {
-        self.v_out.reserve(vertices);
-        self.pos.reserve(vertices);
-        self.next_pos.reserve(vertices);
-        self.v_level.reserve(vertices);
-        self.v_step.reserve(vertices);
-        self.v_alive.reserve(vertices);
-        for v in [&mut self.he_next, &mut self.he_prev] {
-            v.reserve(2 * edges);
-        }
-        self.he_to.reserve(2 * edges);
-        self.he_face.reserve(2 * edges);
-        self.e_level.reserve(edges);
-        self.e_alive.reserve(edges);
-        self.e_block.reserve(edges);
-        self.e_transversal.reserve(edges);
-        self.f_he.reserve(faces);
-        self.f_level.reserve(faces);
-        self.f_alive.reserve(faces);
+        grow(&mut self.v_out, vertices);
+        grow(&mut self.pos, vertices);
+        grow(&mut self.next_pos, vertices);
+        grow(&mut self.v_level, vertices);
+        grow(&mut self.v_step, vertices);
+        grow(&mut self.v_alive, vertices);
+        grow(&mut self.he_next, 2 * edges);
+        grow(&mut self.he_prev, 2 * edges);
+        grow(&mut self.he_to, 2 * edges);
+        grow(&mut self.he_face, 2 * edges);
+        grow(&mut self.e_level, edges);
+        grow(&mut self.e_alive, edges);
+        grow(&mut self.e_block, edges);
+        grow(&mut self.e_transversal, edges);
+        grow(&mut self.f_he, faces);
+        grow(&mut self.f_level, faces);
+        grow(&mut self.f_alive, faces);
     }
 
     pub(crate) fn new_vertex(&mut self, p: DVec3, level: u32) -> VertexId {
@@ -590,4 +589,44 @@ impl Iterator for OutgoingIter<'_> {
         self.cur = if Some(n) == self.start { None } else { Some(n) };
         Some(h)
     }
+}
+
+/// Makes room for `additional` more elements. A large array moves to a
+/// new allocation that the kernel is asked to back with huge pages before
+/// anything is written to it: a subdivision step writes hundreds of
+/// megabytes, and with 4 KiB pages much of its time goes to page faults.
+/// The advice changes how memory is backed, never what it holds.
+fn grow<T: Copy>(v: &mut Vec<T>, additional: usize) {
+    const HUGE: usize = 2 << 20;
+    let need = v.len() + additional;
+    if need <= v.capacity() {
+        return;
+    }
+    let cap = need.max(2 * v.capacity());
+    let bytes = cap * std::mem::size_of::<T>();
+    if bytes < 2 * HUGE || !cfg!(target_os = "linux") {
+        v.reserve(additional);
+        return;
+    }
+    let mut fresh: Vec<T> = Vec::with_capacity(cap);
+    #[cfg(target_os = "linux")]
+    {
+        let start = fresh.as_ptr() as usize;
+        let aligned = (start + HUGE - 1) & !(HUGE - 1);
+        let end = (start + bytes) & !(HUGE - 1);
+        if end > aligned {
+            // SAFETY: the range lies inside `fresh`'s own allocation, and
+            // MADV_HUGEPAGE never changes memory's contents; a failure
+            // leaves ordinary pages.
+            unsafe {
+                libc::madvise(
+                    aligned as *mut libc::c_void,
+                    end - aligned,
+                    libc::MADV_HUGEPAGE,
+                );
+            }
+        }
+    }
+    fresh.extend_from_slice(v);
+    *v = fresh;
 }

@@ -195,15 +195,15 @@ impl Mesh {
             if self.v_out[b.index()] == Some(t) {
                 self.v_out[b.index()] = Some(g.twin());
             }
-            let vs = self.face_vertices(f3);
-            self.f_level[f3.index()] = self.face_level_from_vertices(vs);
-            let vs = self.face_vertices(f4);
-            self.f_level[f4.index()] = self.face_level_from_vertices(vs);
+            // Faces a-d-v and v-d-b: l(v) is above l(a) and l(b).
+            let l = lv.max(self.v_level[d.index()]) + 1;
+            self.f_level[f3.index()] = l;
+            self.f_level[f4.index()] = l;
         }
-        for f in [f1, f2] {
-            let vs = self.face_vertices(f);
-            self.f_level[f.index()] = self.face_level_from_vertices(vs);
-        }
+        // Faces a-v-c and v-b-c.
+        let l = lv.max(self.v_level[c.index()]) + 1;
+        self.f_level[f1.index()] = l;
+        self.f_level[f2.index()] = l;
         if was_block {
             match self.block_split {
                 BlockSplit::Quadrisection => {
@@ -211,9 +211,12 @@ impl Mesh {
                     // become the internal edges of the four quads that
                     // splitting the block's external edges completes
                     // (primal quadrisection, paper 000, Fig. 12a).
-                    let spokes: Vec<EdgeId> =
-                        self.outgoing_halfedges(v).map(|h| h.edge()).collect();
-                    for s in spokes {
+                    // The new vertex has three or four edges.
+                    let mut spokes = [None; 4];
+                    for (slot, h) in spokes.iter_mut().zip(self.outgoing_halfedges(v)) {
+                        *slot = Some(h.edge());
+                    }
+                    for s in spokes.into_iter().flatten() {
                         self.e_block[s.index()] = true;
                     }
                 }
@@ -221,7 +224,11 @@ impl Mesh {
                     // The block's external edges, each now opposite the new
                     // vertex, become the internal edges of the next blocks
                     // (√2 bisection of 4-8 meshes, Fig. 8).
-                    for f in self.vertex_faces(v).collect::<Vec<_>>() {
+                    let mut faces = [None; 4];
+                    for (slot, f) in faces.iter_mut().zip(self.vertex_faces(v)) {
+                        *slot = Some(f);
+                    }
+                    for f in faces.into_iter().flatten() {
                         for h in self.face_halfedges(f) {
                             if self.from(h) != v && self.to(h) != v {
                                 self.e_block[h.edge().index()] = true;

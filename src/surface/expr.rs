@@ -89,6 +89,14 @@ pub enum X {
     MakeVec(Box<X>, Box<X>, Box<X>),
 }
 
+/// A one-ring condition evaluated without the frame.
+#[derive(Clone, Copy)]
+enum Fast {
+    All,
+    New(bool),
+    Level(BinOp),
+}
+
 /// A value at run time.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Val {
@@ -677,6 +685,52 @@ impl Eval<'_> {
                 };
                 let mut sum = DVec3::ZERO;
                 let mut count = 0usize;
+                // The common conditions on a one-ring, tested without the
+                // frame: none, `l(w) OP c`, `new(w)` and `!new(w)`.
+                let fast = match cond.as_deref() {
+                    None => Some(Fast::All),
+                    Some(X::LevelVsCurrent(op, s)) if s == slot => Some(Fast::Level(*op)),
+                    Some(X::IsNew(a)) if matches!(**a, X::Slot(s) if s == *slot) => {
+                        Some(Fast::New(true))
+                    }
+                    Some(X::Not(n)) if matches!(&**n, X::IsNew(a) if matches!(**a, X::Slot(s) if s == *slot)) => {
+                        Some(Fast::New(false))
+                    }
+                    _ => None,
+                };
+                let c = self.current;
+                let keep = |f: Fast, w: VertexId| match f {
+                    Fast::All => true,
+                    Fast::New(b) => self.mesh.is_new_vertex(w) == b,
+                    Fast::Level(op) => {
+                        let l = self.mesh.vertex_level(w);
+                        match op {
+                            BinOp::Lt => l < c,
+                            BinOp::Le => l <= c,
+                            BinOp::Gt => l > c,
+                            BinOp::Ge => l >= c,
+                            BinOp::Eq => l == c,
+                            _ => l != c,
+                        }
+                    }
+                };
+                if let (Some(fast), SetKind::Ring, SetOf::V(v)) = (fast, kind, of) {
+                    for w in self.mesh.one_ring(v) {
+                        if keep(fast, w) {
+                            sum += self.mesh.position(w);
+                            count += 1;
+                        }
+                    }
+                    return match op {
+                        0 => Val::P(sum),
+                        1 => Val::P(if count > 0 {
+                            sum / count as f64
+                        } else {
+                            DVec3::NAN
+                        }),
+                        _ => Val::N(count as f64),
+                    };
+                }
                 let mut visit = |w: VertexId, frame: &mut [Val]| {
                     frame[*slot as usize] = Val::V(w);
                     let ok = match cond {

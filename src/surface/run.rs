@@ -12,6 +12,7 @@
 //! runs √3 exactly as printed; the grammar files note where they differ.)
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::mesh::{BlockSplit, Mesh, VertexId};
 use crate::syntax::span::{Diagnostic, SourceMap, Span};
@@ -276,76 +277,134 @@ impl Grammar {
             .max()
             .unwrap_or(0);
         mesh.current_level = current;
-        let mut frame = vec![Val::N(0.0); rule.frame];
-        let mut matched: Vec<Val> = Vec::new();
-        let mut edge_ids: Vec<crate::mesh::EdgeId> = Vec::new();
-        {
-            let ev = Eval { mesh, current };
-            let mut consider = |val: Val, frame: &mut Vec<Val>| {
-                frame[rule.elem_slot as usize] = val;
-                let ok = match &rule.cond {
-                    Some(c) => matches!(ev.eval(c, frame), Val::B(true)),
-                    None => true,
-                };
-                if ok {
-                    matched.push(val);
-                }
-                ok
-            };
-            match rule.op {
-                Op::FaceSplit => {
-                    for f in mesh.faces() {
-                        consider(
-                            Val::F(mesh.face_vertices(f), mesh.face_level(f)),
-                            &mut frame,
-                        );
+        let mesh: &Mesh = mesh;
+        let ev = Eval { mesh, current };
+        let slots = match rule.op {
+            Op::FaceSplit => mesh.f_alive.len(),
+            Op::EdgeSplit | Op::BoundarySplit | Op::Flip => mesh.e_alive.len(),
+            Op::Vertex => mesh.v_alive.len(),
+        };
+        // Conditions are pure, so ranges of ids are tested in parallel,
+        // each by a plain loop, and the matches joined in id order.
+        let ranges: Vec<(u32, u32)> = (0..slots.div_ceil(CHUNK))
+            .map(|k| ((k * CHUNK) as u32, (((k + 1) * CHUNK).min(slots)) as u32))
+            .collect();
+        let parts: Vec<(Vec<Val>, Vec<crate::mesh::EdgeId>)> = ranges
+            .into_par_iter()
+            .map(|(lo, hi)| {
+                let mut frame = vec![Val::N(0.0); rule.frame];
+                let mut vals = Vec::new();
+                let mut ids = Vec::new();
+                let mut test = |val: Val| {
+                    frame[rule.elem_slot as usize] = val;
+                    match &rule.cond {
+                        Some(c) => matches!(ev.eval(c, &mut frame), Val::B(true)),
+                        None => true,
                     }
-                }
-                Op::EdgeSplit | Op::BoundarySplit | Op::Flip => {
-                    let want_boundary = rule.op == Op::BoundarySplit;
-                    for e in mesh.edges() {
-                        let b = mesh.is_boundary_edge(e);
-                        if b == want_boundary {
+                };
+                match rule.op {
+                    Op::FaceSplit => {
+                        for f in (lo..hi).map(crate::mesh::FaceId) {
+                            if mesh.is_face(f) {
+                                let val = Val::F(mesh.face_vertices(f), mesh.face_level(f));
+                                if test(val) {
+                                    vals.push(val);
+                                }
+                            }
+                        }
+                    }
+                    Op::EdgeSplit | Op::BoundarySplit | Op::Flip => {
+                        let want_boundary = rule.op == Op::BoundarySplit;
+                        for e in (lo..hi).map(crate::mesh::EdgeId) {
+                            if !mesh.is_edge(e) || mesh.is_boundary_edge(e) != want_boundary {
+                                continue;
+                            }
                             // A boundary edge runs the way its face does.
                             let h = e.halfedge();
                             let h = if mesh.face(h).is_none() { h.twin() } else { h };
-                            let (p, q) = (mesh.from(h), mesh.to(h));
-                            if consider(
-                                Val::E(
-                                    p,
-                                    q,
-                                    mesh.edge_level(e),
-                                    b,
-                                    mesh.is_block_edge(e),
-                                    mesh.is_transversal_edge(e),
-                                ),
-                                &mut frame,
-                            ) {
-                                edge_ids.push(e);
+                            let val = Val::E(
+                                mesh.from(h),
+                                mesh.to(h),
+                                mesh.edge_level(e),
+                                want_boundary,
+                                mesh.is_block_edge(e),
+                                mesh.is_transversal_edge(e),
+                            );
+                            if test(val) {
+                                vals.push(val);
+                                ids.push(e);
+                            }
+                        }
+                    }
+                    Op::Vertex => {
+                        for v in (lo..hi).map(VertexId) {
+                            if !mesh.is_vertex(v) || mesh.outgoing(v).is_none() {
+                                continue;
+                            }
+                            let ok = match rule.context {
+                                VertexContext::Any => true,
+                                VertexContext::Boundary => mesh.is_boundary_vertex(v),
+                                VertexContext::Interior => !mesh.is_boundary_vertex(v),
+                            };
+                            if ok && test(Val::V(v)) {
+                                vals.push(Val::V(v));
                             }
                         }
                     }
                 }
-                Op::Vertex => {
-                    for v in mesh.vertices() {
-                        let b = mesh.is_boundary_vertex(v);
-                        let ok = match rule.context {
-                            VertexContext::Any => true,
-                            VertexContext::Boundary => b,
-                            VertexContext::Interior => !b,
-                        };
-                        if ok && mesh.outgoing(v).is_some() {
-                            consider(Val::V(v), &mut frame);
-                        }
-                    }
-                }
-            }
+                (vals, ids)
+            })
+            .collect();
+        let mut vals = Vec::with_capacity(parts.iter().map(|p| p.0.len()).sum());
+        let mut edge_ids = Vec::with_capacity(parts.iter().map(|p| p.1.len()).sum());
+        for (v, e) in parts {
+            vals.extend(v);
+            edge_ids.extend(e);
         }
         Matches {
             current,
-            vals: matched,
+            vals,
             edge_ids,
         }
+    }
+
+    /// Evaluates `assign` for each of `items` (the frame slots to set, in
+    /// parallel), giving the points in order, or the first item whose
+    /// point is not finite.
+    fn eval_points(
+        &self,
+        rule: &Rule,
+        mesh: &Mesh,
+        current: u32,
+        assign: &X,
+        items: &[Bindings],
+    ) -> Result<Vec<DVec3>, (usize, Option<DVec3>)> {
+        let ev = Eval { mesh, current };
+        let out: Vec<Option<DVec3>> = items
+            .par_iter()
+            .with_min_len(CHUNK)
+            .map_init(
+                || vec![Val::N(0.0); rule.frame],
+                |frame, &(slot, val, extra)| {
+                    frame[slot as usize] = val;
+                    if let Some((s, v)) = extra {
+                        frame[s as usize] = v;
+                    }
+                    match ev.eval(assign, frame) {
+                        Val::P(p) => Some(p),
+                        _ => None,
+                    }
+                },
+            )
+            .collect();
+        let mut points = Vec::with_capacity(out.len());
+        for (k, p) in out.into_iter().enumerate() {
+            match p {
+                Some(p) if p.is_finite() => points.push(p),
+                other => return Err((k, other)),
+            }
+        }
+        Ok(points)
     }
 
     /// Applies `rules` in order. An interior and a boundary edge-split rule
@@ -401,34 +460,24 @@ impl Grammar {
                 format!("at step {step}, rule `{}`: {m}", rule.text)
             },
         };
-        let mut frame = vec![Val::N(0.0); rule.frame];
 
         match rule.op {
             Op::Vertex => {
                 let Some(assign) = &rule.assign else {
                     return Ok(());
                 };
-                let mut out = Vec::with_capacity(matched.len());
-                {
-                    let ev = Eval { mesh, current };
-                    for &val in &matched {
-                        frame[rule.elem_slot as usize] = val;
-                        match ev.eval(assign, &mut frame) {
-                            Val::P(p) if p.is_finite() => out.push(p),
-                            Val::P(p) => {
-                                let Val::V(v) = val else { unreachable!() };
-                                return Err(fail(format!(
-                                    "vertex {v} would move to {p}, which is not finite"
-                                )));
-                            }
-                            _ => return Err(fail("the assignment did not give a point".into())),
-                        }
-                    }
-                }
+                let items: Vec<_> = matched.iter().map(|&v| (rule.elem_slot, v, None)).collect();
+                let out = self
+                    .eval_points(rule, mesh, current, assign, &items)
+                    .map_err(|(k, p)| match p {
+                        Some(p) => fail(format!(
+                            "vertex {} would move to {p}, which is not finite",
+                            vertex_of(matched[k])
+                        )),
+                        None => fail("the assignment did not give a point".into()),
+                    })?;
                 for (val, p) in matched.iter().zip(out) {
-                    if let Val::V(v) = val {
-                        mesh.set_next_position(*v, p);
-                    }
+                    mesh.set_next_position(vertex_of(*val), p);
                 }
                 Ok(())
             }
@@ -481,29 +530,39 @@ impl Grammar {
                     return Ok(());
                 };
                 let vslot = rule.vertex_slot.expect("an assignment names its vertex");
-                let mut out = Vec::with_capacity(made.len());
-                {
-                    let ev = Eval { mesh, current };
-                    for &(v, parent) in &made {
-                        frame[rule.elem_slot as usize] = parent;
-                        frame[vslot as usize] = Val::V(v);
-                        match ev.eval(assign, &mut frame) {
-                            Val::P(p) if p.is_finite() => out.push(p),
-                            Val::P(p) => {
-                                return Err(fail(format!(
-                                    "new vertex {v} would be at {p}, which is not finite"
-                                )))
-                            }
-                            _ => return Err(fail("the assignment did not give a point".into())),
-                        }
-                    }
-                }
+                let items: Vec<_> = made
+                    .iter()
+                    .map(|&(v, parent)| (rule.elem_slot, parent, Some((vslot, Val::V(v)))))
+                    .collect();
+                let out = self
+                    .eval_points(rule, mesh, current, assign, &items)
+                    .map_err(|(k, p)| match p {
+                        Some(p) => fail(format!(
+                            "new vertex {} would be at {p}, which is not finite",
+                            made[k].0
+                        )),
+                        None => fail("the assignment did not give a point".into()),
+                    })?;
                 for ((v, _), p) in made.iter().zip(out) {
                     mesh.set_position(*v, p);
                 }
                 Ok(())
             }
         }
+    }
+}
+
+/// Frame slots to set before evaluating an assignment: the predecessor's,
+/// and the new vertex's if there is one.
+type Bindings = (u16, Val, Option<(u16, Val)>);
+
+/// Elements per parallel task: small jobs stay on one thread.
+const CHUNK: usize = 16384;
+
+fn vertex_of(val: Val) -> VertexId {
+    match val {
+        Val::V(v) => v,
+        _ => VertexId(u32::MAX),
     }
 }
 

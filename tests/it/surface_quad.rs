@@ -277,3 +277,28 @@ fn every_surface_grammar_runs_on_its_own_mesh() {
         assert!(m.face_count() > soup.faces.len(), "{}", path.display());
     }
 }
+
+/// Conditions and assignments are evaluated in parallel; the result does
+/// not depend on how many threads there are, to the last bit.
+#[test]
+fn parallel_evaluation_gives_the_same_bits_on_one_thread() {
+    let soup = shapes::icosphere(4);
+    let run_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let g = grammar("surfaces/loop.lsys");
+            let mut m = Mesh::from_soup(&soup).unwrap();
+            g.run(&mut m, 2, |_| {}).unwrap();
+            m.to_soup()
+        })
+    };
+    let (one, four) = (run_on(1), run_on(4));
+    assert_eq!(one.faces, four.faces);
+    assert!(one.positions.len() > 40_000, "big enough to be split up");
+    for (a, b) in one.positions.iter().zip(&four.positions) {
+        assert_eq!(a.to_array().map(f64::to_bits), b.to_array().map(f64::to_bits));
+    }
+}
