@@ -5,7 +5,9 @@
 //! - Loop (lsystems/surfaces/loop.lsys), one level, on an icosphere of
 //!   81,920 triangles;
 //! - Catmull-Clark (lsystems/surfaces/catmull-clark.lsys), one level, on a
-//!   316 x 316 quad torus.
+//!   316 x 316 quad torus;
+//! - sqrt(3) (lsystems/surfaces/sqrt3.lsys), one level, on the icosphere
+//!   (CGAL's time on the same file comes from `benches/xcheck.py`).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -44,6 +46,16 @@ fn main() {
     io::write(&out.join("icosphere6-loop.obj"), &m.to_soup()).expect("write");
     println!(
         "Loop grammar: {} -> {} triangles, best of {runs}: {:.1} ms",
+        base.face_count(),
+        m.face_count(),
+        t * 1e3
+    );
+
+    let g = subgram::surface::load_file(&root.join("lsystems/surfaces/sqrt3.lsys"), &[])
+        .expect("grammar");
+    let (t, m) = best_of(runs, &base, &g);
+    println!(
+        "sqrt(3) grammar: {} -> {} triangles, best of {runs}: {:.1} ms",
         base.face_count(),
         m.face_count(),
         t * 1e3

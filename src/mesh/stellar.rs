@@ -431,10 +431,10 @@ impl Mesh {
         self.e_level[e.index()] += 1;
         self.e_block[e.index()] = false;
         self.e_transversal[e.index()] = false;
-        for f in [f1, f2] {
-            let vs = self.face_vertices(f);
-            self.f_level[f.index()] = self.face_level_from_vertices(vs);
-        }
+        // The faces are now d-c-a and c-d-b.
+        let lcd = self.v_level[c.index()].max(self.v_level[d.index()]);
+        self.f_level[f1.index()] = lcd.max(self.v_level[a.index()]) + 1;
+        self.f_level[f2.index()] = lcd.max(self.v_level[b.index()]) + 1;
         Ok(())
     }
 }

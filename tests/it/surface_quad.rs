@@ -299,6 +299,9 @@ fn parallel_evaluation_gives_the_same_bits_on_one_thread() {
     assert_eq!(one.faces, four.faces);
     assert!(one.positions.len() > 40_000, "big enough to be split up");
     for (a, b) in one.positions.iter().zip(&four.positions) {
-        assert_eq!(a.to_array().map(f64::to_bits), b.to_array().map(f64::to_bits));
+        assert_eq!(
+            a.to_array().map(f64::to_bits),
+            b.to_array().map(f64::to_bits)
+        );
     }
 }
