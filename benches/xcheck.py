@@ -312,7 +312,8 @@ def part_a(binary, out):
     torus_path = os.path.join(out, "torus316.obj")
     v, f = quad_torus(316, 316)
     write_obj(torus_path, v, f, "316 x 316 quad torus, R = 1, r = 0.35")
-    cases = [(os.path.join(MESHES, m), (1, 2)) for m in ("cube.obj", "torus.obj", "grid.obj")]
+    cases = [(os.path.join(MESHES, m), (1, 2)) for m in
+             ("cube.obj", "torus.obj", "grid.obj", "tetrahedron.obj", "octahedron.obj")]
     cases.append((torus_path, (1,)))
     worst = {}
     for path, levels in cases:
@@ -443,12 +444,12 @@ def part_d(binary, out):
     vj = v + np.c_[rng.uniform(-0.03, 0.03, (len(v), 2)), rng.uniform(-0.1, 0.1, len(v))]
     trij = os.path.join(out, "grid-tri-jitter.obj")
     write_obj(trij, vj, f, "grid-tri.obj with random jitter, z in [-0.1, 0.1]")
-    for k in (1, 2):
+    for k in (1, 2, 3, 4):
         vo, fo = cgal("sqrt3", vj, f, k)
         write_obj(os.path.join(out, f"cgal-grid-jitter-sqrt3-{k}.obj"), vo, fo,
                   f"CGAL Sqrt3_subdivision of grid-tri-jitter.obj, {k} step(s)")
         mine = ours(binary, trij, "sqrt3.lsys", k)
-        compare(f"ours (no boundary rule yet) vs CGAL, jittered grid n={k}", (vo, fo), mine, show=0)
+        compare(f"ours (Kobbelt's boundary rule) vs CGAL, jittered grid n={k}", (vo, fo), mine, show=0)
         bv = set(boundary_vertices(fo))
         d, _ = cKDTree(mine[0]).query(vo)
         miss = set(np.nonzero(d > 1e-9)[0].tolist())

@@ -130,6 +130,11 @@ pub struct Mesh {
     pub step: u32,
     /// What splitting a basic block's internal edge makes of the block.
     pub block_split: BlockSplit,
+    /// Set while a grammar that reads blocks runs: a face split then makes
+    /// its three spokes internal edges of blocks, as splitting a block's
+    /// internal edge does, so that a lone triangle joins a quad mesh's
+    /// primal quadrisection (Catmull-Clark on triangles).
+    pub face_split_makes_blocks: bool,
 }
 
 /// What splitting the internal edge of a basic block does to the blocks

@@ -46,6 +46,11 @@ impl Mesh {
             let vs = self.face_vertices(g);
             self.f_level[g.index()] = self.face_level_from_vertices(vs);
         }
+        if self.face_split_makes_blocks {
+            for s in [va, vb, vc] {
+                self.e_block[s.edge().index()] = true;
+            }
+        }
         Ok(v)
     }
 

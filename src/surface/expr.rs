@@ -401,10 +401,11 @@ impl<'g> Compiler<'g> {
             }
             "block" => {
                 let (x, t) = one(self)?;
-                if t != T::Edge {
+                if !matches!(t, T::Edge | T::Face) {
                     return err(
                         span,
-                        "`block` takes an edge: true for the internal edge of a basic block",
+                        "`block` takes an edge (true for the internal edge of a basic block) \
+                         or a face (true for half of a block)",
                     );
                 }
                 self.block_used_at.get_or_insert(span);
@@ -644,7 +645,15 @@ impl Eval<'_> {
                 }),
                 _ => false,
             }),
-            X::IsBlock(a) => Val::B(matches!(self.eval(a, frame), Val::E(_, _, _, _, true, _))),
+            X::IsBlock(a) => Val::B(match self.eval(a, frame) {
+                Val::E(_, _, _, _, b, _) => b,
+                Val::F(vs, _) => (0..3).any(|k| {
+                    self.mesh
+                        .find_halfedge(vs[k], vs[(k + 1) % 3])
+                        .is_some_and(|h| self.mesh.is_block_edge(h.edge()))
+                }),
+                _ => false,
+            }),
             X::IsTransversal(a) => {
                 Val::B(matches!(self.eval(a, frame), Val::E(_, _, _, _, _, true)))
             }

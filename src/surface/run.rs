@@ -222,6 +222,9 @@ impl Grammar {
     ) -> Result<(), RunError> {
         match self.block_used_at {
             None => mesh.forget_blocks(),
+            // A grammar with a face split (Catmull-Clark) takes lone
+            // triangles too: it splits them at their centres.
+            Some(_) if self.rules.iter().any(|r| r.op == Op::FaceSplit) => {}
             Some(span) => {
                 if let Some(f) = mesh.face_outside_blocks() {
                     let [a, b, c] = mesh.face_vertices(f).map(|v| v.index() + 1);
@@ -247,6 +250,7 @@ impl Grammar {
             }
         }
         mesh.block_split = self.block_split;
+        mesh.face_split_makes_blocks = self.block_used_at.is_some();
         let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
         let each: Vec<&Rule> = self.rules.iter().filter(|r| !r.init).collect();
         self.apply_all(&init, mesh, 0)?;

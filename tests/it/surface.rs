@@ -301,20 +301,21 @@ fn check_catmull_clark(soup: &PolygonSoup) {
     let old = base.vertex_count() as u32;
     let m = run("surfaces/catmull-clark.lsys", &base);
     let p = |i: u32| soup.positions[i as usize];
-    let centroid = |q: &Vec<u32>| q.iter().map(|&i| p(i)).sum::<DVec3>() / 4.0;
-    let quads_of = |v: u32| soup.faces.iter().filter(move |q| q.contains(&v));
-    let boundary = |a: u32, b: u32| quads_of(a).filter(|q| q.contains(&b)).count() == 1;
+    let centroid = |q: &Vec<u32>| q.iter().map(|&i| p(i)).sum::<DVec3>() / q.len() as f64;
+    let faces_of = |v: u32| soup.faces.iter().filter(move |q| q.contains(&v));
+    let boundary = |a: u32, b: u32| faces_of(a).filter(|q| q.contains(&b)).count() == 1;
     let mut worst: f64 = 0.0;
     for q in &soup.faces {
+        let n = q.len();
         let fp = child_of_exactly(&m, &q.iter().map(|&i| VertexId(i)).collect::<Vec<_>>(), old);
         worst = worst.max(m.position(fp).distance(centroid(q)));
-        for k in 0..4 {
-            let (a, b) = (q[k], q[(k + 1) % 4]);
+        for k in 0..n {
+            let (a, b) = (q[k], q[(k + 1) % n]);
             let ep = child_of_exactly(&m, &[VertexId(a), VertexId(b)], old);
             let want = if boundary(a, b) {
                 (p(a) + p(b)) / 2.0
             } else {
-                let fs: DVec3 = quads_of(a).filter(|g| g.contains(&b)).map(centroid).sum();
+                let fs: DVec3 = faces_of(a).filter(|g| g.contains(&b)).map(centroid).sum();
                 (p(a) + p(b) + fs) / 4.0
             };
             worst = worst.max(m.position(ep).distance(want));
@@ -322,9 +323,10 @@ fn check_catmull_clark(soup: &PolygonSoup) {
     }
     for v in 0..old {
         let mut nbrs: Vec<u32> = Vec::new();
-        for q in quads_of(v) {
+        for q in faces_of(v) {
+            let n = q.len();
             let k = q.iter().position(|&i| i == v).unwrap();
-            for w in [q[(k + 1) % 4], q[(k + 3) % 4]] {
+            for w in [q[(k + 1) % n], q[(k + n - 1) % n]] {
                 if !nbrs.contains(&w) {
                     nbrs.push(w);
                 }
@@ -334,7 +336,7 @@ fn check_catmull_clark(soup: &PolygonSoup) {
         let want = if on_boundary.is_empty() {
             let n = nbrs.len() as f64;
             let e: DVec3 = nbrs.iter().map(|&w| p(w)).sum();
-            let f: DVec3 = quads_of(v).map(centroid).sum();
+            let f: DVec3 = faces_of(v).map(centroid).sum();
             (n - 2.0) / n * p(v) + (e + f) / (n * n)
         } else {
             0.75 * p(v) + 0.125 * (p(on_boundary[0]) + p(on_boundary[1]))
@@ -347,9 +349,10 @@ fn check_catmull_clark(soup: &PolygonSoup) {
     );
     assert_eq!(
         m.to_quad_soup().faces.len(),
-        4 * soup.faces.len(),
-        "the output is quads"
+        soup.faces.iter().map(|q| q.len()).sum::<usize>(),
+        "the output is quads, one per corner of the input"
     );
+    assert!(m.to_quad_soup().faces.iter().all(|q| q.len() == 4));
 }
 
 #[test]
@@ -570,14 +573,45 @@ fn triangle_schemes_read_quads_as_two_triangles() {
 }
 
 #[test]
-fn catmull_clark_refuses_a_mesh_with_triangles() {
-    let g = grammar("surfaces/catmull-clark.lsys");
+fn catmull_clark_grammar_on_triangles_and_mixed_meshes() {
+    // Triangles are split at their centroids, and their spokes become the
+    // next quads' internal edges, as a quad's do.
+    check_catmull_clark(&jitter(shapes::icosahedron(), 31));
+    // A square pyramid: four triangles and a quad.
+    let pyramid = PolygonSoup {
+        positions: vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.5, 0.5, 0.8),
+        ],
+        faces: vec![
+            vec![0, 3, 2, 1],
+            vec![0, 1, 4],
+            vec![1, 2, 4],
+            vec![2, 3, 4],
+            vec![3, 0, 4],
+        ],
+        ..PolygonSoup::default()
+    };
+    check_catmull_clark(&jitter(pyramid, 37));
+    // An open grid with one quad cut to a triangle: boundary rules meet it.
+    let mut open = shapes::quad_grid(3, 2);
+    let (a, b, c) = (open.faces[0][0], open.faces[0][1], open.faces[0][2]);
+    open.faces[0] = vec![a, b, c];
+    check_catmull_clark(&jitter(open, 41));
+}
+
+#[test]
+fn dual_schemes_refuse_a_mesh_with_triangles() {
+    let g = grammar("surfaces/doo-sabin.lsys");
     let mut m = Mesh::from_soup(&shapes::icosahedron()).unwrap();
     let e = g.run(&mut m, 1, |_| {}).unwrap_err();
     let text = g.render_error(&e);
     assert!(text.contains("needs a mesh of quads"), "{text}");
     assert!(text.contains("is not half of a quad"), "{text}");
-    assert!(text.contains("catmull-clark.lsys:"), "{text}");
+    assert!(text.contains("doo-sabin.lsys:"), "{text}");
 }
 
 #[test]
