@@ -47,6 +47,14 @@ impl Mesh {
         if soup.faces.is_empty() {
             return Err(MeshError::new("the mesh has no faces"));
         }
+        let fanned = soup.faces.iter().position(|f| f.len() > 4).map(|fi| {
+            format!(
+                "face {}{} has {} sides",
+                fi + 1,
+                at_line(soup, fi),
+                soup.faces[fi].len()
+            )
+        });
         let quads = soup.faces.iter().any(|f| f.len() == 4);
         let outer_level = if quads { 1 } else { 0 };
         // (triangle, source face, which of its edges are diagonals)
@@ -122,7 +130,10 @@ impl Mesh {
             }
             seen.insert(key, *fi);
         }
-        let mut m = Mesh::default();
+        let mut m = Mesh {
+            fanned_polygon: fanned,
+            ..Mesh::default()
+        };
         for p in &soup.positions {
             m.new_vertex(*p, 0);
         }

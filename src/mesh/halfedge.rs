@@ -135,6 +135,10 @@ pub struct Mesh {
     /// internal edge does, so that a lone triangle joins a quad mesh's
     /// primal quadrisection (Catmull-Clark on triangles).
     pub face_split_makes_blocks: bool,
+    /// The first polygon of more than four sides in the file the mesh was
+    /// built from, which was fanned into triangles: schemes that read
+    /// quads would take those triangles for faces of their own.
+    pub fanned_polygon: Option<String>,
 }
 
 /// What splitting the internal edge of a basic block does to the blocks

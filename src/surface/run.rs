@@ -212,14 +212,27 @@ impl Grammar {
         }
     }
 
-    /// Runs `steps` steps of the grammar on `mesh`; `progress` hears after
-    /// each step.
+    /// Runs the `init:` rules, then `steps` steps of the grammar on `mesh`;
+    /// `progress` hears after each step. Checks that can be made before
+    /// the run (quads for block grammars, closed meshes for dual ones) leave
+    /// the mesh untouched; an error during a rule leaves it partly derived,
+    /// so callers that must keep it run on a copy.
     pub fn run(
         &self,
         mesh: &mut Mesh,
         steps: usize,
         mut progress: impl FnMut(StepCounts),
     ) -> Result<(), RunError> {
+        if let (Some(span), Some(what)) = (self.block_used_at, &mesh.fanned_polygon) {
+            return Err(RunError {
+                span: Some(span),
+                message: format!(
+                    "this grammar reads quads as basic blocks, but {what}; polygons of more \
+                     than four sides are not supported by such grammars yet (split them \
+                     into quads and triangles first)"
+                ),
+            });
+        }
         match self.block_used_at {
             None => mesh.forget_blocks(),
             // A grammar with a face split (Catmull-Clark) takes lone

@@ -305,3 +305,39 @@ fn parallel_evaluation_gives_the_same_bits_on_one_thread() {
         );
     }
 }
+
+/// A pentagon is fanned into triangles on input; a grammar that reads
+/// quads would take the fan's triangles for faces, so it refuses by name.
+#[test]
+fn block_grammars_refuse_fanned_polygons() {
+    let soup = PolygonSoup {
+        positions: vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.3, 0.8, 0.0),
+            DVec3::new(0.5, 1.3, 0.0),
+            DVec3::new(-0.3, 0.8, 0.0),
+            DVec3::new(0.5, 0.5, 1.0),
+        ],
+        faces: vec![
+            vec![0, 1, 2, 3, 4],
+            vec![0, 5, 1],
+            vec![1, 5, 2],
+            vec![2, 5, 3],
+            vec![3, 5, 4],
+            vec![4, 5, 0],
+        ],
+        ..PolygonSoup::default()
+    };
+    for file in ["surfaces/catmull-clark.lsys", "surfaces/doo-sabin.lsys"] {
+        let g = grammar(file);
+        let mut m = Mesh::from_soup(&soup).unwrap();
+        let e = g.run(&mut m, 1, |_| {}).unwrap_err();
+        let text = g.render_error(&e);
+        assert!(text.contains("face 1 has 5 sides"), "{text}");
+    }
+    // Loop reads everything as triangles and runs.
+    let g = grammar("surfaces/loop.lsys");
+    let mut m = Mesh::from_soup(&soup).unwrap();
+    g.run(&mut m, 1, |_| {}).unwrap();
+}
