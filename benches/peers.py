@@ -6,7 +6,7 @@ Run after `cargo run --release --example bench_surface /tmp/subgram-bench`:
 
 Needs `pip install libigl pymeshlab numpy scipy`. Not part of `cargo test`.
 It times igl.loop and pymeshlab's Loop (Loop's beta, threshold 0) on the
-same 81,920-triangle icosphere, best of 3 with conversions included, and
+same 81,920-triangle icosphere, best of 7 with conversions included, and
 compares pymeshlab's result with the grammar's output written by the
 example: vertices are matched by nearest position (both keep the original
 vertices, but new ones come in different orders).
@@ -28,7 +28,7 @@ def read_obj(path):
     return np.array(v), np.array(f, dtype=np.int64)
 
 
-def best_of(fn, runs=3):
+def best_of(fn, runs=7):
     best, out = float("inf"), None
     for _ in range(runs):
         t = time.perf_counter()
@@ -56,8 +56,8 @@ def main(folder):
     ours, our_faces = read_obj(f"{folder}/icosphere6-loop.obj")
     d, _ = cKDTree(vm).query(ours)
     print(f"input: {len(f)} triangles")
-    print(f"igl.loop (Warren's beta): {len(fi)} triangles, best of 3: {t_igl * 1e3:.1f} ms")
-    print(f"pymeshlab Loop (Loop's beta): {len(fm)} triangles, best of 3: {t_ml * 1e3:.1f} ms")
+    print(f"igl.loop (Warren's beta): {len(fi)} triangles, best of 7: {t_igl * 1e3:.1f} ms")
+    print(f"pymeshlab Loop (Loop's beta): {len(fm)} triangles, best of 7: {t_ml * 1e3:.1f} ms")
     print(
         f"grammar vs pymeshlab: {len(ours)} vs {len(vm)} vertices, "
         f"largest distance to the nearest pymeshlab vertex {d.max():.3e}"

@@ -35,7 +35,7 @@ fn main() {
     );
     std::fs::create_dir_all(&out).expect("output folder");
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let runs = 3;
+    let runs = 7;
 
     let sphere = shapes::icosphere(6);
     io::write(&out.join("icosphere6.obj"), &sphere).expect("write");

@@ -385,43 +385,43 @@ impl Grammar {
         }
     }
 
-    /// Evaluates `assign` for each of `items` (the frame slots to set, in
-    /// parallel), giving the points in order, or the first item whose
-    /// point is not finite.
+    /// Evaluates `assign` for elements `0..n` in parallel, `bind` setting
+    /// each one's frame slots, giving the points in order; or the first
+    /// element whose point is not finite, with that point (None when the
+    /// assignment gave no point at all).
     fn eval_points(
         &self,
         rule: &Rule,
         mesh: &Mesh,
         current: u32,
         assign: &X,
-        items: &[Bindings],
+        n: usize,
+        bind: impl Fn(&mut [Val], usize) + Sync,
     ) -> Result<Vec<DVec3>, (usize, Option<DVec3>)> {
         let ev = Eval { mesh, current };
-        let out: Vec<Option<DVec3>> = items
-            .par_iter()
+        let one = |frame: &mut Vec<Val>, k: usize| {
+            bind(frame, k);
+            ev.eval(assign, frame)
+        };
+        let points: Vec<DVec3> = (0..n)
+            .into_par_iter()
             .with_min_len(CHUNK)
             .map_init(
                 || vec![Val::N(0.0); rule.frame],
-                |frame, &(slot, val, extra)| {
-                    frame[slot as usize] = val;
-                    if let Some((s, v)) = extra {
-                        frame[s as usize] = v;
-                    }
-                    match ev.eval(assign, frame) {
-                        Val::P(p) => Some(p),
-                        _ => None,
-                    }
+                |frame, k| match one(frame, k) {
+                    Val::P(p) => p,
+                    _ => DVec3::NAN,
                 },
             )
             .collect();
-        let mut points = Vec::with_capacity(out.len());
-        for (k, p) in out.into_iter().enumerate() {
-            match p {
-                Some(p) if p.is_finite() => points.push(p),
-                other => return Err((k, other)),
-            }
+        match points.iter().position(|p| !p.is_finite()) {
+            None => Ok(points),
+            // Evaluate the first bad one again, to say what it gave.
+            Some(k) => match one(&mut vec![Val::N(0.0); rule.frame], k) {
+                Val::P(p) => Err((k, Some(p))),
+                _ => Err((k, None)),
+            },
         }
-        Ok(points)
     }
 
     /// Applies `rules` in order. An interior and a boundary edge-split rule
@@ -483,9 +483,11 @@ impl Grammar {
                 let Some(assign) = &rule.assign else {
                     return Ok(());
                 };
-                let items: Vec<_> = matched.iter().map(|&v| (rule.elem_slot, v, None)).collect();
+                let slot = rule.elem_slot as usize;
                 let out = self
-                    .eval_points(rule, mesh, current, assign, &items)
+                    .eval_points(rule, mesh, current, assign, matched.len(), |frame, k| {
+                        frame[slot] = matched[k];
+                    })
                     .map_err(|(k, p)| match p {
                         Some(p) => fail(format!(
                             "vertex {} would move to {p}, which is not finite",
@@ -547,12 +549,12 @@ impl Grammar {
                     return Ok(());
                 };
                 let vslot = rule.vertex_slot.expect("an assignment names its vertex");
-                let items: Vec<_> = made
-                    .iter()
-                    .map(|&(v, parent)| (rule.elem_slot, parent, Some((vslot, Val::V(v)))))
-                    .collect();
+                let slot = rule.elem_slot as usize;
                 let out = self
-                    .eval_points(rule, mesh, current, assign, &items)
+                    .eval_points(rule, mesh, current, assign, made.len(), |frame, k| {
+                        frame[slot] = made[k].1;
+                        frame[vslot as usize] = Val::V(made[k].0);
+                    })
                     .map_err(|(k, p)| match p {
                         Some(p) => fail(format!(
                             "new vertex {} would be at {p}, which is not finite",
@@ -568,10 +570,6 @@ impl Grammar {
         }
     }
 }
-
-/// Frame slots to set before evaluating an assignment: the predecessor's,
-/// and the new vertex's if there is one.
-type Bindings = (u16, Val, Option<(u16, Val)>);
 
 /// Elements per parallel task: small jobs stay on one thread.
 const CHUNK: usize = 16384;
