@@ -10,6 +10,9 @@ use std::fmt;
 
 use glam::DVec3;
 
+/// `he_face` of a boundary half-edge.
+pub(crate) const NO_FACE: u32 = u32::MAX;
+
 macro_rules! id {
     ($(#[$m:meta])* $name:ident) => {
         $(#[$m])*
@@ -107,7 +110,8 @@ pub struct Mesh {
     pub(crate) he_to: Vec<VertexId>,
     pub(crate) he_next: Vec<HalfEdgeId>,
     pub(crate) he_prev: Vec<HalfEdgeId>,
-    pub(crate) he_face: Vec<Option<FaceId>>,
+    /// The face of each half-edge, `NO_FACE` on the boundary.
+    pub(crate) he_face: Vec<u32>,
     // Edges.
     pub(crate) e_level: Vec<u32>,
     pub(crate) e_alive: Vec<bool>,
@@ -202,7 +206,7 @@ impl Mesh {
     /// Bytes of storage per face, for the benchmark's report.
     pub fn bytes_per_face(&self) -> f64 {
         let v = self.v_alive.len() * (8 + 24 + 24 + 4 + 4 + 1);
-        let h = self.he_to.len() * (4 + 4 + 4 + 8);
+        let h = self.he_to.len() * (4 + 4 + 4 + 4);
         let e = self.e_alive.len() * (4 + 1 + 1);
         let f = self.f_alive.len() * (4 + 4 + 1);
         (v + h + e + f) as f64 / self.face_count().max(1) as f64
@@ -309,7 +313,8 @@ impl Mesh {
 
     #[inline]
     pub fn face(&self, h: HalfEdgeId) -> Option<FaceId> {
-        self.he_face[h.index()]
+        let f = self.he_face[h.index()];
+        (f != NO_FACE).then_some(FaceId(f))
     }
 
     pub fn face_halfedge(&self, f: FaceId) -> HalfEdgeId {
@@ -322,7 +327,7 @@ impl Mesh {
     }
 
     pub fn is_boundary_halfedge(&self, h: HalfEdgeId) -> bool {
-        self.he_face[h.index()].is_none()
+        self.he_face[h.index()] == NO_FACE
     }
 
     pub fn is_boundary_edge(&self, e: EdgeId) -> bool {
@@ -488,15 +493,15 @@ impl Mesh {
                 self.he_to.push(VertexId(0));
                 self.he_next.push(dummy);
                 self.he_prev.push(dummy);
-                self.he_face.push(None);
+                self.he_face.push(NO_FACE);
             }
             e
         };
         let h = e.halfedge();
         self.he_to[h.index()] = b;
         self.he_to[h.twin().index()] = a;
-        self.he_face[h.index()] = None;
-        self.he_face[h.twin().index()] = None;
+        self.he_face[h.index()] = NO_FACE;
+        self.he_face[h.twin().index()] = NO_FACE;
         h
     }
 
@@ -547,7 +552,7 @@ impl Mesh {
         self.link(h1, h2);
         self.link(h2, h0);
         for h in [h0, h1, h2] {
-            self.he_face[h.index()] = Some(f);
+            self.he_face[h.index()] = f.0;
         }
         self.f_he[f.index()] = h0;
     }

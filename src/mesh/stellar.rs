@@ -5,7 +5,7 @@
 
 use glam::DVec3;
 
-use super::halfedge::{BlockSplit, EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId};
+use super::halfedge::{BlockSplit, EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId, NO_FACE};
 
 impl Mesh {
     /// Face split: a new vertex `v` inside triangle `abc` joined to its
@@ -178,8 +178,8 @@ impl Mesh {
             // ... -> (b -> v) -> (v -> a) -> ...
             let (tp, tn) = (self.prev(t), self.next(t));
             let gt = g.twin();
-            self.he_face[gt.index()] = None;
-            self.he_face[t.index()] = None;
+            self.he_face[gt.index()] = NO_FACE;
+            self.he_face[t.index()] = NO_FACE;
             self.link(tp, gt);
             self.link(gt, t);
             self.link(t, tn);
@@ -319,7 +319,7 @@ impl Mesh {
             self.e_level[x.edge().index()] = le;
             self.e_transversal[x.edge().index()] = false;
             self.set_triangle(f, o1, o2, x);
-            self.he_face[bin.index()] = None;
+            self.he_face[bin.index()] = NO_FACE;
             self.link(bp, bin);
             self.link(bin, bn);
             for w in [n0, n1, n2] {

@@ -108,8 +108,10 @@ pub enum Val {
     /// whether it was on the boundary, whether it was a basic block's
     /// internal edge, and whether it was a transversal edge.
     E(VertexId, VertexId, u32, bool, bool, bool),
-    /// A face by its vertices and level.
-    F([VertexId; 3], u32),
+    /// A face by its vertices (captured before a split), level, whether
+    /// one of its edges was on the boundary and whether one was a basic
+    /// block's internal edge.
+    F([VertexId; 3], u32, bool, bool),
     /// A set: its kind and the element it belongs to.
     S(SetKind, SetOf),
 }
@@ -624,7 +626,7 @@ impl Eval<'_> {
             X::Level(a) => Val::N(match self.eval(a, frame) {
                 Val::V(v) => self.mesh.vertex_level(v) as f64,
                 Val::E(_, _, l, _, _, _) => l as f64,
-                Val::F(_, l) => l as f64,
+                Val::F(_, l, _, _) => l as f64,
                 _ => f64::NAN,
             }),
             X::Pos(a) => match self.eval(a, frame) {
@@ -638,20 +640,12 @@ impl Eval<'_> {
             X::IsBoundary(a) => Val::B(match self.eval(a, frame) {
                 Val::V(v) => self.mesh.is_boundary_vertex(v),
                 Val::E(_, _, _, b, _, _) => b,
-                Val::F(vs, _) => (0..3).any(|k| {
-                    self.mesh
-                        .find_halfedge(vs[(k + 1) % 3], vs[k])
-                        .is_some_and(|h| self.mesh.face(h).is_none())
-                }),
+                Val::F(_, _, b, _) => b,
                 _ => false,
             }),
             X::IsBlock(a) => Val::B(match self.eval(a, frame) {
                 Val::E(_, _, _, _, b, _) => b,
-                Val::F(vs, _) => (0..3).any(|k| {
-                    self.mesh
-                        .find_halfedge(vs[k], vs[(k + 1) % 3])
-                        .is_some_and(|h| self.mesh.is_block_edge(h.edge()))
-                }),
+                Val::F(_, _, _, b) => b,
                 _ => false,
             }),
             X::IsTransversal(a) => {
@@ -669,7 +663,7 @@ impl Eval<'_> {
                 Val::E(p, q, _, _, _, _) => {
                     Val::P((self.mesh.position(p) + self.mesh.position(q)) * 0.5)
                 }
-                Val::F(vs, _) => {
+                Val::F(vs, ..) => {
                     Val::P(vs.iter().map(|v| self.mesh.position(*v)).sum::<DVec3>() / 3.0)
                 }
                 _ => Val::P(DVec3::NAN),
@@ -678,7 +672,7 @@ impl Eval<'_> {
                 let of = match self.eval(a, frame) {
                     Val::V(v) => SetOf::V(v),
                     Val::E(p, q, _, _, _, _) => SetOf::E(p, q),
-                    Val::F(vs, _) => SetOf::F(vs),
+                    Val::F(vs, ..) => SetOf::F(vs),
                     _ => SetOf::V(VertexId(0)),
                 };
                 Val::S(*k, of)
@@ -813,7 +807,7 @@ impl Eval<'_> {
                 let l = match frame[*s as usize] {
                     Val::V(v) => self.mesh.vertex_level(v),
                     Val::E(_, _, l, _, _, _) => l,
-                    Val::F(_, l) => l,
+                    Val::F(_, l, _, _) => l,
                     _ => return Val::B(false),
                 };
                 let c = self.current;

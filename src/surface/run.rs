@@ -323,7 +323,13 @@ impl Grammar {
                     Op::FaceSplit => {
                         for f in (lo..hi).map(crate::mesh::FaceId) {
                             if mesh.is_face(f) {
-                                let val = Val::F(mesh.face_vertices(f), mesh.face_level(f));
+                                let hs = mesh.face_halfedges(f);
+                                let val = Val::F(
+                                    hs.map(|h| mesh.from(h)),
+                                    mesh.face_level(f),
+                                    hs.iter().any(|h| mesh.face(h.twin()).is_none()),
+                                    hs.iter().any(|h| mesh.is_block_edge(h.edge())),
+                                );
                                 if test(val) {
                                     vals.push(val);
                                 }
@@ -525,7 +531,7 @@ impl Grammar {
                 }
                 for (k, &val) in matched.iter().enumerate() {
                     let v = match val {
-                        Val::F(vs, _) => {
+                        Val::F(vs, ..) => {
                             let Some(f) = face_of(mesh, vs) else {
                                 return Err(fail("a face to split is gone".into()));
                             };
