@@ -101,7 +101,9 @@ pub struct Mesh {
     // Vertices.
     pub(crate) v_out: Vec<Option<HalfEdgeId>>,
     pub(crate) pos: Vec<DVec3>,
-    pub(crate) next_pos: Vec<DVec3>,
+    /// Positions written for the next step (the second buffer of paper
+    /// 000, §7), kept as a list: only smoothed vertices have one.
+    pub(crate) next_pos: Vec<(VertexId, DVec3)>,
     pub(crate) v_level: Vec<u32>,
     /// The step of the grammar run that made the vertex (0: the base mesh).
     pub(crate) v_step: Vec<u32>,
@@ -205,7 +207,7 @@ impl Mesh {
 
     /// Bytes of storage per face, for the benchmark's report.
     pub fn bytes_per_face(&self) -> f64 {
-        let v = self.v_alive.len() * (8 + 24 + 24 + 4 + 4 + 1);
+        let v = self.v_alive.len() * (8 + 24 + 4 + 4 + 1);
         let h = self.he_to.len() * (4 + 4 + 4 + 4);
         let e = self.e_alive.len() * (4 + 1 + 1);
         let f = self.f_alive.len() * (4 + 4 + 1);
@@ -221,23 +223,30 @@ impl Mesh {
 
     pub fn set_position(&mut self, v: VertexId, p: DVec3) {
         self.pos[v.index()] = p;
-        self.next_pos[v.index()] = p;
     }
 
-    /// The next-position buffer of a vertex (smoothing writes here).
+    /// The position a vertex will have after the next swap: the last one
+    /// written for it, else its current one.
     pub fn next_position(&self, v: VertexId) -> DVec3 {
-        self.next_pos[v.index()]
+        self.next_pos
+            .iter()
+            .rev()
+            .find(|(w, _)| *w == v)
+            .map_or(self.pos[v.index()], |(_, p)| *p)
     }
 
+    /// Writes a vertex's position for the next step (smoothing writes
+    /// here); it becomes current at `swap_positions`.
     pub fn set_next_position(&mut self, v: VertexId, p: DVec3) {
-        self.next_pos[v.index()] = p;
+        self.next_pos.push((v, p));
     }
 
     /// Makes the next positions current (paper 000, §7: the buffer is
-    /// swapped after each step). Next positions start equal to current.
+    /// swapped after each step), in the order they were written.
     pub fn swap_positions(&mut self) {
-        std::mem::swap(&mut self.pos, &mut self.next_pos);
-        self.next_pos.copy_from_slice(&self.pos);
+        for (v, p) in std::mem::take(&mut self.next_pos) {
+            self.pos[v.index()] = p;
+        }
     }
 
     pub fn vertex_level(&self, v: VertexId) -> u32 {
@@ -435,7 +444,6 @@ impl Mesh {
     pub fn reserve(&mut self, vertices: usize, edges: usize, faces: usize) {
         grow(&mut self.v_out, vertices);
         grow(&mut self.pos, vertices);
-        grow(&mut self.next_pos, vertices);
         grow(&mut self.v_level, vertices);
         grow(&mut self.v_step, vertices);
         grow(&mut self.v_alive, vertices);
@@ -457,7 +465,6 @@ impl Mesh {
             let k = i as usize;
             self.v_out[k] = None;
             self.pos[k] = p;
-            self.next_pos[k] = p;
             self.v_level[k] = level;
             self.v_step[k] = self.step;
             self.v_alive[k] = true;
@@ -465,7 +472,6 @@ impl Mesh {
         }
         self.v_out.push(None);
         self.pos.push(p);
-        self.next_pos.push(p);
         self.v_level.push(level);
         self.v_step.push(self.step);
         self.v_alive.push(true);

@@ -501,9 +501,8 @@ impl Grammar {
                         )),
                         None => fail("the assignment did not give a point".into()),
                     })?;
-                for (val, p) in matched.iter().zip(out) {
-                    mesh.set_next_position(vertex_of(*val), p);
-                }
+                mesh.next_pos
+                    .extend(matched.iter().zip(out).map(|(val, p)| (vertex_of(*val), p)));
                 Ok(())
             }
             Op::Flip => {
