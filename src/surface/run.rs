@@ -287,14 +287,9 @@ impl Grammar {
     /// and, for edge rules, their ids. Edges keep their ids through the
     /// splits and flips of other edges, so the ids stay valid while the
     /// rule runs.
-    fn find_matches(&self, rule: &Rule, mesh: &mut Mesh) -> Matches {
-        let current = mesh
-            .vertices()
-            .map(|v| mesh.vertex_level(v))
-            .max()
-            .unwrap_or(0);
-        mesh.current_level = current;
-        let mesh: &Mesh = mesh;
+    fn find_matches(&self, rule: &Rule, mesh: &Mesh) -> Matches {
+        // `c`, kept up to date by `apply_all` as rules make vertices.
+        let current = mesh.current_level;
         let ev = Eval { mesh, current };
         let slots = match rule.op {
             Op::FaceSplit => mesh.f_alive.len(),
@@ -435,6 +430,13 @@ impl Grammar {
     /// both match when the first starts, so that what one splits (or marks
     /// as a block's internal edge) cannot feed the other in the same step.
     fn apply_all(&self, rules: &[&Rule], mesh: &mut Mesh, step: usize) -> Result<(), RunError> {
+        // c: the highest vertex level, raised below by the vertices that
+        // splits make (rules never remove vertices).
+        mesh.current_level = mesh
+            .vertices()
+            .map(|v| mesh.vertex_level(v))
+            .max()
+            .unwrap_or(0);
         let mut i = 0;
         while i < rules.len() {
             let rule = rules[i];
@@ -474,7 +476,6 @@ impl Grammar {
             vals: matched,
             edge_ids,
         } = m;
-        mesh.current_level = current;
         let fail = |m: String| RunError {
             span: Some(rule.span),
             message: if step == 0 {
@@ -550,6 +551,10 @@ impl Grammar {
                     };
                     made.push((v, val));
                 }
+                mesh.current_level = made
+                    .iter()
+                    .map(|(v, _)| mesh.vertex_level(*v))
+                    .fold(mesh.current_level, u32::max);
                 let Some(assign) = &rule.assign else {
                     return Ok(());
                 };
@@ -570,6 +575,7 @@ impl Grammar {
                 for ((v, _), p) in made.iter().zip(out) {
                     mesh.set_position(*v, p);
                 }
+
                 Ok(())
             }
         }
