@@ -604,14 +604,14 @@ fn catmull_clark_grammar_on_triangles_and_mixed_meshes() {
 }
 
 #[test]
-fn dual_schemes_refuse_a_mesh_with_triangles() {
-    let g = grammar("surfaces/doo-sabin.lsys");
+fn four_eight_refuses_a_mesh_with_triangles() {
+    let g = grammar("surfaces/four-eight.lsys");
     let mut m = Mesh::from_soup(&shapes::icosahedron()).unwrap();
     let e = g.run(&mut m, 1, |_| {}).unwrap_err();
     let text = g.render_error(&e);
     assert!(text.contains("needs a mesh of quads"), "{text}");
     assert!(text.contains("is not half of a quad"), "{text}");
-    assert!(text.contains("doo-sabin.lsys:"), "{text}");
+    assert!(text.contains("four-eight.lsys:"), "{text}");
 }
 
 #[test]

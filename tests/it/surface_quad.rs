@@ -139,6 +139,33 @@ fn doo_sabin_grammar_on_triangles_is_the_averaging_form() {
     }
 }
 
+/// Triangles become dual blocks at initialization: one step on a jittered
+/// icosahedron gives the averaging form on every triangle (Doo-Sabin) and
+/// (a + 2b + c)/4 (Peters).
+#[test]
+fn dual_schemes_on_triangle_meshes() {
+    let mut base = shapes::icosahedron();
+    let mut x = 0x2545_F491_4F6C_DD1Du64;
+    for p in &mut base.positions {
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        *p += DVec3::new(r(), r(), r()) * 0.2;
+    }
+    let ds = run("surfaces/doo-sabin.lsys", &base, 1);
+    // A face per face (20), edge (30) and vertex (12).
+    assert_eq!(ds.faces.len(), 62);
+    let d = match_points(&ds.positions, &per_corner(&base, doo_sabin_average));
+    assert!(d < 1e-12, "{d}");
+    let pe = run("surfaces/peters.lsys", &base, 1);
+    let mid_mid = |ps: &[DVec3], k: usize| (ps[(k + 2) % 3] + ps[k] * 2.0 + ps[(k + 1) % 3]) * 0.25;
+    let d = match_points(&pe.positions, &per_corner(&base, mid_mid));
+    assert!(d < 1e-12, "{d}");
+}
+
 #[test]
 fn peters_grammar_is_two_mid_edge_steps() {
     let base = cube();
