@@ -12,8 +12,11 @@ pub struct MeshInfo {
     pub vertices: usize,
     pub edges: usize,
     pub faces: usize,
-    /// Faces after merging basic blocks back into quads.
+    /// Faces after merging basic blocks back into quads (or, for dual
+    /// blocks, the polygons around their centres).
     pub quads: usize,
+    /// Vertices after merging: dual-block centres are left out.
+    pub merged_vertices: usize,
     pub boundary_loops: usize,
     pub components: usize,
     /// Vertices on no edge (an OBJ `v` no face uses). They count in
@@ -31,6 +34,7 @@ pub struct MeshInfo {
 
 impl Mesh {
     pub fn info(&self) -> MeshInfo {
+        let merged = self.to_quad_soup();
         let mut seen = vec![false; self.he_to.len()];
         let mut loops = 0;
         for e in self.edges() {
@@ -97,7 +101,8 @@ impl Mesh {
             vertices: v,
             edges: e,
             faces: f,
-            quads: self.to_quad_soup().faces.len(),
+            quads: merged.faces.len(),
+            merged_vertices: merged.positions.len(),
             boundary_loops: loops,
             components: roots.len(),
             isolated_vertices: isolated,
@@ -113,11 +118,20 @@ impl Mesh {
 
 impl std::fmt::Display for MeshInfo {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        writeln!(
-            f,
-            "vertices {}, edges {}, faces {} (triangles; {} after merging basic blocks)",
-            self.vertices, self.edges, self.faces, self.quads
-        )?;
+        if self.merged_vertices == self.vertices {
+            writeln!(
+                f,
+                "vertices {}, edges {}, faces {} (triangles; {} after merging basic blocks)",
+                self.vertices, self.edges, self.faces, self.quads
+            )?;
+        } else {
+            writeln!(
+                f,
+                "vertices {}, edges {}, faces {} (triangles; {} vertices and {} polygons after \
+                 merging basic blocks, whose centres are left out)",
+                self.vertices, self.edges, self.faces, self.merged_vertices, self.quads
+            )?;
+        }
         write!(
             f,
             "components {}, boundary loops {}",
