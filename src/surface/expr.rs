@@ -673,7 +673,9 @@ impl Eval<'_> {
                     Val::V(v) => SetOf::V(v),
                     Val::E(p, q, _, _, _, _) => SetOf::E(p, q),
                     Val::F(vs, ..) => SetOf::F(vs),
-                    _ => SetOf::V(VertexId(0)),
+                    // No element (bnext of an interior vertex): no set, and
+                    // whatever is made from it is not finite.
+                    _ => return NO_VERTEX,
                 };
                 Val::S(*k, of)
             }
@@ -684,7 +686,11 @@ impl Eval<'_> {
                 cond,
             } => {
                 let Val::S(kind, of) = self.eval(set, frame) else {
-                    return Val::P(DVec3::NAN);
+                    return if *op == 2 {
+                        Val::N(f64::NAN)
+                    } else {
+                        Val::P(DVec3::NAN)
+                    };
                 };
                 let mut sum = DVec3::ZERO;
                 let mut count = 0usize;

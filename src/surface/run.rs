@@ -267,6 +267,8 @@ impl Grammar {
         let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
         let each: Vec<&Rule> = self.rules.iter().filter(|r| !r.init).collect();
         self.apply_all(&init, mesh, 0)?;
+        // What init's vertex rules wrote is current before the first step.
+        mesh.swap_positions();
         let first = mesh.step;
         for step in 1..=steps {
             // Vertices made from here on record this step (`new(v)`).
@@ -497,10 +499,11 @@ impl Grammar {
                     })
                     .map_err(|(k, p)| match p {
                         Some(p) => fail(format!(
-                            "vertex {} would move to {p}, which is not finite",
-                            vertex_of(matched[k])
+                            "vertex {} would move to {p}, which is not finite{}",
+                            vertex_of(matched[k]),
+                            hint(rule)
                         )),
-                        None => fail("the assignment did not give a point".into()),
+                        None => fail(format!("the assignment did not give a point{}", hint(rule))),
                     })?;
                 mesh.next_pos
                     .extend(matched.iter().zip(out).map(|(val, p)| (vertex_of(*val), p)));
@@ -567,10 +570,11 @@ impl Grammar {
                     })
                     .map_err(|(k, p)| match p {
                         Some(p) => fail(format!(
-                            "new vertex {} would be at {p}, which is not finite",
-                            made[k].0
+                            "new vertex {} would be at {p}, which is not finite{}",
+                            made[k].0,
+                            hint(rule)
                         )),
-                        None => fail("the assignment did not give a point".into()),
+                        None => fail(format!("the assignment did not give a point{}", hint(rule))),
                     })?;
                 for ((v, _), p) in made.iter().zip(out) {
                     mesh.set_position(*v, p);
@@ -584,6 +588,16 @@ impl Grammar {
 
 /// Elements per parallel task: small jobs stay on one thread.
 const CHUNK: usize = 16384;
+
+/// A hint for a rule whose assignment failed: `bnext` and `bprev` give no
+/// vertex off the boundary.
+fn hint(rule: &Rule) -> &'static str {
+    if rule.text.contains("bnext") || rule.text.contains("bprev") {
+        " (bnext and bprev give no vertex for a vertex that is not on the boundary)"
+    } else {
+        ""
+    }
+}
 
 fn vertex_of(val: Val) -> VertexId {
     match val {

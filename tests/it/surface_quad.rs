@@ -368,3 +368,48 @@ fn block_grammars_refuse_fanned_polygons() {
     let mut m = Mesh::from_soup(&soup).unwrap();
     g.run(&mut m, 1, |_| {}).unwrap();
 }
+
+/// What an `init:` vertex rule writes is current before the first step.
+#[test]
+fn init_vertex_rules_take_effect_before_the_first_step() {
+    let g = subgram::surface::load_str(
+        "g.lsys",
+        "init: V(v) -> V(v = 2*v);\nE(e) | F^2 -> V(v = avg(e)) || E^4 F^4;\n",
+        &[],
+    )
+    .unwrap_or_else(|e| panic!("{}", e.render()));
+    let base = Mesh::from_soup(&shapes::icosahedron()).unwrap();
+    let mut m = base.clone();
+    g.run(&mut m, 1, |_| {}).unwrap();
+    for v in base.vertices() {
+        assert!(m.position(v).distance(base.position(v) * 2.0) < 1e-12);
+    }
+    for e in base.edges() {
+        let (a, b) = base.edge_vertices(e);
+        let mid = base.position(a) + base.position(b);
+        assert!(
+            m.vertices().any(|w| m.position(w).distance(mid) < 1e-12),
+            "the split saw the doubled positions"
+        );
+    }
+}
+
+/// `bnext` of an interior vertex is no vertex: the rule fails with a
+/// message that says why, instead of reading some other vertex.
+#[test]
+fn boundary_walks_off_the_boundary_are_errors() {
+    for body in [
+        "bnext(v)",
+        "avg(ring(bprev(v)))",
+        "v + count(w in ring(bnext(v)))*v",
+    ] {
+        let text = format!("V(v) -> V(v = {body});\n");
+        let g = subgram::surface::load_str("g.lsys", &text, &[])
+            .unwrap_or_else(|e| panic!("{}", e.render()));
+        let mut m = Mesh::from_soup(&shapes::icosahedron()).unwrap();
+        let e = g.run(&mut m, 1, |_| {}).unwrap_err();
+        let msg = g.render_error(&e);
+        assert!(msg.contains("g.lsys:1:1"), "{msg}");
+        assert!(msg.contains("not on the boundary"), "{msg}");
+    }
+}
