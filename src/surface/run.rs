@@ -244,8 +244,8 @@ impl Grammar {
                     return Err(RunError {
                         span: Some(span),
                         message: format!(
-                            "this grammar asks `block(e)`, so it needs a mesh of quads, but the triangle \
-                             on vertices {a}, {b} and {c} is not half of a quad"
+                            "this grammar reads basic blocks (here), so it needs a mesh of quads, but the \
+                             triangle on vertices {a}, {b} and {c} is not half of a quad"
                         ),
                     });
                 }
