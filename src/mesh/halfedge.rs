@@ -145,6 +145,9 @@ pub struct Mesh {
     /// built from, which was fanned into triangles: schemes that read
     /// quads would take those triangles for faces of their own.
     pub fanned_polygon: Option<String>,
+    /// Set once a grammar's `init:` rules have run on the mesh: a later
+    /// run continues its steps without them.
+    pub initialized: bool,
 }
 
 /// What splitting the internal edge of a basic block does to the blocks

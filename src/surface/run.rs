@@ -212,7 +212,8 @@ impl Grammar {
         }
     }
 
-    /// Runs the `init:` rules, then `steps` steps of the grammar on `mesh`;
+    /// Runs the `init:` rules (once per mesh: a second run continues the
+    /// steps), then `steps` steps of the grammar on `mesh`;
     /// `progress` hears after each step. Checks that can be made before
     /// the run (quads for block grammars, closed meshes for dual ones) leave
     /// the mesh untouched; an error during a rule leaves it partly derived,
@@ -266,9 +267,13 @@ impl Grammar {
         mesh.face_split_makes_blocks = self.block_used_at.is_some();
         let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
         let each: Vec<&Rule> = self.rules.iter().filter(|r| !r.init).collect();
-        self.apply_all(&init, mesh, 0)?;
-        // What init's vertex rules wrote is current before the first step.
-        mesh.swap_positions();
+        if !mesh.initialized {
+            self.apply_all(&init, mesh, 0)?;
+            // What init's vertex rules wrote is current before the first
+            // step.
+            mesh.swap_positions();
+            mesh.initialized = true;
+        }
         let first = mesh.step;
         for step in 1..=steps {
             // Vertices made from here on record this step (`new(v)`).

@@ -413,3 +413,29 @@ fn boundary_walks_off_the_boundary_are_errors() {
         assert!(msg.contains("not on the boundary"), "{msg}");
     }
 }
+
+/// Two runs of one step each are one run of two steps, for every grammar:
+/// init rules run once, `step` and `new(v)` continue.
+#[test]
+fn running_twice_continues_the_steps() {
+    for (g, mesh) in [
+        ("doo-sabin", "cube"),
+        ("peters", "cube"),
+        ("four-eight", "torus"),
+        ("sqrt3", "grid"),
+        ("catmull-clark", "cube"),
+        ("loop", "octahedron"),
+    ] {
+        let gr = grammar(&format!("surfaces/{g}.lsys"));
+        let soup = subgram::mesh::io::read(&lsys(&format!("meshes/{mesh}.obj"))).unwrap();
+        let base = Mesh::from_soup(&soup).unwrap();
+        let mut a = base.clone();
+        gr.run(&mut a, 2, |_| {}).unwrap();
+        let mut b = base.clone();
+        gr.run(&mut b, 1, |_| {}).unwrap();
+        gr.run(&mut b, 1, |_| {}).unwrap();
+        let (sa, sb) = (a.to_quad_soup(), b.to_quad_soup());
+        assert_eq!(sa.faces, sb.faces, "{g}");
+        assert_eq!(sa.positions, sb.positions, "{g}");
+    }
+}
