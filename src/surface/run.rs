@@ -295,6 +295,18 @@ impl Grammar {
     /// splits and flips of other edges, so the ids stay valid while the
     /// rule runs.
     fn find_matches(&self, rule: &Rule, mesh: &Mesh) -> Matches {
+        self.find_matches_with(rule, None, mesh).0
+    }
+
+    /// What `rule` applies to, and `other`, an edge rule for the other
+    /// context (boundary or interior), tested in the same pass over the
+    /// edges: both fixed when the first starts.
+    fn find_matches_with(
+        &self,
+        rule: &Rule,
+        other: Option<&Rule>,
+        mesh: &Mesh,
+    ) -> (Matches, Matches) {
         // `c`, kept up to date by `apply_all` as rules make vertices.
         let current = mesh.current_level;
         let ev = Eval { mesh, current };
@@ -303,20 +315,21 @@ impl Grammar {
             Op::EdgeSplit | Op::BoundarySplit | Op::Flip => mesh.e_alive.len(),
             Op::Vertex => mesh.v_alive.len(),
         };
+        let frame_len = rule.frame.max(other.map_or(0, |o| o.frame));
+        type Part = (Vec<Val>, Vec<crate::mesh::EdgeId>);
         // Conditions are pure, so ranges of ids are tested in parallel,
         // each by a plain loop, and the matches joined in id order.
         let ranges: Vec<(u32, u32)> = (0..slots.div_ceil(CHUNK))
             .map(|k| ((k * CHUNK) as u32, (((k + 1) * CHUNK).min(slots)) as u32))
             .collect();
-        let parts: Vec<(Vec<Val>, Vec<crate::mesh::EdgeId>)> = ranges
+        let parts: Vec<(Part, Part)> = ranges
             .into_par_iter()
             .map(|(lo, hi)| {
-                let mut frame = vec![Val::N(0.0); rule.frame];
-                let mut vals = Vec::new();
-                let mut ids = Vec::new();
-                let mut test = |val: Val| {
-                    frame[rule.elem_slot as usize] = val;
-                    match &rule.cond {
+                let mut frame = vec![Val::N(0.0); frame_len];
+                let (mut a, mut b): (Part, Part) = Default::default();
+                let mut test = |r: &Rule, val: Val| {
+                    frame[r.elem_slot as usize] = val;
+                    match &r.cond {
                         Some(c) => matches!(ev.eval(c, &mut frame), Val::B(true)),
                         None => true,
                     }
@@ -332,8 +345,8 @@ impl Grammar {
                                     hs.iter().any(|h| mesh.face(h.twin()).is_none()),
                                     hs.iter().any(|h| mesh.is_block_edge(h.edge())),
                                 );
-                                if test(val) {
-                                    vals.push(val);
+                                if test(rule, val) {
+                                    a.0.push(val);
                                 }
                             }
                         }
@@ -341,9 +354,17 @@ impl Grammar {
                     Op::EdgeSplit | Op::BoundarySplit | Op::Flip => {
                         let want_boundary = rule.op == Op::BoundarySplit;
                         for e in (lo..hi).map(crate::mesh::EdgeId) {
-                            if !mesh.is_edge(e) || mesh.is_boundary_edge(e) != want_boundary {
+                            if !mesh.is_edge(e) {
                                 continue;
                             }
+                            let on_boundary = mesh.is_boundary_edge(e);
+                            let (r, out) = if on_boundary == want_boundary {
+                                (rule, &mut a)
+                            } else if let Some(o) = other {
+                                (o, &mut b)
+                            } else {
+                                continue;
+                            };
                             // A boundary edge runs the way its face does.
                             let h = e.halfedge();
                             let h = if mesh.face(h).is_none() { h.twin() } else { h };
@@ -351,13 +372,13 @@ impl Grammar {
                                 mesh.from(h),
                                 mesh.to(h),
                                 mesh.edge_level(e),
-                                want_boundary,
+                                on_boundary,
                                 mesh.is_block_edge(e),
                                 mesh.is_transversal_edge(e),
                             );
-                            if test(val) {
-                                vals.push(val);
-                                ids.push(e);
+                            if test(r, val) {
+                                out.0.push(val);
+                                out.1.push(e);
                             }
                         }
                     }
@@ -371,26 +392,29 @@ impl Grammar {
                                 VertexContext::Boundary => mesh.is_boundary_vertex(v),
                                 VertexContext::Interior => !mesh.is_boundary_vertex(v),
                             };
-                            if ok && test(Val::V(v)) {
-                                vals.push(Val::V(v));
+                            if ok && test(rule, Val::V(v)) {
+                                a.0.push(Val::V(v));
                             }
                         }
                     }
                 }
-                (vals, ids)
+                (a, b)
             })
             .collect();
-        let mut vals = Vec::with_capacity(parts.iter().map(|p| p.0.len()).sum());
-        let mut edge_ids = Vec::with_capacity(parts.iter().map(|p| p.1.len()).sum());
-        for (v, e) in parts {
-            vals.extend(v);
-            edge_ids.extend(e);
-        }
-        Matches {
-            current,
-            vals,
-            edge_ids,
-        }
+        let join = |pick: &dyn Fn(&(Part, Part)) -> &Part| {
+            let mut vals = Vec::with_capacity(parts.iter().map(|p| pick(p).0.len()).sum());
+            let mut edge_ids = Vec::with_capacity(parts.iter().map(|p| pick(p).1.len()).sum());
+            for p in &parts {
+                vals.extend_from_slice(&pick(p).0);
+                edge_ids.extend_from_slice(&pick(p).1);
+            }
+            Matches {
+                current,
+                vals,
+                edge_ids,
+            }
+        };
+        (join(&|p| &p.0), join(&|p| &p.1))
     }
 
     /// Evaluates `assign` for elements `0..n` in parallel, `bind` setting
@@ -455,8 +479,7 @@ impl Grammar {
             });
             match pair {
                 Some(next) => {
-                    let a = self.find_matches(rule, mesh);
-                    let b = self.find_matches(next, mesh);
+                    let (a, b) = self.find_matches_with(rule, Some(next), mesh);
                     self.apply_matched(rule, mesh, step, a)?;
                     self.apply_matched(next, mesh, step, b)?;
                     i += 2;
