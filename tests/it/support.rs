@@ -3,8 +3,9 @@
 
 use std::path::PathBuf;
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 use subgram::lang::Value;
+use subgram::mesh::PolygonSoup;
 use subgram::{DeriveOptions, Derived, Loaded};
 
 pub fn root() -> PathBuf {
@@ -202,4 +203,24 @@ pub fn open_polygon() -> Vec<DVec2> {
         .iter()
         .map(|&(x, y)| DVec2::new(x, y))
         .collect()
+}
+
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn unit(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The soup with every position moved at random, so that masks cannot hide.
+pub fn jitter(mut s: PolygonSoup, seed: u64) -> PolygonSoup {
+    let mut r = Rng(seed);
+    for p in &mut s.positions {
+        *p += DVec3::new(r.unit(), r.unit(), r.unit()) * 0.3 - 0.15;
+    }
+    s
 }

@@ -7,26 +7,6 @@ use subgram::mesh::{shapes, Mesh, PolygonSoup, VertexId};
 
 use crate::support::*;
 
-struct Rng(u64);
-
-impl Rng {
-    fn unit(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-/// The soup with every position moved at random, so that masks cannot hide.
-fn jitter(mut s: PolygonSoup, seed: u64) -> PolygonSoup {
-    let mut r = Rng(seed);
-    for p in &mut s.positions {
-        *p += DVec3::new(r.unit(), r.unit(), r.unit()) * 0.3 - 0.15;
-    }
-    s
-}
-
 fn grammar(file: &str) -> subgram::surface::Grammar {
     subgram::surface::load_file(&lsys(file), &[]).unwrap_or_else(|e| panic!("{}", e.render()))
 }

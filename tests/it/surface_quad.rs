@@ -21,19 +21,11 @@ fn run(file: &str, soup: &PolygonSoup, steps: usize) -> PolygonSoup {
 }
 
 fn cube() -> PolygonSoup {
-    let mut s = subgram::mesh::io::read(&lsys("meshes/cube.obj")).unwrap();
-    // Move every corner, so that no mask can hide behind symmetry.
-    let mut x = 0x9E37_79B9_7F4A_7C15u64;
-    for p in &mut s.positions {
-        let mut r = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        *p += DVec3::new(r(), r(), r()) * 0.3;
-    }
-    s
+    // Every corner moved, so that no mask can hide behind symmetry.
+    jitter(
+        subgram::mesh::io::read(&lsys("meshes/cube.obj")).unwrap(),
+        0x9E37_79B9_7F4A_7C15,
+    )
 }
 
 /// For every corner of every polygon, `rule(polygon positions, corner
@@ -144,17 +136,7 @@ fn doo_sabin_grammar_on_triangles_is_the_averaging_form() {
 /// (a + 2b + c)/4 (Peters).
 #[test]
 fn dual_schemes_on_triangle_meshes() {
-    let mut base = shapes::icosahedron();
-    let mut x = 0x2545_F491_4F6C_DD1Du64;
-    for p in &mut base.positions {
-        let mut r = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        *p += DVec3::new(r(), r(), r()) * 0.2;
-    }
+    let base = jitter(shapes::icosahedron(), 0x2545_F491_4F6C_DD1D);
     let ds = run("surfaces/doo-sabin.lsys", &base, 1);
     // A face per face (20), edge (30) and vertex (12).
     assert_eq!(ds.faces.len(), 62);
