@@ -335,6 +335,15 @@ impl<'g> Compiler<'g> {
             }
             c.compile(&args[0])
         };
+        // The one argument, which must be one of `allowed`; else `what`.
+        let element = |c: &mut Self, allowed: &[T], what: &str| -> Result<Box<X>, Diagnostic> {
+            let (x, t) = one(c)?;
+            if allowed.contains(&t) {
+                Ok(Box::new(x))
+            } else {
+                err(span, what)
+            }
+        };
         let math1: Option<fn(f64) -> f64> = match name {
             "cos" => Some(f64::cos),
             "sin" => Some(f64::sin),
@@ -380,27 +389,22 @@ impl<'g> Compiler<'g> {
                 }
                 Ok((X::Level(Box::new(x)), T::Num))
             }
-            "pos" => {
-                let (x, t) = one(self)?;
-                if t != T::Vertex {
-                    return err(span, "`pos` takes a vertex");
-                }
-                Ok((X::Pos(Box::new(x)), T::Vec))
-            }
-            "valence" | "deg" => {
-                let (x, t) = one(self)?;
-                if t != T::Vertex {
-                    return err(span, format!("`{name}` takes a vertex"));
-                }
-                Ok((X::Valence(Box::new(x)), T::Num))
-            }
-            "boundary" => {
-                let (x, t) = one(self)?;
-                if !matches!(t, T::Vertex | T::Edge | T::Face) {
-                    return err(span, "`boundary` takes a vertex, an edge or a face");
-                }
-                Ok((X::IsBoundary(Box::new(x)), T::Bool))
-            }
+            "pos" => Ok((
+                X::Pos(element(self, &[T::Vertex], "`pos` takes a vertex")?),
+                T::Vec,
+            )),
+            "valence" | "deg" => Ok((
+                X::Valence(element(self, &[T::Vertex], &format!("`{name}` takes a vertex"))?),
+                T::Num,
+            )),
+            "boundary" => Ok((
+                X::IsBoundary(element(
+                    self,
+                    &[T::Vertex, T::Edge, T::Face],
+                    "`boundary` takes a vertex, an edge or a face",
+                )?),
+                T::Bool,
+            )),
             "block" => {
                 let (x, t) = one(self)?;
                 if !matches!(t, T::Edge | T::Face) {
@@ -413,40 +417,36 @@ impl<'g> Compiler<'g> {
                 self.block_used_at.get_or_insert(span);
                 Ok((X::IsBlock(Box::new(x)), T::Bool))
             }
-            "transversal" => {
-                let (x, t) = one(self)?;
-                if t != T::Edge {
-                    return err(
-                        span,
-                        "`transversal` takes an edge: true for an edge that an edge split drew to an opposite vertex",
-                    );
-                }
-                Ok((X::IsTransversal(Box::new(x)), T::Bool))
-            }
-            "tail" | "head" => {
-                let (x, t) = one(self)?;
-                if t != T::Edge {
-                    return err(span, format!("`{name}` takes an edge"));
-                }
-                Ok((X::EdgeEnd(name == "head", Box::new(x)), T::Vertex))
-            }
-            "bnext" | "bprev" => {
-                let (x, t) = one(self)?;
-                if t != T::Vertex {
-                    return err(span, format!("`{name}` takes a boundary vertex"));
-                }
-                Ok((X::BoundaryStep(name == "bnext", Box::new(x)), T::Vertex))
-            }
-            "new" => {
-                let (x, t) = one(self)?;
-                if t != T::Vertex {
-                    return err(
-                        span,
-                        "`new` takes a vertex: true for a vertex made in this step",
-                    );
-                }
-                Ok((X::IsNew(Box::new(x)), T::Bool))
-            }
+            "transversal" => Ok((
+                X::IsTransversal(element(
+                    self,
+                    &[T::Edge],
+                    "`transversal` takes an edge: true for an edge that an edge split drew to an opposite vertex",
+                )?),
+                T::Bool,
+            )),
+            "tail" | "head" => Ok((
+                X::EdgeEnd(
+                    name == "head",
+                    element(self, &[T::Edge], &format!("`{name}` takes an edge"))?,
+                ),
+                T::Vertex,
+            )),
+            "bnext" | "bprev" => Ok((
+                X::BoundaryStep(
+                    name == "bnext",
+                    element(self, &[T::Vertex], &format!("`{name}` takes a boundary vertex"))?,
+                ),
+                T::Vertex,
+            )),
+            "new" => Ok((
+                X::IsNew(element(
+                    self,
+                    &[T::Vertex],
+                    "`new` takes a vertex: true for a vertex made in this step",
+                )?),
+                T::Bool,
+            )),
             "center" | "centre" => {
                 let (x, t) = one(self)?;
                 if t != T::Vertex {
@@ -474,13 +474,13 @@ impl<'g> Compiler<'g> {
                 };
                 Ok((X::Set(k, Box::new(x)), T::Set))
             }
-            "verts" => {
-                let (x, t) = one(self)?;
-                if !matches!(t, T::Edge | T::Face) {
-                    return err(span, "`verts` takes an edge or a face");
-                }
-                Ok((X::Set(SetKind::Verts, Box::new(x)), T::Set))
-            }
+            "verts" => Ok((
+                X::Set(
+                    SetKind::Verts,
+                    element(self, &[T::Edge, T::Face], "`verts` takes an edge or a face")?,
+                ),
+                T::Set,
+            )),
             "avg" => {
                 let (x, t) = one(self)?;
                 match t {
