@@ -344,6 +344,21 @@ impl Mesh {
                 .flat_map(|&g| self.face_halfedges(g))
                 .filter(|&h| region(&mut parent, h.twin()) != Some(r))
                 .collect();
+            // Only a basic block (two triangles) or a dual block (a fan
+            // whose centre is on every face and not on the border) becomes
+            // one polygon; any other region keeps its triangles.
+            let block_shape = !border.is_empty()
+                && (faces.len() == 2 || {
+                    let first = self.face_vertices(faces[0]);
+                    first.iter().any(|&c| {
+                        faces.iter().all(|&g| self.face_vertices(g).contains(&c))
+                            && border.iter().all(|&h| self.from(h) != c && self.to(h) != c)
+                    })
+                });
+            if !block_shape {
+                polygons.extend(faces.iter().map(|&g| self.face_vertices(g).to_vec()));
+                continue;
+            }
             let mut loop_vs = Vec::with_capacity(border.len());
             let mut h = border[0];
             let mut ok = true;

@@ -161,6 +161,10 @@ pub enum BlockSplit {
     /// √2 bisection on 4-8 meshes (Fig. 8): the block's four external
     /// edges become the internal edges of the next blocks.
     Bisection,
+    /// Dual quadrisection (Fig. 12b): blocks are fans of triangles around
+    /// a centre; splitting an internal edge marks the edges at the new
+    /// vertex, as in primal quadrisection.
+    Dual,
 }
 
 impl Mesh {

@@ -211,7 +211,7 @@ impl Mesh {
         self.f_level[f2.index()] = l;
         if was_block {
             match self.block_split {
-                BlockSplit::Quadrisection => {
+                BlockSplit::Quadrisection | BlockSplit::Dual => {
                     // A basic block split at its centre: its four spokes
                     // become the internal edges of the four quads that
                     // splitting the block's external edges completes

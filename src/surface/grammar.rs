@@ -91,7 +91,8 @@ pub struct GrammarFile {
     pub length: Option<Expr>,
     pub functions: Vec<FunctionDef>,
     pub rules: Vec<RuleDef>,
-    /// `blocks: bisection;` (4-8 meshes) or `blocks: quadrisection;`.
+    /// `blocks: bisection;` (4-8 meshes), `blocks: dual;` (Doo-Sabin,
+    /// Peters) or `blocks: quadrisection;`.
     pub block_split: Option<(BlockSplit, Span)>,
 }
 
@@ -245,7 +246,8 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
             let how = match p.peek().map(|t| &t.tok) {
                 Some(Tok::Ident(w)) if w == "quadrisection" => BlockSplit::Quadrisection,
                 Some(Tok::Ident(w)) if w == "bisection" => BlockSplit::Bisection,
-                _ => return p.err("`quadrisection` or `bisection` after `blocks:`"),
+                Some(Tok::Ident(w)) if w == "dual" => BlockSplit::Dual,
+                _ => return p.err("`quadrisection`, `bisection` or `dual` after `blocks:`"),
             };
             p.pos += 1;
             p.expect(";", "after the block refinement")?;

@@ -47,9 +47,9 @@ pub struct Grammar {
     /// Where the grammar first asks `block(e)`: such a grammar is for
     /// tri-quad meshes. Without it, quads are read as two triangles.
     pub block_used_at: Option<Span>,
-    /// Where the grammar first asks `center(v)`: a dual scheme, which
-    /// needs a closed mesh.
-    pub centre_used_at: Option<Span>,
+    /// Where the grammar says it is a dual scheme (`blocks: dual;`, or
+    /// its first `center(v)`): it needs a closed mesh.
+    pub dual_at: Option<Span>,
     /// What splitting a block's internal edge does (`blocks:`).
     pub block_split: BlockSplit,
     /// A rule that would make more faces than this stops the run with an
@@ -172,7 +172,10 @@ pub fn compile(
         length,
         sources,
         block_used_at: block_used_at.or(file.block_split.map(|(_, s)| s)),
-        centre_used_at,
+        dual_at: match file.block_split {
+            Some((BlockSplit::Dual, at)) => Some(at),
+            _ => centre_used_at,
+        },
         block_split: file
             .block_split
             .map_or(BlockSplit::Quadrisection, |(b, _)| b),
@@ -252,13 +255,13 @@ impl Grammar {
                 }
             }
         }
-        if let Some(span) = self.centre_used_at {
+        if let Some(span) = self.dual_at {
             if let Some(v) = mesh.vertices().find(|&v| mesh.is_boundary_vertex(v)) {
                 return Err(RunError {
                     span: Some(span),
                     message: format!(
-                        "this grammar asks `center(v)`, a dual scheme, which runs on closed meshes \
-                         only; vertex {v} is on a boundary"
+                        "this grammar is a dual scheme, which runs on closed meshes only; \
+                         vertex {v} is on a boundary"
                     ),
                 });
             }

@@ -148,6 +148,47 @@ fn dual_schemes_on_triangle_meshes() {
     assert!(d < 1e-12, "{d}");
 }
 
+/// The output polygons themselves: one Doo-Sabin step on the cube gives,
+/// for every input face, a polygon through that face's corner points in
+/// the face's own order (so with its orientation); for every edge a quad,
+/// and for every vertex a triangle.
+#[test]
+fn doo_sabin_polygons_follow_the_input_faces() {
+    let base = cube();
+    let one = run("surfaces/doo-sabin.lsys", &base, 1);
+    let want = per_corner(&base, doo_sabin_average);
+    // Output vertex index of each (face, corner) point.
+    let index: Vec<usize> = want
+        .iter()
+        .map(|w| {
+            let (i, d) = one
+                .positions
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (i, p.distance(*w)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap();
+            assert!(d < 1e-12);
+            i
+        })
+        .collect();
+    let mut k = 0;
+    for f in &base.faces {
+        let ring: Vec<u32> = (0..f.len()).map(|j| index[k + j] as u32).collect();
+        k += f.len();
+        let found = one.faces.iter().any(|g| {
+            g.len() == ring.len()
+                && (0..g.len()).any(|r| (0..g.len()).all(|j| g[(r + j) % g.len()] == ring[j]))
+        });
+        assert!(
+            found,
+            "face {f:?}: no output polygon {ring:?} in the same order"
+        );
+    }
+    let sizes = |n: usize| one.faces.iter().filter(|g| g.len() == n).count();
+    assert_eq!((sizes(4), sizes(3)), (6 + 12, 8));
+}
+
 #[test]
 fn peters_grammar_is_two_mid_edge_steps() {
     let base = cube();
@@ -166,12 +207,55 @@ fn peters_grammar_is_two_mid_edge_steps() {
 
 #[test]
 fn dual_schemes_refuse_open_meshes() {
-    let g = grammar("surfaces/doo-sabin.lsys");
-    let mut m = Mesh::from_soup(&shapes::quad_grid(3, 3)).unwrap();
-    let e = g.run(&mut m, 1, |_| {}).unwrap_err();
-    let text = g.render_error(&e);
-    assert!(text.contains("runs on closed meshes only"), "{text}");
-    assert!(text.contains("is on a boundary"), "{text}");
+    for file in ["surfaces/doo-sabin.lsys", "surfaces/peters.lsys"] {
+        let g = grammar(file);
+        let mut m = Mesh::from_soup(&shapes::quad_grid(3, 3)).unwrap();
+        let before = m.clone();
+        let e = g.run(&mut m, 1, |_| {}).unwrap_err();
+        let text = g.render_error(&e);
+        assert!(text.contains("runs on closed meshes only"), "{text}");
+        assert!(text.contains("is on a boundary"), "{text}");
+        assert!(
+            text.contains("blocks: dual"),
+            "the caret is on the declaration: {text}"
+        );
+        assert_eq!(m, before, "refused before anything changed");
+    }
+}
+
+/// Output merges only basic blocks (two triangles) and dual blocks (fans
+/// around a centre); other regions joined by block edges keep their
+/// triangles, so the file is a valid mesh. A region that covers a whole
+/// closed surface has no border at all.
+#[test]
+fn output_merges_only_block_shaped_regions() {
+    let cube = subgram::mesh::io::read(&lsys("meshes/cube.obj")).unwrap();
+    for (text, steps) in [
+        // Every edge ends up a block edge: one region, no border.
+        (
+            "F(f) -> V(v = avg(f)) || E^3 F^3;\nE(e; !block(e)) | F^2 -> E || F^2;\n",
+            2,
+        ),
+        // Regions of many triangles that are neither blocks nor fans.
+        (
+            "F(f; block(f)) -> V(v = avg(f)) || E^3 F^3;\nE(e; !block(e)) | F^2 -> E || F^2;\n",
+            1,
+        ),
+    ] {
+        let g = subgram::surface::load_str("g.lsys", text, &[])
+            .unwrap_or_else(|e| panic!("{}", e.render()));
+        let mut m = Mesh::from_soup(&cube).unwrap();
+        g.run(&mut m, steps, |_| {}).unwrap();
+        let soup = m.to_quad_soup();
+        let back = Mesh::from_soup(&soup).unwrap_or_else(|e| panic!("{text}: {}", e.message));
+        back.validate().unwrap();
+        let info = back.info();
+        assert_eq!(
+            (info.boundary_loops, info.euler_characteristic),
+            (0, 2),
+            "{text}"
+        );
+    }
 }
 
 /// Paper 004's two-scale coefficients of the C4 four-directional box
@@ -245,7 +329,7 @@ fn block_rules_are_checked() {
     .unwrap_err()
     .render();
     assert!(e.contains("g.lsys:1:9"), "{e}");
-    assert!(e.contains("`quadrisection` or `bisection`"), "{e}");
+    assert!(e.contains("`quadrisection`, `bisection` or `dual`"), "{e}");
     let e = subgram::surface::load_str(
         "g.lsys",
         "F(f) -> V(v = avg(f)) || E^3 F^3;\ninit: E(e; block(e)) | F^2 -> V(v = avg(e)) || E^4 F^4;\n",
@@ -255,10 +339,11 @@ fn block_rules_are_checked() {
     .render();
     assert!(e.contains("g.lsys:2:1"), "{e}");
     assert!(e.contains("come before the other rules"), "{e}");
-    let e = subgram::surface::load_str("g.lsys", "V(v; center(e)) -> V(v = v);\n", &[])
+    let e = subgram::surface::load_str("g.lsys", "E(e; center(e)) | F^2 -> E || F^2;\n", &[])
         .unwrap_err()
         .render();
-    assert!(e.contains("unknown identifier `e`"), "{e}");
+    assert!(e.contains("g.lsys:1:6"), "{e}");
+    assert!(e.contains("`center` takes a vertex"), "{e}");
 }
 
 /// Every grammar in lsystems/surfaces runs on the mesh it names, for its
