@@ -18,14 +18,12 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 
+from xcheck import read_obj as read_obj_list  # the same folder
+
+
 def read_obj(path):
-    v, f = [], []
-    for line in open(path):
-        if line.startswith("v "):
-            v.append([float(x) for x in line.split()[1:4]])
-        elif line.startswith("f "):
-            f.append([int(x.split("/")[0]) - 1 for x in line.split()[1:]])
-    return np.array(v), np.array(f, dtype=np.int64)
+    v, f = read_obj_list(path)
+    return v, np.array(f, dtype=np.int64)
 
 
 def best_of(fn, runs=7):
