@@ -66,6 +66,6 @@ fn value_json(v: &Value) -> Json {
         Value::V3(p) => json!([p.x, p.y, p.z]),
         Value::Struct(fs) => Json::Array(fs.iter().map(value_json).collect()),
         Value::Str(s) => json!(s.as_ref()),
-        Value::Void => Json::Null,
+        Value::Void | Value::Elem(_) => Json::Null,
     }
 }

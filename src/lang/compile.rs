@@ -8,29 +8,87 @@ use std::collections::HashMap;
 use crate::syntax::ast::{self, BinOp, ExprKind, Init, Item, Section, UnOp};
 use crate::syntax::span::{Diagnostic, Span};
 
+use super::builtins::{self, HostTable, SigError, LIBRARY, WORD_HOST};
 use super::ir::*;
 use super::modules::{Alphabet, Signature, Sym};
 use super::value::{StructDef, Ty, Value};
 
 pub fn compile(file: &ast::File) -> Result<Program, Vec<Diagnostic>> {
-    let mut c = Compiler {
-        alphabet: Alphabet::new(),
-        structs: Vec::new(),
-        typedefs: HashMap::new(),
-        globals: Vec::new(),
-        global_names: HashMap::new(),
-        diags: Vec::new(),
-    };
+    let mut c = Compiler::new(&WORD_HOST, Vec::new());
     c.declarations(file);
     if file.abop {
         c.declare_from_use(file);
     }
-    let program = c.rules_and_directives(file);
+    let mut program = c.rules_and_directives(file);
     if c.diags.is_empty() {
+        c.warnings.sort_by_key(|d| (d.span.file.0, d.span.start));
+        program.warnings = c.warnings;
         Ok(program)
     } else {
         c.diags.sort_by_key(|d| (d.span.file.0, d.span.start));
         Err(c.diags)
+    }
+}
+
+/// Compiles the guards and successor expressions of rules on a topology
+/// other than words (a surface grammar's conditions and assignments): the
+/// same checker as curve bodies, with the topology's elements and host
+/// built-ins from its [`HostTable`], and `define` functions inlined.
+pub struct RuleCompiler {
+    c: Compiler,
+    scope: Scope,
+}
+
+impl RuleCompiler {
+    pub fn new(host: &'static HostTable, functions: &[ast::Define]) -> RuleCompiler {
+        RuleCompiler {
+            c: Compiler::new(host, functions.to_vec()),
+            scope: Scope::rule(),
+        }
+    }
+
+    /// A fresh rule: no locals bound, the inlining budget renewed.
+    pub fn start_rule(&mut self) {
+        self.scope = Scope::rule();
+        self.c.inlined = 0;
+    }
+
+    /// Binds `name` to a new local of type `ty`: the predecessor's element.
+    pub fn bind(&mut self, name: &str, ty: Ty) -> u16 {
+        self.scope.declare(name, ty)
+    }
+
+    /// Compiles `e`, which must have type `want` (an element used as a
+    /// number or a vector reads as one, a number converts as in C).
+    pub fn expr_as(&mut self, e: &ast::Expr, want: Ty) -> Option<Ex> {
+        let (ex, ty) = self.c.expr(e, &mut self.scope)?;
+        if want == Ty::Bool {
+            return self.c.condition_of(ex, ty, e.span);
+        }
+        self.c.coerce(ex, ty, want, e.span)
+    }
+
+    /// Compiles `e` whatever its type.
+    pub fn expr(&mut self, e: &ast::Expr) -> Option<(Ex, Ty)> {
+        self.c.expr(e, &mut self.scope)
+    }
+
+    /// The locals the rule compiled so far needs.
+    pub fn frame_size(&self) -> usize {
+        self.scope.max as usize
+    }
+
+    /// The errors and the warnings found so far, taken.
+    pub fn take_diagnostics(&mut self) -> (Vec<Diagnostic>, Vec<Diagnostic>) {
+        (
+            std::mem::take(&mut self.c.diags),
+            std::mem::take(&mut self.c.warnings),
+        )
+    }
+
+    /// A type's name as messages give it.
+    pub fn type_name(&self, ty: Ty) -> String {
+        self.c.type_name(ty)
     }
 }
 
@@ -41,7 +99,20 @@ struct Compiler {
     globals: Vec<GlobalVar>,
     global_names: HashMap<String, u16>,
     diags: Vec<Diagnostic>,
+    warnings: Vec<Diagnostic>,
+    /// The topology's elements and built-ins.
+    host: &'static HostTable,
+    /// `define` functions, inlined where they are called.
+    functions: Vec<ast::Define>,
+    /// Functions being inlined, innermost last (they may not recurse).
+    inlining: Vec<usize>,
+    /// Calls inlined in the current rule.
+    inlined: usize,
 }
+
+/// Function calls are inlined; past this many in one rule, functions that
+/// call each other twice over would take exponential time.
+const MAX_INLINED_CALLS: usize = 10_000;
 
 /// Local variables of one body, with nested block scopes.
 #[derive(Default)]
@@ -54,6 +125,9 @@ struct Scope {
     max: u16,
     loops: u32,
     in_rule: bool,
+    /// Names before this index are not visible (the caller's locals,
+    /// inside an inlined function's body).
+    barrier: usize,
 }
 
 impl Scope {
@@ -82,7 +156,7 @@ impl Scope {
     }
 
     fn lookup(&self, name: &str) -> Option<(Ty, u16)> {
-        self.vars
+        self.vars[self.barrier..]
             .iter()
             .rev()
             .find(|(n, _, _)| n == name)
@@ -93,8 +167,71 @@ impl Scope {
 type Typed = Option<(Ex, Ty)>;
 
 impl Compiler {
+    fn new(host: &'static HostTable, functions: Vec<ast::Define>) -> Compiler {
+        Compiler {
+            alphabet: Alphabet::new(),
+            structs: Vec::new(),
+            typedefs: HashMap::new(),
+            globals: Vec::new(),
+            global_names: HashMap::new(),
+            diags: Vec::new(),
+            warnings: Vec::new(),
+            host,
+            functions,
+            inlining: Vec::new(),
+            inlined: 0,
+        }
+    }
+
     fn err(&mut self, span: Span, msg: impl Into<String>) {
         self.diags.push(Diagnostic::new(span, msg));
+    }
+
+    /// Warns when `ex` is a division of integer constants that truncates
+    /// and its value is about to be used as a floating-point number.
+    fn check_truncation(&mut self, ex: &Ex) {
+        if let Ex::Bin(BinOp::Div, a, b, span) = ex {
+            if let (Ex::Const(Value::Int(x)), Ex::Const(Value::Int(y))) = (&**a, &**b) {
+                if *y != 0 && x % y != 0 {
+                    let at = Diagnostic::new(
+                        *span,
+                        format!(
+                            "`{x}/{y}` is {} in integer arithmetic; write {x}.0/{y}",
+                            x / y
+                        ),
+                    );
+                    if !self.warnings.contains(&at) {
+                        self.warnings.push(at);
+                    }
+                }
+            }
+        }
+    }
+
+    /// An element in arithmetic reads as its value (a mesh vertex as its
+    /// position); anything else is left as it is.
+    fn arith(&self, ex: Ex, ty: Ty, span: Span) -> (Ex, Ty) {
+        if let Ty::Elem(k) = ty {
+            if let Some((f, t)) = (self.host.arith)(k) {
+                return (Ex::Call(f, vec![ex], span), t);
+            }
+        }
+        (ex, ty)
+    }
+
+    /// A checked expression used as a condition.
+    fn condition_of(&mut self, ex: Ex, ty: Ty, span: Span) -> Option<Ex> {
+        if !ty.is_numeric() {
+            self.err(
+                span,
+                format!(
+                    "expected a condition (a number or bool), found {}",
+                    self.type_name(ty)
+                ),
+            );
+            return None;
+        }
+        Some(ex)
     }
 
     fn type_name(&self, ty: Ty) -> String {
@@ -107,6 +244,7 @@ impl Compiler {
             Ty::Struct(i) => self.structs[i as usize].name.clone(),
             Ty::Str => "string".into(),
             Ty::Void => "void".into(),
+            Ty::Elem(k) => self.host.element_name(k).into(),
         }
     }
 
@@ -260,6 +398,7 @@ impl Compiler {
             angle: None,
             rules: Vec::new(),
             control: Vec::new(),
+            warnings: Vec::new(),
         };
         let mut section = Section::Productions;
         let mut group = 0i64;
@@ -474,7 +613,18 @@ impl Compiler {
         if from == to {
             return Some(ex);
         }
+        let (ex, from) = if matches!(to, Ty::Elem(_)) {
+            (ex, from)
+        } else {
+            self.arith(ex, from, span)
+        };
+        if from == to {
+            return Some(ex);
+        }
         if from.is_numeric() && to.is_numeric() {
+            if from == Ty::Int && to == Ty::Float {
+                self.check_truncation(&ex);
+            }
             return Some(Ex::Convert(to, Box::new(ex)));
         }
         self.err(
@@ -883,17 +1033,7 @@ impl Compiler {
 
     fn condition(&mut self, e: &ast::Expr, scope: &mut Scope) -> Option<Ex> {
         let (ex, ty) = self.expr(e, scope)?;
-        if !ty.is_numeric() {
-            self.err(
-                e.span,
-                format!(
-                    "expected a condition (a number or bool), found {}",
-                    self.type_name(ty)
-                ),
-            );
-            return None;
-        }
-        Some(ex)
+        self.condition_of(ex, ty, e.span)
     }
 
     fn place(&mut self, e: &ast::Expr, scope: &mut Scope) -> Option<Place> {
@@ -986,6 +1126,9 @@ impl Compiler {
                 if let Some(&g) = self.global_names.get(n) {
                     return Some((Ex::Global(g), self.globals[g as usize].ty));
                 }
+                if let Some((f, ty)) = self.host.value(n) {
+                    return Some((Ex::Call(f, Vec::new(), span), ty));
+                }
                 let c = match n.as_str() {
                     "true" => Value::Bool(true),
                     "false" => Value::Bool(false),
@@ -1011,11 +1154,12 @@ impl Compiler {
             }
             ExprKind::Unary(op, a) => {
                 let (x, t) = self.expr(a, scope)?;
+                let (x, t) = self.arith(x, t, a.span);
                 match op {
                     UnOp::Plus if t.is_numeric() || t.is_vector() => Some((x, t)),
                     UnOp::Neg if t.is_numeric() || t.is_vector() => {
                         let t = if t == Ty::Bool { Ty::Int } else { t };
-                        Some((Ex::Neg(Box::new(x)), t))
+                        Some((fold_unary(Ex::Neg(Box::new(x))), t))
                     }
                     UnOp::Not if t.is_numeric() => Some((Ex::Not(Box::new(x)), Ty::Bool)),
                     _ => {
@@ -1039,6 +1183,8 @@ impl Compiler {
                 let l = self.expr(a, scope);
                 let r = self.expr(b, scope);
                 let ((lx, lt), (rx, rt)) = (l?, r?);
+                let (lx, lt) = self.arith(lx, lt, a.span);
+                let (rx, rt) = self.arith(rx, rt, b.span);
                 let Some(ty) = binary_type(*op, lt, rt) else {
                     self.err(
                         span,
@@ -1051,6 +1197,14 @@ impl Compiler {
                     );
                     return None;
                 };
+                if !matches!(ty, Ty::Int | Ty::Bool) {
+                    self.check_truncation(&lx);
+                    self.check_truncation(&rx);
+                }
+                if let Some(c) = fold_constants(*op, &lx, &rx) {
+                    return Some((Ex::Convert(ty, Box::new(c)), ty))
+                        .map(|(x, t)| (fold_unary(x), t));
+                }
                 let ex = match op {
                     BinOp::And => Ex::Logic(true, Box::new(lx), Box::new(rx)),
                     BinOp::Or => Ex::Logic(false, Box::new(lx), Box::new(rx)),
@@ -1118,6 +1272,11 @@ impl Compiler {
                 let l = self.expr(a, scope);
                 let r = self.expr(b, scope);
                 let (c, (lx, lt), (rx, rt)) = (c?, l?, r?);
+                let ((lx, lt), (rx, rt)) = if lt == rt {
+                    ((lx, lt), (rx, rt))
+                } else {
+                    (self.arith(lx, lt, a.span), self.arith(rx, rt, b.span))
+                };
                 let ty = if lt == rt {
                     lt
                 } else if lt.is_numeric() && rt.is_numeric() {
@@ -1175,9 +1334,8 @@ impl Compiler {
                 Some((Ex::Field(Box::new(x), idx), ft))
             }
             ExprKind::Method(recv, name, args) => self.method(recv, name, args, span, scope),
-            ExprKind::Gather { op, .. } => {
-                self.err(op.span, format!("`{}(... in ...)` sums over a mesh neighbourhood and belongs in a surface grammar", op.text));
-                None
+            ExprKind::Gather { op, var, set, cond } => {
+                self.gather(op, Some(var), set, cond.as_deref(), scope)
             }
             ExprKind::Call(name, args) => self.call(name, args, span, scope),
             ExprKind::InContext(kind, pats) => {
@@ -1281,6 +1439,10 @@ impl Compiler {
         span: Span,
         scope: &mut Scope,
     ) -> Typed {
+        let n = name.text.as_str();
+        if let Some(f) = self.functions.iter().position(|d| d.name == n) {
+            return self.inline(f, args, span, scope);
+        }
         let mut typed = Vec::new();
         let mut ok = true;
         for a in args {
@@ -1292,191 +1454,293 @@ impl Compiler {
         if !ok {
             return None;
         }
-        let n = name.text.as_str();
-        let arity_err = |c: &mut Compiler, want: usize| {
-            c.err(
-                span,
-                format!(
-                    "`{n}` takes {want} argument(s), but {} were given",
-                    typed.len()
-                ),
-            );
-        };
         if matches!(n, "V2f" | "V2d" | "V3f" | "V3d") {
             let ty = if n.starts_with("V2") { Ty::V2 } else { Ty::V3 };
             let ex = self.construct(ty, typed, args, span)?;
             return Some((ex, ty));
         }
-        let math1: Option<fn(f64) -> f64> = match n {
-            "sin" => Some(f64::sin),
-            "cos" => Some(f64::cos),
-            "tan" => Some(f64::tan),
-            "asin" => Some(f64::asin),
-            "acos" => Some(f64::acos),
-            "atan" => Some(f64::atan),
-            "sinh" => Some(f64::sinh),
-            "cosh" => Some(f64::cosh),
-            "tanh" => Some(f64::tanh),
-            "sqrt" => Some(f64::sqrt),
-            "cbrt" => Some(f64::cbrt),
-            "exp" => Some(f64::exp),
-            "log" => Some(f64::ln),
-            "log10" => Some(f64::log10),
-            "log2" => Some(f64::log2),
-            "fabs" => Some(f64::abs),
-            "floor" => Some(f64::floor),
-            "ceil" => Some(f64::ceil),
-            "round" => Some(f64::round),
-            "trunc" => Some(f64::trunc),
-            _ => None,
-        };
-        let math2: Option<fn(f64, f64) -> f64> = match n {
-            "atan2" => Some(f64::atan2),
-            "pow" => Some(f64::powf),
-            "fmod" => Some(|a: f64, b: f64| a % b),
-            "hypot" => Some(f64::hypot),
-            "fmin" => Some(f64::min),
-            "fmax" => Some(f64::max),
-            _ => None,
-        };
-        let numeric_args = |c: &mut Compiler, typed: &Vec<(Ex, Ty)>| -> bool {
-            for ((_, t), a) in typed.iter().zip(args) {
-                if !t.is_numeric() {
-                    c.err(
-                        a.span,
-                        format!(
-                            "type error: `{n}` expects a number, found {}",
-                            c.type_name(*t)
-                        ),
-                    );
-                    return false;
-                }
+        // `avg(ring(v))`: an aggregate over a whole set.
+        if let ("sum" | "avg" | "count", [(_, Ty::Elem(k))]) = (n, typed.as_slice()) {
+            if (self.host.members)(*k).is_some() {
+                let (set, ty) = typed.pop()?;
+                return self.fold(name, set, ty, args[0].span, None, None, scope);
             }
-            true
-        };
-        if let Some(f) = math1 {
-            if typed.len() != 1 {
-                arity_err(self, 1);
-                return None;
-            }
-            if !numeric_args(self, &typed) {
-                return None;
-            }
-            let a = typed.pop()?.0;
-            return Some((Ex::Call(Func::Math1(f), vec![a], span), Ty::Float));
         }
-        if let Some(f) = math2 {
-            if typed.len() != 2 {
-                arity_err(self, 2);
-                return None;
-            }
-            if !numeric_args(self, &typed) {
-                return None;
-            }
-            let exs = typed.into_iter().map(|(e, _)| e).collect();
-            return Some((Ex::Call(Func::Math2(f), exs, span), Ty::Float));
+        let Some(b) = builtins::lookup(n, self.host) else {
+            let hint = if self.alphabet.lookup(n).is_some() {
+                format!(": `{n}` is a module; modules go after `produce`, not in expressions")
+            } else {
+                String::new()
+            };
+            self.err(name.span, format!("unknown function `{n}`{hint}"));
+            return None;
+        };
+        let library = LIBRARY.iter().any(|l| l.name == n);
+        if library {
+            // The library takes numbers and vectors: elements read as
+            // their values.
+            typed = typed
+                .into_iter()
+                .zip(args)
+                .map(|((x, t), a)| self.arith(x, t, a.span))
+                .collect();
         }
-        match n {
-            "abs" | "min" | "max" => {
-                let want = if n == "abs" { 1 } else { 2 };
-                if typed.len() != want {
-                    arity_err(self, want);
-                    return None;
+        let tys: Vec<Ty> = typed.iter().map(|(_, t)| *t).collect();
+        match (b.resolve)(&tys) {
+            Ok((f, ty)) => {
+                if matches!(f, Func::Math1(_) | Func::Math2(_)) {
+                    for (x, _) in &typed {
+                        self.check_truncation(x);
+                    }
                 }
-                if !numeric_args(self, &typed) {
-                    return None;
-                }
-                let all_int = typed.iter().all(|(_, t)| *t == Ty::Int);
                 let exs = typed.into_iter().map(|(e, _)| e).collect();
-                let (f, ty) = match (n, all_int) {
-                    ("abs", true) => (Func::AbsInt, Ty::Int),
-                    ("abs", false) => (Func::Math1(f64::abs), Ty::Float),
-                    ("min", true) => (Func::MinInt, Ty::Int),
-                    ("min", false) => (Func::Math2(f64::min), Ty::Float),
-                    ("max", true) => (Func::MaxInt, Ty::Int),
-                    _ => (Func::Math2(f64::max), Ty::Float),
-                };
-                Some((Ex::Call(f, exs, span), ty))
+                Some((fold_unary(Ex::Call(f, exs, span)), ty))
             }
-            "Normalize" | "Length" => {
-                if typed.len() != 1 || !typed[0].1.is_vector() {
-                    self.err(span, format!("`{n}` takes one vector argument"));
-                    return None;
-                }
-                let (x, t) = typed.pop()?;
-                if n == "Length" {
-                    Some((Ex::Call(Func::Length, vec![x], span), Ty::Float))
-                } else {
-                    Some((Ex::Call(Func::Normalized, vec![x], span), t))
-                }
+            Err(SigError::Arity(want)) => {
+                self.err(
+                    span,
+                    format!(
+                        "`{n}` takes {want} argument(s), but {} were given",
+                        typed.len()
+                    ),
+                );
+                None
             }
-            "Dot" | "Cross" => {
-                if typed.len() != 2 || typed[0].1 != typed[1].1 || !typed[0].1.is_vector() {
-                    self.err(span, format!("`{n}` takes two vectors of the same type"));
-                    return None;
-                }
-                if n == "Cross" && typed[0].1 != Ty::V3 {
-                    self.err(span, "`Cross` takes two V3f vectors");
-                    return None;
-                }
-                let ty = if n == "Dot" { Ty::Float } else { Ty::V3 };
-                let f = if n == "Dot" { Func::Dot } else { Func::Cross };
-                Some((
-                    Ex::Call(f, typed.into_iter().map(|(e, _)| e).collect(), span),
-                    ty,
-                ))
+            Err(SigError::NotNumber(i)) => {
+                let found = self.type_name(tys[i]);
+                self.err(
+                    args[i].span,
+                    format!("type error: `{n}` expects a number, found {found}"),
+                );
+                None
             }
-            "StepNo" | "CurrentGroup" | "Forward" | "Backward" | "IsForward" | "Stop"
-            | "RunSimulation" | "PauseSimulation" | "DisplayFrame" | "Environment"
-            | "NoEnvironment" => {
-                if !typed.is_empty() {
-                    arity_err(self, 0);
-                    return None;
-                }
-                let (f, ty) = match n {
-                    "StepNo" => (Func::StepNo, Ty::Int),
-                    "CurrentGroup" => (Func::CurrentGroup, Ty::Int),
-                    "Forward" => (Func::Forward, Ty::Void),
-                    "Backward" => (Func::Backward, Ty::Void),
-                    "IsForward" => (Func::IsForward, Ty::Bool),
-                    "Stop" => (Func::Stop, Ty::Void),
-                    _ => (Func::NoOp, Ty::Void),
-                };
-                Some((Ex::Call(f, Vec::new(), span), ty))
-            }
-            "UseGroup" => {
-                if typed.len() != 1 {
-                    arity_err(self, 1);
-                    return None;
-                }
-                if !numeric_args(self, &typed) {
-                    return None;
-                }
-                Some((
-                    Ex::Call(Func::UseGroup, vec![typed.pop()?.0], span),
-                    Ty::Void,
-                ))
-            }
-            "ran" => {
-                if typed.len() != 1 {
-                    arity_err(self, 1);
-                    return None;
-                }
-                if !numeric_args(self, &typed) {
-                    return None;
-                }
-                Some((Ex::Call(Func::Ran, vec![typed.pop()?.0], span), Ty::Float))
-            }
-            _ => {
-                let hint = if self.alphabet.lookup(n).is_some() {
-                    format!(": `{n}` is a module; modules go after `produce`, not in expressions")
-                } else {
-                    String::new()
-                };
-                self.err(name.span, format!("unknown function `{n}`{hint}"));
+            Err(SigError::Message(m)) => {
+                self.err(span, m);
                 None
             }
         }
+    }
+
+    /// `sum(w in SET where COND)`: the variable is a local while the
+    /// condition is checked.
+    fn gather(
+        &mut self,
+        op: &ast::Name,
+        var: Option<&ast::Name>,
+        set: &ast::Expr,
+        cond: Option<&ast::Expr>,
+        scope: &mut Scope,
+    ) -> Typed {
+        let (sx, st) = self.expr(set, scope)?;
+        self.fold(op, sx, st, set.span, var, cond, scope)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn fold(
+        &mut self,
+        op: &ast::Name,
+        set: Ex,
+        set_ty: Ty,
+        set_span: Span,
+        var: Option<&ast::Name>,
+        cond: Option<&ast::Expr>,
+        scope: &mut Scope,
+    ) -> Typed {
+        let fold_op = match op.text.as_str() {
+            "sum" => FoldOp::Sum,
+            "avg" => FoldOp::Avg,
+            "count" => FoldOp::Count,
+            other => {
+                self.err(
+                    op.span,
+                    format!("unknown aggregate `{other}`: expected sum, avg or count"),
+                );
+                return None;
+            }
+        };
+        let member = match set_ty {
+            Ty::Elem(k) => (self.host.members)(k),
+            _ => None,
+        };
+        let Some(member) = member else {
+            let what = if self.host.elements.is_empty() {
+                format!("a {} has no sets to sum over", self.host.name)
+            } else {
+                format!(
+                    "`{}` sums over a set, such as `ring(v)`; this is {}",
+                    op.text,
+                    self.type_name(set_ty)
+                )
+            };
+            self.err(set_span, what);
+            return None;
+        };
+        let mark = (scope.vars.len(), scope.next);
+        let slot = scope.declare(var.map_or("", |v| v.text.as_str()), Ty::Elem(member));
+        let cond = match cond {
+            Some(c) => self.condition(c, scope).map(|x| Some(Box::new(x))),
+            None => Some(None),
+        };
+        let value = match fold_op {
+            FoldOp::Count => Some(None),
+            _ => {
+                let (x, t) = self.arith(Ex::Local(slot), Ty::Elem(member), op.span);
+                if t.is_numeric() || t.is_vector() {
+                    Some(Some((Box::new(x), t)))
+                } else {
+                    self.err(
+                        op.span,
+                        format!(
+                            "`{}` adds up values, but {} has no value to add",
+                            op.text,
+                            self.type_name(Ty::Elem(member))
+                        ),
+                    );
+                    None
+                }
+            }
+        };
+        scope.vars.truncate(mark.0);
+        scope.next = mark.1;
+        let (cond, value) = (cond?, value?);
+        let ty = match (&value, fold_op) {
+            (Some((_, t)), FoldOp::Sum) => *t,
+            (Some((_, t)), FoldOp::Avg) if t.is_vector() => *t,
+            (Some(_), FoldOp::Avg) => Ty::Float,
+            _ => Ty::Int,
+        };
+        Some((
+            Ex::Fold {
+                op: fold_op,
+                slot,
+                set: Box::new(set),
+                cond,
+                value,
+            },
+            ty,
+        ))
+    }
+
+    /// A call of a `define` function: the arguments bind fresh locals,
+    /// reserved before the arguments are compiled so that no argument's
+    /// own locals overwrite a parameter already set; then the body sees
+    /// only its parameters. The locals are free again after the call.
+    fn inline(&mut self, f: usize, args: &[ast::Expr], span: Span, scope: &mut Scope) -> Typed {
+        let def = self.functions[f].clone();
+        if def.params.len() != args.len() {
+            self.err(
+                span,
+                format!(
+                    "`{}` takes {} argument(s), but {} were given",
+                    def.name,
+                    def.params.len(),
+                    args.len()
+                ),
+            );
+            return None;
+        }
+        if self.inlining.contains(&f) {
+            self.err(
+                span,
+                format!("`{}` calls itself; functions may not recurse", def.name),
+            );
+            return None;
+        }
+        self.inlined += 1;
+        if self.inlined > MAX_INLINED_CALLS {
+            self.err(
+                span,
+                format!(
+                    "the functions called here expand to more than {MAX_INLINED_CALLS} calls; \
+                     name a shared value with a parameter instead of calling a function twice"
+                ),
+            );
+            return None;
+        }
+        let mark = (scope.vars.len(), scope.next);
+        let first = scope.next;
+        scope.next += args.len() as u16;
+        scope.max = scope.max.max(scope.next);
+        let mut lets = Vec::with_capacity(args.len());
+        let mut ok = true;
+        for a in args {
+            match self.expr(a, scope) {
+                Some(t) => lets.push(t),
+                None => ok = false,
+            }
+        }
+        if !ok {
+            scope.vars.truncate(mark.0);
+            scope.next = mark.1;
+            return None;
+        }
+        let barrier = scope.barrier;
+        scope.barrier = scope.vars.len();
+        for (i, (p, (_, t))) in def.params.iter().zip(&lets).enumerate() {
+            scope.vars.push((p.clone(), *t, first + i as u16));
+        }
+        self.inlining.push(f);
+        let errors = self.diags.len();
+        let body = self.expr(&def.body, scope);
+        self.inlining.pop();
+        // The caret points into the body; name the function once, at the
+        // innermost call.
+        for d in &mut self.diags[errors..] {
+            if !d.message.contains(" (in `") {
+                d.message = format!("{} (in `{}`)", d.message, def.name);
+            }
+        }
+        scope.barrier = barrier;
+        scope.vars.truncate(mark.0);
+        scope.next = mark.1;
+        let (mut x, t) = body?;
+        for (i, (a, _)) in lets.into_iter().enumerate().rev() {
+            x = Ex::Let(first + i as u16, Box::new(a), Box::new(x));
+        }
+        Some((x, t))
+    }
+}
+
+/// `a op b` of two constants, computed once at compile time. Divisions of
+/// integers are left alone: `check` warns about those that truncate, and
+/// division by zero is an error where the program runs.
+fn fold_constants(op: BinOp, a: &Ex, b: &Ex) -> Option<Ex> {
+    let (Ex::Const(x), Ex::Const(y)) = (a, b) else {
+        return None;
+    };
+    let int = |v: &Value| matches!(v, Value::Int(_) | Value::Bool(_));
+    if matches!(op, BinOp::Div | BinOp::Rem) && int(x) && int(y) {
+        return None;
+    }
+    if matches!(op, BinOp::And | BinOp::Or) {
+        return None;
+    }
+    super::eval::binary(op, x.clone(), y.clone())
+        .ok()
+        .map(Ex::Const)
+}
+
+/// A negation, conversion or maths function of constants, computed once.
+fn fold_unary(e: Ex) -> Ex {
+    match e {
+        Ex::Neg(a) => match *a {
+            Ex::Const(Value::Int(i)) => Ex::Const(Value::Int(i.wrapping_neg())),
+            Ex::Const(Value::Float(f)) => Ex::Const(Value::Float(-f)),
+            a => Ex::Neg(Box::new(a)),
+        },
+        Ex::Convert(t, a) => match *a {
+            Ex::Const(v) => Ex::Const(v.convert(t)),
+            a => Ex::Convert(t, Box::new(a)),
+        },
+        Ex::Call(Func::Math1(f), args, span) => match args.as_slice() {
+            [Ex::Const(a)] => Ex::Const(Value::Float(f(a.as_f64()))),
+            _ => Ex::Call(Func::Math1(f), args, span),
+        },
+        Ex::Call(Func::Math2(f), args, span) => match args.as_slice() {
+            [Ex::Const(a), Ex::Const(b)] => Ex::Const(Value::Float(f(a.as_f64(), b.as_f64()))),
+            _ => Ex::Call(Func::Math2(f), args, span),
+        },
+        e => e,
     }
 }
 

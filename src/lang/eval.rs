@@ -11,7 +11,7 @@ use crate::syntax::span::Span;
 
 use super::ir::*;
 use super::modules::Sym;
-use super::value::{StructDef, Value};
+use super::value::{StructDef, Ty, Value};
 
 /// Global state shared by all bodies of one derivation.
 #[derive(Clone, Debug)]
@@ -56,26 +56,55 @@ impl RuntimeError {
     }
 }
 
-type R<T> = Result<T, RuntimeError>;
+/// Inside the interpreter an error is boxed: a result stays the size of a
+/// value, which every expression node returns.
+type R<T> = Result<T, Box<RuntimeError>>;
+
+fn rt(span: Option<Span>, m: impl Into<String>) -> Box<RuntimeError> {
+    Box::new(RuntimeError::new(span, m))
+}
 
 /// Receives successor modules.
 pub trait Emit {
     fn emit(&mut self, sym: Sym, args: &[Value]);
 }
 
-/// Answers context tests made inside a body (`InLeftContext(...)` ...).
-/// On success it appends the matched modules' parameters to `out`, in order.
+/// The topology a body runs on, as the body sees it: it answers context
+/// tests, evaluates the topology's built-ins ([`Func::Host`]) and lists the
+/// members of its sets.
 pub trait Host {
-    fn in_context(&mut self, kind: ContextKind, pats: &[Pattern], out: &mut Vec<Value>) -> bool;
+    /// A context test made inside a body (`InLeftContext(...)` ...). On
+    /// success it appends the matched modules' parameters to `out`, in
+    /// order.
+    fn in_context(&mut self, kind: ContextKind, pats: &[Pattern], out: &mut Vec<Value>) -> bool {
+        let _ = (kind, pats, out);
+        false
+    }
+
+    /// Built-in number `id` of the topology's table, on checked
+    /// arguments; an error says why the arguments have no value (`bnext`
+    /// of a vertex off the boundary).
+    fn call(&mut self, id: u16, args: &[Value]) -> Result<Value, String> {
+        let _ = (id, args);
+        Ok(Value::Void)
+    }
+
+    /// Appends the members of `set` to `out`.
+    fn members(&mut self, set: &Value, out: &mut Vec<Value>) {
+        let _ = (set, out);
+    }
 }
 
 /// A host for bodies that have no context (control blocks, initialisers).
 pub struct NoHost;
 
-impl Host for NoHost {
-    fn in_context(&mut self, _: ContextKind, _: &[Pattern], _: &mut Vec<Value>) -> bool {
-        false
-    }
+impl Host for NoHost {}
+
+/// A sink for expressions, which produce nothing.
+struct NoSink;
+
+impl Emit for NoSink {
+    fn emit(&mut self, _: Sym, _: &[Value]) {}
 }
 
 impl Emit for Vec<(Sym, Vec<Value>)> {
@@ -123,7 +152,7 @@ impl<'p> Interp<'p> {
         env: &mut Env,
         host: &mut dyn Host,
         sink: &mut dyn Emit,
-    ) -> R<Flow> {
+    ) -> Result<Flow, RuntimeError> {
         self.fuel = LOOP_LIMIT;
         let mut cx = Cx {
             frame,
@@ -132,7 +161,7 @@ impl<'p> Interp<'p> {
             sink,
         };
         for s in body {
-            match self.stmt(s, &mut cx)? {
+            match self.stmt(s, &mut cx).map_err(|e| *e)? {
                 Flow::Normal => {}
                 f => return Ok(f),
             }
@@ -140,8 +169,27 @@ impl<'p> Interp<'p> {
         Ok(Flow::Return)
     }
 
+    /// Evaluates an expression over `frame`'s locals against `host`: a
+    /// guard or an assignment of a rule on another topology.
+    pub fn eval(
+        &mut self,
+        e: &Ex,
+        frame: &mut [Value],
+        env: &mut Env,
+        host: &mut dyn Host,
+    ) -> Result<Value, RuntimeError> {
+        let mut sink = NoSink;
+        let mut cx = Cx {
+            frame,
+            env,
+            host,
+            sink: &mut sink,
+        };
+        self.expr(e, &mut cx).map_err(|e| *e)
+    }
+
     /// Evaluates an expression with no locals (initialisers, directives).
-    pub fn eval_global(&mut self, e: &Ex, env: &mut Env) -> R<Value> {
+    pub fn eval_global(&mut self, e: &Ex, env: &mut Env) -> Result<Value, RuntimeError> {
         let mut frame: Vec<Value> = Vec::new();
         let mut sink: Vec<(Sym, Vec<Value>)> = Vec::new();
         let mut cx = Cx {
@@ -150,11 +198,16 @@ impl<'p> Interp<'p> {
             host: &mut NoHost,
             sink: &mut sink,
         };
-        self.expr(e, &mut cx)
+        self.expr(e, &mut cx).map_err(|e| *e)
     }
 
     /// Evaluates successor modules with no locals (the axiom).
-    pub fn eval_modules(&mut self, succ: &[Succ], env: &mut Env, sink: &mut dyn Emit) -> R<()> {
+    pub fn eval_modules(
+        &mut self,
+        succ: &[Succ],
+        env: &mut Env,
+        sink: &mut dyn Emit,
+    ) -> Result<(), RuntimeError> {
         let mut frame: Vec<Value> = Vec::new();
         let mut cx = Cx {
             frame: &mut frame,
@@ -162,7 +215,7 @@ impl<'p> Interp<'p> {
             host: &mut NoHost,
             sink,
         };
-        self.produce(succ, &mut cx)
+        self.produce(succ, &mut cx).map_err(|e| *e)
     }
 
     fn stmt(&mut self, s: &St, cx: &mut Cx) -> R<Flow> {
@@ -203,7 +256,7 @@ impl<'p> Interp<'p> {
                     }
                     first = false;
                     if self.fuel == 0 {
-                        return Err(RuntimeError::new(
+                        return Err(rt(
                             Some(*span),
                             format!("a loop ran more than {LOOP_LIMIT} iterations in one body; is its condition ever false?"),
                         ));
@@ -246,7 +299,7 @@ impl<'p> Interp<'p> {
                 let v = self.expr(a, cx)?;
                 if v.is_non_finite() {
                     self.scratch.truncate(base);
-                    return Err(RuntimeError::new(
+                    return Err(rt(
                         Some(m.span),
                         format!(
                             "parameter {} of this successor module is {v}; NaN and infinity are not allowed in a word",
@@ -262,6 +315,7 @@ impl<'p> Interp<'p> {
         Ok(())
     }
 
+    #[inline(never)]
     fn load(&self, place: &Place, cx: &Cx) -> Value {
         let mut v = if place.global {
             &cx.env.globals[place.slot as usize]
@@ -275,6 +329,7 @@ impl<'p> Interp<'p> {
         v
     }
 
+    #[inline(never)]
     fn store(&self, place: &Place, value: Value, cx: &mut Cx) {
         let root = if place.global {
             &mut cx.env.globals[place.slot as usize]
@@ -302,7 +357,10 @@ impl<'p> Interp<'p> {
             Ex::Bin(op, a, b, span) => {
                 let x = self.expr(a, cx)?;
                 let y = self.expr(b, cx)?;
-                binary(*op, x, y).map_err(|m| RuntimeError::new(Some(*span), m))?
+                match float_binary(*op, &x, &y) {
+                    Some(v) => v,
+                    None => binary(*op, x, y).map_err(|m| rt(Some(*span), m))?,
+                }
             }
             Ex::Logic(and, a, b) => {
                 let x = self.expr(a, cx)?.truthy();
@@ -320,13 +378,28 @@ impl<'p> Interp<'p> {
                 }
             }
             Ex::Convert(t, a) => self.expr(a, cx)?.convert(*t),
+            Ex::Call(f, args, span) => self.call(*f, args, *span, cx)?,
+            Ex::Let(slot, a, body) => {
+                let v = self.expr(a, cx)?;
+                cx.frame[*slot as usize] = v;
+                self.expr(body, cx)?
+            }
+            _ => self.expr_rare(e, cx)?,
+        })
+    }
+
+    /// The expressions that bodies use less often, kept out of `expr`
+    /// so that its frame stays small.
+    #[inline(never)]
+    fn expr_rare(&mut self, e: &Ex, cx: &mut Cx) -> R<Value> {
+        Ok(match e {
             Ex::Assign(place, op, rhs, ty) => {
                 let r = self.expr(rhs, cx)?;
                 let v = match op {
                     None => r,
                     Some(op) => {
                         let cur = self.load(place, cx);
-                        binary(*op, cur, r).map_err(|m| RuntimeError::new(None, m))?
+                        binary(*op, cur, r).map_err(|m| rt(None, m))?
                     }
                 }
                 .convert(*ty);
@@ -336,7 +409,7 @@ impl<'p> Interp<'p> {
             Ex::IncDec(place, d, prefix) => {
                 let cur = self.load(place, cx);
                 let new = binary(BinOp::Add, cur.clone(), Value::Int(*d as i64))
-                    .map_err(|m| RuntimeError::new(None, m))?
+                    .map_err(|m| rt(None, m))?
                     .convert(place.ty);
                 self.store(place, new.clone(), cx);
                 if *prefix {
@@ -345,7 +418,6 @@ impl<'p> Interp<'p> {
                     cur
                 }
             }
-            Ex::Call(f, args, span) => self.call(*f, args, *span, cx)?,
             Ex::MakeV2(x, y) => Value::V2(DVec2::new(
                 self.expr(x, cx)?.as_f64(),
                 self.expr(y, cx)?.as_f64(),
@@ -362,6 +434,13 @@ impl<'p> Interp<'p> {
                 }
                 Value::Struct(vs.into_boxed_slice())
             }
+            Ex::Fold {
+                op,
+                slot,
+                set,
+                cond,
+                value,
+            } => self.fold(*op, *slot, set, cond.as_deref(), value.as_ref(), cx)?,
             Ex::InContext(kind, pats, places) => {
                 let mut vals = Vec::new();
                 if cx.host.in_context(*kind, pats, &mut vals) {
@@ -373,16 +452,95 @@ impl<'p> Interp<'p> {
                     Value::Bool(false)
                 }
             }
+            // `expr` handles every other expression.
+            _ => Value::Void,
         })
     }
 
-    fn call(&mut self, f: Func, args: &[Ex], span: Span, cx: &mut Cx) -> R<Value> {
-        let mut vals = Vec::with_capacity(args.len());
-        for a in args {
-            vals.push(self.expr(a, cx)?);
+    /// A sum, average or count over the members of a set, which go into
+    /// local `slot` one at a time. Members are listed on the scratch stack,
+    /// so folds nest without allocating.
+    #[inline(never)]
+    fn fold(
+        &mut self,
+        op: FoldOp,
+        slot: u16,
+        set: &Ex,
+        cond: Option<&Ex>,
+        value: Option<&(Box<Ex>, Ty)>,
+        cx: &mut Cx,
+    ) -> R<Value> {
+        let set = self.expr(set, cx)?;
+        let base = self.scratch.len();
+        cx.host.members(&set, &mut self.scratch);
+        let end = self.scratch.len();
+        let mut count = 0i64;
+        let mut sum = value.map(|(_, t)| Value::zero(*t, self.structs));
+        let mut result = Ok(());
+        for k in base..end {
+            let m = self.scratch[k].clone();
+            cx.frame[slot as usize] = m;
+            let keep = match cond {
+                None => Ok(true),
+                Some(c) => self.expr(c, cx).map(|v| v.truthy()),
+            };
+            match keep {
+                Ok(true) => {}
+                Ok(false) => continue,
+                Err(e) => {
+                    result = Err(e);
+                    break;
+                }
+            }
+            count += 1;
+            if let (Some((v, _)), Some(acc)) = (value, sum.as_mut()) {
+                match self
+                    .expr(v, cx)
+                    .and_then(|x| binary(BinOp::Add, acc.clone(), x).map_err(|m| rt(None, m)))
+                {
+                    Ok(s) => *acc = s,
+                    Err(e) => {
+                        result = Err(e);
+                        break;
+                    }
+                }
+            }
         }
+        self.scratch.truncate(base);
+        result?;
+        Ok(match (op, sum) {
+            (FoldOp::Count, _) | (_, None) => Value::Int(count),
+            (FoldOp::Sum, Some(s)) => s,
+            (FoldOp::Avg, Some(s)) => {
+                binary(BinOp::Div, s, Value::Float(count as f64)).map_err(|m| rt(None, m))?
+            }
+        })
+    }
+
+    #[inline(never)]
+    fn call(&mut self, f: Func, args: &[Ex], span: Span, cx: &mut Cx) -> R<Value> {
+        // Arguments go on the scratch stack: no allocation per call.
+        let base = self.scratch.len();
+        for a in args {
+            match self.expr(a, cx) {
+                Ok(v) => self.scratch.push(v),
+                Err(e) => {
+                    self.scratch.truncate(base);
+                    return Err(e);
+                }
+            }
+        }
+        let v = self.apply(f, base, span, cx);
+        self.scratch.truncate(base);
+        v.map_err(|m| rt(Some(span), m))
+    }
+
+    #[inline(never)]
+    fn apply(&mut self, f: Func, base: usize, span: Span, cx: &mut Cx) -> Result<Value, String> {
+        let vals = &self.scratch[base..];
         let num = |i: usize| vals[i].as_f64();
         Ok(match f {
+            Func::Host(id) => return cx.host.call(id, vals),
             Func::Math1(g) => Value::Float(g(num(0))),
             Func::Math2(g) => Value::Float(g(num(0), num(1))),
             Func::AbsInt => Value::Int(vals[0].as_i64().wrapping_abs()),
@@ -471,6 +629,36 @@ fn set_path(root: &mut Value, path: &[u16], value: Value) {
         Value::Struct(fs) => set_path(&mut fs[first as usize], rest, value),
         _ => {}
     }
+}
+
+/// The common cases of [`binary`], floating-point numbers and points,
+/// without moving the values: the same results, fewer steps.
+#[inline]
+fn float_binary(op: BinOp, x: &Value, y: &Value) -> Option<Value> {
+    use BinOp::*;
+    Some(match (x, y) {
+        (Value::Float(a), Value::Float(b)) => match op {
+            Add => Value::Float(a + b),
+            Sub => Value::Float(a - b),
+            Mul => Value::Float(a * b),
+            Div => Value::Float(a / b),
+            Lt => Value::Bool(a < b),
+            Le => Value::Bool(a <= b),
+            Gt => Value::Bool(a > b),
+            Ge => Value::Bool(a >= b),
+            _ => return None,
+        },
+        (Value::V3(a), Value::V3(b)) => match op {
+            Add => Value::V3(*a + *b),
+            Sub => Value::V3(*a - *b),
+            _ => return None,
+        },
+        (Value::Float(s), Value::V3(p)) | (Value::V3(p), Value::Float(s)) if op == Mul => {
+            Value::V3(*p * *s)
+        }
+        (Value::V3(p), Value::Float(s)) if op == Div => Value::V3(*p / *s),
+        _ => return None,
+    })
 }
 
 /// Applies a binary operator to two values whose types were checked.

@@ -9,6 +9,7 @@ use crate::syntax::span::Span;
 
 use super::modules::{Alphabet, Sym};
 use super::value::{StructDef, Ty, Value};
+use crate::syntax::span::Diagnostic;
 
 #[derive(Clone, Debug)]
 pub enum Ex {
@@ -33,6 +34,28 @@ pub enum Ex {
     MakeStruct(Vec<Ex>),
     /// A context test: the modules to match and the places their parameters go.
     InContext(ContextKind, Vec<Pattern>, Vec<Place>),
+    /// `let slot = a in body`: binds a local, then evaluates the body (an
+    /// inlined `define` function's parameter).
+    Let(u16, Box<Ex>, Box<Ex>),
+    /// `sum(w in SET where COND)`, `avg(...)`, `count(...)`: the members
+    /// of a set, which the topology lists, go into local `slot` one at a
+    /// time; those that pass `cond` are counted and their `value` summed.
+    Fold {
+        op: FoldOp,
+        slot: u16,
+        set: Box<Ex>,
+        cond: Option<Box<Ex>>,
+        /// What is summed (absent for `count`) and its type.
+        value: Option<(Box<Ex>, Ty)>,
+    },
+}
+
+/// What a [`Ex::Fold`] computes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FoldOp {
+    Sum,
+    Avg,
+    Count,
 }
 
 /// An assignable location: a variable and a path of field indices.
@@ -64,6 +87,10 @@ pub enum Func {
     Stop,
     Ran,
     NoOp,
+    /// A built-in of the topology the program runs on, by its number in
+    /// the topology's [`HostTable`](super::builtins::HostTable); the
+    /// [`Host`](super::eval::Host) evaluates it.
+    Host(u16),
 }
 
 #[derive(Clone, Debug)]
@@ -178,6 +205,8 @@ pub struct Program {
     pub angle: Option<(Ex, Span)>,
     pub rules: Vec<Rule>,
     pub control: Vec<(ControlKind, Vec<St>, usize)>,
+    /// What `check` reports without refusing the program.
+    pub warnings: Vec<Diagnostic>,
 }
 
 impl Program {

@@ -1,5 +1,6 @@
 //! The language's meaning: types, values, checking and the interpreter.
 
+pub mod builtins;
 pub mod compile;
 pub mod eval;
 pub mod ir;

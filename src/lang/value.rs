@@ -16,6 +16,10 @@ pub enum Ty {
     Struct(u16),
     Str,
     Void,
+    /// An element of a topology: its kind, numbered by the topology's
+    /// [`HostTable`](super::builtins::HostTable) (a mesh's vertex, edge,
+    /// face or set of vertices).
+    Elem(u8),
 }
 
 impl Ty {
@@ -39,6 +43,18 @@ pub enum Value {
     Struct(Box<[Value]>),
     Str(std::sync::Arc<str>),
     Void,
+    /// An element of a topology, as its topology captured it.
+    Elem(Elem),
+}
+
+/// An element of a topology (a mesh vertex, edge or face, a set of them):
+/// a kind and a small payload that only the topology's built-ins read.
+/// The language passes it around and never looks inside.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Elem {
+    pub kind: u8,
+    pub flags: u8,
+    pub ids: [u32; 4],
 }
 
 impl Value {
@@ -95,7 +111,7 @@ impl Value {
                     .collect(),
             ),
             Ty::Str => Value::Str("".into()),
-            Ty::Void => Value::Void,
+            Ty::Void | Ty::Elem(_) => Value::Void,
         }
     }
 
@@ -131,6 +147,7 @@ impl fmt::Display for Value {
             }
             Value::Str(s) => write!(f, "\"{s}\""),
             Value::Void => f.write_str("void"),
+            Value::Elem(e) => write!(f, "element {}", e.ids[0]),
         }
     }
 }
@@ -152,7 +169,7 @@ pub fn width(ty: Ty, structs: &[StructDef]) -> usize {
             .iter()
             .map(|(_, t)| width(*t, structs))
             .sum(),
-        Ty::Void => 0,
+        Ty::Void | Ty::Elem(_) => 0,
         _ => 1,
     }
 }
@@ -168,7 +185,7 @@ pub fn encode(v: &Value, out: &mut Vec<f64>) {
         Value::V3(p) => out.extend_from_slice(&[p.x, p.y, p.z]),
         Value::Struct(fs) => fs.iter().for_each(|f| encode(f, out)),
         Value::Str(s) => out.push(f64::from_bits(intern(s) as u64)),
-        Value::Void => {}
+        Value::Void | Value::Elem(_) => {}
     }
 }
 
@@ -193,7 +210,7 @@ pub fn decode(ty: Ty, slots: &[f64], structs: &[StructDef]) -> (Value, usize) {
             (Value::Struct(fs.into_boxed_slice()), used)
         }
         Ty::Str => (Value::Str(interned(at(0).to_bits() as usize)), 1),
-        Ty::Void => (Value::Void, 0),
+        Ty::Void | Ty::Elem(_) => (Value::Void, 0),
     }
 }
 

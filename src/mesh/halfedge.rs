@@ -281,6 +281,11 @@ impl Mesh {
         self.e_block[e.index()]
     }
 
+    /// The step of a grammar run that made the vertex (0: the base mesh).
+    pub fn vertex_step(&self, v: VertexId) -> u32 {
+        self.v_step[v.index()]
+    }
+
     /// True for a vertex made in the grammar step now running.
     pub fn is_new_vertex(&self, v: VertexId) -> bool {
         self.v_step[v.index()] == self.step

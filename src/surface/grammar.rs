@@ -77,13 +77,7 @@ pub struct RuleDef {
     pub init: bool,
 }
 
-#[derive(Clone, Debug)]
-pub struct FunctionDef {
-    pub name: String,
-    pub params: Vec<String>,
-    pub body: Expr,
-    pub span: Span,
-}
+pub use crate::syntax::ast::Define as FunctionDef;
 
 #[derive(Clone, Debug, Default)]
 pub struct GrammarFile {

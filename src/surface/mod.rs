@@ -1,8 +1,8 @@
 //! Stellar subdivision grammars (paper 000): rules over faces, edges and
 //! vertices with levels, run on the half-edge mesh.
 
-pub mod expr;
 pub mod grammar;
+pub mod host;
 pub mod run;
 
 use std::path::Path;

@@ -14,19 +14,27 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::lang::compile::RuleCompiler;
+use crate::lang::eval::{Env, Interp, RuntimeError};
+use crate::lang::ir::{Ex, Func};
+use crate::lang::value::{Ty, Value};
 use crate::mesh::{BlockSplit, Mesh, VertexId};
 use crate::syntax::span::{Diagnostic, SourceMap, Span};
 
-use super::expr::{Compiler, Eval, Val, T, X};
 use super::grammar::{GrammarFile, Op, VertexContext};
+use super::host::{self, id, MeshHost, SURFACE_HOST};
 
 /// A compiled rule.
 #[derive(Debug)]
 pub struct Rule {
     pub op: Op,
     pub context: VertexContext,
-    pub cond: Option<X>,
-    pub assign: Option<X>,
+    pub cond: Option<Ex>,
+    pub assign: Option<Ex>,
+    /// `cond` as a guard on the element alone, when it is one.
+    guard: Option<host::Guard>,
+    /// `assign` as an affine combination, when it is one.
+    affine: Option<host::Affine>,
     /// Frame slots: the predecessor element and the new vertex.
     pub elem_slot: u16,
     pub vertex_slot: Option<u16>,
@@ -55,78 +63,124 @@ pub struct Grammar {
     /// A rule that would make more faces than this stops the run with an
     /// error instead of exhausting memory (about 110 bytes a face).
     pub max_faces: usize,
+    /// What `check` reports without refusing the grammar.
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// The default face limit: about 5.5 GB of mesh.
 pub const MAX_FACES: usize = 50_000_000;
 
-/// Compiles a parsed grammar file.
+/// Where the first call of host built-in `f` in `e` is, if there is one.
+fn first_call(e: &Ex, f: u16) -> Option<Span> {
+    let mut found: Option<Span> = None;
+    visit(e, &mut |x| {
+        if let Ex::Call(Func::Host(g), _, span) = x {
+            if *g == f && found.is_none() {
+                found = Some(*span);
+            }
+        }
+    });
+    found
+}
+
+/// Calls `f` on `e` and every expression inside it, parents first.
+fn visit(e: &Ex, f: &mut dyn FnMut(&Ex)) {
+    f(e);
+    match e {
+        Ex::Field(a, _) | Ex::Neg(a) | Ex::Not(a) | Ex::Convert(_, a) => visit(a, f),
+        Ex::Assign(_, _, a, _) => visit(a, f),
+        Ex::Bin(_, a, b, _) | Ex::Logic(_, a, b) | Ex::MakeV2(a, b) | Ex::Let(_, a, b) => {
+            visit(a, f);
+            visit(b, f);
+        }
+        Ex::Cond(a, b, c) | Ex::MakeV3(a, b, c) => {
+            visit(a, f);
+            visit(b, f);
+            visit(c, f);
+        }
+        Ex::Call(_, args, _) | Ex::MakeStruct(args) => args.iter().for_each(|a| visit(a, f)),
+        Ex::Fold {
+            set, cond, value, ..
+        } => {
+            visit(set, f);
+            if let Some(c) = cond {
+                visit(c, f);
+            }
+            if let Some((v, _)) = value {
+                visit(v, f);
+            }
+        }
+        Ex::Const(_) | Ex::Local(_) | Ex::Global(_) | Ex::IncDec(..) | Ex::InContext(..) => {}
+    }
+}
+
+/// Compiles a parsed grammar file: its conditions and assignments are
+/// checked by the language's one checker, with the stellar topology's
+/// elements and built-ins.
 pub fn compile(
     file: &GrammarFile,
     sources: SourceMap,
 ) -> Result<Grammar, (SourceMap, Vec<Diagnostic>)> {
     let mut rules = Vec::new();
     let mut diags = Vec::new();
+    let mut warnings = Vec::new();
     let mut block_used_at = None;
     let mut centre_used_at = None;
+    let mut c = RuleCompiler::new(&SURFACE_HOST, &file.functions);
     for r in &file.rules {
-        let mut c = Compiler::new(&file.functions);
-        let elem_t = match r.op {
-            Op::FaceSplit => T::Face,
-            Op::EdgeSplit | Op::BoundarySplit | Op::Flip => T::Edge,
-            Op::Vertex => T::Vertex,
-        };
-        let elem_slot = match c.bind(&r.name, elem_t, r.span) {
-            Ok(s) => s,
-            Err(d) => {
-                diags.push(d);
-                continue;
-            }
-        };
-        let cond = match &r.cond {
-            Some(e) => match c.compile_as(e, T::Bool) {
-                Ok(x) => Some(x),
-                Err(d) => {
-                    diags.push(d);
-                    continue;
-                }
-            },
-            None => None,
-        };
+        c.start_rule();
+        let elem_t = Ty::Elem(match r.op {
+            Op::FaceSplit => host::FACE,
+            Op::EdgeSplit | Op::BoundarySplit | Op::Flip => host::EDGE,
+            Op::Vertex => host::VERTEX,
+        });
+        let elem_slot = c.bind(&r.name, elem_t);
+        let cond = r.cond.as_ref().map(|e| c.expr_as(e, Ty::Bool));
         let (vertex_slot, assign) = match &r.assign {
             Some((name, e)) => {
                 // In a vertex rule the successor's name is the same vertex.
                 let s = if r.op == Op::Vertex && *name == r.name {
                     elem_slot
                 } else {
-                    match c.bind(name, T::Vertex, r.span) {
-                        Ok(s) => s,
-                        Err(d) => {
-                            diags.push(d);
-                            continue;
-                        }
-                    }
+                    c.bind(name, Ty::Elem(host::VERTEX))
                 };
-                match c.compile_as(e, T::Vec) {
-                    Ok(x) => (Some(s), Some(x)),
-                    Err(d) => {
-                        diags.push(d);
-                        continue;
-                    }
-                }
+                (Some(s), Some(c.expr_as(e, Ty::V3)))
             }
             None => (None, None),
         };
-        block_used_at = block_used_at.or(c.block_used_at);
-        centre_used_at = centre_used_at.or(c.centre_used_at);
+        let (errors, warned) = c.take_diagnostics();
+        warnings.extend(warned);
+        if !errors.is_empty() {
+            diags.extend(errors);
+            continue;
+        }
+        let (Some(mut cond), Some(mut assign)) = (
+            cond.map_or(Some(None), |x| x.map(Some)),
+            assign.map_or(Some(None), |x| x.map(Some)),
+        ) else {
+            continue;
+        };
+        for x in cond.iter().chain(assign.iter()) {
+            block_used_at = block_used_at
+                .or(first_call(x, id::BLOCK))
+                .or(first_call(x, id::CENTER));
+            centre_used_at = centre_used_at.or(first_call(x, id::CENTER));
+        }
+        cond.iter_mut()
+            .chain(assign.iter_mut())
+            .for_each(host::specialise);
+        let guard = cond.as_ref().and_then(|c| host::Guard::of(c, elem_slot));
+        let affine = assign.as_ref().and_then(host::Affine::of);
         rules.push(Rule {
+            guard,
+            affine,
             op: r.op,
             context: r.vertex_context,
             cond,
             assign,
             elem_slot,
             vertex_slot,
-            frame: c.max_slots as usize + 1,
+            frame: c.frame_size().max(1),
             span: r.span,
             text: r.text.clone(),
             init: r.init,
@@ -135,37 +189,49 @@ pub fn compile(
     let length = match &file.length {
         None => None,
         Some(e) => {
-            let mut c = Compiler::new(&file.functions);
-            match c.compile_as(e, T::Num) {
-                Ok(x) => {
-                    let m = Mesh::default();
-                    let ev = Eval {
-                        mesh: &m,
-                        current: 0,
-                    };
-                    match ev.eval(&x, &mut vec![Val::N(0.0); c.max_slots as usize + 1]) {
-                        Val::N(n) if n.fract() == 0.0 && (0.0..=64.0).contains(&n) => {
-                            Some(n as u64)
-                        }
-                        _ => {
-                            diags.push(Diagnostic::new(
-                                e.span,
-                                "the derivation length must be a whole number of steps from 0 to 64",
-                            ));
-                            None
-                        }
+            c.start_rule();
+            let x = c.expr(e).map(|(x, _)| x);
+            let (errors, warned) = c.take_diagnostics();
+            warnings.extend(warned);
+            diags.extend(errors);
+            x.and_then(|x| {
+                let m = Mesh::default();
+                let mut host = MeshHost {
+                    mesh: &m,
+                    current: 0,
+                    step: 0,
+                };
+                let got = Interp::new(&[]).eval(
+                    &x,
+                    &mut vec![Value::Void; c.frame_size().max(1)],
+                    &mut Env::new(Vec::new()),
+                    &mut host,
+                );
+                match got {
+                    Ok(Value::Int(n)) if (0..=64).contains(&n) => Some(n as u64),
+                    Ok(Value::Float(n)) if n.fract() == 0.0 && (0.0..=64.0).contains(&n) => {
+                        Some(n as u64)
+                    }
+                    Ok(_) => {
+                        diags.push(Diagnostic::new(
+                            e.span,
+                            "the derivation length must be a whole number of steps from 0 to 64",
+                        ));
+                        None
+                    }
+                    Err(err) => {
+                        diags.push(Diagnostic::new(err.span.unwrap_or(e.span), err.message));
+                        None
                     }
                 }
-                Err(d) => {
-                    diags.push(d);
-                    None
-                }
-            }
+            })
         }
     };
     if !diags.is_empty() {
+        diags.sort_by_key(|d| (d.span.file.0, d.span.start));
         return Err((sources, diags));
     }
+    warnings.sort_by_key(|d| (d.span.file.0, d.span.start));
     Ok(Grammar {
         rules,
         mesh: file.mesh.clone(),
@@ -180,13 +246,14 @@ pub fn compile(
             .block_split
             .map_or(BlockSplit::Quadrisection, |(b, _)| b),
         max_faces: MAX_FACES,
+        warnings,
     })
 }
 
 /// The elements a rule matched when it started.
 struct Matches {
     current: u32,
-    vals: Vec<Val>,
+    vals: Vec<Value>,
     edge_ids: Vec<crate::mesh::EdgeId>,
 }
 
@@ -204,6 +271,63 @@ pub struct StepCounts {
     pub vertices: usize,
     pub edges: usize,
     pub faces: usize,
+}
+
+impl From<RuntimeError> for RunError {
+    fn from(e: RuntimeError) -> RunError {
+        RunError {
+            span: e.span,
+            message: e.message,
+        }
+    }
+}
+
+/// What one thread needs to evaluate a rule's expressions.
+struct Evaluator<'m> {
+    interp: Interp<'static>,
+    env: Env,
+    host: MeshHost<'m>,
+    frame: Vec<Value>,
+}
+
+impl<'m> Evaluator<'m> {
+    fn new(mesh: &'m Mesh, current: u32, step: u32, frame: usize) -> Evaluator<'m> {
+        Evaluator {
+            interp: Interp::new(&[]),
+            env: Env::new(Vec::new()),
+            host: MeshHost {
+                mesh,
+                current,
+                step,
+            },
+            frame: vec![Value::Void; frame],
+        }
+    }
+
+    fn eval(&mut self, e: &Ex) -> Result<Value, RuntimeError> {
+        self.interp
+            .eval(e, &mut self.frame, &mut self.env, &mut self.host)
+    }
+
+    /// Whether the element passes `rule`'s condition.
+    fn test(&mut self, rule: &Rule, val: &Value) -> Result<bool, RuntimeError> {
+        if let Some(g) = &rule.guard {
+            return Ok(g.test(&mut self.host, val));
+        }
+        self.frame[rule.elem_slot as usize] = val.clone();
+        match &rule.cond {
+            Some(c) => self.eval(c).map(|v| v.truthy()),
+            None => Ok(true),
+        }
+    }
+
+    /// `rule`'s assignment, on the locals bound in the frame.
+    fn assign(&mut self, rule: &Rule, assign: &Ex) -> Result<Value, RuntimeError> {
+        match &rule.affine {
+            Some(a) => Ok(a.eval(&mut self.host, &self.frame)),
+            None => self.eval(assign),
+        }
+    }
 }
 
 impl Grammar {
@@ -297,8 +421,8 @@ impl Grammar {
     /// and, for edge rules, their ids. Edges keep their ids through the
     /// splits and flips of other edges, so the ids stay valid while the
     /// rule runs.
-    fn find_matches(&self, rule: &Rule, mesh: &Mesh) -> Matches {
-        self.find_matches_with(rule, None, mesh).0
+    fn find_matches(&self, rule: &Rule, mesh: &Mesh) -> Result<Matches, RuntimeError> {
+        Ok(self.find_matches_with(rule, None, mesh)?.0)
     }
 
     /// What `rule` applies to, and `other`, an edge rule for the other
@@ -309,46 +433,39 @@ impl Grammar {
         rule: &Rule,
         other: Option<&Rule>,
         mesh: &Mesh,
-    ) -> (Matches, Matches) {
+    ) -> Result<(Matches, Matches), RuntimeError> {
         // `c`, kept up to date by `apply_all` as rules make vertices.
         let current = mesh.current_level;
-        let ev = Eval { mesh, current };
+        let step = mesh.step;
         let slots = match rule.op {
             Op::FaceSplit => mesh.f_alive.len(),
             Op::EdgeSplit | Op::BoundarySplit | Op::Flip => mesh.e_alive.len(),
             Op::Vertex => mesh.v_alive.len(),
         };
         let frame_len = rule.frame.max(other.map_or(0, |o| o.frame));
-        type Part = (Vec<Val>, Vec<crate::mesh::EdgeId>);
+        type Part = (Vec<Value>, Vec<crate::mesh::EdgeId>);
         // Conditions are pure, so ranges of ids are tested in parallel,
         // each by a plain loop, and the matches joined in id order.
         let ranges: Vec<(u32, u32)> = (0..slots.div_ceil(CHUNK))
             .map(|k| ((k * CHUNK) as u32, (((k + 1) * CHUNK).min(slots)) as u32))
             .collect();
-        let parts: Vec<(Part, Part)> = ranges
+        let parts: Vec<Result<(Part, Part), RuntimeError>> = ranges
             .into_par_iter()
             .map(|(lo, hi)| {
-                let mut frame = vec![Val::N(0.0); frame_len];
+                let mut ev = Evaluator::new(mesh, current, step, frame_len);
                 let (mut a, mut b): (Part, Part) = Default::default();
-                let mut test = |r: &Rule, val: Val| {
-                    frame[r.elem_slot as usize] = val;
-                    match &r.cond {
-                        Some(c) => matches!(ev.eval(c, &mut frame), Val::B(true)),
-                        None => true,
-                    }
-                };
                 match rule.op {
                     Op::FaceSplit => {
                         for f in (lo..hi).map(crate::mesh::FaceId) {
                             if mesh.is_face(f) {
                                 let hs = mesh.face_halfedges(f);
-                                let val = Val::F(
+                                let val = host::face(
                                     hs.map(|h| mesh.from(h)),
                                     mesh.face_level(f),
                                     hs.iter().any(|h| mesh.face(h.twin()).is_none()),
                                     hs.iter().any(|h| mesh.is_block_edge(h.edge())),
                                 );
-                                if test(rule, val) {
+                                if ev.test(rule, &val)? {
                                     a.0.push(val);
                                 }
                             }
@@ -371,7 +488,7 @@ impl Grammar {
                             // A boundary edge runs the way its face does.
                             let h = e.halfedge();
                             let h = if mesh.face(h).is_none() { h.twin() } else { h };
-                            let val = Val::E(
+                            let val = host::edge(
                                 mesh.from(h),
                                 mesh.to(h),
                                 mesh.edge_level(e),
@@ -379,7 +496,7 @@ impl Grammar {
                                 mesh.is_block_edge(e),
                                 mesh.is_transversal_edge(e),
                             );
-                            if test(r, val) {
+                            if ev.test(r, &val)? {
                                 out.0.push(val);
                                 out.1.push(e);
                             }
@@ -395,15 +512,17 @@ impl Grammar {
                                 VertexContext::Boundary => mesh.is_boundary_vertex(v),
                                 VertexContext::Interior => !mesh.is_boundary_vertex(v),
                             };
-                            if ok && test(rule, Val::V(v)) {
-                                a.0.push(Val::V(v));
+                            let val = host::vertex(v);
+                            if ok && ev.test(rule, &val)? {
+                                a.0.push(val);
                             }
                         }
                     }
                 }
-                (a, b)
+                Ok((a, b))
             })
             .collect();
+        let parts = parts.into_iter().collect::<Result<Vec<_>, _>>()?;
         let join = |pick: &dyn Fn(&(Part, Part)) -> &Part| {
             let mut vals = Vec::with_capacity(parts.iter().map(|p| pick(p).0.len()).sum());
             let mut edge_ids = Vec::with_capacity(parts.iter().map(|p| pick(p).1.len()).sum());
@@ -417,34 +536,34 @@ impl Grammar {
                 edge_ids,
             }
         };
-        (join(&|p| &p.0), join(&|p| &p.1))
+        Ok((join(&|p| &p.0), join(&|p| &p.1)))
     }
 
     /// Evaluates `assign` for elements `0..n` in parallel, `bind` setting
     /// each one's frame slots, giving the points in order; or the first
-    /// element whose point is not finite, with that point (None when the
-    /// assignment gave no point at all).
+    /// element whose point is not finite, with what it gave: a point, a
+    /// value that is not one, or an error.
     fn eval_points(
         &self,
         rule: &Rule,
         mesh: &Mesh,
         current: u32,
-        assign: &X,
+        assign: &Ex,
         n: usize,
-        bind: impl Fn(&mut [Val], usize) + Sync,
-    ) -> Result<Vec<DVec3>, (usize, Option<DVec3>)> {
-        let ev = Eval { mesh, current };
-        let one = |frame: &mut Vec<Val>, k: usize| {
-            bind(frame, k);
-            ev.eval(assign, frame)
+        bind: impl Fn(&mut [Value], usize) + Sync,
+    ) -> Result<Vec<DVec3>, (usize, Result<Value, RuntimeError>)> {
+        let step = mesh.step;
+        let one = |ev: &mut Evaluator, k: usize| {
+            bind(&mut ev.frame, k);
+            ev.assign(rule, assign)
         };
         let points: Vec<DVec3> = (0..n)
             .into_par_iter()
             .with_min_len(CHUNK)
             .map_init(
-                || vec![Val::N(0.0); rule.frame],
-                |frame, k| match one(frame, k) {
-                    Val::P(p) => p,
+                || Evaluator::new(mesh, current, step, rule.frame),
+                |ev, k| match one(ev, k) {
+                    Ok(Value::V3(p)) => p,
                     _ => DVec3::NAN,
                 },
             )
@@ -452,10 +571,10 @@ impl Grammar {
         match points.iter().position(|p| !p.is_finite()) {
             None => Ok(points),
             // Evaluate the first bad one again, to say what it gave.
-            Some(k) => match one(&mut vec![Val::N(0.0); rule.frame], k) {
-                Val::P(p) => Err((k, Some(p))),
-                _ => Err((k, None)),
-            },
+            Some(k) => Err((
+                k,
+                one(&mut Evaluator::new(mesh, current, step, rule.frame), k),
+            )),
         }
     }
 
@@ -482,19 +601,36 @@ impl Grammar {
             });
             match pair {
                 Some(next) => {
-                    let (a, b) = self.find_matches_with(rule, Some(next), mesh);
+                    let (a, b) = self
+                        .find_matches_with(rule, Some(next), mesh)
+                        .map_err(|e| self.runtime_error(rule, step, e))?;
                     self.apply_matched(rule, mesh, step, a)?;
                     self.apply_matched(next, mesh, step, b)?;
                     i += 2;
                 }
                 None => {
-                    let m = self.find_matches(rule, mesh);
+                    let m = self
+                        .find_matches(rule, mesh)
+                        .map_err(|e| self.runtime_error(rule, step, e))?;
                     self.apply_matched(rule, mesh, step, m)?;
                     i += 1;
                 }
             }
         }
         Ok(())
+    }
+
+    /// A run-time error in a rule's expressions, located and with the step.
+    fn runtime_error(&self, rule: &Rule, step: usize, e: RuntimeError) -> RunError {
+        let at = if step == 0 {
+            format!("at initialization, rule `{}`", rule.text)
+        } else {
+            format!("at step {step}, rule `{}`", rule.text)
+        };
+        RunError {
+            span: Some(e.span.unwrap_or(rule.span)),
+            message: format!("{at}: {}", e.message),
+        }
     }
 
     fn apply_matched(
@@ -526,18 +662,18 @@ impl Grammar {
                 let slot = rule.elem_slot as usize;
                 let out = self
                     .eval_points(rule, mesh, current, assign, matched.len(), |frame, k| {
-                        frame[slot] = matched[k];
+                        frame[slot] = matched[k].clone();
                     })
                     .map_err(|(k, p)| match p {
-                        Some(p) => fail(format!(
-                            "vertex {} would move to {p}, which is not finite{}",
-                            vertex_of(matched[k]),
-                            hint(rule)
+                        Ok(Value::V3(p)) => fail(format!(
+                            "vertex {} would move to {p}, which is not finite",
+                            vertex_of(&matched[k])
                         )),
-                        None => fail(format!("the assignment did not give a point{}", hint(rule))),
+                        Ok(_) => fail("the assignment did not give a point".into()),
+                        Err(e) => self.runtime_error(rule, step, e),
                     })?;
                 mesh.next_pos
-                    .extend(matched.iter().zip(out).map(|(val, p)| (vertex_of(*val), p)));
+                    .extend(matched.iter().zip(out).map(|(val, p)| (vertex_of(val), p)));
                 Ok(())
             }
             Op::Flip => {
@@ -556,23 +692,24 @@ impl Grammar {
                         self.max_faces
                     )));
                 }
-                let mut made: Vec<(VertexId, Val)> = Vec::with_capacity(matched.len());
+                let mut made: Vec<(VertexId, &Value)> = Vec::with_capacity(matched.len());
                 match rule.op {
                     Op::FaceSplit => {
                         mesh.reserve(matched.len(), 3 * matched.len(), 2 * matched.len())
                     }
                     _ => mesh.reserve(matched.len(), 3 * matched.len(), 2 * matched.len()),
                 }
-                for (k, &val) in matched.iter().enumerate() {
-                    let v = match val {
-                        Val::F(vs, ..) => {
+                for (k, val) in matched.iter().enumerate() {
+                    let v = if let Some(vs) = host::face_vertices(val) {
+                        {
                             let Some(f) = face_of(mesh, vs) else {
                                 return Err(fail("a face to split is gone".into()));
                             };
                             let p = vs.iter().map(|v| mesh.position(*v)).sum::<DVec3>() / 3.0;
                             mesh.face_split(f, p).map_err(|e| fail(e.message))?
                         }
-                        Val::E(p, q, _, _, _, _) => {
+                    } else if let Some((p, q)) = host::edge_vertices(val) {
+                        {
                             let e = edge_ids[k];
                             debug_assert!({
                                 let (a, b) = mesh.edge_vertices(e);
@@ -581,7 +718,8 @@ impl Grammar {
                             let at = (mesh.position(p) + mesh.position(q)) * 0.5;
                             mesh.edge_split(e, at).map_err(|e| fail(e.message))?
                         }
-                        _ => continue,
+                    } else {
+                        continue;
                     };
                     made.push((v, val));
                 }
@@ -596,16 +734,16 @@ impl Grammar {
                 let slot = rule.elem_slot as usize;
                 let out = self
                     .eval_points(rule, mesh, current, assign, made.len(), |frame, k| {
-                        frame[slot] = made[k].1;
-                        frame[vslot as usize] = Val::V(made[k].0);
+                        frame[slot] = made[k].1.clone();
+                        frame[vslot as usize] = host::vertex(made[k].0);
                     })
                     .map_err(|(k, p)| match p {
-                        Some(p) => fail(format!(
-                            "new vertex {} would be at {p}, which is not finite{}",
-                            made[k].0,
-                            hint(rule)
+                        Ok(Value::V3(p)) => fail(format!(
+                            "new vertex {} would be at {p}, which is not finite",
+                            made[k].0
                         )),
-                        None => fail(format!("the assignment did not give a point{}", hint(rule))),
+                        Ok(_) => fail("the assignment did not give a point".into()),
+                        Err(e) => self.runtime_error(rule, step, e),
                     })?;
                 for ((v, _), p) in made.iter().zip(out) {
                     mesh.set_position(*v, p);
@@ -620,21 +758,8 @@ impl Grammar {
 /// Elements per parallel task: small jobs stay on one thread.
 const CHUNK: usize = 16384;
 
-/// A hint for a rule whose assignment failed: `bnext` and `bprev` give no
-/// vertex off the boundary.
-fn hint(rule: &Rule) -> &'static str {
-    if rule.text.contains("bnext") || rule.text.contains("bprev") {
-        " (bnext and bprev give no vertex for a vertex that is not on the boundary)"
-    } else {
-        ""
-    }
-}
-
-fn vertex_of(val: Val) -> VertexId {
-    match val {
-        Val::V(v) => v,
-        _ => VertexId(u32::MAX),
-    }
+fn vertex_of(val: &Value) -> VertexId {
+    host::vertex_of(val).unwrap_or(VertexId(u32::MAX))
 }
 
 fn face_of(mesh: &Mesh, vs: [VertexId; 3]) -> Option<crate::mesh::FaceId> {

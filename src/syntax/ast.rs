@@ -293,11 +293,23 @@ pub enum ExprKind {
     Field(Box<Expr>, Name),
     Cast(TypeRef, Box<Expr>),
     InContext(ContextKind, Vec<PatModule>),
-    /// `sum(w in SET where COND)` (also `avg`, `count`): surface grammars.
+    /// `sum(w in SET where COND)` (also `avg`, `count`): an aggregate over
+    /// the members of a set, for topologies whose elements have sets (a
+    /// mesh vertex's one-ring).
     Gather {
         op: Name,
         var: Name,
         set: Box<Expr>,
         cond: Option<Box<Expr>>,
     },
+}
+
+/// `define f(a, b) = expr;`: a function whose body is inlined at each
+/// call, its parameters taking the types of the arguments.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Define {
+    pub name: String,
+    pub params: Vec<String>,
+    pub body: Expr,
+    pub span: Span,
 }

@@ -240,7 +240,7 @@ fn grammar_errors_point_at_the_rule() {
         .unwrap_err()
         .render();
     assert!(
-        bad.contains("g.lsys:1:25: error: type error: cannot apply `+` to a point and a number"),
+        bad.contains("g.lsys:1:25: error: type error: cannot apply `+` to V3f and int"),
         "{bad}"
     );
     let bad = subgram::surface::load_str("g.lsys", "V(v) -> V(v = smooth(v));\n", &[])
@@ -449,13 +449,14 @@ fn surface_grammars_run_under_every_command() {
         back.faces.iter().all(|f| f.len() == 4),
         "Catmull-Clark gives quads"
     );
-    // A bad grammar: the message points at the rule.
+    // A bad grammar: the message points at the rule. `v * v` is the dot
+    // product of two points in L+C, a number, where a point is expected.
     let bad = dir.join("bad.lsys");
     std::fs::write(&bad, "mesh: \"x.obj\";\nV(v) -> V(v = v * v);\n").unwrap();
     let o = bin(&["check", bad.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr)
-        .contains("bad.lsys:2:15: error: type error: cannot apply `*` to a point and a point"));
+        .contains("bad.lsys:2:15: error: type mismatch: expected V3f, found float"));
 }
 
 /// Valences and how many vertices have each.

@@ -476,7 +476,9 @@ fn boundary_walks_off_the_boundary_are_errors() {
         let mut m = Mesh::from_soup(&shapes::icosahedron()).unwrap();
         let e = g.run(&mut m, 1, |_| {}).unwrap_err();
         let msg = g.render_error(&e);
-        assert!(msg.contains("g.lsys:1:1"), "{msg}");
+        // The caret is at the walk that left the boundary.
+        let at = text.find('b').unwrap() + 1;
+        assert!(msg.contains(&format!("g.lsys:1:{at}")), "{msg}");
         assert!(msg.contains("not on the boundary"), "{msg}");
     }
 }

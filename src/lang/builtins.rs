@@ -1,0 +1,248 @@
+//! The one table of built-in functions: lpfg's maths and library functions,
+//! then the host built-ins of the topology a program runs on (a mesh's
+//! `l(x)`, `valence(v)`, `ring(v)`, …). The checker sees functions only
+//! through this table, so `fabs`, `%`, `/` and division by zero mean the
+//! same in a curve and in a surface grammar.
+
+use super::ir::Func;
+use super::value::Ty;
+
+/// Why a call does not fit a built-in's signature.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SigError {
+    /// It takes this many arguments.
+    Arity(usize),
+    /// Argument `i` should be a number.
+    NotNumber(usize),
+    /// Anything else, said in full.
+    Message(String),
+}
+
+/// A built-in function: its name and how it resolves the argument types to
+/// an implementation and a result type.
+#[derive(Clone, Copy)]
+pub struct Builtin {
+    pub name: &'static str,
+    pub resolve: fn(&[Ty]) -> Result<(Func, Ty), SigError>,
+}
+
+/// What a topology adds to the language: its element types, its host
+/// built-ins, the values it names with plain identifiers, how an element
+/// reads in arithmetic and what a set holds.
+pub struct HostTable {
+    /// What a program of this topology is called in messages.
+    pub name: &'static str,
+    /// The element kinds of [`Ty::Elem`], as messages name them ("a vertex").
+    pub elements: &'static [&'static str],
+    pub functions: &'static [Builtin],
+    /// Identifiers that read a value of the host (`c`, the current level).
+    pub values: &'static [(&'static str, Func, Ty)],
+    /// The built-in that gives an element's value in arithmetic (a mesh
+    /// vertex stands for its position), with the value's type.
+    pub arith: fn(u8) -> Option<(Func, Ty)>,
+    /// The element kind a set of kind `k` holds, if `k` is a set.
+    pub members: fn(u8) -> Option<u8>,
+}
+
+impl HostTable {
+    pub fn function(&self, name: &str) -> Option<&Builtin> {
+        self.functions.iter().find(|b| b.name == name)
+    }
+
+    pub fn value(&self, name: &str) -> Option<(Func, Ty)> {
+        self.values
+            .iter()
+            .find(|(n, _, _)| *n == name)
+            .map(|(_, f, t)| (*f, *t))
+    }
+
+    pub fn element_name(&self, kind: u8) -> &'static str {
+        self.elements
+            .get(kind as usize)
+            .copied()
+            .unwrap_or("an element")
+    }
+}
+
+/// Words of modules have no elements and no host built-ins beyond the
+/// library: their contexts are matched by the predecessor and by
+/// `InLeftContext` and its kin, which are syntax.
+pub static WORD_HOST: HostTable = HostTable {
+    name: "L-system",
+    elements: &[],
+    functions: &[],
+    values: &[],
+    arith: |_| None,
+    members: |_| None,
+};
+
+/// Looks a function up: the library first, then the host's table.
+pub fn lookup<'h>(name: &str, host: &'h HostTable) -> Option<&'h Builtin> {
+    LIBRARY
+        .iter()
+        .find(|b| b.name == name)
+        .or_else(|| host.function(name))
+}
+
+fn numbers(args: &[Ty], n: usize) -> Result<(), SigError> {
+    if args.len() != n {
+        return Err(SigError::Arity(n));
+    }
+    match args.iter().position(|t| !t.is_numeric()) {
+        Some(i) => Err(SigError::NotNumber(i)),
+        None => Ok(()),
+    }
+}
+
+macro_rules! math1 {
+    ($name:literal, $f:expr) => {
+        Builtin {
+            name: $name,
+            resolve: |a| {
+                numbers(a, 1)?;
+                Ok((Func::Math1($f), Ty::Float))
+            },
+        }
+    };
+}
+
+macro_rules! math2 {
+    ($name:literal, $f:expr) => {
+        Builtin {
+            name: $name,
+            resolve: |a| {
+                numbers(a, 2)?;
+                Ok((Func::Math2($f), Ty::Float))
+            },
+        }
+    };
+}
+
+macro_rules! nullary {
+    ($name:literal, $f:expr, $t:expr) => {
+        Builtin {
+            name: $name,
+            resolve: |a| {
+                if a.is_empty() {
+                    Ok(($f, $t))
+                } else {
+                    Err(SigError::Arity(0))
+                }
+            },
+        }
+    };
+}
+
+fn vector(a: &[Ty], name: &str) -> Result<Ty, SigError> {
+    match a {
+        [t] if t.is_vector() => Ok(*t),
+        _ => Err(SigError::Message(format!(
+            "`{name}` takes one vector argument"
+        ))),
+    }
+}
+
+fn int_or_float(a: &[Ty], n: usize, int: Func, float: Func) -> Result<(Func, Ty), SigError> {
+    numbers(a, n)?;
+    Ok(if a.iter().all(|t| *t == Ty::Int) {
+        (int, Ty::Int)
+    } else {
+        (float, Ty::Float)
+    })
+}
+
+/// lpfg's maths and library functions, the same for every topology.
+pub static LIBRARY: &[Builtin] = &[
+    math1!("sin", f64::sin),
+    math1!("cos", f64::cos),
+    math1!("tan", f64::tan),
+    math1!("asin", f64::asin),
+    math1!("acos", f64::acos),
+    math1!("atan", f64::atan),
+    math1!("sinh", f64::sinh),
+    math1!("cosh", f64::cosh),
+    math1!("tanh", f64::tanh),
+    math1!("sqrt", f64::sqrt),
+    math1!("cbrt", f64::cbrt),
+    math1!("exp", f64::exp),
+    math1!("log", f64::ln),
+    math1!("log10", f64::log10),
+    math1!("log2", f64::log2),
+    math1!("fabs", f64::abs),
+    math1!("floor", f64::floor),
+    math1!("ceil", f64::ceil),
+    math1!("round", f64::round),
+    math1!("trunc", f64::trunc),
+    math2!("atan2", f64::atan2),
+    math2!("pow", f64::powf),
+    math2!("fmod", |a: f64, b: f64| a % b),
+    math2!("hypot", f64::hypot),
+    math2!("fmin", f64::min),
+    math2!("fmax", f64::max),
+    Builtin {
+        name: "abs",
+        resolve: |a| int_or_float(a, 1, Func::AbsInt, Func::Math1(f64::abs)),
+    },
+    Builtin {
+        name: "min",
+        resolve: |a| int_or_float(a, 2, Func::MinInt, Func::Math2(f64::min)),
+    },
+    Builtin {
+        name: "max",
+        resolve: |a| int_or_float(a, 2, Func::MaxInt, Func::Math2(f64::max)),
+    },
+    Builtin {
+        name: "Length",
+        resolve: |a| vector(a, "Length").map(|_| (Func::Length, Ty::Float)),
+    },
+    Builtin {
+        name: "Normalize",
+        resolve: |a| vector(a, "Normalize").map(|t| (Func::Normalized, t)),
+    },
+    Builtin {
+        name: "Dot",
+        resolve: |a| match a {
+            [x, y] if x == y && x.is_vector() => Ok((Func::Dot, Ty::Float)),
+            _ => Err(SigError::Message(
+                "`Dot` takes two vectors of the same type".into(),
+            )),
+        },
+    },
+    Builtin {
+        name: "Cross",
+        resolve: |a| match a {
+            [Ty::V3, Ty::V3] => Ok((Func::Cross, Ty::V3)),
+            [x, y] if x == y && x.is_vector() => {
+                Err(SigError::Message("`Cross` takes two V3f vectors".into()))
+            }
+            _ => Err(SigError::Message(
+                "`Cross` takes two vectors of the same type".into(),
+            )),
+        },
+    },
+    nullary!("StepNo", Func::StepNo, Ty::Int),
+    nullary!("CurrentGroup", Func::CurrentGroup, Ty::Int),
+    nullary!("Forward", Func::Forward, Ty::Void),
+    nullary!("Backward", Func::Backward, Ty::Void),
+    nullary!("IsForward", Func::IsForward, Ty::Bool),
+    nullary!("Stop", Func::Stop, Ty::Void),
+    nullary!("RunSimulation", Func::NoOp, Ty::Void),
+    nullary!("PauseSimulation", Func::NoOp, Ty::Void),
+    nullary!("DisplayFrame", Func::NoOp, Ty::Void),
+    nullary!("Environment", Func::NoOp, Ty::Void),
+    nullary!("NoEnvironment", Func::NoOp, Ty::Void),
+    Builtin {
+        name: "UseGroup",
+        resolve: |a| {
+            numbers(a, 1)?;
+            Ok((Func::UseGroup, Ty::Void))
+        },
+    },
+    Builtin {
+        name: "ran",
+        resolve: |a| {
+            numbers(a, 1)?;
+            Ok((Func::Ran, Ty::Float))
+        },
+    },
+];

@@ -1,0 +1,810 @@
+//! The stellar topology as the language sees it: mesh vertices, edges,
+//! faces and sets of vertices as element values, and the host built-ins
+//! (`l(x)`, `valence(v)`, `ring(v)`, `block(e)`, …) in one table beside the
+//! library's maths. Expressions are checked by `lang::compile` and run by
+//! `lang::eval` against a [`MeshHost`].
+//!
+//! Two forms that every scheme evaluates for every element are fused into
+//! one built-in each after checking (see [`specialise`]): `l(x) OP c` and
+//! a sum, average or count over a one-ring with no condition, `l(w) OP c`,
+//! `new(w)` or `!new(w)`. They are specialisations of the shared IR, as the
+//! curve stencils are: the same meaning, fewer interpreter steps.
+
+use glam::DVec3;
+
+use crate::lang::builtins::{Builtin, HostTable, SigError};
+use crate::lang::eval::Host;
+use crate::lang::ir::{Ex, FoldOp, Func};
+use crate::lang::value::{Elem, Ty, Value};
+use crate::mesh::{Mesh, VertexId};
+use crate::syntax::ast::BinOp;
+
+/// Element kinds.
+pub const VERTEX: u8 = 0;
+pub const EDGE: u8 = 1;
+pub const FACE: u8 = 2;
+pub const SET: u8 = 3;
+
+/// Host built-in numbers.
+pub mod id {
+    pub const LEVEL: u16 = 0;
+    pub const POS: u16 = 1;
+    pub const VALENCE: u16 = 2;
+    pub const BOUNDARY: u16 = 3;
+    pub const BLOCK: u16 = 4;
+    pub const TRANSVERSAL: u16 = 5;
+    pub const NEW: u16 = 6;
+    pub const CENTER: u16 = 7;
+    pub const AVG_OF: u16 = 8;
+    pub const RING: u16 = 9;
+    pub const BOUNDARY_RING: u16 = 10;
+    pub const VERTS: u16 = 11;
+    pub const TAIL: u16 = 12;
+    pub const HEAD: u16 = 13;
+    pub const BNEXT: u16 = 14;
+    pub const BPREV: u16 = 15;
+    pub const CURRENT: u16 = 16;
+    pub const STEP: u16 = 17;
+    pub const POINT: u16 = 18;
+    /// Fused `l(x) OP c`: the element and the operator's code.
+    pub const LEVEL_VS_CURRENT: u16 = 100;
+    /// Fused fold over a one-ring: the vertex, the fold and the filter.
+    pub const RING_FOLD: u16 = 101;
+}
+
+/// Edge and face flags.
+const ON_BOUNDARY: u8 = 1;
+const IN_BLOCK: u8 = 2;
+const TRANSVERSAL: u8 = 4;
+
+/// Set kinds, in the low bits of a set's flags; the element the set
+/// belongs to is in the high bits.
+const RING: u8 = 0;
+const BOUNDARY_RING: u8 = 1;
+const VERTS: u8 = 2;
+
+pub fn vertex(v: VertexId) -> Value {
+    Value::Elem(Elem {
+        kind: VERTEX,
+        flags: 0,
+        ids: [v.0, 0, 0, 0],
+    })
+}
+
+/// An edge by its end vertices, captured before a split, with its level
+/// and marks.
+pub fn edge(
+    p: VertexId,
+    q: VertexId,
+    level: u32,
+    boundary: bool,
+    block: bool,
+    transversal: bool,
+) -> Value {
+    let flags = (boundary as u8 * ON_BOUNDARY)
+        | (block as u8 * IN_BLOCK)
+        | (transversal as u8 * TRANSVERSAL);
+    Value::Elem(Elem {
+        kind: EDGE,
+        flags,
+        ids: [p.0, q.0, level, 0],
+    })
+}
+
+/// A face by its vertices, captured before a split, with its level and
+/// whether one of its edges is on the boundary or a block's internal edge.
+pub fn face(vs: [VertexId; 3], level: u32, boundary: bool, block: bool) -> Value {
+    Value::Elem(Elem {
+        kind: FACE,
+        flags: (boundary as u8 * ON_BOUNDARY) | (block as u8 * IN_BLOCK),
+        ids: [vs[0].0, vs[1].0, vs[2].0, level],
+    })
+}
+
+/// The vertex of a vertex value.
+pub fn vertex_of(v: &Value) -> Option<VertexId> {
+    match v {
+        Value::Elem(e) if e.kind == VERTEX => Some(VertexId(e.ids[0])),
+        _ => None,
+    }
+}
+
+/// The vertices of a face value.
+pub fn face_vertices(v: &Value) -> Option<[VertexId; 3]> {
+    match v {
+        Value::Elem(e) if e.kind == FACE => {
+            Some([VertexId(e.ids[0]), VertexId(e.ids[1]), VertexId(e.ids[2])])
+        }
+        _ => None,
+    }
+}
+
+/// The end vertices of an edge value.
+pub fn edge_vertices(v: &Value) -> Option<(VertexId, VertexId)> {
+    match v {
+        Value::Elem(e) if e.kind == EDGE => Some((VertexId(e.ids[0]), VertexId(e.ids[1]))),
+        _ => None,
+    }
+}
+
+fn one(a: &[Ty], kinds: &[u8], what: &str) -> Result<(), SigError> {
+    match a {
+        [Ty::Elem(k)] if kinds.contains(k) => Ok(()),
+        [_] => Err(SigError::Message(what.into())),
+        _ => Err(SigError::Arity(1)),
+    }
+}
+
+const V: Ty = Ty::Elem(VERTEX);
+
+static FUNCTIONS: &[Builtin] = &[
+    Builtin {
+        name: "l",
+        resolve: |a| {
+            one(
+                a,
+                &[VERTEX, EDGE, FACE],
+                "`l` takes a vertex, an edge or a face",
+            )?;
+            Ok((Func::Host(id::LEVEL), Ty::Int))
+        },
+    },
+    Builtin {
+        name: "pos",
+        resolve: |a| {
+            one(a, &[VERTEX], "`pos` takes a vertex")?;
+            Ok((Func::Host(id::POS), Ty::V3))
+        },
+    },
+    Builtin {
+        name: "valence",
+        resolve: |a| {
+            one(a, &[VERTEX], "`valence` takes a vertex")?;
+            Ok((Func::Host(id::VALENCE), Ty::Int))
+        },
+    },
+    Builtin {
+        name: "deg",
+        resolve: |a| {
+            one(a, &[VERTEX], "`deg` takes a vertex")?;
+            Ok((Func::Host(id::VALENCE), Ty::Int))
+        },
+    },
+    Builtin {
+        name: "boundary",
+        resolve: |a| {
+            one(
+                a,
+                &[VERTEX, EDGE, FACE],
+                "`boundary` takes a vertex, an edge or a face",
+            )?;
+            Ok((Func::Host(id::BOUNDARY), Ty::Bool))
+        },
+    },
+    Builtin {
+        name: "block",
+        resolve: |a| {
+            one(
+                a,
+                &[EDGE, FACE],
+                "`block` takes an edge (true for the internal edge of a basic block) \
+                 or a face (true for half of a block)",
+            )?;
+            Ok((Func::Host(id::BLOCK), Ty::Bool))
+        },
+    },
+    Builtin {
+        name: "transversal",
+        resolve: |a| {
+            one(
+                a,
+                &[EDGE],
+                "`transversal` takes an edge: true for an edge that an edge split drew to an \
+                 opposite vertex",
+            )?;
+            Ok((Func::Host(id::TRANSVERSAL), Ty::Bool))
+        },
+    },
+    Builtin {
+        name: "new",
+        resolve: |a| {
+            one(
+                a,
+                &[VERTEX],
+                "`new` takes a vertex: true for a vertex made in this step",
+            )?;
+            Ok((Func::Host(id::NEW), Ty::Bool))
+        },
+    },
+    Builtin {
+        name: "center",
+        resolve: |a| {
+            one(
+                a,
+                &[VERTEX],
+                "`center` takes a vertex: true for the centre of a dual block, whose edges are \
+                 all internal edges of blocks",
+            )?;
+            Ok((Func::Host(id::CENTER), Ty::Bool))
+        },
+    },
+    Builtin {
+        name: "centre",
+        resolve: |a| {
+            one(
+                a,
+                &[VERTEX],
+                "`centre` takes a vertex: true for the centre of a dual block, whose edges are \
+                 all internal edges of blocks",
+            )?;
+            Ok((Func::Host(id::CENTER), Ty::Bool))
+        },
+    },
+    Builtin {
+        name: "avg",
+        resolve: |a| {
+            one(
+                a,
+                &[EDGE, FACE],
+                "`avg` takes an edge, a face or a set of vertices",
+            )?;
+            Ok((Func::Host(id::AVG_OF), Ty::V3))
+        },
+    },
+    Builtin {
+        name: "ring",
+        resolve: |a| {
+            one(a, &[VERTEX], "`ring` takes a vertex")?;
+            Ok((Func::Host(id::RING), Ty::Elem(SET)))
+        },
+    },
+    Builtin {
+        name: "N1",
+        resolve: |a| {
+            one(a, &[VERTEX], "`N1` takes a vertex")?;
+            Ok((Func::Host(id::RING), Ty::Elem(SET)))
+        },
+    },
+    Builtin {
+        name: "boundary_ring",
+        resolve: |a| {
+            one(a, &[VERTEX], "`boundary_ring` takes a vertex")?;
+            Ok((Func::Host(id::BOUNDARY_RING), Ty::Elem(SET)))
+        },
+    },
+    Builtin {
+        name: "verts",
+        resolve: |a| {
+            one(a, &[EDGE, FACE], "`verts` takes an edge or a face")?;
+            Ok((Func::Host(id::VERTS), Ty::Elem(SET)))
+        },
+    },
+    Builtin {
+        name: "tail",
+        resolve: |a| {
+            one(a, &[EDGE], "`tail` takes an edge")?;
+            Ok((Func::Host(id::TAIL), V))
+        },
+    },
+    Builtin {
+        name: "head",
+        resolve: |a| {
+            one(a, &[EDGE], "`head` takes an edge")?;
+            Ok((Func::Host(id::HEAD), V))
+        },
+    },
+    Builtin {
+        name: "bnext",
+        resolve: |a| {
+            one(a, &[VERTEX], "`bnext` takes a boundary vertex")?;
+            Ok((Func::Host(id::BNEXT), V))
+        },
+    },
+    Builtin {
+        name: "bprev",
+        resolve: |a| {
+            one(a, &[VERTEX], "`bprev` takes a boundary vertex")?;
+            Ok((Func::Host(id::BPREV), V))
+        },
+    },
+    Builtin {
+        name: "point",
+        resolve: |a| match a {
+            [x, y, z] if x.is_numeric() && y.is_numeric() && z.is_numeric() => {
+                Ok((Func::Host(id::POINT), Ty::V3))
+            }
+            [_, _, _] => Err(SigError::Message("`point` takes three numbers".into())),
+            _ => Err(SigError::Arity(3)),
+        },
+    },
+];
+
+/// The table of the stellar topology.
+pub static SURFACE_HOST: HostTable = HostTable {
+    name: "surface grammar",
+    elements: &["a vertex", "an edge", "a face", "a set of vertices"],
+    functions: FUNCTIONS,
+    values: &[
+        ("c", Func::Host(id::CURRENT), Ty::Int),
+        ("step", Func::Host(id::STEP), Ty::Int),
+    ],
+    arith: |k| (k == VERTEX).then_some((Func::Host(id::POS), Ty::V3)),
+    members: |k| (k == SET).then_some(VERTEX),
+};
+
+/// The mesh as a rule's expressions see it while the rule runs.
+pub struct MeshHost<'m> {
+    pub mesh: &'m Mesh,
+    /// `c`, the current level when the rule started.
+    pub current: u32,
+    /// The step being run (0 in `init:` rules): `step`, and the vertices
+    /// it made are `new`.
+    pub step: u32,
+}
+
+fn cmp(op: i64, l: u32, c: u32) -> bool {
+    match op {
+        0 => l < c,
+        1 => l <= c,
+        2 => l > c,
+        3 => l >= c,
+        4 => l == c,
+        _ => l != c,
+    }
+}
+
+fn op_code(op: BinOp) -> Option<i64> {
+    Some(match op {
+        BinOp::Lt => 0,
+        BinOp::Le => 1,
+        BinOp::Gt => 2,
+        BinOp::Ge => 3,
+        BinOp::Eq => 4,
+        BinOp::Ne => 5,
+        _ => return None,
+    })
+}
+
+impl MeshHost<'_> {
+    fn level(&self, v: &Value) -> Option<u32> {
+        match v {
+            Value::Elem(e) => Some(match e.kind {
+                VERTEX => self.mesh.vertex_level(VertexId(e.ids[0])),
+                EDGE => e.ids[2],
+                FACE => e.ids[3],
+                _ => return None,
+            }),
+            _ => None,
+        }
+    }
+
+    fn is_new(&self, v: VertexId) -> bool {
+        self.mesh.vertex_step(v) == self.step
+    }
+
+    /// A sum, average or count over the one-ring of `v`, with filter `f`:
+    /// 0 all, 1 new, 2 not new, 10 + op `l(w) OP c`.
+    fn ring_fold(&self, v: VertexId, fold: i64, f: i64) -> Value {
+        let mut sum = DVec3::ZERO;
+        let mut count = 0i64;
+        for w in self.mesh.one_ring(v) {
+            let keep = match f {
+                0 => true,
+                1 => self.is_new(w),
+                2 => !self.is_new(w),
+                _ => cmp(f - 10, self.mesh.vertex_level(w), self.current),
+            };
+            if keep {
+                sum += self.mesh.position(w);
+                count += 1;
+            }
+        }
+        match fold {
+            0 => Value::V3(sum),
+            1 => Value::V3(sum / count as f64),
+            _ => Value::Int(count),
+        }
+    }
+}
+
+impl Host for MeshHost<'_> {
+    fn call(&mut self, f: u16, args: &[Value]) -> Result<Value, String> {
+        let m = self.mesh;
+        let elem = match args.first() {
+            Some(Value::Elem(e)) => Some(*e),
+            _ => None,
+        };
+        let v = || {
+            elem.filter(|e| e.kind == VERTEX)
+                .map(|e| VertexId(e.ids[0]))
+        };
+        let flag = |bit: u8| Value::Bool(elem.is_some_and(|e| e.flags & bit != 0));
+        Ok(match f {
+            id::LEVEL => self
+                .level(&args[0])
+                .map_or(Value::Int(-1), |l| Value::Int(l as i64)),
+            id::POS => match v() {
+                Some(v) => Value::V3(m.position(v)),
+                None => Value::V3(DVec3::NAN),
+            },
+            id::VALENCE => match v() {
+                Some(v) => Value::Int(m.valence(v) as i64),
+                None => Value::Int(0),
+            },
+            id::BOUNDARY => match elem {
+                Some(e) if e.kind == VERTEX => {
+                    Value::Bool(m.is_boundary_vertex(VertexId(e.ids[0])))
+                }
+                _ => flag(ON_BOUNDARY),
+            },
+            id::BLOCK => flag(IN_BLOCK),
+            id::TRANSVERSAL => flag(TRANSVERSAL),
+            id::NEW => Value::Bool(v().is_some_and(|v| self.is_new(v))),
+            id::CENTER => Value::Bool(v().is_some_and(|v| m.is_block_centre(v))),
+            id::AVG_OF => match elem {
+                Some(e) if e.kind == EDGE => Value::V3(
+                    (m.position(VertexId(e.ids[0])) + m.position(VertexId(e.ids[1]))) * 0.5,
+                ),
+                Some(e) if e.kind == FACE => Value::V3(
+                    e.ids[..3]
+                        .iter()
+                        .map(|&i| m.position(VertexId(i)))
+                        .sum::<DVec3>()
+                        / 3.0,
+                ),
+                _ => Value::V3(DVec3::NAN),
+            },
+            id::RING | id::BOUNDARY_RING | id::VERTS => match elem {
+                Some(e) if e.kind != SET => {
+                    let k = match f {
+                        id::RING => RING,
+                        id::BOUNDARY_RING => BOUNDARY_RING,
+                        _ => VERTS,
+                    };
+                    Value::Elem(Elem {
+                        kind: SET,
+                        flags: k | (e.kind << 4),
+                        ids: e.ids,
+                    })
+                }
+                _ => return Err("this is not an element of the mesh".into()),
+            },
+            id::TAIL | id::HEAD => match elem {
+                Some(e) if e.kind == EDGE => vertex(VertexId(e.ids[(f == id::HEAD) as usize])),
+                _ => return Err("this is not an edge of the mesh".into()),
+            },
+            id::BNEXT | id::BPREV => match v() {
+                Some(v) => match m.boundary_neighbour(v, f == id::BNEXT) {
+                    Some(w) => vertex(w),
+                    None => {
+                        return Err(format!(
+                            "`{}` of vertex {v}: the vertex is not on the boundary, so it has \
+                             no neighbour along the boundary",
+                            if f == id::BNEXT { "bnext" } else { "bprev" }
+                        ))
+                    }
+                },
+                None => return Err("this is not a vertex of the mesh".into()),
+            },
+            id::CURRENT => Value::Int(self.current as i64),
+            id::STEP => Value::Int(self.step as i64),
+            id::POINT => Value::V3(DVec3::new(
+                args[0].as_f64(),
+                args[1].as_f64(),
+                args[2].as_f64(),
+            )),
+            id::LEVEL_VS_CURRENT => Value::Bool(
+                self.level(&args[0])
+                    .is_some_and(|l| cmp(args[1].as_i64(), l, self.current)),
+            ),
+            id::RING_FOLD => match v() {
+                Some(v) => self.ring_fold(v, args[1].as_i64(), args[2].as_i64()),
+                None => match args[1].as_i64() {
+                    2 => Value::Int(0),
+                    _ => Value::V3(DVec3::NAN),
+                },
+            },
+            _ => Value::Void,
+        })
+    }
+
+    fn members(&mut self, set: &Value, out: &mut Vec<Value>) {
+        let Value::Elem(s) = set else { return };
+        if s.kind != SET {
+            return;
+        }
+        let m = self.mesh;
+        let (k, of) = (s.flags & 0xF, s.flags >> 4);
+        match (k, of) {
+            (RING, VERTEX) => out.extend(m.one_ring(VertexId(s.ids[0])).map(vertex)),
+            (BOUNDARY_RING, VERTEX) => {
+                for h in m.outgoing_halfedges(VertexId(s.ids[0])) {
+                    if m.is_boundary_edge(h.edge()) {
+                        out.push(vertex(m.to(h)));
+                    }
+                }
+            }
+            (_, EDGE) => out.extend(s.ids[..2].iter().map(|&i| vertex(VertexId(i)))),
+            (_, FACE) => out.extend(s.ids[..3].iter().map(|&i| vertex(VertexId(i)))),
+            _ => {}
+        }
+    }
+}
+
+/// Rewrites the two forms every scheme evaluates for every element into
+/// fused built-ins: `l(x) OP c` and a fold over `ring(v)` whose value is
+/// the member's position and whose condition is absent, `l(w) OP c`,
+/// `new(w)` or `!new(w)`. Everything else is left to the interpreter.
+pub fn specialise(e: &mut Ex) {
+    // Children first, so that a fused condition inside a fold is seen.
+    match e {
+        Ex::Field(a, _) | Ex::Neg(a) | Ex::Not(a) | Ex::Convert(_, a) => specialise(a),
+        Ex::Bin(_, a, b, _) | Ex::Logic(_, a, b) | Ex::MakeV2(a, b) | Ex::Let(_, a, b) => {
+            specialise(a);
+            specialise(b);
+        }
+        Ex::Cond(a, b, c) | Ex::MakeV3(a, b, c) => {
+            specialise(a);
+            specialise(b);
+            specialise(c);
+        }
+        Ex::Assign(_, _, a, _) => specialise(a),
+        Ex::Call(_, args, _) | Ex::MakeStruct(args) => args.iter_mut().for_each(specialise),
+        Ex::Fold {
+            set, cond, value, ..
+        } => {
+            specialise(set);
+            if let Some(c) = cond {
+                specialise(c);
+            }
+            if let Some((v, _)) = value {
+                specialise(v);
+            }
+        }
+        Ex::Const(_) | Ex::Local(_) | Ex::Global(_) | Ex::IncDec(..) | Ex::InContext(..) => {}
+    }
+    if let Some(fused) = fused(e) {
+        *e = fused;
+    }
+}
+
+fn host_call<'a>(e: &'a Ex, f: u16) -> Option<&'a [Ex]> {
+    match e {
+        Ex::Call(Func::Host(g), args, _) if *g == f => Some(args),
+        _ => None,
+    }
+}
+
+fn is_local(e: &Ex, slot: u16) -> bool {
+    matches!(e, Ex::Local(s) if *s == slot)
+}
+
+fn int(i: i64) -> Ex {
+    Ex::Const(Value::Int(i))
+}
+
+fn fused(e: &Ex) -> Option<Ex> {
+    match e {
+        // l(x) OP c
+        Ex::Bin(op, a, b, span) => {
+            let code = op_code(*op)?;
+            let x = host_call(a, id::LEVEL)?;
+            host_call(b, id::CURRENT)?;
+            Some(Ex::Call(
+                Func::Host(id::LEVEL_VS_CURRENT),
+                vec![x[0].clone(), int(code)],
+                *span,
+            ))
+        }
+        Ex::Fold {
+            op,
+            slot,
+            set,
+            cond,
+            value,
+        } => {
+            let ring = host_call(set, id::RING)?;
+            if let Some((v, _)) = value {
+                let p = host_call(v, id::POS)?;
+                if !is_local(&p[0], *slot) {
+                    return None;
+                }
+            }
+            let filter = match cond.as_deref() {
+                None => 0,
+                Some(c) => {
+                    if let Some(a) = host_call(c, id::NEW) {
+                        if !is_local(&a[0], *slot) {
+                            return None;
+                        }
+                        1
+                    } else if let Ex::Not(n) = c {
+                        let a = host_call(n, id::NEW)?;
+                        if !is_local(&a[0], *slot) {
+                            return None;
+                        }
+                        2
+                    } else {
+                        let a = host_call(c, id::LEVEL_VS_CURRENT)?;
+                        if !is_local(&a[0], *slot) {
+                            return None;
+                        }
+                        let Ex::Const(Value::Int(code)) = a[1] else {
+                            return None;
+                        };
+                        10 + code
+                    }
+                }
+            };
+            let fold = match op {
+                FoldOp::Sum => 0,
+                FoldOp::Avg => 1,
+                FoldOp::Count => 2,
+            };
+            Some(Ex::Call(
+                Func::Host(id::RING_FOLD),
+                vec![ring[0].clone(), int(fold), int(filter)],
+                crate::syntax::span::Span::default(),
+            ))
+        }
+        _ => None,
+    }
+}
+
+/// A guard that reads only the rule's own element (its marks, its level
+/// against `c`, whether it is new), recognised in the checked IR and
+/// tested without the interpreter: the same meaning as the expression it
+/// came from, as a curve stencil is for its body.
+#[derive(Clone, Debug)]
+pub enum Guard {
+    /// `l(x) OP c`, by the operator's code.
+    Level(i64),
+    /// A built-in that takes the element alone and gives a bool.
+    Test(u16),
+    Not(Box<Guard>),
+    And(Box<Guard>, Box<Guard>),
+    Or(Box<Guard>, Box<Guard>),
+}
+
+impl Guard {
+    /// The guard of condition `e` on the element in local `slot`, if `e`
+    /// has that form.
+    pub fn of(e: &Ex, slot: u16) -> Option<Guard> {
+        Some(match e {
+            Ex::Call(Func::Host(id::LEVEL_VS_CURRENT), args, _) => match args.as_slice() {
+                [x, Ex::Const(Value::Int(op))] if is_local(x, slot) => Guard::Level(*op),
+                _ => return None,
+            },
+            Ex::Call(
+                Func::Host(f @ (id::BOUNDARY | id::BLOCK | id::TRANSVERSAL | id::NEW | id::CENTER)),
+                args,
+                _,
+            ) => match args.as_slice() {
+                [x] if is_local(x, slot) => Guard::Test(*f),
+                _ => return None,
+            },
+            Ex::Not(a) => Guard::Not(Box::new(Guard::of(a, slot)?)),
+            Ex::Logic(and, a, b) => {
+                let (a, b) = (Box::new(Guard::of(a, slot)?), Box::new(Guard::of(b, slot)?));
+                if *and {
+                    Guard::And(a, b)
+                } else {
+                    Guard::Or(a, b)
+                }
+            }
+            _ => return None,
+        })
+    }
+
+    pub fn test(&self, host: &mut MeshHost, elem: &Value) -> bool {
+        match self {
+            Guard::Level(op) => host.level(elem).is_some_and(|l| cmp(*op, l, host.current)),
+            Guard::Test(f) => matches!(
+                host.call(*f, std::slice::from_ref(elem)),
+                Ok(Value::Bool(true))
+            ),
+            Guard::Not(a) => !a.test(host, elem),
+            Guard::And(a, b) => a.test(host, elem) && b.test(host, elem),
+            Guard::Or(a, b) => a.test(host, elem) || b.test(host, elem),
+        }
+    }
+}
+
+/// An assignment that is an affine combination, with constant weights, of
+/// points the host gives for the rule's locals (`pos(v)`, `avg(e)`, a sum
+/// or average over a one-ring): recognised in the checked IR and evaluated
+/// as a weighted sum, as a curve stencil is.
+#[derive(Clone, Debug)]
+pub struct Affine {
+    terms: Vec<(f64, u16, u16, [i64; 2])>,
+}
+
+impl Affine {
+    /// The combination `e` is, if it is one.
+    pub fn of(e: &Ex) -> Option<Affine> {
+        let mut terms = Vec::new();
+        let mut alias = Vec::new();
+        collect(e, 1.0, &mut alias, &mut terms)?;
+        Some(Affine { terms })
+    }
+
+    /// The point, reading the locals from `frame`.
+    pub fn eval(&self, host: &mut MeshHost, frame: &[Value]) -> Value {
+        let mut p = DVec3::ZERO;
+        for (w, f, slot, k) in &self.terms {
+            let x = &frame[*slot as usize];
+            let v = match *f {
+                id::RING_FOLD => host.call(*f, &[x.clone(), Value::Int(k[0]), Value::Int(k[1])]),
+                _ => host.call(*f, std::slice::from_ref(x)),
+            };
+            match v {
+                Ok(Value::V3(q)) => p += *w * q,
+                _ => return Value::V3(DVec3::NAN),
+            }
+        }
+        Value::V3(p)
+    }
+}
+
+/// Adds the terms of `w * e` to `out`; `alias` maps the locals of inlined
+/// parameters bound to other locals.
+fn collect(
+    e: &Ex,
+    w: f64,
+    alias: &mut Vec<(u16, u16)>,
+    out: &mut Vec<(f64, u16, u16, [i64; 2])>,
+) -> Option<()> {
+    let local = |x: &Ex, alias: &Vec<(u16, u16)>| match x {
+        Ex::Local(s) => Some(
+            alias
+                .iter()
+                .rev()
+                .find(|(a, _)| a == s)
+                .map_or(*s, |(_, b)| *b),
+        ),
+        _ => None,
+    };
+    let weight = |x: &Ex| match x {
+        Ex::Const(Value::Float(f)) => Some(*f),
+        Ex::Const(Value::Int(i)) => Some(*i as f64),
+        _ => None,
+    };
+    match e {
+        Ex::Let(s, a, body) => {
+            let target = local(a, alias)?;
+            alias.push((*s, target));
+            let r = collect(body, w, alias, out);
+            alias.pop();
+            r
+        }
+        Ex::Bin(BinOp::Add, a, b, _) => {
+            collect(a, w, alias, out)?;
+            collect(b, w, alias, out)
+        }
+        Ex::Bin(BinOp::Sub, a, b, _) => {
+            collect(a, w, alias, out)?;
+            collect(b, -w, alias, out)
+        }
+        Ex::Bin(BinOp::Mul, a, b, _) => match (weight(a), weight(b)) {
+            (Some(k), None) => collect(b, w * k, alias, out),
+            (None, Some(k)) => collect(a, w * k, alias, out),
+            _ => None,
+        },
+        Ex::Bin(BinOp::Div, a, b, _) => collect(a, w / weight(b)?, alias, out),
+        Ex::Neg(a) => collect(a, -w, alias, out),
+        Ex::Call(Func::Host(f @ (id::POS | id::AVG_OF)), args, _) => {
+            let s = local(args.first()?, alias)?;
+            out.push((w, *f, s, [0, 0]));
+            Some(())
+        }
+        Ex::Call(Func::Host(id::RING_FOLD), args, _) => match args.as_slice() {
+            [x, Ex::Const(Value::Int(fold @ (0 | 1))), Ex::Const(Value::Int(filter))] => {
+                let s = local(x, alias)?;
+                out.push((w, id::RING_FOLD, s, [*fold, *filter]));
+                Some(())
+            }
+            _ => None,
+        },
+        _ => None,
+    }
+}
