@@ -30,14 +30,16 @@ fn points_attr(points: &[glam::DVec2]) -> String {
     s
 }
 
-/// Renders a scene as an SVG document. A background that is not opaque
+/// Renders a scene as an SVG document. Polygons fill by the even-odd rule,
+/// as in the PNG (set once, on the root); a background that is not opaque
 /// keeps its opacity.
 pub fn render(scene: &Scene) -> String {
     let (w, h) = (scene.width, scene.height);
     let mut doc = Document::new()
         .set("width", w)
         .set("height", h)
-        .set("viewBox", format!("0 0 {w} {h}"));
+        .set("viewBox", format!("0 0 {w} {h}"))
+        .set("fill-rule", "evenodd");
     let b = scene.background;
     if b.3 > 0 {
         let mut rect = Rectangle::new()
@@ -103,8 +105,7 @@ pub fn render(scene: &Scene) -> String {
             } => {
                 let mut polygon = Polygon::new()
                     .set("points", points_attr(points))
-                    .set("fill", color.hex())
-                    .set("fill-rule", "evenodd");
+                    .set("fill", color.hex());
                 if let Some(o) = outline {
                     polygon = polygon
                         .set("stroke", o.color.hex())

@@ -423,6 +423,9 @@ fn both_backends_stroke_a_polygon_outline_over_its_fill() {
         assert!(doc.contains(attr), "{attr} missing in {doc}");
     }
     assert!(!svg::render(&plain).contains("stroke"));
+    // Polygons fill by the even-odd rule, as in the PNG: set on the root.
+    let root = &doc[..doc.find('>').unwrap()];
+    assert!(root.contains("fill-rule=\"evenodd\""), "{root}");
 }
 
 #[test]
