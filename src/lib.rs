@@ -18,6 +18,7 @@
 //! assert_eq!(derived.word.len(), 16); // 4 points, doubled twice
 //! ```
 
+mod atomic;
 pub mod draw;
 pub mod lang;
 pub mod mesh;

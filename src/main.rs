@@ -711,7 +711,7 @@ fn write_mesh_picture(
     view: Option<&str>,
     wireframe: bool,
 ) -> Result<(), (u8, String)> {
-    use subgram::mesh::draw::{self, MeshView};
+    use subgram::render::mesh::{self as draw, MeshView};
     let lower = output.to_ascii_lowercase();
     if !lower.ends_with(".png") && !lower.ends_with(".svg") {
         return Err((
@@ -750,7 +750,7 @@ fn write_mesh_output(
 ) -> Result<(), (u8, String)> {
     let lower = output.to_ascii_lowercase();
     if lower.ends_with(".png") || lower.ends_with(".svg") {
-        let d = subgram::mesh::draw::MeshView::default();
+        let d = subgram::render::mesh::MeshView::default();
         return write_mesh_picture(
             m,
             output,

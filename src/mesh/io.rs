@@ -75,7 +75,7 @@ pub fn read_str(name: &str, format: Format, bytes: &[u8]) -> Result<PolygonSoup,
 pub fn write(path: &Path, soup: &PolygonSoup) -> Result<(), MeshFileError> {
     let name = path.display().to_string();
     let format = format_of(&name, path)?;
-    crate::render::write_atomic(path, &to_bytes(format, soup))
+    crate::atomic::write_atomic(path, &to_bytes(format, soup))
         .map_err(|e| error(&name, None, format!("cannot write the file: {e}")))
 }
 

@@ -1,8 +1,7 @@
 //! Meshes: polygon soups from files, the half-edge mesh with levels, the
-//! stellar operators, validation, and pictures.
+//! stellar operators and validation: geometry and topology only.
 
 pub mod build;
-pub mod draw;
 pub mod halfedge;
 pub mod info;
 pub mod io;

@@ -1,8 +1,13 @@
-//! From drawing events to pictures: fitting the view, then PNG (tiny-skia)
-//! or SVG (the svg crate) from the same [`Scene`].
+//! From drawing events and meshes to pictures: fitting the view, then PNG
+//! (tiny-skia) or SVG (the svg crate) from the same [`Scene`]. Turtle
+//! events are laid out here; [`mesh`] turns a polygon mesh into shaded
+//! polygons of a scene.
 
+pub mod mesh;
 pub mod png;
 pub mod svg;
+
+pub use crate::atomic::write_atomic;
 
 use glam::{DVec2, DVec3};
 
@@ -132,10 +137,20 @@ pub enum Item {
         color: Rgba,
         width: f64,
     },
+    /// A filled polygon (even-odd rule), with an optional outline stroked
+    /// over the fill with round joins.
     Polygon {
         points: Vec<DVec2>,
         color: Rgba,
+        outline: Option<Outline>,
     },
+}
+
+/// The pen of a polygon's outline: a colour and a width in pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outline {
+    pub color: Rgba,
+    pub width: f64,
 }
 
 /// A picture ready for a backend: size, background and items.
@@ -158,15 +173,54 @@ impl RenderError {
     }
 }
 
+/// The largest accepted image side, in pixels.
+const MAX_SIDE: u32 = 20_000;
+
+/// Refuses an image with a zero side or a side over [`MAX_SIDE`].
+fn check_size(width: u32, height: u32) -> Result<(), RenderError> {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(RenderError::new(format!(
+            "the image size {width}x{height} is out of range: each side must be 1 to {MAX_SIDE} pixels"
+        )));
+    }
+    Ok(())
+}
+
+/// The map from drawing-plane coordinates (y up) to pixels (y down): a
+/// bounding box scaled uniformly into a cell of the image, with a margin,
+/// and centred in it.
+#[derive(Clone, Copy, Debug)]
+struct Fit {
+    scale: f64,
+    centre: DVec2,
+    mid: DVec2,
+}
+
+impl Fit {
+    /// Fits the box `lo..hi` into the cell that starts at pixel column `x0`
+    /// and is `width`×`height` pixels, leaving `margin` (a fraction of the
+    /// cell's smaller side) on every side.
+    fn new(lo: DVec2, hi: DVec2, x0: f64, width: f64, height: f64, margin: f64) -> Fit {
+        let m = margin * width.min(height);
+        let avail = DVec2::new(width - 2.0 * m, height - 2.0 * m).max(DVec2::ONE);
+        Fit {
+            scale: fit_scale(avail, hi - lo),
+            centre: (lo + hi) * 0.5,
+            mid: DVec2::new(x0 + width * 0.5, height * 0.5),
+        }
+    }
+
+    /// The pixel position of a drawing-plane point.
+    fn pixel(&self, q: DVec2) -> DVec2 {
+        let d = (q - self.centre) * self.scale;
+        DVec2::new(self.mid.x + d.x, self.mid.y - d.y)
+    }
+}
+
 /// Lays out panels side by side: each list of events is fitted into its own
 /// cell of equal width. One panel is the usual single picture.
 pub fn scene(panels: &[Vec<Event>], opts: &RenderOptions) -> Result<Scene, RenderError> {
-    if opts.width == 0 || opts.height == 0 || opts.width > 20_000 || opts.height > 20_000 {
-        return Err(RenderError::new(format!(
-            "the image size {}x{} is out of range: each side must be 1 to 20000 pixels",
-            opts.width, opts.height
-        )));
-    }
+    check_size(opts.width, opts.height)?;
     if panels.iter().all(|p| p.is_empty()) {
         return Err(RenderError::new(
             "nothing to draw: after interpretation the word has no drawing modules (F, LineTo2f, Circle, ...)",
@@ -221,17 +275,9 @@ fn fit_panel(
             "the drawing has a NaN or infinite coordinate and cannot be fitted",
         ));
     }
-    let margin = opts.margin * cell_w.min(opts.height as f64);
-    let avail =
-        DVec2::new(cell_w - 2.0 * margin, opts.height as f64 - 2.0 * margin).max(DVec2::ONE);
-    let ext = hi - lo;
-    let scale = fit_scale(avail, ext);
-    let centre = (lo + hi) * 0.5;
-    let mid = DVec2::new(x0 + cell_w * 0.5, opts.height as f64 * 0.5);
-    let px = |p: DVec3| {
-        let q = (v.project(p) - centre) * scale;
-        DVec2::new(mid.x + q.x, mid.y - q.y)
-    };
+    let fit = Fit::new(lo, hi, x0, cell_w, opts.height as f64, opts.margin);
+    let scale = fit.scale;
+    let px = |p: DVec3| fit.pixel(v.project(p));
     let mut run: Option<(Vec<DVec2>, Rgba, f64)> = None;
     let flush = |run: &mut Option<(Vec<DVec2>, Rgba, f64)>, items: &mut Vec<Item>| {
         if let Some((points, color, width)) = run.take() {
@@ -279,6 +325,7 @@ fn fit_panel(
             Event::Polygon { points, color } => Item::Polygon {
                 points: points.iter().map(|p| px(*p)).collect(),
                 color: palette(*color),
+                outline: None,
             },
             Event::Line { .. } => unreachable!("handled above"),
         });
@@ -287,35 +334,10 @@ fn fit_panel(
     Ok(())
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same folder and
-/// a rename, so that a failure never leaves a truncated file behind.
-pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
 /// The scale that fits a drawing of extent `ext` into `avail`, keeping its
 /// aspect; a flat extent (a line, a point) fits by its other side, or not
 /// at all.
-pub(crate) fn fit_scale(avail: DVec2, ext: DVec2) -> f64 {
+fn fit_scale(avail: DVec2, ext: DVec2) -> f64 {
     match (ext.x > 1e-12, ext.y > 1e-12) {
         (true, true) => (avail.x / ext.x).min(avail.y / ext.y),
         (true, false) => avail.x / ext.x,

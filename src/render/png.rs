@@ -1,4 +1,5 @@
-//! PNG output with tiny-skia: antialiased strokes with round caps and joins.
+//! PNG output with tiny-skia: antialiased fills, and strokes with round caps
+//! and joins.
 
 use tiny_skia::{
     Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, Transform,
@@ -7,7 +8,7 @@ use tiny_skia::{
 use super::{Item, RenderError, Rgba, Scene};
 
 /// An anti-aliased solid paint.
-pub(crate) fn paint(c: Rgba) -> Paint<'static> {
+fn paint(c: Rgba) -> Paint<'static> {
     let mut p = Paint::default();
     p.set_color(Color::from_rgba8(c.0, c.1, c.2, c.3));
     p.anti_alias = true;
@@ -37,9 +38,12 @@ pub fn render(scene: &Scene) -> Result<Vec<u8>, RenderError> {
                 color,
                 width,
             } => {
+                let [first, rest @ ..] = points.as_slice() else {
+                    continue;
+                };
                 let mut pb = PathBuilder::new();
-                pb.move_to(points[0].x as f32, points[0].y as f32);
-                for p in &points[1..] {
+                pb.move_to(first.x as f32, first.y as f32);
+                for p in rest {
                     pb.line_to(p.x as f32, p.y as f32);
                 }
                 if let Some(path) = pb.finish() {
@@ -60,15 +64,25 @@ pub fn render(scene: &Scene) -> Result<Vec<u8>, RenderError> {
                     pm.stroke_path(&path, &paint(*color), &stroke(*width), id, None);
                 }
             }
-            Item::Polygon { points, color } => {
+            Item::Polygon {
+                points,
+                color,
+                outline,
+            } => {
+                let [first, rest @ ..] = points.as_slice() else {
+                    continue;
+                };
                 let mut pb = PathBuilder::new();
-                pb.move_to(points[0].x as f32, points[0].y as f32);
-                for p in &points[1..] {
+                pb.move_to(first.x as f32, first.y as f32);
+                for p in rest {
                     pb.line_to(p.x as f32, p.y as f32);
                 }
                 pb.close();
                 if let Some(path) = pb.finish() {
                     pm.fill_path(&path, &paint(*color), FillRule::EvenOdd, id, None);
+                    if let Some(o) = outline {
+                        pm.stroke_path(&path, &paint(o.color), &stroke(o.width), id, None);
+                    }
                 }
             }
         }

@@ -1,5 +1,6 @@
-//! SVG output with the svg crate: one `path` per polyline, coordinates in
-//! pixels with two decimals, so that PNG and SVG agree in size and width.
+//! SVG output with the svg crate: one `path` per polyline and one `polygon`
+//! per polygon, coordinates in pixels with two decimals, so that PNG and SVG
+//! agree in size and width.
 
 use std::fmt::Write;
 
@@ -19,21 +20,36 @@ fn num(x: f64) -> String {
     }
 }
 
-/// Renders a scene as an SVG document.
+/// "x1,y1 x2,y2 ..." with at most two decimals.
+fn points_attr(points: &[glam::DVec2]) -> String {
+    let mut s = String::with_capacity(points.len() * 14);
+    for (k, p) in points.iter().enumerate() {
+        let sep = if k == 0 { "" } else { " " };
+        let _ = write!(s, "{sep}{},{}", num(p.x), num(p.y));
+    }
+    s
+}
+
+/// Renders a scene as an SVG document. Polygons fill by the even-odd rule,
+/// as in the PNG (set once, on the root); a background that is not opaque
+/// keeps its opacity.
 pub fn render(scene: &Scene) -> String {
     let (w, h) = (scene.width, scene.height);
     let mut doc = Document::new()
         .set("width", w)
         .set("height", h)
-        .set("viewBox", format!("0 0 {w} {h}"));
+        .set("viewBox", format!("0 0 {w} {h}"))
+        .set("fill-rule", "evenodd");
     let b = scene.background;
     if b.3 > 0 {
-        doc = doc.add(
-            Rectangle::new()
-                .set("width", "100%")
-                .set("height", "100%")
-                .set("fill", b.hex()),
-        );
+        let mut rect = Rectangle::new()
+            .set("width", "100%")
+            .set("height", "100%")
+            .set("fill", b.hex());
+        if b.3 < 255 {
+            rect = rect.set("fill-opacity", num(b.3 as f64 / 255.0));
+        }
+        doc = doc.add(rect);
     }
     for item in &scene.items {
         match item {
@@ -82,17 +98,21 @@ pub fn render(scene: &Scene) -> String {
                         .set("stroke-width", num(*width)),
                 );
             }
-            Item::Polygon { points, color } => {
-                let pts: Vec<String> = points
-                    .iter()
-                    .map(|p| format!("{},{}", num(p.x), num(p.y)))
-                    .collect();
-                doc = doc.add(
-                    Polygon::new()
-                        .set("points", pts.join(" "))
-                        .set("fill", color.hex())
-                        .set("fill-rule", "evenodd"),
-                );
+            Item::Polygon {
+                points,
+                color,
+                outline,
+            } => {
+                let mut polygon = Polygon::new()
+                    .set("points", points_attr(points))
+                    .set("fill", color.hex());
+                if let Some(o) = outline {
+                    polygon = polygon
+                        .set("stroke", o.color.hex())
+                        .set("stroke-width", num(o.width))
+                        .set("stroke-linejoin", "round");
+                }
+                doc = doc.add(polygon);
             }
         }
     }

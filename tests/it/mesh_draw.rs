@@ -4,11 +4,11 @@
 use std::collections::HashMap;
 
 use glam::{DVec2, DVec3};
-use subgram::mesh::draw::{
-    light_direction, project, render_png, render_svg, view_direction, MeshView,
-};
 use subgram::mesh::PolygonSoup;
-use subgram::render::Rgba;
+use subgram::render::mesh::{
+    light_direction, project, render_png, render_svg, scene, view_direction, MeshView,
+};
+use subgram::render::{Item, Rgba};
 use tiny_skia::Pixmap;
 
 /// A soup without source lines.
@@ -503,6 +503,75 @@ fn wireframe_darkens_the_edges_and_can_be_turned_off() {
     let sum = |c: [u8; 3]| c.iter().map(|&v| v as u32).sum::<u32>();
     assert!(sum(e) + 60 < sum(p), "edge {e:?} vs plain {p:?}");
     assert!(render_svg(&s, &plain).contains("stroke-width=\"0.7\""));
+}
+
+#[test]
+fn a_mesh_is_a_scene_of_outlined_polygons_back_to_front() {
+    let s = sphere(1);
+    let view = MeshView::default();
+    let sc = scene(&s, &view).expect("the mesh draws");
+    assert_eq!(
+        (sc.width, sc.height, sc.background),
+        (800, 800, view.background)
+    );
+    assert_eq!(sc.items.len(), s.faces.len());
+    let px = project(&view, &s);
+    let dir = view.direction.normalize();
+    // The pixel outline of each face, and its depth, to find the items.
+    let faces: Vec<(Vec<DVec2>, f64)> = s
+        .faces
+        .iter()
+        .map(|f| {
+            let pts = f.iter().map(|&i| px[i as usize]).collect();
+            let depth = f
+                .iter()
+                .map(|&i| s.positions[i as usize].dot(dir))
+                .sum::<f64>()
+                / 3.0;
+            (pts, depth)
+        })
+        .collect();
+    let mut depths = Vec::new();
+    for item in &sc.items {
+        let Item::Polygon {
+            points,
+            color,
+            outline,
+        } = item
+        else {
+            panic!("not a polygon: {item:?}");
+        };
+        let (_, depth) = faces
+            .iter()
+            .find(|(pts, _)| pts == points)
+            .expect("every polygon is a projected face");
+        depths.push(*depth);
+        let o = outline.expect("a wireframe outline");
+        assert_ne!(o.color, *color, "the wireframe is darker than the face");
+        assert!(o.width > 0.0);
+    }
+    assert!(
+        depths.windows(2).all(|d| d[0] >= d[1]),
+        "back to front: {depths:?}"
+    );
+    // Without the wireframe, each face is outlined in its own colour.
+    let plain = MeshView {
+        wireframe: false,
+        ..MeshView::default()
+    };
+    for item in scene(&s, &plain).expect("draws").items {
+        let Item::Polygon { color, outline, .. } = item else {
+            panic!("not a polygon");
+        };
+        assert_eq!(outline.map(|o| o.color), Some(color));
+    }
+    // The PNG is this scene drawn by the shared backend; failures come first.
+    assert_eq!(
+        render_png(&s, &view).expect("renders"),
+        subgram::render::png::render(&sc).expect("renders")
+    );
+    let empty = soup(vec![DVec3::ZERO], vec![]);
+    assert!(scene(&empty, &view).is_err());
 }
 
 /// Renders the pictures a person should look at; with MESH_DRAW_OUT set,

@@ -375,3 +375,68 @@ fn the_view_projects_the_3d_turtle() {
         );
     }
 }
+
+/// A 100×100 scene on white with one square from (20, 20) to (80, 80).
+fn square_scene(outline: Option<render::Outline>, background: render::Rgba) -> Scene {
+    let p = |x: f64, y: f64| glam::DVec2::new(x, y);
+    Scene {
+        width: 100,
+        height: 100,
+        background,
+        items: vec![Item::Polygon {
+            points: vec![p(20.0, 20.0), p(80.0, 20.0), p(80.0, 80.0), p(20.0, 80.0)],
+            color: render::Rgba(200, 210, 220, 255),
+            outline,
+        }],
+    }
+}
+
+#[test]
+fn both_backends_stroke_a_polygon_outline_over_its_fill() {
+    let white = render::Rgba(255, 255, 255, 255);
+    let pen = render::Outline {
+        color: render::Rgba(10, 20, 30, 255),
+        width: 4.0,
+    };
+    let rgb = |s: &Scene, x: u32, y: u32| {
+        let pm = tiny_skia::Pixmap::decode_png(&png::render(s).unwrap()).unwrap();
+        let c = pm.pixel(x, y).unwrap().demultiply();
+        [c.red(), c.green(), c.blue()]
+    };
+    let (plain, outlined) = (square_scene(None, white), square_scene(Some(pen), white));
+    // On the edge, the outline covers the fill and reaches outside it.
+    assert_eq!(rgb(&plain, 50, 19), [255, 255, 255]);
+    assert_eq!(rgb(&outlined, 50, 20), [10, 20, 30]);
+    assert_eq!(rgb(&outlined, 50, 19), [10, 20, 30]);
+    // Inside, the fill is untouched.
+    assert_eq!(rgb(&plain, 50, 50), [200, 210, 220]);
+    assert_eq!(rgb(&outlined, 50, 50), [200, 210, 220]);
+    let doc = svg::render(&outlined);
+    assert_eq!(doc.matches("<polygon").count(), 1);
+    for attr in [
+        "points=\"20,20 80,20 80,80 20,80\"",
+        "fill=\"#c8d2dc\"",
+        "stroke=\"#0a141e\"",
+        "stroke-width=\"4\"",
+        "stroke-linejoin=\"round\"",
+    ] {
+        assert!(doc.contains(attr), "{attr} missing in {doc}");
+    }
+    assert!(!svg::render(&plain).contains("stroke"));
+    // Polygons fill by the even-odd rule, as in the PNG: set on the root.
+    let root = &doc[..doc.find('>').unwrap()];
+    assert!(root.contains("fill-rule=\"evenodd\""), "{root}");
+}
+
+#[test]
+fn an_svg_background_keeps_its_opacity() {
+    let half = svg::render(&square_scene(None, render::Rgba(255, 0, 0, 128)));
+    assert!(
+        half.contains("fill=\"#ff0000\" fill-opacity=\"0.5\""),
+        "{half}"
+    );
+    let opaque = svg::render(&square_scene(None, render::Rgba(255, 0, 0, 255)));
+    assert!(!opaque.contains("fill-opacity"), "{opaque}");
+    let none = svg::render(&square_scene(None, render::Rgba(0, 0, 0, 0)));
+    assert!(!none.contains("<rect"), "{none}");
+}

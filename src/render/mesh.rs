@@ -1,4 +1,5 @@
-//! Pictures of polygon meshes: a flat-shaded orthographic view as PNG or SVG.
+//! Pictures of polygon meshes: a flat-shaded orthographic view, as the
+//! shaded polygons of a [`Scene`] that the PNG and SVG backends draw.
 //!
 //! The mesh is projected along the view direction, fitted into the image
 //! with a margin (uniform scale, centred), and its faces are painted back
@@ -6,21 +7,13 @@
 //! Lambert shade of a light grey-blue from a key light and a weak fill
 //! light that are fixed relative to the viewer, so every view is lit the
 //! same way; faces seen from behind (the inside of an open mesh) get a
-//! warmer tint. Thin dark edges show the polygons.
-
-use std::fmt::Write;
+//! warmer tint. Thin dark outlines show the polygons.
 
 use glam::{DVec2, DVec3};
-use svg::node::element::{Polygon, Rectangle};
-use svg::Document;
-use tiny_skia::{Color, FillRule, LineCap, LineJoin, PathBuilder, Pixmap, Stroke};
 
-use super::PolygonSoup;
-use crate::render::png::paint;
-use crate::render::{fit_scale, RenderError, Rgba};
+use super::{check_size, png, svg, Fit, Item, Outline, RenderError, Rgba, Scene};
+use crate::mesh::PolygonSoup;
 
-/// The largest accepted image side, in pixels.
-const MAX_SIDE: u32 = 20_000;
 /// The colour of faces seen from the front (a light grey-blue).
 const FRONT_BASE: DVec3 = DVec3::new(0.70, 0.77, 0.88);
 /// The colour of faces seen from behind (a light warm grey).
@@ -36,6 +29,9 @@ const FILL: f64 = 0.16;
 const GAMMA: f64 = 0.7;
 /// The colour of the wireframe edges.
 const EDGE: Rgba = Rgba(38, 46, 60, 255);
+/// The width of the seam-closing outline drawn in the face colour when the
+/// wireframe is off, so antialiased neighbours leave no light cracks.
+const SEAM_WIDTH: f64 = 0.7;
 
 /// How a mesh is looked at and how the picture is laid out.
 #[derive(Clone, Debug, PartialEq)]
@@ -147,46 +143,27 @@ pub fn light_direction(view: &MeshView) -> DVec3 {
     Camera::or_default(view).key_light()
 }
 
-/// The map from screen-plane coordinates to pixels (y down).
-#[derive(Clone, Copy, Debug)]
-struct Fit {
-    scale: f64,
-    centre: DVec2,
-    mid: DVec2,
-}
-
-impl Fit {
-    /// Fits the bounding box of `points` (screen plane) into the image.
-    fn new(points: impl Iterator<Item = DVec2>, view: &MeshView) -> Fit {
-        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        for p in points.filter(|p| p.is_finite()) {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-        if !(lo.is_finite() && hi.is_finite()) {
-            (lo, hi) = (DVec2::ZERO, DVec2::ZERO);
-        }
-        let size = DVec2::new(view.width as f64, view.height as f64);
-        let fraction = if view.margin.is_finite() {
-            view.margin.clamp(0.0, 0.45)
-        } else {
-            0.04
-        };
-        let avail = (size - 2.0 * fraction * size.min_element()).max(DVec2::ONE);
-        let ext = hi - lo;
-        let scale = fit_scale(avail, ext);
-        Fit {
-            scale,
-            centre: (lo + hi) * 0.5,
-            mid: size * 0.5,
-        }
+/// Fits the screen-plane bounding box of the vertices that faces use into
+/// the whole image.
+fn fit(soup: &PolygonSoup, cam: &Camera, view: &MeshView) -> Fit {
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in used_vertices(soup)
+        .map(|p| cam.plane(p))
+        .filter(|p| p.is_finite())
+    {
+        lo = lo.min(p);
+        hi = hi.max(p);
     }
-
-    /// The pixel position of a screen-plane point.
-    fn pixel(&self, q: DVec2) -> DVec2 {
-        let d = (q - self.centre) * self.scale;
-        DVec2::new(self.mid.x + d.x, self.mid.y - d.y)
+    if !(lo.is_finite() && hi.is_finite()) {
+        (lo, hi) = (DVec2::ZERO, DVec2::ZERO);
     }
+    let margin = if view.margin.is_finite() {
+        view.margin.clamp(0.0, 0.45)
+    } else {
+        0.04
+    };
+    let (w, h) = (view.width as f64, view.height as f64);
+    Fit::new(lo, hi, 0.0, w, h, margin)
 }
 
 /// The vertices that faces refer to (valid indices only).
@@ -201,7 +178,7 @@ fn used_vertices(soup: &PolygonSoup) -> impl Iterator<Item = DVec3> + '_ {
 /// would draw (y down, origin at the top left corner).
 pub fn project(view: &MeshView, soup: &PolygonSoup) -> Vec<DVec2> {
     let cam = Camera::or_default(view);
-    let fit = Fit::new(used_vertices(soup).map(|p| cam.plane(p)), view);
+    let fit = fit(soup, &cam, view);
     soup.positions
         .iter()
         .map(|&p| fit.pixel(cam.plane(p)))
@@ -211,23 +188,18 @@ pub fn project(view: &MeshView, soup: &PolygonSoup) -> Vec<DVec2> {
 /// Checks that `soup` can be drawn with `view`: a sane image size, a usable
 /// direction, at least one face, finite positions and valid indices.
 pub fn validate(soup: &PolygonSoup, view: &MeshView) -> Result<(), RenderError> {
-    let (w, h) = (view.width, view.height);
-    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-        return Err(error(format!(
-            "the image size {w}x{h} is out of range: each side must be 1 to {MAX_SIDE} pixels"
-        )));
-    }
+    check_size(view.width, view.height)?;
     if Camera::new(view).is_none() {
-        return Err(error(
+        return Err(RenderError::new(
             "the view direction must be a finite, non-zero vector",
         ));
     }
     if soup.faces.is_empty() {
-        return Err(error("nothing to draw: the mesh has no faces"));
+        return Err(RenderError::new("nothing to draw: the mesh has no faces"));
     }
     if let Some(v) = soup.positions.iter().position(|p| !p.is_finite()) {
         let p = soup.positions[v];
-        return Err(error(format!(
+        return Err(RenderError::new(format!(
             "vertex {v}{} has a non-finite position ({}, {}, {})",
             at_line(soup.vertex_line(v)),
             p.x,
@@ -243,7 +215,7 @@ fn check_indices(soup: &PolygonSoup) -> Result<(), RenderError> {
     let n = soup.positions.len();
     for (f, face) in soup.faces.iter().enumerate() {
         if let Some(&i) = face.iter().find(|&&i| i as usize >= n) {
-            return Err(error(format!(
+            return Err(RenderError::new(format!(
                 "face {f}{} refers to vertex {i}, but the mesh has {n} vertices",
                 at_line(soup.face_line(f))
             )));
@@ -257,38 +229,76 @@ fn at_line(line: Option<usize>) -> String {
     line.map(|l| format!(" (line {l})")).unwrap_or_default()
 }
 
-fn error(message: impl Into<String>) -> RenderError {
-    RenderError {
-        message: message.into(),
+/// The picture of `soup` seen with `view`, after [`validate`]: one shaded
+/// polygon per drawable face, back to front.
+pub fn scene(soup: &PolygonSoup, view: &MeshView) -> Result<Scene, RenderError> {
+    validate(soup, view)?;
+    Ok(unchecked_scene(soup, view))
+}
+
+/// The scene without the checks: faces that cannot be drawn are left out,
+/// and a view with an unusable direction is drawn from the default one.
+fn unchecked_scene(soup: &PolygonSoup, view: &MeshView) -> Scene {
+    Scene {
+        width: view.width,
+        height: view.height,
+        background: view.background,
+        items: faces(soup, view),
     }
 }
 
-/// One face ready to paint: its outline in pixels and its flat colour.
-#[derive(Clone, Debug)]
+/// Renders the mesh as a PNG image.
+pub fn render_png(soup: &PolygonSoup, view: &MeshView) -> Result<Vec<u8>, RenderError> {
+    png::render(&scene(soup, view)?)
+}
+
+/// Renders the mesh as an SVG document that looks like the PNG: one
+/// `<polygon>` per drawable face, back to front. It does not check its
+/// input (see [`validate`]): faces that cannot be drawn are left out, and a
+/// view with an unusable direction is drawn from the default one.
+pub fn render_svg(soup: &PolygonSoup, view: &MeshView) -> String {
+    svg::render(&unchecked_scene(soup, view))
+}
+
+/// One face ready to paint, with what orders it.
 struct Shaded {
-    points: Vec<DVec2>,
-    fill: Rgba,
+    item: Item,
     depth: f64,
     back: bool,
 }
 
-/// The drawable faces of `soup`, shaded and sorted back to front. Faces
-/// with fewer than three vertices, invalid indices or zero area are left
-/// out.
-fn shaded_faces(soup: &PolygonSoup, view: &MeshView) -> Vec<Shaded> {
+/// The drawable faces of `soup` as scene polygons, shaded and sorted back
+/// to front (farther first; at equal depth a back face first). Faces with
+/// fewer than three vertices, invalid indices or zero area are left out.
+fn faces(soup: &PolygonSoup, view: &MeshView) -> Vec<Item> {
     let cam = Camera::or_default(view);
-    let fit = Fit::new(used_vertices(soup).map(|p| cam.plane(p)), view);
+    let fit = fit(soup, &cam, view);
+    let edge = if view.wireframe {
+        Some(Outline {
+            color: EDGE,
+            width: edge_width(view),
+        })
+    } else {
+        None
+    };
     let mut faces: Vec<Shaded> = soup
         .faces
         .iter()
-        .filter_map(|face| shade_face(soup, face, &cam, &fit))
+        .filter_map(|face| shade_face(soup, face, &cam, &fit, edge))
         .collect();
     faces.sort_by(|a, b| b.depth.total_cmp(&a.depth).then(b.back.cmp(&a.back)));
-    faces
+    faces.into_iter().map(|f| f.item).collect()
 }
 
-/// The shaded, projected face, or None when it cannot be drawn.
-fn shade_face(soup: &PolygonSoup, face: &[u32], cam: &Camera, fit: &Fit) -> Option<Shaded> {
+/// The shaded, projected face, or None when it cannot be drawn. Its outline
+/// is `edge`, or without a wireframe a thin seam closer in its own colour.
+fn shade_face(
+    soup: &PolygonSoup,
+    face: &[u32],
+    cam: &Camera,
+    fit: &Fit,
+    edge: Option<Outline>,
+) -> Option<Shaded> {
     let corners: Vec<DVec3> = face
         .iter()
         .map(|&i| soup.positions.get(i as usize).copied())
@@ -300,9 +310,17 @@ fn shade_face(soup: &PolygonSoup, face: &[u32], cam: &Camera, fit: &Fit) -> Opti
     let back = normal.dot(cam.dir) > 0.0;
     let seen = if back { -normal } else { normal };
     let depth = corners.iter().map(|p| p.dot(cam.dir)).sum::<f64>() / corners.len() as f64;
+    let color = shade(seen, back, cam);
+    let outline = edge.unwrap_or(Outline {
+        color,
+        width: SEAM_WIDTH,
+    });
     Some(Shaded {
-        points: corners.iter().map(|&p| fit.pixel(cam.plane(p))).collect(),
-        fill: shade(seen, back, cam),
+        item: Item::Polygon {
+            points: corners.iter().map(|&p| fit.pixel(cam.plane(p))).collect(),
+            color,
+            outline: Some(outline),
+        },
         depth,
         back,
     })
@@ -341,113 +359,4 @@ fn shade(seen: DVec3, back: bool, cam: &Camera) -> Rgba {
 /// The width of edge strokes: thin, growing slowly with the image.
 fn edge_width(view: &MeshView) -> f64 {
     (view.width.min(view.height) as f64 / 800.0).clamp(0.6, 3.0)
-}
-
-/// The width of the seam-closing stroke drawn in the face colour when the
-/// wireframe is off, so antialiased neighbours leave no light cracks.
-const SEAM_WIDTH: f64 = 0.7;
-
-/// Renders the mesh as a PNG image.
-pub fn render_png(soup: &PolygonSoup, view: &MeshView) -> Result<Vec<u8>, RenderError> {
-    validate(soup, view)?;
-    let mut pm = Pixmap::new(view.width, view.height)
-        .ok_or_else(|| error("cannot allocate an image of that size"))?;
-    let b = view.background;
-    pm.fill(Color::from_rgba8(b.0, b.1, b.2, b.3));
-    let edge_stroke = stroke(if view.wireframe {
-        edge_width(view)
-    } else {
-        SEAM_WIDTH
-    });
-    for face in shaded_faces(soup, view) {
-        paint_face(&mut pm, &face, view.wireframe, &edge_stroke);
-    }
-    pm.encode_png()
-        .map_err(|e| error(format!("cannot encode the PNG: {e}")))
-}
-
-/// Fills one face and strokes its outline (edges, or the seam closer).
-fn paint_face(pm: &mut Pixmap, face: &Shaded, wireframe: bool, edge_stroke: &Stroke) {
-    let mut pb = PathBuilder::new();
-    pb.move_to(face.points[0].x as f32, face.points[0].y as f32);
-    for p in &face.points[1..] {
-        pb.line_to(p.x as f32, p.y as f32);
-    }
-    pb.close();
-    let Some(path) = pb.finish() else {
-        return;
-    };
-    let id = tiny_skia::Transform::identity();
-    pm.fill_path(&path, &paint(face.fill), FillRule::EvenOdd, id, None);
-    let outline = if wireframe { EDGE } else { face.fill };
-    pm.stroke_path(&path, &paint(outline), edge_stroke, id, None);
-}
-
-fn stroke(width: f64) -> Stroke {
-    Stroke {
-        width: width as f32,
-        line_cap: LineCap::Round,
-        line_join: LineJoin::Round,
-        ..Stroke::default()
-    }
-}
-
-/// Renders the mesh as an SVG document that looks like the PNG: one
-/// `<polygon>` per drawable face, back to front. It does not check its
-/// input (see [`validate`]): faces that cannot be drawn are left out, and a
-/// view with an unusable direction is drawn from the default one.
-pub fn render_svg(soup: &PolygonSoup, view: &MeshView) -> String {
-    let (w, h) = (view.width, view.height);
-    let mut doc = Document::new()
-        .set("width", w)
-        .set("height", h)
-        .set("viewBox", format!("0 0 {w} {h}"));
-    let b = view.background;
-    if b.3 > 0 {
-        doc = doc.add(
-            Rectangle::new()
-                .set("width", "100%")
-                .set("height", "100%")
-                .set("fill", b.hex())
-                .set("fill-opacity", num(b.3 as f64 / 255.0)),
-        );
-    }
-    let (outline_width, wireframe) = if view.wireframe {
-        (edge_width(view), true)
-    } else {
-        (SEAM_WIDTH, false)
-    };
-    for face in shaded_faces(soup, view) {
-        let outline = if wireframe { EDGE } else { face.fill };
-        doc = doc.add(
-            Polygon::new()
-                .set("points", points_attr(&face.points))
-                .set("fill", face.fill.hex())
-                .set("stroke", outline.hex())
-                .set("stroke-width", num(outline_width))
-                .set("stroke-linejoin", "round"),
-        );
-    }
-    doc.to_string()
-}
-
-/// "x1,y1 x2,y2 ..." with at most two decimals.
-fn points_attr(points: &[DVec2]) -> String {
-    let mut s = String::with_capacity(points.len() * 14);
-    for (k, p) in points.iter().enumerate() {
-        let sep = if k == 0 { "" } else { " " };
-        let _ = write!(s, "{sep}{},{}", num(p.x), num(p.y));
-    }
-    s
-}
-
-/// A number with at most two decimals and no trailing zeros.
-fn num(x: f64) -> String {
-    let s = format!("{x:.2}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".to_string()
-    } else {
-        s.to_string()
-    }
 }
