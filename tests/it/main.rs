@@ -7,6 +7,7 @@ mod curves;
 mod errors;
 mod golden;
 mod golden_tests;
+mod lsystems;
 mod mesh;
 mod mesh_draw;
 mod mesh_io;
