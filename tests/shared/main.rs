@@ -13,7 +13,6 @@
 
 use std::path::PathBuf;
 
-#[allow(dead_code)]
 #[path = "../it/golden.rs"]
 mod golden;
 mod lpfg;
