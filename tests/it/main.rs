@@ -1,9 +1,13 @@
-//! The integration tests: one binary, one module per area.
+//! The integration tests: one binary, one module per area. The checks
+//! against the shared lpfg corpus are a separate target, tests/shared.
 
+mod abop;
 mod cli;
-mod corpus;
 mod curves;
 mod errors;
+mod golden;
+mod golden_tests;
+mod lsystems;
 mod mesh;
 mod mesh_draw;
 mod mesh_io;

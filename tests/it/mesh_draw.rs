@@ -574,11 +574,15 @@ fn a_mesh_is_a_scene_of_outlined_polygons_back_to_front() {
     assert!(scene(&empty, &view).is_err());
 }
 
-/// Renders the pictures a person should look at; with MESH_DRAW_OUT set,
-/// writes them into that folder.
+/// The pictures a person looked at, against the stored ones in
+/// `tests/golden/mesh/` (240×240; `UPDATE_GOLDEN=1` rewrites them).
 #[test]
 fn example_pictures() {
-    let out = std::env::var_os("MESH_DRAW_OUT").map(std::path::PathBuf::from);
+    let small = |view: MeshView| MeshView {
+        width: 240,
+        height: 240,
+        ..view
+    };
     let pictures = [
         ("cube-iso", cube(), MeshView::default()),
         ("cube-top", cube(), named("top")),
@@ -596,15 +600,12 @@ fn example_pictures() {
             },
         ),
     ];
+    let mut failures = Vec::new();
     for (name, s, view) in pictures {
+        let view = small(view);
         let bytes = render_png(&s, &view).expect("renders");
-        let svg = render_svg(&s, &view);
-        if let Some(dir) = &out {
-            std::fs::create_dir_all(dir).expect("the output folder");
-            subgram::render::write_atomic(&dir.join(format!("{name}.png")), &bytes)
-                .expect("writes the PNG");
-            subgram::render::write_atomic(&dir.join(format!("{name}.svg")), svg.as_bytes())
-                .expect("writes the SVG");
-        }
+        let path = format!("tests/golden/mesh/{name}.png");
+        failures.extend(crate::golden::compare(&path, &bytes, crate::golden::Kind::Png).err());
     }
+    crate::golden::assert_all(failures);
 }

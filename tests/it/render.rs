@@ -1,58 +1,11 @@
 //! Pictures: the SVG's structure against what the word implies, PNGs
 //! against images that were looked at, fitting, and failures.
 
-use std::path::PathBuf;
-
 use subgram::render::{self, png, svg, Item, RenderOptions, Scene};
 use subgram::{DeriveOptions, FigureOptions};
 
+use crate::golden::{self, Kind};
 use crate::support::*;
-
-fn figure(path: &PathBuf, opts: FigureOptions) -> Scene {
-    let l = load(path);
-    l.figure(&opts)
-        .unwrap_or_else(|e| panic!("{}", l.render_figure_error(&e)))
-}
-
-fn sized(w: u32, h: u32) -> FigureOptions {
-    FigureOptions {
-        render: RenderOptions {
-            width: w,
-            height: h,
-            ..RenderOptions::default()
-        },
-        ..FigureOptions::default()
-    }
-}
-
-/// Segments (`L` commands), circles and polygons in an SVG document.
-fn svg_counts(doc: &str) -> (usize, usize, usize) {
-    let mut segments = 0;
-    for part in doc.split(" d=\"").skip(1) {
-        let d = &part[..part.find('"').unwrap()];
-        segments += d.matches('L').count();
-    }
-    (
-        segments,
-        doc.matches("<circle").count(),
-        doc.matches("<polygon").count(),
-    )
-}
-
-#[test]
-fn koch_svg_has_one_segment_per_f() {
-    let s = figure(&corpus("01-quadratic-Koch.l"), FigureOptions::default());
-    let (segments, circles, polygons) = svg_counts(&svg::render(&s));
-    assert_eq!((segments, circles, polygons), (4096, 0, 0));
-}
-
-#[test]
-fn b_spline_svg_has_a_sphere_and_a_line_per_point() {
-    // Interpretation: P -> MoveTo2f Sphere, P < E > P -> Line2f.
-    let s = figure(&corpus("B-spline.l"), FigureOptions::default());
-    let (segments, circles, _) = svg_counts(&svg::render(&s));
-    assert_eq!((segments, circles), (32, 32));
-}
 
 #[test]
 fn paper_program_1_draws_lines_and_circles() {
@@ -102,7 +55,7 @@ fn each_draws_every_step_side_by_side() {
 #[test]
 fn the_drawing_is_fitted_inside_the_margin() {
     for (w, h) in [(800, 800), (800, 300), (300, 800)] {
-        let s = figure(&corpus("03-snowflake.l"), sized(w, h));
+        let s = figure(&lsys("abop/koch-snowflake.lsys"), sized(w, h));
         let m = 0.04 * w.min(h) as f64;
         let (mut lo, mut hi) = (glam::DVec2::splat(f64::MAX), glam::DVec2::splat(f64::MIN));
         for item in &s.items {
@@ -187,59 +140,24 @@ fn png_and_svg_draw_the_same_scene() {
     }
 }
 
-/// Compares a PNG with a stored one that was looked at and found right.
-/// `UPDATE_GOLDEN=1` rewrites the stored image.
-fn check_golden(name: &str, bytes: &[u8]) {
-    let path = root().join("tests/golden").join(name);
-    if std::env::var_os("UPDATE_GOLDEN").is_some() {
-        std::fs::write(&path, bytes).unwrap();
-        return;
-    }
-    let want = tiny_skia::Pixmap::decode_png(&std::fs::read(&path).unwrap()).unwrap();
-    let got = tiny_skia::Pixmap::decode_png(bytes).unwrap();
-    assert_eq!((got.width(), got.height()), (want.width(), want.height()));
-    let mut total = 0u64;
-    let mut far = 0usize;
-    for (a, b) in got.pixels().iter().zip(want.pixels()) {
-        let d = [
-            a.red().abs_diff(b.red()),
-            a.green().abs_diff(b.green()),
-            a.blue().abs_diff(b.blue()),
-        ];
-        let m = *d.iter().max().unwrap();
-        total += m as u64;
-        if m > 64 {
-            far += 1;
-        }
-    }
-    let n = got.pixels().len();
-    assert!(
-        far * 200 < n,
-        "{name}: {far} of {n} pixels differ by more than 64"
-    );
-    assert!(
-        (total as f64 / n as f64) < 2.0,
-        "{name}: mean difference {}",
-        total as f64 / n as f64
-    );
-}
-
 #[test]
 fn png_matches_the_stored_chaikin_figure() {
     let s = figure(&lsys("curves/chaikin-13.lsys"), sized(240, 240));
-    check_golden("chaikin-13.png", &png::render(&s).unwrap());
+    golden::check(
+        "tests/golden/chaikin-13.png",
+        &png::render(&s).unwrap(),
+        Kind::Png,
+    );
 }
 
 #[test]
 fn png_matches_the_stored_kolam() {
     let s = figure(&lsys("figures/fig10-kolam.lsys"), sized(240, 240));
-    check_golden("fig10-kolam.png", &png::render(&s).unwrap());
-}
-
-#[test]
-fn png_matches_the_stored_fern() {
-    let s = figure(&corpus("07-fractal-ferns.l"), sized(240, 240));
-    check_golden("07-fractal-ferns.png", &png::render(&s).unwrap());
+    golden::check(
+        "tests/golden/fig10-kolam.png",
+        &png::render(&s).unwrap(),
+        Kind::Png,
+    );
 }
 
 #[test]

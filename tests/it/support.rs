@@ -1,12 +1,14 @@
-//! Shared helpers: loading files, reading points out of words, and the
-//! subdivision matrices that serve as oracles.
+//! Shared helpers: loading files, reading points out of words, figures,
+//! and the subdivision matrices that serve as oracles. The `shared` test
+//! target (tests/shared) includes this file too.
 
 use std::path::PathBuf;
 
 use glam::{DVec2, DVec3};
 use subgram::lang::Value;
 use subgram::mesh::PolygonSoup;
-use subgram::{DeriveOptions, Derived, Loaded};
+use subgram::render::{RenderOptions, Scene};
+use subgram::{DeriveOptions, Derived, FigureOptions, Loaded};
 
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -15,11 +17,6 @@ pub fn root() -> PathBuf {
 /// `lsystems/NAME` inside the project.
 pub fn lsys(name: &str) -> PathBuf {
     root().join("lsystems").join(name)
-}
-
-/// `../shared/corpus/lpfg/NAME`, the external corpus.
-pub fn corpus(name: &str) -> PathBuf {
-    root().join("../shared/corpus/lpfg").join(name)
 }
 
 pub fn load(path: &PathBuf) -> Loaded {
@@ -41,6 +38,39 @@ pub fn derive(l: &Loaded, opts: DeriveOptions) -> Derived {
         Ok(d) => d,
         Err(e) => panic!("derivation failed:\n{}", l.render_derive_error(&e)),
     }
+}
+
+/// The figure of the file at `path`.
+pub fn figure(path: &PathBuf, opts: FigureOptions) -> Scene {
+    let l = load(path);
+    l.figure(&opts)
+        .unwrap_or_else(|e| panic!("{}", l.render_figure_error(&e)))
+}
+
+/// Figure options for a `w` × `h` picture.
+pub fn sized(w: u32, h: u32) -> FigureOptions {
+    FigureOptions {
+        render: RenderOptions {
+            width: w,
+            height: h,
+            ..RenderOptions::default()
+        },
+        ..FigureOptions::default()
+    }
+}
+
+/// Segments (`L` commands), circles and polygons in an SVG document.
+pub fn svg_counts(doc: &str) -> (usize, usize, usize) {
+    let mut segments = 0;
+    for part in doc.split(" d=\"").skip(1) {
+        let d = &part[..part.find('"').unwrap()];
+        segments += d.matches('L').count();
+    }
+    (
+        segments,
+        doc.matches("<circle").count(),
+        doc.matches("<polygon").count(),
+    )
 }
 
 /// The word as text, for compact assertions.
