@@ -6,15 +6,15 @@ use subgram::DeriveOptions;
 fn load_error(src: &str) -> String {
     match subgram::load_str("bad.lsys", src, &[]) {
         Ok(_) => panic!("the program loaded, but an error was expected"),
-        Err(e) => e.render(),
+        Err(e) => e.to_string(),
     }
 }
 
 fn derive_error(src: &str, opts: DeriveOptions) -> String {
-    let l = subgram::load_str("bad.lsys", src, &[]).unwrap_or_else(|e| panic!("{}", e.render()));
+    let l = subgram::load_str("bad.lsys", src, &[]).unwrap_or_else(|e| panic!("{}", e.to_string()));
     match subgram::derive(&l.program, opts) {
         Ok(_) => panic!("the derivation succeeded, but an error was expected"),
-        Err(e) => l.render_derive_error(&e),
+        Err(e) => l.error(e).to_string(),
     }
 }
 
@@ -150,7 +150,7 @@ fn runaway_growth_is_stopped_by_the_module_limit() {
     );
     assert_eq!(
         got,
-        "error: at step 10, the word grew past 1000 modules; raise the limit with --max-modules or derive fewer steps"
+        "at step 10, the word grew past 1000 modules; raise the limit with --max-modules or derive fewer steps"
     );
 }
 

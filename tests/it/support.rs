@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 
 use glam::{DVec2, DVec3};
-use subgram::lang::Value;
 use subgram::mesh::PolygonSoup;
-use subgram::{DeriveOptions, Derived, Loaded};
+use subgram::Value;
+use subgram::{Curve as Loaded, DeriveOptions, Derived};
 
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -25,21 +25,21 @@ pub fn corpus(name: &str) -> PathBuf {
 pub fn load(path: &PathBuf) -> Loaded {
     match subgram::load_file(path, &[]) {
         Ok(l) => l,
-        Err(e) => panic!("{} does not load:\n{}", path.display(), e.render()),
+        Err(e) => panic!("{} does not load:\n{}", path.display(), e.to_string()),
     }
 }
 
 pub fn load_text(text: &str) -> Loaded {
     match subgram::load_str("test.lsys", text, &[]) {
         Ok(l) => l,
-        Err(e) => panic!("the test program does not load:\n{}", e.render()),
+        Err(e) => panic!("the test program does not load:\n{}", e.to_string()),
     }
 }
 
 pub fn derive(l: &Loaded, opts: DeriveOptions) -> Derived {
     match subgram::derive(&l.program, opts) {
         Ok(d) => d,
-        Err(e) => panic!("derivation failed:\n{}", l.render_derive_error(&e)),
+        Err(e) => panic!("derivation failed:\n{}", l.error(e)),
     }
 }
 
