@@ -176,3 +176,116 @@ pub(crate) fn curve(front: Front) -> Result<Curve, Error> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kind(text: &str) -> &'static str {
+        let f = front("t.lsys", text.to_string(), &[]).unwrap();
+        if surface::is_surface(&f.tokens) {
+            "surface"
+        } else {
+            "curve"
+        }
+    }
+
+    #[test]
+    fn the_kind_comes_from_the_tokens() {
+        assert_eq!(kind("mesh: \"cube.obj\";\nV(v) -> V(v = v);\n"), "surface");
+        assert_eq!(kind("F(f) -> V(v = avg(f)) || E^3 F^3;\n"), "surface");
+        assert_eq!(kind("E(e) | F^2 -> V(v = avg(e)) || E^4 F^4;\n"), "surface");
+        // `mesh:` inside a comment or a string is not a directive.
+        assert_eq!(
+            kind("// mesh: \"cube.obj\";\nmodule A;\nAxiom: A;\n"),
+            "curve"
+        );
+        // C's `||` in a condition, or inside a module's parentheses, and a
+        // `||` on a later line do not make a surface rule.
+        let curve = "module F(float);\nAxiom: F(1);\nF(x) -> F(x + 1)\n\
+                     F(x) : x > 2 || x < 0 -> F(x)\nF(x) -> F(x > 1 || x < 0)\n";
+        assert_eq!(kind(curve), "curve");
+        assert_eq!(
+            kind("module V(float);\nV(x) : { produce V(x) || V(x); }\n"),
+            "curve"
+        );
+        // With `angle:`, `|` turns the turtle around.
+        assert_eq!(
+            kind("angle: 90;\nAxiom: F(1);\nF(x) -> F(x)||F(x)\n"),
+            "curve"
+        );
+        // The decision is made after preprocessing: a macro can spell the
+        // directive, as the grammar's parser will read it.
+        assert_eq!(kind("#define M mesh\nM: \"cube.obj\";\n"), "surface");
+    }
+
+    #[test]
+    fn a_file_is_loaded_as_its_kind() {
+        let opts = LoadOptions::default();
+        let s = load_text("g.lsys", "F(f) -> V(v = avg(f)) || E^3 F^3;\n", &opts).unwrap();
+        assert!(matches!(s, System::Surface(_)));
+        let c = load_text("c.lsys", "module A;\nAxiom: A;\n", &opts).unwrap();
+        assert!(matches!(c, System::Curve(_)));
+    }
+
+    #[test]
+    fn defines_are_checked_and_applied() {
+        let text = "#define N 2\nmodule A(int);\nAxiom: A(N);\n";
+        let opts = LoadOptions::default().define("N=5");
+        let System::Curve(c) = load_text("d.lsys", text, &opts).unwrap() else {
+            panic!("a curve")
+        };
+        assert_eq!(c.derive(Default::default()).unwrap().word.len(), 1);
+        let run = c.run(Default::default()).unwrap();
+        assert_eq!(run.text(), "A(5)");
+        for bad in ["N", "=5", "N M=5"] {
+            let e = load_text("d.lsys", text, &LoadOptions::default().define(bad)).unwrap_err();
+            assert!(matches!(e, Error::Usage(_)), "{bad}: {e:?}");
+            assert!(e.to_string().contains("must have the form NAME=VALUE"));
+        }
+        // A `-D` value that does not lex points into its own source.
+        let e = load_text("d.lsys", text, &LoadOptions::default().define("N=`")).unwrap_err();
+        assert!(e.to_string().starts_with("<-D N>:1:1: error: "), "{e}");
+    }
+
+    #[test]
+    fn errors_are_std_errors_without_an_error_prefix() {
+        fn read_missing() -> Result<System, Box<dyn std::error::Error>> {
+            Ok(load("no/such/file.lsys", &LoadOptions::default())?)
+        }
+        let e = read_missing().unwrap_err();
+        assert!(e.source().is_some(), "the io::Error is the source");
+        assert!(e
+            .to_string()
+            .starts_with("cannot read `no/such/file.lsys`: "));
+        // Every diagnostic, each with its line and caret, a blank line between.
+        let text = "module A;\nAxiom: B;\nA -> C\n";
+        let e = load_text("two.lsys", text, &LoadOptions::default()).unwrap_err();
+        assert_eq!(e.diagnostics().len(), 2, "{e}");
+        assert!(e.has_location());
+        let shown = e.to_string();
+        let blocks: Vec<&str> = shown.split("\n\n").collect();
+        assert_eq!(blocks.len(), 2, "{shown}");
+        assert!(blocks[0].starts_with("two.lsys:2:8: error: "), "{shown}");
+        assert!(blocks[1].starts_with("two.lsys:3:6: error: "), "{shown}");
+        assert!(blocks
+            .iter()
+            .all(|b| b.lines().count() == 4 && b.ends_with('^')));
+    }
+
+    #[test]
+    fn a_failed_run_points_at_the_rule() {
+        let text = "module A(float);\nderivation length: 1;\nAxiom: A(1);\n\
+                    A(x) : { produce A(x / 0); }\n";
+        let c = load_str("r.lsys", text, &[]).unwrap();
+        let e = c.derive(Default::default()).unwrap_err();
+        let shown = e.to_string();
+        assert!(shown.starts_with("r.lsys:4:"), "{shown}");
+        assert!(
+            shown.contains("\n4 | A(x) : { produce A(x / 0); }\n"),
+            "{shown}"
+        );
+        let too_many = crate::DeriveOptions::default().with_steps(crate::MAX_STEPS + 1);
+        assert!(matches!(c.derive(too_many), Err(Error::Usage(_))));
+    }
+}
