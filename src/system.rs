@@ -12,6 +12,7 @@ use crate::syntax::SourceMap;
 
 /// A checked `.lsys` file: what [`crate::load`] returns.
 #[derive(Debug)]
+#[allow(clippy::large_enum_variant)] // one per loaded file: boxing saves nothing
 pub enum System {
     /// An L-system whose word of modules is derived and drawn as a curve.
     Curve(Curve),

@@ -11,7 +11,7 @@ fn load_error(src: &str) -> String {
 }
 
 fn derive_error(src: &str, opts: DeriveOptions) -> String {
-    let l = subgram::load_str("bad.lsys", src, &[]).unwrap_or_else(|e| panic!("{}", e.to_string()));
+    let l = subgram::load_str("bad.lsys", src, &[]).unwrap_or_else(|e| panic!("{e}"));
     match subgram::derive(&l.program, opts) {
         Ok(_) => panic!("the derivation succeeded, but an error was expected"),
         Err(e) => l.error(e).to_string(),

@@ -25,14 +25,14 @@ pub fn corpus(name: &str) -> PathBuf {
 pub fn load(path: &PathBuf) -> Loaded {
     match subgram::load_file(path, &[]) {
         Ok(l) => l,
-        Err(e) => panic!("{} does not load:\n{}", path.display(), e.to_string()),
+        Err(e) => panic!("{} does not load:\n{}", path.display(), e),
     }
 }
 
 pub fn load_text(text: &str) -> Loaded {
     match subgram::load_str("test.lsys", text, &[]) {
         Ok(l) => l,
-        Err(e) => panic!("the test program does not load:\n{}", e.to_string()),
+        Err(e) => panic!("the test program does not load:\n{e}"),
     }
 }
 

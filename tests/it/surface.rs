@@ -8,7 +8,7 @@ use subgram::mesh::{shapes, Mesh, PolygonSoup, VertexId};
 use crate::support::*;
 
 fn grammar(file: &str) -> subgram::surface::Grammar {
-    subgram::surface::load_file(&lsys(file), &[]).unwrap_or_else(|e| panic!("{}", e.to_string()))
+    subgram::surface::load_file(&lsys(file), &[]).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn run(file: &str, base: &Mesh) -> Mesh {
@@ -654,8 +654,7 @@ fn deep_function_nesting_reuses_frame_slots() {
         );
     }
     text += "V(v) -> V(v = g15(v, 0, 1));\n";
-    let g = subgram::surface::load_str("g.lsys", &text, &[])
-        .unwrap_or_else(|e| panic!("{}", e.to_string()));
+    let g = subgram::surface::load_str("g.lsys", &text, &[]).unwrap_or_else(|e| panic!("{e}"));
     let base = Mesh::from_soup(&shapes::icosahedron()).unwrap();
     let m = run_steps(&g, &base, 1);
     for v in m.vertices() {
