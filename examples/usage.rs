@@ -35,7 +35,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     };
 
     let system = subgram::load(&file, &LoadOptions::default())?;
-    match system.run(&RunOptions::default().steps(steps))? {
+    match system.run(&RunOptions::default().with_steps(steps))? {
         Run::Curve(mut curve) => {
             println!(
                 "after {} steps, {} modules:",

@@ -8,7 +8,7 @@ use crate::mesh::Mesh;
 use crate::rewrite::derive::DEFAULT_MAX_MODULES;
 use crate::rewrite::{DeriveOptions, Word};
 use crate::surface::{Grammar, StepCounts};
-use crate::syntax::SourceMap;
+use crate::syntax::{FileId, SourceMap};
 
 /// A checked `.lsys` file: what [`crate::load`] returns.
 #[derive(Debug)]
@@ -48,7 +48,7 @@ impl Default for RunOptions {
 
 impl RunOptions {
     /// Runs `n` steps instead of the file's derivation length.
-    pub fn steps(mut self, n: u64) -> Self {
+    pub fn with_steps(mut self, n: u64) -> Self {
         self.steps = Some(n);
         self
     }
@@ -96,7 +96,7 @@ impl System {
     /// let root = env!("CARGO_MANIFEST_DIR");
     /// let opts = subgram::LoadOptions::default();
     /// let system = subgram::load(format!("{root}/lsystems/surfaces/loop.lsys"), &opts)?;
-    /// let run = system.run(&subgram::RunOptions::default().steps(1))?;
+    /// let run = system.run(&subgram::RunOptions::default().with_steps(1))?;
     /// assert_eq!(run.mesh().unwrap().info().faces, 8 * 4); // an octahedron, each face split in 4
     /// # Ok(()) }
     /// ```
@@ -223,7 +223,8 @@ impl Surface {
             (Some(m), _) => m.clone(),
             (None, Some(p)) => p,
             (None, None) => {
-                let name = &self.grammar.sources.get(Default::default()).name;
+                // The grammar's own file comes first in its sources.
+                let name = &self.grammar.sources.get(FileId(0)).name;
                 return Err(Error::Usage(format!(
                     "give a base mesh: `subgram subdivide MESH --grammar {name} ...`, or `mesh: \"file.obj\";` in the grammar"
                 )));
