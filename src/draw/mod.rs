@@ -127,6 +127,14 @@ pub struct DrawError {
     pub message: String,
 }
 
+impl std::fmt::Display for DrawError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for DrawError {}
+
 fn command(name: &str) -> Cmd {
     use DVec3Axis::*;
     match name {

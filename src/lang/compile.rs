@@ -85,11 +85,6 @@ impl RuleCompiler {
             std::mem::take(&mut self.c.warnings),
         )
     }
-
-    /// A type's name as messages give it.
-    pub fn type_name(&self, ty: Ty) -> String {
-        self.c.type_name(ty)
-    }
 }
 
 struct Compiler {

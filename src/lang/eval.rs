@@ -724,3 +724,11 @@ pub fn binary(op: BinOp, x: Value, y: Value) -> Result<Value, String> {
         }
     })
 }
+
+impl std::fmt::Display for RuntimeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for RuntimeError {}

@@ -345,3 +345,11 @@ fn fit_scale(avail: DVec2, ext: DVec2) -> f64 {
         (false, false) => 1.0,
     }
 }
+
+impl std::fmt::Display for RenderError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for RenderError {}

@@ -11,9 +11,11 @@ pub mod trace;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+use crate::curve::Curve;
+use crate::error::Error;
 use crate::lang::Value;
 use crate::rewrite::Word;
-use crate::{Derivation, DeriveOptions, LoadError, Loaded};
+use crate::{Derivation, DeriveOptions};
 
 pub use input::{Contour, InputError};
 
@@ -23,44 +25,11 @@ pub const OPEN_SCHEME: &str = include_str!("../../lsystems/reverse/chaikin-open.
 
 /// A reverse scheme: group 1 reverses one level, group 2 subdivides one.
 pub struct Scheme {
-    pub loaded: Loaded,
+    pub loaded: Curve,
     /// "builtin:chaikin", "builtin:chaikin-open" or a file path.
     pub name: String,
     pub closed: bool,
 }
-
-/// Why reversing failed.
-#[derive(Debug)]
-pub enum ReverseError {
-    Load(LoadError),
-    /// The scheme failed to run (a message with its source location).
-    Scheme(String),
-    /// The contour became too short for another step.
-    TooShort {
-        step: usize,
-        points: usize,
-        needed: usize,
-    },
-    /// A details file does not fit the coarse contour or is malformed.
-    Details(String),
-}
-
-impl std::fmt::Display for ReverseError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ReverseError::Load(e) => f.write_str(&e.render()),
-            ReverseError::Scheme(m) => f.write_str(m),
-            ReverseError::TooShort { step, points, needed } => write!(
-                f,
-                "error: after {} step(s) the contour has {points} points; step {step} needs at least {needed}: ask for fewer steps",
-                step - 1
-            ),
-            ReverseError::Details(m) => write!(f, "error: {m}"),
-        }
-    }
-}
-
-impl std::error::Error for ReverseError {}
 
 impl Scheme {
     /// The built-in reverse Chaikin scheme, for closed or open contours.
@@ -80,16 +49,16 @@ impl Scheme {
 
     /// A scheme file: module `P(V2f)`, group 1 reverse, group 2 forward.
     /// Open schemes work between endmarkers `#`.
-    pub fn from_file(path: &std::path::Path, closed: bool) -> Result<Scheme, ReverseError> {
-        let loaded = crate::load_file(path, &[]).map_err(ReverseError::Load)?;
+    pub fn from_file(path: &std::path::Path, closed: bool) -> Result<Scheme, Error> {
+        let loaded = crate::load_file(path, &[])?;
         let p = loaded.program.alphabet.lookup("P");
         let ok = p.is_some_and(|s| {
             matches!(&loaded.program.alphabet.get(s).sig,
                 crate::lang::modules::Signature::Fixed(t) if t == &[crate::lang::Ty::V2])
         });
         if !ok {
-            return Err(ReverseError::Scheme(format!(
-                "error: the scheme {} must declare `module P(V2f);` for the contour's points",
+            return Err(Error::Failed(format!(
+                "the scheme {} must declare `module P(V2f);` for the contour's points",
                 path.display()
             )));
         }
@@ -135,10 +104,10 @@ impl Scheme {
         group: i64,
         steps: u64,
         phase: usize,
-    ) -> Result<Vec<DVec2>, ReverseError> {
+    ) -> Result<Vec<DVec2>, Error> {
         let opts = DeriveOptions::default().with_steps(steps).with_phase(phase);
         let l = &self.loaded;
-        let fail = |e: crate::DeriveError| ReverseError::Scheme(l.render_derive_error(&e));
+        let fail = |e| l.error(e);
         let mut d = Derivation::new(&l.program, opts).map_err(fail)?;
         d.word = self.word(pts);
         d.ring = self.closed;
@@ -150,12 +119,12 @@ impl Scheme {
     }
 
     /// One reverse step (group 1) with the partition starting at `phase`.
-    pub fn reverse_step(&self, pts: &[DVec2], phase: usize) -> Result<Vec<DVec2>, ReverseError> {
+    pub fn reverse_step(&self, pts: &[DVec2], phase: usize) -> Result<Vec<DVec2>, Error> {
         self.run(pts, 1, 1, phase)
     }
 
     /// `steps` forward steps (group 2).
-    pub fn forward(&self, pts: &[DVec2], steps: usize) -> Result<Vec<DVec2>, ReverseError> {
+    pub fn forward(&self, pts: &[DVec2], steps: usize) -> Result<Vec<DVec2>, Error> {
         if steps == 0 {
             return Ok(pts.to_vec());
         }
@@ -252,22 +221,19 @@ fn metric_point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
 }
 
 /// Reverses `input` by `opts.steps` levels.
-pub fn reverse(
-    scheme: &Scheme,
-    input: &Contour,
-    opts: &ReverseOptions,
-) -> Result<Reversal, ReverseError> {
+pub fn reverse(scheme: &Scheme, input: &Contour, opts: &ReverseOptions) -> Result<Reversal, Error> {
     let mut level = input.points.clone();
     let mut steps = Vec::new();
     let mut levels = Vec::new();
     for step in 1..=opts.steps {
         let even = level.len() - level.len() % 2;
         if even < scheme.min_points() {
-            return Err(ReverseError::TooShort {
-                step,
-                points: level.len(),
-                needed: scheme.min_points(),
-            });
+            return Err(Error::Failed(format!(
+                "after {} step(s) the contour has {} points; step {step} needs at least {}: ask for fewer steps",
+                step - 1,
+                level.len(),
+                scheme.min_points()
+            )));
         }
         let mut dropped = None;
         if level.len() % 2 == 1 {
@@ -298,8 +264,8 @@ pub fn reverse(
         if opts.details {
             let sub = scheme.forward(&coarse, 1)?;
             if sub.len() != level.len() {
-                return Err(ReverseError::Scheme(format!(
-                    "error: the scheme's forward group turns {} points into {}, not the {} of the finer level, so details cannot be kept",
+                return Err(Error::Failed(format!(
+                    "the scheme's forward group turns {} points into {}, not the {} of the finer level, so details cannot be kept",
                     coarse.len(),
                     sub.len(),
                     level.len()
@@ -363,15 +329,15 @@ pub fn reconstruct(
     coarse: &[DVec2],
     details: &Details,
     upto: Option<usize>,
-) -> Result<Vec<DVec2>, ReverseError> {
+) -> Result<Vec<DVec2>, Error> {
     if details.format != DETAILS_FORMAT || details.version != 1 {
-        return Err(ReverseError::Details(format!(
+        return Err(Error::Failed(format!(
             "not a subgram details file (format `{}` version {})",
             details.format, details.version
         )));
     }
     if coarse.len() != details.coarse_points {
-        return Err(ReverseError::Details(format!(
+        return Err(Error::Failed(format!(
             "the details belong to a coarse contour of {} points, but this one has {}",
             details.coarse_points,
             coarse.len()
@@ -379,7 +345,7 @@ pub fn reconstruct(
     }
     let k = upto.unwrap_or(details.levels.len());
     if k > details.levels.len() {
-        return Err(ReverseError::Details(format!(
+        return Err(Error::Failed(format!(
             "level {k} was asked for, but the details have {} levels",
             details.levels.len()
         )));
@@ -388,7 +354,7 @@ pub fn reconstruct(
     for (li, l) in details.levels[..k].iter().enumerate() {
         let sub = scheme.forward(&level, 1)?;
         if sub.len() != l.details.len() {
-            return Err(ReverseError::Details(format!(
+            return Err(Error::Failed(format!(
                 "level {}: the subdivision has {} points but the details have {}",
                 li + 1,
                 sub.len(),
@@ -402,7 +368,7 @@ pub fn reconstruct(
         }
         if let Some((i, p)) = l.dropped {
             if i > fine.len() {
-                return Err(ReverseError::Details(format!(
+                return Err(Error::Failed(format!(
                     "level {}: a dropped point's index is out of range",
                     li + 1
                 )));
@@ -446,7 +412,7 @@ pub struct Report {
 }
 
 /// Measures a reversal.
-pub fn report(scheme: &Scheme, input: &Contour, r: &Reversal) -> Result<Report, ReverseError> {
+pub fn report(scheme: &Scheme, input: &Contour, r: &Reversal) -> Result<Report, Error> {
     let steps = r.steps.len();
     let rec = scheme.forward(&r.coarse, steps)?;
     let dec = decimate(&input.points, r.coarse.len(), scheme.closed);
@@ -461,6 +427,55 @@ pub fn report(scheme: &Scheme, input: &Contour, r: &Reversal) -> Result<Report, 
         reverse: metric::distance(&input.points, &rec, scheme.closed),
         decimation: metric::distance(&input.points, &dec_rec, scheme.closed),
     })
+}
+
+/// The report as the binary prints it: point counts per step, then the
+/// reconstruction errors of reverse subdivision and of naive decimation.
+impl std::fmt::Display for Report {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let r = self;
+        writeln!(
+            f,
+            "input: {} points, {} ({})\nscheme: {}",
+            r.input_points,
+            if r.closed { "closed" } else { "open" },
+            r.source,
+            r.scheme
+        )?;
+        for st in &r.steps {
+            writeln!(
+                f,
+                "step {}: {} -> {} points, phase {}{}",
+                st.step,
+                st.fine,
+                st.coarse,
+                st.phase,
+                if st.dropped {
+                    " (odd: the flattest point was dropped first)"
+                } else {
+                    ""
+                }
+            )?;
+        }
+        let e =
+            |m: &metric::Error| format!("max {:.6}  mean {:.6}  rms {:.6}", m.max, m.mean, m.rms);
+        writeln!(
+            f,
+            "reconstruction error, {} points subdivided {} times, against the input:\n  reverse subdivision  {}\n  naive decimation     {}",
+            r.coarse_points,
+            r.steps.len(),
+            e(&r.reverse),
+            e(&r.decimation)
+        )?;
+        if r.reverse.rms > 0.0 {
+            write!(
+                f,
+                "  decimation's rms error is {:.2} times reverse subdivision's",
+                r.decimation.rms / r.reverse.rms
+            )?;
+        }
+        Ok(())
+    }
 }
 
 /// Writes points as `x y` lines (`.txt`, `.xy`, anything else), `x,y` CSV

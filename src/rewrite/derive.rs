@@ -63,6 +63,16 @@ pub struct DeriveError {
     pub step: u64,
 }
 
+/// The message alone; [`crate::Curve::error`] adds the rule's line and
+/// caret.
+impl std::fmt::Display for DeriveError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for DeriveError {}
+
 /// The result of a derivation.
 #[derive(Clone, Debug)]
 pub struct Derived {

@@ -7,5 +7,4 @@ pub mod step;
 pub mod word;
 
 pub use derive::{derive, Derivation, DeriveError, DeriveOptions, Derived};
-pub use step::{Rewriter, StepError, StepOptions};
-pub use word::{Seq, Word};
+pub use word::Word;

@@ -37,6 +37,17 @@ pub enum StepError {
     TooLong { limit: usize },
 }
 
+impl std::fmt::Display for StepError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StepError::Runtime { error, .. } => f.write_str(&error.message),
+            StepError::TooLong { limit } => write!(f, "the word grew past {limit} modules"),
+        }
+    }
+}
+
+impl std::error::Error for StepError {}
+
 /// Rewrites words with a program's rules. Holds buffers reused across steps.
 pub struct Rewriter<'p> {
     program: &'p Program,

@@ -11,9 +11,6 @@ use crate::lang::{Alphabet, Sym, Value};
 /// Read access to a sequence of modules, used by context matching.
 pub trait Seq {
     fn len(&self) -> usize;
-    fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
     fn sym(&self, i: usize) -> Sym;
     /// The parameter slots of module `i`.
     fn data(&self, i: usize) -> &[f64];

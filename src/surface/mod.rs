@@ -1,100 +1,94 @@
 //! Stellar subdivision grammars (paper 000): rules over faces, edges and
 //! vertices with levels, run on the half-edge mesh.
+//!
+//! [`crate::load`] tells a grammar from a curve L-system by its syntax;
+//! [`load_str`] and [`load_file`] read text as a grammar whatever it says.
 
-pub mod grammar;
-pub mod host;
-pub mod run;
+pub(crate) mod grammar;
+pub(crate) mod host;
+pub(crate) mod run;
 
 use std::path::Path;
 
-use crate::syntax::{lex, preprocess, Diagnostic, SourceFile, SourceMap, Span};
+use crate::error::Error;
+use crate::load::{self, Front};
+use crate::syntax::lex::Token;
+use crate::syntax::Span;
 
 pub use run::{Grammar, RunError, StepCounts};
 
-/// Why a grammar could not be loaded: its messages with their sources.
-#[derive(Debug)]
-pub struct GrammarError {
-    pub sources: SourceMap,
-    pub diagnostics: Vec<Diagnostic>,
-}
-
-impl GrammarError {
-    pub fn render(&self) -> String {
-        self.diagnostics
-            .iter()
-            .map(|d| self.sources.render(d.span, &d.message))
-            .collect::<Vec<_>>()
-            .join("\n\n")
-    }
-}
-
-/// True when `text` is a surface grammar (it names a base mesh with `mesh:`
-/// or holds rules such as `F(f) -> V(...) || E^3 F^3`).
-pub fn is_surface_text(text: &str) -> bool {
-    text.lines().any(|l| {
-        let t = l.trim_start();
-        t.starts_with("mesh:")
-            || ((t.starts_with("F(") || t.starts_with("E(") || t.starts_with("V("))
-                && t.contains("||"))
-    })
-}
-
-/// Loads a surface grammar from text. `defines` are `-D NAME=VALUE`.
-pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Grammar, GrammarError> {
-    let mut sources = SourceMap::default();
-    let main = sources.add(SourceFile::new(name, text));
-    let fail = |sources: SourceMap, d: Diagnostic| GrammarError {
-        sources,
-        diagnostics: vec![d],
+/// True when preprocessed tokens are a surface grammar: a `mesh:` directive
+/// at the start of a line, or a rule in paper 000's form on one line: `F(`,
+/// `E(` or `V(` at the start of the line, then `->` and a successor context
+/// `||` outside parentheses. (In a curve L-system `||` is C's "or", inside a
+/// module's parentheses or in a condition before the arrow; with `angle:`,
+/// `|` is the turtle's turn, so such files are curves.)
+pub(crate) fn is_surface(toks: &[Token]) -> bool {
+    let directive = |name: &str| {
+        toks.windows(2)
+            .any(|w| w[0].line_start && w[0].tok.is_ident(name) && w[1].tok.is_punct(":"))
     };
-    let mut overrides = Vec::new();
-    for d in defines {
-        let Some((n, v)) = d.split_once('=') else {
-            return Err(fail(
-                sources,
-                Diagnostic::new(
-                    Span::default(),
-                    format!("`-D {d}` must have the form NAME=VALUE"),
-                ),
-            ));
-        };
-        let id = sources.add(SourceFile::new(format!("<-D {n}>"), v));
-        match lex::lex(id, v) {
-            Ok(t) => overrides.push((n.trim().to_string(), t)),
-            Err(e) => return Err(fail(sources, e)),
+    grammar::is_surface(toks)
+        || (!directive("angle") && (0..toks.len()).any(|i| is_rule_at(toks, i)))
+}
+
+/// A surface rule starts at token `i`: see [`is_surface`].
+fn is_rule_at(toks: &[Token], i: usize) -> bool {
+    let t = &toks[i];
+    let element = t.tok.is_ident("F") || t.tok.is_ident("E") || t.tok.is_ident("V");
+    if !t.line_start || !element || !toks.get(i + 1).is_some_and(|n| n.tok.is_punct("(")) {
+        return false;
+    }
+    let (mut depth, mut arrow) = (0usize, false);
+    for n in toks[i + 1..].iter().take_while(|n| !n.line_start) {
+        if n.tok.is_punct("(") {
+            depth += 1;
+        } else if n.tok.is_punct(")") {
+            depth = depth.saturating_sub(1);
+        } else if depth == 0 {
+            if n.tok.is_punct(";") || n.tok.is_punct("{") {
+                return false;
+            }
+            arrow |= n.tok.is_punct("->");
+            if arrow && n.tok.is_punct("||") {
+                return true;
+            }
         }
     }
-    let tokens = match lex::lex(main, text).and_then(|t| preprocess::preprocess(t, &overrides)) {
-        Ok(t) => t,
-        Err(e) => return Err(fail(sources, e)),
-    };
-    let eof = Span::new(main, text.len(), text.len());
+    false
+}
+
+/// Parses and checks preprocessed tokens as a surface grammar.
+pub(crate) fn from_front(front: Front) -> Result<Grammar, Error> {
+    let eof = front.eof();
+    let Front {
+        sources, tokens, ..
+    } = front;
+    // A rule's text for messages and reports, its whitespace folded.
     let text_of = |s: Span| {
-        let t = &text[s.start as usize..(s.end as usize).min(text.len())];
+        let text = &sources.get(s.file).text;
+        let end = (s.end as usize).min(text.len());
+        let t = text.get(s.start as usize..end).unwrap_or_default();
         t.split_whitespace().collect::<Vec<_>>().join(" ")
     };
     let file = match grammar::parse(&tokens, eof, text_of) {
         Ok(f) => f,
-        Err(e) => return Err(fail(sources, e)),
+        Err(e) => return Err(Error::at(&sources, e)),
     };
-    run::compile(&file, sources).map_err(|(sources, diagnostics)| GrammarError {
+    run::compile(&file, sources).map_err(|(sources, diagnostics)| Error::Program {
         sources,
         diagnostics,
     })
 }
 
-/// Loads a surface grammar file.
-pub fn load_file(path: &Path, defines: &[String]) -> Result<Grammar, GrammarError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        let mut sources = SourceMap::default();
-        sources.add(SourceFile::new(path.display().to_string(), ""));
-        GrammarError {
-            sources,
-            diagnostics: vec![Diagnostic::new(
-                Span::default(),
-                format!("cannot read `{}`: {e}", path.display()),
-            )],
-        }
-    })?;
-    load_str(&path.display().to_string(), &text, defines)
+/// Checks text as a surface grammar. `defines` are `NAME=VALUE`
+/// overrides; `name` is the file name in messages.
+pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Grammar, Error> {
+    from_front(load::front(name, text.to_string(), defines)?)
+}
+
+/// Reads and checks a surface grammar file.
+pub fn load_file(path: &Path, defines: &[String]) -> Result<Grammar, Error> {
+    let text = load::read(path)?;
+    from_front(load::front(&path.display().to_string(), text, defines)?)
 }

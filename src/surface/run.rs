@@ -766,3 +766,13 @@ fn face_of(mesh: &Mesh, vs: [VertexId; 3]) -> Option<crate::mesh::FaceId> {
     let h = mesh.find_halfedge(vs[0], vs[1])?;
     mesh.face(h)
 }
+
+/// The message alone; [`crate::Surface::error`] adds the rule's line and
+/// caret.
+impl std::fmt::Display for RunError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for RunError {}

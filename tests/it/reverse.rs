@@ -136,7 +136,7 @@ fn a_contour_too_short_for_the_steps_is_refused() {
     let e = reverse::reverse(&s, &c, &opts(3, Phase::Auto, false)).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "error: after 2 step(s) the contour has 3 points; step 3 needs at least 6: ask for fewer steps"
+        "after 2 step(s) the contour has 3 points; step 3 needs at least 6: ask for fewer steps"
     );
 }
 

@@ -214,7 +214,7 @@ fn control_blocks_run_in_order_with_step_numbers() {
     // Start 1; step 1: StartEach (StepNo 0) 10, A(10), EndEach 109;
     // step 2: StartEach (StepNo 1) 1091, A(1091), EndEach 10919; End 109195.
     assert_eq!(text(&l, &d), "A(1091)");
-    assert_eq!(d.env.globals[0], subgram::lang::Value::Int(109195));
+    assert_eq!(d.env.globals[0], subgram::Value::Int(109195));
 }
 
 #[test]

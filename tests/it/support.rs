@@ -5,10 +5,10 @@
 use std::path::PathBuf;
 
 use glam::{DVec2, DVec3};
-use subgram::lang::Value;
 use subgram::mesh::PolygonSoup;
 use subgram::render::{RenderOptions, Scene};
-use subgram::{DeriveOptions, Derived, FigureOptions, Loaded};
+use subgram::Value;
+use subgram::{Curve as Loaded, DeriveOptions, Derived, FigureOptions};
 
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -22,29 +22,28 @@ pub fn lsys(name: &str) -> PathBuf {
 pub fn load(path: &PathBuf) -> Loaded {
     match subgram::load_file(path, &[]) {
         Ok(l) => l,
-        Err(e) => panic!("{} does not load:\n{}", path.display(), e.render()),
+        Err(e) => panic!("{} does not load:\n{}", path.display(), e),
     }
 }
 
 pub fn load_text(text: &str) -> Loaded {
     match subgram::load_str("test.lsys", text, &[]) {
         Ok(l) => l,
-        Err(e) => panic!("the test program does not load:\n{}", e.render()),
+        Err(e) => panic!("the test program does not load:\n{e}"),
     }
 }
 
 pub fn derive(l: &Loaded, opts: DeriveOptions) -> Derived {
     match subgram::derive(&l.program, opts) {
         Ok(d) => d,
-        Err(e) => panic!("derivation failed:\n{}", l.render_derive_error(&e)),
+        Err(e) => panic!("derivation failed:\n{}", l.error(e)),
     }
 }
 
 /// The figure of the file at `path`.
 pub fn figure(path: &PathBuf, opts: FigureOptions) -> Scene {
     let l = load(path);
-    l.figure(&opts)
-        .unwrap_or_else(|e| panic!("{}", l.render_figure_error(&e)))
+    l.figure(&opts).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Figure options for a `w` × `h` picture.

@@ -8,7 +8,7 @@ use subgram::mesh::{shapes, Mesh, PolygonSoup, VertexId};
 use crate::support::*;
 
 fn grammar(file: &str) -> subgram::surface::Grammar {
-    subgram::surface::load_file(&lsys(file), &[]).unwrap_or_else(|e| panic!("{}", e.render()))
+    subgram::surface::load_file(&lsys(file), &[]).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn run(file: &str, base: &Mesh) -> Mesh {
@@ -231,25 +231,25 @@ fn sqrt3_grammar_follows_kobbelts_boundary_rule() {
 fn grammar_errors_point_at_the_rule() {
     let bad = subgram::surface::load_str("g.lsys", "F(f) -> V(v = avg(f)) || E^4 F^4;\n", &[])
         .unwrap_err()
-        .render();
+        .to_string();
     assert!(
         bad.starts_with("g.lsys:1:1: error: this is not one of the rules of paper 000"),
         "{bad}"
     );
     let bad = subgram::surface::load_str("g.lsys", "V(v; l(v) < c) -> V(v = v + 1);\n", &[])
         .unwrap_err()
-        .render();
+        .to_string();
     assert!(
         bad.contains("g.lsys:1:25: error: type error: cannot apply `+` to V3f and int"),
         "{bad}"
     );
     let bad = subgram::surface::load_str("g.lsys", "V(v) -> V(v = smooth(v));\n", &[])
         .unwrap_err()
-        .render();
+        .to_string();
     assert!(bad.contains("unknown function `smooth`"), "{bad}");
     let bad = subgram::surface::load_str("g.lsys", "E(e) | F^3 -> E || F^2;\n", &[])
         .unwrap_err()
-        .render();
+        .to_string();
     assert!(bad.contains("not one of the rules"), "{bad}");
 }
 
@@ -616,7 +616,7 @@ fn grammar_functions_are_checked() {
     let load = |text: &str| {
         subgram::surface::load_str("g.lsys", text, &[])
             .unwrap_err()
-            .render()
+            .to_string()
     };
     let rule = "V(v) -> V(v = f(v));\n";
     let bad = load(&format!("define f(x) = f(x);\n{rule}"));
@@ -655,8 +655,7 @@ fn deep_function_nesting_reuses_frame_slots() {
         );
     }
     text += "V(v) -> V(v = g15(v, 0, 1));\n";
-    let g = subgram::surface::load_str("g.lsys", &text, &[])
-        .unwrap_or_else(|e| panic!("{}", e.render()));
+    let g = subgram::surface::load_str("g.lsys", &text, &[]).unwrap_or_else(|e| panic!("{e}"));
     let base = Mesh::from_soup(&shapes::icosahedron()).unwrap();
     let m = run_steps(&g, &base, 1);
     for v in m.vertices() {

@@ -8,7 +8,7 @@ use subgram::mesh::{shapes, Mesh, PolygonSoup};
 use crate::support::*;
 
 fn grammar(file: &str) -> subgram::surface::Grammar {
-    subgram::surface::load_file(&lsys(file), &[]).unwrap_or_else(|e| panic!("{}", e.render()))
+    subgram::surface::load_file(&lsys(file), &[]).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn run(file: &str, soup: &PolygonSoup, steps: usize) -> PolygonSoup {
@@ -242,8 +242,7 @@ fn output_merges_only_block_shaped_regions() {
             1,
         ),
     ] {
-        let g = subgram::surface::load_str("g.lsys", text, &[])
-            .unwrap_or_else(|e| panic!("{}", e.render()));
+        let g = subgram::surface::load_str("g.lsys", text, &[]).unwrap_or_else(|e| panic!("{e}"));
         let mut m = Mesh::from_soup(&cube).unwrap();
         g.run(&mut m, steps, |_| {}).unwrap();
         let soup = m.to_quad_soup();
@@ -327,7 +326,7 @@ fn block_rules_are_checked() {
         &[],
     )
     .unwrap_err()
-    .render();
+    .to_string();
     assert!(e.contains("g.lsys:1:9"), "{e}");
     assert!(e.contains("`quadrisection`, `bisection` or `dual`"), "{e}");
     let e = subgram::surface::load_str(
@@ -336,12 +335,12 @@ fn block_rules_are_checked() {
         &[],
     )
     .unwrap_err()
-    .render();
+    .to_string();
     assert!(e.contains("g.lsys:2:1"), "{e}");
     assert!(e.contains("come before the other rules"), "{e}");
     let e = subgram::surface::load_str("g.lsys", "E(e; center(e)) | F^2 -> E || F^2;\n", &[])
         .unwrap_err()
-        .render();
+        .to_string();
     assert!(e.contains("g.lsys:1:6"), "{e}");
     assert!(e.contains("`center` takes a vertex"), "{e}");
 }
@@ -359,8 +358,7 @@ fn every_surface_grammar_runs_on_its_own_mesh() {
     files.sort();
     assert!(files.len() >= 7, "{files:?}");
     for path in files {
-        let g =
-            subgram::surface::load_file(&path, &[]).unwrap_or_else(|e| panic!("{}", e.render()));
+        let g = subgram::surface::load_file(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
         let (mesh, _) = g.mesh.clone().expect("names its base mesh");
         let soup = subgram::mesh::io::read(&dir.join(mesh)).unwrap();
         let mut m = Mesh::from_soup(&soup).unwrap();
@@ -444,7 +442,7 @@ fn init_vertex_rules_take_effect_before_the_first_step() {
         "init: V(v) -> V(v = 2*v);\nE(e) | F^2 -> V(v = avg(e)) || E^4 F^4;\n",
         &[],
     )
-    .unwrap_or_else(|e| panic!("{}", e.render()));
+    .unwrap_or_else(|e| panic!("{e}"));
     let base = Mesh::from_soup(&shapes::icosahedron()).unwrap();
     let mut m = base.clone();
     g.run(&mut m, 1, |_| {}).unwrap();
@@ -471,8 +469,7 @@ fn boundary_walks_off_the_boundary_are_errors() {
         "v + count(w in ring(bnext(v)))*v",
     ] {
         let text = format!("V(v) -> V(v = {body});\n");
-        let g = subgram::surface::load_str("g.lsys", &text, &[])
-            .unwrap_or_else(|e| panic!("{}", e.render()));
+        let g = subgram::surface::load_str("g.lsys", &text, &[]).unwrap_or_else(|e| panic!("{e}"));
         let mut m = Mesh::from_soup(&shapes::icosahedron()).unwrap();
         let e = g.run(&mut m, 1, |_| {}).unwrap_err();
         let msg = g.render_error(&e);

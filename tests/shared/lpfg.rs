@@ -26,17 +26,17 @@ fn every_corpus_program_derives_to_its_length_and_interprets() {
     for f in FILES {
         let l = load(&corpus(f));
         let mut d = Derivation::new(&l.program, DeriveOptions::default())
-            .unwrap_or_else(|e| panic!("{f}: {}", l.render_derive_error(&e)));
+            .unwrap_or_else(|e| panic!("{f}: {}", l.error(e)));
         let length = d.length;
         assert!(length >= 1, "{f} states no derivation length");
         while d.has_next() {
             d.next_step()
-                .unwrap_or_else(|e| panic!("{f}: {}", l.render_derive_error(&e)));
+                .unwrap_or_else(|e| panic!("{f}: {}", l.error(e)));
         }
         assert_eq!(d.step, length, "{f} stopped early");
         let shown = d
             .interpret()
-            .unwrap_or_else(|e| panic!("{f}: {}", l.render_derive_error(&e)));
+            .unwrap_or_else(|e| panic!("{f}: {}", l.error(e)));
         assert!(!shown.is_empty(), "{f} interprets to nothing");
     }
 }

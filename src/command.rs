@@ -1,0 +1,513 @@
+//! The commands of the `subgram` binary, one function each, with their
+//! arguments as plain structs. A command returns the text it prints on
+//! standard output, if any; it writes its output files whole or not at all,
+//! and never over one of its inputs.
+
+use std::path::{Path, PathBuf};
+
+use crate::curve::FigureOptions;
+use crate::error::Error;
+use crate::load::{load, LoadOptions};
+use crate::mesh::{self, Mesh};
+use crate::render::{self, Rgba, Scene, View};
+use crate::reverse::{self, Details, Phase, ReverseOptions, Scheme};
+use crate::rewrite::derive::{DEFAULT_MAX_MODULES, MAX_STEPS};
+use crate::system::{load_mesh, Progress, RunOptions, Surface, System};
+
+/// `subgram check FILE [-D NAME=VALUE]…`: reports every diagnostic, or one
+/// line that says what the file holds.
+pub fn check(file: &str, defines: &[String]) -> Result<String, Error> {
+    let opts = LoadOptions {
+        defines: defines.to_vec(),
+    };
+    Ok(match load(file, &opts)? {
+        System::Surface(s) => format!(
+            "{file}: ok (a surface grammar of {} rules)",
+            s.grammar.rules.len()
+        ),
+        System::Curve(c) => format!(
+            "{file}: ok ({} rules, {} module kinds)",
+            c.program.rules.len(),
+            c.program.alphabet.kinds.len()
+        ),
+    })
+}
+
+/// The arguments of `subgram derive`.
+#[derive(Clone, Debug)]
+pub struct DeriveArgs {
+    pub file: String,
+    /// `-n`: overrides `derivation length:`.
+    pub steps: Option<u64>,
+    /// `--format json` instead of text.
+    pub json: bool,
+    pub defines: Vec<String>,
+    pub max_modules: usize,
+    pub phase: usize,
+    /// Print the word after interpretation rules.
+    pub interpreted: bool,
+}
+
+impl DeriveArgs {
+    pub fn new(file: impl Into<String>) -> DeriveArgs {
+        DeriveArgs {
+            file: file.into(),
+            steps: None,
+            json: false,
+            defines: Vec::new(),
+            max_modules: DEFAULT_MAX_MODULES,
+            phase: 0,
+            interpreted: false,
+        }
+    }
+}
+
+/// `subgram derive`: a curve's final word (or its interpretation) as text
+/// or JSON; for a surface grammar, the subdivided mesh's description.
+pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, Error> {
+    let system = load(&a.file, &load_options(&a.defines))?;
+    let opts = RunOptions {
+        steps: a.steps,
+        max_modules: a.max_modules,
+        phase: a.phase,
+        base_mesh: None,
+    };
+    match system {
+        System::Surface(s) => {
+            let run = s.subdivide(&opts, progress)?;
+            let info = run.mesh.info();
+            Ok(if a.json {
+                json(&info)?
+            } else {
+                format!(
+                    "after {} step(s):\n{}",
+                    run.steps,
+                    info.to_string().trim_end()
+                )
+            })
+        }
+        System::Curve(c) => {
+            check_steps(a.steps)?;
+            let mut run = c.run(opts.derive_options())?;
+            if !a.interpreted {
+                return Ok(if a.json { run.json() } else { run.text() });
+            }
+            let word = run.interpreted()?;
+            Ok(if a.json {
+                c.word_json(&word, run.ring(), run.step())
+            } else {
+                c.word_text(&word)
+            })
+        }
+    }
+}
+
+/// The arguments of `subgram render`.
+#[derive(Clone, Debug)]
+pub struct RenderArgs {
+    /// An `.lsys` file, or a mesh (`.obj`, `.off`, `.ply`) to draw as it is.
+    pub file: String,
+    /// The picture: `.png` or `.svg`.
+    pub output: String,
+    pub steps: Option<u64>,
+    /// Width and height in pixels.
+    pub size: (u32, u32),
+    /// Draw every step 0..=N side by side (curves).
+    pub each: bool,
+    pub background: Rgba,
+    /// Curves: xy (the default), xz or yz. Meshes: iso, front, back, left,
+    /// right, top or bottom.
+    pub view: Option<String>,
+    /// Meshes: draw the edges over the faces.
+    pub wireframe: bool,
+    pub defines: Vec<String>,
+    pub max_modules: usize,
+    pub phase: usize,
+}
+
+impl RenderArgs {
+    pub fn new(file: impl Into<String>, output: impl Into<String>) -> RenderArgs {
+        RenderArgs {
+            file: file.into(),
+            output: output.into(),
+            steps: None,
+            size: (800, 800),
+            each: false,
+            background: Rgba(255, 255, 255, 255),
+            view: None,
+            wireframe: true,
+            defines: Vec::new(),
+            max_modules: DEFAULT_MAX_MODULES,
+            phase: 0,
+        }
+    }
+}
+
+/// `subgram render`: a curve's picture, a surface grammar's subdivided
+/// mesh, or a mesh file, as PNG or SVG.
+pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Error> {
+    let file = Path::new(&a.file);
+    let output = Path::new(&a.output);
+    refuse_overwrite(output, &[file])?;
+    let looks = MeshLooks {
+        size: a.size,
+        background: a.background,
+        view: a.view.as_deref(),
+        wireframe: a.wireframe,
+    };
+    if mesh::io::Format::from_path(file).is_some() {
+        return write_mesh_picture(&load_mesh(file)?, output, &looks);
+    }
+    let format = Picture::from_path(output)?;
+    match load(file, &load_options(&a.defines))? {
+        System::Surface(s) => {
+            looks.check()?;
+            let opts = RunOptions {
+                steps: a.steps,
+                ..RunOptions::default()
+            };
+            let run = s.subdivide(&opts, progress)?;
+            write_mesh_picture(&run.mesh, output, &looks)
+        }
+        System::Curve(c) => {
+            let view = match a.view.as_deref().unwrap_or("xy") {
+                "xy" => View::Xy,
+                "xz" => View::Xz,
+                "yz" => View::Yz,
+                other => {
+                    return Err(Error::Usage(format!(
+                        "`--view {other}` is not a view of an L-system: use xy, xz or yz"
+                    )))
+                }
+            };
+            check_steps(a.steps)?;
+            let opts = RunOptions {
+                steps: a.steps,
+                max_modules: a.max_modules,
+                phase: a.phase,
+                base_mesh: None,
+            };
+            let figure = FigureOptions {
+                derive: opts.derive_options(),
+                each: a.each,
+                draw: Default::default(),
+                render: render::RenderOptions {
+                    width: a.size.0,
+                    height: a.size.1,
+                    background: a.background,
+                    view,
+                    ..Default::default()
+                },
+            };
+            write_picture(&c.figure(&figure)?, output, format)
+        }
+    }
+}
+
+/// The arguments of `subgram subdivide`.
+#[derive(Clone, Debug)]
+pub struct SubdivideArgs {
+    /// The base mesh; by default the grammar's `mesh:`.
+    pub mesh: Option<String>,
+    pub grammar: String,
+    pub steps: Option<u64>,
+    /// `.obj`, `.off`, `.ply`, `.png` or `.svg`.
+    pub output: String,
+    pub defines: Vec<String>,
+    /// For pictures: iso, front, back, left, right, top or bottom.
+    pub view: Option<String>,
+}
+
+/// `subgram subdivide`: runs a surface grammar on a mesh and writes the
+/// mesh or its picture.
+pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<(), Error> {
+    let grammar = Path::new(&a.grammar);
+    let output = Path::new(&a.output);
+    let mut inputs = vec![grammar];
+    inputs.extend(a.mesh.as_deref().map(Path::new));
+    refuse_overwrite(output, &inputs)?;
+    let g = crate::surface::load_file(grammar, &a.defines)?;
+    let opts = RunOptions {
+        steps: a.steps,
+        base_mesh: a.mesh.as_ref().map(PathBuf::from),
+        ..RunOptions::default()
+    };
+    let run = Surface::new(g, Some(grammar)).subdivide(&opts, progress)?;
+    if Picture::from_path(output).is_ok() {
+        let d = crate::render::mesh::MeshView::default();
+        let looks = MeshLooks {
+            size: (d.width, d.height),
+            background: d.background,
+            view: a.view.as_deref(),
+            wireframe: d.wireframe,
+        };
+        return write_mesh_picture(&run.mesh, output, &looks);
+    }
+    Ok(mesh::io::write(output, &run.mesh.to_quad_soup())?)
+}
+
+/// `subgram mesh info`: counts, boundary loops, Euler characteristic, genus,
+/// valences and levels, as text or JSON.
+pub fn mesh_info(file: &str, as_json: bool) -> Result<String, Error> {
+    let info = load_mesh(Path::new(file))?.info();
+    if as_json {
+        json(&info)
+    } else {
+        Ok(info.to_string().trim_end().to_string())
+    }
+}
+
+/// `subgram mesh convert`: checks a mesh and writes it in the format of
+/// `output`'s extension, basic blocks as quads unless `triangles`.
+pub fn mesh_convert(input: &str, output: &str, triangles: bool) -> Result<(), Error> {
+    let (input, output) = (Path::new(input), Path::new(output));
+    refuse_overwrite(output, &[input])?;
+    let m = load_mesh(input)?;
+    let soup = if triangles {
+        m.to_soup()
+    } else {
+        m.to_quad_soup()
+    };
+    Ok(mesh::io::write(output, &soup)?)
+}
+
+/// The arguments of `subgram reverse`.
+#[derive(Clone, Debug)]
+pub struct ReverseArgs {
+    /// Points (`x y` or CSV), an SVG shape, or a PNG silhouette.
+    pub input: String,
+    pub steps: usize,
+    /// The coarse polygon: `.csv`, `.svg`, or `x y` lines.
+    pub output: String,
+    /// A scheme file instead of the built-in Chaikin schemes.
+    pub scheme: Option<String>,
+    pub phase: Phase,
+    /// Treat the contour as open.
+    pub open: bool,
+    /// The picture of input, coarse polygon and reconstruction.
+    pub figure: Option<String>,
+    /// Return the report (point counts and reconstruction errors).
+    pub report: bool,
+    /// The report as JSON.
+    pub json: bool,
+    /// Where to store the details that restore the input exactly.
+    pub details: Option<String>,
+}
+
+/// `subgram reverse`: reverse-subdivides a contour; returns the report when
+/// one was asked for.
+pub fn reverse(a: &ReverseArgs) -> Result<Option<String>, Error> {
+    let fig = a
+        .figure
+        .as_ref()
+        .map(|f| Ok::<_, Error>((Path::new(f), Picture::from_path(Path::new(f))?)))
+        .transpose()?;
+    let input = Path::new(&a.input);
+    let mut inputs = vec![input];
+    inputs.extend(a.scheme.as_deref().map(Path::new));
+    for out in [Some(&a.output), a.figure.as_ref(), a.details.as_ref()]
+        .into_iter()
+        .flatten()
+    {
+        refuse_overwrite(Path::new(out), &inputs)?;
+    }
+    let mut contour = reverse::input::read(input)?;
+    if a.open {
+        contour.closed = false;
+    }
+    let scheme = match &a.scheme {
+        Some(s) => Scheme::from_file(Path::new(s), contour.closed)?,
+        None => Scheme::builtin(contour.closed),
+    };
+    let opts = ReverseOptions {
+        steps: a.steps,
+        phase: a.phase,
+        details: a.details.is_some(),
+    };
+    let r = reverse::reverse(&scheme, &contour, &opts)?;
+    let out = Path::new(&a.output);
+    write_file(
+        out,
+        reverse::format_points(&r.coarse, contour.closed, out).as_bytes(),
+    )?;
+    if let (Some(path), Some(d)) = (&a.details, &r.details) {
+        let text = serde_json::to_string(d).map_err(|e| Error::Failed(e.to_string()))?;
+        write_file(Path::new(path), text.as_bytes())?;
+    }
+    if !a.report && fig.is_none() {
+        return Ok(None);
+    }
+    let rep = reverse::report(&scheme, &contour, &r)?;
+    if let Some((path, format)) = fig {
+        let rec = scheme.forward(&r.coarse, a.steps)?;
+        let events = reverse::figure_events(&contour, &r.coarse, &rec);
+        let scene = render::scene(&[events], &Default::default())?;
+        write_picture(&scene, path, format)?;
+    }
+    if !a.report {
+        return Ok(None);
+    }
+    Ok(Some(if a.json { json(&rep)? } else { rep.to_string() }))
+}
+
+/// The arguments of `subgram reconstruct`.
+#[derive(Clone, Debug)]
+pub struct ReconstructArgs {
+    pub coarse: String,
+    pub details: String,
+    pub output: String,
+    /// Restore only this many levels (default: all).
+    pub level: Option<usize>,
+    /// The scheme the details were made with (default: as recorded).
+    pub scheme: Option<String>,
+}
+
+/// `subgram reconstruct`: restores a contour from a coarse polygon and its
+/// details.
+pub fn reconstruct(a: &ReconstructArgs) -> Result<(), Error> {
+    let (coarse, details, output) = (
+        Path::new(&a.coarse),
+        Path::new(&a.details),
+        Path::new(&a.output),
+    );
+    let mut inputs = vec![coarse, details];
+    inputs.extend(a.scheme.as_deref().map(Path::new));
+    refuse_overwrite(output, &inputs)?;
+    let text = std::fs::read_to_string(details)
+        .map_err(|e| Error::file(&a.details, format!("cannot read the file: {e}")))?;
+    let d: Details = serde_json::from_str(&text).map_err(|e| Error::File {
+        path: a.details.clone(),
+        line: Some(e.line()),
+        message: format!("not a details file: {e}"),
+    })?;
+    let c = reverse::input::read(coarse)?;
+    let scheme = match &a.scheme {
+        Some(s) => Scheme::from_file(Path::new(s), d.closed)?,
+        None if d.scheme.starts_with("builtin:") => Scheme::builtin(d.closed),
+        None => Scheme::from_file(Path::new(&d.scheme), d.closed)?,
+    };
+    let pts = reverse::reconstruct(&scheme, &c.points, &d, a.level)?;
+    write_file(
+        output,
+        reverse::format_points(&pts, d.closed, output).as_bytes(),
+    )
+}
+
+/// A picture format, told by a file's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Picture {
+    Png,
+    Svg,
+}
+
+impl Picture {
+    /// `.png` or `.svg` (any case); any other name is a usage error.
+    pub fn from_path(path: &Path) -> Result<Picture, Error> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("png") => Ok(Picture::Png),
+            Some("svg") => Ok(Picture::Svg),
+            _ => Err(Error::Usage(format!(
+                "cannot tell the format of `{}`: name it .png or .svg",
+                path.display()
+            ))),
+        }
+    }
+}
+
+/// Draws `scene` in `format` and writes it to `path` whole, or not at all.
+pub fn write_picture(scene: &Scene, path: &Path, format: Picture) -> Result<(), Error> {
+    let bytes = match format {
+        Picture::Svg => render::svg::render(scene).into_bytes(),
+        Picture::Png => render::png::render(scene)?,
+    };
+    write_file(path, &bytes)
+}
+
+/// How a mesh is drawn.
+struct MeshLooks<'a> {
+    size: (u32, u32),
+    background: Rgba,
+    view: Option<&'a str>,
+    wireframe: bool,
+}
+
+impl MeshLooks<'_> {
+    /// The view: the default one, or a named one.
+    fn check(&self) -> Result<crate::render::mesh::MeshView, Error> {
+        let mut mv = crate::render::mesh::MeshView {
+            width: self.size.0,
+            height: self.size.1,
+            background: self.background,
+            wireframe: self.wireframe,
+            ..Default::default()
+        };
+        if let Some(name) = self.view {
+            let Some((dir, up)) = crate::render::mesh::view_direction(name) else {
+                return Err(Error::Usage(format!(
+                    "`--view {name}` is not a view of a mesh: use iso, front, back, left, right, top or bottom"
+                )));
+            };
+            mv.direction = dir;
+            mv.up = up;
+        }
+        Ok(mv)
+    }
+}
+
+/// A mesh's picture, flat-shaded, to `.png` or `.svg`.
+fn write_mesh_picture(m: &Mesh, output: &Path, looks: &MeshLooks) -> Result<(), Error> {
+    let format = Picture::from_path(output)?;
+    let mv = looks.check()?;
+    let soup = m.to_quad_soup();
+    crate::render::mesh::validate(&soup, &mv)?;
+    let bytes = match format {
+        Picture::Svg => crate::render::mesh::render_svg(&soup, &mv).into_bytes(),
+        Picture::Png => crate::render::mesh::render_png(&soup, &mv)?,
+    };
+    write_file(output, &bytes)
+}
+
+fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    render::write_atomic(path, bytes).map_err(|e| Error::write(path, e))
+}
+
+fn json(value: &impl serde::Serialize) -> Result<String, Error> {
+    serde_json::to_string_pretty(value).map_err(|e| Error::Failed(e.to_string()))
+}
+
+fn load_options(defines: &[String]) -> LoadOptions {
+    LoadOptions {
+        defines: defines.to_vec(),
+    }
+}
+
+/// `-n` beyond the engine's limit is a usage error.
+fn check_steps(steps: Option<u64>) -> Result<(), Error> {
+    match steps {
+        Some(n) if n > MAX_STEPS => Err(Error::Usage(format!(
+            "-n {n} is beyond the limit of {MAX_STEPS} steps"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// An output that is one of the command's inputs is refused before anything
+/// is read or written.
+fn refuse_overwrite(output: &Path, inputs: &[&Path]) -> Result<(), Error> {
+    let Ok(out) = output.canonicalize() else {
+        return Ok(()); // it does not exist yet
+    };
+    if inputs
+        .iter()
+        .any(|i| i.canonicalize().is_ok_and(|i| i == out))
+    {
+        return Err(Error::Usage(format!(
+            "`{}` is an input of this command; name another output",
+            output.display()
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,190 @@
+//! A checked curve L-system ([`Curve`]), its runs ([`CurveRun`]) and its
+//! pictures ([`FigureOptions`]).
+
+use glam::DVec3;
+
+use crate::draw::{self, Event};
+use crate::error::Error;
+use crate::lang::Program;
+use crate::render;
+use crate::rewrite::derive::MAX_STEPS;
+use crate::rewrite::{Derivation, DeriveError, DeriveOptions, Derived, Word};
+use crate::syntax::{Diagnostic, SourceMap};
+
+/// A checked curve L-system together with the sources its spans point into.
+#[derive(Clone, Debug)]
+pub struct Curve {
+    pub program: Program,
+    pub sources: SourceMap,
+}
+
+/// Settings of a figure: how far to derive, how to draw, how to render.
+#[derive(Clone, Debug, Default)]
+pub struct FigureOptions {
+    pub derive: DeriveOptions,
+    /// Draw every step 0..=N side by side.
+    pub each: bool,
+    pub draw: draw::DrawOptions,
+    pub render: render::RenderOptions,
+}
+
+impl Curve {
+    /// A derivation error as an [`Error`], located at the rule or directive
+    /// at fault when there is one.
+    pub fn error(&self, e: DeriveError) -> Error {
+        match e.span {
+            Some(span) => Error::at(&self.sources, Diagnostic::new(span, e.message)),
+            None => Error::Failed(e.message),
+        }
+    }
+
+    /// Derives the axiom to the derivation length (or `opts.steps`) and runs
+    /// `End`.
+    pub fn derive(&self, opts: DeriveOptions) -> Result<Derived, Error> {
+        check_steps(opts.steps)?;
+        crate::rewrite::derive(&self.program, opts).map_err(|e| self.error(e))
+    }
+
+    /// Derives the axiom to the derivation length (or `opts.steps`) and keeps
+    /// the derivation, so that its word can be interpreted and drawn.
+    pub fn run(&self, opts: DeriveOptions) -> Result<CurveRun<'_>, Error> {
+        check_steps(opts.steps)?;
+        let mut d = Derivation::new(&self.program, opts).map_err(|e| self.error(e))?;
+        while d.has_next() {
+            d.next_step().map_err(|e| self.error(e))?;
+        }
+        Ok(CurveRun { curve: self, d })
+    }
+
+    /// `word` as text: `P([0, 0.25]) E A(1, 2)`, vectors in brackets.
+    pub fn word_text(&self, word: &Word) -> String {
+        crate::output::word_text(word, &self.program.alphabet, &self.program.structs)
+    }
+
+    /// `word` as JSON: `{"ring": bool, "step": N, "modules": [{"symbol": "P",
+    /// "params": [[0.0, 1.0]]}, …]}`.
+    pub fn word_json(&self, word: &Word, ring: bool, step: u64) -> String {
+        crate::output::word_json(
+            word,
+            ring,
+            step,
+            &self.program.alphabet,
+            &self.program.structs,
+        )
+        .to_string()
+    }
+
+    /// Derives, interprets and lays out the program's picture.
+    pub fn figure(&self, opts: &FigureOptions) -> Result<render::Scene, Error> {
+        check_steps(opts.derive.steps)?;
+        let p = &self.program;
+        let fail = |e| self.error(e);
+        let mut d = Derivation::new(p, opts.derive.clone()).map_err(fail)?;
+        let mut draw_opts = opts.draw.clone();
+        if let Some(a) = d.angle().map_err(fail)? {
+            draw_opts.angle = a;
+        }
+        let mut panels = Vec::new();
+        let mut panel = |d: &mut Derivation| -> Result<(), Error> {
+            let word = d.interpret().map_err(fail)?;
+            panels.push(draw::draw(&word, &p.alphabet, &p.structs, &draw_opts)?);
+            Ok(())
+        };
+        if opts.each {
+            panel(&mut d)?;
+        }
+        while d.has_next() {
+            d.next_step().map_err(fail)?;
+            if opts.each {
+                panel(&mut d)?;
+            }
+        }
+        if !opts.each {
+            panel(&mut d)?;
+        }
+        Ok(render::scene(&panels, &opts.render)?)
+    }
+}
+
+/// More steps than this are refused before a derivation starts.
+fn check_steps(steps: Option<u64>) -> Result<(), Error> {
+    match steps {
+        Some(n) if n > MAX_STEPS => Err(Error::Usage(format!(
+            "{n} steps are beyond the limit of {MAX_STEPS}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// A curve L-system derived to its last step. `End` has not run, so the
+/// globals are as the last step left them.
+pub struct CurveRun<'c> {
+    curve: &'c Curve,
+    d: Derivation<'c>,
+}
+
+impl<'c> CurveRun<'c> {
+    /// The derived word.
+    pub fn word(&self) -> &Word {
+        &self.d.word
+    }
+
+    /// The number of steps performed.
+    pub fn step(&self) -> u64 {
+        self.d.step
+    }
+
+    /// True for a ring L-system (contexts wrap around the word).
+    pub fn ring(&self) -> bool {
+        self.d.ring
+    }
+
+    /// The curve that ran.
+    pub fn curve(&self) -> &'c Curve {
+        self.curve
+    }
+
+    /// The derived word as text.
+    pub fn text(&self) -> String {
+        self.curve.word_text(self.word())
+    }
+
+    /// The derived word as JSON (see [`Curve::word_json`]).
+    pub fn json(&self) -> String {
+        self.curve.word_json(self.word(), self.ring(), self.step())
+    }
+
+    /// The word after interpretation rules: what the turtle draws.
+    pub fn interpreted(&mut self) -> Result<Word, Error> {
+        let curve = self.curve;
+        self.d.interpret().map_err(|e| curve.error(e))
+    }
+
+    /// What the turtle draws from the interpreted word: lines, discs,
+    /// polygons, in 3D.
+    pub fn events(&mut self) -> Result<Vec<Event>, Error> {
+        let curve = self.curve;
+        let mut opts = draw::DrawOptions::default();
+        if let Some(a) = self.d.angle().map_err(|e| curve.error(e))? {
+            opts.angle = a;
+        }
+        let word = self.interpreted()?;
+        let p = &curve.program;
+        Ok(draw::draw(&word, &p.alphabet, &p.structs, &opts)?)
+    }
+
+    /// The curve's points: the turtle's lines joined into polylines, a new
+    /// one wherever a line does not start where the previous one ended.
+    pub fn polylines(&mut self) -> Result<Vec<Vec<DVec3>>, Error> {
+        let mut lines: Vec<Vec<DVec3>> = Vec::new();
+        for e in self.events()? {
+            if let Event::Line { a, b, .. } = e {
+                match lines.last_mut() {
+                    Some(l) if l.last() == Some(&a) => l.push(b),
+                    _ => lines.push(vec![a, b]),
+                }
+            }
+        }
+        Ok(lines)
+    }
+}

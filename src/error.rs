@@ -1,0 +1,181 @@
+//! [`Error`]: every way the library can fail, with a message that says what
+//! is wrong and, where there is a place to point at, where.
+
+use std::fmt;
+use std::path::PathBuf;
+
+use crate::syntax::{Diagnostic, SourceMap};
+
+/// What went wrong. Every variant displays as a message for a person; none
+/// starts with `error: ` (a program that prints it adds its own prefix, as
+/// the `subgram` binary does for messages that have no location).
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let opts = subgram::LoadOptions::default();
+/// let err = subgram::load_text("bad.lsys", "module P;\nAxiom: Q;\n", &opts).unwrap_err();
+/// assert!(err.has_location());
+/// assert!(err.to_string().starts_with("bad.lsys:2:8: error: undeclared module `Q`"));
+/// // It converts into `Box<dyn Error>` with `?`:
+/// let ok = subgram::load_text("ok.lsys", "module P;\nAxiom: P;\n", &opts)?;
+/// # let _ = ok; Ok(()) }
+/// ```
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum Error {
+    /// A file could not be read or written.
+    Io {
+        path: PathBuf,
+        /// True when writing failed, false when reading did.
+        write: bool,
+        error: std::io::Error,
+    },
+    /// Problems located in a program's text: everything a check found, or
+    /// the rule at fault when a run failed. Displayed as
+    /// `file:line:col: error: message`, the line and a caret under the place,
+    /// one block per diagnostic.
+    Program {
+        sources: SourceMap,
+        diagnostics: Vec<Diagnostic>,
+    },
+    /// A data file is malformed or describes something unusable: a mesh, a
+    /// contour, a details file. Displayed as `path:line: error: message`
+    /// (without `line:` when the whole file is at fault).
+    File {
+        path: String,
+        line: Option<usize>,
+        message: String,
+    },
+    /// A run failed with nothing in a file to point at: a word that grew
+    /// past its limit, a picture with nothing to draw, a contour too short
+    /// for the steps asked.
+    Failed(String),
+    /// The request cannot be carried out as asked: a malformed `-D`, too many
+    /// steps, an output name whose format cannot be told, an unknown view,
+    /// a surface grammar without a base mesh. The `subgram` binary exits with
+    /// 2 for these, with 1 for every other error.
+    Usage(String),
+}
+
+impl Error {
+    /// True when the message begins with the place it is about
+    /// (`file:line:col:`, `file:line:` or `file:`), followed by `error:`.
+    pub fn has_location(&self) -> bool {
+        matches!(self, Error::Program { .. } | Error::File { .. })
+    }
+
+    /// The diagnostics of a [`Error::Program`] error; empty for the others.
+    pub fn diagnostics(&self) -> &[Diagnostic] {
+        match self {
+            Error::Program { diagnostics, .. } => diagnostics,
+            _ => &[],
+        }
+    }
+
+    /// One diagnostic in `sources`.
+    pub(crate) fn at(sources: &SourceMap, diagnostic: Diagnostic) -> Error {
+        Error::Program {
+            sources: sources.clone(),
+            diagnostics: vec![diagnostic],
+        }
+    }
+
+    pub(crate) fn read(path: impl Into<PathBuf>, error: std::io::Error) -> Error {
+        Error::Io {
+            path: path.into(),
+            write: false,
+            error,
+        }
+    }
+
+    pub(crate) fn write(path: impl Into<PathBuf>, error: std::io::Error) -> Error {
+        Error::Io {
+            path: path.into(),
+            write: true,
+            error,
+        }
+    }
+
+    pub(crate) fn file(path: impl Into<String>, message: impl Into<String>) -> Error {
+        Error::File {
+            path: path.into(),
+            line: None,
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Io { path, write, error } => {
+                let verb = if *write { "write" } else { "read" };
+                write!(f, "cannot {verb} `{}`: {error}", path.display())
+            }
+            Error::Program {
+                sources,
+                diagnostics,
+            } => {
+                for (i, d) in diagnostics.iter().enumerate() {
+                    if i > 0 {
+                        f.write_str("\n\n")?;
+                    }
+                    f.write_str(&sources.render(d.span, &d.message))?;
+                }
+                Ok(())
+            }
+            Error::File {
+                path,
+                line: Some(line),
+                message,
+            } => write!(f, "{path}:{line}: error: {message}"),
+            Error::File {
+                path,
+                line: None,
+                message,
+            } => write!(f, "{path}: error: {message}"),
+            Error::Failed(m) | Error::Usage(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Error::Io { error, .. } => Some(error),
+            _ => None,
+        }
+    }
+}
+
+impl From<crate::mesh::MeshFileError> for Error {
+    fn from(e: crate::mesh::MeshFileError) -> Error {
+        Error::File {
+            path: e.path,
+            line: e.line,
+            message: e.message,
+        }
+    }
+}
+
+impl From<crate::reverse::InputError> for Error {
+    fn from(e: crate::reverse::InputError) -> Error {
+        Error::File {
+            path: e.path,
+            line: e.line,
+            message: e.message,
+        }
+    }
+}
+
+impl From<crate::draw::DrawError> for Error {
+    fn from(e: crate::draw::DrawError) -> Error {
+        Error::Failed(e.message)
+    }
+}
+
+impl From<crate::render::RenderError> for Error {
+    fn from(e: crate::render::RenderError) -> Error {
+        Error::Failed(e.message)
+    }
+}

@@ -1,0 +1,291 @@
+//! The one loader: a file is read once, lexed and preprocessed once, its
+//! kind is decided from the tokens, and the tokens go to the parser of that
+//! kind.
+
+use std::path::{Path, PathBuf};
+
+use crate::curve::Curve;
+use crate::error::Error;
+use crate::lang;
+use crate::surface;
+use crate::syntax::lex::{self, Token};
+use crate::syntax::{parse, preprocess, FileId, SourceFile, SourceMap, Span};
+use crate::system::{Surface, System};
+
+/// Settings of loading.
+#[derive(Clone, Debug, Default)]
+pub struct LoadOptions {
+    /// `#define` overrides, each `NAME=VALUE` (the binary's `-D`); they win
+    /// over the file's own `#define`s and `angle:` values.
+    pub defines: Vec<String>,
+}
+
+impl LoadOptions {
+    /// Adds one `NAME=VALUE` override.
+    pub fn define(mut self, name_value: impl Into<String>) -> Self {
+        self.defines.push(name_value.into());
+        self
+    }
+}
+
+/// Reads and checks a `.lsys` file: a curve L-system or a surface grammar,
+/// told apart by its syntax (a `mesh:` directive, or a rule such as
+/// `F(f) -> V(...) || E^3 F^3`, makes a surface grammar).
+///
+/// ```
+/// # fn main() -> Result<(), subgram::Error> {
+/// let root = env!("CARGO_MANIFEST_DIR");
+/// let opts = subgram::LoadOptions::default();
+/// let curve = subgram::load(format!("{root}/lsystems/curves/chaikin-13.lsys"), &opts)?;
+/// assert!(matches!(curve, subgram::System::Curve(_)));
+/// let loop_ = subgram::load(format!("{root}/lsystems/surfaces/loop.lsys"), &opts)?;
+/// assert!(matches!(loop_, subgram::System::Surface(_)));
+/// # Ok(()) }
+/// ```
+pub fn load(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<System, Error> {
+    let path = path.as_ref();
+    let text = read(path)?;
+    let front = front(&path.display().to_string(), text, &opts.defines)?;
+    if surface::is_surface(&front.tokens) {
+        let grammar = surface::from_front(front)?;
+        Ok(System::Surface(Surface::new(grammar, Some(path))))
+    } else {
+        Ok(System::Curve(curve(front)?))
+    }
+}
+
+/// Checks program text, as [`load`] does a file; `name` is the file name in
+/// messages. A surface grammar's `mesh:` is then relative to the current
+/// folder.
+pub fn load_text(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Error> {
+    let front = front(name, text.to_string(), &opts.defines)?;
+    if surface::is_surface(&front.tokens) {
+        let grammar = surface::from_front(front)?;
+        Ok(System::Surface(Surface::new(grammar, None)))
+    } else {
+        Ok(System::Curve(curve(front)?))
+    }
+}
+
+/// Loads a file as a curve L-system, whatever its syntax says; `defines`
+/// are `NAME=VALUE` overrides.
+pub fn load_file(path: impl AsRef<Path>, defines: &[String]) -> Result<Curve, Error> {
+    let path = path.as_ref();
+    let text = read(path)?;
+    curve(front(&path.display().to_string(), text, defines)?)
+}
+
+/// Checks text as a curve L-system; `name` is the file name in messages.
+///
+/// ```
+/// let src = "
+///     V2f v1(0, 0), v2(0, 1), v3(1, 1), v4(1, 0);
+///     module P(V2f);
+///     ring L-system: 1;
+///     derivation length: 2;
+///     Axiom: P(v1) P(v2) P(v3) P(v4);
+///     P(vl) < P(v) > P(vr) -> P(0.25*vl + 0.75*v) P(0.75*v + 0.25*vr)
+/// ";
+/// let chaikin = subgram::load_str("chaikin.lsys", src, &[]).unwrap();
+/// let derived = chaikin.derive(Default::default()).unwrap();
+/// assert_eq!(derived.word.len(), 16); // 4 points, doubled twice
+/// ```
+pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Curve, Error> {
+    curve(front(name, text.to_string(), defines)?)
+}
+
+pub(crate) fn read(path: &Path) -> Result<String, Error> {
+    std::fs::read_to_string(path).map_err(|e| Error::read(PathBuf::from(path), e))
+}
+
+/// A program's text after lexing and preprocessing.
+pub(crate) struct Front {
+    /// The file, then one source per `-D` override.
+    pub sources: SourceMap,
+    pub main: FileId,
+    pub tokens: Vec<Token>,
+}
+
+impl Front {
+    /// The empty span at the end of the file, for "expected ..., found the
+    /// end of the file".
+    pub fn eof(&self) -> Span {
+        let n = self.sources.get(self.main).text.len();
+        Span::new(self.main, n, n)
+    }
+}
+
+/// Lexes and preprocesses `text` with `defines` (`NAME=VALUE` each).
+pub(crate) fn front(name: &str, text: String, defines: &[String]) -> Result<Front, Error> {
+    let mut sources = SourceMap::default();
+    let main = sources.add(SourceFile::new(name, text));
+    let mut overrides = Vec::new();
+    for d in defines {
+        let bad = || {
+            Error::Usage(format!(
+                "`-D {d}` must have the form NAME=VALUE, e.g. -D STEPS=4"
+            ))
+        };
+        let (n, v) = d.split_once('=').ok_or_else(bad)?;
+        let n = n.trim();
+        if n.is_empty() || !n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(bad());
+        }
+        let id = sources.add(SourceFile::new(format!("<-D {n}>"), v));
+        let toks = lex::lex(id, v).map_err(|e| Error::at(&sources, e))?;
+        overrides.push((n.to_string(), toks));
+    }
+    let tokens = lex::lex(main, &sources.get(main).text)
+        .and_then(|t| preprocess::preprocess(t, &overrides))
+        .map_err(|e| Error::at(&sources, e))?;
+    Ok(Front {
+        sources,
+        main,
+        tokens,
+    })
+}
+
+/// Parses and checks preprocessed tokens as a curve L-system.
+pub(crate) fn curve(front: Front) -> Result<Curve, Error> {
+    let eof = front.eof();
+    let Front {
+        sources, tokens, ..
+    } = front;
+    let predefined: Vec<&str> = lang::modules::PREDEFINED.iter().map(|(n, _)| *n).collect();
+    let file = match parse::parse_file(&tokens, eof, &predefined) {
+        Ok(f) => f,
+        Err(d) => {
+            return Err(Error::Program {
+                sources,
+                diagnostics: vec![d],
+            })
+        }
+    };
+    match lang::compile(&file) {
+        Ok(program) => Ok(Curve { program, sources }),
+        Err(mut diagnostics) => {
+            for d in &mut diagnostics {
+                if d.span == Span::default() {
+                    d.span = eof;
+                }
+            }
+            Err(Error::Program {
+                sources,
+                diagnostics,
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kind(text: &str) -> &'static str {
+        let f = front("t.lsys", text.to_string(), &[]).unwrap();
+        if surface::is_surface(&f.tokens) {
+            "surface"
+        } else {
+            "curve"
+        }
+    }
+
+    #[test]
+    fn the_kind_comes_from_the_tokens() {
+        assert_eq!(kind("mesh: \"cube.obj\";\nV(v) -> V(v = v);\n"), "surface");
+        assert_eq!(kind("F(f) -> V(v = avg(f)) || E^3 F^3;\n"), "surface");
+        assert_eq!(kind("E(e) | F^2 -> V(v = avg(e)) || E^4 F^4;\n"), "surface");
+        // `mesh:` inside a comment or a string is not a directive.
+        assert_eq!(
+            kind("// mesh: \"cube.obj\";\nmodule A;\nAxiom: A;\n"),
+            "curve"
+        );
+        // C's `||` in a condition, or inside a module's parentheses, and a
+        // `||` on a later line do not make a surface rule.
+        let curve = "module F(float);\nAxiom: F(1);\nF(x) -> F(x + 1)\n\
+                     F(x) : x > 2 || x < 0 -> F(x)\nF(x) -> F(x > 1 || x < 0)\n";
+        assert_eq!(kind(curve), "curve");
+        assert_eq!(
+            kind("module V(float);\nV(x) : { produce V(x) || V(x); }\n"),
+            "curve"
+        );
+        // With `angle:`, `|` turns the turtle around.
+        assert_eq!(
+            kind("angle: 90;\nAxiom: F(1);\nF(x) -> F(x)||F(x)\n"),
+            "curve"
+        );
+        // The decision is made after preprocessing: a macro can spell the
+        // directive, as the grammar's parser will read it.
+        assert_eq!(kind("#define M mesh\nM: \"cube.obj\";\n"), "surface");
+    }
+
+    #[test]
+    fn a_file_is_loaded_as_its_kind() {
+        let opts = LoadOptions::default();
+        let s = load_text("g.lsys", "F(f) -> V(v = avg(f)) || E^3 F^3;\n", &opts).unwrap();
+        assert!(matches!(s, System::Surface(_)));
+        let c = load_text("c.lsys", "module A;\nAxiom: A;\n", &opts).unwrap();
+        assert!(matches!(c, System::Curve(_)));
+    }
+
+    #[test]
+    fn defines_are_checked_and_applied() {
+        let text = "#define N 2\nmodule A(int);\nAxiom: A(N);\n";
+        let opts = LoadOptions::default().define("N=5");
+        let System::Curve(c) = load_text("d.lsys", text, &opts).unwrap() else {
+            panic!("a curve")
+        };
+        assert_eq!(c.derive(Default::default()).unwrap().word.len(), 1);
+        let run = c.run(Default::default()).unwrap();
+        assert_eq!(run.text(), "A(5)");
+        for bad in ["N", "=5", "N M=5"] {
+            let e = load_text("d.lsys", text, &LoadOptions::default().define(bad)).unwrap_err();
+            assert!(matches!(e, Error::Usage(_)), "{bad}: {e:?}");
+            assert!(e.to_string().contains("must have the form NAME=VALUE"));
+        }
+        // A `-D` value that does not lex points into its own source.
+        let e = load_text("d.lsys", text, &LoadOptions::default().define("N=`")).unwrap_err();
+        assert!(e.to_string().starts_with("<-D N>:1:1: error: "), "{e}");
+    }
+
+    #[test]
+    fn errors_are_std_errors_without_an_error_prefix() {
+        fn read_missing() -> Result<System, Box<dyn std::error::Error>> {
+            Ok(load("no/such/file.lsys", &LoadOptions::default())?)
+        }
+        let e = read_missing().unwrap_err();
+        assert!(e.source().is_some(), "the io::Error is the source");
+        assert!(e
+            .to_string()
+            .starts_with("cannot read `no/such/file.lsys`: "));
+        // Every diagnostic, each with its line and caret, a blank line between.
+        let text = "module A;\nAxiom: B;\nA -> C\n";
+        let e = load_text("two.lsys", text, &LoadOptions::default()).unwrap_err();
+        assert_eq!(e.diagnostics().len(), 2, "{e}");
+        assert!(e.has_location());
+        let shown = e.to_string();
+        let blocks: Vec<&str> = shown.split("\n\n").collect();
+        assert_eq!(blocks.len(), 2, "{shown}");
+        assert!(blocks[0].starts_with("two.lsys:2:8: error: "), "{shown}");
+        assert!(blocks[1].starts_with("two.lsys:3:6: error: "), "{shown}");
+        assert!(blocks
+            .iter()
+            .all(|b| b.lines().count() == 4 && b.ends_with('^')));
+    }
+
+    #[test]
+    fn a_failed_run_points_at_the_rule() {
+        let text = "module A(float);\nderivation length: 1;\nAxiom: A(1);\n\
+                    A(x) : { produce A(x / 0); }\n";
+        let c = load_str("r.lsys", text, &[]).unwrap();
+        let e = c.derive(Default::default()).unwrap_err();
+        let shown = e.to_string();
+        assert!(shown.starts_with("r.lsys:4:"), "{shown}");
+        assert!(
+            shown.contains("\n4 | A(x) : { produce A(x / 0); }\n"),
+            "{shown}"
+        );
+        let too_many = crate::DeriveOptions::default().with_steps(crate::MAX_STEPS + 1);
+        assert!(matches!(c.derive(too_many), Err(Error::Usage(_))));
+    }
+}

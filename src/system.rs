@@ -1,0 +1,245 @@
+//! [`System`]: a loaded file, curve or surface, and how to run it.
+
+use std::path::{Path, PathBuf};
+
+use crate::curve::{Curve, CurveRun};
+use crate::error::Error;
+use crate::mesh::Mesh;
+use crate::rewrite::derive::DEFAULT_MAX_MODULES;
+use crate::rewrite::{DeriveOptions, Word};
+use crate::surface::{Grammar, StepCounts};
+use crate::syntax::{FileId, SourceMap};
+
+/// A checked `.lsys` file: what [`crate::load`] returns.
+#[derive(Debug)]
+#[allow(clippy::large_enum_variant)] // one per loaded file: boxing saves nothing
+pub enum System {
+    /// An L-system whose word of modules is derived and drawn as a curve.
+    Curve(Curve),
+    /// A stellar subdivision grammar, run on a mesh.
+    Surface(Surface),
+}
+
+/// Settings of [`System::run`].
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// The number of steps; by default the file's `derivation length:`
+    /// (for a surface grammar without one, 1).
+    pub steps: Option<u64>,
+    /// Curves: a step that makes a longer word fails.
+    pub max_modules: usize,
+    /// Curves: where the partition into multi-module strict predecessors
+    /// starts.
+    pub phase: usize,
+    /// Surfaces: the base mesh file, instead of the grammar's `mesh:`.
+    pub base_mesh: Option<PathBuf>,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            steps: None,
+            max_modules: DEFAULT_MAX_MODULES,
+            phase: 0,
+            base_mesh: None,
+        }
+    }
+}
+
+impl RunOptions {
+    /// Runs `n` steps instead of the file's derivation length.
+    pub fn with_steps(mut self, n: u64) -> Self {
+        self.steps = Some(n);
+        self
+    }
+
+    /// The options of a curve's derivation.
+    pub fn derive_options(&self) -> DeriveOptions {
+        let mut d = DeriveOptions::default()
+            .with_max_modules(self.max_modules)
+            .with_phase(self.phase);
+        d.steps = self.steps;
+        d
+    }
+}
+
+/// The result of [`System::run`].
+pub enum Run<'s> {
+    Curve(CurveRun<'s>),
+    Surface(SurfaceRun),
+}
+
+impl Run<'_> {
+    /// A curve's derived word.
+    pub fn word(&self) -> Option<&Word> {
+        match self {
+            Run::Curve(c) => Some(c.word()),
+            Run::Surface(_) => None,
+        }
+    }
+
+    /// A surface grammar's subdivided mesh.
+    pub fn mesh(&self) -> Option<&Mesh> {
+        match self {
+            Run::Curve(_) => None,
+            Run::Surface(s) => Some(&s.mesh),
+        }
+    }
+}
+
+impl System {
+    /// Runs the system: derives a curve's word, or subdivides a surface
+    /// grammar's base mesh.
+    ///
+    /// ```
+    /// # fn main() -> Result<(), subgram::Error> {
+    /// let root = env!("CARGO_MANIFEST_DIR");
+    /// let opts = subgram::LoadOptions::default();
+    /// let system = subgram::load(format!("{root}/lsystems/surfaces/loop.lsys"), &opts)?;
+    /// let run = system.run(&subgram::RunOptions::default().with_steps(1))?;
+    /// assert_eq!(run.mesh().unwrap().info().faces, 8 * 4); // an octahedron, each face split in 4
+    /// # Ok(()) }
+    /// ```
+    pub fn run(&self, opts: &RunOptions) -> Result<Run<'_>, Error> {
+        match self {
+            System::Curve(c) => Ok(Run::Curve(c.run(opts.derive_options())?)),
+            System::Surface(s) => Ok(Run::Surface(s.subdivide(opts, |_| {})?)),
+        }
+    }
+
+    /// The texts the system was checked from: the file and its `-D` values.
+    pub fn sources(&self) -> &SourceMap {
+        match self {
+            System::Curve(c) => &c.sources,
+            System::Surface(s) => &s.grammar.sources,
+        }
+    }
+}
+
+/// The most steps a surface grammar may run: each at least doubles the
+/// faces.
+pub const MAX_SURFACE_STEPS: u64 = 12;
+
+/// A checked surface grammar and the folder its `mesh:` is relative to.
+#[derive(Debug)]
+pub struct Surface {
+    pub grammar: Grammar,
+    dir: Option<PathBuf>,
+}
+
+/// Where a surface run stands, for progress reports: after `step` of
+/// `steps` (0 before the first), the mesh's counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    pub step: usize,
+    pub steps: usize,
+    pub vertices: usize,
+    pub edges: usize,
+    pub faces: usize,
+}
+
+/// A subdivided mesh and the number of steps that made it.
+#[derive(Clone, Debug)]
+pub struct SurfaceRun {
+    pub mesh: Mesh,
+    pub steps: usize,
+}
+
+impl Surface {
+    /// `grammar`, read from `file` (its `mesh:` is relative to the file's
+    /// folder) or from text (relative to the current folder).
+    pub fn new(grammar: Grammar, file: Option<&Path>) -> Surface {
+        let dir = file.map(|f| f.parent().unwrap_or(Path::new("")).to_path_buf());
+        Surface { grammar, dir }
+    }
+
+    /// The base mesh the grammar names with `mesh:`: relative to the
+    /// grammar's folder when that file exists, else as written.
+    pub fn base_mesh(&self) -> Option<PathBuf> {
+        let (p, _) = self.grammar.mesh.as_ref()?;
+        let rel = self.dir.as_deref().unwrap_or(Path::new(".")).join(p);
+        Some(if rel.exists() { rel } else { PathBuf::from(p) })
+    }
+
+    /// The steps a run makes: `requested`, else the grammar's derivation
+    /// length, else 1; more than [`MAX_SURFACE_STEPS`] are refused.
+    pub fn steps(&self, requested: Option<u64>) -> Result<usize, Error> {
+        let n = requested.or(self.grammar.length).unwrap_or(1);
+        if n > MAX_SURFACE_STEPS {
+            return Err(Error::Usage(format!(
+                "{n} steps would multiply the faces by at least 2^{n}; at most {MAX_SURFACE_STEPS} are allowed"
+            )));
+        }
+        Ok(n as usize)
+    }
+
+    /// A run's error as an [`Error`], located at the rule when one is to
+    /// blame.
+    pub fn error(&self, e: crate::surface::RunError) -> Error {
+        match e.span {
+            Some(span) => Error::at(
+                &self.grammar.sources,
+                crate::syntax::Diagnostic::new(span, e.message),
+            ),
+            None => Error::Failed(e.message),
+        }
+    }
+
+    /// Runs `steps` steps on `mesh` (after the `init:` rules, on a mesh's
+    /// first run). `progress` hears before the first step and after each.
+    /// A run that fails in a rule leaves the mesh partly derived.
+    pub fn run_on(
+        &self,
+        mesh: &mut Mesh,
+        steps: usize,
+        mut progress: impl FnMut(Progress),
+    ) -> Result<(), Error> {
+        let at = |c: StepCounts| Progress {
+            step: c.step,
+            steps,
+            vertices: c.vertices,
+            edges: c.edges,
+            faces: c.faces,
+        };
+        progress(at(StepCounts {
+            step: 0,
+            vertices: mesh.vertex_count(),
+            edges: mesh.edge_count(),
+            faces: mesh.face_count(),
+        }));
+        self.grammar
+            .run(mesh, steps, |c| progress(at(c)))
+            .map_err(|e| self.error(e))
+    }
+
+    /// Loads the base mesh (`opts.base_mesh`, else the grammar's `mesh:`) and
+    /// runs `opts.steps` steps on it (see [`Surface::steps`]).
+    pub fn subdivide(
+        &self,
+        opts: &RunOptions,
+        progress: impl FnMut(Progress),
+    ) -> Result<SurfaceRun, Error> {
+        let path = match (&opts.base_mesh, self.base_mesh()) {
+            (Some(m), _) => m.clone(),
+            (None, Some(p)) => p,
+            (None, None) => {
+                // The grammar's own file comes first in its sources.
+                let name = &self.grammar.sources.get(FileId(0)).name;
+                return Err(Error::Usage(format!(
+                    "give a base mesh: `subgram subdivide MESH --grammar {name} ...`, or `mesh: \"file.obj\";` in the grammar"
+                )));
+            }
+        };
+        let mut mesh = load_mesh(&path)?;
+        let steps = self.steps(opts.steps)?;
+        self.run_on(&mut mesh, steps, progress)?;
+        Ok(SurfaceRun { mesh, steps })
+    }
+}
+
+/// Reads a mesh file (`.obj`, `.off`, `.ply`) and builds the half-edge
+/// mesh, with the file's name on every message.
+pub fn load_mesh(path: &Path) -> Result<Mesh, Error> {
+    let soup = crate::mesh::io::read(path)?;
+    Mesh::from_soup(&soup).map_err(|e| Error::file(path.display().to_string(), e.message))
+}
