@@ -519,7 +519,21 @@ impl<'p> Interp<'p> {
 
     #[inline(never)]
     fn call(&mut self, f: Func, args: &[Ex], span: Span, cx: &mut Cx) -> R<Value> {
-        // Arguments go on the scratch stack: no allocation per call.
+        // One argument, the common case, stays on the stack.
+        if let [a] = args {
+            match f {
+                Func::Host(id) => {
+                    let v = self.expr(a, cx)?;
+                    return cx
+                        .host
+                        .call(id, std::slice::from_ref(&v))
+                        .map_err(|m| rt(Some(span), m));
+                }
+                Func::Math1(g) => return Ok(Value::Float(g(self.expr(a, cx)?.as_f64()))),
+                _ => {}
+            }
+        }
+        // Other arguments go on the scratch stack: no allocation per call.
         let base = self.scratch.len();
         for a in args {
             match self.expr(a, cx) {
@@ -631,12 +645,43 @@ fn set_path(root: &mut Value, path: &[u16], value: Value) {
     }
 }
 
-/// The common cases of [`binary`], floating-point numbers and points,
-/// without moving the values: the same results, fewer steps.
+/// The common cases of [`binary`], numbers and points, without moving the
+/// values: the same results, fewer steps.
 #[inline]
 fn float_binary(op: BinOp, x: &Value, y: &Value) -> Option<Value> {
     use BinOp::*;
+    let float = |a: f64, b: f64| -> Option<Value> {
+        Some(match op {
+            Add => Value::Float(a + b),
+            Sub => Value::Float(a - b),
+            Mul => Value::Float(a * b),
+            Div => Value::Float(a / b),
+            Lt => Value::Bool(a < b),
+            Le => Value::Bool(a <= b),
+            Gt => Value::Bool(a > b),
+            Ge => Value::Bool(a >= b),
+            Eq => Value::Bool(a == b),
+            Ne => Value::Bool(a != b),
+            _ => return None,
+        })
+    };
     Some(match (x, y) {
+        (Value::Int(a), Value::Int(b)) => match op {
+            Add => Value::Int(a.wrapping_add(*b)),
+            Sub => Value::Int(a.wrapping_sub(*b)),
+            Mul => Value::Int(a.wrapping_mul(*b)),
+            Div if *b != 0 => Value::Int(a.wrapping_div(*b)),
+            Rem if *b != 0 => Value::Int(a.wrapping_rem(*b)),
+            Lt => Value::Bool(a < b),
+            Le => Value::Bool(a <= b),
+            Gt => Value::Bool(a > b),
+            Ge => Value::Bool(a >= b),
+            Eq => Value::Bool(a == b),
+            Ne => Value::Bool(a != b),
+            _ => return None,
+        },
+        (Value::Int(a), Value::Float(b)) => return float(*a as f64, *b),
+        (Value::Float(a), Value::Int(b)) => return float(*a, *b as f64),
         (Value::Float(a), Value::Float(b)) => match op {
             Add => Value::Float(a + b),
             Sub => Value::Float(a - b),

@@ -13,7 +13,7 @@
 use glam::DVec3;
 
 use crate::lang::builtins::{Builtin, HostTable, SigError};
-use crate::lang::eval::Host;
+use crate::lang::eval::{Host, RuntimeError};
 use crate::lang::ir::{Ex, FoldOp, Func};
 use crate::lang::value::{Elem, Ty, Value};
 use crate::mesh::{Mesh, VertexId};
@@ -63,12 +63,16 @@ const RING: u8 = 0;
 const BOUNDARY_RING: u8 = 1;
 const VERTS: u8 = 2;
 
-pub fn vertex(v: VertexId) -> Value {
-    Value::Elem(Elem {
+pub fn vertex(v: VertexId) -> Elem {
+    Elem {
         kind: VERTEX,
         flags: 0,
         ids: [v.0, 0, 0, 0],
-    })
+    }
+}
+
+fn vertex_value(v: VertexId) -> Value {
+    Value::Elem(vertex(v))
 }
 
 /// An edge by its end vertices, captured before a split, with its level
@@ -80,51 +84,40 @@ pub fn edge(
     boundary: bool,
     block: bool,
     transversal: bool,
-) -> Value {
+) -> Elem {
     let flags = (boundary as u8 * ON_BOUNDARY)
         | (block as u8 * IN_BLOCK)
         | (transversal as u8 * TRANSVERSAL);
-    Value::Elem(Elem {
+    Elem {
         kind: EDGE,
         flags,
         ids: [p.0, q.0, level, 0],
-    })
+    }
 }
 
 /// A face by its vertices, captured before a split, with its level and
 /// whether one of its edges is on the boundary or a block's internal edge.
-pub fn face(vs: [VertexId; 3], level: u32, boundary: bool, block: bool) -> Value {
-    Value::Elem(Elem {
+pub fn face(vs: [VertexId; 3], level: u32, boundary: bool, block: bool) -> Elem {
+    Elem {
         kind: FACE,
         flags: (boundary as u8 * ON_BOUNDARY) | (block as u8 * IN_BLOCK),
         ids: [vs[0].0, vs[1].0, vs[2].0, level],
-    })
+    }
 }
 
 /// The vertex of a vertex value.
-pub fn vertex_of(v: &Value) -> Option<VertexId> {
-    match v {
-        Value::Elem(e) if e.kind == VERTEX => Some(VertexId(e.ids[0])),
-        _ => None,
-    }
+pub fn vertex_of(e: &Elem) -> Option<VertexId> {
+    (e.kind == VERTEX).then_some(VertexId(e.ids[0]))
 }
 
 /// The vertices of a face value.
-pub fn face_vertices(v: &Value) -> Option<[VertexId; 3]> {
-    match v {
-        Value::Elem(e) if e.kind == FACE => {
-            Some([VertexId(e.ids[0]), VertexId(e.ids[1]), VertexId(e.ids[2])])
-        }
-        _ => None,
-    }
+pub fn face_vertices(e: &Elem) -> Option<[VertexId; 3]> {
+    (e.kind == FACE).then_some([VertexId(e.ids[0]), VertexId(e.ids[1]), VertexId(e.ids[2])])
 }
 
 /// The end vertices of an edge value.
-pub fn edge_vertices(v: &Value) -> Option<(VertexId, VertexId)> {
-    match v {
-        Value::Elem(e) if e.kind == EDGE => Some((VertexId(e.ids[0]), VertexId(e.ids[1]))),
-        _ => None,
-    }
+pub fn edge_vertices(e: &Elem) -> Option<(VertexId, VertexId)> {
+    (e.kind == EDGE).then_some((VertexId(e.ids[0]), VertexId(e.ids[1])))
 }
 
 fn one(a: &[Ty], kinds: &[u8], what: &str) -> Result<(), SigError> {
@@ -333,6 +326,7 @@ pub static SURFACE_HOST: HostTable = HostTable {
 };
 
 /// The mesh as a rule's expressions see it while the rule runs.
+#[derive(Clone, Copy)]
 pub struct MeshHost<'m> {
     pub mesh: &'m Mesh,
     /// `c`, the current level when the rule started.
@@ -368,13 +362,33 @@ fn op_code(op: BinOp) -> Option<i64> {
 impl MeshHost<'_> {
     fn level(&self, v: &Value) -> Option<u32> {
         match v {
-            Value::Elem(e) => Some(match e.kind {
-                VERTEX => self.mesh.vertex_level(VertexId(e.ids[0])),
-                EDGE => e.ids[2],
-                FACE => e.ids[3],
-                _ => return None,
-            }),
+            Value::Elem(e) => self.elem_level(e),
             _ => None,
+        }
+    }
+
+    fn elem_level(&self, e: &Elem) -> Option<u32> {
+        Some(match e.kind {
+            VERTEX => self.mesh.vertex_level(VertexId(e.ids[0])),
+            EDGE => e.ids[2],
+            FACE => e.ids[3],
+            _ => return None,
+        })
+    }
+
+    /// A bool built-in on an element (`boundary`, `block`, `transversal`,
+    /// `new`, `center`), read without values.
+    fn test(&self, f: u16, e: &Elem) -> bool {
+        let flag = |bit: u8| e.flags & bit != 0;
+        let v = VertexId(e.ids[0]);
+        match (f, e.kind) {
+            (id::BOUNDARY, VERTEX) => self.mesh.is_boundary_vertex(v),
+            (id::BOUNDARY, EDGE | FACE) => flag(ON_BOUNDARY),
+            (id::BLOCK, EDGE | FACE) => flag(IN_BLOCK),
+            (id::TRANSVERSAL, EDGE) => flag(TRANSVERSAL),
+            (id::NEW, VERTEX) => self.is_new(v),
+            (id::CENTER, VERTEX) => self.mesh.is_block_centre(v),
+            _ => false,
         }
     }
 
@@ -403,6 +417,28 @@ impl MeshHost<'_> {
             0 => Value::V3(sum),
             1 => Value::V3(sum / count as f64),
             _ => Value::Int(count),
+        }
+    }
+}
+
+impl MeshHost<'_> {
+    /// The point built-in `f` gives for element `x` (`pos`, `avg` of an
+    /// edge or a face, a sum or average over a one-ring with `args`), or
+    /// None when `x` is not what it takes.
+    #[inline]
+    fn point(&self, f: u16, x: &Value, args: [i64; 2]) -> Option<DVec3> {
+        let Value::Elem(e) = x else { return None };
+        let m = self.mesh;
+        let at = |i: u32| m.position(VertexId(i));
+        match (f, e.kind) {
+            (id::POS, VERTEX) => Some(at(e.ids[0])),
+            (id::AVG_OF, EDGE) => Some((at(e.ids[0]) + at(e.ids[1])) * 0.5),
+            (id::AVG_OF, FACE) => Some((at(e.ids[0]) + at(e.ids[1]) + at(e.ids[2])) / 3.0),
+            (id::RING_FOLD, VERTEX) => match self.ring_fold(VertexId(e.ids[0]), args[0], args[1]) {
+                Value::V3(p) => Some(p),
+                _ => None,
+            },
+            _ => None,
         }
     }
 }
@@ -470,12 +506,14 @@ impl Host for MeshHost<'_> {
                 _ => return Err("this is not an element of the mesh".into()),
             },
             id::TAIL | id::HEAD => match elem {
-                Some(e) if e.kind == EDGE => vertex(VertexId(e.ids[(f == id::HEAD) as usize])),
+                Some(e) if e.kind == EDGE => {
+                    vertex_value(VertexId(e.ids[(f == id::HEAD) as usize]))
+                }
                 _ => return Err("this is not an edge of the mesh".into()),
             },
             id::BNEXT | id::BPREV => match v() {
                 Some(v) => match m.boundary_neighbour(v, f == id::BNEXT) {
-                    Some(w) => vertex(w),
+                    Some(w) => vertex_value(w),
                     None => {
                         return Err(format!(
                             "`{}` of vertex {v}: the vertex is not on the boundary, so it has \
@@ -516,16 +554,16 @@ impl Host for MeshHost<'_> {
         let m = self.mesh;
         let (k, of) = (s.flags & 0xF, s.flags >> 4);
         match (k, of) {
-            (RING, VERTEX) => out.extend(m.one_ring(VertexId(s.ids[0])).map(vertex)),
+            (RING, VERTEX) => out.extend(m.one_ring(VertexId(s.ids[0])).map(vertex_value)),
             (BOUNDARY_RING, VERTEX) => {
                 for h in m.outgoing_halfedges(VertexId(s.ids[0])) {
                     if m.is_boundary_edge(h.edge()) {
-                        out.push(vertex(m.to(h)));
+                        out.push(vertex_value(m.to(h)));
                     }
                 }
             }
-            (_, EDGE) => out.extend(s.ids[..2].iter().map(|&i| vertex(VertexId(i)))),
-            (_, FACE) => out.extend(s.ids[..3].iter().map(|&i| vertex(VertexId(i)))),
+            (_, EDGE) => out.extend(s.ids[..2].iter().map(|&i| vertex_value(VertexId(i)))),
+            (_, FACE) => out.extend(s.ids[..3].iter().map(|&i| vertex_value(VertexId(i)))),
             _ => {}
         }
     }
@@ -651,28 +689,150 @@ fn fused(e: &Ex) -> Option<Ex> {
     }
 }
 
-/// A guard that reads only the rule's own element (its marks, its level
-/// against `c`, whether it is new), recognised in the checked IR and
-/// tested without the interpreter: the same meaning as the expression it
-/// came from, as a curve stencil is for its body.
+/// What the specialised forms below need from the evaluator that runs a
+/// rule: the interpreter for the parts they leave to it, the host, and
+/// the rule's locals.
+pub trait Evaluate<'m> {
+    /// Runs `e` through the interpreter on the current locals.
+    fn eval(&mut self, e: &Ex) -> Result<Value, RuntimeError>;
+    fn host(&self) -> MeshHost<'m>;
+    fn frame(&mut self) -> &mut [Value];
+    /// What this evaluator remembers between elements: invariant guard
+    /// leaves (by address) and weights (by rule address and integer key).
+    fn memo(&mut self) -> &mut Memo;
+}
+
+/// Values a specialised form computed once and may reuse while the same
+/// rule runs with the same `c` and step.
+#[derive(Default)]
+pub struct Memo {
+    invariants: Vec<(usize, bool)>,
+    weights: Vec<Weights>,
+}
+
+/// The weights of one affine form for one key.
+struct Weights {
+    form: usize,
+    key: [i64; MAX_KEY],
+    w: [f64; MAX_TERMS],
+}
+
+/// Affine forms with more integer lets or more points than these are left
+/// to the interpreter; so are keys past `MAX_MEMO` distinct ones.
+const MAX_KEY: usize = 8;
+const MAX_TERMS: usize = 8;
+const MAX_MEMO: usize = 256;
+
+/// The vertex or element a guard leaf reads: the rule's element, or an end
+/// of it (`tail(e)`, `head(e)`).
+#[derive(Clone, Copy, Debug)]
+pub enum Path {
+    Elem,
+    End(bool),
+}
+
+/// A guard recognised in the checked IR and tested without the
+/// interpreter where it can be: leaves that read the rule's element (its
+/// marks, its level against `c`, whether it or an end of it is new), and
+/// leaves that do not depend on the element at all (`step % 2 == 0`),
+/// which the interpreter evaluates once per rule and the guard remembers.
+/// The same meaning as the expression it came from, as a curve stencil is
+/// for its body.
 #[derive(Clone, Debug)]
 pub enum Guard {
     /// `l(x) OP c`, by the operator's code.
-    Level(i64),
-    /// A built-in that takes the element alone and gives a bool.
-    Test(u16),
+    Level(i64, Path),
+    /// A built-in that takes the element (or an end) and gives a bool.
+    Test(u16, Path),
+    /// An expression that reads no element.
+    Invariant(Box<Ex>),
     Not(Box<Guard>),
     And(Box<Guard>, Box<Guard>),
     Or(Box<Guard>, Box<Guard>),
 }
 
+fn path(e: &Ex, slot: u16) -> Option<Path> {
+    match e {
+        Ex::Local(s) if *s == slot => Some(Path::Elem),
+        Ex::Call(Func::Host(f @ (id::TAIL | id::HEAD)), args, _) => match args.as_slice() {
+            [Ex::Local(s)] if *s == slot => Some(Path::End(*f == id::HEAD)),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// True when `e` reads no local and no element: its value is the same for
+/// every element a rule tests.
+fn invariant(e: &Ex) -> bool {
+    let mut ok = true;
+    walk(e, &mut |x| match x {
+        Ex::Local(_) | Ex::Global(_) | Ex::Assign(..) | Ex::IncDec(..) | Ex::InContext(..) => {
+            ok = false
+        }
+        Ex::Call(Func::Host(f), ..) if !matches!(*f, id::CURRENT | id::STEP) => ok = false,
+        Ex::Call(Func::Ran | Func::UseGroup | Func::Stop, ..) => ok = false,
+        _ => {}
+    });
+    ok
+}
+
+/// Calls `f` on `e` and every expression inside it.
+fn walk(e: &Ex, f: &mut dyn FnMut(&Ex)) {
+    f(e);
+    match e {
+        Ex::Field(a, _) | Ex::Neg(a) | Ex::Not(a) | Ex::Convert(_, a) => walk(a, f),
+        Ex::Assign(_, _, a, _) => walk(a, f),
+        Ex::Bin(_, a, b, _) | Ex::Logic(_, a, b) | Ex::MakeV2(a, b) | Ex::Let(_, a, b) => {
+            walk(a, f);
+            walk(b, f);
+        }
+        Ex::Cond(a, b, c) | Ex::MakeV3(a, b, c) => {
+            walk(a, f);
+            walk(b, f);
+            walk(c, f);
+        }
+        Ex::Call(_, args, _) | Ex::MakeStruct(args) => args.iter().for_each(|a| walk(a, f)),
+        Ex::Fold {
+            set, cond, value, ..
+        } => {
+            walk(set, f);
+            if let Some(c) = cond {
+                walk(c, f);
+            }
+            if let Some((v, _)) = value {
+                walk(v, f);
+            }
+        }
+        Ex::Const(_) | Ex::Local(_) | Ex::Global(_) | Ex::IncDec(..) | Ex::InContext(..) => {}
+    }
+}
+
 impl Guard {
     /// The guard of condition `e` on the element in local `slot`, if `e`
-    /// has that form.
+    /// has that form. A guard that is only invariant leaves is not worth
+    /// one: None.
     pub fn of(e: &Ex, slot: u16) -> Option<Guard> {
+        let g = Guard::leaf(e, slot)?;
+        (!g.is_invariant()).then_some(g)
+    }
+
+    fn is_invariant(&self) -> bool {
+        match self {
+            Guard::Invariant(_) => true,
+            Guard::Level(..) | Guard::Test(..) => false,
+            Guard::Not(a) => a.is_invariant(),
+            Guard::And(a, b) | Guard::Or(a, b) => a.is_invariant() && b.is_invariant(),
+        }
+    }
+
+    fn leaf(e: &Ex, slot: u16) -> Option<Guard> {
+        if invariant(e) {
+            return Some(Guard::Invariant(Box::new(e.clone())));
+        }
         Some(match e {
             Ex::Call(Func::Host(id::LEVEL_VS_CURRENT), args, _) => match args.as_slice() {
-                [x, Ex::Const(Value::Int(op))] if is_local(x, slot) => Guard::Level(*op),
+                [x, Ex::Const(Value::Int(op))] => Guard::Level(*op, path(x, slot)?),
                 _ => return None,
             },
             Ex::Call(
@@ -680,131 +840,286 @@ impl Guard {
                 args,
                 _,
             ) => match args.as_slice() {
-                [x] if is_local(x, slot) => Guard::Test(*f),
+                [x] => Guard::Test(*f, path(x, slot)?),
                 _ => return None,
             },
-            Ex::Not(a) => Guard::Not(Box::new(Guard::of(a, slot)?)),
+            Ex::Not(a) => Guard::Not(Box::new(Guard::leaf(a, slot)?)),
             Ex::Logic(and, a, b) => {
-                let (a, b) = (Box::new(Guard::of(a, slot)?), Box::new(Guard::of(b, slot)?));
+                let (a, b) = (
+                    Box::new(Guard::leaf(a, slot)?),
+                    Box::new(Guard::leaf(b, slot)?),
+                );
                 if *and {
                     Guard::And(a, b)
                 } else {
                     Guard::Or(a, b)
                 }
             }
+            // A call of an inlined function of no parameters, such as
+            // `even()`, is an invariant above; with parameters bound to
+            // the element it is left to the interpreter.
             _ => return None,
         })
     }
 
-    pub fn test(&self, host: &mut MeshHost, elem: &Value) -> bool {
-        match self {
-            Guard::Level(op) => host.level(elem).is_some_and(|l| cmp(*op, l, host.current)),
-            Guard::Test(f) => matches!(
-                host.call(*f, std::slice::from_ref(elem)),
-                Ok(Value::Bool(true))
-            ),
-            Guard::Not(a) => !a.test(host, elem),
-            Guard::And(a, b) => a.test(host, elem) && b.test(host, elem),
-            Guard::Or(a, b) => a.test(host, elem) || b.test(host, elem),
+    pub fn test(&self, ev: &mut dyn Evaluate<'_>, elem: &Elem) -> Result<bool, RuntimeError> {
+        Ok(match self {
+            Guard::Level(op, p) => {
+                let host = ev.host();
+                host.elem_level(&Guard::at(*p, elem))
+                    .is_some_and(|l| cmp(*op, l, host.current))
+            }
+            Guard::Test(f, p) => ev.host().test(*f, &Guard::at(*p, elem)),
+            Guard::Invariant(x) => {
+                let key = &**x as *const Ex as usize;
+                if let Some((_, b)) = ev.memo().invariants.iter().find(|(k, _)| *k == key) {
+                    *b
+                } else {
+                    let b = ev.eval(x)?.truthy();
+                    ev.memo().invariants.push((key, b));
+                    b
+                }
+            }
+            Guard::Not(a) => !a.test(ev, elem)?,
+            Guard::And(a, b) => a.test(ev, elem)? && b.test(ev, elem)?,
+            Guard::Or(a, b) => a.test(ev, elem)? || b.test(ev, elem)?,
+        })
+    }
+
+    /// The element a leaf reads. An end of something that is not an edge
+    /// is no element: the leaf reads as false, as `l` and the tests do
+    /// for values that are not theirs.
+    fn at(p: Path, elem: &Elem) -> Elem {
+        match p {
+            Path::Elem => *elem,
+            Path::End(head) if elem.kind == EDGE => vertex(VertexId(elem.ids[head as usize])),
+            Path::End(_) => Elem {
+                kind: u8::MAX,
+                flags: 0,
+                ids: [0; 4],
+            },
         }
     }
 }
 
-/// An assignment that is an affine combination, with constant weights, of
-/// points the host gives for the rule's locals (`pos(v)`, `avg(e)`, a sum
-/// or average over a one-ring): recognised in the checked IR and evaluated
-/// as a weighted sum, as a curve stencil is.
+/// An assignment that is a weighted sum of points the host gives for the
+/// rule's elements (`pos(v)`, `avg(e)`, a sum or average over a one-ring),
+/// whose weights depend only on integers the host gives for the element
+/// (its valence, a count over its ring) and on constants. Recognised in
+/// the checked IR: the integers are computed for every element, the
+/// weights by the interpreter once per distinct set of integers, and the
+/// points summed. The same meaning as the expression it came from, as a
+/// curve stencil is for its body; only the order of the floating-point
+/// products may differ (`s / n` is `(1 / n) * s`).
 #[derive(Clone, Debug)]
 pub struct Affine {
-    terms: Vec<(f64, u16, u16, [i64; 2])>,
+    /// The locals the expression binds, in order, with their values and
+    /// whether they read the element (else they are functions of the
+    /// earlier ones and constants).
+    lets: Vec<(u16, Ex, bool)>,
+    /// Per point: its weight's factors (each a scalar expression, divided
+    /// by when `true`), a constant factor, and the host built-in with its
+    /// local and constant arguments.
+    terms: Vec<Term>,
+}
+
+#[derive(Clone, Debug)]
+struct Term {
+    factors: Vec<(Ex, bool)>,
+    scale: f64,
+    f: u16,
+    slot: u16,
+    args: [i64; 2],
+}
+
+/// The built-ins that give a point for an element.
+fn point_call(e: &Ex) -> Option<(u16, u16, [i64; 2])> {
+    match e {
+        Ex::Call(Func::Host(f @ (id::POS | id::AVG_OF)), args, _) => match args.as_slice() {
+            [Ex::Local(s)] => Some((*f, *s, [0, 0])),
+            _ => None,
+        },
+        Ex::Call(Func::Host(id::RING_FOLD), args, _) => match args.as_slice() {
+            [Ex::Local(s), Ex::Const(Value::Int(fold @ (0 | 1))), Ex::Const(Value::Int(filter))] => {
+                Some((id::RING_FOLD, *s, [*fold, *filter]))
+            }
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// True when `e` is a scalar that reads no element: constants, locals
+/// (the integers bound by the lets) and arithmetic on them.
+fn scalar(e: &Ex) -> bool {
+    let mut ok = true;
+    walk(e, &mut |x| match x {
+        Ex::Call(Func::Host(f), ..) if !matches!(*f, id::CURRENT | id::STEP) => ok = false,
+        Ex::Global(_)
+        | Ex::Assign(..)
+        | Ex::IncDec(..)
+        | Ex::InContext(..)
+        | Ex::Fold { .. }
+        | Ex::MakeV2(..)
+        | Ex::MakeV3(..)
+        | Ex::MakeStruct(..)
+        | Ex::Call(Func::Ran | Func::UseGroup | Func::Stop, ..) => ok = false,
+        _ => {}
+    });
+    ok
 }
 
 impl Affine {
-    /// The combination `e` is, if it is one.
+    /// The weighted sum `e` is, if it is one.
     pub fn of(e: &Ex) -> Option<Affine> {
-        let mut terms = Vec::new();
-        let mut alias = Vec::new();
-        collect(e, 1.0, &mut alias, &mut terms)?;
-        Some(Affine { terms })
+        let mut a = Affine {
+            lets: Vec::new(),
+            terms: Vec::new(),
+        };
+        a.collect(e, &mut Vec::new(), 1.0)?;
+        let keys = a.lets.iter().filter(|l| l.2).count();
+        (keys <= MAX_KEY && a.terms.len() <= MAX_TERMS).then_some(a)
     }
 
-    /// The point, reading the locals from `frame`.
-    pub fn eval(&self, host: &mut MeshHost, frame: &[Value]) -> Value {
-        let mut p = DVec3::ZERO;
-        for (w, f, slot, k) in &self.terms {
-            let x = &frame[*slot as usize];
-            let v = match *f {
-                id::RING_FOLD => host.call(*f, &[x.clone(), Value::Int(k[0]), Value::Int(k[1])]),
-                _ => host.call(*f, std::slice::from_ref(x)),
-            };
-            match v {
-                Ok(Value::V3(q)) => p += *w * q,
-                _ => return Value::V3(DVec3::NAN),
+    fn collect(&mut self, e: &Ex, factors: &mut Vec<(Ex, bool)>, scale: f64) -> Option<()> {
+        if let Some((f, slot, args)) = point_call(e) {
+            self.terms.push(Term {
+                factors: factors.clone(),
+                scale,
+                f,
+                slot,
+                args,
+            });
+            return Some(());
+        }
+        match e {
+            Ex::Let(s, a, body) => {
+                // A let that reads the element is computed for every
+                // element; one that does not is a function of the others.
+                let reads = !scalar(a) || matches!(**a, Ex::Local(_));
+                if reads && !matches!(**a, Ex::Local(_)) && !integer_host(a) {
+                    return None;
+                }
+                self.lets.push((*s, (**a).clone(), reads));
+                self.collect(body, factors, scale)
+            }
+            Ex::Bin(BinOp::Add, a, b, _) => {
+                self.collect(a, factors, scale)?;
+                self.collect(b, factors, scale)
+            }
+            Ex::Bin(BinOp::Sub, a, b, _) => {
+                self.collect(a, factors, scale)?;
+                self.collect(b, factors, -scale)
+            }
+            Ex::Neg(a) => self.collect(a, factors, -scale),
+            Ex::Bin(BinOp::Mul, a, b, _) => {
+                let (k, x) = if scalar(a) {
+                    (a, b)
+                } else if scalar(b) {
+                    (b, a)
+                } else {
+                    return None;
+                };
+                factors.push(((**k).clone(), false));
+                let r = self.collect(x, factors, scale);
+                factors.pop();
+                r
+            }
+            Ex::Bin(BinOp::Div, a, b, _) if scalar(b) => {
+                factors.push(((**b).clone(), true));
+                let r = self.collect(a, factors, scale);
+                factors.pop();
+                r
+            }
+            _ => None,
+        }
+    }
+
+    /// The point, with the rule's elements bound in the evaluator's frame;
+    /// None where the weights are not numbers (the general path then says
+    /// what they are).
+    pub fn eval(&self, ev: &mut dyn Evaluate<'_>) -> Result<Option<Value>, RuntimeError> {
+        let mut key = [0i64; MAX_KEY];
+        let mut k = 0;
+        for (s, a, reads) in &self.lets {
+            if *reads {
+                let v = ev.eval(a)?;
+                if let Value::Int(i) = v {
+                    key[k] = i;
+                }
+                k += 1;
+                ev.frame()[*s as usize] = v;
             }
         }
-        Value::V3(p)
+        let form = self as *const Affine as usize;
+        let found = ev
+            .memo()
+            .weights
+            .iter()
+            .find(|w| w.form == form && w.key == key)
+            .map(|w| w.w);
+        let weights = match found {
+            Some(w) => w,
+            None => {
+                // Every let that reads the element was an integer or an
+                // element (those give no key): the weights below depend
+                // on the key alone.
+                for (s, a, reads) in &self.lets {
+                    if !*reads {
+                        let v = ev.eval(a)?;
+                        ev.frame()[*s as usize] = v;
+                    }
+                }
+                let mut w = [0.0; MAX_TERMS];
+                for (t, wt) in self.terms.iter().zip(w.iter_mut()) {
+                    *wt = t.scale;
+                    for (x, inverse) in &t.factors {
+                        let k = match ev.eval(x)? {
+                            Value::Int(i) => i as f64,
+                            Value::Float(f) => f,
+                            Value::Bool(b) => b as i64 as f64,
+                            _ => return Ok(None),
+                        };
+                        *wt = if *inverse { *wt / k } else { *wt * k };
+                    }
+                }
+                let memo = ev.memo();
+                if memo.weights.len() < MAX_MEMO {
+                    memo.weights.push(Weights { form, key, w });
+                }
+                w
+            }
+        };
+        let host = ev.host();
+        let frame = ev.frame();
+        let mut p = DVec3::ZERO;
+        for (t, w) in self.terms.iter().zip(weights) {
+            match host.point(t.f, &frame[t.slot as usize], t.args) {
+                Some(q) => p += w * q,
+                None => return Ok(None),
+            }
+        }
+        Ok(Some(Value::V3(p)))
     }
 }
 
-/// Adds the terms of `w * e` to `out`; `alias` maps the locals of inlined
-/// parameters bound to other locals.
-fn collect(
-    e: &Ex,
-    w: f64,
-    alias: &mut Vec<(u16, u16)>,
-    out: &mut Vec<(f64, u16, u16, [i64; 2])>,
-) -> Option<()> {
-    let local = |x: &Ex, alias: &Vec<(u16, u16)>| match x {
-        Ex::Local(s) => Some(
-            alias
-                .iter()
-                .rev()
-                .find(|(a, _)| a == s)
-                .map_or(*s, |(_, b)| *b),
-        ),
-        _ => None,
-    };
-    let weight = |x: &Ex| match x {
-        Ex::Const(Value::Float(f)) => Some(*f),
-        Ex::Const(Value::Int(i)) => Some(*i as f64),
-        _ => None,
-    };
-    match e {
-        Ex::Let(s, a, body) => {
-            let target = local(a, alias)?;
-            alias.push((*s, target));
-            let r = collect(body, w, alias, out);
-            alias.pop();
-            r
-        }
-        Ex::Bin(BinOp::Add, a, b, _) => {
-            collect(a, w, alias, out)?;
-            collect(b, w, alias, out)
-        }
-        Ex::Bin(BinOp::Sub, a, b, _) => {
-            collect(a, w, alias, out)?;
-            collect(b, -w, alias, out)
-        }
-        Ex::Bin(BinOp::Mul, a, b, _) => match (weight(a), weight(b)) {
-            (Some(k), None) => collect(b, w * k, alias, out),
-            (None, Some(k)) => collect(a, w * k, alias, out),
-            _ => None,
-        },
-        Ex::Bin(BinOp::Div, a, b, _) => collect(a, w / weight(b)?, alias, out),
-        Ex::Neg(a) => collect(a, -w, alias, out),
-        Ex::Call(Func::Host(f @ (id::POS | id::AVG_OF)), args, _) => {
-            let s = local(args.first()?, alias)?;
-            out.push((w, *f, s, [0, 0]));
-            Some(())
-        }
-        Ex::Call(Func::Host(id::RING_FOLD), args, _) => match args.as_slice() {
-            [x, Ex::Const(Value::Int(fold @ (0 | 1))), Ex::Const(Value::Int(filter))] => {
-                let s = local(x, alias)?;
-                out.push((w, id::RING_FOLD, s, [*fold, *filter]));
-                Some(())
+/// A let that reads an integer of the element: `valence(v)`, a count over
+/// its ring, arithmetic on those.
+fn integer_host(e: &Ex) -> bool {
+    let mut ok = true;
+    walk(e, &mut |x| match x {
+        Ex::Call(Func::Host(id::RING_FOLD), args, _) => {
+            if !matches!(args.get(1), Some(Ex::Const(Value::Int(2)))) {
+                ok = false
             }
-            _ => None,
-        },
-        _ => None,
-    }
+        }
+        Ex::Call(Func::Host(f), ..) => {
+            if !matches!(*f, id::VALENCE | id::LEVEL | id::CURRENT | id::STEP) {
+                ok = false
+            }
+        }
+        Ex::Const(_) | Ex::Local(_) | Ex::Bin(..) | Ex::Neg(_) | Ex::Convert(..) => {}
+        _ => ok = false,
+    });
+    ok
 }

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use crate::lang::compile::RuleCompiler;
 use crate::lang::eval::{Env, Interp, RuntimeError};
 use crate::lang::ir::{Ex, Func};
-use crate::lang::value::{Ty, Value};
+use crate::lang::value::{Elem, Ty, Value};
 use crate::mesh::{BlockSplit, Mesh, VertexId};
 use crate::syntax::span::{Diagnostic, SourceMap, Span};
 
@@ -253,7 +253,7 @@ pub fn compile(
 /// The elements a rule matched when it started.
 struct Matches {
     current: u32,
-    vals: Vec<Value>,
+    vals: Vec<Elem>,
     edge_ids: Vec<crate::mesh::EdgeId>,
 }
 
@@ -288,6 +288,26 @@ struct Evaluator<'m> {
     env: Env,
     host: MeshHost<'m>,
     frame: Vec<Value>,
+    memo: host::Memo,
+}
+
+impl<'m> host::Evaluate<'m> for Evaluator<'m> {
+    fn eval(&mut self, e: &Ex) -> Result<Value, RuntimeError> {
+        self.interp
+            .eval(e, &mut self.frame, &mut self.env, &mut self.host)
+    }
+
+    fn host(&self) -> MeshHost<'m> {
+        self.host
+    }
+
+    fn frame(&mut self) -> &mut [Value] {
+        &mut self.frame
+    }
+
+    fn memo(&mut self) -> &mut host::Memo {
+        &mut self.memo
+    }
 }
 
 impl<'m> Evaluator<'m> {
@@ -301,32 +321,30 @@ impl<'m> Evaluator<'m> {
                 step,
             },
             frame: vec![Value::Void; frame],
+            memo: host::Memo::default(),
         }
-    }
-
-    fn eval(&mut self, e: &Ex) -> Result<Value, RuntimeError> {
-        self.interp
-            .eval(e, &mut self.frame, &mut self.env, &mut self.host)
     }
 
     /// Whether the element passes `rule`'s condition.
-    fn test(&mut self, rule: &Rule, val: &Value) -> Result<bool, RuntimeError> {
+    fn test(&mut self, rule: &Rule, val: &Elem) -> Result<bool, RuntimeError> {
         if let Some(g) = &rule.guard {
-            return Ok(g.test(&mut self.host, val));
+            return g.test(self, val);
         }
-        self.frame[rule.elem_slot as usize] = val.clone();
+        self.frame[rule.elem_slot as usize] = Value::Elem(*val);
         match &rule.cond {
-            Some(c) => self.eval(c).map(|v| v.truthy()),
+            Some(c) => host::Evaluate::eval(self, c).map(|v| v.truthy()),
             None => Ok(true),
         }
     }
 
     /// `rule`'s assignment, on the locals bound in the frame.
     fn assign(&mut self, rule: &Rule, assign: &Ex) -> Result<Value, RuntimeError> {
-        match &rule.affine {
-            Some(a) => Ok(a.eval(&mut self.host, &self.frame)),
-            None => self.eval(assign),
+        if let Some(a) = &rule.affine {
+            if let Some(v) = a.eval(self)? {
+                return Ok(v);
+            }
         }
+        host::Evaluate::eval(self, assign)
     }
 }
 
@@ -443,7 +461,7 @@ impl Grammar {
             Op::Vertex => mesh.v_alive.len(),
         };
         let frame_len = rule.frame.max(other.map_or(0, |o| o.frame));
-        type Part = (Vec<Value>, Vec<crate::mesh::EdgeId>);
+        type Part = (Vec<Elem>, Vec<crate::mesh::EdgeId>);
         // Conditions are pure, so ranges of ids are tested in parallel,
         // each by a plain loop, and the matches joined in id order.
         let ranges: Vec<(u32, u32)> = (0..slots.div_ceil(CHUNK))
@@ -662,7 +680,7 @@ impl Grammar {
                 let slot = rule.elem_slot as usize;
                 let out = self
                     .eval_points(rule, mesh, current, assign, matched.len(), |frame, k| {
-                        frame[slot] = matched[k].clone();
+                        frame[slot] = Value::Elem(matched[k]);
                     })
                     .map_err(|(k, p)| match p {
                         Ok(Value::V3(p)) => fail(format!(
@@ -692,7 +710,7 @@ impl Grammar {
                         self.max_faces
                     )));
                 }
-                let mut made: Vec<(VertexId, &Value)> = Vec::with_capacity(matched.len());
+                let mut made: Vec<(VertexId, &Elem)> = Vec::with_capacity(matched.len());
                 match rule.op {
                     Op::FaceSplit => {
                         mesh.reserve(matched.len(), 3 * matched.len(), 2 * matched.len())
@@ -734,8 +752,8 @@ impl Grammar {
                 let slot = rule.elem_slot as usize;
                 let out = self
                     .eval_points(rule, mesh, current, assign, made.len(), |frame, k| {
-                        frame[slot] = made[k].1.clone();
-                        frame[vslot as usize] = host::vertex(made[k].0);
+                        frame[slot] = Value::Elem(*made[k].1);
+                        frame[vslot as usize] = Value::Elem(host::vertex(made[k].0));
                     })
                     .map_err(|(k, p)| match p {
                         Ok(Value::V3(p)) => fail(format!(
@@ -758,7 +776,7 @@ impl Grammar {
 /// Elements per parallel task: small jobs stay on one thread.
 const CHUNK: usize = 16384;
 
-fn vertex_of(val: &Value) -> VertexId {
+fn vertex_of(val: &Elem) -> VertexId {
     host::vertex_of(val).unwrap_or(VertexId(u32::MAX))
 }
 
