@@ -976,42 +976,64 @@ impl Affine {
             lets: Vec::new(),
             terms: Vec::new(),
         };
-        a.collect(e, &mut Vec::new(), 1.0)?;
+        a.collect(e, &mut Vec::new(), 1.0, &mut Vec::new())?;
         let keys = a.lets.iter().filter(|l| l.2).count();
         (keys <= MAX_KEY && a.terms.len() <= MAX_TERMS).then_some(a)
     }
 
-    fn collect(&mut self, e: &Ex, factors: &mut Vec<(Ex, bool)>, scale: f64) -> Option<()> {
+    /// Adds the terms of `scale * factors * e`. `alias` maps the locals
+    /// of inlined parameters bound to another local to that local, so
+    /// that nothing needs copying per element.
+    fn collect(
+        &mut self,
+        e: &Ex,
+        factors: &mut Vec<(Ex, bool)>,
+        scale: f64,
+        alias: &mut Vec<(u16, u16)>,
+    ) -> Option<()> {
         if let Some((f, slot, args)) = point_call(e) {
             self.terms.push(Term {
                 factors: factors.clone(),
                 scale,
                 f,
-                slot,
+                slot: resolve(slot, alias),
                 args,
             });
             return Some(());
         }
         match e {
             Ex::Let(s, a, body) => {
-                // A let that reads the element is computed for every
-                // element; one that does not is a function of the others.
-                let reads = !scalar(a) || matches!(**a, Ex::Local(_));
-                if reads && !matches!(**a, Ex::Local(_)) && !integer_host(a) {
+                // Two calls side by side may reuse a slot; the weights are
+                // evaluated after all the lets, so a slot bound twice is
+                // left to the interpreter.
+                if alias.iter().any(|(a, _)| a == s) {
                     return None;
                 }
-                self.lets.push((*s, (**a).clone(), reads));
-                self.collect(body, factors, scale)
+                if let Ex::Local(x) = **a {
+                    alias.push((*s, resolve(x, alias)));
+                } else {
+                    // A let that reads the element is computed for every
+                    // element; one that does not is a function of the
+                    // others and of constants.
+                    let reads = !scalar(a);
+                    if reads && !integer_host(a) {
+                        return None;
+                    }
+                    self.lets.push((*s, subst(a, alias), reads));
+                    // The let's own slot is no alias any more.
+                    alias.push((*s, *s));
+                }
+                self.collect(body, factors, scale, alias)
             }
             Ex::Bin(BinOp::Add, a, b, _) => {
-                self.collect(a, factors, scale)?;
-                self.collect(b, factors, scale)
+                self.collect(a, factors, scale, alias)?;
+                self.collect(b, factors, scale, alias)
             }
             Ex::Bin(BinOp::Sub, a, b, _) => {
-                self.collect(a, factors, scale)?;
-                self.collect(b, factors, -scale)
+                self.collect(a, factors, scale, alias)?;
+                self.collect(b, factors, -scale, alias)
             }
-            Ex::Neg(a) => self.collect(a, factors, -scale),
+            Ex::Neg(a) => self.collect(a, factors, -scale, alias),
             Ex::Bin(BinOp::Mul, a, b, _) => {
                 let (k, x) = if scalar(a) {
                     (a, b)
@@ -1020,14 +1042,14 @@ impl Affine {
                 } else {
                     return None;
                 };
-                factors.push(((**k).clone(), false));
-                let r = self.collect(x, factors, scale);
+                factors.push((subst(k, alias), false));
+                let r = self.collect(x, factors, scale, alias);
                 factors.pop();
                 r
             }
             Ex::Bin(BinOp::Div, a, b, _) if scalar(b) => {
-                factors.push(((**b).clone(), true));
-                let r = self.collect(a, factors, scale);
+                factors.push((subst(b, alias), true));
+                let r = self.collect(a, factors, scale, alias);
                 factors.pop();
                 r
             }
@@ -1100,6 +1122,67 @@ impl Affine {
             }
         }
         Ok(Some(Value::V3(p)))
+    }
+}
+
+/// The local an alias stands for.
+fn resolve(slot: u16, alias: &[(u16, u16)]) -> u16 {
+    alias
+        .iter()
+        .rev()
+        .find(|(a, _)| *a == slot)
+        .map_or(slot, |(_, b)| *b)
+}
+
+/// `e` with aliased locals replaced by what they stand for; a let or a
+/// fold inside `e` that binds a slot hides the alias of that slot.
+fn subst(e: &Ex, alias: &[(u16, u16)]) -> Ex {
+    let mut e = e.clone();
+    rewrite(&mut e, &mut alias.to_vec());
+    e
+}
+
+fn rewrite(e: &mut Ex, alias: &mut Vec<(u16, u16)>) {
+    match e {
+        Ex::Local(s) => *s = resolve(*s, alias),
+        Ex::Let(s, a, body) => {
+            rewrite(a, alias);
+            alias.push((*s, *s));
+            rewrite(body, alias);
+            alias.pop();
+        }
+        Ex::Fold {
+            slot,
+            set,
+            cond,
+            value,
+            ..
+        } => {
+            rewrite(set, alias);
+            alias.push((*slot, *slot));
+            if let Some(c) = cond {
+                rewrite(c, alias);
+            }
+            if let Some((v, _)) = value {
+                rewrite(v, alias);
+            }
+            alias.pop();
+        }
+        Ex::Field(a, _) | Ex::Neg(a) | Ex::Not(a) | Ex::Convert(_, a) => rewrite(a, alias),
+        Ex::Assign(_, _, a, _) => rewrite(a, alias),
+        Ex::Bin(_, a, b, _) | Ex::Logic(_, a, b) | Ex::MakeV2(a, b) => {
+            rewrite(a, alias);
+            rewrite(b, alias);
+        }
+        Ex::Cond(a, b, c) | Ex::MakeV3(a, b, c) => {
+            rewrite(a, alias);
+            rewrite(b, alias);
+            rewrite(c, alias);
+        }
+        Ex::Call(_, args, _) | Ex::MakeStruct(args) => {
+            args.iter_mut().for_each(|a| rewrite(a, alias))
+        }
+        Ex::Const(_) | Ex::Global(_) | Ex::IncDec(..) | Ex::InContext(..) => {}
     }
 }
 

@@ -121,6 +121,17 @@ pub fn compile(
     file: &GrammarFile,
     sources: SourceMap,
 ) -> Result<Grammar, (SourceMap, Vec<Diagnostic>)> {
+    compile_with(file, sources, true)
+}
+
+/// [`compile`], with the specialisations of the IR (fused built-ins,
+/// guards, affine assignments) or without them: the tests run both and
+/// compare.
+pub(crate) fn compile_with(
+    file: &GrammarFile,
+    sources: SourceMap,
+    specialise: bool,
+) -> Result<Grammar, (SourceMap, Vec<Diagnostic>)> {
     let mut rules = Vec::new();
     let mut diags = Vec::new();
     let mut warnings = Vec::new();
@@ -166,11 +177,14 @@ pub fn compile(
                 .or(first_call(x, id::CENTER));
             centre_used_at = centre_used_at.or(first_call(x, id::CENTER));
         }
-        cond.iter_mut()
-            .chain(assign.iter_mut())
-            .for_each(host::specialise);
-        let guard = cond.as_ref().and_then(|c| host::Guard::of(c, elem_slot));
-        let affine = assign.as_ref().and_then(host::Affine::of);
+        let (mut guard, mut affine) = (None, None);
+        if specialise {
+            cond.iter_mut()
+                .chain(assign.iter_mut())
+                .for_each(host::specialise);
+            guard = cond.as_ref().and_then(|c| host::Guard::of(c, elem_slot));
+            affine = assign.as_ref().and_then(host::Affine::of);
+        }
         rules.push(Rule {
             guard,
             affine,
