@@ -117,16 +117,9 @@ fn visit(e: &Ex, f: &mut dyn FnMut(&Ex)) {
 /// Compiles a parsed grammar file: its conditions and assignments are
 /// checked by the language's one checker, with the stellar topology's
 /// elements and built-ins.
-pub fn compile(
-    file: &GrammarFile,
-    sources: SourceMap,
-) -> Result<Grammar, (SourceMap, Vec<Diagnostic>)> {
-    compile_with(file, sources, true)
-}
-
-/// [`compile`], with the specialisations of the IR (fused built-ins,
-/// guards, affine assignments) or without them: the tests run both and
-/// compare.
+///
+/// With `specialise`, the IR is specialised after checking (fused
+/// built-ins, guards, affine assignments); the tests run both and compare.
 pub(crate) fn compile_with(
     file: &GrammarFile,
     sources: SourceMap,
