@@ -20,7 +20,8 @@ pub fn check(file: &str, defines: &[String]) -> Result<String, Error> {
     let opts = LoadOptions {
         defines: defines.to_vec(),
     };
-    Ok(match load(file, &opts)? {
+    let system = load(file, &opts)?;
+    let ok = match &system {
         System::Surface(s) => format!(
             "{file}: ok (a surface grammar of {} rules)",
             s.grammar.rules.len()
@@ -30,7 +31,11 @@ pub fn check(file: &str, defines: &[String]) -> Result<String, Error> {
             c.program.rules.len(),
             c.program.alphabet.kinds.len()
         ),
-    })
+    };
+    // Warnings first, each with its line and caret, then the verdict.
+    let mut out: Vec<String> = system.warnings();
+    out.push(ok);
+    Ok(out.join("\n\n"))
 }
 
 /// The arguments of `subgram derive`.

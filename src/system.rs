@@ -107,6 +107,21 @@ impl System {
         }
     }
 
+    /// What the checker found questionable without refusing the program,
+    /// each rendered with `file:line:col: warning:`, the line and a caret
+    /// (a division of integer constants that truncates where a
+    /// floating-point number is wanted).
+    pub fn warnings(&self) -> Vec<String> {
+        let (sources, warnings) = match self {
+            System::Curve(c) => (&c.sources, &c.program.warnings),
+            System::Surface(s) => (&s.grammar.sources, &s.grammar.warnings),
+        };
+        warnings
+            .iter()
+            .map(|d| sources.render_warning(d.span, &d.message))
+            .collect()
+    }
+
     /// The texts the system was checked from: the file and its `-D` values.
     pub fn sources(&self) -> &SourceMap {
         match self {

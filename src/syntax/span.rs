@@ -102,6 +102,16 @@ impl SourceMap {
 
     /// Renders `file:line:col: error: message`, the source line and a caret.
     pub fn render(&self, span: Span, message: &str) -> String {
+        self.render_as("error", span, message)
+    }
+
+    /// Renders `file:line:col: warning: message`, the line and a caret:
+    /// what `check` reports without refusing the program.
+    pub fn render_warning(&self, span: Span, message: &str) -> String {
+        self.render_as("warning", span, message)
+    }
+
+    fn render_as(&self, severity: &str, span: Span, message: &str) -> String {
         let file = self.get(span.file);
         let (line, col) = file.line_col(span.start as usize);
         let full = file.line_text(line);
@@ -141,10 +151,11 @@ impl SourceMap {
             .map(|c| if c == '\t' { '\t' } else { ' ' })
             .collect();
         format!(
-            "{}:{}:{}: error: {}\n{:gutter$} |\n{} | {}\n{:gutter$} | {}{}",
+            "{}:{}:{}: {}: {}\n{:gutter$} |\n{} | {}\n{:gutter$} | {}{}",
             file.name,
             line,
             col,
+            severity,
             message,
             "",
             line,

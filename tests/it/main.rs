@@ -11,6 +11,7 @@ mod lsystems;
 mod mesh;
 mod mesh_draw;
 mod mesh_io;
+mod one_language;
 mod render;
 mod reverse;
 mod semantics;

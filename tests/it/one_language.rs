@@ -1,0 +1,212 @@
+//! One language: the same expression means the same thing, and gets the
+//! same message, in a curve L-system and in a surface grammar. The
+//! expected values are C's (L+C's) arithmetic: integer division truncates
+//! towards zero, `%` takes the sign of the dividend, `fabs` is the
+//! floating-point absolute value, and integer division by zero is an
+//! error.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn subgram(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// A fresh folder holding one triangle, for surface grammars to run on.
+fn folder(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "subgram-one-language-{name}-{}",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    dir
+}
+
+fn write(dir: &Path, name: &str, body: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, body).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+/// The values of `-1 % 3`, `7/2`, `fabs(-2.5)` and `abs(-3)`: in a curve,
+/// the parameters of the axiom's module; in a surface grammar, how far
+/// a vertex rule moves every vertex.
+#[test]
+fn the_same_expressions_give_the_same_values() {
+    let dir = folder("values");
+    let curve = write(
+        &dir,
+        "c.lsys",
+        "module A(float, float, float, float);\nderivation length: 0;\n\
+         Axiom: A(-1 % 3, 7/2, fabs(-2.5), abs(-3));\n",
+    );
+    let o = subgram(&["derive", &curve, "--format", "json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let word: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        word["modules"][0]["params"],
+        serde_json::json!([-1.0, 3.0, 2.5, 3.0])
+    );
+
+    let surface = write(
+        &dir,
+        "s.lsys",
+        "mesh: \"tri.obj\";\nderivation length: 1;\n\
+         V(v) -> V(v = v + V3f(-1 % 3, 7/2, fabs(-2.5)) * abs(-3));\n",
+    );
+    let out = dir.join("out.obj");
+    let o = subgram(&[
+        "subdivide",
+        "--grammar",
+        &surface,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let obj = std::fs::read_to_string(&out).unwrap();
+    let moved: Vec<Vec<f64>> = obj
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    assert_eq!(moved.len(), 3);
+    for (p, q) in moved.iter().zip(base) {
+        let d: Vec<f64> = p.iter().zip(q).map(|(a, b)| a - b).collect();
+        assert_eq!(d, vec![-3.0, 9.0, 7.5], "{obj}");
+    }
+}
+
+/// The message after the location and the caret's width, for the same
+/// subexpression in both kinds of file.
+fn message_and_caret(stderr: &str) -> (String, String) {
+    let first = stderr.lines().next().unwrap_or_default();
+    // `file:line:col: error: message`
+    let message = first
+        .splitn(4, ':')
+        .nth(3)
+        .unwrap_or_default()
+        .trim()
+        .to_string();
+    let caret = stderr
+        .lines()
+        .find(|l| l.contains('^'))
+        .map(|l| l.trim().trim_start_matches('|').trim().to_string())
+        .unwrap_or_default();
+    (message, caret)
+}
+
+#[test]
+fn integer_division_by_zero_is_the_same_error() {
+    let dir = folder("zero");
+    let curve = write(
+        &dir,
+        "c.lsys",
+        "module A(float);\nderivation length: 1;\nAxiom: A(1);\nA(x) -> A(x * (1/0));\n",
+    );
+    let c = subgram(&["derive", &curve]);
+    assert_eq!(c.status.code(), Some(1), "{}", text(&c.stderr));
+    let surface = write(
+        &dir,
+        "s.lsys",
+        "mesh: \"tri.obj\";\nderivation length: 1;\nV(v) -> V(v = v * (1/0));\n",
+    );
+    let out = dir.join("out.obj");
+    let s = subgram(&[
+        "subdivide",
+        "--grammar",
+        &surface,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(s.status.code(), Some(1), "{}", text(&s.stderr));
+    assert!(!out.exists(), "a failed run leaves no output");
+    let (cm, cc) = message_and_caret(&text(&c.stderr));
+    let (sm, sc) = message_and_caret(&text(&s.stderr));
+    assert!(
+        cm.contains("integer division by zero"),
+        "{}",
+        text(&c.stderr)
+    );
+    assert!(
+        sm.contains("integer division by zero"),
+        "{}",
+        text(&s.stderr)
+    );
+    // Both carets are under `(1/0)`, at its column.
+    assert_eq!((cc.as_str(), sc.as_str()), ("^^^^^", "^^^^^"));
+    assert!(text(&c.stderr).starts_with(&format!("{curve}:4:15: error:")));
+    assert!(text(&s.stderr).starts_with(&format!("{surface}:3:19: error:")));
+}
+
+#[test]
+fn a_truncating_constant_division_is_the_same_warning() {
+    let dir = folder("truncation");
+    let curve = write(
+        &dir,
+        "c.lsys",
+        "module A(float);\nderivation length: 1;\nAxiom: A(1);\nA(x) -> A(1/16 * x);\n",
+    );
+    let surface = write(
+        &dir,
+        "s.lsys",
+        "mesh: \"tri.obj\";\nV(v) -> V(v = 1/16 * v);\n",
+    );
+    let c = subgram(&["check", &curve]);
+    let s = subgram(&["check", &surface]);
+    assert!(c.status.success() && s.status.success());
+    let expected = "warning: `1/16` is 0 in integer arithmetic; write 1.0/16";
+    assert!(
+        text(&c.stdout).starts_with(&format!("{curve}:4:11: {expected}")),
+        "{}",
+        text(&c.stdout)
+    );
+    assert!(
+        text(&s.stdout).starts_with(&format!("{surface}:2:15: {expected}")),
+        "{}",
+        text(&s.stdout)
+    );
+    // A division that does not truncate, or one meant as an integer, is
+    // not warned about.
+    let quiet = write(
+        &dir,
+        "q.lsys",
+        "module A(float, int);\nderivation length: 1;\nAxiom: A(8/2 * 1.5, 7/2);\n",
+    );
+    let q = subgram(&["check", &quiet]);
+    assert!(q.status.success());
+    assert!(
+        !text(&q.stdout).contains(": warning:"),
+        "{}",
+        text(&q.stdout)
+    );
+}
+
+#[test]
+fn the_same_type_errors_read_the_same() {
+    let dir = folder("types");
+    let curve = write(
+        &dir,
+        "c.lsys",
+        "module A(V3f);\nderivation length: 1;\nAxiom: A(V3f(0, 0, 0));\nA(p) -> A(p + 1);\n",
+    );
+    let surface = write(
+        &dir,
+        "s.lsys",
+        "mesh: \"tri.obj\";\nV(v) -> V(v = v + 1);\n",
+    );
+    let c = subgram(&["check", &curve]);
+    let s = subgram(&["check", &surface]);
+    let (cm, _) = message_and_caret(&text(&c.stderr));
+    let (sm, _) = message_and_caret(&text(&s.stderr));
+    assert_eq!(cm, "error: type error: cannot apply `+` to V3f and int");
+    assert_eq!(sm, cm);
+}
