@@ -50,9 +50,7 @@ impl Curve {
     pub fn run(&self, opts: DeriveOptions) -> Result<CurveRun<'_>, Error> {
         check_steps(opts.steps)?;
         let mut d = Derivation::new(&self.program, opts).map_err(|e| self.error(e))?;
-        while d.has_next() {
-            d.next_step().map_err(|e| self.error(e))?;
-        }
+        crate::production::run(&mut d, |_| {}).map_err(|e| self.error(e))?;
         Ok(CurveRun { curve: self, d })
     }
 

@@ -33,6 +33,7 @@ mod curve;
 mod error;
 mod lang;
 mod load;
+mod production;
 mod rewrite;
 mod syntax;
 mod system;
