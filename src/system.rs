@@ -200,8 +200,9 @@ impl Surface {
         }
     }
 
-    /// Runs `steps` steps on `mesh` (after the `init:` rules, on a mesh's
-    /// first run). `progress` hears before the first step and after each.
+    /// Runs the `init:` rules, then `steps` steps on `mesh`, as a new run
+    /// ([`Grammar::run`]). `progress` hears before the first step and after
+    /// each.
     /// A run that fails in a rule leaves the mesh partly derived.
     pub fn run_on(
         &self,

@@ -3,7 +3,8 @@
 //! Triangles are taken as they are. A quad becomes a basic block: two
 //! triangles split along its first diagonal (vertices 0 and 2), the
 //! diagonal recorded as the block's internal edge. A polygon of more than
-//! four sides is triangulated as a fan from its first vertex. When the mesh
+//! four sides is triangulated as a fan from its first vertex, and the first
+//! such polygon is recorded ([`Mesh::fanned_polygon`]). When the mesh
 //! has quads, its levels follow paper 000, §7 for tri-quad meshes: internal
 //! (diagonal) edges 0, the polygons' own edges 1; a triangle mesh has every
 //! edge at level 0. Vertices start at level 0, faces one above their
@@ -11,7 +12,7 @@
 
 use std::collections::HashMap;
 
-use super::halfedge::{EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId};
+use super::halfedge::{EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId};
 use super::soup::PolygonSoup;
 
 fn at_line(soup: &PolygonSoup, face: usize) -> String {
@@ -33,6 +34,8 @@ impl Mesh {
     /// out-of-range indices, non-finite coordinates, degenerate faces, edges
     /// with three or more faces, inconsistent orientation, and bow-tie
     /// vertices. Each message names the face or vertex and its line.
+    /// Polygons of more than four sides are fanned into triangles, and the
+    /// first of them is recorded as [`Mesh::fanned_polygon`].
     pub fn from_soup(soup: &PolygonSoup) -> Result<Mesh, MeshError> {
         let nv = soup.positions.len();
         for (i, p) in soup.positions.iter().enumerate() {
@@ -47,14 +50,15 @@ impl Mesh {
         if soup.faces.is_empty() {
             return Err(MeshError::new("the mesh has no faces"));
         }
-        let fanned = soup.faces.iter().position(|f| f.len() > 4).map(|fi| {
-            format!(
-                "face {}{} has {} sides",
-                fi + 1,
-                at_line(soup, fi),
-                soup.faces[fi].len()
-            )
-        });
+        let fanned = soup
+            .faces
+            .iter()
+            .position(|f| f.len() > 4)
+            .map(|fi| FannedPolygon {
+                face: fi,
+                sides: soup.faces[fi].len(),
+                line: soup.face_line(fi),
+            });
         let quads = soup.faces.iter().any(|f| f.len() == 4);
         let outer_level = if quads { 1 } else { 0 };
         // (triangle, source face, which of its edges are diagonals)
@@ -131,11 +135,11 @@ impl Mesh {
             seen.insert(key, *fi);
         }
         let mut m = Mesh {
-            fanned_polygon: fanned,
+            fanned,
             ..Mesh::default()
         };
         for p in &soup.positions {
-            m.new_vertex(*p, 0);
+            m.new_vertex(*p, 0, 0);
         }
         let mut edges: HashMap<(u32, u32), HalfEdgeId> = HashMap::with_capacity(tris.len() * 2);
         let mut face_of_source: Vec<usize> = Vec::with_capacity(tris.len());

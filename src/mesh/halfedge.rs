@@ -1,5 +1,8 @@
-//! The half-edge mesh: typed ids, flat arrays of indices, a refinement
-//! level on every vertex, edge and face, and double-buffered positions.
+//! The half-edge mesh: typed ids, flat arrays of indices, and per-element
+//! attributes (a refinement level on every vertex, edge and face, the step
+//! that made each vertex, block and transversal marks). The state of a
+//! grammar's run (its step, its current level, the positions written for
+//! the next step) lives with the run, in `surface::run`.
 //!
 //! Half-edges come in pairs: `h` and `h ^ 1` are twins, and edge `e` is the
 //! pair `2e`, `2e + 1`. A boundary half-edge has no face. Every vertex keeps
@@ -96,16 +99,18 @@ impl std::error::Error for MeshError {}
 
 /// A triangle mesh with levels. Storage is structure-of-arrays; removed
 /// elements are marked dead and their slots reused.
+///
+/// A mesh holds geometry, topology and per-element attributes only, so two
+/// equal meshes behave alike under any grammar; a run's state is not part
+/// of it.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     // Vertices.
     pub(crate) v_out: Vec<Option<HalfEdgeId>>,
     pub(crate) pos: Vec<DVec3>,
-    /// Positions written for the next step (the second buffer of paper
-    /// 000, §7), kept as a list: only smoothed vertices have one.
-    pub(crate) next_pos: Vec<(VertexId, DVec3)>,
     pub(crate) v_level: Vec<u32>,
-    /// The step of the grammar run that made the vertex (0: the base mesh).
+    /// The step of the grammar run that made the vertex (0: the base mesh
+    /// and `init:` rules).
     pub(crate) v_step: Vec<u32>,
     pub(crate) v_alive: Vec<bool>,
     // Half-edges, in twin pairs.
@@ -130,41 +135,22 @@ pub struct Mesh {
     pub(crate) free_v: Vec<u32>,
     pub(crate) free_e: Vec<u32>,
     pub(crate) free_f: Vec<u32>,
-    /// The current level `c` of the subdivision grammar.
-    pub current_level: u32,
-    /// The step a grammar run is in; new vertices record it.
-    pub step: u32,
-    /// What splitting a basic block's internal edge makes of the block.
-    pub block_split: BlockSplit,
-    /// Set while a grammar that reads blocks runs: a face split then makes
-    /// its three spokes internal edges of blocks, as splitting a block's
-    /// internal edge does, so that a lone triangle joins a quad mesh's
-    /// primal quadrisection (Catmull-Clark on triangles).
-    pub face_split_makes_blocks: bool,
-    /// The first polygon of more than four sides in the file the mesh was
-    /// built from, which was fanned into triangles: schemes that read
-    /// quads would take those triangles for faces of their own.
-    pub fanned_polygon: Option<String>,
-    /// Set once a grammar's `init:` rules have run on the mesh: a later
-    /// run continues its steps without them.
-    pub initialized: bool,
+    /// The first polygon of more than four sides in the soup the mesh was
+    /// built from, which was fanned into triangles: where the mesh came
+    /// from, so that schemes that read quads can refuse those triangles.
+    pub(crate) fanned: Option<FannedPolygon>,
 }
 
-/// What splitting the internal edge of a basic block does to the blocks
-/// (paper 000, §6).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum BlockSplit {
-    /// Primal quadrisection (Fig. 12a): the four edges at the new vertex
-    /// become the internal edges of the next blocks.
-    #[default]
-    Quadrisection,
-    /// √2 bisection on 4-8 meshes (Fig. 8): the block's four external
-    /// edges become the internal edges of the next blocks.
-    Bisection,
-    /// Dual quadrisection (Fig. 12b): blocks are fans of triangles around
-    /// a centre; splitting an internal edge marks the edges at the new
-    /// vertex, as in primal quadrisection.
-    Dual,
+/// A polygon of more than four sides that [`Mesh::from_soup`] fanned into
+/// triangles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FannedPolygon {
+    /// Its index among the soup's faces, from 0.
+    pub face: usize,
+    /// Its number of sides.
+    pub sides: usize,
+    /// The 1-based line of the file it was read from, when known.
+    pub line: Option<usize>,
 }
 
 impl Mesh {
@@ -232,30 +218,6 @@ impl Mesh {
         self.pos[v.index()] = p;
     }
 
-    /// The position a vertex will have after the next swap: the last one
-    /// written for it, else its current one.
-    pub fn next_position(&self, v: VertexId) -> DVec3 {
-        self.next_pos
-            .iter()
-            .rev()
-            .find(|(w, _)| *w == v)
-            .map_or(self.pos[v.index()], |(_, p)| *p)
-    }
-
-    /// Writes a vertex's position for the next step (smoothing writes
-    /// here); it becomes current at `swap_positions`.
-    pub fn set_next_position(&mut self, v: VertexId, p: DVec3) {
-        self.next_pos.push((v, p));
-    }
-
-    /// Makes the next positions current (paper 000, §7: the buffer is
-    /// swapped after each step), in the order they were written.
-    pub fn swap_positions(&mut self) {
-        for (v, p) in std::mem::take(&mut self.next_pos) {
-            self.pos[v.index()] = p;
-        }
-    }
-
     pub fn vertex_level(&self, v: VertexId) -> u32 {
         self.v_level[v.index()]
     }
@@ -286,9 +248,15 @@ impl Mesh {
         self.v_step[v.index()]
     }
 
-    /// True for a vertex made in the grammar step now running.
-    pub fn is_new_vertex(&self, v: VertexId) -> bool {
-        self.v_step[v.index()] == self.step
+    /// The first polygon of more than four sides in the soup the mesh was
+    /// built from, which [`Mesh::from_soup`] fanned into triangles.
+    pub fn fanned_polygon(&self) -> Option<FannedPolygon> {
+        self.fanned
+    }
+
+    /// Makes every vertex one of the base mesh (step 0) for a new run.
+    pub(crate) fn reset_vertex_steps(&mut self) {
+        self.v_step.fill(0);
     }
 
     /// True for the centre of a dual basic block: a vertex all of whose
@@ -472,20 +440,21 @@ impl Mesh {
         grow(&mut self.f_alive, faces);
     }
 
-    pub(crate) fn new_vertex(&mut self, p: DVec3, level: u32) -> VertexId {
+    /// A new vertex at `p`, made in grammar step `step`.
+    pub(crate) fn new_vertex(&mut self, p: DVec3, level: u32, step: u32) -> VertexId {
         if let Some(i) = self.free_v.pop() {
             let k = i as usize;
             self.v_out[k] = None;
             self.pos[k] = p;
             self.v_level[k] = level;
-            self.v_step[k] = self.step;
+            self.v_step[k] = step;
             self.v_alive[k] = true;
             return VertexId(i);
         }
         self.v_out.push(None);
         self.pos.push(p);
         self.v_level.push(level);
-        self.v_step.push(self.step);
+        self.v_step.push(step);
         self.v_alive.push(true);
         VertexId(self.v_alive.len() as u32 - 1)
     }

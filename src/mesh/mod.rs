@@ -10,5 +10,6 @@ pub mod soup;
 pub mod stellar;
 pub mod validate;
 
-pub use halfedge::{BlockSplit, EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId};
+pub use halfedge::{EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId};
 pub use soup::{MeshFileError, PolygonSoup};
+pub use stellar::{BlockSplit, Split};

@@ -1,11 +1,46 @@
 //! The stellar operators of paper 000, §5: face split and weld, edge split
 //! and weld, edge flip. Each checks what it needs first and refuses an
 //! illegal case with an error, leaving the mesh unchanged; levels follow
-//! paper 000, §6.
+//! paper 000, §6. What a split records beyond geometry and levels (the
+//! step that made the new vertex, the basic blocks it marks) is given by
+//! the caller as a [`Split`] policy.
 
 use glam::DVec3;
 
-use super::halfedge::{BlockSplit, EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId, NO_FACE};
+use super::halfedge::{EdgeId, FaceId, HalfEdgeId, Mesh, MeshError, VertexId, NO_FACE};
+
+/// What splitting the internal edge of a basic block does to the blocks
+/// (paper 000, §6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BlockSplit {
+    /// Primal quadrisection (Fig. 12a): the four edges at the new vertex
+    /// become the internal edges of the next blocks.
+    #[default]
+    Quadrisection,
+    /// √2 bisection on 4-8 meshes (Fig. 8): the block's four external
+    /// edges become the internal edges of the next blocks.
+    Bisection,
+    /// Dual quadrisection (Fig. 12b): blocks are fans of triangles around
+    /// a centre; splitting an internal edge marks the edges at the new
+    /// vertex, as in primal quadrisection.
+    Dual,
+}
+
+/// How a face or edge split marks what it makes: the policy of the grammar
+/// run that calls it. The default (step 0, quadrisection, no blocks from
+/// face splits) is that of [`Mesh::face_split`] and [`Mesh::edge_split`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Split {
+    /// The step of the grammar run; the new vertex records it.
+    pub step: u32,
+    /// What splitting a basic block's internal edge makes of the block.
+    pub blocks: BlockSplit,
+    /// A face split makes its three spokes internal edges of blocks, as
+    /// splitting a block's internal edge does, so that a lone triangle
+    /// joins a quad mesh's primal quadrisection (Catmull-Clark on
+    /// triangles). Set while a grammar that reads blocks runs.
+    pub face_split_makes_blocks: bool,
+}
 
 impl Mesh {
     /// Face split: a new vertex `v` inside triangle `abc` joined to its
@@ -22,7 +57,20 @@ impl Mesh {
     ///
     /// Levels: `l(v) = max(l(a), l(b), l(c)) + 1`; the three new edges get
     /// `l(v)`, the level of their common vertex; the faces `l(v) + 1`.
+    /// The default [`Split`]: see [`Mesh::face_split_with`].
     pub fn face_split(&mut self, f: FaceId, p: DVec3) -> Result<VertexId, MeshError> {
+        self.face_split_with(f, p, &Split::default())
+    }
+
+    /// [`Mesh::face_split`] under `policy`: the new vertex records
+    /// `policy.step`, and with `policy.face_split_makes_blocks` the three
+    /// new edges become internal edges of basic blocks.
+    pub fn face_split_with(
+        &mut self,
+        f: FaceId,
+        p: DVec3,
+        policy: &Split,
+    ) -> Result<VertexId, MeshError> {
         if !self.is_face(f) {
             return Err(MeshError::new(format!(
                 "face split: face {} does not exist",
@@ -32,7 +80,7 @@ impl Mesh {
         let [h0, h1, h2] = self.face_halfedges(f);
         let [a, b, c] = self.face_vertices(f);
         let lv = self.face_level_from_vertices([a, b, c]);
-        let v = self.new_vertex(p, lv);
+        let v = self.new_vertex(p, lv, policy.step);
         let va = self.new_edge(v, a, lv);
         let vb = self.new_edge(v, b, lv);
         let vc = self.new_edge(v, c, lv);
@@ -46,7 +94,7 @@ impl Mesh {
             let vs = self.face_vertices(g);
             self.f_level[g.index()] = self.face_level_from_vertices(vs);
         }
-        if self.face_split_makes_blocks {
+        if policy.face_split_makes_blocks {
             for s in [va, vb, vc] {
                 self.e_block[s.edge().index()] = true;
             }
@@ -131,8 +179,21 @@ impl Mesh {
     /// get `l(ab) + 2`; the transversal edges `vc`, `vd` get `l(c) + 1` and
     /// `l(d) + 1`, and are marked transversal. Splitting the internal edge
     /// of a basic block makes the four edges at `v` internal edges of
-    /// blocks.
+    /// blocks (primal quadrisection, the default [`Split`]: see
+    /// [`Mesh::edge_split_with`]).
     pub fn edge_split(&mut self, e: EdgeId, p: DVec3) -> Result<VertexId, MeshError> {
+        self.edge_split_with(e, p, &Split::default())
+    }
+
+    /// [`Mesh::edge_split`] under `policy`: the new vertex records
+    /// `policy.step`, and splitting a block's internal edge marks the next
+    /// blocks as `policy.blocks` says.
+    pub fn edge_split_with(
+        &mut self,
+        e: EdgeId,
+        p: DVec3,
+        policy: &Split,
+    ) -> Result<VertexId, MeshError> {
         if !self.is_edge(e) {
             return Err(MeshError::new(format!(
                 "edge split: edge {} does not exist",
@@ -160,7 +221,7 @@ impl Mesh {
                 a, b, c
             )));
         }
-        let v = self.new_vertex(p, lv);
+        let v = self.new_vertex(p, lv, policy.step);
         // h becomes a -> v, t becomes v -> a.
         self.he_to[h.index()] = v;
         self.he_to[t.index()] = a;
@@ -210,7 +271,7 @@ impl Mesh {
         self.f_level[f1.index()] = l;
         self.f_level[f2.index()] = l;
         if was_block {
-            match self.block_split {
+            match policy.blocks {
                 BlockSplit::Quadrisection | BlockSplit::Dual => {
                     // A basic block split at its centre: its four spokes
                     // become the internal edges of the four quads that

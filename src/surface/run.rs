@@ -10,6 +10,10 @@
 //! advances with each rule; read literally, its level rules and its
 //! printed conditions disagree for Loop and Catmull-Clark. This definition
 //! runs √3 exactly as printed; the grammar files note where they differ.)
+//!
+//! A run's state (its step, `c`, the positions written for the next step,
+//! the block policy of its splits) lives in a [`GrammarRun`], not in the
+//! mesh.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -18,7 +22,7 @@ use crate::lang::compile::RuleCompiler;
 use crate::lang::eval::{Env, Interp, RuntimeError};
 use crate::lang::ir::{Ex, Func};
 use crate::lang::value::{Elem, Ty, Value};
-use crate::mesh::{BlockSplit, Mesh, VertexId};
+use crate::mesh::{BlockSplit, Mesh, Split, VertexId};
 use crate::syntax::span::{Diagnostic, SourceMap, Span};
 
 use super::grammar::{GrammarFile, Op, VertexContext};
@@ -130,7 +134,10 @@ pub(crate) fn compile_with(
     let mut warnings = Vec::new();
     let mut block_used_at = None;
     let mut centre_used_at = None;
-    let mut c = RuleCompiler::new(&SURFACE_HOST, &file.functions);
+    let mut c = RuleCompiler::new(
+        <GrammarRun as crate::production::Topology>::host_table(),
+        &file.functions,
+    );
     for r in &file.rules {
         c.start_rule();
         let elem_t = Ty::Elem(match r.op {
@@ -274,6 +281,7 @@ pub struct RunError {
 /// Counts after a step, for progress reports.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct StepCounts {
+    /// The step, counted from 1 in one call of [`GrammarRun::steps`].
     pub step: usize,
     pub vertices: usize,
     pub edges: usize,
@@ -360,29 +368,53 @@ impl Grammar {
     pub fn render_error(&self, e: &RunError) -> String {
         match e.span {
             Some(s) => self.sources.render(s, &e.message),
-            None => format!("error: {}", e.message),
+            None => e.message.clone(),
         }
     }
 
-    /// Runs the `init:` rules (once per mesh: a second run continues the
-    /// steps), then `steps` steps of the grammar on `mesh`;
-    /// `progress` hears after each step. Checks that can be made before
-    /// the run (quads for block grammars, closed meshes for dual ones) leave
-    /// the mesh untouched; an error during a rule leaves it partly derived,
-    /// so callers that must keep it run on a copy.
+    /// Runs the `init:` rules, then `steps` steps of the grammar on
+    /// `mesh`, as a new run: the mesh is taken as a base mesh, whatever
+    /// runs made it. `progress` hears after each step. Checks that can be
+    /// made before the run (quads for block grammars, closed meshes for
+    /// dual ones) leave the mesh untouched; an error during a rule leaves
+    /// it partly derived, so callers that must keep it run on a copy. To
+    /// continue a run, use [`Grammar::start`] and [`GrammarRun::steps`].
     pub fn run(
         &self,
         mesh: &mut Mesh,
         steps: usize,
-        mut progress: impl FnMut(StepCounts),
+        progress: impl FnMut(StepCounts),
     ) -> Result<(), RunError> {
-        if let (Some(span), Some(what)) = (self.block_used_at, &mesh.fanned_polygon) {
+        let mut run = self.start(mesh)?;
+        run.until = steps as u32;
+        let mut progress = progress;
+        crate::production::run(&mut run, |r| {
+            use crate::production::Topology;
+            let m = r.structure();
+            progress(StepCounts {
+                step: r.steps_done() as usize,
+                vertices: m.vertex_count(),
+                edges: m.edge_count(),
+                faces: m.face_count(),
+            })
+        })
+    }
+
+    /// Starts a run on `mesh`: checks it (see [`Grammar::run`]; a refused
+    /// mesh is left untouched), takes it as the run's base mesh (its
+    /// vertices are made at step 0), and runs the `init:` rules. The run's
+    /// [`GrammarRun::steps`] continue from one call to the next.
+    pub fn start<'a>(&'a self, mesh: &'a mut Mesh) -> Result<GrammarRun<'a>, RunError> {
+        if let (Some(span), Some(fan)) = (self.block_used_at, mesh.fanned_polygon()) {
+            let line = fan.line.map_or(String::new(), |l| format!(" (line {l})"));
             return Err(RunError {
                 span: Some(span),
                 message: format!(
-                    "this grammar reads quads as basic blocks, but {what}; polygons of more \
-                     than four sides are not supported by such grammars yet (split them \
-                     into quads and triangles first)"
+                    "this grammar reads quads as basic blocks, but face {}{line} has {} sides; \
+                     polygons of more than four sides are not supported by such grammars yet \
+                     (split them into quads and triangles first)",
+                    fan.face + 1,
+                    fan.sides
                 ),
             });
         }
@@ -415,39 +447,36 @@ impl Grammar {
                 });
             }
         }
-        mesh.block_split = self.block_split;
-        mesh.face_split_makes_blocks = self.block_used_at.is_some();
+        // `new(v)` counts this run's steps only.
+        mesh.reset_vertex_steps();
+        let mut state = RunState {
+            blocks: self.block_split,
+            face_split_makes_blocks: self.block_used_at.is_some(),
+            ..RunState::default()
+        };
         let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
-        let each: Vec<&Rule> = self.rules.iter().filter(|r| !r.init).collect();
-        if !mesh.initialized {
-            self.apply_all(&init, mesh, 0)?;
-            // What init's vertex rules wrote is current before the first
-            // step.
-            mesh.swap_positions();
-            mesh.initialized = true;
-        }
-        let first = mesh.step;
-        for step in 1..=steps {
-            // Vertices made from here on record this step (`new(v)`).
-            mesh.step = first + step as u32;
-            self.apply_all(&each, mesh, step)?;
-            mesh.swap_positions();
-            progress(StepCounts {
-                step,
-                vertices: mesh.vertex_count(),
-                edges: mesh.edge_count(),
-                faces: mesh.face_count(),
-            });
-        }
-        Ok(())
+        self.apply_all(&init, mesh, &mut state)?;
+        // What init's vertex rules wrote is current before the first step.
+        state.swap_positions(mesh);
+        Ok(GrammarRun {
+            grammar: self,
+            mesh,
+            state,
+            until: 0,
+        })
     }
 
     /// What `rule` applies to, fixed when it starts: the matched elements
     /// and, for edge rules, their ids. Edges keep their ids through the
     /// splits and flips of other edges, so the ids stay valid while the
     /// rule runs.
-    fn find_matches(&self, rule: &Rule, mesh: &Mesh) -> Result<Matches, RuntimeError> {
-        Ok(self.find_matches_with(rule, None, mesh)?.0)
+    fn find_matches(
+        &self,
+        rule: &Rule,
+        mesh: &Mesh,
+        state: &RunState,
+    ) -> Result<Matches, RuntimeError> {
+        Ok(self.find_matches_with(rule, None, mesh, state)?.0)
     }
 
     /// What `rule` applies to, and `other`, an edge rule for the other
@@ -458,10 +487,11 @@ impl Grammar {
         rule: &Rule,
         other: Option<&Rule>,
         mesh: &Mesh,
+        state: &RunState,
     ) -> Result<(Matches, Matches), RuntimeError> {
         // `c`, kept up to date by `apply_all` as rules make vertices.
-        let current = mesh.current_level;
-        let step = mesh.step;
+        let current = state.current_level;
+        let step = state.step;
         let slots = match rule.op {
             Op::FaceSplit => mesh.f_alive.len(),
             Op::EdgeSplit | Op::BoundarySplit | Op::Flip => mesh.e_alive.len(),
@@ -568,16 +598,17 @@ impl Grammar {
     /// each one's frame slots, giving the points in order; or the first
     /// element whose point is not finite, with what it gave: a point, a
     /// value that is not one, or an error.
+    #[allow(clippy::too_many_arguments)] // the host's `c` and step beside the rule's inputs
     fn eval_points(
         &self,
         rule: &Rule,
         mesh: &Mesh,
         current: u32,
+        step: u32,
         assign: &Ex,
         n: usize,
         bind: impl Fn(&mut [Value], usize) + Sync,
     ) -> Result<Vec<DVec3>, (usize, Result<Value, RuntimeError>)> {
-        let step = mesh.step;
         let one = |ev: &mut Evaluator, k: usize| {
             bind(&mut ev.frame, k);
             ev.assign(rule, assign)
@@ -607,10 +638,16 @@ impl Grammar {
     /// written next to each other are the two contexts of one edge split:
     /// both match when the first starts, so that what one splits (or marks
     /// as a block's internal edge) cannot feed the other in the same step.
-    fn apply_all(&self, rules: &[&Rule], mesh: &mut Mesh, step: usize) -> Result<(), RunError> {
+    fn apply_all(
+        &self,
+        rules: &[&Rule],
+        mesh: &mut Mesh,
+        state: &mut RunState,
+    ) -> Result<(), RunError> {
+        let step = state.step as usize;
         // c: the highest vertex level, raised below by the vertices that
         // splits make (rules never remove vertices).
-        mesh.current_level = mesh
+        state.current_level = mesh
             .vertices()
             .map(|v| mesh.vertex_level(v))
             .max()
@@ -627,17 +664,17 @@ impl Grammar {
             match pair {
                 Some(next) => {
                     let (a, b) = self
-                        .find_matches_with(rule, Some(next), mesh)
+                        .find_matches_with(rule, Some(next), mesh, state)
                         .map_err(|e| self.runtime_error(rule, step, e))?;
-                    self.apply_matched(rule, mesh, step, a)?;
-                    self.apply_matched(next, mesh, step, b)?;
+                    self.apply_matched(rule, mesh, state, a)?;
+                    self.apply_matched(next, mesh, state, b)?;
                     i += 2;
                 }
                 None => {
                     let m = self
-                        .find_matches(rule, mesh)
+                        .find_matches(rule, mesh, state)
                         .map_err(|e| self.runtime_error(rule, step, e))?;
-                    self.apply_matched(rule, mesh, step, m)?;
+                    self.apply_matched(rule, mesh, state, m)?;
                     i += 1;
                 }
             }
@@ -662,9 +699,10 @@ impl Grammar {
         &self,
         rule: &Rule,
         mesh: &mut Mesh,
-        step: usize,
+        state: &mut RunState,
         m: Matches,
     ) -> Result<(), RunError> {
+        let step = state.step as usize;
         let Matches {
             current,
             vals: matched,
@@ -686,9 +724,17 @@ impl Grammar {
                 };
                 let slot = rule.elem_slot as usize;
                 let out = self
-                    .eval_points(rule, mesh, current, assign, matched.len(), |frame, k| {
-                        frame[slot] = Value::Elem(matched[k]);
-                    })
+                    .eval_points(
+                        rule,
+                        mesh,
+                        current,
+                        state.step,
+                        assign,
+                        matched.len(),
+                        |frame, k| {
+                            frame[slot] = Value::Elem(matched[k]);
+                        },
+                    )
                     .map_err(|(k, p)| match p {
                         Ok(Value::V3(p)) => fail(format!(
                             "vertex {} would move to {p}, which is not finite",
@@ -697,7 +743,8 @@ impl Grammar {
                         Ok(_) => fail("the assignment did not give a point".into()),
                         Err(e) => self.runtime_error(rule, step, e),
                     })?;
-                mesh.next_pos
+                state
+                    .next_pos
                     .extend(matched.iter().zip(out).map(|(val, p)| (vertex_of(val), p)));
                 Ok(())
             }
@@ -717,6 +764,7 @@ impl Grammar {
                         self.max_faces
                     )));
                 }
+                let split = state.split();
                 let mut made: Vec<(VertexId, &Elem)> = Vec::with_capacity(matched.len());
                 match rule.op {
                     Op::FaceSplit => {
@@ -731,7 +779,8 @@ impl Grammar {
                                 return Err(fail("a face to split is gone".into()));
                             };
                             let p = vs.iter().map(|v| mesh.position(*v)).sum::<DVec3>() / 3.0;
-                            mesh.face_split(f, p).map_err(|e| fail(e.message))?
+                            mesh.face_split_with(f, p, &split)
+                                .map_err(|e| fail(e.message))?
                         }
                     } else if let Some((p, q)) = host::edge_vertices(val) {
                         {
@@ -741,27 +790,36 @@ impl Grammar {
                                 (a, b) == (p, q) || (a, b) == (q, p)
                             });
                             let at = (mesh.position(p) + mesh.position(q)) * 0.5;
-                            mesh.edge_split(e, at).map_err(|e| fail(e.message))?
+                            mesh.edge_split_with(e, at, &split)
+                                .map_err(|e| fail(e.message))?
                         }
                     } else {
                         continue;
                     };
                     made.push((v, val));
                 }
-                mesh.current_level = made
+                state.current_level = made
                     .iter()
                     .map(|(v, _)| mesh.vertex_level(*v))
-                    .fold(mesh.current_level, u32::max);
+                    .fold(state.current_level, u32::max);
                 let Some(assign) = &rule.assign else {
                     return Ok(());
                 };
                 let vslot = rule.vertex_slot.expect("an assignment names its vertex");
                 let slot = rule.elem_slot as usize;
                 let out = self
-                    .eval_points(rule, mesh, current, assign, made.len(), |frame, k| {
-                        frame[slot] = Value::Elem(*made[k].1);
-                        frame[vslot as usize] = Value::Elem(host::vertex(made[k].0));
-                    })
+                    .eval_points(
+                        rule,
+                        mesh,
+                        current,
+                        state.step,
+                        assign,
+                        made.len(),
+                        |frame, k| {
+                            frame[slot] = Value::Elem(*made[k].1);
+                            frame[vslot as usize] = Value::Elem(host::vertex(made[k].0));
+                        },
+                    )
                     .map_err(|(k, p)| match p {
                         Ok(Value::V3(p)) => fail(format!(
                             "new vertex {} would be at {p}, which is not finite",
@@ -776,6 +834,98 @@ impl Grammar {
 
                 Ok(())
             }
+        }
+    }
+}
+
+/// A grammar's run on a mesh, from [`Grammar::start`]: the mesh and what
+/// the run carries from rule to rule and step to step. Each call of
+/// [`GrammarRun::steps`] continues where the last one stopped. After an
+/// error the mesh is partly derived, and the run should not be continued.
+#[derive(Debug)]
+pub struct GrammarRun<'a> {
+    grammar: &'a Grammar,
+    mesh: &'a mut Mesh,
+    state: RunState,
+    /// The step [`crate::production::run`] runs to.
+    until: u32,
+}
+
+impl GrammarRun<'_> {
+    /// Runs `n` more steps; `progress` hears after each, counted from 1 in
+    /// this call.
+    pub fn steps(
+        &mut self,
+        n: usize,
+        mut progress: impl FnMut(StepCounts),
+    ) -> Result<(), RunError> {
+        for k in 1..=n {
+            self.one_step()?;
+            progress(StepCounts {
+                step: k,
+                vertices: self.mesh.vertex_count(),
+                edges: self.mesh.edge_count(),
+                faces: self.mesh.face_count(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The steps run so far (0 after the `init:` rules).
+    pub fn step(&self) -> u32 {
+        self.state.step
+    }
+
+    /// One step: the rules in file order, each applied to what matched when
+    /// it started, then the second position buffer made current.
+    fn one_step(&mut self) -> Result<(), RunError> {
+        let each: Vec<&Rule> = self.grammar.rules.iter().filter(|r| !r.init).collect();
+        // Vertices made from here on record this step (`new(v)`).
+        self.state.step += 1;
+        self.grammar.apply_all(&each, self.mesh, &mut self.state)?;
+        self.state.swap_positions(self.mesh);
+        Ok(())
+    }
+
+    /// The mesh as the run has made it.
+    pub fn mesh(&self) -> &Mesh {
+        self.mesh
+    }
+}
+
+/// What a run carries between rules and steps.
+#[derive(Debug, Default)]
+struct RunState {
+    /// `c`: the highest vertex level when a rule starts, raised as splits
+    /// make vertices.
+    current_level: u32,
+    /// The step running (0 for `init:` rules); new vertices record it.
+    step: u32,
+    /// Positions written for the next step (the second buffer of paper
+    /// 000, §7), kept as a list: only smoothed vertices have one. They
+    /// become current, in the order written, at the end of the step.
+    next_pos: Vec<(VertexId, DVec3)>,
+    /// What splitting a basic block's internal edge makes of the block.
+    blocks: BlockSplit,
+    /// Set for grammars that read blocks: a face split then makes blocks.
+    face_split_makes_blocks: bool,
+}
+
+impl RunState {
+    /// The policy of the splits made now.
+    fn split(&self) -> Split {
+        Split {
+            step: self.step,
+            blocks: self.blocks,
+            face_split_makes_blocks: self.face_split_makes_blocks,
+        }
+    }
+
+    /// Makes the next positions current (paper 000, §7: the buffer is
+    /// swapped after each step), in the order they were written.
+    fn swap_positions(&mut self, mesh: &mut Mesh) {
+        for (v, p) in self.next_pos.drain(..) {
+            mesh.set_position(v, p);
         }
     }
 }
@@ -801,3 +951,30 @@ impl std::fmt::Display for RunError {
 }
 
 impl std::error::Error for RunError {}
+
+/// The stellar topology's schedule: rules in file order, each on what
+/// matched when it started.
+impl crate::production::Topology for GrammarRun<'_> {
+    type Structure = Mesh;
+    type Error = RunError;
+
+    fn host_table() -> &'static crate::lang::builtins::HostTable {
+        &SURFACE_HOST
+    }
+
+    fn structure(&self) -> &Mesh {
+        self.mesh
+    }
+
+    fn steps_done(&self) -> u64 {
+        self.state.step as u64
+    }
+
+    fn has_next(&self) -> bool {
+        self.state.step < self.until
+    }
+
+    fn step(&mut self) -> Result<(), RunError> {
+        self.one_step()
+    }
+}

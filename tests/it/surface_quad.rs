@@ -480,8 +480,8 @@ fn boundary_walks_off_the_boundary_are_errors() {
     }
 }
 
-/// Two runs of one step each are one run of two steps, for every grammar:
-/// init rules run once, `step` and `new(v)` continue.
+/// A run continued by one step, twice, is a run of two steps, for every
+/// grammar: init rules run once, `step` and `new(v)` continue.
 #[test]
 fn running_twice_continues_the_steps() {
     for (g, mesh) in [
@@ -498,8 +498,10 @@ fn running_twice_continues_the_steps() {
         let mut a = base.clone();
         gr.run(&mut a, 2, |_| {}).unwrap();
         let mut b = base.clone();
-        gr.run(&mut b, 1, |_| {}).unwrap();
-        gr.run(&mut b, 1, |_| {}).unwrap();
+        let mut run = gr.start(&mut b).unwrap();
+        run.steps(1, |_| {}).unwrap();
+        run.steps(1, |_| {}).unwrap();
+        assert_eq!(run.step(), 2, "{g}");
         let (sa, sb) = (a.to_quad_soup(), b.to_quad_soup());
         assert_eq!(sa.faces, sb.faces, "{g}");
         assert_eq!(sa.positions, sb.positions, "{g}");
