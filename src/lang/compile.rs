@@ -103,6 +103,8 @@ struct Compiler {
     inlining: Vec<usize>,
     /// Calls inlined in the current rule.
     inlined: usize,
+    /// Where a division of two integers was compiled.
+    int_divisions: Vec<Span>,
 }
 
 /// Function calls are inlined; past this many in one rule, functions that
@@ -175,6 +177,7 @@ impl Compiler {
             functions,
             inlining: Vec::new(),
             inlined: 0,
+            int_divisions: Vec::new(),
         }
     }
 
@@ -184,22 +187,37 @@ impl Compiler {
 
     /// Warns when `ex` is a division of integer constants that truncates
     /// and its value is about to be used as a floating-point number.
+    /// Also where the division is of integer variables (`(n - 2)/n`), which
+    /// C truncates as well, and which a surface grammar written before the
+    /// one language meant as a fraction.
     fn check_truncation(&mut self, ex: &Ex) {
-        if let Ex::Bin(BinOp::Div, a, b, span) = ex {
-            if let (Ex::Const(Value::Int(x)), Ex::Const(Value::Int(y))) = (&**a, &**b) {
-                if *y != 0 && x % y != 0 {
-                    let at = Diagnostic::new(
-                        *span,
-                        format!(
-                            "`{x}/{y}` is {} in integer arithmetic; write {x}.0/{y}",
-                            x / y
-                        ),
-                    );
-                    if !self.warnings.contains(&at) {
-                        self.warnings.push(at);
-                    }
+        let ex = match ex {
+            // An inlined function's value is its body's.
+            Ex::Let(_, _, body) => return self.check_truncation(body),
+            ex => ex,
+        };
+        let Ex::Bin(BinOp::Div, a, b, span) = ex else {
+            return;
+        };
+        let message = match (&**a, &**b) {
+            (Ex::Const(Value::Int(x)), Ex::Const(Value::Int(y))) => {
+                if *y == 0 || x % y == 0 {
+                    return;
                 }
+                format!(
+                    "`{x}/{y}` is {} in integer arithmetic; write {x}.0/{y}",
+                    x / y
+                )
             }
+            _ if self.int_divisions.contains(span) => "this divides integers, which truncates \
+                 (C's arithmetic), and its value is then used as a floating-point number; \
+                 write one operand as a float (`2.0`, or `(float) n`) if a fraction is meant"
+                .to_string(),
+            _ => return,
+        };
+        let at = Diagnostic::new(*span, message);
+        if !self.warnings.contains(&at) {
+            self.warnings.push(at);
         }
     }
 
@@ -1192,6 +1210,9 @@ impl Compiler {
                     );
                     return None;
                 };
+                if *op == BinOp::Div && lt != Ty::Float && rt != Ty::Float && ty == Ty::Int {
+                    self.int_divisions.push(span);
+                }
                 if !matches!(ty, Ty::Int | Ty::Bool) {
                     self.check_truncation(&lx);
                     self.check_truncation(&rx);

@@ -174,6 +174,23 @@ fn a_truncating_constant_division_is_the_same_warning() {
         "{}",
         text(&s.stdout)
     );
+    // A division of integer variables used as a floating-point number is
+    // warned about too: a surface grammar written before the one language
+    // meant `(n - 2)/n` as a fraction.
+    let vars = write(
+        &dir,
+        "v.lsys",
+        "mesh: \"tri.obj\";\ndefine f(v, n) = (n - 2)/n*v;\nV(v) -> V(v = f(v, valence(v)));\n",
+    );
+    let o = subgram(&["check", &vars]);
+    assert!(o.status.success());
+    assert!(
+        text(&o.stdout).starts_with(&format!(
+            "{vars}:2:18: warning: this divides integers, which truncates"
+        )),
+        "{}",
+        text(&o.stdout)
+    );
     // A division that does not truncate, or one meant as an integer, is
     // not warned about.
     let quiet = write(
