@@ -27,7 +27,7 @@
 use crate::mesh::BlockSplit;
 use crate::syntax::ast::Expr;
 use crate::syntax::lex::{Tok, Token};
-use crate::syntax::parse::parse_expression;
+use crate::syntax::parse::Parser;
 use crate::syntax::span::{Diagnostic, Span};
 
 /// The element type a rule rewrites.
@@ -92,104 +92,39 @@ pub struct GrammarFile {
 
 type R<T> = Result<T, Diagnostic>;
 
-struct P<'t> {
-    toks: &'t [Token],
-    pos: usize,
-    eof: Span,
+/// `^ k` after an element letter; 1 when absent.
+fn power(p: &mut Parser) -> R<i64> {
+    if p.eat_punct("^") {
+        match p.peek().map(|t| &t.tok) {
+            Some(Tok::Int(k)) => {
+                p.bump();
+                Ok(*k)
+            }
+            _ => p.error("a count after `^`, as in `F^2`"),
+        }
+    } else {
+        Ok(1)
+    }
 }
 
-impl<'t> P<'t> {
-    fn peek(&self) -> Option<&'t Token> {
-        self.toks.get(self.pos)
-    }
-
-    fn span(&self) -> Span {
-        self.peek().map(|t| t.span).unwrap_or(self.eof)
-    }
-
-    fn found(&self) -> String {
-        self.peek()
-            .map(|t| t.tok.describe())
-            .unwrap_or_else(|| "the end of the file".into())
-    }
-
-    fn err<T>(&self, what: &str) -> R<T> {
-        Err(Diagnostic::new(
-            self.span(),
-            format!("expected {what}, found {}", self.found()),
-        ))
-    }
-
-    fn is(&self, p: &str) -> bool {
-        self.peek().is_some_and(|t| t.tok.is_punct(p))
-    }
-
-    fn is_ident(&self, s: &str) -> bool {
-        self.peek().is_some_and(|t| t.tok.is_ident(s))
-    }
-
-    fn eat(&mut self, p: &str) -> bool {
-        if self.is(p) {
-            self.pos += 1;
-            true
+/// A successor context such as `E^4 F^4`: the counts of E and F.
+fn counts(p: &mut Parser) -> R<(i64, i64)> {
+    let (mut e, mut f) = (0, 0);
+    while p.peek_ident("E") || p.peek_ident("F") {
+        let which = p.name("E or F")?.text;
+        let k = power(p)?;
+        if which == "E" {
+            e += k;
         } else {
-            false
+            f += k;
         }
     }
+    Ok((e, f))
+}
 
-    fn expect(&mut self, p: &str, what: &str) -> R<()> {
-        if self.eat(p) {
-            Ok(())
-        } else {
-            self.err(&format!("`{p}` {what}"))
-        }
-    }
-
-    fn ident(&mut self, what: &str) -> R<String> {
-        match self.peek().map(|t| &t.tok) {
-            Some(Tok::Ident(s)) => {
-                self.pos += 1;
-                Ok(s.clone())
-            }
-            _ => self.err(what),
-        }
-    }
-
-    fn expr(&mut self) -> R<Expr> {
-        let (e, n) = parse_expression(&self.toks[self.pos..], self.eof)?;
-        self.pos += n;
-        Ok(e)
-    }
-
-    /// `^ k` after an element letter; 1 when absent.
-    fn power(&mut self) -> R<i64> {
-        if self.eat("^") {
-            match self.peek().map(|t| &t.tok) {
-                Some(Tok::Int(k)) => {
-                    self.pos += 1;
-                    Ok(*k)
-                }
-                _ => self.err("a count after `^`, as in `F^2`"),
-            }
-        } else {
-            Ok(1)
-        }
-    }
-
-    /// A successor context such as `E^4 F^4`: the counts of E and F.
-    fn counts(&mut self) -> R<(i64, i64)> {
-        let (mut e, mut f) = (0, 0);
-        while self.is_ident("E") || self.is_ident("F") {
-            let which = self.ident("E or F")?;
-            let k = self.power()?;
-            if which == "E" {
-                e += k;
-            } else {
-                f += k;
-            }
-        }
-        Ok((e, f))
-    }
+/// `name` followed by `:`, as in `mesh:`.
+fn at_key(p: &Parser, name: &str) -> bool {
+    p.peek_ident(name) && p.peek_at(1).is_some_and(|t| t.tok.is_punct(":"))
 }
 
 /// True when a token list is a surface grammar: it has `mesh:` at the start
@@ -202,54 +137,55 @@ pub fn is_surface(toks: &[Token]) -> bool {
 
 /// Parses a surface grammar from preprocessed tokens.
 pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<GrammarFile> {
-    let mut p = P { toks, pos: 0, eof };
+    let mut p = Parser::new(toks, eof);
     let mut g = GrammarFile::default();
-    while p.pos < toks.len() {
-        if p.eat(";") {
+    while !p.at_end() {
+        if p.eat_punct(";") {
             continue;
         }
-        let start = p.span();
-        if p.is_ident("mesh") && toks.get(p.pos + 1).is_some_and(|t| t.tok.is_punct(":")) {
-            p.pos += 2;
+        let start = p.span_here();
+        if at_key(&p, "mesh") {
+            p.bump();
+            p.bump();
             let path = match p.peek().map(|t| &t.tok) {
                 Some(Tok::Str(s)) => s.clone(),
                 _ => {
-                    return p.err("the base mesh as a quoted file name, e.g. `mesh: \"cube.obj\";`")
+                    return p
+                        .error("the base mesh as a quoted file name, e.g. `mesh: \"cube.obj\";`")
                 }
             };
-            let span = p.span();
-            p.pos += 1;
-            p.eat(";");
+            let span = p.span_here();
+            p.bump();
+            p.eat_punct(";");
             g.mesh = Some((path, span));
             continue;
         }
-        if p.is_ident("derivation")
-            && toks
-                .get(p.pos + 1)
-                .is_some_and(|t| t.tok.is_ident("length"))
-        {
-            p.pos += 2;
-            p.expect(":", "after `derivation length`")?;
+        if p.peek_ident("derivation") && p.peek_at(1).is_some_and(|t| t.tok.is_ident("length")) {
+            p.bump();
+            p.bump();
+            p.expect_punct(":", "after `derivation length`")?;
             g.length = Some(p.expr()?);
-            p.expect(";", "after the derivation length")?;
+            p.expect_punct(";", "after the derivation length")?;
             continue;
         }
-        if p.is_ident("blocks") && toks.get(p.pos + 1).is_some_and(|t| t.tok.is_punct(":")) {
-            p.pos += 2;
-            let at = p.span();
+        if at_key(&p, "blocks") {
+            p.bump();
+            p.bump();
+            let at = p.span_here();
             let how = match p.peek().map(|t| &t.tok) {
                 Some(Tok::Ident(w)) if w == "quadrisection" => BlockSplit::Quadrisection,
                 Some(Tok::Ident(w)) if w == "bisection" => BlockSplit::Bisection,
                 Some(Tok::Ident(w)) if w == "dual" => BlockSplit::Dual,
-                _ => return p.err("`quadrisection`, `bisection` or `dual` after `blocks:`"),
+                _ => return p.error("`quadrisection`, `bisection` or `dual` after `blocks:`"),
             };
-            p.pos += 1;
-            p.expect(";", "after the block refinement")?;
+            p.bump();
+            p.expect_punct(";", "after the block refinement")?;
             g.block_split = Some((how, at));
             continue;
         }
-        if p.is_ident("init") && toks.get(p.pos + 1).is_some_and(|t| t.tok.is_punct(":")) {
-            p.pos += 2;
+        if at_key(&p, "init") {
+            p.bump();
+            p.bump();
             let mut r = rule(&mut p, &text_of)?;
             if g.rules.iter().any(|r| !r.init) {
                 return Err(Diagnostic::new(
@@ -261,10 +197,10 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
             g.rules.push(r);
             continue;
         }
-        if p.is_ident("define") {
-            p.pos += 1;
-            let name_span = p.span();
-            let name = p.ident("a function name after `define`")?;
+        if p.peek_ident("define") {
+            p.bump();
+            let name_span = p.span_here();
+            let name = p.name("a function name after `define`")?.text;
             if g.functions.iter().any(|f| f.name == name) {
                 return Err(Diagnostic::new(
                     name_span,
@@ -273,12 +209,12 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
                     ),
                 ));
             }
-            p.expect("(", "after the function name")?;
+            p.expect_punct("(", "after the function name")?;
             let mut params = Vec::new();
-            if !p.eat(")") {
+            if !p.eat_punct(")") {
                 loop {
-                    let at = p.span();
-                    let param = p.ident("a parameter name")?;
+                    let at = p.span_here();
+                    let param = p.name("a parameter name")?.text;
                     if params.contains(&param) {
                         return Err(Diagnostic::new(
                             at,
@@ -286,15 +222,15 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
                         ));
                     }
                     params.push(param);
-                    if p.eat(")") {
+                    if p.eat_punct(")") {
                         break;
                     }
-                    p.expect(",", "or `)` between parameters")?;
+                    p.expect_punct(",", "or `)` between parameters")?;
                 }
             }
-            p.expect("=", "before the function's expression")?;
+            p.expect_punct("=", "before the function's expression")?;
             let body = p.expr()?;
-            p.expect(";", "after the function's expression")?;
+            p.expect_punct(";", "after the function's expression")?;
             g.functions.push(FunctionDef {
                 name,
                 params,
@@ -315,46 +251,50 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
 }
 
 /// rule := KIND '(' name [';' cond] ')' [('|' | '||') context] '->' succ ['||' counts] [';']
-fn rule(p: &mut P, text_of: &impl Fn(Span) -> String) -> R<RuleDef> {
-    let start = p.span();
+fn rule(p: &mut Parser, text_of: &impl Fn(Span) -> String) -> R<RuleDef> {
+    let start = p.span_here();
     let kind = match p.peek().map(|t| &t.tok) {
         Some(Tok::Ident(k)) if k == "F" => Kind::Face,
         Some(Tok::Ident(k)) if k == "E" => Kind::Edge,
         Some(Tok::Ident(k)) if k == "V" => Kind::Vertex,
         _ => {
-            return p.err(
+            return p.error(
                 "a rule starting with F, E or V, `init:`, `define`, `mesh:`, `blocks:` or \
                  `derivation length:`",
             )
         }
     };
-    p.pos += 1;
-    p.expect("(", "after the element type")?;
-    let name = p.ident("the element's name, e.g. `F(f)`")?;
-    let cond = if p.eat(";") { Some(p.expr()?) } else { None };
-    p.expect(")", "to close the predecessor")?;
+    p.bump();
+    p.expect_punct("(", "after the element type")?;
+    let name = p.name("the element's name, e.g. `F(f)`")?.text;
+    let cond = if p.eat_punct(";") {
+        Some(p.expr()?)
+    } else {
+        None
+    };
+    p.expect_punct(")", "to close the predecessor")?;
     // The predecessor's context.
     let mut faces = None;
     let mut vertex_context = VertexContext::Any;
-    if p.eat("|") || p.eat("||") {
+    if p.eat_punct("|") || p.eat_punct("||") {
         match kind {
             Kind::Edge => {
-                if !p.is_ident("F") {
-                    return p.err(
+                if !p.peek_ident("F") {
+                    return p.error(
                         "the faces of the edge, `F` (a boundary edge) or `F^2` (an interior edge)",
                     );
                 }
-                p.pos += 1;
-                faces = Some(p.power()?);
+                p.bump();
+                faces = Some(power(p)?);
             }
             Kind::Vertex => {
-                let w = p.ident("`boundary` or `interior`")?;
+                let w = p.name("`boundary` or `interior`")?.text;
                 vertex_context = match w.as_str() {
                     "boundary" => VertexContext::Boundary,
                     "interior" => VertexContext::Interior,
                     _ => {
                         return Err(Diagnostic::new(
-                            p.toks[p.pos - 1].span,
+                            p.prev_span(),
                             format!(
                             "expected `boundary` or `interior` as a vertex's context, found `{w}`"
                         ),
@@ -362,28 +302,28 @@ fn rule(p: &mut P, text_of: &impl Fn(Span) -> String) -> R<RuleDef> {
                     }
                 };
             }
-            Kind::Face => return p.err("`->`: a face rule has no context"),
+            Kind::Face => return p.error("`->`: a face rule has no context"),
         }
     }
-    p.expect("->", "after the predecessor")?;
+    p.expect_punct("->", "after the predecessor")?;
     // The successor.
-    let succ_span = p.span();
-    let succ = p.ident("the successor, `V` or `E`")?;
+    let succ_span = p.span_here();
+    let succ = p.name("the successor, `V` or `E`")?.text;
     let mut assign = None;
-    if p.eat("(") {
-        let v = p.ident("the new vertex's name")?;
-        p.expect("=", "in the assignment `V(v = ...)`")?;
+    if p.eat_punct("(") {
+        let v = p.name("the new vertex's name")?.text;
+        p.expect_punct("=", "in the assignment `V(v = ...)`")?;
         let e = p.expr()?;
-        p.expect(")", "to close the assignment")?;
+        p.expect_punct(")", "to close the assignment")?;
         assign = Some((v, e));
     }
-    let counts = if p.eat("||") { Some(p.counts()?) } else { None };
-    let end = p
-        .toks
-        .get(p.pos.saturating_sub(1))
-        .map(|t| t.span)
-        .unwrap_or(start);
-    p.eat(";");
+    let counts = if p.eat_punct("||") {
+        Some(counts(p)?)
+    } else {
+        None
+    };
+    let end = p.prev_span();
+    p.eat_punct(";");
     let op = match (kind, faces, succ.as_str(), counts) {
         (Kind::Face, None, "V", Some((3, 3))) => Op::FaceSplit,
         (Kind::Edge, Some(2), "V", Some((4, 4))) => Op::EdgeSplit,

@@ -34,21 +34,22 @@ type PResult<T> = Result<T, Diagnostic>;
 /// refused with a message rather than overflowing the stack later.
 pub const MAX_NESTING: usize = 100;
 
-/// Parses one expression at the start of `toks`; returns it and the number
-/// of tokens it took. Used by the surface-grammar parser.
-pub fn parse_expression(toks: &[Token], eof: Span) -> PResult<(Expr, usize)> {
-    let mut p = Parser {
-        toks,
-        pos: 0,
-        abop: false,
-        whole_names: Vec::new(),
-        split_last: None,
-        depth: 0,
-        type_names: Vec::new(),
-        eof,
-    };
-    let e = p.expr()?;
-    Ok((e, p.pos))
+impl<'t> Parser<'t> {
+    /// A parser of the language's expressions over `toks`, for the parsers
+    /// of other rule forms (surface grammars), which share its cursor, its
+    /// messages and its expressions.
+    pub(crate) fn new(toks: &'t [Token], eof: Span) -> Parser<'t> {
+        Parser {
+            toks,
+            pos: 0,
+            abop: false,
+            whole_names: Vec::new(),
+            split_last: None,
+            depth: 0,
+            type_names: Vec::new(),
+            eof,
+        }
+    }
 }
 
 pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<File> {
@@ -82,31 +83,31 @@ pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<Fil
 }
 
 impl<'t> Parser<'t> {
-    fn at_end(&self) -> bool {
+    pub(crate) fn at_end(&self) -> bool {
         self.pos >= self.toks.len()
     }
 
-    fn peek(&self) -> Option<&'t Token> {
+    pub(crate) fn peek(&self) -> Option<&'t Token> {
         self.toks.get(self.pos)
     }
 
-    fn peek_at(&self, k: usize) -> Option<&'t Token> {
+    pub(crate) fn peek_at(&self, k: usize) -> Option<&'t Token> {
         self.toks.get(self.pos + k)
     }
 
-    fn peek_punct(&self, p: &str) -> bool {
+    pub(crate) fn peek_punct(&self, p: &str) -> bool {
         self.peek().is_some_and(|t| t.tok.is_punct(p))
     }
 
-    fn peek_ident(&self, s: &str) -> bool {
+    pub(crate) fn peek_ident(&self, s: &str) -> bool {
         self.peek().is_some_and(|t| t.tok.is_ident(s))
     }
 
-    fn span_here(&self) -> Span {
+    pub(crate) fn span_here(&self) -> Span {
         self.peek().map(|t| t.span).unwrap_or(self.eof)
     }
 
-    fn prev_span(&self) -> Span {
+    pub(crate) fn prev_span(&self) -> Span {
         self.pos
             .checked_sub(1)
             .and_then(|i| self.toks.get(i))
@@ -114,27 +115,27 @@ impl<'t> Parser<'t> {
             .unwrap_or(self.eof)
     }
 
-    fn bump(&mut self) -> &'t Token {
+    pub(crate) fn bump(&mut self) -> &'t Token {
         let t = &self.toks[self.pos];
         self.pos += 1;
         t
     }
 
-    fn found(&self) -> String {
+    pub(crate) fn found(&self) -> String {
         match self.peek() {
             Some(t) => t.tok.describe(),
             None => "the end of the file".to_string(),
         }
     }
 
-    fn error<T>(&self, expected: &str) -> PResult<T> {
+    pub(crate) fn error<T>(&self, expected: &str) -> PResult<T> {
         Err(Diagnostic::new(
             self.span_here(),
             format!("expected {expected}, found {}", self.found()),
         ))
     }
 
-    fn eat_punct(&mut self, p: &str) -> bool {
+    pub(crate) fn eat_punct(&mut self, p: &str) -> bool {
         if self.peek_punct(p) {
             self.pos += 1;
             true
@@ -143,7 +144,7 @@ impl<'t> Parser<'t> {
         }
     }
 
-    fn expect_punct(&mut self, p: &str, what: &str) -> PResult<Span> {
+    pub(crate) fn expect_punct(&mut self, p: &str, what: &str) -> PResult<Span> {
         if self.peek_punct(p) {
             Ok(self.bump().span)
         } else {
@@ -151,7 +152,7 @@ impl<'t> Parser<'t> {
         }
     }
 
-    fn name(&mut self, what: &str) -> PResult<Name> {
+    pub(crate) fn name(&mut self, what: &str) -> PResult<Name> {
         if let Some((at, last)) = self.split_last.take() {
             if at == self.pos {
                 self.pos += 1;
@@ -425,7 +426,7 @@ impl<'t> Parser<'t> {
         Ok(TypeRef { name, span: n.span })
     }
 
-    fn eat_ident(&mut self, s: &str) -> bool {
+    pub(crate) fn eat_ident(&mut self, s: &str) -> bool {
         if self.peek_ident(s) {
             self.pos += 1;
             true
