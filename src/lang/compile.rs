@@ -187,12 +187,14 @@ impl Compiler {
     fn check_truncation(&mut self, ex: &Ex) {
         if let Ex::Bin(BinOp::Div, a, b, span) = ex {
             if let (Ex::Const(Value::Int(x)), Ex::Const(Value::Int(y))) = (&**a, &**b) {
-                if *y != 0 && x % y != 0 {
+                // Wrapping, as the interpreter divides: `i64::MIN / -1`
+                // overflows, and it does not truncate.
+                if *y != 0 && x.wrapping_rem(*y) != 0 {
                     let at = Diagnostic::new(
                         *span,
                         format!(
                             "`{x}/{y}` is {} in integer arithmetic; write {x}.0/{y}",
-                            x / y
+                            x.wrapping_div(*y)
                         ),
                     );
                     if !self.warnings.contains(&at) {

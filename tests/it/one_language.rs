@@ -210,3 +210,37 @@ fn the_same_type_errors_read_the_same() {
     assert_eq!(cm, "error: type error: cannot apply `+` to V3f and int");
     assert_eq!(sm, cm);
 }
+
+/// `i64::MIN / -1` overflows: the interpreter wraps it to `i64::MIN`, as
+/// two's-complement hardware does, and the truncation check must not
+/// panic on it (it divides exactly, so there is nothing to warn about).
+#[test]
+fn the_most_negative_integer_divided_by_minus_one_is_checked_without_a_panic() {
+    let dir = folder("overflow");
+    let min = "(-9223372036854775807 - 1)";
+    let curve = write(
+        &dir,
+        "c.lsys",
+        &format!(
+            "module A(float);\nderivation length: 1;\nAxiom: A(1);\n\
+             A(x) : {{ produce A(x * ({min} / -1)); }}\n"
+        ),
+    );
+    let surface = write(
+        &dir,
+        "s.lsys",
+        &format!("mesh: \"tri.obj\";\nV(v) -> V(v = v * ({min} / -1));\n"),
+    );
+    for f in [&curve, &surface] {
+        let o = subgram(&["check", f]);
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+        assert!(!text(&o.stdout).contains("warning"), "{}", text(&o.stdout));
+    }
+    let o = subgram(&["derive", &curve, "--format", "json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let word: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        word["modules"][0]["params"],
+        serde_json::json!([-9223372036854775808.0])
+    );
+}
