@@ -109,6 +109,12 @@ struct Compiler {
 /// call each other twice over would take exponential time.
 const MAX_INLINED_CALLS: usize = 10_000;
 
+/// Functions calling functions nest no deeper than this (as in the
+/// surface grammars' checker before the one language): each level adds a
+/// body's nesting to the checked expression, which the checker, the
+/// specialisations and the interpreter walk recursively.
+const MAX_INLINE_DEPTH: usize = 32;
+
 /// Local variables of one body, with nested block scopes.
 #[derive(Default)]
 struct Scope {
@@ -1640,6 +1646,17 @@ impl Compiler {
             self.err(
                 span,
                 format!("`{}` calls itself; functions may not recurse", def.name),
+            );
+            return None;
+        }
+        if self.inlining.len() >= MAX_INLINE_DEPTH {
+            self.err(
+                span,
+                format!(
+                    "`{}` is called more than {MAX_INLINE_DEPTH} function calls deep; \
+                     functions may not nest deeper",
+                    def.name
+                ),
             );
             return None;
         }
