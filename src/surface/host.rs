@@ -1066,9 +1066,16 @@ impl Affine {
         for (s, a, reads) in &self.lets {
             if *reads {
                 let v = ev.eval(a)?;
-                if let Value::Int(i) = v {
-                    key[k] = i;
-                }
+                // The whole value is the key: a let that reads the element
+                // may be a float (`valence(v) / 8.0`) or a bool
+                // (`valence(v) > 6`), and its type is the same for every
+                // element. Anything else is left to the interpreter.
+                key[k] = match v {
+                    Value::Int(i) => i,
+                    Value::Bool(b) => b as i64,
+                    Value::Float(f) => f.to_bits() as i64,
+                    _ => return Ok(None),
+                };
                 k += 1;
                 ev.frame()[*s as usize] = v;
             }
@@ -1083,9 +1090,8 @@ impl Affine {
         let weights = match found {
             Some(w) => w,
             None => {
-                // Every let that reads the element was an integer or an
-                // element (those give no key): the weights below depend
-                // on the key alone.
+                // Every let that reads the element is in the key: the
+                // weights below depend on the key alone.
                 for (s, a, reads) in &self.lets {
                     if !*reads {
                         let v = ev.eval(a)?;
