@@ -978,7 +978,36 @@ impl Affine {
         };
         a.collect(e, &mut Vec::new(), 1.0, &mut Vec::new())?;
         let keys = a.lets.iter().filter(|l| l.2).count();
-        (keys <= MAX_KEY && a.terms.len() <= MAX_TERMS).then_some(a)
+        (keys <= MAX_KEY && a.terms.len() <= MAX_TERMS && a.in_order()).then_some(a)
+    }
+
+    /// True when evaluating the lets that read the element first, then
+    /// the others, then the factors, gives each local the value the
+    /// interpreter's order gives it. Not so when a let that reads the
+    /// element reads one that does not (`h(v, valence(v) * a)` inside a
+    /// function of `a`), nor when a factor or a let's value binds a local
+    /// of its own (an inlined call, a fold) in a slot that one of the lets
+    /// holds: sibling calls reuse slots.
+    fn in_order(&self) -> bool {
+        let held: Vec<u16> = self.lets.iter().map(|l| l.0).collect();
+        let later: Vec<u16> = self.lets.iter().filter(|l| !l.2).map(|l| l.0).collect();
+        let mut ok = true;
+        for (_, a, reads) in &self.lets {
+            walk(a, &mut |x| match x {
+                Ex::Local(s) if *reads && later.contains(s) => ok = false,
+                Ex::Let(s, ..) | Ex::Fold { slot: s, .. } if held.contains(s) => ok = false,
+                _ => {}
+            });
+        }
+        for t in &self.terms {
+            for (x, _) in &t.factors {
+                walk(x, &mut |x| match x {
+                    Ex::Let(s, ..) | Ex::Fold { slot: s, .. } if held.contains(s) => ok = false,
+                    _ => {}
+                });
+            }
+        }
+        ok
     }
 
     /// Adds the terms of `scale * factors * e`. `alias` maps the locals
