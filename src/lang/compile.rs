@@ -1578,6 +1578,10 @@ impl Compiler {
             self.err(set_span, what);
             return None;
         };
+        if scope.next == u16::MAX {
+            self.err(set_span, "this expression needs too many variables");
+            return None;
+        }
         let mark = (scope.vars.len(), scope.next);
         let slot = scope.declare(var.map_or("", |v| v.text.as_str()), Ty::Elem(member));
         let cond = match cond {
@@ -1671,9 +1675,18 @@ impl Compiler {
             );
             return None;
         }
+        // Slots are u16: a call with tens of thousands of parameters must
+        // not wrap them (as the surface checker before this one refused).
+        let Some(next) = u16::try_from(scope.next as usize + args.len())
+            .ok()
+            .filter(|n| *n < u16::MAX)
+        else {
+            self.err(span, "this expression needs too many variables");
+            return None;
+        };
         let mark = (scope.vars.len(), scope.next);
         let first = scope.next;
-        scope.next += args.len() as u16;
+        scope.next = next;
         scope.max = scope.max.max(scope.next);
         let mut lets = Vec::with_capacity(args.len());
         let mut ok = true;

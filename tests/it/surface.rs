@@ -664,6 +664,21 @@ fn grammar_functions_are_checked() {
         bad.contains("`f3967` is called more than 32 function calls deep"),
         "{bad}"
     );
+    // Locals are numbered with u16: calls nested 32 deep with 2100
+    // parameters each need more than 65,535 of them, which must be an
+    // error, not slots that wrap onto others (an index out of bounds).
+    let params: Vec<String> = (0..2100).map(|i| format!("p{i}")).collect();
+    let params = params.join(", ");
+    let mut text = format!("define g0(v, {params}) = v;\n");
+    for k in 1..32 {
+        text += &format!("define g{k}(v, {params}) = g{}(v, {params});\n", k - 1);
+    }
+    text += &format!("V(v) -> V(v = g31(v, {}));\n", vec!["1"; 2100].join(", "));
+    let bad = load(&text);
+    assert!(
+        bad.contains("error: this expression needs too many variables"),
+        "{bad}"
+    );
     let bad = load(&format!("define f(x) = x;\ndefine f(y) = y;\n{rule}"));
     assert!(
         bad.contains("g.lsys:2:8: error: function `f` is already defined above"),
