@@ -103,6 +103,10 @@ struct Compiler {
     inlining: Vec<usize>,
     /// Calls inlined in the current rule.
     inlined: usize,
+    /// Parameters of the functions being inlined whose argument is a
+    /// division of integer constants that truncates, with that division:
+    /// the truncation warning follows them into the body.
+    truncating: Vec<(u16, Ex)>,
 }
 
 /// Function calls are inlined; past this many in one rule, functions that
@@ -181,6 +185,7 @@ impl Compiler {
             functions,
             inlining: Vec::new(),
             inlined: 0,
+            truncating: Vec::new(),
         }
     }
 
@@ -191,7 +196,10 @@ impl Compiler {
     /// Warns when `ex` is a division of integer constants that truncates
     /// and its value is about to be used as a floating-point number.
     fn check_truncation(&mut self, ex: &Ex) {
-        if let Ex::Bin(BinOp::Div, a, b, span) = ex {
+        let Some(ex) = self.truncated_division(ex) else {
+            return;
+        };
+        if let Ex::Bin(BinOp::Div, a, b, span) = &ex {
             if let (Ex::Const(Value::Int(x)), Ex::Const(Value::Int(y))) = (&**a, &**b) {
                 // Wrapping, as the interpreter divides: `i64::MIN / -1`
                 // overflows, and it does not truncate.
@@ -208,6 +216,29 @@ impl Compiler {
                     }
                 }
             }
+        }
+    }
+
+    /// The division of integer constants `ex` is, negated or not, or
+    /// the one an inlined parameter `ex` was bound to.
+    fn truncated_division(&self, ex: &Ex) -> Option<Ex> {
+        match ex {
+            Ex::Neg(a) => self.truncated_division(a),
+            Ex::Local(s) => self
+                .truncating
+                .iter()
+                .rev()
+                .find(|(t, _)| t == s)
+                .map(|(_, d)| d.clone()),
+            Ex::Bin(BinOp::Div, a, b, _)
+                if matches!(
+                    (&**a, &**b),
+                    (Ex::Const(Value::Int(_)), Ex::Const(Value::Int(_)))
+                ) =>
+            {
+                Some(ex.clone())
+            }
+            _ => None,
         }
     }
 
@@ -1200,7 +1231,9 @@ impl Compiler {
                     );
                     return None;
                 };
-                if !matches!(ty, Ty::Int | Ty::Bool) {
+                // A float result, or a float on either side (a comparison):
+                // the integers are read as floats.
+                if !matches!(ty, Ty::Int | Ty::Bool) || lt == Ty::Float || rt == Ty::Float {
                     self.check_truncation(&lx);
                     self.check_truncation(&rx);
                 }
@@ -1299,6 +1332,10 @@ impl Compiler {
                     );
                     return None;
                 };
+                if ty == Ty::Float {
+                    self.check_truncation(&lx);
+                    self.check_truncation(&rx);
+                }
                 let lx = if lt == ty {
                     lx
                 } else {
@@ -1706,10 +1743,17 @@ impl Compiler {
         for (i, (p, (_, t))) in def.params.iter().zip(&lets).enumerate() {
             scope.vars.push((p.clone(), *t, first + i as u16));
         }
+        let marked = self.truncating.len();
+        for (i, (a, _)) in lets.iter().enumerate() {
+            if let Some(d) = self.truncated_division(a) {
+                self.truncating.push((first + i as u16, d));
+            }
+        }
         self.inlining.push(f);
         let errors = self.diags.len();
         let body = self.expr(&def.body, scope);
         self.inlining.pop();
+        self.truncating.truncate(marked);
         // The caret points into the body; name the function once, at the
         // innermost call.
         for d in &mut self.diags[errors..] {

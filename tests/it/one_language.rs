@@ -244,3 +244,44 @@ fn the_most_negative_integer_divided_by_minus_one_is_checked_without_a_panic() {
         serde_json::json!([-9223372036854775808.0])
     );
 }
+
+/// The truncation warning follows a constant division wherever its value
+/// is read as a float: through a `define` function's parameter, in a
+/// branch of `?:` whose other branch is a float, in a comparison with a
+/// float, and under a negation. (Before the one language these were all
+/// floating-point divisions: `f(v, 1/16)` moved by 1/16, now by 0.)
+/// Positions counted by hand in the line.
+#[test]
+fn truncation_is_warned_through_parameters_branches_comparisons_and_negations() {
+    let dir = folder("truncation-paths");
+    let surface = write(
+        &dir,
+        "s.lsys",
+        "mesh: \"tri.obj\";\ndefine f(v, k) = k * v;\n\
+         V(v; 1/2 > 0.25) -> V(v = f(v, 1/16) + (new(v) ? 1/4 : 0.5) * v - -(1/8) * v);\n",
+    );
+    let s = subgram(&["check", &surface]);
+    assert!(s.status.success(), "{}", text(&s.stderr));
+    let out = text(&s.stdout);
+    let warned: Vec<&str> = out.lines().filter(|l| l.contains(": warning:")).collect();
+    let expected = [
+        "3:6: warning: `1/2` is 0",
+        "3:32: warning: `1/16` is 0",
+        "3:50: warning: `1/4` is 0",
+        "3:68: warning: `1/8` is 0",
+    ];
+    assert_eq!(warned.len(), expected.len(), "{out}");
+    for (w, e) in warned.iter().zip(expected) {
+        assert!(w.starts_with(&format!("{surface}:{e}")), "{w}\n{out}");
+    }
+    // A parameter read as an integer is not warned about.
+    let quiet = write(
+        &dir,
+        "q.lsys",
+        "mesh: \"tri.obj\";\ndefine f(v, n) = valence(v) > n;\n\
+         V(v; f(v, 7/2)) -> V(v = v);\n",
+    );
+    let q = subgram(&["check", &quiet]);
+    assert!(q.status.success());
+    assert!(!text(&q.stdout).contains("warning"), "{}", text(&q.stdout));
+}
