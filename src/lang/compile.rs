@@ -105,11 +105,21 @@ struct Compiler {
     inlined: usize,
     /// Where a division of two integers was compiled.
     int_divisions: Vec<Span>,
+    /// Parameters of the functions being inlined whose argument is a
+    /// division of integer constants that truncates, with that division:
+    /// the truncation warning follows them into the body.
+    truncating: Vec<(u16, Ex)>,
 }
 
 /// Function calls are inlined; past this many in one rule, functions that
 /// call each other twice over would take exponential time.
 const MAX_INLINED_CALLS: usize = 10_000;
+
+/// Functions calling functions nest no deeper than this (as in the
+/// surface grammars' checker before the one language): each level adds a
+/// body's nesting to the checked expression, which the checker, the
+/// specialisations and the interpreter walk recursively.
+const MAX_INLINE_DEPTH: usize = 32;
 
 /// Local variables of one body, with nested block scopes.
 #[derive(Default)]
@@ -178,6 +188,7 @@ impl Compiler {
             inlining: Vec::new(),
             inlined: 0,
             int_divisions: Vec::new(),
+            truncating: Vec::new(),
         }
     }
 
@@ -191,33 +202,72 @@ impl Compiler {
     /// C truncates as well, and which a surface grammar written before the
     /// one language meant as a fraction.
     fn check_truncation(&mut self, ex: &Ex) {
-        let ex = match ex {
-            // An inlined function's value is its body's.
-            Ex::Let(_, _, body) => return self.check_truncation(body),
-            ex => ex,
-        };
-        let Ex::Bin(BinOp::Div, a, b, span) = ex else {
+        // An inlined function's value is its body's.
+        if let Ex::Let(_, _, body) = ex {
+            return self.check_truncation(body);
+        }
+        // A division of integer variables.
+        if let Ex::Bin(BinOp::Div, a, b, span) = ex {
+            let constants = matches!(
+                (&**a, &**b),
+                (Ex::Const(Value::Int(_)), Ex::Const(Value::Int(_)))
+            );
+            if !constants && self.int_divisions.contains(span) {
+                let at = Diagnostic::new(
+                    *span,
+                    "this divides integers, which truncates (C's arithmetic), and its value is \
+                     then used as a floating-point number; write one operand as a float (`2.0`, \
+                     or `(float) n`) if a fraction is meant",
+                );
+                if !self.warnings.contains(&at) {
+                    self.warnings.push(at);
+                }
+                return;
+            }
+        }
+        let Some(ex) = self.truncated_division(ex) else {
             return;
         };
-        let message = match (&**a, &**b) {
-            (Ex::Const(Value::Int(x)), Ex::Const(Value::Int(y))) => {
-                if *y == 0 || x % y == 0 {
-                    return;
+        if let Ex::Bin(BinOp::Div, a, b, span) = &ex {
+            if let (Ex::Const(Value::Int(x)), Ex::Const(Value::Int(y))) = (&**a, &**b) {
+                // Wrapping, as the interpreter divides: `i64::MIN / -1`
+                // overflows, and it does not truncate.
+                if *y != 0 && x.wrapping_rem(*y) != 0 {
+                    let at = Diagnostic::new(
+                        *span,
+                        format!(
+                            "`{x}/{y}` is {} in integer arithmetic; write {x}.0/{y}",
+                            x.wrapping_div(*y)
+                        ),
+                    );
+                    if !self.warnings.contains(&at) {
+                        self.warnings.push(at);
+                    }
                 }
-                format!(
-                    "`{x}/{y}` is {} in integer arithmetic; write {x}.0/{y}",
-                    x / y
-                )
             }
-            _ if self.int_divisions.contains(span) => "this divides integers, which truncates \
-                 (C's arithmetic), and its value is then used as a floating-point number; \
-                 write one operand as a float (`2.0`, or `(float) n`) if a fraction is meant"
-                .to_string(),
-            _ => return,
-        };
-        let at = Diagnostic::new(*span, message);
-        if !self.warnings.contains(&at) {
-            self.warnings.push(at);
+        }
+    }
+
+    /// The division of integer constants `ex` is, negated or not, or
+    /// the one an inlined parameter `ex` was bound to.
+    fn truncated_division(&self, ex: &Ex) -> Option<Ex> {
+        match ex {
+            Ex::Neg(a) => self.truncated_division(a),
+            Ex::Local(s) => self
+                .truncating
+                .iter()
+                .rev()
+                .find(|(t, _)| t == s)
+                .map(|(_, d)| d.clone()),
+            Ex::Bin(BinOp::Div, a, b, _)
+                if matches!(
+                    (&**a, &**b),
+                    (Ex::Const(Value::Int(_)), Ex::Const(Value::Int(_)))
+                ) =>
+            {
+                Some(ex.clone())
+            }
+            _ => None,
         }
     }
 
@@ -1213,7 +1263,9 @@ impl Compiler {
                 if *op == BinOp::Div && lt != Ty::Float && rt != Ty::Float && ty == Ty::Int {
                     self.int_divisions.push(span);
                 }
-                if !matches!(ty, Ty::Int | Ty::Bool) {
+                // A float result, or a float on either side (a comparison):
+                // the integers are read as floats.
+                if !matches!(ty, Ty::Int | Ty::Bool) || lt == Ty::Float || rt == Ty::Float {
                     self.check_truncation(&lx);
                     self.check_truncation(&rx);
                 }
@@ -1312,6 +1364,10 @@ impl Compiler {
                     );
                     return None;
                 };
+                if ty == Ty::Float {
+                    self.check_truncation(&lx);
+                    self.check_truncation(&rx);
+                }
                 let lx = if lt == ty {
                     lx
                 } else {
@@ -1591,6 +1647,10 @@ impl Compiler {
             self.err(set_span, what);
             return None;
         };
+        if scope.next == u16::MAX {
+            self.err(set_span, "this expression needs too many variables");
+            return None;
+        }
         let mark = (scope.vars.len(), scope.next);
         let slot = scope.declare(var.map_or("", |v| v.text.as_str()), Ty::Elem(member));
         let cond = match cond {
@@ -1662,6 +1722,17 @@ impl Compiler {
             );
             return None;
         }
+        if self.inlining.len() >= MAX_INLINE_DEPTH {
+            self.err(
+                span,
+                format!(
+                    "`{}` is called more than {MAX_INLINE_DEPTH} function calls deep; \
+                     functions may not nest deeper",
+                    def.name
+                ),
+            );
+            return None;
+        }
         self.inlined += 1;
         if self.inlined > MAX_INLINED_CALLS {
             self.err(
@@ -1673,9 +1744,18 @@ impl Compiler {
             );
             return None;
         }
+        // Slots are u16: a call with tens of thousands of parameters must
+        // not wrap them (as the surface checker before this one refused).
+        let Some(next) = u16::try_from(scope.next as usize + args.len())
+            .ok()
+            .filter(|n| *n < u16::MAX)
+        else {
+            self.err(span, "this expression needs too many variables");
+            return None;
+        };
         let mark = (scope.vars.len(), scope.next);
         let first = scope.next;
-        scope.next += args.len() as u16;
+        scope.next = next;
         scope.max = scope.max.max(scope.next);
         let mut lets = Vec::with_capacity(args.len());
         let mut ok = true;
@@ -1695,10 +1775,17 @@ impl Compiler {
         for (i, (p, (_, t))) in def.params.iter().zip(&lets).enumerate() {
             scope.vars.push((p.clone(), *t, first + i as u16));
         }
+        let marked = self.truncating.len();
+        for (i, (a, _)) in lets.iter().enumerate() {
+            if let Some(d) = self.truncated_division(a) {
+                self.truncating.push((first + i as u16, d));
+            }
+        }
         self.inlining.push(f);
         let errors = self.diags.len();
         let body = self.expr(&def.body, scope);
         self.inlining.pop();
+        self.truncating.truncate(marked);
         // The caret points into the body; name the function once, at the
         // innermost call.
         for d in &mut self.diags[errors..] {

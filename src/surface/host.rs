@@ -978,7 +978,36 @@ impl Affine {
         };
         a.collect(e, &mut Vec::new(), 1.0, &mut Vec::new())?;
         let keys = a.lets.iter().filter(|l| l.2).count();
-        (keys <= MAX_KEY && a.terms.len() <= MAX_TERMS).then_some(a)
+        (keys <= MAX_KEY && a.terms.len() <= MAX_TERMS && a.in_order()).then_some(a)
+    }
+
+    /// True when evaluating the lets that read the element first, then
+    /// the others, then the factors, gives each local the value the
+    /// interpreter's order gives it. Not so when a let that reads the
+    /// element reads one that does not (`h(v, valence(v) * a)` inside a
+    /// function of `a`), nor when a factor or a let's value binds a local
+    /// of its own (an inlined call, a fold) in a slot that one of the lets
+    /// holds: sibling calls reuse slots.
+    fn in_order(&self) -> bool {
+        let held: Vec<u16> = self.lets.iter().map(|l| l.0).collect();
+        let later: Vec<u16> = self.lets.iter().filter(|l| !l.2).map(|l| l.0).collect();
+        let mut ok = true;
+        for (_, a, reads) in &self.lets {
+            walk(a, &mut |x| match x {
+                Ex::Local(s) if *reads && later.contains(s) => ok = false,
+                Ex::Let(s, ..) | Ex::Fold { slot: s, .. } if held.contains(s) => ok = false,
+                _ => {}
+            });
+        }
+        for t in &self.terms {
+            for (x, _) in &t.factors {
+                walk(x, &mut |x| match x {
+                    Ex::Let(s, ..) | Ex::Fold { slot: s, .. } if held.contains(s) => ok = false,
+                    _ => {}
+                });
+            }
+        }
+        ok
     }
 
     /// Adds the terms of `scale * factors * e`. `alias` maps the locals
@@ -1066,9 +1095,16 @@ impl Affine {
         for (s, a, reads) in &self.lets {
             if *reads {
                 let v = ev.eval(a)?;
-                if let Value::Int(i) = v {
-                    key[k] = i;
-                }
+                // The whole value is the key: a let that reads the element
+                // may be a float (`valence(v) / 8.0`) or a bool
+                // (`valence(v) > 6`), and its type is the same for every
+                // element. Anything else is left to the interpreter.
+                key[k] = match v {
+                    Value::Int(i) => i,
+                    Value::Bool(b) => b as i64,
+                    Value::Float(f) => f.to_bits() as i64,
+                    _ => return Ok(None),
+                };
                 k += 1;
                 ev.frame()[*s as usize] = v;
             }
@@ -1083,9 +1119,8 @@ impl Affine {
         let weights = match found {
             Some(w) => w,
             None => {
-                // Every let that reads the element was an integer or an
-                // element (those give no key): the weights below depend
-                // on the key alone.
+                // Every let that reads the element is in the key: the
+                // weights below depend on the key alone.
                 for (s, a, reads) in &self.lets {
                     if !*reads {
                         let v = ev.eval(a)?;

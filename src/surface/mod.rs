@@ -148,6 +148,36 @@ mod tests {
              V(v; !new(v)) -> V(v = w(v, count(u in ring(v) where l(u) <= c)) / 2.5);\n"
                 .into(),
         ));
+        // Weights from lets that read the element but are not integers:
+        // each value is its own key (cube.obj's vertices have valences 4
+        // and 5, then 8 and 10).
+        cases.push((
+            "float-and-bool-keys.lsys".into(),
+            "mesh: \"../meshes/cube.obj\";\n\
+             define g(v, k) = k * v + (1 - k) * avg(ring(v));\n\
+             define h(v, b) = (b ? 0.25 : 0.75) * v + (b ? 0.75 : 0.25) * avg(ring(v));\n\
+             F(f) -> V(v = avg(f)) || E^3 F^3;\n\
+             V(v; !new(v)) -> V(v = g(v, valence(v) / 8.0));\n\
+             V(v; !new(v)) -> V(v = h(v, valence(v) > 9));\n"
+                .into(),
+        ));
+        // Lets the weights cannot take in their own order: a call in one
+        // term reusing the slot of a parameter the next term reads, and a
+        // parameter that reads the element computed from one that does
+        // not.
+        cases.push((
+            "slots-and-order.lsys".into(),
+            "mesh: \"../meshes/cube.obj\";\n\
+             define a(m) = m;\n\
+             define f(n, v) = n * v;\n\
+             define g(v) = a(2) * v - f(valence(v), v) / 8;\n\
+             define h(v, n) = n * 0.01 * v;\n\
+             define k(v, a) = h(v, valence(v) * a);\n\
+             F(f) -> V(v = avg(f)) || E^3 F^3;\n\
+             V(v; !new(v)) -> V(v = g(v));\n\
+             V(v; !new(v)) -> V(v = k(v, c + 1));\n"
+                .into(),
+        ));
         for (name, text) in &cases {
             let (a, b) = (run(name, text, false, 2), run(name, text, true, 2));
             assert_eq!(a.vertex_count(), b.vertex_count(), "{name}");

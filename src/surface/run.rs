@@ -476,19 +476,22 @@ impl Grammar {
         mesh: &Mesh,
         state: &RunState,
     ) -> Result<Matches, RuntimeError> {
-        Ok(self.find_matches_with(rule, None, mesh, state)?.0)
+        self.find_matches_with(rule, None, mesh, state)
+            .map(|m| m.0)
+            .map_err(|(_, e)| e)
     }
 
     /// What `rule` applies to, and `other`, an edge rule for the other
     /// context (boundary or interior), tested in the same pass over the
-    /// edges: both fixed when the first starts.
+    /// edges: both fixed when the first starts. An error says whether it
+    /// came from `other`'s condition.
     fn find_matches_with(
         &self,
         rule: &Rule,
         other: Option<&Rule>,
         mesh: &Mesh,
         state: &RunState,
-    ) -> Result<(Matches, Matches), RuntimeError> {
+    ) -> Result<(Matches, Matches), (bool, RuntimeError)> {
         // `c`, kept up to date by `apply_all` as rules make vertices.
         let current = state.current_level;
         let step = state.step;
@@ -504,7 +507,7 @@ impl Grammar {
         let ranges: Vec<(u32, u32)> = (0..slots.div_ceil(CHUNK))
             .map(|k| ((k * CHUNK) as u32, (((k + 1) * CHUNK).min(slots)) as u32))
             .collect();
-        let parts: Vec<Result<(Part, Part), RuntimeError>> = ranges
+        let parts: Vec<Result<(Part, Part), (bool, RuntimeError)>> = ranges
             .into_par_iter()
             .map(|(lo, hi)| {
                 let mut ev = Evaluator::new(mesh, current, step, frame_len);
@@ -520,7 +523,7 @@ impl Grammar {
                                     hs.iter().any(|h| mesh.face(h.twin()).is_none()),
                                     hs.iter().any(|h| mesh.is_block_edge(h.edge())),
                                 );
-                                if ev.test(rule, &val)? {
+                                if ev.test(rule, &val).map_err(|e| (false, e))? {
                                     a.0.push(val);
                                 }
                             }
@@ -551,7 +554,7 @@ impl Grammar {
                                 mesh.is_block_edge(e),
                                 mesh.is_transversal_edge(e),
                             );
-                            if ev.test(r, &val)? {
+                            if ev.test(r, &val).map_err(|e| (!std::ptr::eq(r, rule), e))? {
                                 out.0.push(val);
                                 out.1.push(e);
                             }
@@ -568,7 +571,7 @@ impl Grammar {
                                 VertexContext::Interior => !mesh.is_boundary_vertex(v),
                             };
                             let val = host::vertex(v);
-                            if ok && ev.test(rule, &val)? {
+                            if ok && ev.test(rule, &val).map_err(|e| (false, e))? {
                                 a.0.push(val);
                             }
                         }
@@ -665,7 +668,9 @@ impl Grammar {
                 Some(next) => {
                     let (a, b) = self
                         .find_matches_with(rule, Some(next), mesh, state)
-                        .map_err(|e| self.runtime_error(rule, step, e))?;
+                        .map_err(|(in_next, e)| {
+                            self.runtime_error(if in_next { next } else { rule }, step, e)
+                        })?;
                     self.apply_matched(rule, mesh, state, a)?;
                     self.apply_matched(next, mesh, state, b)?;
                     i += 2;

@@ -227,3 +227,78 @@ fn the_same_type_errors_read_the_same() {
     assert_eq!(cm, "error: type error: cannot apply `+` to V3f and int");
     assert_eq!(sm, cm);
 }
+
+/// `i64::MIN / -1` overflows: the interpreter wraps it to `i64::MIN`, as
+/// two's-complement hardware does, and the truncation check must not
+/// panic on it (it divides exactly, so there is nothing to warn about).
+#[test]
+fn the_most_negative_integer_divided_by_minus_one_is_checked_without_a_panic() {
+    let dir = folder("overflow");
+    let min = "(-9223372036854775807 - 1)";
+    let curve = write(
+        &dir,
+        "c.lsys",
+        &format!(
+            "module A(float);\nderivation length: 1;\nAxiom: A(1);\n\
+             A(x) : {{ produce A(x * ({min} / -1)); }}\n"
+        ),
+    );
+    let surface = write(
+        &dir,
+        "s.lsys",
+        &format!("mesh: \"tri.obj\";\nV(v) -> V(v = v * ({min} / -1));\n"),
+    );
+    for f in [&curve, &surface] {
+        let o = subgram(&["check", f]);
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+        assert!(!text(&o.stdout).contains("warning"), "{}", text(&o.stdout));
+    }
+    let o = subgram(&["derive", &curve, "--format", "json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let word: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        word["modules"][0]["params"],
+        serde_json::json!([-9223372036854775808.0])
+    );
+}
+
+/// The truncation warning follows a constant division wherever its value
+/// is read as a float: through a `define` function's parameter, in a
+/// branch of `?:` whose other branch is a float, in a comparison with a
+/// float, and under a negation. (Before the one language these were all
+/// floating-point divisions: `f(v, 1/16)` moved by 1/16, now by 0.)
+/// Positions counted by hand in the line.
+#[test]
+fn truncation_is_warned_through_parameters_branches_comparisons_and_negations() {
+    let dir = folder("truncation-paths");
+    let surface = write(
+        &dir,
+        "s.lsys",
+        "mesh: \"tri.obj\";\ndefine f(v, k) = k * v;\n\
+         V(v; 1/2 > 0.25) -> V(v = f(v, 1/16) + (new(v) ? 1/4 : 0.5) * v - -(1/8) * v);\n",
+    );
+    let s = subgram(&["check", &surface]);
+    assert!(s.status.success(), "{}", text(&s.stderr));
+    let out = text(&s.stdout);
+    let warned: Vec<&str> = out.lines().filter(|l| l.contains(": warning:")).collect();
+    let expected = [
+        "3:6: warning: `1/2` is 0",
+        "3:32: warning: `1/16` is 0",
+        "3:50: warning: `1/4` is 0",
+        "3:68: warning: `1/8` is 0",
+    ];
+    assert_eq!(warned.len(), expected.len(), "{out}");
+    for (w, e) in warned.iter().zip(expected) {
+        assert!(w.starts_with(&format!("{surface}:{e}")), "{w}\n{out}");
+    }
+    // A parameter read as an integer is not warned about.
+    let quiet = write(
+        &dir,
+        "q.lsys",
+        "mesh: \"tri.obj\";\ndefine f(v, n) = valence(v) > n;\n\
+         V(v; f(v, 7/2)) -> V(v = v);\n",
+    );
+    let q = subgram(&["check", &quiet]);
+    assert!(q.status.success());
+    assert!(!text(&q.stdout).contains("warning"), "{}", text(&q.stdout));
+}

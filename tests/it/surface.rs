@@ -630,6 +630,55 @@ fn grammar_functions_are_checked() {
     text += "V(v) -> V(v = f20(v));\n";
     let bad = load(&text);
     assert!(bad.contains("expand to more than 10000 calls"), "{bad}");
+    // A chain of functions, each calling the one before once inside a
+    // body 40 levels deep: nested 4000 calls deep, it would be 160,000
+    // levels deep and overflow the checker's stack. Chains are refused
+    // past 32 calls, as the surface checker did before the one language;
+    // 32 still check.
+    let chain = |n: usize| {
+        let mut text = String::from("define f0(x) = x;\n");
+        for i in 1..n {
+            text += &format!(
+                "define f{i}(x) = {}f{}(x){};\n",
+                "-(".repeat(20),
+                i - 1,
+                ")".repeat(20)
+            );
+        }
+        text + &format!("V(v) -> V(v = f{}(v));\n", n - 1)
+    };
+    // (On a large stack, as the binary gives the checker.)
+    let (ok, bad) = std::thread::Builder::new()
+        .stack_size(256 << 20)
+        .spawn(move || {
+            (
+                subgram::surface::load_str("g.lsys", &chain(32), &[]).is_ok(),
+                load(&chain(4000)),
+            )
+        })
+        .unwrap()
+        .join()
+        .unwrap();
+    assert!(ok);
+    assert!(
+        bad.contains("`f3967` is called more than 32 function calls deep"),
+        "{bad}"
+    );
+    // Locals are numbered with u16: calls nested 32 deep with 2100
+    // parameters each need more than 65,535 of them, which must be an
+    // error, not slots that wrap onto others (an index out of bounds).
+    let params: Vec<String> = (0..2100).map(|i| format!("p{i}")).collect();
+    let params = params.join(", ");
+    let mut text = format!("define g0(v, {params}) = v;\n");
+    for k in 1..32 {
+        text += &format!("define g{k}(v, {params}) = g{}(v, {params});\n", k - 1);
+    }
+    text += &format!("V(v) -> V(v = g31(v, {}));\n", vec!["1"; 2100].join(", "));
+    let bad = load(&text);
+    assert!(
+        bad.contains("error: this expression needs too many variables"),
+        "{bad}"
+    );
     let bad = load(&format!("define f(x) = x;\ndefine f(y) = y;\n{rule}"));
     assert!(
         bad.contains("g.lsys:2:8: error: function `f` is already defined above"),
