@@ -543,15 +543,28 @@ fn snapshot(dir: &Path) -> BTreeMap<String, Seen> {
     out
 }
 
-/// The directory a case runs in (made empty).
+/// The directory a case runs in; its stderr goes beside it.
 fn case_dir(case: &Case) -> PathBuf {
-    let base = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bad_inputs");
-    let dir = base.join(case.id.replace('/', "__"));
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("bad_inputs")
+        .join(case.id.replace('/', "__"))
+}
+
+/// The case's directory, made empty.
+fn fresh_dir(case: &Case) -> PathBuf {
+    let dir = case_dir(case);
     if dir.exists() {
         std::fs::remove_dir_all(&dir).unwrap();
     }
     std::fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// Removes what a case's run left in `target/tmp`.
+fn clean(case: &Case) {
+    let dir = case_dir(case);
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_file(dir.with_extension("stderr"));
 }
 
 /// Whether `subgram COMMAND --help` lists `--timeout` (asked once per
@@ -573,7 +586,7 @@ fn accepts_timeout(command: &[String]) -> bool {
 }
 
 fn run(case: &Case, limit: Duration) -> Outcome {
-    let dir = case_dir(case);
+    let dir = fresh_dir(case);
     for (name, source) in &case.files {
         let path = dir.join(name);
         match source {
@@ -972,18 +985,19 @@ fn one_case(case: &Case, known: Option<&Known>) -> Result<String, String> {
             clip(&o.stderr)
         )
     };
+    // What a run leaves in target/tmp is kept only where the test fails,
+    // for a person to look at (a sparse file never).
     let passed = tags.is_empty();
-    if passed {
-        // Leave nothing behind when all is well.
-        let dir = case_dir(case);
-        let _ = std::fs::remove_dir_all(&dir);
-        let _ = std::fs::remove_file(dir.with_extension("stderr"));
-    } else if case
+    let recorded = known.is_some_and(|k| {
+        let observed: BTreeSet<String> = tags.iter().map(|t| t.to_string()).collect();
+        k.alternatives.contains(&observed)
+    });
+    let sparse = case
         .files
         .iter()
-        .any(|(_, s)| matches!(s, Source::Sparse(_)))
-    {
-        let _ = std::fs::remove_dir_all(case_dir(case));
+        .any(|(_, s)| matches!(s, Source::Sparse(_)));
+    if passed || recorded || sparse {
+        clean(case);
     }
     match known {
         None if passed => Ok(String::new()),
@@ -1001,8 +1015,7 @@ fn one_case(case: &Case, known: Option<&Known>) -> Result<String, String> {
             case.id
         )),
         Some(k) => {
-            let observed: BTreeSet<String> = tags.iter().map(|t| t.to_string()).collect();
-            if k.alternatives.contains(&observed) {
+            if recorded {
                 Ok(format!(
                     "known failure {}: {} ({})",
                     case.id,
