@@ -6,8 +6,9 @@
 //! * stderr, with the temporary directory written `$TMP`, equals
 //!   `NAME.expected`;
 //! * where the input has lines, the message starts `file:line:col: error:`
-//!   and shows the line with a caret under the place (a case whose input
-//!   has no line to point at says so: `no-line: WHY` in its `.run` file);
+//!   and shows the line with a caret under the place, in one of the case's
+//!   inputs (a case whose input has no line to point at says so: `no-line:
+//!   WHY` in its `.run` file; usage errors, exit code 2, have no place);
 //! * no output and no temporary file is left in the directory, and no
 //!   input is changed or removed (the listing and the contents before and
 //!   after the run are compared);
@@ -40,7 +41,7 @@
 //! replaces `NAME.code`, and `UPDATE_GOLDEN` leaves it alone).
 //!
 //! Cases that misbehave today are listed in `tests/data/bad/KNOWN_FAILURES`
-//! with the way they misbehave ([`Problem`] tags). Such a case still runs
+//! with the way they misbehave (the names in [`PROBLEMS`]). Such a case still runs
 //! (killed after [`SHORT`] when it is recorded as a hang), and the test
 //! asserts that it misbehaves exactly as recorded: when it is fixed, or
 //! misbehaves differently, the test fails and says so, so that the list is
