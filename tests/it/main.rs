@@ -2,6 +2,7 @@
 //! against the shared lpfg corpus are a separate target, tests/shared.
 
 mod abop;
+mod bad_inputs;
 mod cli;
 mod curves;
 mod errors;
