@@ -72,23 +72,21 @@ impl Mesh {
                     f.len()
                 )));
             }
-            for (k, &v) in f.iter().enumerate() {
-                if v as usize >= nv {
-                    return Err(MeshError::new(format!(
-                        "face {}{} refers to vertex {}, but there are only {nv} vertices",
-                        fi + 1,
-                        at_line(soup, fi),
-                        v as usize + 1
-                    )));
-                }
-                if f[..k].contains(&v) {
-                    return Err(MeshError::new(format!(
-                        "face {}{} is degenerate: it uses vertex {} twice",
-                        fi + 1,
-                        at_line(soup, fi),
-                        v as usize + 1
-                    )));
-                }
+            if let Some(k) = f.iter().position(|&v| v as usize >= nv) {
+                return Err(MeshError::new(format!(
+                    "face {}{} refers to vertex {}, but there are only {nv} vertices",
+                    fi + 1,
+                    at_line(soup, fi),
+                    f[k] as usize + 1
+                )));
+            }
+            if let Some(k) = super::soup::first_repeat(f) {
+                return Err(MeshError::new(format!(
+                    "face {}{} is degenerate: it uses vertex {} twice",
+                    fi + 1,
+                    at_line(soup, fi),
+                    f[k] as usize + 1
+                )));
             }
             // A face of zero area.
             let p = |i: usize| soup.positions[f[i] as usize];
