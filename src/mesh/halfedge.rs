@@ -81,11 +81,22 @@ impl EdgeId {
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeshError {
     pub message: String,
+    /// The line of the mesh file that holds the face or vertex at fault,
+    /// where [`Mesh::from_soup`] knows it.
+    pub line: Option<usize>,
 }
 
 impl MeshError {
     pub fn new(m: impl Into<String>) -> MeshError {
-        MeshError { message: m.into() }
+        MeshError {
+            message: m.into(),
+            line: None,
+        }
+    }
+
+    /// The error, about the element on `line` of the mesh file.
+    pub fn at(self, line: Option<usize>) -> MeshError {
+        MeshError { line, ..self }
     }
 }
 

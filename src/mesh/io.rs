@@ -24,6 +24,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
+use super::halfedge::Mesh;
 use super::soup::{first_repeat, MeshFileError, Place, PolygonSoup};
 
 /// The largest mesh file [`read`] reads unless the environment variable
@@ -95,6 +96,25 @@ pub fn read(path: &Path) -> Result<PolygonSoup, MeshFileError> {
     let limit = max_file_bytes().map_err(|m| error(&name, None, m))?;
     let bytes = read_bounded(&name, path, limit)?;
     read_str(&name, format, &bytes)
+}
+
+/// Reads the mesh file at `path` (see [`read`]) and builds the half-edge
+/// mesh, refusing what is not an oriented 2-manifold (see
+/// [`Mesh::from_soup`]). A refusal that names a face or vertex shows its
+/// line, which is read from the file again for the message.
+pub fn read_mesh(path: &Path) -> Result<Mesh, MeshFileError> {
+    let soup = read(path)?;
+    Mesh::from_soup(&soup).map_err(|e| {
+        let name = path.display().to_string();
+        let line = e.line.and_then(|no| {
+            let limit = max_file_bytes().ok()?;
+            let bytes = read_bounded(&name, path, limit).ok()?;
+            let text = utf8(&name, &bytes, 1).ok()?;
+            let line = Source { text, first: 1 }.line(no)?;
+            Some(line.whole(&name, &e.message))
+        });
+        line.unwrap_or_else(|| error(&name, None, e.message))
+    })
 }
 
 /// Reads a mesh in `format` from `bytes`; `name` is the file name for

@@ -287,6 +287,14 @@ fn bounds_mesh_errors_show_the_line_and_a_caret() {
         "b.ply:6:1: error: expected `property TYPE NAME` or `property list COUNT_TYPE ITEM_TYPE NAME`\n  \
          |\n6 | property float z w\n  | ^^^^^^^^^^^^^^^^^^\n"
     );
+    // What the half-edge mesh refuses, at the line of the element.
+    let bowtie = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n";
+    let err = refused(&dir, "bowtie.obj", bowtie, &[], 10);
+    assert_eq!(
+        err,
+        "bowtie.obj:1:1: error: vertex 1 (line 1) is a bow-tie: two separate fans of faces meet \
+         there (non-manifold)\n  |\n1 | v 0 0 0\n  | ^^^^^^^\n"
+    );
     // Invalid UTF-8, at its byte, the line shown with U+FFFD.
     let err = refused(&dir, "u.obj", b"v 0 0 0\nv 1 \xff\xfe 0\n", &[], 10);
     assert_eq!(
