@@ -205,6 +205,10 @@ pub(crate) fn render_line(
     message: &str,
 ) -> String {
     let text = text.split(['\n', '\r']).next().unwrap_or("");
+    if u32::try_from(text.len()).is_err() {
+        // Spans hold 32-bit offsets: a line of 4 GiB is named, not shown.
+        return format!("{path}:{line}: error: {message}");
+    }
     let at = |i: usize| {
         (0..=i.min(text.len()))
             .rev()

@@ -1276,7 +1276,7 @@ mod ply {
                 .unwrap_or(self.rest.len());
             let w = &self.rest[..end];
             self.rest = &self.rest[end..];
-            self.word += 1;
+            self.word = self.word.saturating_add(1);
             self.last = Some((self.line, w));
             self.last
         }
@@ -1473,7 +1473,7 @@ mod ply {
         }
         match role {
             Role::Vertex(_) => raw.push_vertex(DVec3::from(xyz), line),
-            Role::Face(_) => raw.end_face(face_at.0, face_at.1 + 1),
+            Role::Face(_) => raw.end_face(face_at.0, face_at.1.saturating_add(1)),
             Role::Skip => {}
         }
         Ok(())
