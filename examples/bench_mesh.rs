@@ -3,11 +3,16 @@
 //! to a new one across a face. `cargo run --release --example bench_mesh`
 //!
 //! Also timed in the same run, as references: building the half-edge mesh
-//! from the polygon soup, and a plain copy of the mesh's arrays.
+//! from the polygon soup, and a plain copy of the mesh's arrays; then
+//! reading the same mesh from files (OBJ, OFF, ASCII and binary PLY),
+//! written to a temporary folder and removed afterwards.
+
+mod common;
 
 use std::time::Instant;
 
-use subgram::mesh::{shapes, EdgeId, Mesh};
+use subgram::mesh::io::{self, Format};
+use subgram::mesh::{shapes, EdgeId, Mesh, PolygonSoup};
 
 fn main() {
     let soup = shapes::icosphere(8);
@@ -84,4 +89,54 @@ fn main() {
         base.bytes_per_face(),
         m.bytes_per_face()
     );
+    read_files(&soup);
+}
+
+/// Times reading `soup` back from each file format (best of 3).
+fn read_files(soup: &PolygonSoup) {
+    let dir = std::env::temp_dir().join(format!("subgram-bench-mesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary folder");
+    let files = [
+        ("mesh.obj", io::to_bytes(Format::Obj, soup)),
+        ("mesh.off", io::to_bytes(Format::Off, soup)),
+        ("ascii.ply", io::to_bytes(Format::Ply, soup)),
+        ("binary.ply", binary_ply(soup)),
+    ];
+    println!("reading {} faces from files (best of 3):", soup.faces.len());
+    for (name, bytes) in &files {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).expect("write a bench file");
+        let (t, read) = common::best_of(3, || io::read(&path).expect("reads"));
+        assert_eq!(read.faces.len(), soup.faces.len());
+        println!(
+            "  {name:<12} {:>6.1} MB {:>8.1} ms",
+            bytes.len() as f64 / 1e6,
+            t.as_secs_f64() * 1e3
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `soup` as binary little-endian PLY with double coordinates.
+fn binary_ply(soup: &PolygonSoup) -> Vec<u8> {
+    let mut out = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\n\
+         property double x\nproperty double y\nproperty double z\n\
+         element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+        soup.positions.len(),
+        soup.faces.len()
+    )
+    .into_bytes();
+    for p in &soup.positions {
+        for c in [p.x, p.y, p.z] {
+            out.extend(c.to_le_bytes());
+        }
+    }
+    for f in &soup.faces {
+        out.push(f.len() as u8);
+        for &i in f {
+            out.extend(i.to_le_bytes());
+        }
+    }
+    out
 }

@@ -4,7 +4,7 @@
 use std::fmt;
 use std::path::PathBuf;
 
-use crate::syntax::{Diagnostic, SourceMap};
+use crate::syntax::{Diagnostic, SourceFile, SourceMap, Span};
 
 /// What went wrong. Every variant displays as a message for a person; none
 /// starts with `error: ` (a program that prints it adds its own prefix, as
@@ -46,6 +46,19 @@ pub enum Error {
         line: Option<usize>,
         message: String,
     },
+    /// A data file's problem at a place in one of its lines: a token of a
+    /// mesh file. Displayed as `path:line:col: error: message`, the line
+    /// and a caret, as [`Error::Program`]'s diagnostics are.
+    FileAt {
+        path: String,
+        line: usize,
+        /// The text of the line (without its newline).
+        text: String,
+        /// The byte range of `text` that the caret marks.
+        start: usize,
+        end: usize,
+        message: String,
+    },
     /// A run failed with nothing in a file to point at: a word that grew
     /// past its limit, a picture with nothing to draw, a contour too short
     /// for the steps asked.
@@ -61,7 +74,10 @@ impl Error {
     /// True when the message begins with the place it is about
     /// (`file:line:col:`, `file:line:` or `file:`), followed by `error:`.
     pub fn has_location(&self) -> bool {
-        matches!(self, Error::Program { .. } | Error::File { .. })
+        matches!(
+            self,
+            Error::Program { .. } | Error::File { .. } | Error::FileAt { .. }
+        )
     }
 
     /// The diagnostics of a [`Error::Program`] error; empty for the others.
@@ -134,6 +150,14 @@ impl fmt::Display for Error {
                 line: None,
                 message,
             } => write!(f, "{path}: error: {message}"),
+            Error::FileAt {
+                path,
+                line,
+                text,
+                start,
+                end,
+                message,
+            } => f.write_str(&render_line(path, *line, text, *start..*end, message)),
             Error::Failed(m) | Error::Usage(m) => f.write_str(m),
         }
     }
@@ -150,10 +174,102 @@ impl std::error::Error for Error {
 
 impl From<crate::mesh::MeshFileError> for Error {
     fn from(e: crate::mesh::MeshFileError) -> Error {
-        Error::File {
-            path: e.path,
-            line: e.line,
-            message: e.message,
+        match (e.line, e.place) {
+            (Some(line), Some(place)) => Error::FileAt {
+                path: e.path,
+                line,
+                text: place.text,
+                start: place.start,
+                end: place.end,
+                message: e.message,
+            },
+            (line, _) => Error::File {
+                path: e.path,
+                line,
+                message: e.message,
+            },
+        }
+    }
+}
+
+/// `path:line:col: error: message`, then `text`, line `line` of the file,
+/// and a caret under its bytes `range`: what [`SourceMap::render`] shows
+/// for a diagnostic in a program, for a file of which only the one line is
+/// at hand. The one renderer draws it from a file of that line alone; the
+/// line number is then put back in the three places that show it.
+pub(crate) fn render_line(
+    path: &str,
+    line: usize,
+    text: &str,
+    range: std::ops::Range<usize>,
+    message: &str,
+) -> String {
+    let text = text.split(['\n', '\r']).next().unwrap_or("");
+    if u32::try_from(text.len()).is_err() {
+        // Spans hold 32-bit offsets: a line of 4 GiB is named, not shown.
+        return format!("{path}:{line}: error: {message}");
+    }
+    let at = |i: usize| {
+        (0..=i.min(text.len()))
+            .rev()
+            .find(|&i| text.is_char_boundary(i))
+    };
+    let start = at(range.start).unwrap_or(0);
+    let end = at(range.end).unwrap_or(start).max(start);
+    let mut map = SourceMap::default();
+    let file = map.add(SourceFile::new(path, text));
+    let shown = map.render(Span::new(file, start, end), message);
+    // `path:1:col: ...`, ` |`, `1 | text`, `  | ^`: the gutter is one wide.
+    let mut parts = shown.rsplitn(4, '\n');
+    let (Some(caret), Some(source), Some(gutter), Some(header)) =
+        (parts.next(), parts.next(), parts.next(), parts.next())
+    else {
+        return shown;
+    };
+    let (Some(rest), Some(source), Some(gutter), Some(caret)) = (
+        header.strip_prefix(&format!("{path}:1:")),
+        source.strip_prefix('1'),
+        gutter.strip_prefix(' '),
+        caret.strip_prefix(' '),
+    ) else {
+        return shown;
+    };
+    let pad = " ".repeat(line.to_string().len());
+    format!("{path}:{line}:{rest}\n{pad}{gutter}\n{line}{source}\n{pad}{caret}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A line rendered alone reads as the same line rendered in its file.
+    #[test]
+    fn render_line_is_the_one_rendering() {
+        let long = format!("f {}", "12 ".repeat(80));
+        let lines = ["v 0 0 0", "\tv 1 x 0", "é v 2 0 0", long.as_str()];
+        let mut text = String::new();
+        let mut starts = Vec::new();
+        for k in 0..1200 {
+            starts.push(text.len());
+            text.push_str(lines[k % lines.len()]);
+            text.push('\n');
+        }
+        let mut map = SourceMap::default();
+        let file = map.add(SourceFile::new("m.obj", text.clone()));
+        for k in [0, 1, 2, 3, 9, 10, 98, 99, 1001, 1199] {
+            let line = lines[k % lines.len()];
+            let ranges = [(0, 1), (4, 5), (3, 3), (200, 203), (2, 200)];
+            let fits = |&(a, b): &(usize, usize)| {
+                b <= line.len() && line.is_char_boundary(a) && line.is_char_boundary(b)
+            };
+            for (a, b) in ranges.into_iter().filter(fits) {
+                let want = map.render(
+                    Span::new(file, starts[k] + a, starts[k] + b),
+                    "expected a number",
+                );
+                let got = render_line("m.obj", k + 1, line, a..b, "expected a number");
+                assert_eq!(got, want, "line {} bytes {a}..{b}", k + 1);
+            }
         }
     }
 }

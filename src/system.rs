@@ -256,6 +256,5 @@ impl Surface {
 /// Reads a mesh file (`.obj`, `.off`, `.ply`) and builds the half-edge
 /// mesh, with the file's name on every message.
 pub fn load_mesh(path: &Path) -> Result<Mesh, Error> {
-    let soup = crate::mesh::io::read(path)?;
-    Mesh::from_soup(&soup).map_err(|e| Error::file(path.display().to_string(), e.message))
+    Ok(crate::mesh::io::read_mesh(path)?)
 }

@@ -44,7 +44,8 @@ impl Mesh {
                     "vertex {}{} has a non-finite coordinate",
                     i + 1,
                     vertex_at_line(soup, i)
-                )));
+                ))
+                .at(soup.vertex_line(i)));
             }
         }
         if soup.faces.is_empty() {
@@ -70,25 +71,26 @@ impl Mesh {
                     fi + 1,
                     at_line(soup, fi),
                     f.len()
-                )));
+                ))
+                .at(soup.face_line(fi)));
             }
-            for (k, &v) in f.iter().enumerate() {
-                if v as usize >= nv {
-                    return Err(MeshError::new(format!(
-                        "face {}{} refers to vertex {}, but there are only {nv} vertices",
-                        fi + 1,
-                        at_line(soup, fi),
-                        v as usize + 1
-                    )));
-                }
-                if f[..k].contains(&v) {
-                    return Err(MeshError::new(format!(
-                        "face {}{} is degenerate: it uses vertex {} twice",
-                        fi + 1,
-                        at_line(soup, fi),
-                        v as usize + 1
-                    )));
-                }
+            if let Some(k) = f.iter().position(|&v| v as usize >= nv) {
+                return Err(MeshError::new(format!(
+                    "face {}{} refers to vertex {}, but there are only {nv} vertices",
+                    fi + 1,
+                    at_line(soup, fi),
+                    f[k] as usize + 1
+                ))
+                .at(soup.face_line(fi)));
+            }
+            if let Some(k) = super::soup::first_repeat(f) {
+                return Err(MeshError::new(format!(
+                    "face {}{} is degenerate: it uses vertex {} twice",
+                    fi + 1,
+                    at_line(soup, fi),
+                    f[k] as usize + 1
+                ))
+                .at(soup.face_line(fi)));
             }
             // A face of zero area.
             let p = |i: usize| soup.positions[f[i] as usize];
@@ -101,7 +103,8 @@ impl Mesh {
                     "face {}{} is degenerate: it has zero area",
                     fi + 1,
                     at_line(soup, fi)
-                )));
+                ))
+                .at(soup.face_line(fi)));
             }
             for i in 1..f.len() - 1 {
                 // Fan from vertex 0: edge (0, i) is internal unless i == 1,
@@ -129,7 +132,8 @@ impl Mesh {
                         key[0] + 1,
                         key[1] + 1,
                         key[2] + 1
-                    )));
+                    ))
+                    .at(soup.face_line(*fi)));
                 }
             }
             seen.insert(key, *fi);
@@ -177,7 +181,8 @@ impl Mesh {
                                 at_line(soup, *fi),
                                 other + 1,
                                 at_line(soup, other)
-                            )));
+                            ))
+                            .at(soup.face_line(*fi)));
                         }
                         h
                     }
@@ -204,7 +209,8 @@ impl Mesh {
                         "vertex {}{} is a bow-tie: two separate fans of faces meet there (non-manifold)",
                         v.index() + 1,
                         vertex_at_line(soup, v.index())
-                    )));
+                    ))
+                    .at(soup.vertex_line(v.index())));
                 }
                 boundary_out[v.index()] = Some(h);
             }
@@ -233,7 +239,8 @@ impl Mesh {
                     "vertex {}{} is non-manifold: its faces form more than one fan",
                     v + 1,
                     vertex_at_line(soup, v)
-                )));
+                ))
+                .at(soup.vertex_line(v)));
             }
         }
         for f in 0..m.f_alive.len() {

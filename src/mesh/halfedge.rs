@@ -81,11 +81,22 @@ impl EdgeId {
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeshError {
     pub message: String,
+    /// The line of the mesh file that holds the face or vertex at fault,
+    /// where [`Mesh::from_soup`] knows it.
+    pub line: Option<usize>,
 }
 
 impl MeshError {
     pub fn new(m: impl Into<String>) -> MeshError {
-        MeshError { message: m.into() }
+        MeshError {
+            message: m.into(),
+            line: None,
+        }
+    }
+
+    /// The error, about the element on `line` of the mesh file.
+    pub fn at(self, line: Option<usize>) -> MeshError {
+        MeshError { line, ..self }
     }
 }
 
@@ -353,6 +364,39 @@ impl Mesh {
     /// The half-edge from `a` to `b`, if they are joined.
     pub fn find_halfedge(&self, a: VertexId, b: VertexId) -> Option<HalfEdgeId> {
         self.outgoing_halfedges(a).find(|&h| self.to(h) == b)
+    }
+
+    /// The face `vs` (its corners counter-clockwise, from any of them),
+    /// if there is one. The three vertices are walked around in turn, so
+    /// the cost is three times the smallest of their valences: a triangle
+    /// at a vertex of huge valence is found from its other corners.
+    pub fn find_face(&self, vs: [VertexId; 3]) -> Option<FaceId> {
+        let mut walks = vs.map(|v| self.outgoing_halfedges(v));
+        loop {
+            for (k, walk) in walks.iter_mut().enumerate() {
+                // A face at `vs` is met around each of its corners, so a
+                // walk that ends without it means there is none.
+                let h = walk.next()?;
+                if self.to(h) == vs[(k + 1) % 3] && self.to(self.next(h)) == vs[(k + 2) % 3] {
+                    if let Some(f) = self.face(h) {
+                        return Some(f);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The vertex of highest valence and its valence (`None` without
+    /// edges), in one pass over the edges.
+    pub fn max_valence(&self) -> Option<(VertexId, usize)> {
+        let mut count = vec![0u32; self.v_alive.len()];
+        for e in self.edges() {
+            let h = e.halfedge();
+            count[self.to(h).index()] += 1;
+            count[self.to(h.twin()).index()] += 1;
+        }
+        let (v, &n) = count.iter().enumerate().rev().max_by_key(|&(_, n)| *n)?;
+        (n > 0).then_some((VertexId(v as u32), n as usize))
     }
 
     // ----- walkers ----------------------------------------------------

@@ -2,20 +2,40 @@
 //! a checked [`PolygonSoup`], and writing a soup as OBJ, OFF or ASCII PLY.
 //!
 //! Reading never panics on bad input: every problem is a [`MeshFileError`]
-//! that names the file and, for text, the line. Vertex and face numbers in
-//! messages follow the file's own convention: 1-based in OBJ, 0-based in OFF
-//! and PLY. A soup that reads without error has finite coordinates, faces of
-//! at least three distinct, in-range vertices, and at least one face.
+//! that names the file and, for text (and a binary PLY file's header), the
+//! line and the column, shown with the line and a caret. Vertex and face
+//! numbers in messages follow the file's own convention: 1-based in OBJ,
+//! 0-based in OFF and PLY. A soup that reads without error has finite
+//! coordinates, faces of at least three distinct, in-range vertices, and at
+//! least one face.
+//!
+//! Bounds: a file larger than [`max_file_bytes`] (2 GiB unless
+//! `SUBGRAM_MAX_MESH_BYTES` says otherwise) is refused before it is read;
+//! every count a file declares is checked against the data that is there
+//! before anything is looped over or set aside for it; all work is linear
+//! in the file's size, or `n log n` in a face's.
 //!
 //! Coordinates are written with `{:?}`, the shortest text that parses back to
 //! the same `f64`, so a soup written and read again is bit-for-bit the same.
 
-use std::borrow::Cow;
+use std::io::Read;
+use std::ops::Range;
 use std::path::Path;
 
 use glam::DVec3;
 
-use super::soup::{MeshFileError, PolygonSoup};
+use super::halfedge::Mesh;
+use super::soup::{first_repeat, MeshFileError, Place, PolygonSoup};
+
+/// The largest mesh file [`read`] reads unless the environment variable
+/// [`MAX_FILE_BYTES_VAR`] sets another limit: 2 GiB, about 40 million
+/// triangles of OBJ text, the scale of a grammar run's face limit.
+pub const MAX_FILE_BYTES: u64 = 2 << 30;
+
+/// The environment variable that sets the largest mesh file read, as a
+/// number of bytes: `SUBGRAM_MAX_MESH_BYTES=8000000000 subgram mesh info
+/// big.ply`.
+pub const MAX_FILE_BYTES_VAR: &str = "SUBGRAM_MAX_MESH_BYTES";
 
 /// A mesh file format, chosen by file extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -50,24 +70,61 @@ impl Format {
     }
 }
 
-/// Reads the mesh file at `path`, its format chosen by extension.
+/// The largest mesh file [`read`] reads, in bytes: `SUBGRAM_MAX_MESH_BYTES`
+/// when it is set, else [`MAX_FILE_BYTES`]; a message when the variable is
+/// not a whole number.
+pub fn max_file_bytes() -> Result<u64, String> {
+    match std::env::var(MAX_FILE_BYTES_VAR) {
+        Err(std::env::VarError::NotPresent) => Ok(MAX_FILE_BYTES),
+        Ok(v) => v.trim().parse::<u64>().map_err(|_| {
+            format!("{MAX_FILE_BYTES_VAR} must be a whole number of bytes, found `{v}`")
+        }),
+        Err(std::env::VarError::NotUnicode(v)) => Err(format!(
+            "{MAX_FILE_BYTES_VAR} must be a whole number of bytes, found `{}`",
+            v.to_string_lossy()
+        )),
+    }
+}
+
+/// Reads the mesh file at `path`, its format chosen by extension. A file
+/// larger than [`max_file_bytes`] is refused: a regular file by its size
+/// before it is read, anything else (a device, a pipe) as soon as reading
+/// passes the limit.
 pub fn read(path: &Path) -> Result<PolygonSoup, MeshFileError> {
     let name = path.display().to_string();
     let format = format_of(&name, path)?;
-    let bytes = std::fs::read(path)
-        .map_err(|e| error(&name, None, format!("cannot read the file: {e}")))?;
+    let limit = max_file_bytes().map_err(|m| error(&name, None, m))?;
+    let bytes = read_bounded(&name, path, limit)?;
     read_str(&name, format, &bytes)
+}
+
+/// Reads the mesh file at `path` (see [`read`]) and builds the half-edge
+/// mesh, refusing what is not an oriented 2-manifold (see
+/// [`Mesh::from_soup`]). A refusal that names a face or vertex shows its
+/// line, which is read from the file again for the message.
+pub fn read_mesh(path: &Path) -> Result<Mesh, MeshFileError> {
+    let soup = read(path)?;
+    Mesh::from_soup(&soup).map_err(|e| {
+        let name = path.display().to_string();
+        let line = e.line.and_then(|no| {
+            let limit = max_file_bytes().ok()?;
+            let bytes = read_bounded(&name, path, limit).ok()?;
+            let text = utf8(&name, &bytes, 1).ok()?;
+            let line = Source { text, first: 1 }.line(no)?;
+            Some(line.whole(&name, &e.message))
+        });
+        line.unwrap_or_else(|| error(&name, None, e.message))
+    })
 }
 
 /// Reads a mesh in `format` from `bytes`; `name` is the file name for
 /// messages.
 pub fn read_str(name: &str, format: Format, bytes: &[u8]) -> Result<PolygonSoup, MeshFileError> {
-    let raw = match format {
-        Format::Obj => obj::parse(name, bytes)?,
-        Format::Off => off::parse(name, bytes)?,
-        Format::Ply => ply::parse(name, bytes)?,
-    };
-    raw.finish(name)
+    match format {
+        Format::Obj => obj::parse(name, bytes),
+        Format::Off => off::parse(name, bytes),
+        Format::Ply => ply::parse(name, bytes),
+    }
 }
 
 /// Writes `soup` to `path` atomically, its format chosen by extension (PLY
@@ -90,13 +147,78 @@ pub fn to_bytes(format: Format, soup: &PolygonSoup) -> Vec<u8> {
 }
 
 // ---------------------------------------------------------------------------
+// Reading a file
+
+/// The bytes of the file at `path`, or an error when there are more than
+/// `limit` of them.
+fn read_bounded(name: &str, path: &Path, limit: u64) -> Result<Vec<u8>, MeshFileError> {
+    let cannot = |e: std::io::Error| error(name, None, format!("cannot read the file: {e}"));
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let size = file
+        .metadata()
+        .ok()
+        .filter(|m| m.is_file())
+        .map(|m| m.len());
+    if let Some(size) = size.filter(|&s| s > limit) {
+        return Err(too_large(name, Some(size), limit));
+    }
+    let room = size.map_or(0, |s| usize::try_from(s).unwrap_or(0).saturating_add(1));
+    let mut bytes = Vec::with_capacity(room);
+    file.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(name, None, limit));
+    }
+    Ok(bytes)
+}
+
+/// "the file is 3 GiB, more than the limit of ...", naming the limit and
+/// how to raise it; `size` is `None` for a stream read up to the limit.
+fn too_large(name: &str, size: Option<u64>, limit: u64) -> MeshFileError {
+    let what = match size {
+        Some(s) => format!("the file is {}", bytes_text(s)),
+        None => "the file goes on".to_string(),
+    };
+    error(
+        name,
+        None,
+        format!(
+            "{what}, more than the limit of {} for a mesh file; \
+             set {MAX_FILE_BYTES_VAR} to a larger number of bytes to read it",
+            bytes_text(limit)
+        ),
+    )
+}
+
+/// `n` bytes for a person: "2147483648 bytes (2 GiB)".
+fn bytes_text(n: u64) -> String {
+    let units = [
+        (1u64 << 40, "TiB"),
+        (1 << 30, "GiB"),
+        (1 << 20, "MiB"),
+        (1 << 10, "KiB"),
+    ];
+    match units.iter().find(|&&(u, _)| n >= u) {
+        Some(&(u, unit)) => {
+            let v = format!("{:.1}", n as f64 / u as f64);
+            let v = v.strip_suffix(".0").unwrap_or(&v);
+            format!("{n} bytes ({v} {unit})")
+        }
+        None => format!("{n} bytes"),
+    }
+}
+
+// ---------------------------------------------------------------------------
 // Shared reading helpers
 
-/// An error about file `name`, at `line` where one applies.
+/// An error about file `name`, at `line` where one applies, with nothing
+/// to show on it (binary data, or the whole file at fault).
 fn error(name: &str, line: Option<usize>, message: impl Into<String>) -> MeshFileError {
     MeshFileError {
         path: name.to_string(),
         line,
+        place: None,
         message: message.into(),
     }
 }
@@ -104,6 +226,97 @@ fn error(name: &str, line: Option<usize>, message: impl Into<String>) -> MeshFil
 /// A recorded line number as an optional one (0 means unknown).
 fn known(line: usize) -> Option<usize> {
     (line > 0).then_some(line)
+}
+
+/// A line of a text file (or of a PLY header): its 1-based number and its
+/// text without the newline.
+#[derive(Clone, Copy, Debug)]
+struct Line<'a> {
+    no: usize,
+    text: &'a str,
+}
+
+impl Line<'_> {
+    /// An error about `part` of this line, a slice of its text (a word);
+    /// about the whole statement where `part` is not one (a word of OBJ
+    /// lines joined by a backslash).
+    fn at(&self, name: &str, part: &str, message: impl Into<String>) -> MeshFileError {
+        let range = match offset_in(self.text, part) {
+            Some(start) => start..start + part.len(),
+            None => statement(self.text),
+        };
+        self.at_range(name, range, message)
+    }
+
+    /// An error about the whole statement on this line.
+    fn whole(&self, name: &str, message: impl Into<String>) -> MeshFileError {
+        self.at_range(name, statement(self.text), message)
+    }
+
+    /// An error just after the last word of this line: where a file ends
+    /// too early.
+    fn end(&self, name: &str, message: impl Into<String>) -> MeshFileError {
+        let n = self.text.trim_end().len();
+        self.at_range(name, n..n, message)
+    }
+
+    fn at_range(
+        &self,
+        name: &str,
+        range: Range<usize>,
+        message: impl Into<String>,
+    ) -> MeshFileError {
+        MeshFileError {
+            path: name.to_string(),
+            line: Some(self.no),
+            place: Some(Place {
+                text: self.text.to_string(),
+                start: range.start,
+                end: range.end,
+            }),
+            message: message.into(),
+        }
+    }
+}
+
+/// Where `part` starts in `text`, when it is a slice of it.
+fn offset_in(text: &str, part: &str) -> Option<usize> {
+    let start = (part.as_ptr() as usize).checked_sub(text.as_ptr() as usize)?;
+    (start + part.len() <= text.len()).then_some(start)
+}
+
+/// The bytes of a line's statement: from its first word to its last one
+/// before any comment.
+fn statement(text: &str) -> Range<usize> {
+    let body = strip_comment(text);
+    let start = body.len() - body.trim_start().len();
+    start..body.trim_end().len().max(start)
+}
+
+/// A text that a mesh was read from, for messages about its faces after
+/// it is read: the text and the number of its first line.
+#[derive(Clone, Copy)]
+struct Source<'a> {
+    text: &'a str,
+    first: usize,
+}
+
+impl<'a> Source<'a> {
+    /// Line `no`, if the text holds it (a walk over the text, made for
+    /// messages only).
+    fn line(&self, no: usize) -> Option<Line<'a>> {
+        let text = self.text.lines().nth(no.checked_sub(self.first)?)?;
+        Some(Line { no, text })
+    }
+
+    /// The last line: where a file that ends too early ends.
+    fn last(&self) -> Line<'a> {
+        let (count, text) = self.text.lines().fold((0, ""), |(n, _), l| (n + 1, l));
+        Line {
+            no: (self.first + count).saturating_sub(1).max(1),
+            text,
+        }
+    }
 }
 
 /// The format for `path`, or an error listing the supported ones.
@@ -126,15 +339,45 @@ fn format_of(name: &str, path: &Path) -> Result<Format, MeshFileError> {
 fn utf8<'a>(name: &str, bytes: &'a [u8], first_line: usize) -> Result<&'a str, MeshFileError> {
     match std::str::from_utf8(bytes) {
         Ok(text) => Ok(text.strip_prefix('\u{feff}').unwrap_or(text)),
-        Err(e) => {
-            let good = &bytes[..e.valid_up_to()];
-            let line = first_line + good.iter().filter(|&&b| b == b'\n').count();
-            Err(error(
-                name,
-                Some(line),
-                "the file is not UTF-8 text (an invalid byte on this line)",
-            ))
-        }
+        Err(e) => Err(not_text(
+            name,
+            bytes,
+            e.valid_up_to(),
+            first_line,
+            "the file is not UTF-8 text (an invalid byte on this line)",
+        )),
+    }
+}
+
+/// An error at byte `bad` of `bytes`, the first byte that is not UTF-8;
+/// `first_line` is the line number the bytes start on. The line is shown
+/// with the invalid bytes as U+FFFD, the caret under the first.
+fn not_text(
+    name: &str,
+    bytes: &[u8],
+    bad: usize,
+    first_line: usize,
+    message: &str,
+) -> MeshFileError {
+    let good = &bytes[..bad];
+    let start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let end = bytes[bad..]
+        .iter()
+        .position(|&b| b == b'\n')
+        .map_or(bytes.len(), |i| bad + i);
+    let line = first_line + good.iter().filter(|&&b| b == b'\n').count();
+    let text = String::from_utf8_lossy(&bytes[start..end]);
+    // The bytes before `bad` are UTF-8, so they keep their offsets.
+    let col = bad - start;
+    MeshFileError {
+        path: name.to_string(),
+        line: Some(line),
+        place: Some(Place {
+            text: text.trim_end_matches('\r').to_string(),
+            start: col,
+            end: col + '\u{fffd}'.len_utf8(),
+        }),
+        message: message.to_string(),
     }
 }
 
@@ -143,59 +386,54 @@ fn strip_comment(line: &str) -> &str {
     line.split('#').next().unwrap_or(line)
 }
 
-/// The number of lines in `text`, at least 1 (for errors at the end).
-fn last_line(text: &str) -> usize {
-    text.lines().count().max(1)
-}
-
-/// A number, or "expected a number, found `tok`".
-fn parse_number(name: &str, line: Option<usize>, tok: &str) -> Result<f64, MeshFileError> {
+/// A number, or "expected a number, found `tok`" at it.
+fn parse_number(name: &str, line: &Line, tok: &str) -> Result<f64, MeshFileError> {
     tok.parse::<f64>()
-        .map_err(|_| error(name, line, format!("expected a number, found `{tok}`")))
+        .map_err(|_| line.at(name, tok, format!("expected a number, found `{tok}`")))
 }
 
 /// A whole number that counts `what`.
-fn parse_count(
-    name: &str,
-    line: Option<usize>,
-    tok: &str,
-    what: &str,
-) -> Result<usize, MeshFileError> {
+fn parse_count(name: &str, line: &Line, tok: &str, what: &str) -> Result<usize, MeshFileError> {
     tok.parse::<usize>().map_err(|_| {
-        error(
+        line.at(
             name,
-            line,
+            tok,
             format!("expected the number of {what}, found `{tok}`"),
         )
     })
 }
 
 /// A vertex index as written (no base applied).
-fn parse_index(name: &str, line: Option<usize>, tok: &str) -> Result<i64, MeshFileError> {
-    tok.parse::<i64>().map_err(|_| {
-        error(
-            name,
-            line,
-            format!("expected a vertex index, found `{tok}`"),
-        )
-    })
+fn parse_index(name: &str, line: &Line, tok: &str) -> Result<i64, MeshFileError> {
+    tok.parse::<i64>()
+        .map_err(|_| line.at(name, tok, format!("expected a vertex index, found `{tok}`")))
 }
 
-/// A position from the first three of `toks` (further values are ignored).
-fn parse_position(name: &str, line: usize, toks: &[&str]) -> Result<DVec3, MeshFileError> {
-    let line = known(line);
-    if toks.len() < 3 {
-        return Err(error(
+/// A position from the first three of `toks` (further values are ignored);
+/// `raw` numbers it in messages.
+fn parse_position<'a>(
+    name: &str,
+    line: &Line,
+    mut toks: impl Iterator<Item = &'a str>,
+    raw: &Raw,
+) -> Result<DVec3, MeshFileError> {
+    let found = [toks.next(), toks.next(), toks.next()];
+    let [Some(x), Some(y), Some(z)] = found else {
+        let n = found.iter().flatten().count();
+        return Err(line.whole(
             name,
-            line,
-            format!("a vertex needs 3 coordinates (x y z), found {}", toks.len()),
+            format!("a vertex needs 3 coordinates (x y z), found {n}"),
         ));
+    };
+    let p = DVec3::new(
+        parse_number(name, line, x)?,
+        parse_number(name, line, y)?,
+        parse_number(name, line, z)?,
+    );
+    if let Some(k) = (0..3).find(|&k| !p[k].is_finite()) {
+        return Err(line.at(name, [x, y, z][k], raw.non_finite(raw.positions.len())));
     }
-    Ok(DVec3::new(
-        parse_number(name, line, toks[0])?,
-        parse_number(name, line, toks[1])?,
-        parse_number(name, line, toks[2])?,
-    ))
+    Ok(p)
 }
 
 /// A mesh as parsed, before its faces are checked: face indices are
@@ -203,8 +441,14 @@ fn parse_position(name: &str, line: usize, toks: &[&str]) -> Result<DVec3, MeshF
 struct Raw {
     positions: Vec<DVec3>,
     vertex_lines: Vec<usize>,
-    faces: Vec<Vec<i64>>,
+    /// Every face's vertices, one face after another.
+    indices: Vec<i64>,
+    /// Where each face's vertices start in `indices`, and where the last
+    /// one's end.
+    starts: Vec<usize>,
     face_lines: Vec<usize>,
+    /// Which word of its line each face's first vertex is (for messages).
+    face_words: Vec<u32>,
     /// How the file numbers vertices and faces (1 in OBJ, 0 otherwise).
     base: i64,
 }
@@ -215,8 +459,10 @@ impl Raw {
         Raw {
             positions: Vec::new(),
             vertex_lines: Vec::new(),
-            faces: Vec::new(),
+            indices: Vec::new(),
+            starts: vec![0],
             face_lines: Vec::new(),
+            face_words: Vec::new(),
             base,
         }
     }
@@ -227,17 +473,41 @@ impl Raw {
         self.vertex_lines.push(line);
     }
 
-    /// Adds a face read on `line`.
-    fn push_face(&mut self, face: Vec<i64>, line: usize) {
-        self.faces.push(face);
+    /// Ends the face whose vertices were pushed onto `indices` since the
+    /// last one: read on `line`, its first vertex the `word`-th word there.
+    fn end_face(&mut self, line: usize, word: u32) {
+        self.starts.push(self.indices.len());
         self.face_lines.push(line);
+        self.face_words.push(word);
     }
 
-    /// Checks the mesh and turns it into a soup.
-    fn finish(self, name: &str) -> Result<PolygonSoup, MeshFileError> {
-        self.check_vertices(name)?;
-        let faces = (0..self.faces.len())
-            .map(|f| self.check_face(name, f))
+    /// The number of faces so far.
+    fn face_count(&self) -> usize {
+        self.face_lines.len()
+    }
+
+    /// "vertex 3 has a non-finite coordinate", for vertex `v` (0-based).
+    fn non_finite(&self, v: usize) -> String {
+        format!(
+            "vertex {} has a non-finite coordinate",
+            v as i64 + self.base
+        )
+    }
+
+    /// Checks the mesh and turns it into a soup; `source` is the text it
+    /// was read from, to show the lines of faces at fault.
+    fn finish(self, name: &str, source: Option<Source>) -> Result<PolygonSoup, MeshFileError> {
+        if let Some(v) = self.positions.iter().position(|p| !p.is_finite()) {
+            let line = self.vertex_lines[v];
+            let located = source.and_then(|s| s.line(line));
+            let message = self.non_finite(v);
+            return Err(match located {
+                Some(l) => l.whole(name, message),
+                None => error(name, known(line), message),
+            });
+        }
+        let faces = (0..self.face_count())
+            .map(|f| self.check_face(name, source, f))
             .collect::<Result<Vec<_>, _>>()?;
         if faces.is_empty() {
             return Err(error(name, None, "the mesh has no faces"));
@@ -250,55 +520,67 @@ impl Raw {
         })
     }
 
-    /// Refuses non-finite coordinates.
-    fn check_vertices(&self, name: &str) -> Result<(), MeshFileError> {
-        match self.positions.iter().position(|p| !p.is_finite()) {
-            Some(v) => Err(error(
-                name,
-                known(self.vertex_lines[v]),
-                format!(
-                    "vertex {} has a non-finite coordinate",
-                    v as i64 + self.base
-                ),
-            )),
-            None => Ok(()),
-        }
-    }
-
     /// Face `f` with at least three distinct, in-range vertices.
-    fn check_face(&self, name: &str, f: usize) -> Result<Vec<u32>, MeshFileError> {
-        let face = &self.faces[f];
-        let line = known(self.face_lines[f]);
+    fn check_face(
+        &self,
+        name: &str,
+        source: Option<Source>,
+        f: usize,
+    ) -> Result<Vec<u32>, MeshFileError> {
+        let face = &self.indices[self.starts[f]..self.starts[f + 1]];
         let number = f as i64 + self.base;
-        let fail = |message: String| Err(error(name, line, message));
+        // At the face's `k`-th vertex, or at the whole face.
+        let fail = |k: Option<usize>, message: String| {
+            let line = self.face_lines[f];
+            let Some(l) = source.and_then(|s| s.line(line)) else {
+                return Err(error(name, known(line), message));
+            };
+            let word = k.map(|k| self.face_words[f] as usize + k);
+            Err(
+                match word.and_then(|w| strip_comment(l.text).split_whitespace().nth(w)) {
+                    Some(tok) => l.at(name, tok, message),
+                    None => l.whole(name, message),
+                },
+            )
+        };
         if face.len() < 3 {
-            return fail(format!(
-                "face {number} has {} vertices, but a face needs at least 3",
-                face.len()
-            ));
+            return fail(
+                None,
+                format!(
+                    "face {number} has {} vertices, but a face needs at least 3",
+                    face.len()
+                ),
+            );
         }
         let n = self.positions.len();
         let mut out = Vec::with_capacity(face.len());
-        for &i in face {
+        for (k, &i) in face.iter().enumerate() {
             match usize::try_from(i).ok().filter(|&i| i < n) {
-                Some(i) => out.push(u32::try_from(i).map_err(|_| {
-                    error(name, line, "the mesh has too many vertices (over 2^32)")
-                })?),
+                Some(i) => match u32::try_from(i) {
+                    Ok(i) => out.push(i),
+                    Err(_) => {
+                        return fail(Some(k), "the mesh has too many vertices (over 2^32)".into())
+                    }
+                },
                 None => {
-                    return fail(format!(
-                        "face {number} refers to vertex {}, but there are only {n} vertices",
-                        i.saturating_add(self.base)
-                    ))
+                    return fail(
+                        Some(k),
+                        format!(
+                            "face {number} refers to vertex {}, but there are only {n} vertices",
+                            i.saturating_add(self.base)
+                        ),
+                    )
                 }
             }
         }
-        let mut sorted = out.clone();
-        sorted.sort_unstable();
-        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
-            return fail(format!(
-                "face {number} repeats vertex {} (a degenerate face)",
-                i64::from(w[0]) + self.base
-            ));
+        if let Some(k) = first_repeat(&out) {
+            return fail(
+                Some(k),
+                format!(
+                    "face {number} repeats vertex {} (a degenerate face)",
+                    i64::from(out[k]) + self.base
+                ),
+            );
         }
         Ok(out)
     }
@@ -312,97 +594,92 @@ mod obj {
 
     use super::*;
 
-    /// Parses OBJ text into a raw mesh.
-    pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Raw, MeshFileError> {
+    /// Parses OBJ text into a checked soup.
+    pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<PolygonSoup, MeshFileError> {
         let text = utf8(name, bytes, 1)?;
         let mut raw = Raw::new(1);
-        for (line, content) in logical_lines(text) {
-            let toks: Vec<&str> = content.split_whitespace().collect();
-            match toks.first().copied() {
-                Some("v") => raw.push_vertex(parse_position(name, line, &toks[1..])?, line),
+        let mut lines = text.lines().enumerate();
+        let mut joined = String::new();
+        while let Some((i, first)) = lines.next() {
+            let line = Line {
+                no: i + 1,
+                text: first,
+            };
+            let mut content = strip_comment(first).trim_end();
+            if content.ends_with('\\') {
+                // A backslash at the end continues the statement on the
+                // next line.
+                joined.clear();
+                loop {
+                    match content.strip_suffix('\\') {
+                        Some(body) => {
+                            joined.push_str(body);
+                            joined.push(' ');
+                            match lines.next() {
+                                Some((_, next)) => content = strip_comment(next).trim_end(),
+                                None => break,
+                            }
+                        }
+                        None => {
+                            joined.push_str(content);
+                            break;
+                        }
+                    }
+                }
+                content = &joined;
+            }
+            let mut toks = content.split_whitespace();
+            match toks.next() {
+                Some("v") => {
+                    let p = parse_position(name, &line, toks, &raw)?;
+                    raw.push_vertex(p, line.no);
+                }
                 Some("f") | Some("fo") => {
-                    let face = parse_face(name, line, &toks[1..], &raw)?;
-                    raw.push_face(face, line);
+                    parse_face(name, &line, toks, &mut raw)?;
+                    raw.end_face(line.no, 1);
                 }
                 // vt, vn, vp, o, g, s, usemtl, mtllib, l, p, free-form
                 // geometry: nothing this reader needs.
                 _ => {}
             }
         }
-        Ok(raw)
+        raw.finish(name, Some(Source { text, first: 1 }))
     }
 
-    /// The lines of `text` without comments, with backslash-continued lines
-    /// joined, each with its first line number.
-    fn logical_lines(text: &str) -> Vec<(usize, Cow<'_, str>)> {
-        let mut out = Vec::new();
-        let mut pending: Option<(usize, String)> = None;
-        for (i, raw) in text.lines().enumerate() {
-            let content = strip_comment(raw).trim_end();
-            let (body, continues) = match content.strip_suffix('\\') {
-                Some(b) => (b, true),
-                None => (content, false),
-            };
-            match pending.take() {
-                Some((start, mut acc)) => {
-                    acc.push(' ');
-                    acc.push_str(body);
-                    if continues {
-                        pending = Some((start, acc));
-                    } else {
-                        out.push((start, Cow::Owned(acc)));
-                    }
-                }
-                None if continues => pending = Some((i + 1, body.to_string())),
-                None => out.push((i + 1, Cow::Borrowed(body))),
-            }
-        }
-        if let Some((start, acc)) = pending {
-            out.push((start, Cow::Owned(acc)));
-        }
-        out
-    }
-
-    /// The 0-based vertices of an `f` statement (forms `i`, `i/t`, `i//n`,
-    /// `i/t/n`; negative indices count back from the last vertex so far).
-    fn parse_face(
+    /// Pushes the 0-based vertices of an `f` statement (forms `i`, `i/t`,
+    /// `i//n`, `i/t/n`; negative indices count back from the last vertex so
+    /// far).
+    fn parse_face<'a>(
         name: &str,
-        line: usize,
-        toks: &[&str],
-        raw: &Raw,
-    ) -> Result<Vec<i64>, MeshFileError> {
-        let number = raw.faces.len() + 1;
+        line: &Line,
+        toks: impl Iterator<Item = &'a str>,
+        raw: &mut Raw,
+    ) -> Result<(), MeshFileError> {
+        let number = raw.face_count() + 1;
         let count = raw.positions.len();
-        toks.iter()
-            .map(|tok| {
-                let first = tok.split('/').next().unwrap_or(tok);
-                let i = parse_index(name, Some(line), first)?;
-                resolve(name, line, number, count, i)
-            })
-            .collect()
+        for tok in toks {
+            let first = tok.split('/').next().unwrap_or(tok);
+            let i = parse_index(name, line, first)?;
+            let i = resolve(number, count, i).map_err(|m| line.at(name, tok, m))?;
+            raw.indices.push(i);
+        }
+        Ok(())
     }
 
     /// A written OBJ index as 0-based, refusing 0 and indices before the
     /// first vertex.
-    fn resolve(
-        name: &str,
-        line: usize,
-        face: usize,
-        count: usize,
-        i: i64,
-    ) -> Result<i64, MeshFileError> {
-        let fail = |message: String| Err(error(name, Some(line), message));
+    fn resolve(face: usize, count: usize, i: i64) -> Result<i64, String> {
         if i > 0 {
             return Ok(i - 1);
         }
         if i == 0 {
-            return fail(format!(
+            return Err(format!(
                 "face {face} refers to vertex 0, but OBJ indices start at 1"
             ));
         }
         let resolved = count as i64 + i;
         if resolved < 0 {
-            return fail(format!(
+            return Err(format!(
                 "face {face} refers to vertex {i}, but only {count} vertices precede it"
             ));
         }
@@ -419,52 +696,69 @@ mod off {
 
     use super::*;
 
-    /// A non-empty line's number and words.
-    type Line<'a> = (usize, Vec<&'a str>);
-
-    /// Parses OFF text into a raw mesh.
-    pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Raw, MeshFileError> {
+    /// Parses OFF text into a checked soup.
+    pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<PolygonSoup, MeshFileError> {
         let text = utf8(name, bytes, 1)?;
-        let end = last_line(text);
+        let source = Source { text, first: 1 };
         let mut lines = text
             .lines()
             .enumerate()
-            .map(|(i, l)| (i + 1, strip_comment(l).split_whitespace().collect()))
-            .filter(|(_, toks): &Line| !toks.is_empty());
-        let (line, counts) = counts(name, &mut lines, end)?;
-        let nv = parse_count(name, Some(line), counts[0], "vertices")?;
-        let nf = parse_count(name, Some(line), counts[1], "faces")?;
+            .map(|(i, l)| Line { no: i + 1, text: l })
+            .filter(|l| strip_comment(l.text).split_whitespace().next().is_some());
+        let (line, counts) = counts(name, &mut lines, source)?;
+        let nv = parse_count(name, &line, counts[0], "vertices")?;
+        let nf = parse_count(name, &line, counts[1], "faces")?;
         let mut raw = Raw::new(0);
+        // Room for what the counts declare, as far as the text can hold it
+        // (a vertex takes 6 bytes or more, a face 8): a count is checked
+        // against the lines that are there as they are read.
+        raw.positions.reserve(nv.min(text.len() / 6));
+        raw.face_lines.reserve(nf.min(text.len() / 8));
         for v in 0..nv {
-            let (line, toks) = lines
+            let line = lines
                 .next()
-                .ok_or_else(|| ends_early(name, end, v, nv, "vertices"))?;
-            raw.push_vertex(parse_position(name, line, &toks)?, line);
-        }
-        for f in 0..nf {
-            let (line, toks) = lines
-                .next()
-                .ok_or_else(|| ends_early(name, end, f, nf, "faces"))?;
-            raw.push_face(parse_face(name, line, f, &toks)?, line);
-        }
-        match lines.next() {
-            Some((line, toks)) => Err(error(
+                .ok_or_else(|| ends_early(name, source, v, nv, "vertices"))?;
+            let p = parse_position(
                 name,
-                Some(line),
+                &line,
+                strip_comment(line.text).split_whitespace(),
+                &raw,
+            )?;
+            raw.push_vertex(p, line.no);
+        }
+        let mut toks = Vec::new();
+        for f in 0..nf {
+            let line = lines
+                .next()
+                .ok_or_else(|| ends_early(name, source, f, nf, "faces"))?;
+            toks.clear();
+            toks.extend(strip_comment(line.text).split_whitespace());
+            parse_face(name, &line, f, &toks, &mut raw)?;
+            raw.end_face(line.no, 1);
+        }
+        if let Some(line) = lines.next() {
+            let words: Vec<&str> = strip_comment(line.text).split_whitespace().collect();
+            return Err(line.whole(
+                name,
                 format!(
                     "unexpected `{}` after the {nf} declared faces",
-                    toks.join(" ")
+                    words.join(" ")
                 ),
-            )),
-            None => Ok(raw),
+            ));
         }
+        raw.finish(name, Some(source))
     }
 
-    /// "the file ends after 3 of the 8 declared vertices".
-    fn ends_early(name: &str, end: usize, got: usize, want: usize, what: &str) -> MeshFileError {
-        error(
+    /// "the file ends after 3 of the 8 declared vertices", where it ends.
+    fn ends_early(
+        name: &str,
+        source: Source,
+        got: usize,
+        want: usize,
+        what: &str,
+    ) -> MeshFileError {
+        source.last().end(
             name,
-            Some(end),
             format!("the file ends after {got} of the {want} declared {what}"),
         )
     }
@@ -473,25 +767,36 @@ mod off {
     fn counts<'a>(
         name: &str,
         lines: &mut impl Iterator<Item = Line<'a>>,
-        end: usize,
-    ) -> Result<Line<'a>, MeshFileError> {
+        source: Source<'a>,
+    ) -> Result<(Line<'a>, Vec<&'a str>), MeshFileError> {
         let expected = "expected the counts line `vertices faces edges`";
-        let (line, toks) = lines
-            .next()
-            .ok_or_else(|| error(name, Some(end), format!("the file is empty: {expected}")))?;
+        let words = |l: &Line<'a>| -> Vec<&'a str> {
+            let text: &'a str = l.text;
+            strip_comment(text).split_whitespace().collect()
+        };
+        let line = lines.next().ok_or_else(|| {
+            source
+                .last()
+                .end(name, format!("the file is empty: {expected}"))
+        })?;
+        let toks = words(&line);
         let (line, toks) = if is_header(toks[0]) {
-            check_header(name, line, &toks)?;
+            check_header(name, &line, &toks)?;
             if toks.len() > 1 {
                 (line, toks[1..].to_vec())
             } else {
-                lines
-                    .next()
-                    .ok_or_else(|| error(name, Some(end), format!("the file ends: {expected}")))?
+                let next = lines.next().ok_or_else(|| {
+                    source
+                        .last()
+                        .end(name, format!("the file ends: {expected}"))
+                })?;
+                let toks = words(&next);
+                (next, toks)
             }
         } else if toks[0].parse::<f64>().is_err() {
-            return Err(error(
+            return Err(line.at(
                 name,
-                Some(line),
+                toks[0],
                 format!(
                     "expected an `OFF` header or the counts line, found `{}`",
                     toks[0]
@@ -501,11 +806,7 @@ mod off {
             (line, toks)
         };
         if toks.len() < 2 {
-            return Err(error(
-                name,
-                Some(line),
-                format!("{expected}, found `{}`", toks.join(" ")),
-            ));
+            return Err(line.whole(name, format!("{expected}, found `{}`", toks.join(" "))));
         }
         Ok((line, toks))
     }
@@ -517,44 +818,52 @@ mod off {
     }
 
     /// Refuses the OFF variants this reader does not handle.
-    fn check_header(name: &str, line: usize, toks: &[&str]) -> Result<(), MeshFileError> {
-        let refuse = |message: &str| Err(error(name, Some(line), message));
+    fn check_header(name: &str, line: &Line, toks: &[&str]) -> Result<(), MeshFileError> {
         if toks[0].contains('4') {
-            return refuse("4OFF (four coordinates per vertex) is not supported");
+            return Err(line.at(
+                name,
+                toks[0],
+                "4OFF (four coordinates per vertex) is not supported",
+            ));
         }
         if toks[0].contains('n') {
-            return refuse("nOFF (any number of coordinates per vertex) is not supported");
+            return Err(line.at(
+                name,
+                toks[0],
+                "nOFF (any number of coordinates per vertex) is not supported",
+            ));
         }
-        if toks.get(1) == Some(&"BINARY") {
-            return refuse("binary OFF is not supported");
+        if let Some(&word @ "BINARY") = toks.get(1) {
+            return Err(line.at(name, word, "binary OFF is not supported"));
         }
         Ok(())
     }
 
-    /// Face `f`: `k i1 .. ik`, further values (colours) ignored.
+    /// Pushes face `f`: `k i1 .. ik`, further values (colours) ignored.
     fn parse_face(
         name: &str,
-        line: usize,
+        line: &Line,
         f: usize,
         toks: &[&str],
-    ) -> Result<Vec<i64>, MeshFileError> {
-        let k = toks[0].parse::<usize>().map_err(|_| {
-            let found = toks[0];
+        raw: &mut Raw,
+    ) -> Result<(), MeshFileError> {
+        let found = toks[0];
+        let k = found.parse::<usize>().map_err(|_| {
             let message = format!("expected the number of vertices of face {f}, found `{found}`");
-            error(name, Some(line), message)
+            line.at(name, found, message)
         })?;
         let listed = toks.len() - 1;
         if listed < k {
-            return Err(error(
+            return Err(line.at(
                 name,
-                Some(line),
+                found,
                 format!("face {f} declares {k} vertices but lists {listed}"),
             ));
         }
-        toks[1..=k]
-            .iter()
-            .map(|tok| parse_index(name, Some(line), tok))
-            .collect()
+        for tok in &toks[1..=k] {
+            raw.indices.push(parse_index(name, line, tok)?);
+        }
+        Ok(())
     }
 }
 
@@ -640,26 +949,49 @@ mod ply {
 
     /// A declared property.
     #[derive(Clone, Debug)]
-    struct Property {
-        name: String,
+    struct Property<'a> {
+        name: &'a str,
         kind: Kind,
     }
 
     /// A declared element with its instance count and header line.
     #[derive(Clone, Debug)]
-    struct Element {
-        name: String,
+    struct Element<'a> {
+        name: &'a str,
         count: usize,
-        props: Vec<Property>,
-        line: usize,
+        props: Vec<Property<'a>>,
+        line: Line<'a>,
+        /// The count as written on `line`, for messages.
+        count_word: &'a str,
+    }
+
+    impl Element<'_> {
+        /// The fewest bytes an instance takes in binary data (its scalars
+        /// and its lists' counts), and whether every instance takes that
+        /// many (no lists).
+        fn least_size(&self) -> (usize, bool) {
+            let mut fixed = true;
+            let size = self
+                .props
+                .iter()
+                .map(|p| match p.kind {
+                    Kind::Scalar(s) => s.size(),
+                    Kind::List { count, .. } => {
+                        fixed = false;
+                        count.size()
+                    }
+                })
+                .sum();
+            (size, fixed)
+        }
     }
 
     /// The parsed header.
-    struct Header {
+    struct Header<'a> {
         binary: bool,
-        elements: Vec<Element>,
-        /// The line of `end_header`.
-        end_line: usize,
+        elements: Vec<Element<'a>>,
+        /// The `end_header` line.
+        end: Line<'a>,
         /// The byte offset where the data starts.
         body: usize,
     }
@@ -674,8 +1006,8 @@ mod ply {
         Skip,
     }
 
-    /// Parses a PLY file into a raw mesh.
-    pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Raw, MeshFileError> {
+    /// Parses a PLY file into a checked soup.
+    pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<PolygonSoup, MeshFileError> {
         let header = parse_header(name, bytes)?;
         let body = &bytes[header.body..];
         if header.binary {
@@ -683,129 +1015,134 @@ mod ply {
                 bytes: body,
                 pos: 0,
             };
-            read_elements(name, &header, &mut src)
+            read_elements(name, &header, &mut src)?.finish(name, None)
         } else {
-            let text = utf8(name, body, header.end_line + 1)?;
-            let mut src = Ascii::new(text, header.end_line);
+            let first = header.end.no + 1;
+            let text = utf8(name, body, first)?;
+            let mut src = Ascii::new(text, header.end);
             let raw = read_elements(name, &header, &mut src)?;
             src.check_end(name)?;
-            Ok(raw)
+            raw.finish(name, Some(Source { text, first }))
         }
     }
 
     // -- header
 
     /// Reads the header lines up to `end_header`.
-    fn parse_header(name: &str, bytes: &[u8]) -> Result<Header, MeshFileError> {
+    fn parse_header<'a>(name: &str, bytes: &'a [u8]) -> Result<Header<'a>, MeshFileError> {
         let mut pos = 0;
-        let mut line = 0;
+        let mut last: Option<Line<'a>> = None;
         let mut format = None;
-        let mut elements: Vec<Element> = Vec::new();
-        loop {
+        let mut elements: Vec<Element<'a>> = Vec::new();
+        let end = loop {
+            let no = last.map_or(1, |l| l.no + 1);
             if pos >= bytes.len() {
-                let message = if line == 0 {
-                    "the file is empty: expected a PLY header"
-                } else {
-                    "the header ends without an `end_header` line"
-                };
-                return Err(error(name, Some(line.max(1)), message));
+                return Err(match last {
+                    None => Line { no: 1, text: "" }
+                        .end(name, "the file is empty: expected a PLY header"),
+                    Some(l) => l.end(name, "the header ends without an `end_header` line"),
+                });
             }
-            let end = bytes[pos..]
+            let stop = bytes[pos..]
                 .iter()
                 .position(|&b| b == b'\n')
                 .map_or(bytes.len(), |k| pos + k);
-            line += 1;
-            let raw = &bytes[pos..end];
+            let raw = &bytes[pos..stop];
             let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
-            pos = end + 1;
-            if line == 1 {
-                if raw.trim_ascii() != b"ply" {
-                    return Err(error(
-                        name,
-                        Some(1),
-                        "not a PLY file: the first line must be `ply`",
-                    ));
-                }
+            pos = stop + 1;
+            if no == 1 && raw.trim_ascii() != b"ply" {
+                let text = String::from_utf8_lossy(raw);
+                let line = Line { no, text: &text };
+                return Err(line.whole(name, "not a PLY file: the first line must be `ply`"));
+            }
+            let text = std::str::from_utf8(raw).map_err(|e| {
+                not_text(name, raw, e.valid_up_to(), no, "the PLY header is not text")
+            })?;
+            let line = Line { no, text };
+            last = Some(line);
+            if no == 1 {
                 continue;
             }
-            let text = std::str::from_utf8(raw)
-                .map_err(|_| error(name, Some(line), "the PLY header is not text"))?;
-            let toks: Vec<&str> = text.split_whitespace().collect();
+            let toks: Vec<&'a str> = text.split_whitespace().collect();
             match toks.first().copied() {
                 None | Some("comment") | Some("obj_info") => {}
-                Some("end_header") => break,
-                Some("format") => format = Some(parse_format(name, line, &toks)?),
+                Some("end_header") => break line,
+                Some("format") => format = Some(parse_format(name, &line, &toks)?),
                 Some("element") => elements.push(parse_element(name, line, &toks)?),
                 Some("property") => {
                     let element = elements.last_mut().ok_or_else(|| {
-                        error(name, Some(line), "a `property` line before any `element`")
+                        line.at(name, toks[0], "a `property` line before any `element`")
                     })?;
-                    element.props.push(parse_property(name, line, &toks)?);
+                    element.props.push(parse_property(name, &line, &toks)?);
                 }
                 Some(other) => {
-                    return Err(error(
-                        name,
-                        Some(line),
-                        format!("unknown PLY header line `{other}`"),
-                    ))
+                    return Err(line.at(name, other, format!("unknown PLY header line `{other}`")))
                 }
             }
-        }
+        };
         let binary =
-            format.ok_or_else(|| error(name, Some(line), "the PLY header has no `format` line"))?;
+            format.ok_or_else(|| end.whole(name, "the PLY header has no `format` line"))?;
         Ok(Header {
             binary,
             elements,
-            end_line: line,
+            end,
             body: pos.min(bytes.len()),
         })
     }
 
     /// `format ascii 1.0` (false) or `format binary_little_endian 1.0`
     /// (true).
-    fn parse_format(name: &str, line: usize, toks: &[&str]) -> Result<bool, MeshFileError> {
+    fn parse_format(name: &str, line: &Line, toks: &[&str]) -> Result<bool, MeshFileError> {
         match toks.get(1).copied() {
             Some("ascii") => Ok(false),
             Some("binary_little_endian") => Ok(true),
-            Some("binary_big_endian") => Err(error(
+            Some(big @ "binary_big_endian") => Err(line.at(
                 name,
-                Some(line),
+                big,
                 "big-endian binary PLY is not supported; convert it to ascii or binary_little_endian",
             )),
-            Some(other) => Err(error(
+            Some(other) => Err(line.at(
                 name,
-                Some(line),
+                other,
                 format!("unknown PLY format `{other}`: expected ascii or binary_little_endian"),
             )),
-            None => Err(error(
+            None => Err(line.whole(
                 name,
-                Some(line),
                 "expected `format ascii 1.0` or `format binary_little_endian 1.0`",
             )),
         }
     }
 
     /// `element NAME COUNT`.
-    fn parse_element(name: &str, line: usize, toks: &[&str]) -> Result<Element, MeshFileError> {
-        let [_, element, count] = toks else {
-            return Err(error(name, Some(line), "expected `element NAME COUNT`"));
+    fn parse_element<'a>(
+        name: &str,
+        line: Line<'a>,
+        toks: &[&'a str],
+    ) -> Result<Element<'a>, MeshFileError> {
+        let &[_, element, count] = toks else {
+            return Err(line.whole(name, "expected `element NAME COUNT`"));
         };
         Ok(Element {
-            name: element.to_string(),
-            count: parse_count(name, Some(line), count, &format!("`{element}` elements"))?,
+            name: element,
+            count: parse_count(name, &line, count, &format!("`{element}` elements"))?,
             props: Vec::new(),
             line,
+            count_word: count,
         })
     }
 
     /// `property TYPE NAME` or `property list COUNT_TYPE ITEM_TYPE NAME`.
-    fn parse_property(name: &str, line: usize, toks: &[&str]) -> Result<Property, MeshFileError> {
+    fn parse_property<'a>(
+        name: &str,
+        line: &Line,
+        toks: &[&'a str],
+    ) -> Result<Property<'a>, MeshFileError> {
         let scalar = |t: &str| {
             Scalar::parse(t)
-                .ok_or_else(|| error(name, Some(line), format!("unknown PLY property type `{t}`")))
+                .ok_or_else(|| line.at(name, t, format!("unknown PLY property type `{t}`")))
         };
         let (prop, kind) =
-            match toks {
+            match *toks {
                 [_, "list", count, item, prop] => (
                     prop,
                     Kind::List {
@@ -813,24 +1150,20 @@ mod ply {
                         item: scalar(item)?,
                     },
                 ),
-                [_, ty, prop] if *ty != "list" => (prop, Kind::Scalar(scalar(ty)?)),
-                _ => return Err(error(
+                [_, ty, prop] if ty != "list" => (prop, Kind::Scalar(scalar(ty)?)),
+                _ => return Err(line.whole(
                     name,
-                    Some(line),
                     "expected `property TYPE NAME` or `property list COUNT_TYPE ITEM_TYPE NAME`",
                 )),
             };
-        Ok(Property {
-            name: prop.to_string(),
-            kind,
-        })
+        Ok(Property { name: prop, kind })
     }
 
     /// The role of `el`, checking that vertices have x, y, z and faces a
     /// list of integer vertex indices.
     fn role(name: &str, el: &Element) -> Result<Role, MeshFileError> {
-        let fail = |message: String| Err(error(name, Some(el.line), message));
-        match el.name.as_str() {
+        let fail = |message: String| Err(el.line.at(name, el.name, message));
+        match el.name {
             "vertex" => {
                 let mut ix = [0; 3];
                 for (k, axis) in ["x", "y", "z"].into_iter().enumerate() {
@@ -867,40 +1200,93 @@ mod ply {
     trait Values {
         /// The next value, read as type `ty`; `None` where the data ends.
         fn next(&mut self, name: &str, ty: Scalar) -> Result<Option<f64>, MeshFileError>;
-        /// The line of the next value (the last line at the end; `None` in
-        /// binary data).
-        fn line(&self) -> Option<usize>;
+        /// The line of the next value and which word of it the value is
+        /// (0 and 0 in binary data).
+        fn position(&mut self) -> (usize, u32);
+        /// An error about the value read last (about the file, in binary
+        /// data).
+        fn at_last(&self, name: &str, message: String) -> MeshFileError;
+        /// "the file ends after 3 of the 4 declared `face` elements": where
+        /// text ends; at the count in the header for binary data.
+        fn ended(&self, name: &str, el: &Element, got: usize) -> MeshFileError;
+        /// The bytes left, in binary data.
+        fn bytes_left(&self) -> Option<usize>;
     }
 
-    /// ASCII data: whitespace-separated words with their lines.
+    /// ASCII data: whitespace-separated words, read as they are needed.
     struct Ascii<'a> {
-        words: Vec<(usize, &'a str)>,
-        pos: usize,
-        end: usize,
+        /// The lines not yet reached, `None` after the last.
+        ahead: Option<&'a str>,
+        /// The line being read, and what is left of it.
+        line: Line<'a>,
+        rest: &'a str,
+        /// Which word of `line` starts `rest`.
+        word: u32,
+        /// The word read last and its line.
+        last: Option<(Line<'a>, &'a str)>,
     }
 
     impl<'a> Ascii<'a> {
-        /// The words of `text`, whose first line follows `header_end`.
-        fn new(text: &'a str, header_end: usize) -> Ascii<'a> {
-            let mut end = header_end;
-            let mut words = Vec::new();
-            for (i, l) in text.lines().enumerate() {
-                end = header_end + i + 1;
-                words.extend(l.split_whitespace().map(|w| (end, w)));
-            }
+        /// The words of `text`, which follows the header's last line `end`.
+        fn new(text: &'a str, end: Line<'a>) -> Ascii<'a> {
             Ascii {
-                words,
-                pos: 0,
-                end: end.max(1),
+                ahead: (!text.is_empty()).then_some(text),
+                line: end,
+                rest: "",
+                word: 0,
+                last: None,
             }
         }
 
+        /// Moves to the start of the next word; false where the data ends.
+        fn seek(&mut self) -> bool {
+            loop {
+                let rest = self.rest.trim_start();
+                if !rest.is_empty() {
+                    self.rest = rest;
+                    return true;
+                }
+                let Some(text) = self.ahead else {
+                    self.rest = "";
+                    return false;
+                };
+                let (line, ahead) = match text.find('\n') {
+                    Some(i) => (&text[..i], Some(&text[i + 1..]).filter(|t| !t.is_empty())),
+                    None => (text, None),
+                };
+                let line = line.strip_suffix('\r').unwrap_or(line);
+                self.ahead = ahead;
+                self.line = Line {
+                    no: self.line.no + 1,
+                    text: line,
+                };
+                self.rest = line;
+                self.word = 0;
+            }
+        }
+
+        /// The next word and its line.
+        fn take(&mut self) -> Option<(Line<'a>, &'a str)> {
+            if !self.seek() {
+                return None;
+            }
+            let end = self
+                .rest
+                .find(char::is_whitespace)
+                .unwrap_or(self.rest.len());
+            let w = &self.rest[..end];
+            self.rest = &self.rest[end..];
+            self.word = self.word.saturating_add(1);
+            self.last = Some((self.line, w));
+            self.last
+        }
+
         /// Refuses words left after the declared elements.
-        fn check_end(&self, name: &str) -> Result<(), MeshFileError> {
-            match self.words.get(self.pos) {
-                Some(&(line, w)) => Err(error(
+        fn check_end(&mut self, name: &str) -> Result<(), MeshFileError> {
+            match self.take() {
+                Some((line, w)) => Err(line.at(
                     name,
-                    Some(line),
+                    w,
                     format!("unexpected `{w}` after the declared elements"),
                 )),
                 None => Ok(()),
@@ -910,15 +1296,36 @@ mod ply {
 
     impl Values for Ascii<'_> {
         fn next(&mut self, name: &str, _ty: Scalar) -> Result<Option<f64>, MeshFileError> {
-            let Some(&(line, w)) = self.words.get(self.pos) else {
-                return Ok(None);
-            };
-            self.pos += 1;
-            parse_number(name, Some(line), w).map(Some)
+            match self.take() {
+                Some((line, w)) => parse_number(name, &line, w).map(Some),
+                None => Ok(None),
+            }
         }
 
-        fn line(&self) -> Option<usize> {
-            Some(self.words.get(self.pos).map_or(self.end, |&(l, _)| l))
+        fn position(&mut self) -> (usize, u32) {
+            self.seek();
+            (self.line.no, self.word)
+        }
+
+        fn at_last(&self, name: &str, message: String) -> MeshFileError {
+            match self.last {
+                Some((line, w)) => line.at(name, w, message),
+                None => self.line.end(name, message),
+            }
+        }
+
+        fn ended(&self, name: &str, el: &Element, got: usize) -> MeshFileError {
+            self.line.end(
+                name,
+                format!(
+                    "the file ends after {got} of the {} declared `{}` elements",
+                    el.count, el.name
+                ),
+            )
+        }
+
+        fn bytes_left(&self) -> Option<usize> {
+            None
         }
     }
 
@@ -938,27 +1345,73 @@ mod ply {
             Ok(Some(ty.decode_le(b)))
         }
 
-        fn line(&self) -> Option<usize> {
-            None
+        fn position(&mut self) -> (usize, u32) {
+            (0, 0)
+        }
+
+        fn at_last(&self, name: &str, message: String) -> MeshFileError {
+            error(name, None, message)
+        }
+
+        fn ended(&self, name: &str, el: &Element, got: usize) -> MeshFileError {
+            el.line.at(
+                name,
+                el.count_word,
+                format!(
+                    "the binary data ends after {got} of the {} declared `{}` elements",
+                    el.count, el.name
+                ),
+            )
+        }
+
+        fn bytes_left(&self) -> Option<usize> {
+            Some(self.bytes.len() - self.pos)
         }
     }
 
-    /// Reads every element's instances in header order.
-    fn read_elements(
+    /// Reads every element's instances in header order. A count is checked
+    /// against the data before it is looped over: an element without
+    /// properties may have no instances, and in binary data elements of a
+    /// fixed size must fit in the bytes left; every other instance reads
+    /// at least one word or byte, so a loop ends where the data does.
+    fn read_elements<V: Values>(
         name: &str,
         header: &Header,
-        src: &mut dyn Values,
+        src: &mut V,
     ) -> Result<Raw, MeshFileError> {
         if !header.elements.iter().any(|e| e.name == "vertex") {
-            return Err(error(
-                name,
-                Some(header.end_line),
-                "the PLY header declares no `vertex` element",
-            ));
+            return Err(header
+                .end
+                .whole(name, "the PLY header declares no `vertex` element"));
         }
         let mut raw = Raw::new(0);
         for el in &header.elements {
             let role = role(name, el)?;
+            if el.props.is_empty() {
+                if el.count > 0 {
+                    return Err(el.line.at(
+                        name,
+                        el.count_word,
+                        format!(
+                            "the `{}` element declares {} instances but no properties to read \
+                             for them; declare its properties, or a count of 0",
+                            el.name, el.count
+                        ),
+                    ));
+                }
+                continue;
+            }
+            let (least, fixed) = el.least_size();
+            if let Some(left) = src.bytes_left() {
+                if fixed && el.count > left / least {
+                    return Err(src.ended(name, el, left / least));
+                }
+            }
+            if let Role::Vertex(_) = role {
+                let room = src.bytes_left().map_or(0, |left| left / least);
+                raw.positions.reserve(el.count.min(room));
+                raw.vertex_lines.reserve(el.count.min(room));
+            }
             for i in 0..el.count {
                 read_instance(name, el, role, i, src, &mut raw)?;
             }
@@ -967,41 +1420,52 @@ mod ply {
     }
 
     /// Reads instance `i` of `el`, keeping what its role needs.
-    fn read_instance(
+    fn read_instance<V: Values>(
         name: &str,
         el: &Element,
         role: Role,
         i: usize,
-        src: &mut dyn Values,
+        src: &mut V,
         raw: &mut Raw,
     ) -> Result<(), MeshFileError> {
-        let line = src.line().unwrap_or(0);
+        let (line, _) = src.position();
         let mut xyz = [0.0; 3];
-        let mut face = Vec::new();
+        let mut face_at = (line, 0);
         for (p, prop) in el.props.iter().enumerate() {
             match prop.kind {
                 Kind::Scalar(ty) => {
                     let v = value(name, el, i, src, ty)?;
                     if let Role::Vertex(ix) = role {
                         for k in (0..3).filter(|&k| ix[k] == p) {
+                            if !v.is_finite() {
+                                return Err(src.at_last(name, raw.non_finite(raw.positions.len())));
+                            }
                             xyz[k] = v;
                         }
                     }
                 }
                 Kind::List { count, item } => {
+                    let keep = matches!(role, Role::Face(fp) if fp == p);
+                    if keep {
+                        face_at = src.position();
+                    }
                     let n = value(name, el, i, src, count)?;
                     let n = whole(n).ok_or_else(|| {
-                        error(
+                        src.at_last(
                             name,
-                            src.line(),
                             format!("a list length must be a whole number, found {n}"),
                         )
                     })?;
-                    let keep = matches!(role, Role::Face(fp) if fp == p);
+                    // A list longer than the binary data left ends it.
+                    if let Some(left) = src.bytes_left() {
+                        if n > (left / item.size()) as u64 {
+                            return Err(src.ended(name, el, i));
+                        }
+                    }
                     for _ in 0..n {
                         let v = value(name, el, i, src, item)?;
                         if keep {
-                            face.push(index(name, src, v)?);
+                            raw.indices.push(index(name, src, v)?);
                         }
                     }
                 }
@@ -1009,35 +1473,24 @@ mod ply {
         }
         match role {
             Role::Vertex(_) => raw.push_vertex(DVec3::from(xyz), line),
-            Role::Face(_) => raw.push_face(face, line),
+            Role::Face(_) => raw.end_face(face_at.0, face_at.1.saturating_add(1)),
             Role::Skip => {}
         }
         Ok(())
     }
 
     /// The next value, or an error saying where the data ended.
-    fn value(
+    fn value<V: Values>(
         name: &str,
         el: &Element,
         i: usize,
-        src: &mut dyn Values,
+        src: &mut V,
         ty: Scalar,
     ) -> Result<f64, MeshFileError> {
-        src.next(name, ty)?.ok_or_else(|| {
-            let data = if src.line().is_some() {
-                "file"
-            } else {
-                "binary data"
-            };
-            error(
-                name,
-                src.line(),
-                format!(
-                    "the {data} ends after {i} of the {} declared `{}` elements",
-                    el.count, el.name
-                ),
-            )
-        })
+        match src.next(name, ty)? {
+            Some(v) => Ok(v),
+            None => Err(src.ended(name, el, i)),
+        }
     }
 
     /// `v` as a non-negative whole number, if it is one.
@@ -1046,15 +1499,11 @@ mod ply {
     }
 
     /// `v` as a vertex index (range is checked later).
-    fn index(name: &str, src: &dyn Values, v: f64) -> Result<i64, MeshFileError> {
+    fn index<V: Values>(name: &str, src: &V, v: f64) -> Result<i64, MeshFileError> {
         if v.fract() == 0.0 && v.abs() <= i64::MAX as f64 {
             Ok(v as i64)
         } else {
-            Err(error(
-                name,
-                src.line(),
-                format!("expected a vertex index, found {v}"),
-            ))
+            Err(src.at_last(name, format!("expected a vertex index, found {v}")))
         }
     }
 }

@@ -11,5 +11,5 @@ pub mod stellar;
 pub mod validate;
 
 pub use halfedge::{EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId};
-pub use soup::{MeshFileError, PolygonSoup};
+pub use soup::{MeshFileError, Place, PolygonSoup};
 pub use stellar::{BlockSplit, Split};

@@ -17,19 +17,43 @@ pub struct PolygonSoup {
 }
 
 /// A problem with a mesh file or with the mesh it describes.
+///
+/// Displayed as `path:line:col: error: message`, the line and a caret
+/// where the file has a line to show (text files, and the header of a
+/// binary PLY file), as `path: error: message` where the whole file is at
+/// fault or the problem lies in binary data.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeshFileError {
     pub path: String,
     /// The 1-based line, where one applies.
     pub line: Option<usize>,
+    /// What the caret marks on `line`.
+    pub place: Option<Place>,
     pub message: String,
+}
+
+/// A place on a line of a file: the line's text and the byte range of it
+/// that a message is about.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Place {
+    /// The line, without its newline; invalid UTF-8 is shown as U+FFFD.
+    pub text: String,
+    pub start: usize,
+    pub end: usize,
 }
 
 impl std::fmt::Display for MeshFileError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{}:{}: error: {}", self.path, l, self.message),
-            None => write!(f, "{}: error: {}", self.path, self.message),
+        match (self.line, &self.place) {
+            (Some(l), Some(p)) => f.write_str(&crate::error::render_line(
+                &self.path,
+                l,
+                &p.text,
+                p.start..p.end,
+                &self.message,
+            )),
+            (Some(l), None) => write!(f, "{}:{}: error: {}", self.path, l, self.message),
+            (None, _) => write!(f, "{}: error: {}", self.path, self.message),
         }
     }
 }
@@ -46,4 +70,15 @@ impl PolygonSoup {
     pub fn vertex_line(&self, v: usize) -> Option<usize> {
         self.vertex_lines.get(v).copied().filter(|&l| l > 0)
     }
+}
+
+/// The first position in `face` whose vertex came before it: pairwise for
+/// the short faces of most meshes, through a set for long ones, so that a
+/// polygon of any size is checked in linear time.
+pub(crate) fn first_repeat(face: &[u32]) -> Option<usize> {
+    if face.len() <= 16 {
+        return (1..face.len()).find(|&k| face[..k].contains(&face[k]));
+    }
+    let mut seen = std::collections::HashSet::with_capacity(face.len());
+    face.iter().position(|&v| !seen.insert(v))
 }

@@ -67,12 +67,49 @@ pub struct Grammar {
     /// A rule that would make more faces than this stops the run with an
     /// error instead of exhausting memory (about 110 bytes a face).
     pub max_faces: usize,
+    /// A rule after which a vertex has a higher valence than this (or
+    /// than twice the base mesh's highest, where that is more) stops the
+    /// run with an error: work at a vertex grows with its valence, so a
+    /// grammar whose valences keep growing (two face splits a step) would
+    /// slow down without end. [`MAX_VALENCE_VAR`] in the environment, when
+    /// set, takes its place.
+    pub max_valence: usize,
     /// What `check` reports without refusing the grammar.
     pub warnings: Vec<Diagnostic>,
 }
 
 /// The default face limit: about 5.5 GB of mesh.
 pub const MAX_FACES: usize = 50_000_000;
+
+/// The default valence limit ([`Grammar::max_valence`]): far above what
+/// subdivision schemes make (they keep valences, or double them for a
+/// rule), low enough that a grammar whose valences explode stops within
+/// seconds.
+pub const MAX_VALENCE: usize = 1000;
+
+/// The environment variable that sets the valence limit:
+/// `SUBGRAM_MAX_VALENCE=5000`.
+pub const MAX_VALENCE_VAR: &str = "SUBGRAM_MAX_VALENCE";
+
+/// The valence limit of a run on `mesh`: `configured`, or
+/// [`MAX_VALENCE_VAR`] where it is set, raised to twice the mesh's highest
+/// valence.
+fn valence_limit(configured: usize, mesh: &Mesh) -> Result<usize, String> {
+    let limit = match std::env::var(MAX_VALENCE_VAR) {
+        Err(std::env::VarError::NotPresent) => configured,
+        Ok(v) => v
+            .trim()
+            .parse()
+            .map_err(|_| format!("{MAX_VALENCE_VAR} must be a whole number, found `{v}`"))?,
+        Err(std::env::VarError::NotUnicode(v)) => {
+            return Err(format!(
+                "{MAX_VALENCE_VAR} must be a whole number, found `{}`",
+                v.to_string_lossy()
+            ))
+        }
+    };
+    Ok(limit.max(2 * mesh.max_valence().map_or(0, |(_, n)| n)))
+}
 
 /// Where the first call of host built-in `f` in `e` is, if there is one.
 fn first_call(e: &Ex, f: u16) -> Option<Span> {
@@ -260,6 +297,7 @@ pub(crate) fn compile_with(
             .block_split
             .map_or(BlockSplit::Quadrisection, |(b, _)| b),
         max_faces: MAX_FACES,
+        max_valence: MAX_VALENCE,
         warnings,
     })
 }
@@ -449,7 +487,12 @@ impl Grammar {
         }
         // `new(v)` counts this run's steps only.
         mesh.reset_vertex_steps();
+        let valence_limit = valence_limit(self.max_valence, mesh).map_err(|message| RunError {
+            span: None,
+            message,
+        })?;
         let mut state = RunState {
+            valence_limit,
             blocks: self.block_split,
             face_split_makes_blocks: self.block_used_at.is_some(),
             ..RunState::default()
@@ -757,7 +800,7 @@ impl Grammar {
                 for &e in &edge_ids {
                     mesh.edge_flip(e).map_err(|e| fail(e.message))?;
                 }
-                Ok(())
+                state.check_valence(mesh).map_err(fail)
             }
             Op::FaceSplit | Op::EdgeSplit | Op::BoundarySplit => {
                 let per = if rule.op == Op::BoundarySplit { 1 } else { 2 };
@@ -803,6 +846,7 @@ impl Grammar {
                     };
                     made.push((v, val));
                 }
+                state.check_valence(mesh).map_err(fail)?;
                 state.current_level = made
                     .iter()
                     .map(|(v, _)| mesh.vertex_level(*v))
@@ -914,6 +958,8 @@ struct RunState {
     blocks: BlockSplit,
     /// Set for grammars that read blocks: a face split then makes blocks.
     face_split_makes_blocks: bool,
+    /// The highest valence a rule may leave (see [`Grammar::max_valence`]).
+    valence_limit: usize,
 }
 
 impl RunState {
@@ -923,6 +969,19 @@ impl RunState {
             step: self.step,
             blocks: self.blocks,
             face_split_makes_blocks: self.face_split_makes_blocks,
+        }
+    }
+
+    /// Refuses a mesh with a vertex of higher valence than the limit.
+    fn check_valence(&self, mesh: &Mesh) -> Result<(), String> {
+        match mesh.max_valence() {
+            Some((v, n)) if n > self.valence_limit => Err(format!(
+                "vertex {v} has valence {n} after this rule, more than the limit of {}; \
+                 a grammar whose valences keep growing slows down without end \
+                 (set {MAX_VALENCE_VAR} to a larger number to allow more)",
+                self.valence_limit
+            )),
+            _ => Ok(()),
         }
     }
 
@@ -943,8 +1002,7 @@ fn vertex_of(val: &Elem) -> VertexId {
 }
 
 fn face_of(mesh: &Mesh, vs: [VertexId; 3]) -> Option<crate::mesh::FaceId> {
-    let h = mesh.find_halfedge(vs[0], vs[1])?;
-    mesh.face(h)
+    mesh.find_face(vs)
 }
 
 /// The message alone; [`crate::Surface::error`] adds the rule's line and

@@ -10,6 +10,7 @@ mod golden;
 mod golden_tests;
 mod lsystems;
 mod mesh;
+mod mesh_bounds;
 mod mesh_draw;
 mod mesh_io;
 mod one_language;

@@ -594,7 +594,8 @@ fn mesh_commands_info_convert_and_render() {
     assert_eq!(o.status.code(), Some(1));
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert!(
-        err.contains("bad.obj: error: the edge between vertices 1 and 2 of face 2 (line 6)"),
+        err.contains("bad.obj:6:1: error: the edge between vertices 1 and 2 of face 2 (line 6)")
+            && err.contains("6 | f 1 2 4\n  | ^^^^^^^"),
         "{err}"
     );
     assert!(err.contains("inconsistent orientation"), "{err}");
