@@ -4,8 +4,10 @@
 //! that `subgram check` can list all of them at once.
 
 use std::collections::HashMap;
+use std::rc::Rc;
 
 use crate::syntax::ast::{self, BinOp, ExprKind, Init, Item, Section, UnOp};
+use crate::syntax::parse::MAX_NESTING;
 use crate::syntax::span::{Diagnostic, Span};
 
 use super::builtins::{self, HostTable, SigError, LIBRARY, WORD_HOST};
@@ -97,8 +99,14 @@ struct Compiler {
     warnings: Vec<Diagnostic>,
     /// The topology's elements and built-ins.
     host: &'static HostTable,
-    /// `define` functions, inlined where they are called.
-    functions: Vec<ast::Define>,
+    /// `define` functions, inlined where they are called, shared so that
+    /// inlining one does not copy its body.
+    functions: Rc<[ast::Define]>,
+    /// Each function's index in `functions`, by name (the first of a name).
+    function_names: HashMap<String, usize>,
+    /// How many expressions enclose the one being compiled, counting those
+    /// of the functions being inlined.
+    depth: usize,
     /// Functions being inlined, innermost last (they may not recurse).
     inlining: Vec<usize>,
     /// Calls inlined in the current rule.
@@ -165,6 +173,10 @@ type Typed = Option<(Ex, Ty)>;
 
 impl Compiler {
     fn new(host: &'static HostTable, functions: Vec<ast::Define>) -> Compiler {
+        let mut function_names = HashMap::new();
+        for (i, f) in functions.iter().enumerate() {
+            function_names.entry(f.name.clone()).or_insert(i);
+        }
         Compiler {
             alphabet: Alphabet::new(),
             structs: Vec::new(),
@@ -174,7 +186,9 @@ impl Compiler {
             diags: Vec::new(),
             warnings: Vec::new(),
             host,
-            functions,
+            functions: functions.into(),
+            function_names,
+            depth: 0,
             inlining: Vec::new(),
             inlined: 0,
             int_divisions: Vec::new(),
@@ -1126,7 +1140,33 @@ impl Compiler {
         found
     }
 
+    /// Compiles an expression. The parser bounds the nesting of what is
+    /// written; inlined functions nest their bodies inside their calls, so
+    /// the same bound is kept here (and so on the interpreter's recursion).
     fn expr(&mut self, e: &ast::Expr, scope: &mut Scope) -> Typed {
+        self.nested(1, e.span, |c| c.expr_inner(e, scope))
+    }
+
+    /// Runs `f` `levels` deeper, or refuses with the nesting limit's
+    /// message at `span`.
+    fn nested(&mut self, levels: usize, span: Span, f: impl FnOnce(&mut Self) -> Typed) -> Typed {
+        if self.depth + levels > MAX_NESTING {
+            self.err(
+                span,
+                format!(
+                    "this is nested more than {MAX_NESTING} levels deep once the functions it \
+                     calls are inlined; split it into simpler parts"
+                ),
+            );
+            return None;
+        }
+        self.depth += levels;
+        let r = f(self);
+        self.depth -= levels;
+        r
+    }
+
+    fn expr_inner(&mut self, e: &ast::Expr, scope: &mut Scope) -> Typed {
         let span = e.span;
         match &e.kind {
             ExprKind::Int(i) => Some((Ex::Const(Value::Int(*i)), Ty::Int)),
@@ -1456,7 +1496,7 @@ impl Compiler {
         scope: &mut Scope,
     ) -> Typed {
         let n = name.text.as_str();
-        if let Some(f) = self.functions.iter().position(|d| d.name == n) {
+        if let Some(&f) = self.function_names.get(n) {
             return self.inline(f, args, span, scope);
         }
         let mut typed = Vec::new();
@@ -1642,7 +1682,8 @@ impl Compiler {
     /// own locals overwrite a parameter already set; then the body sees
     /// only its parameters. The locals are free again after the call.
     fn inline(&mut self, f: usize, args: &[ast::Expr], span: Span, scope: &mut Scope) -> Typed {
-        let def = self.functions[f].clone();
+        let functions = Rc::clone(&self.functions);
+        let def = &functions[f];
         if def.params.len() != args.len() {
             self.err(
                 span,
@@ -1673,6 +1714,17 @@ impl Compiler {
             );
             return None;
         }
+        // Each argument binds a local around the body: `Let`s nest.
+        self.nested(args.len(), span, |c| c.inline_body(f, def, args, scope))
+    }
+
+    fn inline_body(
+        &mut self,
+        f: usize,
+        def: &ast::Define,
+        args: &[ast::Expr],
+        scope: &mut Scope,
+    ) -> Typed {
         let mark = (scope.vars.len(), scope.next);
         let first = scope.next;
         scope.next += args.len() as u16;

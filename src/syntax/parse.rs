@@ -21,8 +21,14 @@ pub struct Parser<'t> {
     whole_names: Vec<String>,
     /// The last character of a split identifier, read in its place.
     split_last: Option<(usize, Name)>,
-    /// How deeply expressions and statements are nested right now.
+    /// How deeply expressions and statements are nested right now: the
+    /// number of syntax-tree levels above the node being parsed.
     depth: usize,
+    /// The deepest level reached since [`Parser::measure`] last started
+    /// measuring. A node built around an operand parsed before it (`a +
+    /// b`, `a.x`, `c ? a : b`, `a = b`) moves that operand one level down,
+    /// so the operand's deepest level is what must stay under the limit.
+    peak: usize,
     /// Struct and typedef names seen so far.
     type_names: Vec<String>,
     eof: Span,
@@ -30,8 +36,13 @@ pub struct Parser<'t> {
 
 type PResult<T> = Result<T, Diagnostic>;
 
-/// How deeply expressions and statements may nest. Deeper programs are
-/// refused with a message rather than overflowing the stack later.
+/// How deeply expressions and statements may nest: the height of the
+/// syntax tree, counting every level that the checker and the interpreter
+/// recurse through (an operator, a call, a field, a cast, a parenthesis, a
+/// statement, a block). Deeper programs are refused with a message rather
+/// than overflowing the stack later; a chain that the grammar nests
+/// (`a = b = c`, `x ? y : x ? y : z`, `a + b + c`, `v.x.y`) counts one
+/// level per link.
 pub const MAX_NESTING: usize = 100;
 
 impl<'t> Parser<'t> {
@@ -46,6 +57,7 @@ impl<'t> Parser<'t> {
             whole_names: Vec::new(),
             split_last: None,
             depth: 0,
+            peak: 0,
             type_names: Vec::new(),
             eof,
         }
@@ -72,6 +84,7 @@ pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<Fil
         whole_names,
         split_last: None,
         depth: 0,
+        peak: 0,
         type_names: Vec::new(),
         eof,
     };
@@ -849,21 +862,63 @@ impl<'t> Parser<'t> {
         }
     }
 
-    fn enter(&mut self, extra: usize) -> PResult<()> {
-        if self.depth + extra > MAX_NESTING {
-            return Err(Diagnostic::new(
-                self.span_here(),
-                format!("this is nested more than {MAX_NESTING} levels deep; split it into simpler parts"),
-            ));
+    fn too_deep<T>(&self, at: Span) -> PResult<T> {
+        Err(Diagnostic::new(
+            at,
+            format!(
+                "this is nested more than {MAX_NESTING} levels deep; split it into simpler parts"
+            ),
+        ))
+    }
+
+    /// Goes one level deeper, to parse the children of a node; [`ascend`]
+    /// comes back. (Plain calls rather than a closure: every stack frame
+    /// counts on a deep parse in a debug build.)
+    ///
+    /// [`ascend`]: Parser::ascend
+    fn descend(&mut self) -> PResult<()> {
+        if self.depth + 1 > MAX_NESTING {
+            return self.too_deep(self.span_here());
         }
+        self.depth += 1;
+        self.peak = self.peak.max(self.depth);
         Ok(())
     }
 
-    fn stmt(&mut self) -> PResult<Stmt> {
-        self.enter(1)?;
-        self.depth += 1;
-        let r = self.stmt_inner();
+    fn ascend(&mut self) {
         self.depth -= 1;
+    }
+
+    /// Starts measuring the deepest level that the parse which follows
+    /// reaches; [`reached`] ends it with the level, given what this
+    /// returned.
+    ///
+    /// [`reached`]: Parser::reached
+    fn measure(&mut self) -> usize {
+        std::mem::replace(&mut self.peak, self.depth)
+    }
+
+    fn reached(&mut self, outer: usize) -> usize {
+        let reached = self.peak;
+        self.peak = outer.max(reached);
+        reached
+    }
+
+    /// A node is built around an operand whose deepest level was
+    /// `reached`: everything in it moves one level down. The error points
+    /// at `at`, the operator that makes the node.
+    fn wrap(&mut self, reached: usize, at: Span) -> PResult<usize> {
+        if reached + 1 > MAX_NESTING {
+            return self.too_deep(at);
+        }
+        self.peak = self.peak.max(reached + 1);
+        Ok(reached + 1)
+    }
+
+    fn stmt(&mut self) -> PResult<Stmt> {
+        self.descend()?;
+        let r = self.stmt_inner();
+        self.ascend();
         r
     }
 
@@ -1022,7 +1077,9 @@ impl<'t> Parser<'t> {
 
     /// assign := cond [ ('=' | '+=' | '-=' | '*=' | '/=' | '%=') assign ]
     fn assign_expr(&mut self) -> PResult<Expr> {
+        let outer = self.measure();
         let lhs = self.cond_expr()?;
+        let reached = self.reached(outer);
         let op = match self.peek().map(|t| &t.tok) {
             Some(Tok::Punct("=")) => Some(None),
             Some(Tok::Punct("+=")) => Some(Some(BinOp::Add)),
@@ -1033,8 +1090,11 @@ impl<'t> Parser<'t> {
             _ => None,
         };
         if let Some(op) = op {
+            self.wrap(reached, self.span_here())?;
             self.pos += 1;
+            self.descend()?;
             let rhs = self.assign_expr()?;
+            self.ascend();
             let span = lhs.span.to(rhs.span);
             return Ok(Expr {
                 kind: ExprKind::Assign(op, Box::new(lhs), Box::new(rhs)),
@@ -1046,11 +1106,17 @@ impl<'t> Parser<'t> {
 
     /// cond := binary(0) [ '?' expr ':' cond ]
     fn cond_expr(&mut self) -> PResult<Expr> {
+        let outer = self.measure();
         let c = self.binary(0)?;
-        if self.eat_punct("?") {
+        let reached = self.reached(outer);
+        if self.peek_punct("?") {
+            self.wrap(reached, self.span_here())?;
+            self.pos += 1;
+            self.descend()?;
             let a = self.expr()?;
             self.expect_punct(":", "in the conditional expression `c ? a : b`")?;
             let b = self.cond_expr()?;
+            self.ascend();
             let span = c.span.to(b.span);
             return Ok(Expr {
                 kind: ExprKind::Cond(Box::new(c), Box::new(a), Box::new(b)),
@@ -1060,11 +1126,13 @@ impl<'t> Parser<'t> {
         Ok(c)
     }
 
-    /// Precedence climbing over the C binary operators.
+    /// Precedence climbing over the C binary operators. A chain `a + b +
+    /// c` is a left-deep tree: each operator moves what came before it one
+    /// level down.
     fn binary(&mut self, min_prec: u8) -> PResult<Expr> {
+        let outer = self.measure();
         let mut lhs = self.unary()?;
-        // Each operator of a chain deepens the tree by one.
-        let mut chain = 0;
+        let mut reached = self.reached(outer);
         loop {
             let Some((op, prec)) = self.peek().and_then(|t| binop_of(&t.tok)) else {
                 return Ok(lhs);
@@ -1072,13 +1140,13 @@ impl<'t> Parser<'t> {
             if prec < min_prec {
                 return Ok(lhs);
             }
-            chain += 1;
-            self.enter(chain)?;
+            reached = self.wrap(reached, self.span_here())?;
             self.pos += 1;
-            self.depth += chain;
-            let rhs = self.binary(prec + 1);
-            self.depth -= chain;
-            let rhs = rhs?;
+            let outer = self.measure();
+            self.descend()?;
+            let rhs = self.binary(prec + 1)?;
+            self.ascend();
+            reached = reached.max(self.reached(outer));
             let span = lhs.span.to(rhs.span);
             lhs = Expr {
                 kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
@@ -1088,11 +1156,12 @@ impl<'t> Parser<'t> {
     }
 
     /// unary := ('-' | '+' | '!' | '++' | '--') unary | '(' TYPE ')' unary | postfix
+    ///
+    /// Every operand goes through here, one level below its parent.
     fn unary(&mut self) -> PResult<Expr> {
-        self.enter(1)?;
-        self.depth += 1;
+        self.descend()?;
         let r = self.unary_inner();
-        self.depth -= 1;
+        self.ascend();
         r
     }
 
@@ -1154,13 +1223,22 @@ impl<'t> Parser<'t> {
         self.postfix()
     }
 
+    /// postfix := primary { '.' NAME [ '(' args ')' ] | '++' | '--' }, a
+    /// left-deep chain like a binary operator's.
     fn postfix(&mut self) -> PResult<Expr> {
+        let outer = self.measure();
         let mut e = self.primary()?;
+        let mut reached = self.reached(outer);
         loop {
+            if self.peek_punct(".") || self.peek_punct("++") || self.peek_punct("--") {
+                reached = self.wrap(reached, self.span_here())?;
+            }
             if self.eat_punct(".") {
                 let name = self.name("a field or method name after `.`")?;
                 if self.eat_punct("(") {
+                    let outer = self.measure();
                     let args = self.args(")")?;
+                    reached = reached.max(self.reached(outer));
                     let span = e.span.to(self.prev_span());
                     e = Expr {
                         kind: ExprKind::Method(Box::new(e), name, args),
