@@ -80,7 +80,12 @@ pub fn preprocess(
                 !n.line_start && matches!(&n.tok, Tok::Ident(s) if DIRECTIVES.contains(&s.as_str()))
             });
         if !is_directive {
-            pending.push(t);
+            if macros.is_empty() {
+                // Nothing to expand: straight to the output.
+                out.push(t);
+            } else {
+                pending.push(t);
+            }
             continue;
         }
         out.extend(expander.expand(std::mem::take(&mut pending), &macros, next_id)?);

@@ -19,7 +19,9 @@ use crate::support::root;
 /// Runs `tests/data/err/NAME.lsys` as its first line says; the stderr, or
 /// why the run is wrong.
 fn diagnostic(dir: &Path, name: &str) -> Result<Vec<u8>, String> {
-    let text = std::fs::read_to_string(dir.join(name)).map_err(|e| format!("{name}: {e}"))?;
+    // Read as bytes: some bad inputs are not UTF-8.
+    let text = std::fs::read(dir.join(name)).map_err(|e| format!("{name}: {e}"))?;
+    let text = String::from_utf8_lossy(&text);
     let run = text
         .lines()
         .next()
