@@ -43,7 +43,10 @@ impl LoadOptions {
 /// # Ok(()) }
 /// ```
 pub fn load(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<System, Error> {
-    let path = path.as_ref();
+    load_path(path.as_ref(), opts).map_err(at_most_some)
+}
+
+fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
     let text = read(path)?;
     let front = front(&path.display().to_string(), text, &opts.defines)?;
     if surface::is_surface(&front.tokens) {
@@ -58,6 +61,10 @@ pub fn load(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<System, Error>
 /// messages. A surface grammar's `mesh:` is then relative to the current
 /// folder.
 pub fn load_text(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Error> {
+    load_text_as(name, text, opts).map_err(at_most_some)
+}
+
+fn load_text_as(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Error> {
     let front = front(name, text.to_string(), &opts.defines)?;
     if surface::is_surface(&front.tokens) {
         let grammar = surface::from_front(front)?;
@@ -72,7 +79,7 @@ pub fn load_text(name: &str, text: &str, opts: &LoadOptions) -> Result<System, E
 pub fn load_file(path: impl AsRef<Path>, defines: &[String]) -> Result<Curve, Error> {
     let path = path.as_ref();
     let text = read(path)?;
-    curve(front(&path.display().to_string(), text, defines)?)
+    curve(front(&path.display().to_string(), text, defines)?).map_err(at_most_some)
 }
 
 /// Checks text as a curve L-system; `name` is the file name in messages.
@@ -91,7 +98,39 @@ pub fn load_file(path: impl AsRef<Path>, defines: &[String]) -> Result<Curve, Er
 /// assert_eq!(derived.word.len(), 16); // 4 points, doubled twice
 /// ```
 pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Curve, Error> {
-    curve(front(name, text.to_string(), defines)?)
+    curve(front(name, text.to_string(), defines)?).map_err(at_most_some)
+}
+
+/// The most diagnostics a check reports; the count of the others follows
+/// them, so that a file with an error on every line does not print
+/// megabytes.
+pub const MAX_DIAGNOSTICS: usize = 100;
+
+/// `e` with at most [`MAX_DIAGNOSTICS`] diagnostics and a last one, at the
+/// first left out, that counts the rest.
+fn at_most_some(e: Error) -> Error {
+    match e {
+        Error::Program {
+            sources,
+            mut diagnostics,
+        } if diagnostics.len() > MAX_DIAGNOSTICS + 1 => {
+            let rest = diagnostics.len() - MAX_DIAGNOSTICS;
+            let next = diagnostics[MAX_DIAGNOSTICS].span;
+            diagnostics.truncate(MAX_DIAGNOSTICS);
+            diagnostics.push(Diagnostic::new(
+                next,
+                format!(
+                    "{rest} more errors from here on are not shown (at most {MAX_DIAGNOSTICS} \
+                     are); fix the ones above first"
+                ),
+            ));
+            Error::Program {
+                sources,
+                diagnostics,
+            }
+        }
+        e => e,
+    }
 }
 
 /// The largest program file read, in bytes: lpfg programs are a few

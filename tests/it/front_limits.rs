@@ -297,3 +297,85 @@ fn inlined_functions_close_to_the_limit_run() {
     let after: Vec<_> = mesh.vertices().map(|v| mesh.position(v)).collect();
     assert_eq!(after, before);
 }
+
+/// Counts that the checker numbers with 16 bits: past 65,535 globals the
+/// numbers wrapped and `g0 + g69999` read `g4463` (exit 0, a wrong
+/// word); past 65,535 locals the interpreter indexed out of its frame (a
+/// panic). Each is now refused once, at the first one too many, and the
+/// lookups by name that made large programs quadratic are hashed (70,000
+/// modules took 24 s, a struct of 70,000 fields 17 s).
+#[test]
+fn declarations_past_what_16_bits_number_are_refused() {
+    let dir = scratch("counts");
+    let n = 70_000;
+    let mut globals = String::new();
+    for i in 0..n {
+        globals += &format!("float g{i} = {i};\n");
+    }
+    globals += &format!("module A(float);\nAxiom: A(g0 + g{});\n", n - 1);
+    let mut locals = String::from("module A(float);\nAxiom: A(1);\nA(x) : {\n");
+    for i in 0..n {
+        locals += &format!("float v{i} = {i};\n");
+    }
+    locals += &format!("produce A(v0 + v{});\n}}\n", n - 1);
+    let mut modules = String::new();
+    for i in 0..n {
+        modules += &format!("module M{i};\n");
+    }
+    modules += &format!("Axiom: M0 M{};\n", n - 1);
+    let mut fields = String::from("struct S {");
+    for i in 0..n {
+        fields += &format!(" float f{i};");
+    }
+    fields += " };\nS s;\nmodule A(float);\nAxiom: A(s.f1);\n";
+    let cases = [
+        (
+            "globals.lsys",
+            globals,
+            ":65536:7: error: more than 65535 global variables are declared",
+        ),
+        (
+            "locals.lsys",
+            locals,
+            ":65538:7: error: more than 65535 local variables in one body",
+        ),
+        (
+            "modules.lsys",
+            modules,
+            ":65448:8: error: more than 65447 modules are declared",
+        ),
+        (
+            "fields.lsys",
+            fields,
+            ":1:906398: error: more than 65535 fields are declared in struct `S`",
+        ),
+    ];
+    for (name, text, want) in cases {
+        let f = dir.join(name);
+        std::fs::write(&f, text).unwrap();
+        let err = refused(&f, want, Duration::from_secs(20));
+        // Once, not once per declaration past the limit, and first.
+        assert_eq!(err.matches("error: more than").count(), 1, "{err}");
+        assert!(err.starts_with(&format!("{}{want}", f.display())), "{err}");
+    }
+}
+
+/// A thousand errors on one 2 MB line: rendering a diagnostic costs its
+/// window, not its line (this took minutes), and a check reports the
+/// first 100 and counts the rest.
+#[test]
+fn many_errors_on_one_long_line_are_reported_quickly_and_counted() {
+    let dir = scratch("errors");
+    let f = dir.join("many.lsys");
+    let n = 1_000_000;
+    std::fs::write(&f, format!("module A;\nAxiom: {};\n", "Q ".repeat(n))).unwrap();
+    let err = refused(&f, "error: undeclared module `Q`", Duration::from_secs(20));
+    assert_eq!(err.matches(": error: ").count(), 101, "{}", err.len());
+    assert!(
+        err.contains(
+            ":2:208: error: 999900 more errors from here on are not shown (at most 100 are)"
+        ),
+        "{}",
+        &err[err.len() - 400..]
+    );
+}
