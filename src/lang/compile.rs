@@ -614,12 +614,14 @@ impl Compiler {
                             None => self.err(n.span, format!("undeclared module `{}` in the module list; declare it with `module {}(...);`", n.text, n.text)),
                         }
                     }
+                    syms.sort();
+                    syms.dedup();
                     filter = if names.is_empty() {
                         Filter::All
                     } else if *consider {
-                        Filter::Consider(syms)
+                        Filter::Consider(syms.into())
                     } else {
-                        Filter::Ignore(syms)
+                        Filter::Ignore(syms.into())
                     };
                 }
                 Item::Section { section: s, .. } => {

@@ -3,6 +3,8 @@
 //! Every function parses one production of the grammar, shown in its doc
 //! comment. Errors say what was expected and what was found, at the token.
 
+use std::collections::HashSet;
+
 use super::ast::*;
 use super::lex::{Tok, Token};
 use super::span::{Diagnostic, Span};
@@ -18,7 +20,7 @@ pub struct Parser<'t> {
     /// Single-character turtle mode, switched on by `angle:`.
     abop: bool,
     /// Names that are never split into characters in that mode.
-    whole_names: Vec<String>,
+    whole_names: HashSet<String>,
     /// The last character of a split identifier, read in its place.
     split_last: Option<(usize, Name)>,
     /// How deeply expressions and statements are nested right now: the
@@ -30,7 +32,7 @@ pub struct Parser<'t> {
     /// so the operand's deepest level is what must stay under the limit.
     peak: usize,
     /// Struct and typedef names seen so far.
-    type_names: Vec<String>,
+    type_names: HashSet<String>,
     eof: Span,
 }
 
@@ -54,11 +56,11 @@ impl<'t> Parser<'t> {
             toks,
             pos: 0,
             abop: false,
-            whole_names: Vec::new(),
+            whole_names: HashSet::new(),
             split_last: None,
             depth: 0,
             peak: 0,
-            type_names: Vec::new(),
+            type_names: HashSet::new(),
             eof,
         }
     }
@@ -69,11 +71,11 @@ pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<Fil
     let abop = toks
         .windows(2)
         .any(|w| w[0].line_start && w[0].tok.is_ident("angle") && w[1].tok.is_punct(":"));
-    let mut whole_names: Vec<String> = predefined.iter().map(|s| s.to_string()).collect();
+    let mut whole_names: HashSet<String> = predefined.iter().map(|s| s.to_string()).collect();
     for w in toks.windows(2) {
         if let (Tok::Ident(m), Tok::Ident(n)) = (&w[0].tok, &w[1].tok) {
             if m == "module" {
-                whole_names.push(n.clone());
+                whole_names.insert(n.clone());
             }
         }
     }
@@ -85,7 +87,7 @@ pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<Fil
         split_last: None,
         depth: 0,
         peak: 0,
-        type_names: Vec::new(),
+        type_names: HashSet::new(),
         eof,
     };
     let mut items = Vec::new();
@@ -189,7 +191,7 @@ impl<'t> Parser<'t> {
     }
 
     fn is_type_name(&self, s: &str) -> bool {
-        TYPE_KEYWORDS.contains(&s) || self.type_names.iter().any(|t| t == s)
+        TYPE_KEYWORDS.contains(&s) || self.type_names.contains(s)
     }
 
     /// True when the tokens at the cursor begin a declaration:
@@ -452,7 +454,7 @@ impl<'t> Parser<'t> {
     fn struct_decl(&mut self, items: &mut Vec<Item>) -> PResult<()> {
         self.pos += 1;
         let name = self.name("a struct name")?;
-        self.type_names.push(name.text.clone());
+        self.type_names.insert(name.text.clone());
         self.expect_punct("{", "to open the struct body")?;
         let mut fields = Vec::new();
         while !self.eat_punct("}") {
@@ -479,7 +481,7 @@ impl<'t> Parser<'t> {
         self.pos += 1;
         let ty = self.type_ref()?;
         let name = self.name("the new type name")?;
-        self.type_names.push(name.text.clone());
+        self.type_names.insert(name.text.clone());
         self.expect_punct(";", "after the typedef")?;
         items.push(Item::Typedef { ty, name });
         Ok(())
@@ -759,7 +761,7 @@ impl<'t> Parser<'t> {
         }
         let t = self.peek()?;
         let Tok::Ident(s) = &t.tok else { return None };
-        if s.len() < 2 || self.whole_names.iter().any(|w| w == s) || !s.is_ascii() {
+        if s.len() < 2 || self.whole_names.contains(s) || !s.is_ascii() {
             return None;
         }
         let start = t.span.start as usize;

@@ -31,6 +31,32 @@ struct Macro {
     id: usize,
     params: Option<Vec<String>>,
     body: Vec<Token>,
+    /// For each token of the body, the parameter it names, if any: found
+    /// once, when the macro is defined.
+    uses: Vec<Option<usize>>,
+}
+
+impl Macro {
+    fn new(id: usize, params: Option<Vec<String>>, body: Vec<Token>) -> Macro {
+        // A name given twice means its first parameter.
+        let mut index: HashMap<&str, usize> = HashMap::new();
+        for (k, p) in params.iter().flatten().enumerate() {
+            index.entry(p.as_str()).or_insert(k);
+        }
+        let uses = body
+            .iter()
+            .map(|b| match &b.tok {
+                Tok::Ident(p) => index.get(p.as_str()).copied(),
+                _ => None,
+            })
+            .collect();
+        Macro {
+            id,
+            params,
+            body,
+            uses,
+        }
+    }
 }
 
 /// Tokens that macro expansion may produce or pass as arguments in all,
@@ -52,14 +78,7 @@ pub fn preprocess(
     // Ids of definitions, from 0 up.
     let mut next_id = 0;
     for (name, body) in overrides {
-        macros.insert(
-            name.clone(),
-            Macro {
-                id: next_id,
-                params: None,
-                body: body.clone(),
-            },
-        );
+        macros.insert(name.clone(), Macro::new(next_id, None, body.clone()));
         next_id += 1;
     }
     let overridden: HashSet<&str> = overrides.iter().map(|(n, _)| n.as_str()).collect();
@@ -106,7 +125,7 @@ pub fn preprocess(
                 if !overridden.contains(mname.as_str()) {
                     let id = next_id;
                     next_id += 1;
-                    macros.insert(mname, Macro { id, params, body });
+                    macros.insert(mname, Macro::new(id, params, body));
                 }
             }
             "undef" => {
@@ -359,10 +378,9 @@ impl Expander {
                     }
                     self.nesting -= 1;
                     let mut body = Vec::new();
-                    for b in &m.body {
-                        match &b.tok {
-                            Tok::Ident(p) if params.contains(p) => {
-                                let k = params.iter().position(|q| q == p).expect("contained");
+                    for (b, k) in m.body.iter().zip(&m.uses) {
+                        match *k {
+                            Some(k) => {
                                 self.spend(expanded[k].len(), t.span)?;
                                 body.extend(
                                     expanded[k].iter().map(|(a, p)| Item::Tok(a.clone(), *p)),
