@@ -9,7 +9,7 @@ use crate::error::Error;
 use crate::lang;
 use crate::surface;
 use crate::syntax::lex::{self, Token};
-use crate::syntax::{parse, preprocess, FileId, SourceFile, SourceMap, Span};
+use crate::syntax::{parse, preprocess, Diagnostic, FileId, SourceFile, SourceMap, Span};
 use crate::system::{Surface, System};
 
 /// Settings of loading.
@@ -43,7 +43,10 @@ impl LoadOptions {
 /// # Ok(()) }
 /// ```
 pub fn load(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<System, Error> {
-    let path = path.as_ref();
+    load_path(path.as_ref(), opts).map_err(at_most_some)
+}
+
+fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
     let text = read(path)?;
     let front = front(&path.display().to_string(), text, &opts.defines)?;
     if surface::is_surface(&front.tokens) {
@@ -58,6 +61,10 @@ pub fn load(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<System, Error>
 /// messages. A surface grammar's `mesh:` is then relative to the current
 /// folder.
 pub fn load_text(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Error> {
+    load_text_as(name, text, opts).map_err(at_most_some)
+}
+
+fn load_text_as(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Error> {
     let front = front(name, text.to_string(), &opts.defines)?;
     if surface::is_surface(&front.tokens) {
         let grammar = surface::from_front(front)?;
@@ -72,7 +79,7 @@ pub fn load_text(name: &str, text: &str, opts: &LoadOptions) -> Result<System, E
 pub fn load_file(path: impl AsRef<Path>, defines: &[String]) -> Result<Curve, Error> {
     let path = path.as_ref();
     let text = read(path)?;
-    curve(front(&path.display().to_string(), text, defines)?)
+    curve(front(&path.display().to_string(), text, defines)?).map_err(at_most_some)
 }
 
 /// Checks text as a curve L-system; `name` is the file name in messages.
@@ -91,11 +98,148 @@ pub fn load_file(path: impl AsRef<Path>, defines: &[String]) -> Result<Curve, Er
 /// assert_eq!(derived.word.len(), 16); // 4 points, doubled twice
 /// ```
 pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Curve, Error> {
-    curve(front(name, text.to_string(), defines)?)
+    curve(front(name, text.to_string(), defines)?).map_err(at_most_some)
 }
 
+/// The most diagnostics a check reports; the count of the others follows
+/// them, so that a file with an error on every line does not print
+/// megabytes.
+pub const MAX_DIAGNOSTICS: usize = 100;
+
+/// `e` with at most [`MAX_DIAGNOSTICS`] diagnostics and a last one, at the
+/// first left out, that counts the rest.
+fn at_most_some(e: Error) -> Error {
+    match e {
+        Error::Program {
+            sources,
+            mut diagnostics,
+        } if diagnostics.len() > MAX_DIAGNOSTICS + 1 => {
+            let rest = diagnostics.len() - MAX_DIAGNOSTICS;
+            let next = diagnostics[MAX_DIAGNOSTICS].span;
+            diagnostics.truncate(MAX_DIAGNOSTICS);
+            diagnostics.push(Diagnostic::new(
+                next,
+                format!(
+                    "{rest} more errors from here on are not shown (at most {MAX_DIAGNOSTICS} \
+                     are); fix the ones above first"
+                ),
+            ));
+            Error::Program {
+                sources,
+                diagnostics,
+            }
+        }
+        e => e,
+    }
+}
+
+/// The largest program file read, in bytes: lpfg programs are a few
+/// kilobytes, and the front end holds about fifty bytes per character of a
+/// file at worst. The environment variable [`MAX_PROGRAM_SIZE_VAR`] raises
+/// (or lowers) it, in mebibytes.
+pub const MAX_PROGRAM_BYTES: u64 = 16 << 20;
+
+/// The environment variable that sets the largest program file read, in
+/// mebibytes (`SUBGRAM_MAX_PROGRAM_MIB=64`).
+pub const MAX_PROGRAM_SIZE_VAR: &str = "SUBGRAM_MAX_PROGRAM_MIB";
+
+/// The limit on a program file's size: [`MAX_PROGRAM_BYTES`], or what
+/// [`MAX_PROGRAM_SIZE_VAR`] says.
+fn program_size_limit() -> Result<u64, Error> {
+    match std::env::var(MAX_PROGRAM_SIZE_VAR) {
+        Err(std::env::VarError::NotPresent) => Ok(MAX_PROGRAM_BYTES),
+        Ok(v) => match v.trim().parse::<u64>() {
+            Ok(mib) if mib > 0 && mib <= 1 << 20 => Ok(mib << 20),
+            _ => Err(Error::Usage(format!(
+                "{MAX_PROGRAM_SIZE_VAR}={v}: expected a whole number of mebibytes from 1 to {}",
+                1 << 20
+            ))),
+        },
+        Err(std::env::VarError::NotUnicode(v)) => Err(Error::Usage(format!(
+            "{MAX_PROGRAM_SIZE_VAR}={}: expected a whole number of mebibytes",
+            v.to_string_lossy()
+        ))),
+    }
+}
+
+/// Reads a program file, once: its size is checked against the limit
+/// before it is read whole (a device or a pipe, which has no size, is read
+/// up to the limit and no further), and text that is not UTF-8 is refused
+/// at its first bad byte.
 pub(crate) fn read(path: &Path) -> Result<String, Error> {
-    std::fs::read_to_string(path).map_err(|e| Error::read(PathBuf::from(path), e))
+    let limit = program_size_limit()?;
+    let bytes = read_at_most(path, limit)?;
+    utf8(&path.display().to_string(), bytes)
+}
+
+/// The bytes of `path`, or an error that names `limit` when there are
+/// more.
+fn read_at_most(path: &Path, limit: u64) -> Result<Vec<u8>, Error> {
+    use std::io::Read;
+    let io = |e| Error::read(PathBuf::from(path), e);
+    let file = std::fs::File::open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    let too_big = |size: Option<u64>| {
+        let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
+        let is = match size {
+            Some(b) => format!("the file is {:.1} MiB ({b} bytes)", mib(b)),
+            None => format!("more than {} MiB were read from it", limit >> 20),
+        };
+        Error::file(
+            path.display().to_string(),
+            format!(
+                "{is}; a program may be at most {} MiB: set {MAX_PROGRAM_SIZE_VAR} to a larger \
+                 number of mebibytes to raise the limit",
+                limit >> 20
+            ),
+        )
+    };
+    if meta.is_file() && meta.len() > limit {
+        return Err(too_big(Some(meta.len())));
+    }
+    let expected = if meta.is_file() { meta.len() } else { 0 };
+    let mut bytes = Vec::with_capacity(expected as usize);
+    file.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
+    if bytes.len() as u64 > limit {
+        // A file that grew while it was read, or one without a size.
+        return Err(too_big(meta.is_file().then_some(bytes.len() as u64)));
+    }
+    Ok(bytes)
+}
+
+/// `bytes` as text, or an error located at the first byte that is not
+/// UTF-8, shown in the line as a replacement character.
+pub(crate) fn utf8(name: &str, bytes: Vec<u8>) -> Result<String, Error> {
+    let e = match String::from_utf8(bytes) {
+        Ok(text) => return Ok(text),
+        Err(e) => e,
+    };
+    let at = e.utf8_error().valid_up_to();
+    let bad_len = e
+        .utf8_error()
+        .error_len()
+        .unwrap_or(e.as_bytes().len() - at);
+    let bad: Vec<String> = e.as_bytes()[at..at + bad_len]
+        .iter()
+        .map(|b| format!("0x{b:02X}"))
+        .collect();
+    // The valid prefix is kept as it is; the bad byte becomes U+FFFD.
+    let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
+    let mut sources = SourceMap::default();
+    let file = sources.add(SourceFile::new(name, text));
+    let what = if e.utf8_error().error_len().is_none() {
+        "the file ends inside a character"
+    } else if bad.len() == 1 {
+        "the byte"
+    } else {
+        "the bytes"
+    };
+    let message = format!(
+        "invalid UTF-8 ({what} {}): a program must be UTF-8 text; save the file as UTF-8",
+        bad.join(" ")
+    );
+    let span = Span::new(file, at, at + '\u{FFFD}'.len_utf8());
+    Err(Error::at(&sources, Diagnostic::new(span, message)))
 }
 
 /// A program's text after lexing and preprocessing.

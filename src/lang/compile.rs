@@ -3,9 +3,11 @@
 //! Every problem found is reported; compilation goes on after an error so
 //! that `subgram check` can list all of them at once.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
+use std::rc::Rc;
 
 use crate::syntax::ast::{self, BinOp, ExprKind, Init, Item, Section, UnOp};
+use crate::syntax::parse::MAX_NESTING;
 use crate::syntax::span::{Diagnostic, Span};
 
 use super::builtins::{self, HostTable, SigError, LIBRARY, WORD_HOST};
@@ -97,12 +99,25 @@ struct Compiler {
     warnings: Vec<Diagnostic>,
     /// The topology's elements and built-ins.
     host: &'static HostTable,
-    /// `define` functions, inlined where they are called.
-    functions: Vec<ast::Define>,
+    /// `define` functions, inlined where they are called, shared so that
+    /// inlining one does not copy its body.
+    functions: Rc<[ast::Define]>,
+    /// Each function's index in `functions`, by name (the first of a name).
+    function_names: HashMap<String, usize>,
+    /// How many expressions enclose the one being compiled, counting those
+    /// of the functions being inlined.
+    depth: usize,
     /// Functions being inlined, innermost last (they may not recurse).
     inlining: Vec<usize>,
     /// Calls inlined in the current rule.
     inlined: usize,
+    /// Each struct's index by name, its fields' indices by name, and its
+    /// size: the values it holds and how deeply structs nest in it.
+    struct_names: HashMap<String, u16>,
+    struct_fields: Vec<HashMap<String, u16>>,
+    struct_shapes: Vec<(usize, usize)>,
+    /// The limits on counts already reported: each is reported once.
+    counts_reported: HashSet<&'static str>,
     /// Where a division of two integers was compiled.
     int_divisions: Vec<Span>,
     /// Parameters of the functions being inlined whose argument is a
@@ -125,9 +140,12 @@ const MAX_INLINE_DEPTH: usize = 32;
 #[derive(Default)]
 struct Scope {
     vars: Vec<(String, Ty, u16)>,
+    /// Where each name is in `vars`, innermost last: a lookup does not
+    /// walk the body's variables.
+    by_name: HashMap<String, Vec<usize>>,
     marks: Vec<usize>,
     /// Slots of `const` locals.
-    consts: Vec<u16>,
+    consts: HashSet<u16>,
     next: u16,
     max: u16,
     loops: u32,
@@ -135,7 +153,22 @@ struct Scope {
     /// Names before this index are not visible (the caller's locals,
     /// inside an inlined function's body).
     barrier: usize,
+    /// The body asked for more locals than slots can number.
+    full: bool,
+    /// ... and that has been reported.
+    full_reported: bool,
 }
+
+/// The most local variables one body may have (their slots are `u16`s).
+const MAX_LOCALS: usize = u16::MAX as usize;
+
+/// The most modules, globals, structs, or fields in one struct, that a
+/// program may declare: each is numbered with a `u16`.
+const MAX_DECLARED: usize = u16::MAX as usize;
+
+/// The most values a struct may hold, counting those of the structs
+/// inside it: every value of the type is built that large.
+const MAX_STRUCT_VALUES: usize = 1 << 16;
 
 impl Scope {
     fn rule() -> Scope {
@@ -151,23 +184,63 @@ impl Scope {
 
     fn pop(&mut self) {
         let m = self.marks.pop().expect("balanced scopes");
-        self.vars.truncate(m);
+        self.truncate(m);
     }
 
-    fn declare(&mut self, name: &str, ty: Ty) -> u16 {
-        let slot = self.next;
-        self.next += 1;
-        self.max = self.max.max(self.next);
+    /// Forgets the variables from the `len`th on.
+    fn truncate(&mut self, len: usize) {
+        for (name, _, _) in self.vars.drain(len.min(self.vars.len())..) {
+            if let Some(at) = self.by_name.get_mut(&name) {
+                at.pop();
+                if at.is_empty() {
+                    self.by_name.remove(&name);
+                }
+            }
+        }
+    }
+
+    /// Names `slot`, already reserved, `name`.
+    fn bind(&mut self, name: &str, ty: Ty, slot: u16) {
+        self.by_name
+            .entry(name.to_string())
+            .or_default()
+            .push(self.vars.len());
         self.vars.push((name.to_string(), ty, slot));
+    }
+
+    /// Reserves `n` slots and returns the first; `None` when they would
+    /// not fit.
+    fn reserve(&mut self, n: usize) -> Option<u16> {
+        if self.next as usize + n > MAX_LOCALS {
+            self.full = true;
+            return None;
+        }
+        let first = self.next;
+        self.next += n as u16;
+        self.max = self.max.max(self.next);
+        Some(first)
+    }
+
+    /// A new local; when the slots have run out, slot 0 stands in and
+    /// `full` is set for the caller to report.
+    fn declare(&mut self, name: &str, ty: Ty) -> u16 {
+        let slot = self.reserve(1).unwrap_or(0);
+        self.bind(name, ty, slot);
         slot
     }
 
     fn lookup(&self, name: &str) -> Option<(Ty, u16)> {
-        self.vars[self.barrier..]
-            .iter()
-            .rev()
-            .find(|(n, _, _)| n == name)
-            .map(|(_, t, s)| (*t, *s))
+        let &i = self.by_name.get(name)?.last()?;
+        if i < self.barrier {
+            return None;
+        }
+        let (_, t, s) = &self.vars[i];
+        Some((*t, *s))
+    }
+
+    /// Whether `name` is declared, visible or not.
+    fn has(&self, name: &str) -> bool {
+        self.by_name.contains_key(name)
     }
 }
 
@@ -175,6 +248,10 @@ type Typed = Option<(Ex, Ty)>;
 
 impl Compiler {
     fn new(host: &'static HostTable, functions: Vec<ast::Define>) -> Compiler {
+        let mut function_names = HashMap::new();
+        for (i, f) in functions.iter().enumerate() {
+            function_names.entry(f.name.clone()).or_insert(i);
+        }
         Compiler {
             alphabet: Alphabet::new(),
             structs: Vec::new(),
@@ -184,7 +261,13 @@ impl Compiler {
             diags: Vec::new(),
             warnings: Vec::new(),
             host,
-            functions,
+            functions: functions.into(),
+            function_names,
+            depth: 0,
+            struct_names: HashMap::new(),
+            struct_fields: Vec::new(),
+            struct_shapes: Vec::new(),
+            counts_reported: HashSet::new(),
             inlining: Vec::new(),
             inlined: 0,
             int_divisions: Vec::new(),
@@ -194,6 +277,14 @@ impl Compiler {
 
     fn err(&mut self, span: Span, msg: impl Into<String>) {
         self.diags.push(Diagnostic::new(span, msg));
+    }
+
+    /// Reports that more than `limit` `what` are declared, at the first
+    /// one too many only.
+    fn too_many(&mut self, limit: usize, what: &'static str, span: Span) {
+        if self.counts_reported.insert(what) {
+            self.err(span, format!("more than {limit} {what} are declared"));
+        }
     }
 
     /// Warns when `ex` is a division of integer constants that truncates
@@ -322,8 +413,8 @@ impl Compiler {
             other => {
                 if let Some(t) = self.typedefs.get(other) {
                     *t
-                } else if let Some(i) = self.structs.iter().position(|s| s.name == other) {
-                    Ty::Struct(i as u16)
+                } else if let Some(&i) = self.struct_names.get(other) {
+                    Ty::Struct(i)
                 } else {
                     self.err(
                         t.span,
@@ -341,26 +432,72 @@ impl Compiler {
         for item in &file.items {
             match item {
                 Item::Struct { name, fields } => {
-                    if self.structs.iter().any(|s| s.name == name.text) {
+                    if self.struct_names.contains_key(&name.text) {
                         self.err(
                             name.span,
                             format!("struct `{}` is already declared", name.text),
                         );
                         continue;
                     }
+                    if self.structs.len() >= MAX_DECLARED {
+                        self.too_many(MAX_DECLARED, "structs", name.span);
+                        continue;
+                    }
                     let mut fs: Vec<(String, Ty)> = Vec::new();
+                    let mut index: HashMap<String, u16> = HashMap::new();
+                    // The struct itself, then its fields'.
+                    let (mut values, mut depth) = (1usize, 1usize);
                     for (t, n) in fields {
-                        if fs.iter().any(|(f, _)| *f == n.text) {
+                        if index.contains_key(&n.text) {
                             self.err(
                                 n.span,
                                 format!("struct `{}` already has a field `{}`", name.text, n.text),
                             );
                             continue;
                         }
+                        if fs.len() >= MAX_DECLARED {
+                            self.err(
+                                n.span,
+                                format!(
+                                    "more than {MAX_DECLARED} fields are declared in struct `{}`",
+                                    name.text
+                                ),
+                            );
+                            break;
+                        }
                         if let Some(ty) = self.resolve_type(t) {
+                            let (v, d) = match ty {
+                                Ty::Struct(i) => self.struct_shapes[i as usize],
+                                _ => (1, 0),
+                            };
+                            values = values.saturating_add(v);
+                            depth = depth.max(d + 1);
+                            index.insert(n.text.clone(), fs.len() as u16);
                             fs.push((n.text.clone(), ty));
                         }
                     }
+                    let problem = if depth > MAX_NESTING {
+                        Some(format!(
+                            "structs nest more than {MAX_NESTING} levels deep in `{}`",
+                            name.text
+                        ))
+                    } else if values > MAX_STRUCT_VALUES {
+                        Some(format!(
+                            "struct `{}` holds more than {MAX_STRUCT_VALUES} values, counting those of the structs inside it",
+                            name.text
+                        ))
+                    } else {
+                        None
+                    };
+                    if let Some(m) = problem {
+                        // Declared empty, so that its uses are not errors too.
+                        self.err(name.span, m);
+                        (fs, index, values, depth) = (Vec::new(), HashMap::new(), 1, 1);
+                    }
+                    self.struct_names
+                        .insert(name.text.clone(), self.structs.len() as u16);
+                    self.struct_fields.push(index);
+                    self.struct_shapes.push((values, depth));
                     self.structs.push(StructDef {
                         name: name.text.clone(),
                         fields: fs,
@@ -382,6 +519,11 @@ impl Compiler {
                         continue;
                     }
                     let tys: Vec<Ty> = params.iter().filter_map(|p| self.resolve_type(p)).collect();
+                    if self.alphabet.kinds.len() >= MAX_DECLARED {
+                        let limit = MAX_DECLARED - super::modules::PREDEFINED.len();
+                        self.too_many(limit, "modules", name.span);
+                        continue;
+                    }
                     if tys.len() == params.len() {
                         self.alphabet.declare(&name.text, tys);
                     }
@@ -443,6 +585,11 @@ impl Compiler {
         }
         for (name, arity) in used {
             if self.alphabet.lookup(&name).is_none() {
+                if self.alphabet.kinds.len() >= MAX_DECLARED {
+                    let limit = MAX_DECLARED - super::modules::PREDEFINED.len();
+                    self.too_many(limit, "modules", Span::default());
+                    return;
+                }
                 self.alphabet.declare(&name, vec![Ty::Float; arity]);
             }
         }
@@ -517,12 +664,14 @@ impl Compiler {
                             None => self.err(n.span, format!("undeclared module `{}` in the module list; declare it with `module {}(...);`", n.text, n.text)),
                         }
                     }
+                    syms.sort();
+                    syms.dedup();
                     filter = if names.is_empty() {
                         Filter::All
                     } else if *consider {
-                        Filter::Consider(syms)
+                        Filter::Consider(syms.into())
                     } else {
-                        Filter::Ignore(syms)
+                        Filter::Ignore(syms.into())
                     };
                 }
                 Item::Section { section: s, .. } => {
@@ -585,6 +734,10 @@ impl Compiler {
                         d.name.text
                     ),
                 );
+                continue;
+            }
+            if self.globals.len() >= MAX_DECLARED {
+                self.too_many(MAX_DECLARED, "global variables", d.name.span);
                 continue;
             }
             self.global_names
@@ -712,7 +865,7 @@ impl Compiler {
         let mut ok = true;
         let mut pats =
             |c: &mut Compiler, list: &[ast::PatModule], scope: &mut Scope| -> Vec<Pattern> {
-                let mut out = Vec::new();
+                let mut out = Vec::with_capacity(list.len());
                 for m in list {
                     match c.pattern(m, scope) {
                         Some(pat) => out.push(pat),
@@ -766,7 +919,7 @@ impl Compiler {
         let (sym, tys, width) = self.module_params(&m.name, m.params.len())?;
         let mut slots = Vec::new();
         for (n, t) in m.params.iter().zip(tys.iter().copied()) {
-            if scope.vars.iter().any(|(v, _, _)| *v == n.text) {
+            if scope.has(&n.text) {
                 self.err(
                     n.span,
                     format!(
@@ -776,7 +929,7 @@ impl Compiler {
                 );
                 return None;
             }
-            slots.push(scope.declare(&n.text, t));
+            slots.push(self.local(scope, &n.text, t, n.span));
         }
         Some(Pattern {
             sym,
@@ -852,9 +1005,10 @@ impl Compiler {
     }
 
     fn successors(&mut self, modules: &[ast::ModuleCall], scope: &mut Scope) -> Vec<Succ> {
-        let mut out = Vec::new();
+        // Sized exactly: a program may hold hundreds of thousands of rules.
+        let mut out = Vec::with_capacity(modules.len());
         for m in modules {
-            let mut args = Vec::new();
+            let mut args = Vec::with_capacity(m.args.len());
             let mut ok = true;
             for a in &m.args {
                 match self.expr(a, scope) {
@@ -968,9 +1122,9 @@ impl Compiler {
                 };
                 for v in &d.vars {
                     let init = self.initializer(ty, &v.init, scope);
-                    let slot = scope.declare(&v.name.text, ty);
+                    let slot = self.local(scope, &v.name.text, ty, v.name.span);
                     if d.is_const {
-                        scope.consts.push(slot);
+                        scope.consts.insert(slot);
                     }
                     let value = init.unwrap_or(Ex::Const(Value::zero(ty, &self.structs)));
                     out.push(St::Init(slot, value));
@@ -1094,6 +1248,28 @@ impl Compiler {
         }
     }
 
+    /// A new local variable, or the error that there are too many, at
+    /// `span`.
+    fn local(&mut self, scope: &mut Scope, name: &str, ty: Ty, span: Span) -> u16 {
+        let slot = scope.declare(name, ty);
+        if scope.full {
+            self.too_many_locals(scope, span);
+        }
+        slot
+    }
+
+    fn too_many_locals(&mut self, scope: &mut Scope, span: Span) {
+        if scope.full && !std::mem::replace(&mut scope.full_reported, true) {
+            self.err(
+                span,
+                format!(
+                    "more than {MAX_LOCALS} local variables in one body (parameters, \
+                     declarations and inlined functions' arguments); split it into several rules"
+                ),
+            );
+        }
+    }
+
     fn condition(&mut self, e: &ast::Expr, scope: &mut Scope) -> Option<Ex> {
         let (ex, ty) = self.expr(e, scope)?;
         self.condition_of(ex, ty, e.span)
@@ -1160,11 +1336,9 @@ impl Compiler {
                 .iter()
                 .position(|c| *c == f.text)
                 .map(|i| (i as u16, Ty::Float)),
-            Ty::Struct(s) => self.structs[s as usize]
-                .fields
-                .iter()
-                .position(|(n, _)| *n == f.text)
-                .map(|i| (i as u16, self.structs[s as usize].fields[i].1)),
+            Ty::Struct(s) => self.struct_fields[s as usize]
+                .get(&f.text)
+                .map(|&i| (i, self.structs[s as usize].fields[i as usize].1)),
             _ => None,
         };
         if found.is_none() {
@@ -1176,7 +1350,33 @@ impl Compiler {
         found
     }
 
+    /// Compiles an expression. The parser bounds the nesting of what is
+    /// written; inlined functions nest their bodies inside their calls, so
+    /// the same bound is kept here (and so on the interpreter's recursion).
     fn expr(&mut self, e: &ast::Expr, scope: &mut Scope) -> Typed {
+        self.nested(1, e.span, |c| c.expr_inner(e, scope))
+    }
+
+    /// Runs `f` `levels` deeper, or refuses with the nesting limit's
+    /// message at `span`.
+    fn nested(&mut self, levels: usize, span: Span, f: impl FnOnce(&mut Self) -> Typed) -> Typed {
+        if self.depth + levels > MAX_NESTING {
+            self.err(
+                span,
+                format!(
+                    "this is nested more than {MAX_NESTING} levels deep once the functions it \
+                     calls are inlined; split it into simpler parts"
+                ),
+            );
+            return None;
+        }
+        self.depth += levels;
+        let r = f(self);
+        self.depth -= levels;
+        r
+    }
+
+    fn expr_inner(&mut self, e: &ast::Expr, scope: &mut Scope) -> Typed {
         let span = e.span;
         match &e.kind {
             ExprKind::Int(i) => Some((Ex::Const(Value::Int(*i)), Ty::Int)),
@@ -1512,7 +1712,7 @@ impl Compiler {
         scope: &mut Scope,
     ) -> Typed {
         let n = name.text.as_str();
-        if let Some(f) = self.functions.iter().position(|d| d.name == n) {
+        if let Some(&f) = self.function_names.get(n) {
             return self.inline(f, args, span, scope);
         }
         let mut typed = Vec::new();
@@ -1652,7 +1852,8 @@ impl Compiler {
             return None;
         }
         let mark = (scope.vars.len(), scope.next);
-        let slot = scope.declare(var.map_or("", |v| v.text.as_str()), Ty::Elem(member));
+        let name = var.map_or("", |v| v.text.as_str());
+        let slot = self.local(scope, name, Ty::Elem(member), op.span);
         let cond = match cond {
             Some(c) => self.condition(c, scope).map(|x| Some(Box::new(x))),
             None => Some(None),
@@ -1676,7 +1877,7 @@ impl Compiler {
                 }
             }
         };
-        scope.vars.truncate(mark.0);
+        scope.truncate(mark.0);
         scope.next = mark.1;
         let (cond, value) = (cond?, value?);
         let ty = match (&value, fold_op) {
@@ -1702,7 +1903,8 @@ impl Compiler {
     /// own locals overwrite a parameter already set; then the body sees
     /// only its parameters. The locals are free again after the call.
     fn inline(&mut self, f: usize, args: &[ast::Expr], span: Span, scope: &mut Scope) -> Typed {
-        let def = self.functions[f].clone();
+        let functions = Rc::clone(&self.functions);
+        let def = &functions[f];
         if def.params.len() != args.len() {
             self.err(
                 span,
@@ -1744,19 +1946,25 @@ impl Compiler {
             );
             return None;
         }
-        // Slots are u16: a call with tens of thousands of parameters must
-        // not wrap them (as the surface checker before this one refused).
-        let Some(next) = u16::try_from(scope.next as usize + args.len())
-            .ok()
-            .filter(|n| *n < u16::MAX)
-        else {
-            self.err(span, "this expression needs too many variables");
+        // Each argument binds a local around the body: `Let`s nest.
+        self.nested(args.len(), span, |c| {
+            c.inline_body(f, def, args, span, scope)
+        })
+    }
+
+    fn inline_body(
+        &mut self,
+        f: usize,
+        def: &ast::Define,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Typed {
+        let mark = (scope.vars.len(), scope.next);
+        let Some(first) = scope.reserve(args.len()) else {
+            self.too_many_locals(scope, span);
             return None;
         };
-        let mark = (scope.vars.len(), scope.next);
-        let first = scope.next;
-        scope.next = next;
-        scope.max = scope.max.max(scope.next);
         let mut lets = Vec::with_capacity(args.len());
         let mut ok = true;
         for a in args {
@@ -1766,14 +1974,14 @@ impl Compiler {
             }
         }
         if !ok {
-            scope.vars.truncate(mark.0);
+            scope.truncate(mark.0);
             scope.next = mark.1;
             return None;
         }
         let barrier = scope.barrier;
         scope.barrier = scope.vars.len();
         for (i, (p, (_, t))) in def.params.iter().zip(&lets).enumerate() {
-            scope.vars.push((p.clone(), *t, first + i as u16));
+            scope.bind(p, *t, first + i as u16);
         }
         let marked = self.truncating.len();
         for (i, (a, _)) in lets.iter().enumerate() {
@@ -1794,7 +2002,7 @@ impl Compiler {
             }
         }
         scope.barrier = barrier;
-        scope.vars.truncate(mark.0);
+        scope.truncate(mark.0);
         scope.next = mark.1;
         let (mut x, t) = body?;
         for (i, (a, _)) in lets.into_iter().enumerate().rev() {

@@ -145,8 +145,10 @@ pub struct Pattern {
 pub enum Filter {
     #[default]
     All,
-    Ignore(Vec<Sym>),
-    Consider(Vec<Sym>),
+    /// The modules, sorted, without repeats; shared by the rules that
+    /// follow the list, not copied into each.
+    Ignore(std::sync::Arc<[Sym]>),
+    Consider(std::sync::Arc<[Sym]>),
 }
 
 impl Filter {
@@ -155,8 +157,8 @@ impl Filter {
     pub fn skips(&self, s: Sym) -> bool {
         match self {
             Filter::All => false,
-            Filter::Ignore(v) => v.contains(&s),
-            Filter::Consider(v) => !v.contains(&s),
+            Filter::Ignore(v) => v.binary_search(&s).is_ok(),
+            Filter::Consider(v) => v.binary_search(&s).is_err(),
         }
     }
 }

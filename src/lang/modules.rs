@@ -1,5 +1,7 @@
 //! The module alphabet: lpfg's predefined modules and the user's declarations.
 
+use std::collections::HashMap;
+
 use super::value::Ty;
 
 /// Index of a module kind in [`Alphabet`].
@@ -26,6 +28,9 @@ pub struct ModuleKind {
 #[derive(Clone, Debug)]
 pub struct Alphabet {
     pub kinds: Vec<ModuleKind>,
+    /// Each kind's symbol by name (the first of a name), so that a lookup
+    /// does not walk a long alphabet.
+    index: HashMap<String, Sym>,
 }
 
 use Ty::{Float as F, Int as I, V2, V3};
@@ -144,23 +149,29 @@ pub const PREDEFINED: &[(&str, &[&[Ty]])] = &[
 
 impl Alphabet {
     pub fn new() -> Alphabet {
-        Alphabet {
-            kinds: PREDEFINED
-                .iter()
-                .map(|(name, sig)| ModuleKind {
-                    name: (*name).to_string(),
-                    sig: Signature::Overloads(sig),
-                    builtin: true,
-                })
-                .collect(),
+        let mut a = Alphabet {
+            kinds: Vec::new(),
+            index: HashMap::new(),
+        };
+        for (name, sig) in PREDEFINED {
+            a.push(ModuleKind {
+                name: (*name).to_string(),
+                sig: Signature::Overloads(sig),
+                builtin: true,
+            });
         }
+        a
+    }
+
+    fn push(&mut self, kind: ModuleKind) -> Sym {
+        let sym = Sym(self.kinds.len() as u16);
+        self.index.entry(kind.name.clone()).or_insert(sym);
+        self.kinds.push(kind);
+        sym
     }
 
     pub fn lookup(&self, name: &str) -> Option<Sym> {
-        self.kinds
-            .iter()
-            .position(|k| k.name == name)
-            .map(|i| Sym(i as u16))
+        self.index.get(name).copied()
     }
 
     pub fn get(&self, s: Sym) -> &ModuleKind {
@@ -194,13 +205,14 @@ impl Alphabet {
         }
     }
 
+    /// Declares a module kind; the checker keeps their number within
+    /// what a [`Sym`] can index.
     pub fn declare(&mut self, name: &str, params: Vec<Ty>) -> Sym {
-        self.kinds.push(ModuleKind {
+        self.push(ModuleKind {
             name: name.to_string(),
             sig: Signature::Fixed(params),
             builtin: false,
-        });
-        Sym(self.kinds.len() as u16 - 1)
+        })
     }
 }
 

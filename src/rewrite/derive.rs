@@ -133,16 +133,16 @@ impl<'p> Derivation<'p> {
             (Some(n), _) => n,
             (None, None) => 0,
             (None, Some((v, span))) => {
-                if !v.is_finite() || v > MAX_STEPS as f64 {
+                if !(0.0..=MAX_STEPS as f64).contains(&v) || v.fract() != 0.0 {
                     return Err(DeriveError {
                         span: Some(span),
                         message: format!(
-                            "the derivation length is {v}; it must be a number of steps from 0 to {MAX_STEPS}"
+                            "the derivation length must be a whole number of steps from 0 to {MAX_STEPS}"
                         ),
                         step: 0,
                     });
                 }
-                v.max(0.0) as u64
+                v as u64
             }
         };
         if length > MAX_STEPS {

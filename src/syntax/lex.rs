@@ -7,7 +7,7 @@
 
 use nom::{
     branch::alt,
-    bytes::complete::{tag, take_until, take_while, take_while1},
+    bytes::complete::{take_until, take_while, take_while1},
     character::complete::{char, digit0, digit1, one_of},
     combinator::{opt, recognize},
     sequence::{pair, tuple},
@@ -94,15 +94,13 @@ fn string_lit(i: &str) -> IResult<&str, &str> {
 }
 
 fn punct(i: &str) -> IResult<&str, &'static str> {
-    for p in PUNCTS {
-        if let Ok((rest, _)) = tag::<_, _, nom::error::Error<&str>>(*p)(i) {
-            return Ok((rest, p));
-        }
+    match PUNCTS.iter().find(|p| i.starts_with(**p)) {
+        Some(p) => Ok((&i[p.len()..], p)),
+        None => Err(nom::Err::Error(nom::error::Error::new(
+            i,
+            nom::error::ErrorKind::Tag,
+        ))),
     }
-    Err(nom::Err::Error(nom::error::Error::new(
-        i,
-        nom::error::ErrorKind::Tag,
-    )))
 }
 
 /// Splits `text` into tokens. Comments and line continuations are whitespace.

@@ -3,6 +3,8 @@
 //! Every function parses one production of the grammar, shown in its doc
 //! comment. Errors say what was expected and what was found, at the token.
 
+use std::collections::HashSet;
+
 use super::ast::*;
 use super::lex::{Tok, Token};
 use super::span::{Diagnostic, Span};
@@ -18,20 +20,31 @@ pub struct Parser<'t> {
     /// Single-character turtle mode, switched on by `angle:`.
     abop: bool,
     /// Names that are never split into characters in that mode.
-    whole_names: Vec<String>,
+    whole_names: HashSet<String>,
     /// The last character of a split identifier, read in its place.
     split_last: Option<(usize, Name)>,
-    /// How deeply expressions and statements are nested right now.
+    /// How deeply expressions and statements are nested right now: the
+    /// number of syntax-tree levels above the node being parsed.
     depth: usize,
+    /// The deepest level reached since [`Parser::measure`] last started
+    /// measuring. A node built around an operand parsed before it (`a +
+    /// b`, `a.x`, `c ? a : b`, `a = b`) moves that operand one level down,
+    /// so the operand's deepest level is what must stay under the limit.
+    peak: usize,
     /// Struct and typedef names seen so far.
-    type_names: Vec<String>,
+    type_names: HashSet<String>,
     eof: Span,
 }
 
 type PResult<T> = Result<T, Diagnostic>;
 
-/// How deeply expressions and statements may nest. Deeper programs are
-/// refused with a message rather than overflowing the stack later.
+/// How deeply expressions and statements may nest: the height of the
+/// syntax tree, counting every level that the checker and the interpreter
+/// recurse through (an operator, a call, a field, a cast, a parenthesis, a
+/// statement, a block). Deeper programs are refused with a message rather
+/// than overflowing the stack later; a chain that the grammar nests
+/// (`a = b = c`, `x ? y : x ? y : z`, `a + b + c`, `v.x.y`) counts one
+/// level per link.
 pub const MAX_NESTING: usize = 100;
 
 impl<'t> Parser<'t> {
@@ -43,10 +56,11 @@ impl<'t> Parser<'t> {
             toks,
             pos: 0,
             abop: false,
-            whole_names: Vec::new(),
+            whole_names: HashSet::new(),
             split_last: None,
             depth: 0,
-            type_names: Vec::new(),
+            peak: 0,
+            type_names: HashSet::new(),
             eof,
         }
     }
@@ -57,11 +71,11 @@ pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<Fil
     let abop = toks
         .windows(2)
         .any(|w| w[0].line_start && w[0].tok.is_ident("angle") && w[1].tok.is_punct(":"));
-    let mut whole_names: Vec<String> = predefined.iter().map(|s| s.to_string()).collect();
+    let mut whole_names: HashSet<String> = predefined.iter().map(|s| s.to_string()).collect();
     for w in toks.windows(2) {
         if let (Tok::Ident(m), Tok::Ident(n)) = (&w[0].tok, &w[1].tok) {
             if m == "module" {
-                whole_names.push(n.clone());
+                whole_names.insert(n.clone());
             }
         }
     }
@@ -72,7 +86,8 @@ pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<Fil
         whole_names,
         split_last: None,
         depth: 0,
-        type_names: Vec::new(),
+        peak: 0,
+        type_names: HashSet::new(),
         eof,
     };
     let mut items = Vec::new();
@@ -176,7 +191,7 @@ impl<'t> Parser<'t> {
     }
 
     fn is_type_name(&self, s: &str) -> bool {
-        TYPE_KEYWORDS.contains(&s) || self.type_names.iter().any(|t| t == s)
+        TYPE_KEYWORDS.contains(&s) || self.type_names.contains(s)
     }
 
     /// True when the tokens at the cursor begin a declaration:
@@ -439,7 +454,7 @@ impl<'t> Parser<'t> {
     fn struct_decl(&mut self, items: &mut Vec<Item>) -> PResult<()> {
         self.pos += 1;
         let name = self.name("a struct name")?;
-        self.type_names.push(name.text.clone());
+        self.type_names.insert(name.text.clone());
         self.expect_punct("{", "to open the struct body")?;
         let mut fields = Vec::new();
         while !self.eat_punct("}") {
@@ -466,7 +481,7 @@ impl<'t> Parser<'t> {
         self.pos += 1;
         let ty = self.type_ref()?;
         let name = self.name("the new type name")?;
-        self.type_names.push(name.text.clone());
+        self.type_names.insert(name.text.clone());
         self.expect_punct(";", "after the typedef")?;
         items.push(Item::Typedef { ty, name });
         Ok(())
@@ -746,7 +761,7 @@ impl<'t> Parser<'t> {
         }
         let t = self.peek()?;
         let Tok::Ident(s) = &t.tok else { return None };
-        if s.len() < 2 || self.whole_names.iter().any(|w| w == s) || !s.is_ascii() {
+        if s.len() < 2 || self.whole_names.contains(s) || !s.is_ascii() {
             return None;
         }
         let start = t.span.start as usize;
@@ -849,21 +864,63 @@ impl<'t> Parser<'t> {
         }
     }
 
-    fn enter(&mut self, extra: usize) -> PResult<()> {
-        if self.depth + extra > MAX_NESTING {
-            return Err(Diagnostic::new(
-                self.span_here(),
-                format!("this is nested more than {MAX_NESTING} levels deep; split it into simpler parts"),
-            ));
+    fn too_deep<T>(&self, at: Span) -> PResult<T> {
+        Err(Diagnostic::new(
+            at,
+            format!(
+                "this is nested more than {MAX_NESTING} levels deep; split it into simpler parts"
+            ),
+        ))
+    }
+
+    /// Goes one level deeper, to parse the children of a node; [`ascend`]
+    /// comes back. (Plain calls rather than a closure: every stack frame
+    /// counts on a deep parse in a debug build.)
+    ///
+    /// [`ascend`]: Parser::ascend
+    fn descend(&mut self) -> PResult<()> {
+        if self.depth + 1 > MAX_NESTING {
+            return self.too_deep(self.span_here());
         }
+        self.depth += 1;
+        self.peak = self.peak.max(self.depth);
         Ok(())
     }
 
-    fn stmt(&mut self) -> PResult<Stmt> {
-        self.enter(1)?;
-        self.depth += 1;
-        let r = self.stmt_inner();
+    fn ascend(&mut self) {
         self.depth -= 1;
+    }
+
+    /// Starts measuring the deepest level that the parse which follows
+    /// reaches; [`reached`] ends it with the level, given what this
+    /// returned.
+    ///
+    /// [`reached`]: Parser::reached
+    fn measure(&mut self) -> usize {
+        std::mem::replace(&mut self.peak, self.depth)
+    }
+
+    fn reached(&mut self, outer: usize) -> usize {
+        let reached = self.peak;
+        self.peak = outer.max(reached);
+        reached
+    }
+
+    /// A node is built around an operand whose deepest level was
+    /// `reached`: everything in it moves one level down. The error points
+    /// at `at`, the operator that makes the node.
+    fn wrap(&mut self, reached: usize, at: Span) -> PResult<usize> {
+        if reached + 1 > MAX_NESTING {
+            return self.too_deep(at);
+        }
+        self.peak = self.peak.max(reached + 1);
+        Ok(reached + 1)
+    }
+
+    fn stmt(&mut self) -> PResult<Stmt> {
+        self.descend()?;
+        let r = self.stmt_inner();
+        self.ascend();
         r
     }
 
@@ -1022,7 +1079,9 @@ impl<'t> Parser<'t> {
 
     /// assign := cond [ ('=' | '+=' | '-=' | '*=' | '/=' | '%=') assign ]
     fn assign_expr(&mut self) -> PResult<Expr> {
+        let outer = self.measure();
         let lhs = self.cond_expr()?;
+        let reached = self.reached(outer);
         let op = match self.peek().map(|t| &t.tok) {
             Some(Tok::Punct("=")) => Some(None),
             Some(Tok::Punct("+=")) => Some(Some(BinOp::Add)),
@@ -1033,8 +1092,11 @@ impl<'t> Parser<'t> {
             _ => None,
         };
         if let Some(op) = op {
+            self.wrap(reached, self.span_here())?;
             self.pos += 1;
+            self.descend()?;
             let rhs = self.assign_expr()?;
+            self.ascend();
             let span = lhs.span.to(rhs.span);
             return Ok(Expr {
                 kind: ExprKind::Assign(op, Box::new(lhs), Box::new(rhs)),
@@ -1046,11 +1108,17 @@ impl<'t> Parser<'t> {
 
     /// cond := binary(0) [ '?' expr ':' cond ]
     fn cond_expr(&mut self) -> PResult<Expr> {
+        let outer = self.measure();
         let c = self.binary(0)?;
-        if self.eat_punct("?") {
+        let reached = self.reached(outer);
+        if self.peek_punct("?") {
+            self.wrap(reached, self.span_here())?;
+            self.pos += 1;
+            self.descend()?;
             let a = self.expr()?;
             self.expect_punct(":", "in the conditional expression `c ? a : b`")?;
             let b = self.cond_expr()?;
+            self.ascend();
             let span = c.span.to(b.span);
             return Ok(Expr {
                 kind: ExprKind::Cond(Box::new(c), Box::new(a), Box::new(b)),
@@ -1060,11 +1128,13 @@ impl<'t> Parser<'t> {
         Ok(c)
     }
 
-    /// Precedence climbing over the C binary operators.
+    /// Precedence climbing over the C binary operators. A chain `a + b +
+    /// c` is a left-deep tree: each operator moves what came before it one
+    /// level down.
     fn binary(&mut self, min_prec: u8) -> PResult<Expr> {
+        let outer = self.measure();
         let mut lhs = self.unary()?;
-        // Each operator of a chain deepens the tree by one.
-        let mut chain = 0;
+        let mut reached = self.reached(outer);
         loop {
             let Some((op, prec)) = self.peek().and_then(|t| binop_of(&t.tok)) else {
                 return Ok(lhs);
@@ -1072,13 +1142,13 @@ impl<'t> Parser<'t> {
             if prec < min_prec {
                 return Ok(lhs);
             }
-            chain += 1;
-            self.enter(chain)?;
+            reached = self.wrap(reached, self.span_here())?;
             self.pos += 1;
-            self.depth += chain;
-            let rhs = self.binary(prec + 1);
-            self.depth -= chain;
-            let rhs = rhs?;
+            let outer = self.measure();
+            self.descend()?;
+            let rhs = self.binary(prec + 1)?;
+            self.ascend();
+            reached = reached.max(self.reached(outer));
             let span = lhs.span.to(rhs.span);
             lhs = Expr {
                 kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
@@ -1088,11 +1158,12 @@ impl<'t> Parser<'t> {
     }
 
     /// unary := ('-' | '+' | '!' | '++' | '--') unary | '(' TYPE ')' unary | postfix
+    ///
+    /// Every operand goes through here, one level below its parent.
     fn unary(&mut self) -> PResult<Expr> {
-        self.enter(1)?;
-        self.depth += 1;
+        self.descend()?;
         let r = self.unary_inner();
-        self.depth -= 1;
+        self.ascend();
         r
     }
 
@@ -1154,13 +1225,22 @@ impl<'t> Parser<'t> {
         self.postfix()
     }
 
+    /// postfix := primary { '.' NAME [ '(' args ')' ] | '++' | '--' }, a
+    /// left-deep chain like a binary operator's.
     fn postfix(&mut self) -> PResult<Expr> {
+        let outer = self.measure();
         let mut e = self.primary()?;
+        let mut reached = self.reached(outer);
         loop {
+            if self.peek_punct(".") || self.peek_punct("++") || self.peek_punct("--") {
+                reached = self.wrap(reached, self.span_here())?;
+            }
             if self.eat_punct(".") {
                 let name = self.name("a field or method name after `.`")?;
                 if self.eat_punct("(") {
+                    let outer = self.measure();
                     let args = self.args(")")?;
+                    reached = reached.max(self.reached(outer));
                     let span = e.span.to(self.prev_span());
                     e = Expr {
                         kind: ExprKind::Method(Box::new(e), name, args),

@@ -42,6 +42,8 @@ pub struct SourceFile {
     pub name: String,
     pub text: String,
     line_starts: Vec<usize>,
+    /// Every character is one byte: a column is a byte count.
+    ascii: bool,
 }
 
 impl SourceFile {
@@ -55,6 +57,7 @@ impl SourceFile {
         }
         SourceFile {
             name: name.into(),
+            ascii: text.is_ascii(),
             text,
             line_starts,
         }
@@ -62,14 +65,27 @@ impl SourceFile {
 
     /// 1-based line and column (in characters) of a byte offset.
     pub fn line_col(&self, offset: usize) -> (usize, usize) {
-        let offset = offset.min(self.text.len());
+        let offset = self.boundary(offset);
         let line = match self.line_starts.binary_search(&offset) {
             Ok(i) => i,
             Err(i) => i - 1,
         };
         let start = self.line_starts[line];
-        let col = self.text[start..offset].chars().count() + 1;
-        (line + 1, col)
+        let col = if self.ascii {
+            offset - start
+        } else {
+            self.text[start..offset].chars().count()
+        };
+        (line + 1, col + 1)
+    }
+
+    /// `offset` within the text, moved back to a character boundary.
+    fn boundary(&self, offset: usize) -> usize {
+        let mut offset = offset.min(self.text.len());
+        while !self.text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        offset
     }
 
     /// The text of 1-based line `line`, without its newline.
@@ -111,45 +127,63 @@ impl SourceMap {
         self.render_as("warning", span, message)
     }
 
+    /// The work is proportional to the window shown, not to the line:
+    /// many diagnostics on one long line render in linear time.
     fn render_as(&self, severity: &str, span: Span, message: &str) -> String {
-        let file = self.get(span.file);
-        let (line, col) = file.line_col(span.start as usize);
-        let full = file.line_text(line);
         // A very long line is shown as a window around the column.
         const WINDOW: usize = 60;
-        let chars: Vec<char> = full
-            .chars()
-            .map(|c| if c.is_control() && c != '\t' { ' ' } else { c })
-            .collect();
-        let (text, shift) = if chars.len() > 2 * WINDOW + 20 {
-            let from = (col - 1).saturating_sub(WINDOW);
-            let to = (col - 1 + WINDOW).min(chars.len());
-            let mut t: String = chars[from..to].iter().collect();
-            let mut shift = from;
-            if from > 0 {
-                t.insert_str(0, "...");
-                shift = from.saturating_sub(3);
-            }
-            if to < chars.len() {
-                t.push_str("...");
-            }
-            (t, shift)
+        let file = self.get(span.file);
+        let start = file.boundary(span.start as usize);
+        let (line, col) = file.line_col(start);
+        let full = file.line_text(line);
+        let at = (start - file.line_starts[line - 1]).min(full.len());
+        let (before, after) = full.split_at(at);
+        let long = full.chars().take(2 * WINDOW + 21).count() > 2 * WINDOW + 20;
+        let (from, to) = if long {
+            // Up to WINDOW characters before the caret and from it.
+            let from = before
+                .char_indices()
+                .rev()
+                .nth(WINDOW - 1)
+                .map_or(0, |(i, _)| i);
+            let to = after
+                .char_indices()
+                .nth(WINDOW)
+                .map_or(full.len(), |(i, _)| at + i);
+            (from, to)
         } else {
-            (chars.iter().collect::<String>(), 0)
+            (0, full.len())
         };
-        let text = text.as_str();
-        let (end_line, end_col) = file.line_col(span.end as usize);
-        let width = if end_line == line && end_col > col {
-            (end_col - col).min(2 * WINDOW)
+        let visible = |s: &str| -> String {
+            s.chars()
+                .map(|c| if c.is_control() && c != '\t' { ' ' } else { c })
+                .collect()
+        };
+        let lead = visible(&full[from..at]);
+        let mut text = String::new();
+        if from > 0 {
+            text.push_str("...");
+        }
+        text.push_str(&lead);
+        text.push_str(&visible(&full[at..to]));
+        if to < full.len() {
+            text.push_str("...");
+        }
+        // The caret's width: the span's characters on this line.
+        let end = file.boundary((span.end as usize).max(start));
+        let line_end = file.line_starts[line - 1] + full.len();
+        let width = if end <= line_end && end > start {
+            file.text[start..end].chars().take(2 * WINDOW).count()
         } else {
             1
         };
         let gutter = line.to_string().len();
-        let pad: String = text
-            .chars()
-            .take(col - 1 - shift)
-            .map(|c| if c == '\t' { '\t' } else { ' ' })
-            .collect();
+        let mut pad: String = if from > 0 {
+            "   ".into()
+        } else {
+            String::new()
+        };
+        pad.extend(lead.chars().map(|c| if c == '\t' { '\t' } else { ' ' }));
         format!(
             "{}:{}:{}: {}: {}\n{:gutter$} |\n{} | {}\n{:gutter$} | {}{}",
             file.name,

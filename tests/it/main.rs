@@ -6,6 +6,7 @@ mod bad_inputs;
 mod cli;
 mod curves;
 mod errors;
+mod front_limits;
 mod golden;
 mod golden_tests;
 mod lsystems;
