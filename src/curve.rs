@@ -9,7 +9,7 @@ use crate::lang::Program;
 use crate::render;
 use crate::rewrite::derive::MAX_STEPS;
 use crate::rewrite::{Derivation, DeriveError, DeriveOptions, Derived, Word};
-use crate::syntax::{Diagnostic, SourceMap};
+use crate::syntax::{Diagnostic, FileId, SourceMap};
 
 /// A checked curve L-system together with the sources its spans point into.
 #[derive(Clone, Debug)]
@@ -30,12 +30,26 @@ pub struct FigureOptions {
 
 impl Curve {
     /// A derivation error as an [`Error`], located at the rule or directive
-    /// at fault when there is one.
+    /// at fault when there is one, else at the program's file.
     pub fn error(&self, e: DeriveError) -> Error {
         match e.span {
             Some(span) => Error::at(&self.sources, Diagnostic::new(span, e.message)),
-            None => Error::Failed(e.message),
+            None => self.file_error(e.message),
         }
+    }
+
+    /// An error about the program's run as a whole: named by its file.
+    fn file_error(&self, message: String) -> Error {
+        Error::File {
+            path: self.sources.get(FileId(0)).name.clone(),
+            line: None,
+            message,
+        }
+    }
+
+    /// A word of step `step` that the turtle cannot draw.
+    fn draw_error(&self, e: draw::DrawError, step: u64) -> Error {
+        self.file_error(format!("at step {step}, {}", e.message))
     }
 
     /// Derives the axiom to the derivation length (or `opts.steps`) and runs
@@ -85,7 +99,9 @@ impl Curve {
         let mut panels = Vec::new();
         let mut panel = |d: &mut Derivation| -> Result<(), Error> {
             let word = d.interpret().map_err(fail)?;
-            panels.push(draw::draw(&word, &p.alphabet, &p.structs, &draw_opts)?);
+            let events = draw::draw(&word, &p.alphabet, &p.structs, &draw_opts)
+                .map_err(|e| self.draw_error(e, d.step))?;
+            panels.push(events);
             Ok(())
         };
         if opts.each {
@@ -168,7 +184,8 @@ impl<'c> CurveRun<'c> {
         }
         let word = self.interpreted()?;
         let p = &curve.program;
-        Ok(draw::draw(&word, &p.alphabet, &p.structs, &opts)?)
+        draw::draw(&word, &p.alphabet, &p.structs, &opts)
+            .map_err(|e| curve.draw_error(e, self.step()))
     }
 
     /// The curve's points: the turtle's lines joined into polylines, a new

@@ -2,6 +2,7 @@
 //! `StartEach`/`EndEach` blocks and groups, decomposition after the axiom
 //! and after every step, `End`, and interpretation on request.
 
+use crate::deadline::Deadline;
 use crate::lang::eval::{Env, Interp, NoHost, RuntimeError};
 use crate::lang::ir::{Program, St};
 use crate::lang::{Sym, Value};
@@ -20,6 +21,9 @@ pub struct DeriveOptions {
     pub max_modules: usize,
     /// Where the partition into multi-module strict predecessors starts.
     pub phase: usize,
+    /// The derivation, its decomposition and interpretation stop with an
+    /// error once this passes. Default: none.
+    pub deadline: Option<Deadline>,
 }
 
 impl Default for DeriveOptions {
@@ -28,6 +32,7 @@ impl Default for DeriveOptions {
             steps: None,
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
+            deadline: None,
         }
     }
 }
@@ -53,6 +58,18 @@ impl DeriveOptions {
         self.max_modules = m;
         self
     }
+
+    pub fn with_deadline(mut self, d: Option<Deadline>) -> Self {
+        self.deadline = d;
+        self
+    }
+}
+
+/// What a word that outgrew `limit` modules says after where it happened.
+fn too_long(limit: usize) -> String {
+    format!(
+        "the word grew past {limit} modules; raise the limit with --max-modules or derive fewer steps"
+    )
 }
 
 /// A failed derivation: the message, where in the program, and at which step.
@@ -102,7 +119,7 @@ impl<'p> Derivation<'p> {
     /// Initialises globals, evaluates the directives, runs `Start`, sets the
     /// word to the axiom and decomposes it.
     pub fn new(program: &'p Program, opts: DeriveOptions) -> Result<Derivation<'p>, DeriveError> {
-        let mut interp = Interp::new(&program.structs);
+        let mut interp = Interp::with_deadline(&program.structs, opts.deadline);
         let mut env = Env::new(Vec::new());
         for g in &program.globals {
             let v = match &g.init {
@@ -166,6 +183,17 @@ impl<'p> Derivation<'p> {
             opts,
         };
         d.control(ControlKind::Start)?;
+        if let Some(m) = program.axiom.get(d.opts.max_modules) {
+            return Err(DeriveError {
+                span: Some(m.span),
+                message: format!(
+                    "the axiom has {} modules, more than the limit of {}; raise the limit with --max-modules",
+                    program.axiom.len(),
+                    d.opts.max_modules
+                ),
+                step: 0,
+            });
+        }
         let mut axiom = Word::new();
         interp
             .eval_modules(&program.axiom, &mut d.env, &mut axiom)
@@ -251,7 +279,7 @@ impl<'p> Derivation<'p> {
     }
 
     fn control(&mut self, kind: ControlKind) -> Result<(), DeriveError> {
-        let mut interp = Interp::new(&self.program.structs);
+        let mut interp = Interp::with_deadline(&self.program.structs, self.opts.deadline);
         for (k, body, frame) in &self.program.control {
             if *k == kind {
                 let mut frame = vec![Value::Void; *frame];
@@ -289,6 +317,7 @@ impl<'p> Derivation<'p> {
             forward: self.env.forward,
             phase: self.opts.phase,
             max_modules: self.opts.max_modules,
+            deadline: self.opts.deadline,
         }
     }
 
@@ -299,6 +328,9 @@ impl<'p> Derivation<'p> {
 
     /// Performs one derivation step with its control blocks.
     pub fn next_step(&mut self) -> Result<(), DeriveError> {
+        if let Err(m) = crate::deadline::check(self.opts.deadline) {
+            return Err(self.step_error(StepError::Timeout(m), self.step + 1));
+        }
         self.control(ControlKind::StartEach)?;
         self.env.current_group = self.env.next_group;
         let rules = self.candidates(Section::Productions);
@@ -341,25 +373,33 @@ impl<'p> Derivation<'p> {
     }
 
     fn step_error(&self, e: StepError, step: u64) -> DeriveError {
-        match e {
-            StepError::Runtime { rule, error } => {
-                let r = &self.program.rules[rule];
-                let what = match r.section {
-                    Section::Productions => "production",
-                    Section::Decomposition => "decomposition rule",
-                    Section::Interpretation => "interpretation rule",
-                };
-                DeriveError {
-                    span: error.span.or(Some(r.span)),
-                    message: format!("at step {step}, {what} `{}`: {}", r.label, error.message),
-                    step,
-                }
+        let at_rule = |rule: usize, span: Option<Span>, message: &str| {
+            let r = &self.program.rules[rule];
+            let what = match r.section {
+                Section::Productions => "production",
+                Section::Decomposition => "decomposition rule",
+                Section::Interpretation => "interpretation rule",
+            };
+            DeriveError {
+                span: span.or(Some(r.span)),
+                message: format!("at step {step}, {what} `{}`: {message}", r.label),
+                step,
             }
-            StepError::TooLong { limit } => DeriveError {
+        };
+        match e {
+            StepError::Runtime { rule, error } => at_rule(rule, error.span, &error.message),
+            StepError::TooLong {
+                limit,
+                rule: Some(rule),
+            } => at_rule(rule, None, &too_long(limit)),
+            StepError::TooLong { limit, rule: None } => DeriveError {
                 span: None,
-                message: format!(
-                    "at step {step}, the word grew past {limit} modules; raise the limit with --max-modules or derive fewer steps"
-                ),
+                message: format!("at step {step}, {}", too_long(limit)),
+                step,
+            },
+            StepError::Timeout(m) => DeriveError {
+                span: None,
+                message: format!("at step {step}, {m}"),
                 step,
             },
         }
