@@ -7,6 +7,7 @@ mod curves;
 mod errors;
 mod golden;
 mod golden_tests;
+mod limits;
 mod lsystems;
 mod mesh;
 mod mesh_draw;
