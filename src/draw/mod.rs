@@ -125,6 +125,8 @@ impl Default for DrawOptions {
 #[derive(Clone, Debug, PartialEq)]
 pub struct DrawError {
     pub message: String,
+    /// The module at fault (counted from 0), when one is.
+    pub module: Option<usize>,
 }
 
 impl std::fmt::Display for DrawError {
@@ -247,6 +249,7 @@ pub fn draw_with_queries(
                     i + 1,
                     alphabet.name(sym)
                 ),
+                module: Some(i),
             });
         }
         let int_arg = || match word.values(i, alphabet, structs).first() {
@@ -417,6 +420,7 @@ fn beyond(
             "module {} of the interpreted word, `{module}`, {what} an infinite coordinate, which cannot be drawn",
             i + 1
         ),
+        module: Some(i),
     }
 }
 

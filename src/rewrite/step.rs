@@ -53,6 +53,10 @@ impl std::fmt::Display for StepError {
     }
 }
 
+/// In an origin, a module copied from the old word (the low bits give its
+/// index there), rather than produced by a rule.
+pub const COPIED: u32 = 1 << 31;
+
 /// Source modules between two looks at the deadline on the general path.
 const DEADLINE_EVERY: usize = 4096;
 
@@ -113,8 +117,9 @@ impl<'p> Rewriter<'p> {
     /// One step with the rules `rules` (indices into `Program::rules`, in the
     /// order they are tried). `eligible`, when given, says which modules of
     /// `src` may be rewritten at all; `origin`, when given, receives for each
-    /// module of `dst` whether a rule produced it. Returns how many modules
-    /// of `src` a rule rewrote.
+    /// module of `dst` what made it: the index of the rule that produced it,
+    /// or [`COPIED`] with the index of the module of `src` it copies.
+    /// Returns how many modules of `src` a rule rewrote.
     #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
@@ -124,7 +129,7 @@ impl<'p> Rewriter<'p> {
         env: &mut Env,
         opts: &StepOptions,
         eligible: Option<&[bool]>,
-        mut origin: Option<&mut Vec<bool>>,
+        mut origin: Option<&mut Vec<u32>>,
     ) -> Result<usize, StepError> {
         dst.clear();
         if let Some(o) = origin.as_deref_mut() {
@@ -219,7 +224,11 @@ impl<'p> Rewriter<'p> {
                 dst.push_from(src, i);
             }
             if let Some(o) = origin.as_deref_mut() {
-                o.resize(dst.len(), produced);
+                let made = match last_rule {
+                    Some(r) if produced => r as u32,
+                    _ => COPIED | i as u32,
+                };
+                o.resize(dst.len(), made);
             }
             if dst.len() > opts.max_modules {
                 return Err(StepError::TooLong {

@@ -354,7 +354,7 @@ fn the_module_limit_names_the_production_on_every_path() {
 }
 
 #[test]
-fn a_drawing_that_overflows_names_its_module_step_and_file() {
+fn a_drawing_that_overflows_names_its_module_step_and_maker() {
     let s = Scratch::new("overflow");
     s.write(
         "far.lsys",
@@ -363,9 +363,13 @@ fn a_drawing_that_overflows_names_its_module_step_and_file() {
     let r = subgram(&s.0, &["render", "far.lsys", "-o", "far.png"]);
     fails_with(
         &r,
-        "far.lsys: error: at step 2, module 2 of the interpreted word, `F(1e308)`, \
-         moves the turtle to an infinite coordinate, which cannot be drawn",
+        "far.lsys:4:1: error: at step 2, module 2 of the interpreted word, `F(1e308)`, \
+         moves the turtle to an infinite coordinate, which cannot be drawn; \
+         production `A(x)` made that module\n  |\n4 | A(x) -> F(x) A(x)\n  | ^^^^",
     );
+    // Each step drawn: step 1 draws, step 2 overflows.
+    let r = subgram(&s.0, &["render", "far.lsys", "-o", "far.png", "--each"]);
+    fails_with(&r, "far.lsys:4:1: error: at step 2, module 2 ");
     s.write(
         "disc.lsys",
         "module A;\nderivation length: 0;\nAxiom: MoveTo2f(V2f(1e308, 0)) Circle(1e308);\n",
@@ -373,17 +377,25 @@ fn a_drawing_that_overflows_names_its_module_step_and_file() {
     let r = subgram(&s.0, &["render", "disc.lsys", "-o", "disc.svg"]);
     fails_with(
         &r,
-        "disc.lsys: error: at step 0, module 2 of the interpreted word, `Circle(1e308)`, \
-         draws a circle that reaches an infinite coordinate",
+        "disc.lsys:3:32: error: at step 0, module 2 of the interpreted word, `Circle(1e308)`, \
+         draws a circle that reaches an infinite coordinate, which cannot be drawn; \
+         the axiom made that module",
     );
     assert_eq!(s.files(), ["disc.lsys", "far.lsys"]);
 
-    // The library says the same.
-    let l = load_text("module A;\nderivation length: 2;\nAxiom: A;\nA -> F(1e308) A\n");
+    // The library says the same, through an interpretation rule.
+    let l = load_text(
+        "module A; module B;\nderivation length: 2;\nAxiom: A;\nA -> B A\n\
+         interpretation:\nB -> F(1e308)\n",
+    );
     let mut run = l.run(DeriveOptions::default()).unwrap();
     let e = run.events().unwrap_err().to_string();
     assert!(
-        e.starts_with("test.lsys: error: at step 2, module 2 of the interpreted word, `F(1e308)`"),
+        e.starts_with(
+            "test.lsys:6:1: error: at step 2, module 2 of the interpreted word, `F(1e308)`, \
+             moves the turtle to an infinite coordinate, which cannot be drawn; \
+             interpretation rule `B()` made that module"
+        ),
         "{e}"
     );
 }
