@@ -288,7 +288,7 @@ impl<'p> Interp<'p> {
                     }
                     self.fuel -= 1;
                     self.ticks = self.ticks.wrapping_add(1);
-                    if self.ticks % DEADLINE_EVERY == 0 {
+                    if self.ticks.is_multiple_of(DEADLINE_EVERY) {
                         if let Err(m) = crate::deadline::check(self.deadline) {
                             return Err(rt(Some(*span), m));
                         }

@@ -171,10 +171,10 @@ impl<'p> Rewriter<'p> {
         let mut wrapped_at = None;
         // The rule that produced last, to blame for a word grown too long.
         let mut last_rule = None;
-        let mut scanned = 0;
+        let mut scanned: usize = 0;
         while k < n {
             scanned += 1;
-            if scanned % DEADLINE_EVERY == 0 {
+            if scanned.is_multiple_of(DEADLINE_EVERY) {
                 crate::deadline::check(opts.deadline).map_err(StepError::Timeout)?;
             }
             // The scan position; backward steps walk from the right end.
