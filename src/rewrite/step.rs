@@ -14,7 +14,7 @@ use crate::lang::value::{decode, decode_all, StructDef};
 use crate::lang::{Sym, Ty, Value};
 use crate::syntax::ast::ContextKind;
 
-use super::context::{match_left, match_right, module_matches, Brackets, Rules};
+use super::context::{match_left, match_right, module_matches, Rules, Tables};
 use super::word::{Reversed, Seq, Word};
 
 /// How one step runs.
@@ -93,8 +93,8 @@ pub struct Rewriter<'p> {
     matched: Vec<usize>,
     new_matched: Vec<usize>,
     tmp: Word,
-    /// The brackets of the word a step rewrites.
-    brackets: Brackets,
+    /// The context tables of the word a step rewrites.
+    tables: Tables,
 }
 
 impl<'p> Rewriter<'p> {
@@ -110,7 +110,7 @@ impl<'p> Rewriter<'p> {
             matched: Vec::new(),
             new_matched: Vec::new(),
             tmp: Word::new(),
-            brackets: Brackets::default(),
+            tables: Tables::default(),
         }
     }
 
@@ -141,7 +141,7 @@ impl<'p> Rewriter<'p> {
         }
         crate::deadline::check(opts.deadline).map_err(StepError::Timeout)?;
         self.interp.deadline = opts.deadline;
-        self.brackets.clear();
+        self.tables.clear();
         // Size the new word from the last step's growth, so that it is
         // allocated once instead of doubling its way up.
         let g = self.growth.clamp(1.0, 64.0);
@@ -600,7 +600,7 @@ impl<'p> Rewriter<'p> {
             eb: self.eb,
             filter: &rule.filter,
             ring: opts.ring,
-            brackets: Some(&self.brackets),
+            tables: Some(&self.tables),
         };
         // Cheap test first: the strict predecessor matches exactly.
         for (j, p) in rule.strict.iter().enumerate() {
@@ -639,7 +639,7 @@ impl<'p> Rewriter<'p> {
         self.new_matched.clear();
         let new_ctx = Rules {
             ring: false,
-            brackets: None,
+            tables: None,
             ..ctx
         };
         let mut new_left_end = dst.len() as isize - 1;
@@ -944,7 +944,7 @@ impl Host for WordHost<'_> {
         let mut idx = Vec::new();
         let new_ctx = Rules {
             ring: false,
-            brackets: None,
+            tables: None,
             ..self.ctx
         };
         match kind {

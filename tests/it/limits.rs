@@ -232,6 +232,23 @@ fn right_contexts_skip_deep_branches_in_linear_time() {
     assert!(r.took < Duration::from_secs(20), "{:?}", r.took);
 }
 
+/// `ignore: A` and a run of A between two B: each A's contexts look past
+/// the whole run, both ways. Walking it module by module was quadratic.
+#[test]
+fn contexts_skip_long_runs_of_ignored_modules_in_linear_time() {
+    let s = Scratch::new("runs");
+    let n = 100_000;
+    let text = format!(
+        "module A; module B; module C;\nignore: A;\nderivation length: 1;\nAxiom: B{} B;\nB < A > B -> C\n",
+        " A".repeat(n)
+    );
+    s.write("runs.lsys", &text);
+    let r = subgram(&s.0, &["derive", "runs.lsys", "--timeout", "20"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert_eq!(r.stdout.trim(), format!("B{} B", " C".repeat(n)));
+    assert!(r.took < Duration::from_secs(20), "{:?}", r.took);
+}
+
 /// A strict predecessor of two modules that wraps a ring's seam, whose
 /// right context then skips ignored modules past the next turn: the scan
 /// ran off the word (an index panic).
