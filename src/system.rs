@@ -69,6 +69,7 @@ impl RunOptions {
 }
 
 /// The result of [`System::run`].
+#[allow(clippy::large_enum_variant)] // one per run: boxing saves nothing
 pub enum Run<'s> {
     Curve(CurveRun<'s>),
     Surface(SurfaceRun),
