@@ -4,8 +4,10 @@
 //! and never over one of its inputs.
 
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use crate::curve::FigureOptions;
+use crate::deadline::{Deadline, DEFAULT_TIMEOUT};
 use crate::error::Error;
 use crate::load::{load, LoadOptions};
 use crate::mesh::{self, Mesh};
@@ -51,6 +53,8 @@ pub struct DeriveArgs {
     pub phase: usize,
     /// Print the word after interpretation rules.
     pub interpreted: bool,
+    /// `--timeout`: the command stops with an error after this long.
+    pub timeout: Option<Duration>,
 }
 
 impl DeriveArgs {
@@ -63,6 +67,7 @@ impl DeriveArgs {
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             interpreted: false,
+            timeout: Some(DEFAULT_TIMEOUT),
         }
     }
 }
@@ -70,12 +75,14 @@ impl DeriveArgs {
 /// `subgram derive`: a curve's final word (or its interpretation) as text
 /// or JSON; for a surface grammar, the subdivided mesh's description.
 pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, Error> {
+    let deadline = a.timeout.map(Deadline::after);
     let system = load(&a.file, &load_options(&a.defines))?;
     let opts = RunOptions {
         steps: a.steps,
         max_modules: a.max_modules,
         phase: a.phase,
         base_mesh: None,
+        deadline,
     };
     match system {
         System::Surface(s) => {
@@ -128,6 +135,8 @@ pub struct RenderArgs {
     pub defines: Vec<String>,
     pub max_modules: usize,
     pub phase: usize,
+    /// `--timeout`: the command stops with an error after this long.
+    pub timeout: Option<Duration>,
 }
 
 impl RenderArgs {
@@ -144,6 +153,7 @@ impl RenderArgs {
             defines: Vec::new(),
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
+            timeout: Some(DEFAULT_TIMEOUT),
         }
     }
 }
@@ -151,6 +161,7 @@ impl RenderArgs {
 /// `subgram render`: a curve's picture, a surface grammar's subdivided
 /// mesh, or a mesh file, as PNG or SVG.
 pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Error> {
+    let deadline = a.timeout.map(Deadline::after);
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
     refuse_overwrite(output, &[file])?;
@@ -169,6 +180,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
             looks.check()?;
             let opts = RunOptions {
                 steps: a.steps,
+                deadline,
                 ..RunOptions::default()
             };
             let run = s.subdivide(&opts, progress)?;
@@ -191,6 +203,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                 max_modules: a.max_modules,
                 phase: a.phase,
                 base_mesh: None,
+                deadline,
             };
             let figure = FigureOptions {
                 derive: opts.derive_options(),
@@ -221,11 +234,14 @@ pub struct SubdivideArgs {
     pub defines: Vec<String>,
     /// For pictures: iso, front, back, left, right, top or bottom.
     pub view: Option<String>,
+    /// `--timeout`: the command stops with an error after this long.
+    pub timeout: Option<Duration>,
 }
 
 /// `subgram subdivide`: runs a surface grammar on a mesh and writes the
 /// mesh or its picture.
 pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<(), Error> {
+    let deadline = a.timeout.map(Deadline::after);
     let grammar = Path::new(&a.grammar);
     let output = Path::new(&a.output);
     let mut inputs = vec![grammar];
@@ -235,6 +251,7 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
     let opts = RunOptions {
         steps: a.steps,
         base_mesh: a.mesh.as_ref().map(PathBuf::from),
+        deadline,
         ..RunOptions::default()
     };
     let run = Surface::new(g, Some(grammar)).subdivide(&opts, progress)?;
@@ -297,11 +314,14 @@ pub struct ReverseArgs {
     pub json: bool,
     /// Where to store the details that restore the input exactly.
     pub details: Option<String>,
+    /// `--timeout`: the command stops with an error after this long.
+    pub timeout: Option<Duration>,
 }
 
 /// `subgram reverse`: reverse-subdivides a contour; returns the report when
 /// one was asked for.
 pub fn reverse(a: &ReverseArgs) -> Result<Option<String>, Error> {
+    let deadline = a.timeout.map(Deadline::after);
     let fig = a
         .figure
         .as_ref()
@@ -320,10 +340,11 @@ pub fn reverse(a: &ReverseArgs) -> Result<Option<String>, Error> {
     if a.open {
         contour.closed = false;
     }
-    let scheme = match &a.scheme {
+    let mut scheme = match &a.scheme {
         Some(s) => Scheme::from_file(Path::new(s), contour.closed)?,
         None => Scheme::builtin(contour.closed),
     };
+    scheme.deadline = deadline;
     let opts = ReverseOptions {
         steps: a.steps,
         phase: a.phase,
@@ -365,11 +386,14 @@ pub struct ReconstructArgs {
     pub level: Option<usize>,
     /// The scheme the details were made with (default: as recorded).
     pub scheme: Option<String>,
+    /// `--timeout`: the command stops with an error after this long.
+    pub timeout: Option<Duration>,
 }
 
 /// `subgram reconstruct`: restores a contour from a coarse polygon and its
 /// details.
 pub fn reconstruct(a: &ReconstructArgs) -> Result<(), Error> {
+    let deadline = a.timeout.map(Deadline::after);
     let (coarse, details, output) = (
         Path::new(&a.coarse),
         Path::new(&a.details),
@@ -386,11 +410,12 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), Error> {
         message: format!("not a details file: {e}"),
     })?;
     let c = reverse::input::read(coarse)?;
-    let scheme = match &a.scheme {
+    let mut scheme = match &a.scheme {
         Some(s) => Scheme::from_file(Path::new(s), d.closed)?,
         None if d.scheme.starts_with("builtin:") => Scheme::builtin(d.closed),
         None => Scheme::from_file(Path::new(&d.scheme), d.closed)?,
     };
+    scheme.deadline = deadline;
     let pts = reverse::reconstruct(&scheme, &c.points, &d, a.level)?;
     write_file(
         output,

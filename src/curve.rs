@@ -7,9 +7,9 @@ use crate::draw::{self, Event};
 use crate::error::Error;
 use crate::lang::Program;
 use crate::render;
-use crate::rewrite::derive::MAX_STEPS;
+use crate::rewrite::derive::{rule_kind, Maker, MAX_STEPS};
 use crate::rewrite::{Derivation, DeriveError, DeriveOptions, Derived, Word};
-use crate::syntax::{Diagnostic, SourceMap};
+use crate::syntax::{Diagnostic, FileId, SourceMap};
 
 /// A checked curve L-system together with the sources its spans point into.
 #[derive(Clone, Debug)]
@@ -30,12 +30,70 @@ pub struct FigureOptions {
 
 impl Curve {
     /// A derivation error as an [`Error`], located at the rule or directive
-    /// at fault when there is one.
+    /// at fault when there is one, else at the program's file.
     pub fn error(&self, e: DeriveError) -> Error {
         match e.span {
             Some(span) => Error::at(&self.sources, Diagnostic::new(span, e.message)),
-            None => Error::Failed(e.message),
+            None => self.file_error(e.message),
         }
+    }
+
+    /// An error about the program's run as a whole: named by its file.
+    fn file_error(&self, message: String) -> Error {
+        Error::File {
+            path: self.sources.get(FileId(0)).name.clone(),
+            line: None,
+            message,
+        }
+    }
+
+    /// A word of step `step` that the turtle cannot draw: located at
+    /// what made the module at fault, when that is known.
+    fn draw_error(&self, e: draw::DrawError, step: u64, maker: Option<Maker>) -> Error {
+        let message = format!("at step {step}, {}", e.message);
+        let (span, made) = match maker {
+            Some(Maker::Axiom(k)) => (self.program.axiom[k].span, "the axiom".to_string()),
+            Some(Maker::Rule(r)) => {
+                let rule = &self.program.rules[r];
+                let kind = rule_kind(rule.section);
+                (rule.span, format!("{kind} `{}`", rule.label))
+            }
+            None => return self.file_error(message),
+        };
+        let message = format!("{message}; {made} made that module");
+        Error::at(&self.sources, Diagnostic::new(span, message))
+    }
+
+    /// What made module `module` of `drawn`, the interpreted word that
+    /// [`Curve::figure`] drew at step `step`: the figure's derivation run
+    /// again, traced. `None` when the replay does not draw the same word.
+    fn maker_in_figure(
+        &self,
+        opts: &FigureOptions,
+        step: u64,
+        drawn: &Word,
+        module: usize,
+    ) -> Option<Maker> {
+        let mut d = Derivation::traced(&self.program, opts.derive.clone()).ok()?;
+        d.angle().ok()?;
+        let mut shown = None;
+        if opts.each {
+            shown = Some(d.interpret_traced().ok()?);
+        }
+        while d.step < step && d.has_next() {
+            d.next_step().ok()?;
+            if opts.each {
+                shown = Some(d.interpret_traced().ok()?);
+            }
+        }
+        if !opts.each {
+            shown = Some(d.interpret_traced().ok()?);
+        }
+        let (word, makers) = shown?;
+        if d.step != step || word != *drawn {
+            return None;
+        }
+        makers?.get(module).copied()
     }
 
     /// Derives the axiom to the derivation length (or `opts.steps`) and runs
@@ -85,7 +143,12 @@ impl Curve {
         let mut panels = Vec::new();
         let mut panel = |d: &mut Derivation| -> Result<(), Error> {
             let word = d.interpret().map_err(fail)?;
-            panels.push(draw::draw(&word, &p.alphabet, &p.structs, &draw_opts)?);
+            let step = d.step;
+            let events = draw::draw(&word, &p.alphabet, &p.structs, &draw_opts).map_err(|e| {
+                let maker = (e.module).and_then(|m| self.maker_in_figure(opts, step, &word, m));
+                self.draw_error(e, step, maker)
+            })?;
+            panels.push(events);
             Ok(())
         };
         if opts.each {
@@ -168,7 +231,24 @@ impl<'c> CurveRun<'c> {
         }
         let word = self.interpreted()?;
         let p = &curve.program;
-        Ok(draw::draw(&word, &p.alphabet, &p.structs, &opts)?)
+        draw::draw(&word, &p.alphabet, &p.structs, &opts).map_err(|e| {
+            let maker = (e.module).and_then(|m| self.maker(&word, m));
+            curve.draw_error(e, self.step(), maker)
+        })
+    }
+
+    /// What made module `module` of `drawn`, this run's interpreted word:
+    /// the derivation run again, traced. `None` when the replay does not
+    /// give the same word.
+    fn maker(&self, drawn: &Word, module: usize) -> Option<Maker> {
+        let mut d = Derivation::traced(&self.curve.program, self.d.options().clone()).ok()?;
+        crate::production::run(&mut d, |_| {}).ok()?;
+        d.angle().ok()?;
+        let (word, makers) = d.interpret_traced().ok()?;
+        if word != *drawn {
+            return None;
+        }
+        makers?.get(module).copied()
     }
 
     /// The curve's points: the turtle's lines joined into polylines, a new

@@ -30,6 +30,7 @@
 
 mod atomic;
 mod curve;
+mod deadline;
 mod error;
 mod lang;
 mod load;
@@ -47,6 +48,7 @@ pub mod reverse;
 pub mod surface;
 
 pub use curve::{Curve, CurveRun, FigureOptions};
+pub use deadline::{Deadline, DEFAULT_TIMEOUT};
 pub use error::Error;
 pub use lang::{Program, Value};
 pub use load::{load, load_file, load_str, load_text, LoadOptions};

@@ -3,6 +3,7 @@
 //! to exit codes (1 for a problem with the input, 2 for a usage error).
 
 use std::process::ExitCode;
+use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
@@ -42,6 +43,10 @@ enum Command {
         /// Print the word after interpretation rules instead.
         #[arg(long)]
         interpreted: bool,
+        /// Stop with an error after this many seconds (0: no limit).
+        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+        timeout: Timeout,
     },
     /// Render an .lsys file's picture to PNG or SVG.
     Render {
@@ -73,6 +78,10 @@ enum Command {
         max_modules: usize,
         #[arg(long, default_value_t = 0)]
         phase: usize,
+        /// Stop with an error after this many seconds (0: no limit).
+        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+        timeout: Timeout,
     },
     /// Reverse-subdivide a contour into a compact control polygon.
     Reverse {
@@ -103,6 +112,10 @@ enum Command {
         /// Store the details that restore the input exactly.
         #[arg(long)]
         details: Option<String>,
+        /// Stop with an error after this many seconds (0: no limit).
+        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+        timeout: Timeout,
     },
     /// Restore a contour from a coarse polygon and its details.
     Reconstruct {
@@ -117,6 +130,10 @@ enum Command {
         /// The scheme the details were made with (default: as recorded).
         #[arg(long)]
         scheme: Option<String>,
+        /// Stop with an error after this many seconds (0: no limit).
+        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+        timeout: Timeout,
     },
     /// Subdivide a mesh with a surface grammar.
     Subdivide {
@@ -134,6 +151,10 @@ enum Command {
         /// For pictures: iso, front, back, left, right, top, bottom.
         #[arg(long)]
         view: Option<String>,
+        /// Stop with an error after this many seconds (0: no limit).
+        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+        timeout: Timeout,
     },
     /// Meshes: information and conversion.
     Mesh {
@@ -154,6 +175,31 @@ fn parse_phase(s: &str) -> Result<subgram::reverse::Phase, String> {
         "0" => Ok(subgram::reverse::Phase::Fixed(0)),
         "1" => Ok(subgram::reverse::Phase::Fixed(1)),
         _ => Err(format!("`{s}` is not a phase: use auto, 0 or 1")),
+    }
+}
+
+/// `--timeout SECONDS`: the time limit, none for 0.
+#[derive(Clone, Copy)]
+struct Timeout(Option<Duration>);
+
+impl std::fmt::Display for Timeout {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0.map_or(0.0, |d| d.as_secs_f64()))
+    }
+}
+
+/// `--timeout SECONDS`: a number of seconds, 0 for no limit.
+fn parse_timeout(s: &str) -> Result<Timeout, String> {
+    let secs: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number of seconds"))?;
+    match Duration::try_from_secs_f64(secs) {
+        Ok(d) if d.is_zero() => Ok(Timeout(None)),
+        Ok(d) => Ok(Timeout(Some(d))),
+        Err(_) => Err(format!(
+            "`{s}` is not a time limit: give a number of seconds, or 0 for no limit"
+        )),
     }
 }
 
@@ -241,6 +287,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             max_modules,
             phase,
             interpreted,
+            timeout,
         } => {
             let args = DeriveArgs {
                 file,
@@ -250,6 +297,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 max_modules,
                 phase,
                 interpreted,
+                timeout: timeout.0,
             };
             print_out(&with_progress(|p| command::derive(&args, p))?)
         }
@@ -265,6 +313,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             define,
             max_modules,
             phase,
+            timeout,
         } => {
             let args = RenderArgs {
                 file,
@@ -278,6 +327,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 defines: define,
                 max_modules,
                 phase,
+                timeout: timeout.0,
             };
             with_progress(|p| command::render(&args, p))
         }
@@ -288,6 +338,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             output,
             define,
             view,
+            timeout,
         } => {
             let args = SubdivideArgs {
                 mesh,
@@ -296,6 +347,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 output,
                 defines: define,
                 view,
+                timeout: timeout.0,
             };
             with_progress(|p| command::subdivide(&args, p))
         }
@@ -320,6 +372,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             report,
             format,
             details,
+            timeout,
         } => {
             let args = ReverseArgs {
                 input,
@@ -332,6 +385,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 report,
                 json: matches!(format, Format::Json),
                 details,
+                timeout: timeout.0,
             };
             match command::reverse(&args)? {
                 Some(report) => print_out(&report),
@@ -344,12 +398,14 @@ fn run(cli: Cli) -> Result<(), Error> {
             output,
             level,
             scheme,
+            timeout,
         } => command::reconstruct(&command::ReconstructArgs {
             coarse,
             details,
             output,
             level,
             scheme,
+            timeout: timeout.0,
         }),
     }
 }

@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::curve::{Curve, CurveRun};
+use crate::deadline::Deadline;
 use crate::error::Error;
 use crate::mesh::Mesh;
 use crate::rewrite::derive::DEFAULT_MAX_MODULES;
@@ -33,6 +34,8 @@ pub struct RunOptions {
     pub phase: usize,
     /// Surfaces: the base mesh file, instead of the grammar's `mesh:`.
     pub base_mesh: Option<PathBuf>,
+    /// The run stops with an error once this passes. Default: none.
+    pub deadline: Option<Deadline>,
 }
 
 impl Default for RunOptions {
@@ -42,6 +45,7 @@ impl Default for RunOptions {
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             base_mesh: None,
+            deadline: None,
         }
     }
 }
@@ -57,13 +61,15 @@ impl RunOptions {
     pub fn derive_options(&self) -> DeriveOptions {
         let mut d = DeriveOptions::default()
             .with_max_modules(self.max_modules)
-            .with_phase(self.phase);
+            .with_phase(self.phase)
+            .with_deadline(self.deadline);
         d.steps = self.steps;
         d
     }
 }
 
 /// The result of [`System::run`].
+#[allow(clippy::large_enum_variant)] // one per run: boxing saves nothing
 pub enum Run<'s> {
     Curve(CurveRun<'s>),
     Surface(SurfaceRun),
@@ -189,25 +195,30 @@ impl Surface {
     }
 
     /// A run's error as an [`Error`], located at the rule when one is to
-    /// blame.
+    /// blame, else at the grammar's file.
     pub fn error(&self, e: crate::surface::RunError) -> Error {
         match e.span {
             Some(span) => Error::at(
                 &self.grammar.sources,
                 crate::syntax::Diagnostic::new(span, e.message),
             ),
-            None => Error::Failed(e.message),
+            None => Error::File {
+                path: self.grammar.sources.get(FileId(0)).name.clone(),
+                line: None,
+                message: e.message,
+            },
         }
     }
 
     /// Runs the `init:` rules, then `steps` steps on `mesh`, as a new run
-    /// ([`Grammar::run`]). `progress` hears before the first step and after
-    /// each.
+    /// ([`Grammar::run_until`]), stopping once `deadline` passes.
+    /// `progress` hears before the first step and after each.
     /// A run that fails in a rule leaves the mesh partly derived.
     pub fn run_on(
         &self,
         mesh: &mut Mesh,
         steps: usize,
+        deadline: Option<Deadline>,
         mut progress: impl FnMut(Progress),
     ) -> Result<(), Error> {
         let at = |c: StepCounts| Progress {
@@ -224,7 +235,7 @@ impl Surface {
             faces: mesh.face_count(),
         }));
         self.grammar
-            .run(mesh, steps, |c| progress(at(c)))
+            .run_until(mesh, steps, deadline, |c| progress(at(c)))
             .map_err(|e| self.error(e))
     }
 
@@ -248,7 +259,7 @@ impl Surface {
         };
         let mut mesh = load_mesh(&path)?;
         let steps = self.steps(opts.steps)?;
-        self.run_on(&mut mesh, steps, progress)?;
+        self.run_on(&mut mesh, steps, opts.deadline, progress)?;
         Ok(SurfaceRun { mesh, steps })
     }
 }

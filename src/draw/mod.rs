@@ -125,6 +125,8 @@ impl Default for DrawOptions {
 #[derive(Clone, Debug, PartialEq)]
 pub struct DrawError {
     pub message: String,
+    /// The module at fault (counted from 0), when one is.
+    pub module: Option<usize>,
 }
 
 impl std::fmt::Display for DrawError {
@@ -247,6 +249,7 @@ pub fn draw_with_queries(
                     i + 1,
                     alphabet.name(sym)
                 ),
+                module: Some(i),
             });
         }
         let int_arg = || match word.values(i, alphabet, structs).first() {
@@ -333,18 +336,33 @@ pub fn draw_with_queries(
                     i += 1;
                 }
             }
-            Cmd::Disc => out.push(Event::Disc {
-                c: t.pos,
-                r: arg(0, 1.0),
-                color: t.pen.color,
-            }),
+            Cmd::Disc | Cmd::Ring => {
+                let r = arg(0, 1.0);
+                if !(t.pos.abs().max_element() + r.abs()).is_finite() {
+                    return Err(beyond(
+                        word,
+                        i,
+                        alphabet,
+                        structs,
+                        "draws a circle that reaches",
+                    ));
+                }
+                out.push(if cmd == Cmd::Disc {
+                    Event::Disc {
+                        c: t.pos,
+                        r,
+                        color: t.pen.color,
+                    }
+                } else {
+                    Event::Ring {
+                        c: t.pos,
+                        r,
+                        pen: t.pen,
+                    }
+                })
+            }
             Cmd::Dot => out.push(Event::Dot {
                 c: t.pos,
-                pen: t.pen,
-            }),
-            Cmd::Ring => out.push(Event::Ring {
-                c: t.pos,
-                r: arg(0, 1.0),
                 pen: t.pen,
             }),
             Cmd::Query(q) => {
@@ -370,7 +388,59 @@ pub fn draw_with_queries(
                 }
             }
         }
+        // Finite parameters can still add up past the largest number.
+        if !t.pos.is_finite() {
+            return Err(beyond(word, i, alphabet, structs, "moves the turtle to"));
+        }
         i += 1;
     }
     Ok(out)
+}
+
+/// Module `i` took the drawing to an infinite coordinate: which one, with
+/// its parameters.
+fn beyond(
+    word: &Word,
+    i: usize,
+    alphabet: &Alphabet,
+    structs: &[StructDef],
+    what: &str,
+) -> DrawError {
+    let params: Vec<String> = word
+        .values(i, alphabet, structs)
+        .iter()
+        .map(short)
+        .collect();
+    let module = match params.is_empty() {
+        true => alphabet.name(word.sym(i)).to_string(),
+        false => format!("{}({})", alphabet.name(word.sym(i)), params.join(", ")),
+    };
+    DrawError {
+        message: format!(
+            "module {} of the interpreted word, `{module}`, {what} an infinite coordinate, which cannot be drawn",
+            i + 1
+        ),
+        module: Some(i),
+    }
+}
+
+/// A parameter in a message: large and small numbers in exponent form.
+fn short(v: &Value) -> String {
+    let num = |x: f64| {
+        if x != 0.0 && !(1e-6..1e16).contains(&x.abs()) {
+            format!("{x:e}")
+        } else {
+            format!("{x}")
+        }
+    };
+    match v {
+        Value::Float(x) => num(*x),
+        Value::V2(p) => format!("[{}, {}]", num(p.x), num(p.y)),
+        Value::V3(p) => format!("[{}, {}, {}]", num(p.x), num(p.y), num(p.z)),
+        Value::Struct(fs) => format!(
+            "{{{}}}",
+            fs.iter().map(short).collect::<Vec<_>>().join(", ")
+        ),
+        other => other.to_string(),
+    }
 }

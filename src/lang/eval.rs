@@ -6,6 +6,7 @@
 
 use glam::{DVec2, DVec3};
 
+use crate::deadline::Deadline;
 use crate::syntax::ast::{BinOp, ContextKind};
 use crate::syntax::span::Span;
 
@@ -67,6 +68,12 @@ fn rt(span: Option<Span>, m: impl Into<String>) -> Box<RuntimeError> {
 /// Receives successor modules.
 pub trait Emit {
     fn emit(&mut self, sym: Sym, args: &[Value]);
+
+    /// True when the sink holds more than it may: the interpreter stops
+    /// the body after the `produce` that filled it.
+    fn full(&self) -> bool {
+        false
+    }
 }
 
 /// The topology a body runs on, as the body sees it: it answers context
@@ -128,11 +135,19 @@ pub enum Flow {
 /// Loop iterations one body may run before it is stopped.
 pub const LOOP_LIMIT: u64 = 10_000_000;
 
+/// Loop iterations, over all bodies, between two looks at the deadline.
+const DEADLINE_EVERY: u32 = 1 << 16;
+
 /// Runs bodies. Holds scratch space reused across calls.
 pub struct Interp<'p> {
     pub structs: &'p [StructDef],
     scratch: Vec<Value>,
     fuel: u64,
+    /// The run stops once this passes; looked at every
+    /// [`DEADLINE_EVERY`] loop iterations.
+    pub deadline: Option<Deadline>,
+    /// Loop iterations since the interpreter was made, wrapping.
+    ticks: u32,
 }
 
 impl<'p> Interp<'p> {
@@ -141,6 +156,16 @@ impl<'p> Interp<'p> {
             structs,
             scratch: Vec::new(),
             fuel: LOOP_LIMIT,
+            deadline: None,
+            ticks: 0,
+        }
+    }
+
+    /// An interpreter that stops once `deadline` passes.
+    pub fn with_deadline(structs: &'p [StructDef], deadline: Option<Deadline>) -> Interp<'p> {
+        Interp {
+            deadline,
+            ..Interp::new(structs)
         }
     }
 
@@ -262,6 +287,12 @@ impl<'p> Interp<'p> {
                         ));
                     }
                     self.fuel -= 1;
+                    self.ticks = self.ticks.wrapping_add(1);
+                    if self.ticks.is_multiple_of(DEADLINE_EVERY) {
+                        if let Err(m) = crate::deadline::check(self.deadline) {
+                            return Err(rt(Some(*span), m));
+                        }
+                    }
                     match self.stmt(body, cx)? {
                         Flow::Break => break,
                         Flow::Normal | Flow::Continue => {}
@@ -311,6 +342,12 @@ impl<'p> Interp<'p> {
             }
             cx.sink.emit(m.sym, &self.scratch[base..]);
             self.scratch.truncate(base);
+        }
+        if cx.sink.full() {
+            return Err(rt(
+                modules.first().map(|m| m.span),
+                "this successor takes the word past its limit",
+            ));
         }
         Ok(())
     }

@@ -29,6 +29,8 @@ pub struct Scheme {
     /// "builtin:chaikin", "builtin:chaikin-open" or a file path.
     pub name: String,
     pub closed: bool,
+    /// Every run of the scheme stops with an error once this passes.
+    pub deadline: Option<crate::Deadline>,
 }
 
 impl Scheme {
@@ -44,6 +46,7 @@ impl Scheme {
             loaded,
             name: name.to_string(),
             closed,
+            deadline: None,
         }
     }
 
@@ -66,6 +69,7 @@ impl Scheme {
             loaded,
             name: path.display().to_string(),
             closed,
+            deadline: None,
         })
     }
 
@@ -105,7 +109,10 @@ impl Scheme {
         steps: u64,
         phase: usize,
     ) -> Result<Vec<DVec2>, Error> {
-        let opts = DeriveOptions::default().with_steps(steps).with_phase(phase);
+        let opts = DeriveOptions::default()
+            .with_steps(steps)
+            .with_phase(phase)
+            .with_deadline(self.deadline);
         let l = &self.loaded;
         let fail = |e| l.error(e);
         let mut d = Derivation::new(&l.program, opts).map_err(fail)?;

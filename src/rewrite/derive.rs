@@ -2,13 +2,14 @@
 //! `StartEach`/`EndEach` blocks and groups, decomposition after the axiom
 //! and after every step, `End`, and interpretation on request.
 
+use crate::deadline::Deadline;
 use crate::lang::eval::{Env, Interp, NoHost, RuntimeError};
 use crate::lang::ir::{Program, St};
 use crate::lang::{Sym, Value};
 use crate::syntax::ast::{ControlKind, Section};
 use crate::syntax::span::Span;
 
-use super::step::{Rewriter, StepError, StepOptions};
+use super::step::{Rewriter, StepError, StepOptions, COPIED};
 use super::word::Word;
 
 /// Settings of a derivation. `Default` gives lpfg's behaviour.
@@ -20,6 +21,9 @@ pub struct DeriveOptions {
     pub max_modules: usize,
     /// Where the partition into multi-module strict predecessors starts.
     pub phase: usize,
+    /// The derivation, its decomposition and interpretation stop with an
+    /// error once this passes. Default: none.
+    pub deadline: Option<Deadline>,
 }
 
 impl Default for DeriveOptions {
@@ -28,6 +32,7 @@ impl Default for DeriveOptions {
             steps: None,
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
+            deadline: None,
         }
     }
 }
@@ -53,6 +58,18 @@ impl DeriveOptions {
         self.max_modules = m;
         self
     }
+
+    pub fn with_deadline(mut self, d: Option<Deadline>) -> Self {
+        self.deadline = d;
+        self
+    }
+}
+
+/// What a word that outgrew `limit` modules says after where it happened.
+fn too_long(limit: usize) -> String {
+    format!(
+        "the word grew past {limit} modules; raise the limit with --max-modules or derive fewer steps"
+    )
 }
 
 /// A failed derivation: the message, where in the program, and at which step.
@@ -84,6 +101,35 @@ pub struct Derived {
     pub env: Env,
 }
 
+/// What made a module of a traced derivation's word: a module of the
+/// axiom, or a rule (indices into `Program::axiom` and `Program::rules`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Maker {
+    Axiom(usize),
+    Rule(usize),
+}
+
+/// "production", "decomposition rule" or "interpretation rule".
+pub fn rule_kind(section: Section) -> &'static str {
+    match section {
+        Section::Productions => "production",
+        Section::Decomposition => "decomposition rule",
+        Section::Interpretation => "interpretation rule",
+    }
+}
+
+/// The makers of a step's new word, from the old word's and the step's
+/// origins; `None` when they do not fit the old word.
+fn made_by(makers: &[Maker], origin: &[u32]) -> Option<Vec<Maker>> {
+    origin
+        .iter()
+        .map(|&o| match o & COPIED {
+            0 => Some(Maker::Rule(o as usize)),
+            _ => makers.get((o & !COPIED) as usize).copied(),
+        })
+        .collect()
+}
+
 /// Runs a program and keeps the state between steps, so that callers can
 /// look at every intermediate word (`--each`) or stop early.
 pub struct Derivation<'p> {
@@ -96,13 +142,33 @@ pub struct Derivation<'p> {
     pub length: u64,
     pub step: u64,
     opts: DeriveOptions,
+    /// For a traced derivation, what made each module of the word.
+    makers: Option<Vec<Maker>>,
 }
 
 impl<'p> Derivation<'p> {
     /// Initialises globals, evaluates the directives, runs `Start`, sets the
     /// word to the axiom and decomposes it.
     pub fn new(program: &'p Program, opts: DeriveOptions) -> Result<Derivation<'p>, DeriveError> {
-        let mut interp = Interp::new(&program.structs);
+        Self::start(program, opts, false)
+    }
+
+    /// [`Derivation::new`] that also keeps what made each module (see
+    /// [`Derivation::interpret_traced`]). Steps take the general path,
+    /// whose results are those of the fast paths.
+    pub(crate) fn traced(
+        program: &'p Program,
+        opts: DeriveOptions,
+    ) -> Result<Derivation<'p>, DeriveError> {
+        Self::start(program, opts, true)
+    }
+
+    fn start(
+        program: &'p Program,
+        opts: DeriveOptions,
+        traced: bool,
+    ) -> Result<Derivation<'p>, DeriveError> {
+        let mut interp = Interp::with_deadline(&program.structs, opts.deadline);
         let mut env = Env::new(Vec::new());
         for g in &program.globals {
             let v = match &g.init {
@@ -164,12 +230,27 @@ impl<'p> Derivation<'p> {
             length,
             step: 0,
             opts,
+            makers: None,
         };
         d.control(ControlKind::Start)?;
+        if let Some(m) = program.axiom.get(d.opts.max_modules) {
+            return Err(DeriveError {
+                span: Some(m.span),
+                message: format!(
+                    "the axiom has {} modules, more than the limit of {}; raise the limit with --max-modules",
+                    program.axiom.len(),
+                    d.opts.max_modules
+                ),
+                step: 0,
+            });
+        }
         let mut axiom = Word::new();
         interp
             .eval_modules(&program.axiom, &mut d.env, &mut axiom)
             .map_err(|e| runtime(e, None, 0))?;
+        if traced {
+            d.makers = Some((0..axiom.len()).map(Maker::Axiom).collect());
+        }
         d.word = axiom;
         d.decompose()?;
         d.answer_queries()?;
@@ -251,7 +332,7 @@ impl<'p> Derivation<'p> {
     }
 
     fn control(&mut self, kind: ControlKind) -> Result<(), DeriveError> {
-        let mut interp = Interp::new(&self.program.structs);
+        let mut interp = Interp::with_deadline(&self.program.structs, self.opts.deadline);
         for (k, body, frame) in &self.program.control {
             if *k == kind {
                 let mut frame = vec![Value::Void; *frame];
@@ -289,7 +370,13 @@ impl<'p> Derivation<'p> {
             forward: self.env.forward,
             phase: self.opts.phase,
             max_modules: self.opts.max_modules,
+            deadline: self.opts.deadline,
         }
+    }
+
+    /// The options the derivation runs with.
+    pub fn options(&self) -> &DeriveOptions {
+        &self.opts
     }
 
     /// True while steps remain and `Stop()` has not been called.
@@ -299,12 +386,17 @@ impl<'p> Derivation<'p> {
 
     /// Performs one derivation step with its control blocks.
     pub fn next_step(&mut self) -> Result<(), DeriveError> {
+        if let Err(m) = crate::deadline::check(self.opts.deadline) {
+            return Err(self.step_error(StepError::Timeout(m), self.step + 1));
+        }
         self.control(ControlKind::StartEach)?;
         self.env.current_group = self.env.next_group;
         let rules = self.candidates(Section::Productions);
         let opts = self.step_options();
         let mut dst = std::mem::take(&mut self.spare);
         let step = self.step + 1;
+        let mut origin = Vec::new();
+        let traced = self.makers.is_some();
         let result = self.rewriter.step(
             &rules,
             &self.word,
@@ -312,10 +404,13 @@ impl<'p> Derivation<'p> {
             &mut self.env,
             &opts,
             None,
-            None,
+            traced.then_some(&mut origin),
         );
         if let Err(e) = result {
             return Err(self.step_error(e, step));
+        }
+        if let Some(m) = &self.makers {
+            self.makers = made_by(m, &origin);
         }
         self.spare = std::mem::replace(&mut self.word, dst);
         self.env.step = step as i64;
@@ -341,25 +436,29 @@ impl<'p> Derivation<'p> {
     }
 
     fn step_error(&self, e: StepError, step: u64) -> DeriveError {
-        match e {
-            StepError::Runtime { rule, error } => {
-                let r = &self.program.rules[rule];
-                let what = match r.section {
-                    Section::Productions => "production",
-                    Section::Decomposition => "decomposition rule",
-                    Section::Interpretation => "interpretation rule",
-                };
-                DeriveError {
-                    span: error.span.or(Some(r.span)),
-                    message: format!("at step {step}, {what} `{}`: {}", r.label, error.message),
-                    step,
-                }
+        let at_rule = |rule: usize, span: Option<Span>, message: &str| {
+            let r = &self.program.rules[rule];
+            let what = rule_kind(r.section);
+            DeriveError {
+                span: span.or(Some(r.span)),
+                message: format!("at step {step}, {what} `{}`: {message}", r.label),
+                step,
             }
-            StepError::TooLong { limit } => DeriveError {
+        };
+        match e {
+            StepError::Runtime { rule, error } => at_rule(rule, error.span, &error.message),
+            StepError::TooLong {
+                limit,
+                rule: Some(rule),
+            } => at_rule(rule, None, &too_long(limit)),
+            StepError::TooLong { limit, rule: None } => DeriveError {
                 span: None,
-                message: format!(
-                    "at step {step}, the word grew past {limit} modules; raise the limit with --max-modules or derive fewer steps"
-                ),
+                message: format!("at step {step}, {}", too_long(limit)),
+                step,
+            },
+            StepError::Timeout(m) => DeriveError {
+                span: None,
+                message: format!("at step {step}, {m}"),
                 step,
             },
         }
@@ -369,7 +468,9 @@ impl<'p> Derivation<'p> {
     fn decompose(&mut self) -> Result<(), DeriveError> {
         let depth = self.depth(Section::Decomposition)?;
         let word = std::mem::take(&mut self.word);
-        self.word = self.rewrite_to_depth(Section::Decomposition, word, depth)?;
+        let mut makers = self.makers.take();
+        self.word = self.rewrite_to_depth(Section::Decomposition, word, depth, &mut makers)?;
+        self.makers = makers;
         Ok(())
     }
 
@@ -396,21 +497,24 @@ impl<'p> Derivation<'p> {
 
     /// Rewrites `word` with the rules of `section` recursively: after the
     /// first pass only modules that a rule produced are rewritten again.
+    /// `makers`, if any, follow the word's modules.
     fn rewrite_to_depth(
         &mut self,
         section: Section,
         mut word: Word,
         depth: u64,
+        makers: &mut Option<Vec<Maker>>,
     ) -> Result<Word, DeriveError> {
         let rules = self.candidates(section);
         if rules.is_empty() {
             return Ok(word);
         }
         let opts = self.step_options();
-        let mut eligible: Option<Vec<bool>> = None;
+        // After the first pass: which modules a rule produced.
+        let mut eligible: Vec<bool> = Vec::new();
         let mut origin = Vec::new();
         let mut dst = Word::new();
-        for _ in 0..depth {
+        for pass in 0..depth {
             let n = self
                 .rewriter
                 .step(
@@ -419,15 +523,19 @@ impl<'p> Derivation<'p> {
                     &mut dst,
                     &mut self.env,
                     &opts,
-                    eligible.as_deref(),
+                    (pass > 0).then_some(&eligible[..]),
                     Some(&mut origin),
                 )
                 .map_err(|e| self.step_error(e, self.step))?;
             std::mem::swap(&mut word, &mut dst);
+            if let Some(m) = makers {
+                *makers = made_by(m, &origin);
+            }
             if n == 0 {
                 break;
             }
-            eligible = Some(std::mem::take(&mut origin));
+            eligible.clear();
+            eligible.extend(origin.iter().map(|&o| o & COPIED == 0));
         }
         Ok(word)
     }
@@ -446,9 +554,18 @@ impl<'p> Derivation<'p> {
 
     /// The word after interpretation rules: what the turtle draws.
     pub fn interpret(&mut self) -> Result<Word, DeriveError> {
+        Ok(self.interpret_traced()?.0)
+    }
+
+    /// [`Derivation::interpret`], with what made each module of the
+    /// interpreted word when the derivation is traced
+    /// ([`Derivation::traced`]) and the word was not replaced.
+    pub(crate) fn interpret_traced(&mut self) -> Result<(Word, Option<Vec<Maker>>), DeriveError> {
         let depth = self.depth(Section::Interpretation)?;
         let word = self.word.clone();
-        self.rewrite_to_depth(Section::Interpretation, word, depth)
+        let mut makers = self.makers.clone().filter(|m| m.len() == self.word.len());
+        let word = self.rewrite_to_depth(Section::Interpretation, word, depth, &mut makers)?;
+        Ok((word, makers))
     }
 }
 

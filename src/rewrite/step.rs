@@ -6,14 +6,15 @@
 //! (pseudo-L-systems) partition the word without overlap, starting at the
 //! phase. `src` is never mutated.
 
-use crate::lang::eval::{Env, Flow, Host, Interp, RuntimeError};
+use crate::deadline::Deadline;
+use crate::lang::eval::{Emit, Env, Flow, Host, Interp, RuntimeError};
 use crate::lang::ir::{Pattern, Program, Rule};
 use crate::lang::stencil::Stencil;
 use crate::lang::value::{decode, decode_all, StructDef};
 use crate::lang::{Sym, Ty, Value};
 use crate::syntax::ast::ContextKind;
 
-use super::context::{match_left, match_right, module_matches, Rules};
+use super::context::{match_left, match_right, module_matches, Rules, Tables};
 use super::word::{Reversed, Seq, Word};
 
 /// How one step runs.
@@ -26,6 +27,8 @@ pub struct StepOptions {
     pub phase: usize,
     /// The step fails once the new word holds more modules than this.
     pub max_modules: usize,
+    /// The step fails once this passes.
+    pub deadline: Option<Deadline>,
 }
 
 /// Why a step failed.
@@ -33,16 +36,44 @@ pub struct StepOptions {
 pub enum StepError {
     /// A rule's body failed; `rule` indexes `Program::rules`.
     Runtime { rule: usize, error: RuntimeError },
-    /// The new word outgrew `max_modules`.
-    TooLong { limit: usize },
+    /// The new word outgrew `max_modules`; `rule` is the rule that
+    /// produced last, if one did.
+    TooLong { limit: usize, rule: Option<usize> },
+    /// The deadline passed: what it says.
+    Timeout(String),
 }
 
 impl std::fmt::Display for StepError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             StepError::Runtime { error, .. } => f.write_str(&error.message),
-            StepError::TooLong { limit } => write!(f, "the word grew past {limit} modules"),
+            StepError::TooLong { limit, .. } => write!(f, "the word grew past {limit} modules"),
+            StepError::Timeout(m) => f.write_str(m),
         }
+    }
+}
+
+/// In an origin, a module copied from the old word (the low bits give its
+/// index there), rather than produced by a rule.
+pub const COPIED: u32 = 1 << 31;
+
+/// Source modules between two looks at the deadline on the general path.
+const DEADLINE_EVERY: usize = 4096;
+
+/// A sink for one module's successor that is full once the new word
+/// would hold more than its limit.
+struct Successor<'w> {
+    word: &'w mut Word,
+    room: usize,
+}
+
+impl Emit for Successor<'_> {
+    fn emit(&mut self, sym: Sym, args: &[Value]) {
+        self.word.push(sym, args);
+    }
+
+    fn full(&self) -> bool {
+        self.word.len() > self.room
     }
 }
 
@@ -62,6 +93,8 @@ pub struct Rewriter<'p> {
     matched: Vec<usize>,
     new_matched: Vec<usize>,
     tmp: Word,
+    /// The context tables of the word a step rewrites.
+    tables: Tables,
 }
 
 impl<'p> Rewriter<'p> {
@@ -77,14 +110,16 @@ impl<'p> Rewriter<'p> {
             matched: Vec::new(),
             new_matched: Vec::new(),
             tmp: Word::new(),
+            tables: Tables::default(),
         }
     }
 
     /// One step with the rules `rules` (indices into `Program::rules`, in the
     /// order they are tried). `eligible`, when given, says which modules of
     /// `src` may be rewritten at all; `origin`, when given, receives for each
-    /// module of `dst` whether a rule produced it. Returns how many modules
-    /// of `src` a rule rewrote.
+    /// module of `dst` what made it: the index of the rule that produced it,
+    /// or [`COPIED`] with the index of the module of `src` it copies.
+    /// Returns how many modules of `src` a rule rewrote.
     #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
@@ -94,7 +129,7 @@ impl<'p> Rewriter<'p> {
         env: &mut Env,
         opts: &StepOptions,
         eligible: Option<&[bool]>,
-        mut origin: Option<&mut Vec<bool>>,
+        mut origin: Option<&mut Vec<u32>>,
     ) -> Result<usize, StepError> {
         dst.clear();
         if let Some(o) = origin.as_deref_mut() {
@@ -104,6 +139,9 @@ impl<'p> Rewriter<'p> {
         if n == 0 {
             return Ok(0);
         }
+        crate::deadline::check(opts.deadline).map_err(StepError::Timeout)?;
+        self.interp.deadline = opts.deadline;
+        self.tables.clear();
         // Size the new word from the last step's growth, so that it is
         // allocated once instead of doubling its way up.
         let g = self.growth.clamp(1.0, 64.0);
@@ -131,7 +169,14 @@ impl<'p> Rewriter<'p> {
         // Where, in the new word, the successors of modules scanned after
         // the scan wrapped from the end of a ring to its start begin.
         let mut wrapped_at = None;
+        // The rule that produced last, to blame for a word grown too long.
+        let mut last_rule = None;
+        let mut scanned: usize = 0;
         while k < n {
+            scanned += 1;
+            if scanned.is_multiple_of(DEADLINE_EVERY) {
+                crate::deadline::check(opts.deadline).map_err(StepError::Timeout)?;
+            }
             // The scan position; backward steps walk from the right end.
             let i = match (opts.ring, opts.forward) {
                 (true, true) => wrap(phase + k, n),
@@ -164,11 +209,9 @@ impl<'p> Rewriter<'p> {
                     } else {
                         i + 1 - len
                     };
-                    if self
-                        .try_rule(r, rule, src, start, dst, env, opts)
-                        .map_err(|error| StepError::Runtime { rule: r, error })?
-                    {
+                    if self.try_rule(r, rule, src, start, dst, env, opts)? {
                         used = len;
+                        last_rule = Some(r);
                         break;
                     }
                 }
@@ -181,11 +224,16 @@ impl<'p> Rewriter<'p> {
                 dst.push_from(src, i);
             }
             if let Some(o) = origin.as_deref_mut() {
-                o.resize(dst.len(), produced);
+                let made = match last_rule {
+                    Some(r) if produced => r as u32,
+                    _ => COPIED | i as u32,
+                };
+                o.resize(dst.len(), made);
             }
             if dst.len() > opts.max_modules {
                 return Err(StepError::TooLong {
                     limit: opts.max_modules,
+                    rule: last_rule,
                 });
             }
             k += used;
@@ -284,6 +332,7 @@ impl<'p> Rewriter<'p> {
         if n.saturating_mul(out_per_module) > opts.max_modules {
             return Err(StepError::TooLong {
                 limit: opts.max_modules,
+                rule: Some(r),
             });
         }
         let data = src.all_slots();
@@ -472,6 +521,7 @@ impl<'p> Rewriter<'p> {
         };
         let mut matched = [0usize; 16];
         let mut rewritten = 0;
+        let mut last_rule = None;
         for i in 0..n {
             let mut done = false;
             'rules: for &r in rules {
@@ -504,6 +554,7 @@ impl<'p> Rewriter<'p> {
                 apply_stencil(st, src, &matched[..total], dst);
                 rewritten += 1;
                 done = true;
+                last_rule = Some(r);
                 break;
             }
             if !done {
@@ -512,6 +563,7 @@ impl<'p> Rewriter<'p> {
             if dst.len() > opts.max_modules {
                 return Err(StepError::TooLong {
                     limit: opts.max_modules,
+                    rule: last_rule,
                 });
             }
         }
@@ -540,7 +592,7 @@ impl<'p> Rewriter<'p> {
         dst: &mut Word,
         env: &mut Env,
         opts: &StepOptions,
-    ) -> Result<bool, RuntimeError> {
+    ) -> Result<bool, StepError> {
         let n = src.len();
         let len = rule.strict.len();
         let ctx = Rules {
@@ -548,6 +600,7 @@ impl<'p> Rewriter<'p> {
             eb: self.eb,
             filter: &rule.filter,
             ring: opts.ring,
+            tables: Some(&self.tables),
         };
         // Cheap test first: the strict predecessor matches exactly.
         for (j, p) in rule.strict.iter().enumerate() {
@@ -584,7 +637,11 @@ impl<'p> Rewriter<'p> {
         };
         // New contexts match the part of the new word built so far.
         self.new_matched.clear();
-        let new_ctx = Rules { ring: false, ..ctx };
+        let new_ctx = Rules {
+            ring: false,
+            tables: None,
+            ..ctx
+        };
         let mut new_left_end = dst.len() as isize - 1;
         let mut new_right_end = 0;
         if !rule.new_left.is_empty() {
@@ -618,10 +675,13 @@ impl<'p> Rewriter<'p> {
             let ok = apply_stencil(st, src, &self.matched, dst);
             if !ok {
                 dst.truncate(before);
-                return Err(RuntimeError::new(
-                    None,
-                    "a parameter of the successor is NaN or infinite",
-                ));
+                return Err(StepError::Runtime {
+                    rule: r,
+                    error: RuntimeError::new(
+                        None,
+                        "a parameter of the successor is NaN or infinite",
+                    ),
+                });
             }
             if !opts.forward {
                 reverse_tail(dst, before, &mut self.tmp);
@@ -674,10 +734,23 @@ impl<'p> Rewriter<'p> {
             new_left: new_left_end,
             new_right: new_right_end,
         };
+        let mut successor = Successor {
+            word: &mut self.tmp,
+            room: opts.max_modules.saturating_sub(dst.len()),
+        };
         let flow = self
             .interp
-            .run(&rule.body, &mut self.frame, env, &mut host, &mut self.tmp)?;
-        let _ = r;
+            .run(&rule.body, &mut self.frame, env, &mut host, &mut successor)
+            .map_err(|error| {
+                if successor.full() {
+                    StepError::TooLong {
+                        limit: opts.max_modules,
+                        rule: Some(r),
+                    }
+                } else {
+                    StepError::Runtime { rule: r, error }
+                }
+            })?;
         if flow != Flow::Produced {
             return Ok(false);
         }
@@ -871,6 +944,7 @@ impl Host for WordHost<'_> {
         let mut idx = Vec::new();
         let new_ctx = Rules {
             ring: false,
+            tables: None,
             ..self.ctx
         };
         match kind {

@@ -423,7 +423,20 @@ impl Grammar {
         steps: usize,
         progress: impl FnMut(StepCounts),
     ) -> Result<(), RunError> {
+        self.run_until(mesh, steps, None, progress)
+    }
+
+    /// [`Grammar::run`] that stops with an error once `deadline` passes:
+    /// it is looked at before every rule.
+    pub fn run_until(
+        &self,
+        mesh: &mut Mesh,
+        steps: usize,
+        deadline: Option<crate::Deadline>,
+        progress: impl FnMut(StepCounts),
+    ) -> Result<(), RunError> {
         let mut run = self.start(mesh)?;
+        run.state.deadline = deadline;
         run.until = steps as u32;
         let mut progress = progress;
         crate::production::run(&mut run, |r| {
@@ -701,6 +714,12 @@ impl Grammar {
         let mut i = 0;
         while i < rules.len() {
             let rule = rules[i];
+            if let Err(m) = crate::deadline::check(state.deadline) {
+                return Err(RunError {
+                    span: Some(rule.span),
+                    message: format!("at step {step}, before rule `{}`: {m}", rule.text),
+                });
+            }
             let pair = rules.get(i + 1).filter(|next| {
                 matches!(
                     (rule.op, next.op),
@@ -960,6 +979,8 @@ struct RunState {
     face_split_makes_blocks: bool,
     /// The highest valence a rule may leave (see [`Grammar::max_valence`]).
     valence_limit: usize,
+    /// The run stops once this passes.
+    deadline: Option<crate::Deadline>,
 }
 
 impl RunState {

@@ -292,7 +292,7 @@ fn inlined_functions_close_to_the_limit_run() {
     };
     let mut mesh = Mesh::from_soup(&shapes::icosahedron()).unwrap();
     let before: Vec<_> = mesh.vertices().map(|v| mesh.position(v)).collect();
-    s.run_on(&mut mesh, 1, |_| {})
+    s.run_on(&mut mesh, 1, None, |_| {})
         .unwrap_or_else(|e| panic!("{e}"));
     let after: Vec<_> = mesh.vertices().map(|v| mesh.position(v)).collect();
     assert_eq!(after, before);

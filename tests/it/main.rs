@@ -9,6 +9,7 @@ mod errors;
 mod front_limits;
 mod golden;
 mod golden_tests;
+mod limits;
 mod lsystems;
 mod mesh;
 mod mesh_bounds;
