@@ -217,7 +217,7 @@ fn flattest(pts: &[DVec2], closed: bool) -> usize {
 }
 
 fn metric_point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    metric::distance(&[p], &[a, b], false).max
+    metric::point_segment(p, a, b)
 }
 
 /// Reverses `input` by `opts.steps` levels.
