@@ -103,6 +103,36 @@ impl Error {
             message: message.into(),
         }
     }
+
+    /// A message about the bytes `at` of a data file's `text` (a contour, a
+    /// details file), displayed as a program's diagnostics are:
+    /// `file:line:col: error: message`, the line and a caret.
+    pub(crate) fn in_text(
+        name: &str,
+        text: &str,
+        at: std::ops::Range<usize>,
+        message: impl Into<String>,
+    ) -> Error {
+        let start = at.start.min(text.len());
+        if text.len() > u32::MAX as usize {
+            // Beyond what a span can address: the line alone.
+            return Error::File {
+                path: name.to_string(),
+                line: Some(1 + text.as_bytes()[..start].iter().filter(|&&b| b == b'\n').count()),
+                message: message.into(),
+            };
+        }
+        let end = at.end.clamp(start, text.len());
+        let mut sources = SourceMap::default();
+        let file = sources.add(crate::syntax::SourceFile::new(name, text));
+        Error::Program {
+            sources,
+            diagnostics: vec![Diagnostic::new(
+                crate::syntax::Span::new(file, start, end),
+                message,
+            )],
+        }
+    }
 }
 
 impl fmt::Display for Error {
@@ -150,16 +180,6 @@ impl std::error::Error for Error {
 
 impl From<crate::mesh::MeshFileError> for Error {
     fn from(e: crate::mesh::MeshFileError) -> Error {
-        Error::File {
-            path: e.path,
-            line: e.line,
-            message: e.message,
-        }
-    }
-}
-
-impl From<crate::reverse::InputError> for Error {
-    fn from(e: crate::reverse::InputError) -> Error {
         Error::File {
             path: e.path,
             line: e.line,

@@ -73,6 +73,9 @@ enum Command {
         max_modules: usize,
         #[arg(long, default_value_t = 0)]
         phase: usize,
+        /// Write the output even when it is one of the inputs.
+        #[arg(long)]
+        force: bool,
     },
     /// Reverse-subdivide a contour into a compact control polygon.
     Reverse {
@@ -103,6 +106,12 @@ enum Command {
         /// Store the details that restore the input exactly.
         #[arg(long)]
         details: Option<String>,
+        /// Write the output even when it is one of the inputs.
+        #[arg(long)]
+        force: bool,
+        /// The size limit of input files: bytes, or with K, M or G (KiB, MiB, GiB).
+        #[arg(long, value_name = "SIZE", default_value = "64M", value_parser = parse_byte_size)]
+        max_input_size: u64,
     },
     /// Restore a contour from a coarse polygon and its details.
     Reconstruct {
@@ -117,6 +126,12 @@ enum Command {
         /// The scheme the details were made with (default: as recorded).
         #[arg(long)]
         scheme: Option<String>,
+        /// Write the output even when it is one of the inputs.
+        #[arg(long)]
+        force: bool,
+        /// The size limit of input files: bytes, or with K, M or G (KiB, MiB, GiB).
+        #[arg(long, value_name = "SIZE", default_value = "64M", value_parser = parse_byte_size)]
+        max_input_size: u64,
     },
     /// Subdivide a mesh with a surface grammar.
     Subdivide {
@@ -134,6 +149,9 @@ enum Command {
         /// For pictures: iso, front, back, left, right, top, bottom.
         #[arg(long)]
         view: Option<String>,
+        /// Write the output even when it is one of the inputs.
+        #[arg(long)]
+        force: bool,
     },
     /// Meshes: information and conversion.
     Mesh {
@@ -155,6 +173,28 @@ fn parse_phase(s: &str) -> Result<subgram::reverse::Phase, String> {
         "1" => Ok(subgram::reverse::Phase::Fixed(1)),
         _ => Err(format!("`{s}` is not a phase: use auto, 0 or 1")),
     }
+}
+
+/// `1048576`, `512K`, `64M`, `2G` (powers of 1024).
+fn parse_byte_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (digits, unit) = match t.find(|c: char| !c.is_ascii_digit()) {
+        Some(i) => t.split_at(i),
+        None => (t, ""),
+    };
+    let shift = match unit.to_ascii_uppercase().as_str() {
+        "" | "B" => 0,
+        "K" | "KB" | "KIB" => 10,
+        "M" | "MB" | "MIB" => 20,
+        "G" | "GB" | "GIB" => 30,
+        _ => return Err(format!("`{s}` is not a size: write bytes, or a number with K, M or G")),
+    };
+    let n: u64 = digits
+        .parse()
+        .map_err(|_| format!("`{s}` is not a size: write bytes, or a number with K, M or G"))?;
+    n.checked_mul(1 << shift)
+        .filter(|&b| b <= u32::MAX as u64)
+        .ok_or_else(|| format!("`{s}` is more than the largest input size, 4G"))
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -195,6 +235,9 @@ enum MeshCommand {
         /// Write the triangles, not the quads of basic blocks.
         #[arg(long)]
         triangles: bool,
+        /// Write the output even when it is the input (what the format cannot hold is lost).
+        #[arg(long)]
+        force: bool,
     },
 }
 
@@ -265,6 +308,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             define,
             max_modules,
             phase,
+            force,
         } => {
             let args = RenderArgs {
                 file,
@@ -278,6 +322,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 defines: define,
                 max_modules,
                 phase,
+                force,
             };
             with_progress(|p| command::render(&args, p))
         }
@@ -288,6 +333,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             output,
             define,
             view,
+            force,
         } => {
             let args = SubdivideArgs {
                 mesh,
@@ -296,6 +342,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 output,
                 defines: define,
                 view,
+                force,
             };
             with_progress(|p| command::subdivide(&args, p))
         }
@@ -307,7 +354,8 @@ fn run(cli: Cli) -> Result<(), Error> {
                 input,
                 output,
                 triangles,
-            } => command::mesh_convert(&input, &output, triangles),
+                force,
+            } => command::mesh_convert(&input, &output, triangles, force),
         },
         Command::Reverse {
             input,
@@ -320,6 +368,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             report,
             format,
             details,
+            force,
+            max_input_size,
         } => {
             let args = ReverseArgs {
                 input,
@@ -332,6 +382,8 @@ fn run(cli: Cli) -> Result<(), Error> {
                 report,
                 json: matches!(format, Format::Json),
                 details,
+                force,
+                max_input: max_input_size,
             };
             match command::reverse(&args)? {
                 Some(report) => print_out(&report),
@@ -344,12 +396,16 @@ fn run(cli: Cli) -> Result<(), Error> {
             output,
             level,
             scheme,
+            force,
+            max_input_size,
         } => command::reconstruct(&command::ReconstructArgs {
             coarse,
             details,
             output,
             level,
             scheme,
+            force,
+            max_input: max_input_size,
         }),
     }
 }

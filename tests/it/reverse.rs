@@ -249,12 +249,12 @@ fn bad_inputs_get_clear_errors_naming_the_file_and_line() {
         (
             "text.csv",
             b"x,y\n1,2\n3,abc\n",
-            "text.csv:3: error: expected two numbers `x y`, but `abc` is not a number",
+            "text.csv:3:3: error: expected two numbers `x y`, but `abc` is not a number\n  |\n3 | 3,abc\n  |   ^^^",
         ),
         (
             "nan.txt",
             b"1 2\nNaN 3\n4 5\n",
-            "nan.txt:2: error: the point (NaN, 3) is not finite",
+            "nan.txt:2:1: error: the point (NaN, 3) is not finite\n  |\n2 | NaN 3\n  | ^^^",
         ),
         (
             "none.svg",
@@ -264,7 +264,7 @@ fn bad_inputs_get_clear_errors_naming_the_file_and_line() {
         (
             "curve.svg",
             b"<svg>\n<path d=\"M0 0 C 1 1 2 2 3 3\"/></svg>",
-            "curve.svg:2: error: path command `C` (a curve) is not supported",
+            "curve.svg:2:15: error: path command `C` (a curve) is not supported",
         ),
         (
             "broken.png",
