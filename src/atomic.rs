@@ -96,7 +96,10 @@ mod tests {
         // The second is renamed onto a folder and fails: the first goes.
         let e = write_all_atomic(&[(&a, b"a"), (&dir.join("taken"), b"t")]).unwrap_err();
         assert_eq!(e.0, dir.join("taken"));
-        let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+        let left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
         assert_eq!(left, vec![std::ffi::OsString::from("taken")]);
         write_all_atomic(&[(&a, b"a"), (&b, b"b")]).unwrap();
         assert_eq!(std::fs::read(&b).unwrap(), b"b");

@@ -118,7 +118,12 @@ impl Error {
             // Beyond what a span can address: the line alone.
             return Error::File {
                 path: name.to_string(),
-                line: Some(1 + text.as_bytes()[..start].iter().filter(|&&b| b == b'\n').count()),
+                line: Some(
+                    1 + text.as_bytes()[..start]
+                        .iter()
+                        .filter(|&&b| b == b'\n')
+                        .count(),
+                ),
                 message: message.into(),
             };
         }

@@ -187,7 +187,11 @@ fn parse_byte_size(s: &str) -> Result<u64, String> {
         "K" | "KB" | "KIB" => 10,
         "M" | "MB" | "MIB" => 20,
         "G" | "GB" | "GIB" => 30,
-        _ => return Err(format!("`{s}` is not a size: write bytes, or a number with K, M or G")),
+        _ => {
+            return Err(format!(
+                "`{s}` is not a size: write bytes, or a number with K, M or G"
+            ))
+        }
     };
     let n: u64 = digits
         .parse()

@@ -44,7 +44,10 @@ impl Reader<'_> {
     }
 
     fn here(&self) -> Range<usize> {
-        let len = self.text[self.pos..].chars().next().map_or(0, char::len_utf8);
+        let len = self.text[self.pos..]
+            .chars()
+            .next()
+            .map_or(0, char::len_utf8);
         self.pos..self.pos + len
     }
 
@@ -61,7 +64,10 @@ impl Reader<'_> {
     fn expected(&self, what: &str) -> Error {
         match self.text[self.pos..].chars().next() {
             Some(c) => self.error(self.here(), format!("expected {what}, found `{c}`")),
-            None => self.error(self.pos..self.pos, format!("expected {what}, found the end of the file")),
+            None => self.error(
+                self.pos..self.pos,
+                format!("expected {what}, found the end of the file"),
+            ),
         }
     }
 
@@ -96,7 +102,10 @@ impl Reader<'_> {
         })
     }
 
-    fn nested(&mut self, f: impl FnOnce(&mut Self) -> Result<Value, Error>) -> Result<Value, Error> {
+    fn nested(
+        &mut self,
+        f: impl FnOnce(&mut Self) -> Result<Value, Error>,
+    ) -> Result<Value, Error> {
         if self.depth == MAX_DEPTH {
             return Err(self.error(
                 self.here(),
@@ -236,7 +245,10 @@ impl Reader<'_> {
                     }
                 }
                 c if (c as u32) < 0x20 => {
-                    return Err(self.error(self.here(), "a control character inside a string: write it as an escape"))
+                    return Err(self.error(
+                        self.here(),
+                        "a control character inside a string: write it as an escape",
+                    ))
                 }
                 c => {
                     out.push(c);
@@ -263,12 +275,11 @@ impl Reader<'_> {
         }
         let int_start = i;
         let ok = digits(&mut i) && !(b[int_start] == b'0' && i - int_start > 1);
-        let ok = ok
-            && (i >= b.len() || b[i] != b'.' || {
+        let ok =
+            ok && (i >= b.len() || b[i] != b'.' || {
                 i += 1;
                 digits(&mut i)
-            })
-            && (i >= b.len() || !matches!(b[i], b'e' | b'E') || {
+            }) && (i >= b.len() || !matches!(b[i], b'e' | b'E') || {
                 i += 1;
                 if i < b.len() && matches!(b[i], b'+' | b'-') {
                     i += 1;
@@ -277,7 +288,8 @@ impl Reader<'_> {
             });
         // A number runs to the next delimiter.
         let mut end = i;
-        while end < b.len() && !matches!(b[end], b',' | b']' | b'}' | b' ' | b'\t' | b'\n' | b'\r') {
+        while end < b.len() && !matches!(b[end], b',' | b']' | b'}' | b' ' | b'\t' | b'\n' | b'\r')
+        {
             end += 1;
         }
         if !ok || end != i {
@@ -422,7 +434,10 @@ fn decode(r: &Reader, root: &Node) -> Result<(Details, Places), Error> {
     };
     let string = |n: &Node, what: &str| match &n.value {
         Value::String(s) => Ok(s.clone()),
-        v => Err(r.error(n.at.clone(), format!("`{what}` must be a string, not {}", kind(v)))),
+        v => Err(r.error(
+            n.at.clone(),
+            format!("`{what}` must be a string, not {}", kind(v)),
+        )),
     };
     let format = field("format")?;
     let format_text = string(format, "format")?;
@@ -430,9 +445,7 @@ fn decode(r: &Reader, root: &Node) -> Result<(Details, Places), Error> {
     if format_text != DETAILS_FORMAT || whole(r, version, "version")? != 1 {
         return Err(r.error(
             format.at.start..version.at.end.max(format.at.end),
-            format!(
-                "not a subgram details file: expected format `{DETAILS_FORMAT}` version 1"
-            ),
+            format!("not a subgram details file: expected format `{DETAILS_FORMAT}` version 1"),
         ));
     }
     let scheme = string(field("scheme")?, "scheme")?;
@@ -440,7 +453,10 @@ fn decode(r: &Reader, root: &Node) -> Result<(Details, Places), Error> {
     let Value::Bool(closed) = closed_node.value else {
         return Err(r.error(
             closed_node.at.clone(),
-            format!("`closed` must be true or false, not {}", kind(&closed_node.value)),
+            format!(
+                "`closed` must be true or false, not {}",
+                kind(&closed_node.value)
+            ),
         ));
     };
     let coarse = field("coarse_points")?;
@@ -449,7 +465,10 @@ fn decode(r: &Reader, root: &Node) -> Result<(Details, Places), Error> {
     let Value::Array(level_nodes) = &levels_node.value else {
         return Err(r.error(
             levels_node.at.clone(),
-            format!("`levels` must be an array, not {}", kind(&levels_node.value)),
+            format!(
+                "`levels` must be an array, not {}",
+                kind(&levels_node.value)
+            ),
         ));
     };
     let mut places = Places {
@@ -482,7 +501,10 @@ fn decode_level(r: &Reader, node: &Node) -> Result<(LevelDetails, LevelPlaces), 
     let Value::Object(members) = &node.value else {
         return Err(r.error(
             node.at.clone(),
-            format!("a level is an object with `shift`, `details` and `dropped`, not {}", kind(&node.value)),
+            format!(
+                "a level is an object with `shift`, `details` and `dropped`, not {}",
+                kind(&node.value)
+            ),
         ));
     };
     let field = |key: &str| {
@@ -490,14 +512,22 @@ fn decode_level(r: &Reader, node: &Node) -> Result<(LevelDetails, LevelPlaces), 
             .iter()
             .find(|(k, _, _)| k == key)
             .map(|(_, _, v)| v)
-            .ok_or_else(|| r.error(node.at.start..node.at.start + 1, format!("this level has no `{key}`")))
+            .ok_or_else(|| {
+                r.error(
+                    node.at.start..node.at.start + 1,
+                    format!("this level has no `{key}`"),
+                )
+            })
     };
     let shift_node = field("shift")?;
     let details_node = field("details")?;
     let Value::Array(items) = &details_node.value else {
         return Err(r.error(
             details_node.at.clone(),
-            format!("`details` must be an array of [dx, dy] pairs, not {}", kind(&details_node.value)),
+            format!(
+                "`details` must be an array of [dx, dy] pairs, not {}",
+                kind(&details_node.value)
+            ),
         ));
     };
     let mut details = Vec::with_capacity(items.len());
@@ -511,7 +541,9 @@ fn decode_level(r: &Reader, node: &Node) -> Result<(LevelDetails, LevelPlaces), 
     if shift >= n.max(1) {
         return Err(r.error(
             shift_node.at.clone(),
-            format!("`shift` is {shift}, but this level has {n} point(s): a shift must be below that"),
+            format!(
+                "`shift` is {shift}, but this level has {n} point(s): a shift must be below that"
+            ),
         ));
     }
     let dropped_node = field("dropped")?;
@@ -530,7 +562,10 @@ fn decode_level(r: &Reader, node: &Node) -> Result<(LevelDetails, LevelPlaces), 
         other => {
             return Err(r.error(
                 dropped_node.at.clone(),
-                format!("`dropped` must be null or [index, [x, y]], not {}", kind(other)),
+                format!(
+                    "`dropped` must be null or [index, [x, y]], not {}",
+                    kind(other)
+                ),
             ))
         }
     };
@@ -555,7 +590,10 @@ fn whole(r: &Reader, n: &Node, what: &str) -> Result<usize, Error> {
     match n.value {
         Value::Number => text.parse::<usize>().map_err(|_| {
             let why = if text.parse::<u128>().is_ok() {
-                format!("`{what}` is {text}, beyond the largest whole number, {}", usize::MAX)
+                format!(
+                    "`{what}` is {text}, beyond the largest whole number, {}",
+                    usize::MAX
+                )
             } else {
                 format!("`{what}` must be a whole number from 0, not {text}")
             };
@@ -563,7 +601,10 @@ fn whole(r: &Reader, n: &Node, what: &str) -> Result<usize, Error> {
         }),
         _ => Err(r.error(
             n.at.clone(),
-            format!("`{what}` must be a whole number from 0, not {}", kind(&n.value)),
+            format!(
+                "`{what}` must be a whole number from 0, not {}",
+                kind(&n.value)
+            ),
         )),
     }
 }

@@ -347,7 +347,12 @@ pub fn read_svg(name: &str, text: &str) -> Result<Contour, Error> {
 
 /// The numbers of an attribute's value with their byte ranges in it:
 /// separated by commas or spaces, or by a sign.
-fn numbers(name: &str, text: &str, attr: &Attr, range: Range<usize>) -> Result<Vec<(f64, Range<usize>)>, Error> {
+fn numbers(
+    name: &str,
+    text: &str,
+    attr: &Attr,
+    range: Range<usize>,
+) -> Result<Vec<(f64, Range<usize>)>, Error> {
     let s = &attr.value[range.clone()];
     let mut out = Vec::new();
     let mut start: Option<usize> = None;
@@ -355,7 +360,12 @@ fn numbers(name: &str, text: &str, attr: &Attr, range: Range<usize>) -> Result<V
         let r = range.start + from..range.start + to;
         let word = &s[from..to];
         let v: f64 = word.parse().map_err(|_| {
-            Error::in_text(name, text, attr.at(r.clone()), format!("`{word}` is not a number"))
+            Error::in_text(
+                name,
+                text,
+                attr.at(r.clone()),
+                format!("`{word}` is not a number"),
+            )
         })?;
         if !v.is_finite() {
             return Err(Error::in_text(
@@ -531,12 +541,8 @@ pub fn read_png(name: &str, bytes: &[u8]) -> Result<Contour, Error> {
             ));
         }
     }
-    let pm = tiny_skia::Pixmap::decode_png(bytes).map_err(|e| {
-        Error::file(
-            name,
-            format!("cannot read the PNG image: {e}"),
-        )
-    })?;
+    let pm = tiny_skia::Pixmap::decode_png(bytes)
+        .map_err(|e| Error::file(name, format!("cannot read the PNG image: {e}")))?;
     let (w, h) = (pm.width() as usize, pm.height() as usize);
     let field: Vec<f64> = pm
         .pixels()

@@ -153,7 +153,10 @@ impl Scheme {
         if let Some(p) = out.iter().find(|p| !p.is_finite()) {
             return Err(Error::file(
                 &self.name,
-                format!("the scheme's {group} produced the point ({}, {}), which is not finite", p.x, p.y),
+                format!(
+                    "the scheme's {group} produced the point ({}, {}), which is not finite",
+                    p.x, p.y
+                ),
             ));
         }
         Ok(())
@@ -484,7 +487,10 @@ fn restore(
             }
             let p = DVec2::from(p);
             if !p.is_finite() {
-                return Err(at(Place::Dropped(li), "the dropped point is not finite".into()));
+                return Err(at(
+                    Place::Dropped(li),
+                    "the dropped point is not finite".into(),
+                ));
             }
             fine.insert(i, p);
         }
