@@ -127,9 +127,19 @@ impl Error {
                 message: message.into(),
             };
         }
-        let end = at.end.clamp(start, text.len());
+        let mut end = at.end.clamp(start, text.len());
+        // Spans fall on characters; snap any that would not.
+        let mut start = start;
+        while !text.is_char_boundary(start) {
+            start -= 1;
+        }
+        while !text.is_char_boundary(end) {
+            end += 1;
+        }
+        // The text up to the end of the place's line is all the message shows.
+        let cut = text[end..].find('\n').map_or(text.len(), |i| end + i);
         let mut sources = SourceMap::default();
-        let file = sources.add(crate::syntax::SourceFile::new(name, text));
+        let file = sources.add(crate::syntax::SourceFile::new(name, &text[..cut]));
         Error::Program {
             sources,
             diagnostics: vec![Diagnostic::new(

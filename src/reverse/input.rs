@@ -28,6 +28,10 @@ pub const MAX_IMAGE_PIXELS: u64 = 8192 * 8192;
 /// The option of the binary that raises [`MAX_INPUT_BYTES`], for messages.
 pub const RAISE_INPUT_LIMIT: &str = "--max-input-size";
 
+/// What the readers return when a file is refused: a [`crate::Error`],
+/// located (`file:line:col`, the line and a caret) where the file has lines.
+pub type InputError = Error;
+
 /// A contour: its points, whether it is closed, and where it came from.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Contour {
@@ -99,7 +103,7 @@ pub fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, Error> {
 /// A limit that holds `size`, as `--max-input-size` takes it: "256M".
 fn suggestion(size: u64) -> String {
     let mib = size.div_ceil(1 << 20).next_power_of_two().max(1);
-    if mib >= 1024 && mib % 1024 == 0 {
+    if mib >= 1024 && mib.is_multiple_of(1024) {
         format!("{}G", mib / 1024)
     } else {
         format!("{mib}M")

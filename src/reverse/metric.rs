@@ -74,7 +74,7 @@ pub(crate) fn scale_for<'a>(points: impl IntoIterator<Item = &'a DVec2>) -> Opti
 /// distance itself is beyond `f64::MAX`).
 pub fn point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     match scale_for([&p, &a, &b]) {
-        Some(s) if s == 1.0 => point_segment2(p, a, b).sqrt(),
+        Some(1.0) => point_segment2(p, a, b).sqrt(),
         Some(s) => point_segment2(p * s, a * s, b * s).sqrt() / s,
         None => f64::NAN,
     }
@@ -174,7 +174,7 @@ impl Hierarchy {
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
             // A box no nearer than the best segment cannot hold a nearer one.
-            if !(box_distance2(p, node.lo, node.hi) < best) {
+            if box_distance2(p, node.lo, node.hi) >= best {
                 continue;
             }
             if node.count > 0 {

@@ -19,7 +19,7 @@ use crate::rewrite::Word;
 use crate::{Derivation, DeriveOptions};
 
 pub use details::{DetailsFile, Place};
-pub use input::Contour;
+pub use input::{Contour, InputError};
 
 /// The scheme files built into the binary (also in `lsystems/reverse/`).
 pub const CLOSED_SCHEME: &str = include_str!("../../lsystems/reverse/chaikin.lsys");
