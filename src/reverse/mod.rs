@@ -280,6 +280,20 @@ pub fn reverse(scheme: &Scheme, input: &Contour, opts: &ReverseOptions) -> Resul
         let mut best: Option<(f64, usize, Vec<DVec2>)> = None;
         for ph in candidates {
             let coarse = scheme.reverse_step(&level, ph)?;
+            // A reverse step leaves fewer points, and enough for a shape:
+            // so a run has at most log2(n) steps whatever the scheme.
+            let least = if scheme.closed { 3 } else { 2 };
+            if coarse.len() < least || coarse.len() >= level.len() {
+                return Err(Error::file(
+                    &scheme.name,
+                    format!(
+                        "at step {step}, the scheme's group 1 (the reverse step) turned {} points into {}: a reverse step must leave fewer points than it is given, and at least {least} for a coarse {}",
+                        level.len(),
+                        coarse.len(),
+                        if scheme.closed { "polygon" } else { "polyline" }
+                    ),
+                ));
+            }
             let score = if best.is_none() && opts.phase != Phase::Auto {
                 0.0
             } else {
@@ -292,18 +306,6 @@ pub fn reverse(scheme: &Scheme, input: &Contour, opts: &ReverseOptions) -> Resul
             }
         }
         let (_, ph, coarse) = best.expect("one candidate at least");
-        let least = if scheme.closed { 3 } else { 2 };
-        if coarse.len() < least {
-            return Err(Error::file(
-                &scheme.name,
-                format!(
-                    "at step {step}, the scheme's group 1 (the reverse step) turned {} points into {}: a coarse {} needs at least {least}",
-                    level.len(),
-                    coarse.len(),
-                    if scheme.closed { "polygon" } else { "polyline" }
-                ),
-            ));
-        }
         if opts.details {
             let sub = scheme.forward(&coarse, 1)?;
             if sub.len() != level.len() {

@@ -233,6 +233,19 @@ fn svg_shapes_are_read() {
         ]
     );
     assert!(c.closed);
+    // Of two subpaths, the one with more points; the other is not appended.
+    let two = r#"<svg><path d="M0,0 L1,0 L1,1 Z M5,5 l1,0 l0,1 l-1,0 Z"/></svg>"#;
+    let c = reverse::input::read_svg("two.svg", two).unwrap();
+    assert_eq!(
+        c.points,
+        vec![
+            DVec2::new(5.0, -5.0),
+            DVec2::new(6.0, -5.0),
+            DVec2::new(6.0, -6.0),
+            DVec2::new(5.0, -6.0)
+        ]
+    );
+    assert!(c.closed);
 }
 
 #[test]
@@ -913,5 +926,22 @@ fn a_report_beyond_floating_point_is_refused() {
     assert!(
         e.starts_with("the reconstruction error cannot be measured"),
         "{e}"
+    );
+}
+
+#[test]
+fn a_scheme_whose_reverse_step_does_not_reduce_is_an_error() {
+    // Group 1 copies the points: without the check, `-n` steps would each
+    // reconstruct the whole contour, for as many steps as asked.
+    let scheme = "module P(V2f);\nring L-system: 1;\nderivation length: 1;\nAxiom: P(V2f(0,0));\n\
+                  group 1:\nP(v) -> P(v)\n\
+                  group 2:\nP(v) -> P(v)\n";
+    let circle = CIRCLE_64();
+    refused(
+        "same",
+        &[("same.lsys", scheme.as_bytes()), ("c.txt", circle.as_bytes())],
+        &["reverse", "c.txt", "-n", "1000000", "-o", "out.csv", "--scheme", "same.lsys"],
+        1,
+        "same.lsys: error: at step 1, the scheme's group 1 (the reverse step) turned 64 points into 64: a reverse step must leave fewer points than it is given, and at least 3 for a coarse polygon\n",
     );
 }
