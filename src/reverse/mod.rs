@@ -251,6 +251,37 @@ fn metric_point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     metric::point_segment(p, a, b)
 }
 
+/// What a distance measurement is for, to say in its messages.
+#[derive(Clone, Copy)]
+enum Measured {
+    Phase,
+    Report,
+}
+
+/// [`metric::distance`], with its budget's message.
+fn measure(
+    points: &[DVec2],
+    line: &[DVec2],
+    closed: bool,
+    what: Measured,
+) -> Result<metric::Error, Error> {
+    metric::distance(points, line, closed).map_err(|e| {
+        let (doing, instead) = match what {
+            Measured::Phase => (
+                "choosing the phase (--phase auto)",
+                "--phase 0 or --phase 1 chooses without measuring",
+            ),
+            Measured::Report => (
+                "measuring the reconstruction error (--report, --figure)",
+                "without --report and --figure nothing is measured",
+            ),
+        };
+        Error::Failed(format!(
+            "{doing}: {e}; the reconstruction is far from most of the input (is it noise, or does the scheme draw something else?); {instead}"
+        ))
+    })
+}
+
 /// Reverses `input` by `opts.steps` levels.
 pub fn reverse(scheme: &Scheme, input: &Contour, opts: &ReverseOptions) -> Result<Reversal, Error> {
     let mut level = input.points.clone();
@@ -299,7 +330,7 @@ pub fn reverse(scheme: &Scheme, input: &Contour, opts: &ReverseOptions) -> Resul
             } else {
                 // Reconstruct all the way to the input and compare.
                 let rec = scheme.forward(&coarse, step)?;
-                metric::distance(&input.points, &rec, scheme.closed).rms
+                measure(&input.points, &rec, scheme.closed, Measured::Phase)?.rms
             };
             if best.as_ref().is_none_or(|(s, _, _)| score < *s) {
                 best = Some((score, ph, coarse));
@@ -539,8 +570,8 @@ pub fn report(scheme: &Scheme, input: &Contour, r: &Reversal) -> Result<Report, 
     let rec = scheme.forward(&r.coarse, steps)?;
     let dec = decimate(&input.points, r.coarse.len(), scheme.closed);
     let dec_rec = scheme.forward(&dec, steps)?;
-    let reverse = metric::distance(&input.points, &rec, scheme.closed);
-    let decimation = metric::distance(&input.points, &dec_rec, scheme.closed);
+    let reverse = measure(&input.points, &rec, scheme.closed, Measured::Report)?;
+    let decimation = measure(&input.points, &dec_rec, scheme.closed, Measured::Report)?;
     if !reverse.is_finite() || !decimation.is_finite() {
         return Err(Error::Failed(format!(
             "the reconstruction error cannot be measured: a distance is beyond the range of floating-point numbers (reverse subdivision: max {}, naive decimation: max {}); the contour's coordinates are too large",

@@ -945,3 +945,49 @@ fn a_scheme_whose_reverse_step_does_not_reduce_is_an_error() {
         "same.lsys: error: at step 1, the scheme's group 1 (the reverse step) turned 64 points into 64: a reverse step must leave fewer points than it is given, and at least 3 for a coarse polygon\n",
     );
 }
+
+#[test]
+fn noise_stops_at_the_measurement_budget_and_fixed_phases_still_run() {
+    // 20,000 random points: the reconstruction is far from most of them,
+    // and each distance search visits a long stretch of boxes.
+    let mut seed = 12345u64;
+    let mut next = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 1000.0
+    };
+    let noise: String = (0..20_000)
+        .map(|_| format!("{} {}\n", next(), next()))
+        .collect();
+    let r = refused(
+        "noise",
+        &[("noise.txt", noise.as_bytes())],
+        &["reverse", "noise.txt", "-n", "4", "-o", "out.csv"],
+        1,
+        "error: choosing the phase (--phase auto): measuring the distance of 20000 points to a polyline of 20000 segments needs more than ",
+    );
+    assert!(
+        r.stderr
+            .contains("--phase 0 or --phase 1 chooses without measuring"),
+        "{}",
+        r.stderr
+    );
+    let dir = scratch("noise-fixed");
+    std::fs::write(dir.join("noise.txt"), &noise).unwrap();
+    let r = run_in(
+        &dir,
+        &[
+            "reverse",
+            "noise.txt",
+            "-n",
+            "4",
+            "--phase",
+            "0",
+            "-o",
+            "out.csv",
+        ],
+    );
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
