@@ -12,7 +12,7 @@ use crate::error::Error;
 use crate::load::{load, LoadOptions};
 use crate::mesh::{self, Mesh};
 use crate::render::{self, Rgba, Scene, View};
-use crate::reverse::{self, Details, Phase, ReverseOptions, Scheme};
+use crate::reverse::{self, Phase, ReverseOptions, Scheme};
 use crate::rewrite::derive::{DEFAULT_MAX_MODULES, MAX_STEPS};
 use crate::system::{load_mesh, Progress, RunOptions, Surface, System};
 
@@ -137,6 +137,8 @@ pub struct RenderArgs {
     pub phase: usize,
     /// `--timeout`: the command stops with an error after this long.
     pub timeout: Option<Duration>,
+    /// Write the picture even over one of the inputs.
+    pub force: bool,
 }
 
 impl RenderArgs {
@@ -154,6 +156,7 @@ impl RenderArgs {
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             timeout: Some(DEFAULT_TIMEOUT),
+            force: false,
         }
     }
 }
@@ -164,7 +167,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
     let deadline = a.timeout.map(Deadline::after);
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
-    refuse_overwrite(output, &[file])?;
+    refuse_overwrite(&[output], &[file], a.force)?;
     let looks = MeshLooks {
         size: a.size,
         background: a.background,
@@ -236,6 +239,8 @@ pub struct SubdivideArgs {
     pub view: Option<String>,
     /// `--timeout`: the command stops with an error after this long.
     pub timeout: Option<Duration>,
+    /// Write the output even over one of the inputs.
+    pub force: bool,
 }
 
 /// `subgram subdivide`: runs a surface grammar on a mesh and writes the
@@ -244,9 +249,9 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
     let deadline = a.timeout.map(Deadline::after);
     let grammar = Path::new(&a.grammar);
     let output = Path::new(&a.output);
-    let mut inputs = vec![grammar];
-    inputs.extend(a.mesh.as_deref().map(Path::new));
-    refuse_overwrite(output, &inputs)?;
+    let mut inputs = vec![grammar.to_path_buf()];
+    inputs.extend(a.mesh.as_deref().map(PathBuf::from));
+    refuse_overwrite(&[output], &as_paths(&inputs), a.force)?;
     let g = crate::surface::load_file(grammar, &a.defines)?;
     let opts = RunOptions {
         steps: a.steps,
@@ -254,7 +259,13 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         deadline,
         ..RunOptions::default()
     };
-    let run = Surface::new(g, Some(grammar)).subdivide(&opts, progress)?;
+    let surface = Surface::new(g, Some(grammar));
+    if a.mesh.is_none() {
+        // The grammar's own `mesh:` is an input too.
+        inputs.extend(surface.base_mesh());
+        refuse_overwrite(&[output], &as_paths(&inputs), a.force)?;
+    }
+    let run = surface.subdivide(&opts, progress)?;
     if Picture::from_path(output).is_ok() {
         let d = crate::render::mesh::MeshView::default();
         let looks = MeshLooks {
@@ -280,10 +291,12 @@ pub fn mesh_info(file: &str, as_json: bool) -> Result<String, Error> {
 }
 
 /// `subgram mesh convert`: checks a mesh and writes it in the format of
-/// `output`'s extension, basic blocks as quads unless `triangles`.
-pub fn mesh_convert(input: &str, output: &str, triangles: bool) -> Result<(), Error> {
+/// `output`'s extension, basic blocks as quads unless `triangles`. The
+/// output may be the input only with `force` (a conversion may lose what
+/// subgram does not keep, such as texture coordinates and normals).
+pub fn mesh_convert(input: &str, output: &str, triangles: bool, force: bool) -> Result<(), Error> {
     let (input, output) = (Path::new(input), Path::new(output));
-    refuse_overwrite(output, &[input])?;
+    refuse_overwrite(&[output], &[input], force)?;
     let m = load_mesh(input)?;
     let soup = if triangles {
         m.to_soup()
@@ -316,10 +329,36 @@ pub struct ReverseArgs {
     pub details: Option<String>,
     /// `--timeout`: the command stops with an error after this long.
     pub timeout: Option<Duration>,
+    /// Write the outputs even over one of the inputs.
+    pub force: bool,
+    /// The size limit of the input file, in bytes.
+    pub max_input: u64,
+}
+
+impl ReverseArgs {
+    pub fn new(input: impl Into<String>, steps: usize, output: impl Into<String>) -> ReverseArgs {
+        ReverseArgs {
+            input: input.into(),
+            steps,
+            output: output.into(),
+            scheme: None,
+            phase: Phase::Auto,
+            open: false,
+            figure: None,
+            report: false,
+            json: false,
+            details: None,
+            force: false,
+            max_input: reverse::input::MAX_INPUT_BYTES,
+            timeout: Some(DEFAULT_TIMEOUT),
+        }
+    }
 }
 
 /// `subgram reverse`: reverse-subdivides a contour; returns the report when
-/// one was asked for.
+/// one was asked for. Everything is computed before anything is written,
+/// and the outputs (coarse polygon, details, figure) are written all or
+/// none.
 pub fn reverse(a: &ReverseArgs) -> Result<Option<String>, Error> {
     let deadline = a.timeout.map(Deadline::after);
     let fig = a
@@ -330,13 +369,14 @@ pub fn reverse(a: &ReverseArgs) -> Result<Option<String>, Error> {
     let input = Path::new(&a.input);
     let mut inputs = vec![input];
     inputs.extend(a.scheme.as_deref().map(Path::new));
-    for out in [Some(&a.output), a.figure.as_ref(), a.details.as_ref()]
+    let out = Path::new(&a.output);
+    let outputs: Vec<&Path> = [Some(&a.output), a.details.as_ref(), a.figure.as_ref()]
         .into_iter()
         .flatten()
-    {
-        refuse_overwrite(Path::new(out), &inputs)?;
-    }
-    let mut contour = reverse::input::read(input)?;
+        .map(Path::new)
+        .collect();
+    refuse_overwrite(&outputs, &inputs, a.force)?;
+    let mut contour = reverse::input::read_with_limit(input, a.max_input)?;
     if a.open {
         contour.closed = false;
     }
@@ -351,29 +391,29 @@ pub fn reverse(a: &ReverseArgs) -> Result<Option<String>, Error> {
         details: a.details.is_some(),
     };
     let r = reverse::reverse(&scheme, &contour, &opts)?;
-    let out = Path::new(&a.output);
-    write_file(
+    let mut files: Vec<(&Path, Vec<u8>)> = vec![(
         out,
-        reverse::format_points(&r.coarse, contour.closed, out).as_bytes(),
-    )?;
+        reverse::format_points(&r.coarse, contour.closed, out).into_bytes(),
+    )];
     if let (Some(path), Some(d)) = (&a.details, &r.details) {
         let text = serde_json::to_string(d).map_err(|e| Error::Failed(e.to_string()))?;
-        write_file(Path::new(path), text.as_bytes())?;
+        files.push((Path::new(path), text.into_bytes()));
     }
-    if !a.report && fig.is_none() {
-        return Ok(None);
+    let mut printed = None;
+    if a.report || fig.is_some() {
+        let rep = reverse::report(&scheme, &contour, &r)?;
+        if let Some((path, format)) = fig {
+            let rec = scheme.forward(&r.coarse, r.steps.len())?;
+            let events = reverse::figure_events(&contour, &r.coarse, &rec);
+            let scene = render::scene(&[events], &Default::default())?;
+            files.push((path, picture_bytes(&scene, format)?));
+        }
+        if a.report {
+            printed = Some(if a.json { json(&rep)? } else { rep.to_string() });
+        }
     }
-    let rep = reverse::report(&scheme, &contour, &r)?;
-    if let Some((path, format)) = fig {
-        let rec = scheme.forward(&r.coarse, a.steps)?;
-        let events = reverse::figure_events(&contour, &r.coarse, &rec);
-        let scene = render::scene(&[events], &Default::default())?;
-        write_picture(&scene, path, format)?;
-    }
-    if !a.report {
-        return Ok(None);
-    }
-    Ok(Some(if a.json { json(&rep)? } else { rep.to_string() }))
+    write_files(&files)?;
+    Ok(printed)
 }
 
 /// The arguments of `subgram reconstruct`.
@@ -388,6 +428,10 @@ pub struct ReconstructArgs {
     pub scheme: Option<String>,
     /// `--timeout`: the command stops with an error after this long.
     pub timeout: Option<Duration>,
+    /// Write the output even over one of the inputs.
+    pub force: bool,
+    /// The size limit of each input file, in bytes.
+    pub max_input: u64,
 }
 
 /// `subgram reconstruct`: restores a contour from a coarse polygon and its
@@ -401,26 +445,25 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), Error> {
     );
     let mut inputs = vec![coarse, details];
     inputs.extend(a.scheme.as_deref().map(Path::new));
-    refuse_overwrite(output, &inputs)?;
-    let text = std::fs::read_to_string(details)
-        .map_err(|e| Error::file(&a.details, format!("cannot read the file: {e}")))?;
-    let d: Details = serde_json::from_str(&text).map_err(|e| Error::File {
-        path: a.details.clone(),
-        line: Some(e.line()),
-        message: format!("not a details file: {e}"),
-    })?;
-    let c = reverse::input::read(coarse)?;
+    refuse_overwrite(&[output], &inputs, a.force)?;
+    let d = reverse::DetailsFile::read(details, a.max_input)?;
+    let c = reverse::input::read_with_limit(coarse, a.max_input)?;
+    let recorded = &d.details.scheme;
     let mut scheme = match &a.scheme {
-        Some(s) => Scheme::from_file(Path::new(s), d.closed)?,
-        None if d.scheme.starts_with("builtin:") => Scheme::builtin(d.closed),
-        None => Scheme::from_file(Path::new(&d.scheme), d.closed)?,
+        Some(s) => Scheme::from_file(Path::new(s), d.details.closed)?,
+        None if recorded.starts_with("builtin:") => Scheme::builtin(d.details.closed),
+        None => {
+            let p = Path::new(recorded);
+            refuse_overwrite(&[output], &[p], a.force)?;
+            Scheme::from_file(p, d.details.closed)?
+        }
     };
     scheme.deadline = deadline;
-    let pts = reverse::reconstruct(&scheme, &c.points, &d, a.level)?;
-    write_file(
+    let pts = reverse::reconstruct_file(&scheme, &c.points, &d, a.level)?;
+    write_files(&[(
         output,
-        reverse::format_points(&pts, d.closed, output).as_bytes(),
-    )
+        reverse::format_points(&pts, d.details.closed, output).into_bytes(),
+    )])
 }
 
 /// A picture format, told by a file's extension.
@@ -449,11 +492,15 @@ impl Picture {
 
 /// Draws `scene` in `format` and writes it to `path` whole, or not at all.
 pub fn write_picture(scene: &Scene, path: &Path, format: Picture) -> Result<(), Error> {
-    let bytes = match format {
+    write_file(path, &picture_bytes(scene, format)?)
+}
+
+/// `scene` drawn in `format`.
+fn picture_bytes(scene: &Scene, format: Picture) -> Result<Vec<u8>, Error> {
+    Ok(match format {
         Picture::Svg => render::svg::render(scene).into_bytes(),
         Picture::Png => render::png::render(scene)?,
-    };
-    write_file(path, &bytes)
+    })
 }
 
 /// How a mesh is drawn.
@@ -504,6 +551,12 @@ fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     render::write_atomic(path, bytes).map_err(|e| Error::write(path, e))
 }
 
+/// Writes every file or none (see [`crate::atomic::write_all_atomic`]).
+fn write_files(files: &[(&Path, Vec<u8>)]) -> Result<(), Error> {
+    let all: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
+    crate::atomic::write_all_atomic(&all).map_err(|(path, e)| Error::write(path, e))
+}
+
 fn json(value: &impl serde::Serialize) -> Result<String, Error> {
     serde_json::to_string_pretty(value).map_err(|e| Error::Failed(e.to_string()))
 }
@@ -524,20 +577,65 @@ fn check_steps(steps: Option<u64>) -> Result<(), Error> {
     }
 }
 
-/// An output that is one of the command's inputs is refused before anything
-/// is read or written.
-fn refuse_overwrite(output: &Path, inputs: &[&Path]) -> Result<(), Error> {
-    let Ok(out) = output.canonicalize() else {
-        return Ok(()); // it does not exist yet
-    };
-    if inputs
-        .iter()
-        .any(|i| i.canonicalize().is_ok_and(|i| i == out))
-    {
-        return Err(Error::Usage(format!(
-            "`{}` is an input of this command; name another output",
-            output.display()
-        )));
+fn as_paths(v: &[PathBuf]) -> Vec<&Path> {
+    v.iter().map(PathBuf::as_path).collect()
+}
+
+/// Where a path leads: the file itself when it exists (links and other
+/// spellings resolved), else its resolved folder and its name.
+fn resolved(p: &Path) -> PathBuf {
+    if let Ok(c) = p.canonicalize() {
+        return c;
+    }
+    let parent = p
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    match (parent.canonicalize(), p.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => p.to_path_buf(),
+    }
+}
+
+/// True when `a` and `b` name one file: the same device and inode where
+/// both exist (hard links too), else the same resolved path.
+fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    if let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+        use std::os::unix::fs::MetadataExt;
+        return (ma.dev(), ma.ino()) == (mb.dev(), mb.ino());
+    }
+    resolved(a) == resolved(b)
+}
+
+/// Before anything is read or written: an output named twice is refused,
+/// and so is an output that is one of the command's inputs, unless `force`
+/// (a usage error, exit code 2).
+fn refuse_overwrite(outputs: &[&Path], inputs: &[&Path], force: bool) -> Result<(), Error> {
+    for (k, out) in outputs.iter().enumerate() {
+        if let Some(first) = outputs[..k].iter().find(|o| same_file(o, out)) {
+            return Err(Error::Usage(format!(
+                "`{}` and `{}` are the same output file; name two different files",
+                first.display(),
+                out.display()
+            )));
+        }
+    }
+    if force {
+        return Ok(());
+    }
+    for out in outputs {
+        if let Some(input) = inputs.iter().find(|i| same_file(i, out)) {
+            let which = if input == out {
+                "an input of this command".to_string()
+            } else {
+                format!("the same file as the input `{}`", input.display())
+            };
+            return Err(Error::Usage(format!(
+                "the output `{}` is {which}: writing it would replace the input; name another output, or add --force to replace it",
+                out.display()
+            )));
+        }
     }
     Ok(())
 }

@@ -119,6 +119,51 @@ impl Error {
             message: message.into(),
         }
     }
+
+    /// A message about the bytes `at` of a data file's `text` (a contour, a
+    /// details file), displayed as a program's diagnostics are:
+    /// `file:line:col: error: message`, the line and a caret.
+    pub(crate) fn in_text(
+        name: &str,
+        text: &str,
+        at: std::ops::Range<usize>,
+        message: impl Into<String>,
+    ) -> Error {
+        let start = at.start.min(text.len());
+        if text.len() > u32::MAX as usize {
+            // Beyond what a span can address: the line alone.
+            return Error::File {
+                path: name.to_string(),
+                line: Some(
+                    1 + text.as_bytes()[..start]
+                        .iter()
+                        .filter(|&&b| b == b'\n')
+                        .count(),
+                ),
+                message: message.into(),
+            };
+        }
+        let mut end = at.end.clamp(start, text.len());
+        // Spans fall on characters; snap any that would not.
+        let mut start = start;
+        while !text.is_char_boundary(start) {
+            start -= 1;
+        }
+        while !text.is_char_boundary(end) {
+            end += 1;
+        }
+        // The text up to the end of the place's line is all the message shows.
+        let cut = text[end..].find('\n').map_or(text.len(), |i| end + i);
+        let mut sources = SourceMap::default();
+        let file = sources.add(crate::syntax::SourceFile::new(name, &text[..cut]));
+        Error::Program {
+            sources,
+            diagnostics: vec![Diagnostic::new(
+                crate::syntax::Span::new(file, start, end),
+                message,
+            )],
+        }
+    }
 }
 
 impl fmt::Display for Error {
@@ -270,16 +315,6 @@ mod tests {
                 let got = render_line("m.obj", k + 1, line, a..b, "expected a number");
                 assert_eq!(got, want, "line {} bytes {a}..{b}", k + 1);
             }
-        }
-    }
-}
-
-impl From<crate::reverse::InputError> for Error {
-    fn from(e: crate::reverse::InputError) -> Error {
-        Error::File {
-            path: e.path,
-            line: e.line,
-            message: e.message,
         }
     }
 }

@@ -82,6 +82,9 @@ enum Command {
         #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
         timeout: Timeout,
+        /// Write the output even when it is one of the inputs.
+        #[arg(long)]
+        force: bool,
     },
     /// Reverse-subdivide a contour into a compact control polygon.
     Reverse {
@@ -116,6 +119,12 @@ enum Command {
         #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
         timeout: Timeout,
+        /// Write the output even when it is one of the inputs.
+        #[arg(long)]
+        force: bool,
+        /// The size limit of input files: bytes, or with K, M or G (KiB, MiB, GiB).
+        #[arg(long, value_name = "SIZE", default_value = "64M", value_parser = parse_byte_size)]
+        max_input_size: u64,
     },
     /// Restore a contour from a coarse polygon and its details.
     Reconstruct {
@@ -134,6 +143,12 @@ enum Command {
         #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
         timeout: Timeout,
+        /// Write the output even when it is one of the inputs.
+        #[arg(long)]
+        force: bool,
+        /// The size limit of input files: bytes, or with K, M or G (KiB, MiB, GiB).
+        #[arg(long, value_name = "SIZE", default_value = "64M", value_parser = parse_byte_size)]
+        max_input_size: u64,
     },
     /// Subdivide a mesh with a surface grammar.
     Subdivide {
@@ -155,6 +170,9 @@ enum Command {
         #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
         timeout: Timeout,
+        /// Write the output even when it is one of the inputs.
+        #[arg(long)]
+        force: bool,
     },
     /// Meshes: information and conversion.
     Mesh {
@@ -203,6 +221,32 @@ fn parse_timeout(s: &str) -> Result<Timeout, String> {
     }
 }
 
+/// `1048576`, `512K`, `64M`, `2G` (powers of 1024).
+fn parse_byte_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (digits, unit) = match t.find(|c: char| !c.is_ascii_digit()) {
+        Some(i) => t.split_at(i),
+        None => (t, ""),
+    };
+    let shift = match unit.to_ascii_uppercase().as_str() {
+        "" | "B" => 0,
+        "K" | "KB" | "KIB" => 10,
+        "M" | "MB" | "MIB" => 20,
+        "G" | "GB" | "GIB" => 30,
+        _ => {
+            return Err(format!(
+                "`{s}` is not a size: write bytes, or a number with K, M or G"
+            ))
+        }
+    };
+    let n: u64 = digits
+        .parse()
+        .map_err(|_| format!("`{s}` is not a size: write bytes, or a number with K, M or G"))?;
+    n.checked_mul(1 << shift)
+        .filter(|&b| b <= u32::MAX as u64)
+        .ok_or_else(|| format!("`{s}` is more than the largest input size, 4G"))
+}
+
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
@@ -241,6 +285,9 @@ enum MeshCommand {
         /// Write the triangles, not the quads of basic blocks.
         #[arg(long)]
         triangles: bool,
+        /// Write the output even when it is the input (what the format cannot hold is lost).
+        #[arg(long)]
+        force: bool,
     },
 }
 
@@ -314,6 +361,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             max_modules,
             phase,
             timeout,
+            force,
         } => {
             let args = RenderArgs {
                 file,
@@ -328,6 +376,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 max_modules,
                 phase,
                 timeout: timeout.0,
+                force,
             };
             with_progress(|p| command::render(&args, p))
         }
@@ -339,6 +388,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             define,
             view,
             timeout,
+            force,
         } => {
             let args = SubdivideArgs {
                 mesh,
@@ -348,6 +398,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 defines: define,
                 view,
                 timeout: timeout.0,
+                force,
             };
             with_progress(|p| command::subdivide(&args, p))
         }
@@ -359,7 +410,8 @@ fn run(cli: Cli) -> Result<(), Error> {
                 input,
                 output,
                 triangles,
-            } => command::mesh_convert(&input, &output, triangles),
+                force,
+            } => command::mesh_convert(&input, &output, triangles, force),
         },
         Command::Reverse {
             input,
@@ -373,6 +425,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             format,
             details,
             timeout,
+            force,
+            max_input_size,
         } => {
             let args = ReverseArgs {
                 input,
@@ -386,6 +440,8 @@ fn run(cli: Cli) -> Result<(), Error> {
                 json: matches!(format, Format::Json),
                 details,
                 timeout: timeout.0,
+                force,
+                max_input: max_input_size,
             };
             match command::reverse(&args)? {
                 Some(report) => print_out(&report),
@@ -399,6 +455,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             level,
             scheme,
             timeout,
+            force,
+            max_input_size,
         } => command::reconstruct(&command::ReconstructArgs {
             coarse,
             details,
@@ -406,6 +464,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             level,
             scheme,
             timeout: timeout.0,
+            force,
+            max_input: max_input_size,
         }),
     }
 }

@@ -4,6 +4,7 @@
 //! make the representation lossless, in the spirit of Bartels and
 //! Samavati's multiresolution curves.
 
+pub mod details;
 pub mod input;
 pub mod metric;
 pub mod trace;
@@ -17,6 +18,7 @@ use crate::lang::Value;
 use crate::rewrite::Word;
 use crate::{Derivation, DeriveOptions};
 
+pub use details::{DetailsFile, Place};
 pub use input::{Contour, InputError};
 
 /// The scheme files built into the binary (also in `lsystems/reverse/`).
@@ -126,16 +128,45 @@ impl Scheme {
     }
 
     /// One reverse step (group 1) with the partition starting at `phase`.
+    /// A step that leaves no points is an error about the scheme.
     pub fn reverse_step(&self, pts: &[DVec2], phase: usize) -> Result<Vec<DVec2>, Error> {
-        self.run(pts, 1, 1, phase)
+        let out = self.run(pts, 1, 1, phase)?;
+        self.produced(pts, &out, "group 1 (the reverse step)")?;
+        Ok(out)
     }
 
-    /// `steps` forward steps (group 2).
+    /// `steps` forward steps (group 2). Steps that leave no points are an
+    /// error about the scheme.
     pub fn forward(&self, pts: &[DVec2], steps: usize) -> Result<Vec<DVec2>, Error> {
         if steps == 0 {
             return Ok(pts.to_vec());
         }
-        self.run(pts, 2, steps as u64, 0)
+        let out = self.run(pts, 2, steps as u64, 0)?;
+        self.produced(pts, &out, "group 2 (the forward scheme)")?;
+        Ok(out)
+    }
+
+    /// Points out of points, all finite.
+    fn produced(&self, from: &[DVec2], out: &[DVec2], group: &str) -> Result<(), Error> {
+        if out.is_empty() && !from.is_empty() {
+            return Err(Error::file(
+                &self.name,
+                format!(
+                    "the scheme's {group} turned {} points into none: it must produce `P` modules",
+                    from.len()
+                ),
+            ));
+        }
+        if let Some(p) = out.iter().find(|p| !p.is_finite()) {
+            return Err(Error::file(
+                &self.name,
+                format!(
+                    "the scheme's {group} produced the point ({}, {}), which is not finite",
+                    p.x, p.y
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// The fewest points a level needs for one more reverse step.
@@ -224,7 +255,38 @@ fn flattest(pts: &[DVec2], closed: bool) -> usize {
 }
 
 fn metric_point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    metric::distance(&[p], &[a, b], false).max
+    metric::point_segment(p, a, b)
+}
+
+/// What a distance measurement is for, to say in its messages.
+#[derive(Clone, Copy)]
+enum Measured {
+    Phase,
+    Report,
+}
+
+/// [`metric::distance`], with its budget's message.
+fn measure(
+    points: &[DVec2],
+    line: &[DVec2],
+    closed: bool,
+    what: Measured,
+) -> Result<metric::Error, Error> {
+    metric::distance(points, line, closed).map_err(|e| {
+        let (doing, instead) = match what {
+            Measured::Phase => (
+                "choosing the phase (--phase auto)",
+                "--phase 0 or --phase 1 chooses without measuring",
+            ),
+            Measured::Report => (
+                "measuring the reconstruction error (--report, --figure)",
+                "without --report and --figure nothing is measured",
+            ),
+        };
+        Error::Failed(format!(
+            "{doing}: {e}; the reconstruction is far from most of the input (is it noise, or does the scheme draw something else?); {instead}"
+        ))
+    })
 }
 
 /// Reverses `input` by `opts.steps` levels.
@@ -256,12 +318,26 @@ pub fn reverse(scheme: &Scheme, input: &Contour, opts: &ReverseOptions) -> Resul
         let mut best: Option<(f64, usize, Vec<DVec2>)> = None;
         for ph in candidates {
             let coarse = scheme.reverse_step(&level, ph)?;
+            // A reverse step leaves fewer points, and enough for a shape:
+            // so a run has at most log2(n) steps whatever the scheme.
+            let least = if scheme.closed { 3 } else { 2 };
+            if coarse.len() < least || coarse.len() >= level.len() {
+                return Err(Error::file(
+                    &scheme.name,
+                    format!(
+                        "at step {step}, the scheme's group 1 (the reverse step) turned {} points into {}: a reverse step must leave fewer points than it is given, and at least {least} for a coarse {}",
+                        level.len(),
+                        coarse.len(),
+                        if scheme.closed { "polygon" } else { "polyline" }
+                    ),
+                ));
+            }
             let score = if best.is_none() && opts.phase != Phase::Auto {
                 0.0
             } else {
                 // Reconstruct all the way to the input and compare.
                 let rec = scheme.forward(&coarse, step)?;
-                metric::distance(&input.points, &rec, scheme.closed).rms
+                measure(&input.points, &rec, scheme.closed, Measured::Phase)?.rms
             };
             if best.as_ref().is_none_or(|(s, _, _)| score < *s) {
                 best = Some((score, ph, coarse));
@@ -290,12 +366,19 @@ pub fn reverse(scheme: &Scheme, input: &Contour, opts: &ReverseOptions) -> Resul
                 0
             };
             let n = level.len();
-            let details = (0..n)
-                .map(|i| {
-                    let d = level[(i + shift) % n] - sub[i];
-                    [d.x, d.y]
-                })
-                .collect();
+            let mut details = Vec::with_capacity(n);
+            for i in 0..n {
+                let d = level[(i + shift) % n] - sub[i];
+                if !d.is_finite() {
+                    return Err(Error::Failed(format!(
+                        "at step {step}, the detail of point {} overflows ({:?} minus {:?}): the contour's coordinates are too large to keep details",
+                        (i + shift) % n,
+                        level[(i + shift) % n].to_array(),
+                        sub[i].to_array()
+                    )));
+                }
+                details.push([d.x, d.y]);
+            }
             levels.push(LevelDetails {
                 shift,
                 details,
@@ -337,50 +420,119 @@ pub fn reconstruct(
     details: &Details,
     upto: Option<usize>,
 ) -> Result<Vec<DVec2>, Error> {
+    restore(scheme, coarse, details, upto, |place, message| {
+        Error::Failed(match place {
+            Place::Details(k) | Place::Shift(k) | Place::Dropped(k) => {
+                format!("level {}: {message}", k + 1)
+            }
+            Place::Detail(k, i) => format!("level {}, detail {i}: {message}", k + 1),
+            _ => message,
+        })
+    })
+}
+
+/// [`reconstruct`] from a details file: errors about the details point at
+/// their place in the file.
+pub fn reconstruct_file(
+    scheme: &Scheme,
+    coarse: &[DVec2],
+    file: &DetailsFile,
+    upto: Option<usize>,
+) -> Result<Vec<DVec2>, Error> {
+    restore(scheme, coarse, &file.details, upto, |place, message| {
+        file.error(place, message)
+    })
+}
+
+fn restore(
+    scheme: &Scheme,
+    coarse: &[DVec2],
+    details: &Details,
+    upto: Option<usize>,
+    at: impl Fn(Place, String) -> Error,
+) -> Result<Vec<DVec2>, Error> {
     if details.format != DETAILS_FORMAT || details.version != 1 {
-        return Err(Error::Failed(format!(
-            "not a subgram details file (format `{}` version {})",
-            details.format, details.version
-        )));
+        return Err(at(
+            Place::Format,
+            format!(
+                "not a subgram details file (format `{}` version {})",
+                details.format, details.version
+            ),
+        ));
     }
     if coarse.len() != details.coarse_points {
-        return Err(Error::Failed(format!(
-            "the details belong to a coarse contour of {} points, but this one has {}",
-            details.coarse_points,
-            coarse.len()
-        )));
+        return Err(at(
+            Place::CoarsePoints,
+            format!(
+                "the details belong to a coarse contour of {} points, but this one has {}",
+                details.coarse_points,
+                coarse.len()
+            ),
+        ));
     }
     let k = upto.unwrap_or(details.levels.len());
     if k > details.levels.len() {
-        return Err(Error::Failed(format!(
-            "level {k} was asked for, but the details have {} levels",
-            details.levels.len()
-        )));
+        return Err(at(
+            Place::Levels,
+            format!(
+                "level {k} was asked for, but the details have {} levels",
+                details.levels.len()
+            ),
+        ));
     }
     let mut level = coarse.to_vec();
     for (li, l) in details.levels[..k].iter().enumerate() {
         let sub = scheme.forward(&level, 1)?;
         if sub.len() != l.details.len() {
-            return Err(Error::Failed(format!(
-                "level {}: the subdivision has {} points but the details have {}",
-                li + 1,
-                sub.len(),
-                l.details.len()
-            )));
+            return Err(at(
+                Place::Details(li),
+                format!(
+                    "the subdivision of the level below has {} points but these details have {}",
+                    sub.len(),
+                    l.details.len()
+                ),
+            ));
         }
         let n = sub.len();
+        if l.shift >= n {
+            return Err(at(
+                Place::Shift(li),
+                format!("the shift {} is not below the level's {n} points", l.shift),
+            ));
+        }
         let mut fine = vec![DVec2::ZERO; n];
         for i in 0..n {
-            fine[(i + l.shift) % n] = sub[i] + DVec2::from(l.details[i]);
+            let p = sub[i] + DVec2::from(l.details[i]);
+            if !p.is_finite() {
+                return Err(at(
+                    Place::Detail(li, i),
+                    format!(
+                        "this detail overflows: added to the subdivided point {:?} it gives {:?}, and a restored point must be finite",
+                        sub[i].to_array(),
+                        p.to_array()
+                    ),
+                ));
+            }
+            fine[(i + l.shift) % n] = p;
         }
         if let Some((i, p)) = l.dropped {
             if i > fine.len() {
-                return Err(Error::Failed(format!(
-                    "level {}: a dropped point's index is out of range",
-                    li + 1
-                )));
+                return Err(at(
+                    Place::Dropped(li),
+                    format!(
+                        "the dropped point's index {i} is beyond the level's {} points",
+                        fine.len()
+                    ),
+                ));
             }
-            fine.insert(i, DVec2::from(p));
+            let p = DVec2::from(p);
+            if !p.is_finite() {
+                return Err(at(
+                    Place::Dropped(li),
+                    "the dropped point is not finite".into(),
+                ));
+            }
+            fine.insert(i, p);
         }
         level = fine;
     }
@@ -419,11 +571,20 @@ pub struct Report {
 }
 
 /// Measures a reversal.
+/// Errors too large to represent (coordinates near `f64::MAX`) are refused.
 pub fn report(scheme: &Scheme, input: &Contour, r: &Reversal) -> Result<Report, Error> {
     let steps = r.steps.len();
     let rec = scheme.forward(&r.coarse, steps)?;
     let dec = decimate(&input.points, r.coarse.len(), scheme.closed);
     let dec_rec = scheme.forward(&dec, steps)?;
+    let reverse = measure(&input.points, &rec, scheme.closed, Measured::Report)?;
+    let decimation = measure(&input.points, &dec_rec, scheme.closed, Measured::Report)?;
+    if !reverse.is_finite() || !decimation.is_finite() {
+        return Err(Error::Failed(format!(
+            "the reconstruction error cannot be measured: a distance is beyond the range of floating-point numbers (reverse subdivision: max {}, naive decimation: max {}); the contour's coordinates are too large",
+            reverse.max, decimation.max
+        )));
+    }
     Ok(Report {
         input_points: input.points.len(),
         closed: scheme.closed,
@@ -431,8 +592,8 @@ pub fn report(scheme: &Scheme, input: &Contour, r: &Reversal) -> Result<Report, 
         scheme: scheme.name.clone(),
         steps: r.steps.clone(),
         coarse_points: r.coarse.len(),
-        reverse: metric::distance(&input.points, &rec, scheme.closed),
-        decimation: metric::distance(&input.points, &dec_rec, scheme.closed),
+        reverse,
+        decimation,
     })
 }
 
@@ -464,8 +625,22 @@ impl std::fmt::Display for Report {
                 }
             )?;
         }
-        let e =
-            |m: &metric::Error| format!("max {:.6}  mean {:.6}  rms {:.6}", m.max, m.mean, m.rms);
+        // Six decimals, or six significant digits for huge figures.
+        let num = |v: f64| {
+            if v.abs() < 1e12 {
+                format!("{v:.6}")
+            } else {
+                format!("{v:.6e}")
+            }
+        };
+        let e = |m: &metric::Error| {
+            format!(
+                "max {}  mean {}  rms {}",
+                num(m.max),
+                num(m.mean),
+                num(m.rms)
+            )
+        };
         writeln!(
             f,
             "reconstruction error, {} points subdivided {} times, against the input:\n  reverse subdivision  {}\n  naive decimation     {}",

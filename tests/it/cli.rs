@@ -122,3 +122,115 @@ fn runaway_derivation_stops_with_a_message() {
         stderr(&o)
     );
 }
+
+/// A command whose output is one of its inputs (by another spelling, a
+/// symbolic or a hard link too) is refused with exit code 2 and a message
+/// that names `--force`, and the input is left as it was; `--force`
+/// replaces it.
+#[test]
+fn an_output_that_is_an_input_is_refused_unless_forced() {
+    use crate::reverse::{files_in, run_in, scratch};
+    let dir = scratch("overwrite");
+    let cube = std::fs::read(lsys("meshes/cube.obj")).unwrap();
+    // Texture coordinates and normals that a conversion would drop.
+    let mut a = cube.clone();
+    a.extend_from_slice(b"vt 0 0\nvn 0 0 1\nusemtl skin\n");
+    std::fs::write(dir.join("a.obj"), &a).unwrap();
+    std::fs::hard_link(dir.join("a.obj"), dir.join("hard.obj")).unwrap();
+    std::os::unix::fs::symlink("a.obj", dir.join("soft.obj")).unwrap();
+    std::fs::create_dir_all(dir.join("g/surfaces")).unwrap();
+    std::fs::create_dir_all(dir.join("g/meshes")).unwrap();
+    std::fs::copy(lsys("surfaces/loop.lsys"), dir.join("g/surfaces/loop.lsys")).unwrap();
+    std::fs::copy(
+        lsys("meshes/octahedron.obj"),
+        dir.join("g/meshes/octahedron.obj"),
+    )
+    .unwrap();
+    let points: String = (0..16)
+        .map(|i| format!("{} {}\n", (i as f64).cos(), (i as f64).sin()))
+        .collect();
+    std::fs::write(dir.join("p.txt"), &points).unwrap();
+    let cc = lsys("surfaces/catmull-clark.lsys");
+    let cc = cc.to_str().unwrap();
+    let refusals: &[(&[&str], &str)] = &[
+        (&["subdivide", "a.obj", "--grammar", cc, "-n", "1", "-o", "a.obj"], "the output `a.obj` is an input of this command"),
+        (&["mesh", "convert", "a.obj", "a.obj"], "the output `a.obj` is an input of this command"),
+        (&["mesh", "convert", "a.obj", "./a.obj"], "the output `./a.obj` is the same file as the input `a.obj`"),
+        (&["mesh", "convert", "a.obj", "hard.obj"], "the output `hard.obj` is the same file as the input `a.obj`"),
+        (&["mesh", "convert", "a.obj", "soft.obj"], "the output `soft.obj` is the same file as the input `a.obj`"),
+        (&["subdivide", "--grammar", "g/surfaces/loop.lsys", "-n", "1", "-o", "g/meshes/octahedron.obj"],
+         "the output `g/meshes/octahedron.obj` is the same file as the input `g/surfaces/../meshes/octahedron.obj`"),
+        (&["reverse", "p.txt", "-n", "1", "-o", "q.txt", "--details", "p.txt"], "the output `p.txt` is an input of this command"),
+        (&["reconstruct", "p.txt", "--details", "d.json", "-o", "p.txt"], "the output `p.txt` is an input of this command"),
+        (&["render", "a.obj", "-o", "soft.obj"], "the output `soft.obj` is the same file as the input `a.obj`"),
+    ];
+    let before = files_in(&dir);
+    for (args, message) in refusals {
+        let r = run_in(&dir, args);
+        assert_eq!(r.code, Some(2), "{args:?}: {}", r.stderr);
+        let want = format!(
+            "error: {message}: writing it would replace the input; name another output, or add --force to replace it\n"
+        );
+        assert_eq!(r.stderr, want, "{args:?}");
+        assert_eq!(std::fs::read(dir.join("a.obj")).unwrap(), a, "{args:?}");
+        assert_eq!(files_in(&dir), before, "{args:?}");
+    }
+    // Two outputs that are one file are refused even with --force.
+    let r = run_in(
+        &dir,
+        &[
+            "reverse",
+            "p.txt",
+            "-n",
+            "1",
+            "-o",
+            "q.txt",
+            "--details",
+            "./q.txt",
+            "--force",
+        ],
+    );
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    assert!(
+        r.stderr
+            .contains("`q.txt` and `./q.txt` are the same output file"),
+        "{}",
+        r.stderr
+    );
+    // --force replaces the input.
+    let r = run_in(&dir, &["mesh", "convert", "a.obj", "a.obj", "--force"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let converted = std::fs::read_to_string(dir.join("a.obj")).unwrap();
+    assert!(
+        !converted.contains("vt "),
+        "the conversion drops what it cannot hold"
+    );
+    let r = run_in(
+        &dir,
+        &[
+            "subdivide",
+            "a.obj",
+            "--grammar",
+            cc,
+            "-n",
+            "1",
+            "-o",
+            "a.obj",
+            "--force",
+        ],
+    );
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let r = run_in(
+        &dir,
+        &["reverse", "p.txt", "-n", "1", "-o", "p.txt", "--force"],
+    );
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("p.txt"))
+            .unwrap()
+            .lines()
+            .count(),
+        8
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
