@@ -296,6 +296,17 @@ pub fn mesh_info(file: &str, as_json: bool) -> Result<String, Error> {
 /// subgram does not keep, such as texture coordinates and normals).
 pub fn mesh_convert(input: &str, output: &str, triangles: bool, force: bool) -> Result<(), Error> {
     let (input, output) = (Path::new(input), Path::new(output));
+    if mesh::io::Format::from_path(output).is_none() {
+        // As for pictures: an output whose format cannot be told is a
+        // usage error, found before anything is read.
+        let ext = output
+            .extension()
+            .map_or(String::new(), |e| format!(" `.{}`", e.to_string_lossy()));
+        return Err(Error::Usage(format!(
+            "{}: unknown mesh format{ext}: expected a file ending in .obj, .off or .ply",
+            output.display()
+        )));
+    }
     refuse_overwrite(&[output], &[input], force)?;
     let m = load_mesh(input)?;
     let soup = if triangles {
@@ -455,7 +466,15 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), Error> {
         None => {
             let p = Path::new(recorded);
             refuse_overwrite(&[output], &[p], a.force)?;
-            Scheme::from_file(p, d.details.closed)?
+            // The scheme the details file names: a problem with it is
+            // shown at its name in the details file.
+            Scheme::from_file(p, d.details.closed).map_err(|e| match e {
+                Error::Io { .. } => d.error(
+                    reverse::details::Place::Scheme,
+                    format!("the scheme these details were made with: {e}"),
+                ),
+                e => e,
+            })?
         }
     };
     scheme.deadline = deadline;

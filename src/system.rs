@@ -9,6 +9,7 @@ use crate::mesh::Mesh;
 use crate::rewrite::derive::DEFAULT_MAX_MODULES;
 use crate::rewrite::{DeriveOptions, Word};
 use crate::surface::{Grammar, StepCounts};
+use crate::syntax::Diagnostic;
 use crate::syntax::{FileId, SourceMap};
 
 /// A checked `.lsys` file: what [`crate::load`] returns.
@@ -257,10 +258,37 @@ impl Surface {
                 )));
             }
         };
-        let mut mesh = load_mesh(&path)?;
+        let named_here = opts.base_mesh.is_none();
+        let mut mesh = load_mesh(&path).map_err(|e| match &self.grammar.mesh {
+            // A mesh the grammar names but that cannot be read at all is
+            // shown at its `mesh:` line; a problem inside the mesh file
+            // keeps its own place.
+            Some((_, span)) if named_here && !in_the_file(&e) => Error::at(
+                &self.grammar.sources,
+                Diagnostic::new(
+                    *span,
+                    match &e {
+                        Error::File { path, message, .. } => {
+                            format!("the base mesh `{path}`: {message}")
+                        }
+                        e => format!("the base mesh: {e}"),
+                    },
+                ),
+            ),
+            _ => e,
+        })?;
         let steps = self.steps(opts.steps)?;
         self.run_on(&mut mesh, steps, opts.deadline, progress)?;
         Ok(SurfaceRun { mesh, steps })
+    }
+}
+
+/// True when `e` points at a line of the file it is about.
+fn in_the_file(e: &Error) -> bool {
+    match e {
+        Error::File { line, .. } => line.is_some(),
+        Error::Program { .. } | Error::FileAt { .. } => true,
+        _ => false,
     }
 }
 

@@ -94,7 +94,7 @@ pub fn read(path: &Path) -> Result<PolygonSoup, MeshFileError> {
     let name = path.display().to_string();
     let format = format_of(&name, path)?;
     let limit = max_file_bytes().map_err(|m| error(&name, None, m))?;
-    let bytes = read_bounded(&name, path, limit)?;
+    let bytes = read_bounded_as(&name, path, limit, Some(format))?;
     read_str(&name, format, &bytes)
 }
 
@@ -152,6 +152,19 @@ pub fn to_bytes(format: Format, soup: &PolygonSoup) -> Vec<u8> {
 /// The bytes of the file at `path`, or an error when there are more than
 /// `limit` of them.
 fn read_bounded(name: &str, path: &Path, limit: u64) -> Result<Vec<u8>, MeshFileError> {
+    read_bounded_as(name, path, limit, None)
+}
+
+/// [`read_bounded`]; a stream (a device, a pipe) in `format` is also
+/// checked as it is read, so that what cannot be a mesh of that format
+/// (`/dev/zero`: NUL bytes in a text format, a PLY file without its
+/// `ply` line) is refused at once instead of after reading up to the limit.
+fn read_bounded_as(
+    name: &str,
+    path: &Path,
+    limit: u64,
+    format: Option<Format>,
+) -> Result<Vec<u8>, MeshFileError> {
     let cannot = |e: std::io::Error| error(name, None, format!("cannot read the file: {e}"));
     let file = std::fs::File::open(path).map_err(cannot)?;
     let size = file
@@ -164,13 +177,50 @@ fn read_bounded(name: &str, path: &Path, limit: u64) -> Result<Vec<u8>, MeshFile
     }
     let room = size.map_or(0, |s| usize::try_from(s).unwrap_or(0).saturating_add(1));
     let mut bytes = Vec::with_capacity(room);
-    file.take(limit.saturating_add(1))
-        .read_to_end(&mut bytes)
-        .map_err(cannot)?;
+    let mut file = file.take(limit.saturating_add(1));
+    match (size, format) {
+        (None, Some(format)) => {
+            // A stream: read in chunks, and look at each as it comes.
+            let mut chunk = vec![0u8; 1 << 20];
+            loop {
+                let n = file.read(&mut chunk).map_err(cannot)?;
+                if n == 0 {
+                    break;
+                }
+                let start = bytes.len();
+                bytes.extend_from_slice(&chunk[..n]);
+                if let Some(m) = stream_problem(format, &bytes, start) {
+                    return Err(error(name, None, m));
+                }
+            }
+        }
+        _ => {
+            file.read_to_end(&mut bytes).map_err(cannot)?;
+        }
+    }
     if bytes.len() as u64 > limit {
         return Err(too_large(name, None, limit));
     }
     Ok(bytes)
+}
+
+/// Why the first bytes of a stream, `bytes` (the new ones from `start`),
+/// cannot be a mesh in `format`, if they cannot.
+fn stream_problem(format: Format, bytes: &[u8], start: usize) -> Option<String> {
+    match format {
+        Format::Ply => {
+            let head = &bytes[..bytes.len().min(3)];
+            (head != &b"ply"[..head.len()])
+                .then(|| "a PLY file starts with a line `ply`, and this one does not".to_string())
+        }
+        _ => bytes[start..].iter().position(|&b| b == 0).map(|i| {
+            format!(
+                "byte {} is a NUL byte, and {} files are text",
+                start + i + 1,
+                format.name()
+            )
+        }),
+    }
 }
 
 /// "the file is 3 GiB, more than the limit of ...", naming the limit and

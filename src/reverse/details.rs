@@ -307,6 +307,7 @@ impl Reader<'_> {
 struct Places {
     whole: Range<usize>,
     format: Range<usize>,
+    scheme: Range<usize>,
     coarse_points: Range<usize>,
     levels: Range<usize>,
     level: Vec<LevelPlaces>,
@@ -336,6 +337,8 @@ pub enum Place {
     Detail(usize, usize),
     /// Level `k`'s `dropped` point.
     Dropped(usize),
+    /// The scheme the details were made with.
+    Scheme,
 }
 
 /// A details file as read: the details and the text they came from.
@@ -389,6 +392,7 @@ impl DetailsFile {
         let at = match place {
             Place::File => p.whole.clone(),
             Place::Format => p.format.clone(),
+            Place::Scheme => p.scheme.clone(),
             Place::CoarsePoints => p.coarse_points.clone(),
             Place::Levels => p.levels.clone(),
             Place::Details(k) => level(k).map_or(p.levels.clone(), |l| l.details.clone()),
@@ -448,7 +452,8 @@ fn decode(r: &Reader, root: &Node) -> Result<(Details, Places), Error> {
             format!("not a subgram details file: expected format `{DETAILS_FORMAT}` version 1"),
         ));
     }
-    let scheme = string(field("scheme")?, "scheme")?;
+    let scheme_node = field("scheme")?;
+    let scheme = string(scheme_node, "scheme")?;
     let closed_node = field("closed")?;
     let Value::Bool(closed) = closed_node.value else {
         return Err(r.error(
@@ -474,6 +479,7 @@ fn decode(r: &Reader, root: &Node) -> Result<(Details, Places), Error> {
     let mut places = Places {
         whole: root.at.start..root.at.start + 1,
         format: format.at.clone(),
+        scheme: scheme_node.at.clone(),
         coarse_points: coarse.at.clone(),
         levels: levels_node.at.start..levels_node.at.start + 1,
         level: Vec::new(),

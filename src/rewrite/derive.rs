@@ -485,14 +485,16 @@ impl<'p> Derivation<'p> {
             .eval_global(e, &mut self.env)
             .map_err(|e| runtime(e, Some(*span), self.step))?
             .as_f64();
-        if !v.is_finite() || v > MAX_DEPTH as f64 {
+        if !(0.0..=MAX_DEPTH as f64).contains(&v) || v.fract() != 0.0 {
             return Err(DeriveError {
                 span: Some(*span),
-                message: format!("the maximum depth is {v}; it must be from 0 to {MAX_DEPTH}"),
+                message: format!(
+                    "the maximum depth must be a whole number of levels from 0 to {MAX_DEPTH}"
+                ),
                 step: self.step,
             });
         }
-        Ok(v.max(0.0) as u64)
+        Ok(v as u64)
     }
 
     /// Rewrites `word` with the rules of `section` recursively: after the

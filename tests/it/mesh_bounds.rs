@@ -333,22 +333,51 @@ fn bounds_files_larger_than_the_limit_are_refused_before_reading() {
         &err,
         &["SUBGRAM_MAX_MESH_BYTES must be a whole number of bytes, found `2G`"],
     );
-    // A device is read up to the limit only.
+    // A device that cannot hold a mesh of the format is refused at its
+    // first bytes: `/dev/zero` gives NUL bytes, and OBJ files are text.
     std::os::unix::fs::symlink("/dev/zero", dir.join("zero.obj")).unwrap();
-    let (o, took) = bin(
-        &dir,
-        &["mesh", "convert", "zero.obj", "out.obj"],
-        &[("SUBGRAM_MAX_MESH_BYTES", "1048576")],
-    );
+    let (o, took) = bin(&dir, &["mesh", "convert", "zero.obj", "out.obj"], &[]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(took < Duration::from_secs(10), "{took:?}");
     assert_mentions(
         &err,
-        &["zero.obj: error: the file goes on, more than the limit of 1048576 bytes (1 MiB) for a \
+        &["zero.obj: error: byte 1 is a NUL byte, and OBJ files are text"],
+    );
+    std::fs::remove_file(dir.join("zero.obj")).unwrap();
+    // A stream of text that never ends is read up to the limit only: the
+    // input is the child's standard input, fed with vertex lines until the
+    // child stops reading.
+    std::os::unix::fs::symlink("/dev/stdin", dir.join("stream.obj")).unwrap();
+    let t = Instant::now();
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .current_dir(&dir)
+        .args(["mesh", "convert", "stream.obj", "out.obj"])
+        .env_remove("SUBGRAM_MAX_MESH_BYTES")
+        .env("SUBGRAM_MAX_MESH_BYTES", "1048576")
+        .stdin(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let feeder = std::thread::spawn(move || {
+        use std::io::Write;
+        let line = b"v 0 0 0\n".repeat(4096);
+        // Until the child has read what it wants and closed the pipe.
+        while stdin.write_all(&line).is_ok() {}
+    });
+    let o = child.wait_with_output().unwrap();
+    let took = t.elapsed();
+    feeder.join().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(took < Duration::from_secs(10), "{took:?}");
+    assert_mentions(
+        &err,
+        &["stream.obj: error: the file goes on, more than the limit of 1048576 bytes (1 MiB) for a \
            mesh file; set SUBGRAM_MAX_MESH_BYTES"],
     );
-    assert_eq!(entries(&dir), vec!["zero.obj".to_string()]);
+    assert_eq!(entries(&dir), vec!["stream.obj".to_string()]);
     assert_eq!(io::MAX_FILE_BYTES, 2 << 30);
     let _ = std::fs::remove_dir_all(&dir);
 }
