@@ -94,7 +94,8 @@ pub const MAX_VALENCE_VAR: &str = "SUBGRAM_MAX_VALENCE";
 /// The valence limit of a run on `mesh`: `configured`, or
 /// [`MAX_VALENCE_VAR`] where it is set, raised to twice the mesh's highest
 /// valence.
-fn valence_limit(configured: usize, mesh: &Mesh) -> Result<usize, String> {
+/// Also gives the mesh's highest valence.
+fn valence_limit(configured: usize, mesh: &Mesh) -> Result<(usize, usize), String> {
     let limit = match std::env::var(MAX_VALENCE_VAR) {
         Err(std::env::VarError::NotPresent) => configured,
         Ok(v) => v
@@ -108,7 +109,8 @@ fn valence_limit(configured: usize, mesh: &Mesh) -> Result<usize, String> {
             ))
         }
     };
-    Ok(limit.max(2 * mesh.max_valence().map_or(0, |(_, n)| n)))
+    let highest = mesh.max_valence().map_or(0, |(_, n)| n);
+    Ok((limit.max(2 * highest), highest))
 }
 
 /// Where the first call of host built-in `f` in `e` is, if there is one.
@@ -500,12 +502,14 @@ impl Grammar {
         }
         // `new(v)` counts this run's steps only.
         mesh.reset_vertex_steps();
-        let valence_limit = valence_limit(self.max_valence, mesh).map_err(|message| RunError {
-            span: None,
-            message,
-        })?;
+        let (valence_limit, highest) =
+            valence_limit(self.max_valence, mesh).map_err(|message| RunError {
+                span: None,
+                message,
+            })?;
         let mut state = RunState {
             valence_limit,
+            valence_bound: highest,
             blocks: self.block_split,
             face_split_makes_blocks: self.block_used_at.is_some(),
             ..RunState::default()
@@ -979,6 +983,8 @@ struct RunState {
     face_split_makes_blocks: bool,
     /// The highest valence a rule may leave (see [`Grammar::max_valence`]).
     valence_limit: usize,
+    /// At least the highest valence in the mesh (see `check_valence`).
+    valence_bound: usize,
     /// The run stops once this passes.
     deadline: Option<crate::Deadline>,
 }
@@ -994,8 +1000,19 @@ impl RunState {
     }
 
     /// Refuses a mesh with a vertex of higher valence than the limit.
-    fn check_valence(&self, mesh: &Mesh) -> Result<(), String> {
-        match mesh.max_valence() {
+    /// Checks the valences after a split or flip rule. A split or a flip
+    /// at most doubles a vertex's valence (each edge it adds at a vertex
+    /// sits in a face or beside an edge that was already there), so the
+    /// highest valence is bounded without looking: the mesh is walked only
+    /// when that bound passes the limit, and the walk resets the bound.
+    fn check_valence(&mut self, mesh: &Mesh) -> Result<(), String> {
+        self.valence_bound = self.valence_bound.saturating_mul(2).max(4);
+        if self.valence_bound <= self.valence_limit {
+            return Ok(());
+        }
+        let highest = mesh.max_valence();
+        self.valence_bound = highest.map_or(0, |(_, n)| n);
+        match highest {
             Some((v, n)) if n > self.valence_limit => Err(format!(
                 "vertex {v} has valence {n} after this rule, more than the limit of {}; \
                  a grammar whose valences keep growing slows down without end \
