@@ -71,7 +71,7 @@ pub struct Grammar {
     /// than twice the base mesh's highest, where that is more) stops the
     /// run with an error: work at a vertex grows with its valence, so a
     /// grammar whose valences keep growing (two face splits a step) would
-    /// slow down without end. [`MAX_VALENCE_VAR`] in the environment, when
+    /// slow down without end. `SUBGRAM_MAX_VALENCE` in the environment, when
     /// set, takes its place.
     pub max_valence: usize,
     /// What `check` reports without refusing the grammar.
