@@ -15,8 +15,9 @@
 # FUZZ_RSS_MB (2048), FUZZ_SANITIZER (none; `address` for ASan, slower),
 # FUZZ_JOBS (1 process at a time).
 #
-# cargo-fuzz needs nightly features; on the stable toolchain
-# RUSTC_BOOTSTRAP=1 allows them (set here). Needs `cargo install cargo-fuzz`.
+# Needs `cargo install cargo-fuzz`. Without a sanitizer the stable toolchain
+# builds the targets as it is; AddressSanitizer needs the nightly-only
+# -Zsanitizer, which RUSTC_BOOTSTRAP=1 (set here) lets stable rustc accept.
 set -euo pipefail
 
 if [[ $# -lt 1 || ! $1 =~ ^[0-9]+$ ]]; then

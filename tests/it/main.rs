@@ -5,6 +5,7 @@ mod abop;
 mod cli;
 mod curves;
 mod errors;
+mod fuzz_replay;
 mod golden;
 mod golden_tests;
 mod lsystems;
