@@ -26,8 +26,11 @@ use subgram::reverse::input::{self as contour_input, Contour};
 use subgram::reverse::{self, Details, Phase, ReverseOptions, Scheme};
 use subgram::{DeriveOptions, LoadOptions, System};
 
+/// A target's body.
+pub type Body = fn(&[u8]);
+
 /// The names of the targets, as in `fuzz/Cargo.toml`, with their bodies.
-pub const TARGETS: &[(&str, fn(&[u8]))] = &[
+pub const TARGETS: &[(&str, Body)] = &[
     ("lsys_check", lsys_check),
     ("lsys_derive", lsys_derive),
     ("mesh_read", mesh_read),

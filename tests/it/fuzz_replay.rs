@@ -42,7 +42,7 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn body(target: &str) -> fn(&[u8]) {
+fn body(target: &str) -> bodies::Body {
     bodies::TARGETS
         .iter()
         .find(|(name, _)| *name == target)
