@@ -7,6 +7,7 @@ mod cli;
 mod curves;
 mod errors;
 mod front_limits;
+mod fuzz_replay;
 mod golden;
 mod golden_tests;
 mod limits;

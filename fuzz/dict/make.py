@@ -1,0 +1,70 @@
+#!/usr/bin/env python3
+"""Writes the fuzz dictionaries (libFuzzer's format: one quoted entry a
+line, \\xNN escapes). Run from fuzz/dict: python3 make.py"""
+
+lang = """module Axiom: axiom: produce nproduce interpretation: decomposition: homomorphism:
+Start: StartEach: EndEach: End: group endgroup UseGroup CurrentGroup StepNo Forward Backward IsForward Stop
+ignore: consider: angle: #define #include #undef #ifdef #ifndef #if #endif #else #elif #pragma <lpfgall.h> <math.h> <stdlib.h> <lintrfc.h>
+int float double bool char long unsigned V2f V2d V3f V3d struct typedef const true false
+if else while do for break continue return
+InLeftContext InRightContext InNewLeftContext InNewRightContext
+SB EB SP PP EP F f G g Left Right Up Down RollL RollR TurnAround MoveTo2f MoveTo3f LineTo2f LineTo3f Line2f Line3f LineRel2f LineRel3f
+MoveTo LineTo Cut SetColor IncColor DecColor SetWidth Circle Sphere Circle0 CircleB GetPos GetHead GetLeft GetUp Label Surface
+Length Normalized Normalize sqrt sin cos tan asin acos atan atan2 exp log pow fabs abs floor ceil fmod fmin fmax min max hypot ran round trunc
+PI M_PI""".split() + ["derivation length:", "ring L-system:", "maximum depth:", "produce;"]
+punct = ["<", ">", "<<", ">>", "->", "-->", ":", ";", ",", "(", ")", "{", "}", "[", "]", "?", "==", "!=", "<=", ">=", "&&", "||", "!",
+         "+=", "-=", "*=", "/=", "%=", "++", "--", "=", "+", "-", "*", "/", "%", "^", "&", "|", ".", "'", "\"", "//", "/*", "*/", "\\", "#",
+         "1e308", "-1", "0.5", "2147483648", "9223372036854775807", "1e-320", "0x10", "\n"]
+curve_snippets = ["module P(V2f);", "Axiom: P(v1) P(v2);", "derivation length: 3;", "ring L-system: 1;",
+                  "P(vl) < P(v) > P(vr) : { produce P(v) P(v); }", "P(v) -> P(v) P(v)", "V2f v1(0, 0), v2(1, 1);",
+                  "#define N 4", "#define M(x) ((x)+(x))", "maximum depth: 2;", "Start: { }", "group 1:",
+                  "struct S { int a; float b; };", "typedef struct S T;", "for (int i = 0; i < 3; i++) { }", "x ? y : z", "(float) 1"]
+surface = """mesh: blocks: dual bisection quadrisection define init: F(f) V(v E(e F^2 F^3 F^4 E^3 E^4 || | ^
+l( c step valence( boundary( new( block( center( centre( transversal( avg( sum( count( ring( boundary_ring( verts( tail( head( bnext( bprev( pos(
+where in interior boundary""".split() + ["derivation length:"]
+surface_snippets = ['mesh: "cube.obj";', "F(f) -> V(v = avg(f)) || E^3 F^3;", "E(e; l(e) < c) || F^2 -> E || F^2;",
+                    "E(e) | F^2 -> V(v = avg(e)) || E^4 F^4;", "E(e) | F -> V || E^3 F^2;", "V(v; l(v) < c) -> V(v = v);",
+                    "define a(n) = 1.0/n;", "sum(w in ring(v) where l(w) < c)", "V(v) | boundary -> V(v = v);", "blocks: dual;",
+                    "init: F(f) -> V || E^3 F^3;"]
+mesh = ["v ", "vt ", "vn ", "vp ", "f ", "l ", "p ", "o ", "g ", "s ", "s off", "usemtl ", "mtllib ", "#", "/", "//", "-1", "1/1/1", "1//1",
+        "OFF", "COFF", "NOFF", "STOFF", "4OFF", "nOFF", "OFF BINARY",
+        "ply", "format ascii 1.0", "format binary_little_endian 1.0", "format binary_big_endian 1.0", "comment ", "obj_info ",
+        "element vertex ", "element face ", "element edge ", "property float x", "property double y", "property float z",
+        "property list uchar int vertex_indices", "property list uchar uint vertex_index", "property list int int vertex_indices",
+        "char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "uint8", "int16", "uint16", "int32", "uint32",
+        "float32", "float64", "end_header\n", "nan", "inf", "1e309", "4294967295", "18446744073709551615", "\n", "\r\n", " ", "\t",
+        "\x00\x00\x80\x3f", "\x03", "\x04", "\xff\xff\xff\xff"]
+contour = ["x,y", "x y", "#", "//", ",", ";", " ", "\n", "nan", "inf", "1e308", "-1e308", "1e-308", "0", "-0",
+           "<svg", "</svg>", "<svg xmlns=\"http://www.w3.org/2000/svg\">", "<polygon", "<polyline", "<path", "<g>", "</g>", "/>",
+           "points=\"", "d=\"", "transform=", "viewBox=", "M", "m", "L", "l", "H", "h", "V", "v", "Z", "z", "C", "Q", "A",
+           "<?xml version=\"1.0\"?>", "<!DOCTYPE svg [<!ENTITY a \"1 2\">]>", "&a;", "<![CDATA[", "]]>", "<!--", "-->",
+           "\x89PNG\r\n\x1a\n", "IHDR", "IDAT", "IEND", "PLTE", "tRNS", "gAMA", "\x00\x00\x00\x0d",
+           "\x08\x06\x00\x00\x00", "\x08\x00\x00\x00\x00", "\x08\x03\x00\x00\x00"]
+details = ['"format"', '"subgram-details"', '"version"', '"scheme"', '"builtin:chaikin"', '"builtin:chaikin-open"', '"closed"',
+           '"coarse_points"', '"levels"', '"shift"', '"details"', '"dropped"', "null", "true", "false", "[", "]", "{", "}", ":", ",",
+           "1e308", "-1e308", "18446744073709551615", "4294967295", "0", "6", "[0.5,0.5]"]
+
+
+def esc(s):
+    return ''.join('\\x%02x' % ord(c) if c in '"\\' or ord(c) < 32 or ord(c) >= 127 else c for c in s)
+
+
+def write(name, header, toks):
+    seen = []
+    for t in toks:
+        if t not in seen:
+            seen.append(t)
+    with open(name + '.dict', 'w') as f:
+        f.write('# ' + header + ' (written by make.py)\n')
+        f.write(''.join('"%s"\n' % esc(t) for t in seen))
+
+
+write('lsys_check', '.lsys curve L-systems and surface grammars: keywords, directives, punctuation, lpfg modules',
+      lang + punct + curve_snippets + surface + surface_snippets)
+write('lsys_derive', 'curve L-systems: keywords, directives, punctuation, lpfg modules and turtle commands',
+      lang + punct + curve_snippets)
+write('surface_run', 'surface grammars: directives, rule forms, host built-ins, the shared expression language',
+      surface + surface_snippets + punct + "int float bool if else sqrt cos sin pow fabs PI #define".split())
+write('mesh_read', 'OBJ, OFF and PLY keywords, types and numbers', mesh)
+write('contour_reverse', 'contours: point lists, SVG elements and path commands, PNG signature and chunk names', contour)
+write('details_reconstruct', 'details files (JSON): keys, values, extreme numbers', details)

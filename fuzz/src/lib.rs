@@ -1,0 +1,305 @@
+//! The bodies of the fuzz targets, one function per target, each taking
+//! the fuzzer's bytes. They are the only place where a target's code path
+//! is written down: the cargo-fuzz targets (`fuzz/fuzz_targets/*.rs`) call
+//! them, and the stable `cargo test` at the project root compiles this
+//! same file as a module (`tests/it/fuzz_replay.rs`, `#[path]`) to replay
+//! the seed corpora and the minimised findings through them. So this file
+//! uses nothing but `std`, `subgram`, `glam` and `serde_json`, which the
+//! root package's tests can use too.
+//!
+//! A body returns normally whatever the input is; a panic, an abort, a
+//! timeout or running out of memory is a finding. The checks that
+//! `assert!` are properties the README promises (a mesh written and read
+//! again is the same; a built or subdivided mesh validates).
+//!
+//! Limits are small on purpose, so that each execution is quick: a few
+//! derivation steps, a few thousand modules, a small fixed base mesh and a
+//! face limit of a few thousand.
+
+#![allow(dead_code)]
+
+use glam::DVec2;
+use subgram::mesh::io::{self, Format};
+use subgram::mesh::{shapes, Mesh, PolygonSoup};
+use subgram::render::{self, RenderOptions};
+use subgram::reverse::input::{self as contour_input, Contour};
+use subgram::reverse::{self, Details, Phase, ReverseOptions, Scheme};
+use subgram::{DeriveOptions, LoadOptions, System};
+
+/// A target's body.
+pub type Body = fn(&[u8]);
+
+/// The names of the targets, as in `fuzz/Cargo.toml`, with their bodies.
+pub const TARGETS: &[(&str, Body)] = &[
+    ("lsys_check", lsys_check),
+    ("lsys_derive", lsys_derive),
+    ("mesh_read", mesh_read),
+    ("surface_run", surface_run),
+    ("contour_reverse", contour_reverse),
+    ("details_reconstruct", details_reconstruct),
+];
+
+/// Steps of a curve derivation.
+pub const CURVE_STEPS: u64 = 3;
+/// The longest word a derivation, decomposition or interpretation may make.
+pub const MAX_MODULES: usize = 2_000;
+/// The most faces a surface rule may make.
+pub const MAX_FACES: usize = 2_000;
+/// The most points of a coarse contour built for a details file.
+pub const MAX_COARSE: usize = 4_096;
+
+/// Text as the library takes it: invalid UTF-8 is replaced, as a user's
+/// editor would show it (the loader takes `&str`; reading files as UTF-8
+/// is not what is fuzzed here).
+fn text(data: &[u8]) -> std::borrow::Cow<'_, str> {
+    String::from_utf8_lossy(data)
+}
+
+/// (a) Lexing, preprocessing, parsing and checking a `.lsys` text, curve
+/// L-system or surface grammar, through the public facade; errors and
+/// warnings are rendered with their `file:line:col`, line and caret.
+pub fn lsys_check(data: &[u8]) {
+    let text = text(data);
+    match subgram::load_text("fuzz.lsys", &text, &LoadOptions::default()) {
+        Ok(system) => {
+            for w in system.warnings() {
+                std::hint::black_box(w);
+            }
+        }
+        Err(e) => {
+            std::hint::black_box(e.to_string());
+        }
+    }
+}
+
+/// (b) A curve L-system loaded, derived a few steps with a small module
+/// limit, printed as text and JSON, interpreted, and drawn: turtle events,
+/// the scene fitted to a small picture, and its SVG.
+pub fn lsys_derive(data: &[u8]) {
+    let text = text(data);
+    let Ok(System::Curve(curve)) = subgram::load_text("fuzz.lsys", &text, &LoadOptions::default())
+    else {
+        return;
+    };
+    let opts = DeriveOptions::default()
+        .with_steps(CURVE_STEPS)
+        .with_max_modules(MAX_MODULES);
+    let mut run = match curve.run(opts) {
+        Ok(run) => run,
+        Err(e) => {
+            std::hint::black_box(e.to_string());
+            return;
+        }
+    };
+    std::hint::black_box(run.text());
+    std::hint::black_box(run.json());
+    let events = match run.events() {
+        Ok(ev) => ev,
+        Err(e) => {
+            std::hint::black_box(e.to_string());
+            return;
+        }
+    };
+    let small = RenderOptions {
+        width: 64,
+        height: 64,
+        ..RenderOptions::default()
+    };
+    if let Ok(scene) = render::scene(&[events], &small) {
+        std::hint::black_box(render::svg::render(&scene));
+    }
+}
+
+/// (c) The bytes read as OBJ, as OFF and as PLY (ASCII or binary); a soup
+/// that reads is written in each format and read back to the same
+/// positions and faces, built into a half-edge mesh (which must validate),
+/// described and turned back into a soup.
+pub fn mesh_read(data: &[u8]) {
+    for format in [Format::Obj, Format::Off, Format::Ply] {
+        let soup = match io::read_str("fuzz", format, data) {
+            Ok(s) => s,
+            Err(e) => {
+                std::hint::black_box(e.to_string());
+                continue;
+            }
+        };
+        for out in [Format::Obj, Format::Off, Format::Ply] {
+            let bytes = io::to_bytes(out, &soup);
+            let again = io::read_str("again", out, &bytes).unwrap_or_else(|e| {
+                panic!("a soup written as {} does not read back: {e}", out.name())
+            });
+            assert_eq!(
+                again.positions,
+                soup.positions,
+                "positions after {}",
+                out.name()
+            );
+            assert_eq!(again.faces, soup.faces, "faces after {}", out.name());
+        }
+        build(&soup);
+    }
+}
+
+/// A soup built into a mesh; a mesh that builds must validate.
+fn build(soup: &PolygonSoup) {
+    match Mesh::from_soup(soup) {
+        Ok(mesh) => {
+            if let Err(e) = mesh.validate() {
+                panic!("a mesh built from a soup does not validate: {}", e.message);
+            }
+            std::hint::black_box(mesh.info().to_string());
+            std::hint::black_box(mesh.to_quad_soup());
+        }
+        Err(e) => {
+            std::hint::black_box(e.message);
+        }
+    }
+}
+
+/// The base mesh of a surface run: an icosahedron (closed triangles), a
+/// 3×3 quad torus (closed quads, blocks) or a 2×2 quad grid (open), chosen
+/// by the input's length.
+pub fn base_mesh(data: &[u8]) -> PolygonSoup {
+    match data.len() % 3 {
+        0 => shapes::icosahedron(),
+        1 => shapes::quad_torus(3, 3),
+        _ => shapes::quad_grid(2, 2),
+    }
+}
+
+/// (d) A surface grammar loaded and run on a small fixed mesh for its
+/// derivation length clamped to 1..=2 steps, with a face limit of
+/// [`MAX_FACES`]. Whether the run succeeds or stops with an error, the
+/// mesh must validate (a refused operator leaves the mesh as it was); it is
+/// then described, turned into polygons and drawn into a scene.
+pub fn surface_run(data: &[u8]) {
+    let text = text(data);
+    let Ok(System::Surface(mut surface)) =
+        subgram::load_text("fuzz.lsys", &text, &LoadOptions::default())
+    else {
+        return;
+    };
+    surface.grammar.max_faces = MAX_FACES;
+    let steps = surface.grammar.length.unwrap_or(1).clamp(1, 2) as usize;
+    let Ok(mut mesh) = Mesh::from_soup(&base_mesh(data)) else {
+        panic!("the fixed base mesh does not build");
+    };
+    if let Err(e) = surface.run_on(&mut mesh, steps, None, |p| {
+        std::hint::black_box(p);
+    }) {
+        std::hint::black_box(e.to_string());
+    }
+    if let Err(e) = mesh.validate() {
+        panic!(
+            "a mesh after a surface run does not validate: {}",
+            e.message
+        );
+    }
+    std::hint::black_box(mesh.info().to_string());
+    let soup = mesh.to_quad_soup();
+    let view = render::mesh::MeshView {
+        width: 64,
+        height: 64,
+        ..Default::default()
+    };
+    if let Ok(scene) = render::mesh::scene(&soup, &view) {
+        std::hint::black_box(scene);
+    }
+}
+
+/// The contours the bytes make as a point list, an SVG document and a PNG
+/// image, each with at least the 3 points `reverse::input::read` asks.
+pub fn contours(data: &[u8]) -> Vec<Contour> {
+    let mut found = Vec::new();
+    let mut keep = |r: Result<Contour, contour_input::InputError>| match r {
+        Ok(c) if c.points.len() >= 3 => found.push(c),
+        Ok(_) => {}
+        Err(e) => {
+            std::hint::black_box(e.to_string());
+        }
+    };
+    if let Ok(text) = std::str::from_utf8(data) {
+        keep(contour_input::read_points("fuzz.txt", text));
+        keep(contour_input::read_svg("fuzz.svg", text));
+    }
+    keep(contour_input::read_png("fuzz.png", data));
+    found
+}
+
+/// (e) Contour inputs (point lists, SVG, PNG) and reverse subdivision:
+/// two levels (one below 12 points) with the built-in scheme, the automatic phase and details
+/// (open instead of closed when the input's length is odd, as `--open`),
+/// then the report, the figure's events, the coarse polygon written out,
+/// and the reconstruction from the details.
+pub fn contour_reverse(data: &[u8]) {
+    for mut contour in contours(data) {
+        if data.len() % 2 == 1 {
+            contour.closed = false;
+        }
+        let scheme = Scheme::builtin(contour.closed);
+        let opts = ReverseOptions {
+            steps: if contour.points.len() >= 12 { 2 } else { 1 },
+            phase: Phase::Auto,
+            details: true,
+        };
+        let r = match reverse::reverse(&scheme, &contour, &opts) {
+            Ok(r) => r,
+            Err(e) => {
+                std::hint::black_box(e.to_string());
+                continue;
+            }
+        };
+        std::hint::black_box(reverse::format_points(
+            &r.coarse,
+            contour.closed,
+            std::path::Path::new("coarse.csv"),
+        ));
+        match reverse::report(&scheme, &contour, &r) {
+            Ok(rep) => std::hint::black_box(rep.to_string()),
+            Err(e) => std::hint::black_box(e.to_string()),
+        };
+        if let Ok(rec) = scheme.forward(&r.coarse, r.steps.len()) {
+            std::hint::black_box(reverse::figure_events(&contour, &r.coarse, &rec));
+        }
+        if let Some(d) = &r.details {
+            match reverse::reconstruct(&scheme, &r.coarse, d, None) {
+                Ok(p) => std::hint::black_box(p.len()),
+                Err(e) => std::hint::black_box(e.to_string().len()),
+            };
+        }
+    }
+}
+
+/// A details file (JSON, as `reverse --details` writes it) read and used
+/// to reconstruct, with the built-in scheme, from a regular polygon of its
+/// `coarse_points` (at most [`MAX_COARSE`]): every level, then the first.
+pub fn details_reconstruct(data: &[u8]) {
+    let Ok(d) = serde_json::from_slice::<Details>(data) else {
+        return;
+    };
+    if d.coarse_points > MAX_COARSE {
+        return;
+    }
+    let n = d.coarse_points;
+    let coarse: Vec<DVec2> = (0..n)
+        .map(|i| {
+            let a = i as f64 / n.max(1) as f64 * std::f64::consts::TAU;
+            DVec2::new(a.cos(), a.sin())
+        })
+        .collect();
+    let scheme = Scheme::builtin(d.closed);
+    for upto in [None, Some(1)] {
+        match reverse::reconstruct(&scheme, &coarse, &d, upto) {
+            Ok(p) => {
+                std::hint::black_box(reverse::format_points(
+                    &p,
+                    d.closed,
+                    std::path::Path::new("restored.txt"),
+                ));
+            }
+            Err(e) => {
+                std::hint::black_box(e.to_string());
+            }
+        }
+    }
+}
