@@ -283,6 +283,18 @@ pub(crate) fn render_line(
     format!("{path}:{line}:{rest}\n{pad}{gutter}\n{line}{source}\n{pad}{caret}")
 }
 
+impl From<crate::draw::DrawError> for Error {
+    fn from(e: crate::draw::DrawError) -> Error {
+        Error::Failed(e.message)
+    }
+}
+
+impl From<crate::render::RenderError> for Error {
+    fn from(e: crate::render::RenderError) -> Error {
+        Error::Failed(e.message)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -316,17 +328,5 @@ mod tests {
                 assert_eq!(got, want, "line {} bytes {a}..{b}", k + 1);
             }
         }
-    }
-}
-
-impl From<crate::draw::DrawError> for Error {
-    fn from(e: crate::draw::DrawError) -> Error {
-        Error::Failed(e.message)
-    }
-}
-
-impl From<crate::render::RenderError> for Error {
-    fn from(e: crate::render::RenderError) -> Error {
-        Error::Failed(e.message)
     }
 }

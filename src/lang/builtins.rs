@@ -18,12 +18,16 @@ pub enum SigError {
     Message(String),
 }
 
+/// How a built-in resolves argument types to an implementation and a
+/// result type, or why they do not fit.
+pub type Resolve = fn(&[Ty]) -> Result<(Func, Ty), SigError>;
+
 /// A built-in function: its name and how it resolves the argument types to
 /// an implementation and a result type.
 #[derive(Clone, Copy)]
 pub struct Builtin {
     pub name: &'static str,
-    pub resolve: fn(&[Ty]) -> Result<(Func, Ty), SigError>,
+    pub resolve: Resolve,
 }
 
 /// What a topology adds to the language: its element types, its host

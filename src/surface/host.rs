@@ -606,7 +606,7 @@ pub fn specialise(e: &mut Ex) {
     }
 }
 
-fn host_call<'a>(e: &'a Ex, f: u16) -> Option<&'a [Ex]> {
+fn host_call(e: &Ex, f: u16) -> Option<&[Ex]> {
     match e {
         Ex::Call(Func::Host(g), args, _) if *g == f => Some(args),
         _ => None,
