@@ -36,7 +36,7 @@ const PENDING_SECONDS: u64 = 20;
 const PENDING_MEMORY_KB: u64 = 4 * 1024 * 1024;
 /// A pending finding that was slow passes when it takes less than this
 /// (seconds, debug build).
-const PENDING_QUICK: f64 = 2.0;
+const PENDING_QUICK: f64 = 1.0;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
