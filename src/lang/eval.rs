@@ -719,17 +719,7 @@ fn float_binary(op: BinOp, x: &Value, y: &Value) -> Option<Value> {
         },
         (Value::Int(a), Value::Float(b)) => return float(*a as f64, *b),
         (Value::Float(a), Value::Int(b)) => return float(*a, *b as f64),
-        (Value::Float(a), Value::Float(b)) => match op {
-            Add => Value::Float(a + b),
-            Sub => Value::Float(a - b),
-            Mul => Value::Float(a * b),
-            Div => Value::Float(a / b),
-            Lt => Value::Bool(a < b),
-            Le => Value::Bool(a <= b),
-            Gt => Value::Bool(a > b),
-            Ge => Value::Bool(a >= b),
-            _ => return None,
-        },
+        (Value::Float(a), Value::Float(b)) => return float(*a, *b),
         (Value::V3(a), Value::V3(b)) => match op {
             Add => Value::V3(*a + *b),
             Sub => Value::V3(*a - *b),
