@@ -1,0 +1,238 @@
+//! Model folders: the L-system found in a folder, the files read beside
+//! it, the names they define, and the accessors' values. The expected
+//! values come from lpfg (its output on the same folder, recorded below)
+//! and from hand computations written out here, independent of the
+//! implementation.
+
+use std::path::PathBuf;
+
+use subgram::model::{self, Colours, Model};
+use subgram::{LoadOptions, System, Value};
+
+use crate::support::root;
+
+fn models(name: &str) -> PathBuf {
+    root().join("tests/data/models").join(name)
+}
+
+fn curve(path: &PathBuf) -> subgram::Curve {
+    match subgram::load(path, &LoadOptions::default()) {
+        Ok(System::Curve(c)) => c,
+        Ok(_) => panic!("{} is not a curve", path.display()),
+        Err(e) => panic!("{} does not load:\n{e}", path.display()),
+    }
+}
+
+/// The first parameter of every module, as numbers, in word order.
+fn values(c: &subgram::Curve) -> Vec<f64> {
+    let d = subgram::derive(&c.program, Default::default()).unwrap_or_else(|e| panic!("{}", c.error(e)));
+    d.word
+        .modules(&c.program.alphabet, &c.program.structs)
+        .map(|(_, ps)| match ps.first() {
+            Some(Value::Float(x)) => *x,
+            Some(Value::Int(i)) => *i as f64,
+            other => panic!("expected a number, found {other:?}"),
+        })
+        .collect()
+}
+
+/// lpfg's final string for `tests/data/models/accessors`, made with
+/// `/work/shared/tools/lpfg/run_lpfg.sh tests/data/models/accessors OUT`
+/// (lpfg at vlab commit 9bf820d), printed with 8 significant digits.
+const LPFG_ACCESSORS: [f64; 32] = [
+    0.00001831837,
+    0.2765322,
+    0.49998987,
+    0.866097,
+    0.99998164,
+    0.00001831837,
+    0.99998164,
+    0.6053002,
+    0.56556773,
+    0.1132247,
+    0.60999066,
+    0.9999267,
+    0.5,
+    0.9325383,
+    1.227512,
+    2.5,
+    7.0,
+    -0.6666667,
+    0.0,
+    1.0463466e-6,
+    -0.6666667,
+    0.6666667,
+    3.692761e-6,
+    -0.5263883,
+    -0.38077423,
+    1.3093805,
+    0.23166777,
+    3.8328328,
+    0.16716722,
+    0.5893559,
+    2.0782385,
+    0.6053002,
+];
+
+#[test]
+fn accessors_give_lpfgs_values() {
+    let c = curve(&models("accessors"));
+    let got = values(&c);
+    assert_eq!(got.len(), LPFG_ACCESSORS.len());
+    for (i, (g, w)) in got.iter().zip(LPFG_ACCESSORS).enumerate() {
+        // Functions are computed as lpfg does, in single precision: they
+        // agree to lpfg's printed digits. Contours sum the spline's basis
+        // in another order than lpfg's matrix product: within 1e-5.
+        assert!(
+            (g - w).abs() <= 1e-5 * w.abs().max(1.0),
+            "value {i}: subgram {g}, lpfg {w}"
+        );
+    }
+}
+
+/// The cubic B-spline basis N(k, t) over `knots`, by the Cox–de Boor
+/// recursion, written out for the test.
+fn basis(knots: &[f64], k: usize, t: usize, u: f64) -> f64 {
+    if t == 1 {
+        return if knots[k] <= u && u < knots[k + 1] { 1.0 } else { 0.0 };
+    }
+    let mut s = 0.0;
+    let d1 = knots[k + t - 1] - knots[k];
+    if d1 > 0.0 {
+        s += (u - knots[k]) / d1 * basis(knots, k, t - 1, u);
+    }
+    let d2 = knots[k + t] - knots[k + 1];
+    if d2 > 0.0 {
+        s += (knots[k + t] - u) / d2 * basis(knots, k + 1, t - 1, u);
+    }
+    s
+}
+
+#[test]
+fn functions_follow_the_clamped_b_spline_by_hand() {
+    let c = curve(&models("accessors"));
+    let got = values(&c);
+    // `rise` has 4 points: one span, so its curve is the Bézier cubic of
+    // (0,0) (0.3,0.1) (0.6,0.9) (1,1). At the parameter 1/2 the Bernstein
+    // weights are 1/8 3/8 3/8 1/8: x = (0 + 0.9 + 1.8 + 1)/8 = 0.4625 and
+    // y = (0 + 0.3 + 2.7 + 1)/8 = 0.5. func(rise, 0.4625) is the third value.
+    assert!((got[2] - 0.5).abs() < 5e-4, "{}", got[2]);
+    // The ends: y of the first and last points (x clamped outside [0,1]).
+    assert!(got[0].abs() < 1e-3 && got[5].abs() < 1e-3);
+    assert!((got[4] - 1.0).abs() < 1e-3 && (got[6] - 1.0).abs() < 1e-3);
+    // `bump` has 5 points: knots 0 0 0 0 1 2 2 2 2. At u = 1 (the middle
+    // knot) the basis is 0, 1/4, 1/2, 1/4, 0: x = 0.25/4 + 0.5/2 + 0.75/4
+    // = 0.5 and y = 1/4 + 0 + 1/4 = 0.5; the test's basis agrees.
+    let knots = [0.0, 0.0, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0, 2.0];
+    let w: Vec<f64> = (0..5).map(|k| basis(&knots, k, 4, 1.0)).collect();
+    assert_eq!(w, vec![0.0, 0.25, 0.5, 0.25, 0.0]);
+    let m = load_model("accessors");
+    let bump = &m.functions[1];
+    assert_eq!(bump.name, "bump");
+    // Its 20 samples are 1/19 apart and x = 0.5 falls halfway between two:
+    // lpfg interpolates linearly there, a chord of the curve, off by up to
+    // |y''| h² / 8 (about 7e-3 for this bend).
+    let y = bump.value(0.5).unwrap() as f64;
+    assert!((y - 0.5).abs() < 1e-2, "{y}");
+    // tfunc maps the timeline [2, 20] onto [0,1]: tfunc(grow, 12.5) is
+    // func at (12.5 - 2) / 18; beyond the end it is the last value.
+    let grow = &m.functions[2];
+    assert_eq!((grow.low, grow.up), (2.0, 20.0));
+    assert_eq!(grow.timeline_value(12.5), grow.value(10.5 / 18.0));
+    assert!((got[11] - 1.0).abs() < 1e-3);
+    // The parameters of the .vset.
+    assert_eq!((got[15], got[16]), (2.5, 7.0));
+}
+
+#[test]
+fn contours_by_hand() {
+    let c = curve(&models("accessors"));
+    let got = values(&c);
+    // `ring` is closed with control points (1,0) (0,1) (-1,0) (0,-1); lpfg
+    // starts a closed contour with copies of its last three points, so its
+    // first span is (0,1) (-1,0) (0,-1) (1,0), which starts at
+    // ((0,1) + 4(-1,0) + (0,-1)) / 6 = (-2/3, 0). The contour is symmetric
+    // under quarter turns, so a quarter of its length on it is the next
+    // span's start, (0, -2/3), and half of it is (2/3, 0).
+    let near = |a: f64, b: f64| (a - b).abs() < 1e-4;
+    assert!(near(got[17], -2.0 / 3.0) && near(got[18], 0.0));
+    assert!(near(got[19], 0.0) && near(got[20], -2.0 / 3.0));
+    assert!(near(got[21], 2.0 / 3.0) && near(got[22], 0.0));
+    // An open contour ends 1/1000 of a span short of its last span's end
+    // (lpfg samples each span at 0, 1/1000, …, 999/1000); `blade`'s last
+    // span is (0.5,2) (1,3) (1,4) (1,4), whose end (t = 1, weights 0 1/6
+    // 4/6 1/6) is ((1,3) + 4(1,4) + (1,4)) / 6 = (1, 23/6); the tangent
+    // there is (0, 1/2), so the contour ends 1/2000 short of it.
+    let m = load_model("accessors");
+    let blade = m.contours.iter().find(|c| c.name == "blade").unwrap();
+    let end = blade.point(1.0);
+    assert!((end[0] - 1.0).abs() < 1e-3 && (end[1] as f64 - 23.0 / 6.0).abs() < 2e-3, "{end:?}");
+}
+
+fn load_model(name: &str) -> Model {
+    let files = model::find(&models(name)).unwrap().unwrap();
+    Model::read(&files.files).unwrap()
+}
+
+#[test]
+fn names_are_numbered_as_lpfg_numbers_them() {
+    let m = load_model("accessors");
+    // Functions from 1: the .fset's, the .tset's, the .vset's, then each
+    // .func; contours from 0, lpfg's default circle first.
+    let d = m.defines();
+    for want in [
+        "rise=1", "bump=2", "grow=3", "LEN=4", "WIDTH=5", "lone=6", "def_contour=0", "ring=1",
+        "wave=2", "blade=3",
+    ] {
+        assert!(d.contains(&want.to_string()), "{want} not in {d:?}");
+    }
+}
+
+#[test]
+fn a_folder_a_program_in_it_and_main_find_the_same_model() {
+    let dir = models("accessors");
+    let by_dir = model::find(&dir).unwrap().unwrap();
+    let by_file = model::find(&dir.join("lsystem.l")).unwrap().unwrap();
+    assert_eq!(by_dir, by_file);
+    assert_eq!(by_dir.lsystem, dir.join("lsystem.l"));
+    // The specifications name 6 files besides the program.
+    assert_eq!(by_dir.files.len(), 6);
+    // A `.lsys` file is a program alone.
+    assert!(model::find(&root().join("lsystems/curves/chaikin-13.lsys"))
+        .unwrap()
+        .is_none());
+}
+
+#[test]
+fn materials_and_colour_maps_by_the_manual() {
+    // A material record: index, transparency, ambient, diffuse, emission,
+    // specular, shininess (VLABToolsManual §4.4).
+    let mut bytes = vec![0u8; 30];
+    bytes[..15].copy_from_slice(&[0, 0, 1, 2, 3, 10, 20, 30, 100, 150, 200, 0, 0, 0, 0]);
+    bytes[15..].copy_from_slice(&[5, 0, 50, 0, 0, 100, 100, 0, 0, 0, 0, 0, 0, 0, 0]);
+    let m = model::colours::read_mat("m.mat", &bytes).unwrap();
+    // The background is material 0's emission.
+    assert_eq!(m.background(), [100, 150, 200]);
+    // Lit by the default light, from the viewer, white: emission +
+    // ambient × (0.2 global + 1) + diffuse × 1. Material 5: red
+    // 50 × 1.2 + 100 = 160, green 100, blue 0.
+    assert_eq!(m.colour(5, &[]), [160, 100, 0]);
+    // An index the file does not set keeps the default material:
+    // ambient 0.2, diffuse 0.8: 0.2 × 1.2 + 0.8 = 1.04, white.
+    assert_eq!(m.colour(7, &[]), [255, 255, 255]);
+    // A colour map: 256 RGB triplets.
+    let mut map = vec![0u8; 768];
+    map[3..6].copy_from_slice(&[1, 2, 3]);
+    let c = model::colours::read_map("c.map", &map).unwrap();
+    assert!(matches!(c, Colours::Map(_)));
+    assert_eq!((c.colour(1, &[]), c.colour(257, &[])), ([1, 2, 3], [1, 2, 3]));
+}
+
+#[test]
+fn a_model_without_the_named_function_says_which_files_it_read() {
+    let dir = models("missing-function");
+    let e = subgram::load(&dir, &LoadOptions::default()).unwrap_err().to_string();
+    assert!(e.contains("lsystem.l:"), "{e}");
+    assert!(e.contains("`stem` names no function"), "{e}");
+    assert!(e.contains("`functions.fset`"), "{e}");
+}
