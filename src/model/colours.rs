@@ -120,9 +120,10 @@ pub fn read_mat(path: &str, bytes: &[u8]) -> Result<Colours, Error> {
                 if bytes.is_empty() {
                     String::new()
                 } else {
+                    let whole = bytes.len() / RECORD;
                     format!(
-                        " ({} whole records and {} bytes over)",
-                        bytes.len() / RECORD,
+                        " ({whole} whole record{} and {} bytes over)",
+                        if whole == 1 { "" } else { "s" },
                         bytes.len() % RECORD
                     )
                 }

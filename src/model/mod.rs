@@ -126,13 +126,12 @@ fn option_values(opt: &str) -> usize {
 /// program file that is not an lpfg `.l` file (a `.lsys`): it is read
 /// alone.
 pub fn find(input: &Path) -> Result<Option<ModelFiles>, Error> {
+    // A program in the current folder keeps its files' names bare: the
+    // folder is the empty path, listed as `.`.
     let (dir, given) = if input.is_dir() {
         (input.to_path_buf(), None)
     } else if ext(input) == "l" {
-        let dir = match input.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
+        let dir = input.parent().map(Path::to_path_buf).unwrap_or_default();
         (dir, input.file_name().map(PathBuf::from))
     } else {
         return Ok(None);
@@ -226,9 +225,14 @@ pub fn find(input: &Path) -> Result<Option<ModelFiles>, Error> {
     };
     // The lone file of each kind; `.func` and `.con` files may be many.
     let mut files = Vec::new();
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .map_err(|e| Error::read(dir.clone(), e))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
+    let listed = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir.as_path()
+    };
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(listed)
+        .map_err(|e| Error::read(listed, e))?
+        .filter_map(|e| e.ok().map(|e| dir.join(e.file_name())))
         .filter(|p| p.is_file())
         .collect();
     entries.sort();
@@ -243,7 +247,7 @@ pub fn find(input: &Path) -> Result<Option<ModelFiles>, Error> {
             let names: Vec<String> = of.iter().map(|p| format!("`{}`", p.display())).collect();
             return Err(Error::Usage(format!(
                 "the model folder `{}` has {} `.{k}` files ({}): lpfg reads one; name it on the `lpfg` line of a `specifications` file",
-                dir.display(),
+                listed.display(),
                 of.len(),
                 names.join(", ")
             )));
@@ -303,7 +307,7 @@ impl Model {
             let v = view::read_v(&n, &t, &mut m.notes)?;
             m.widths_in_units = v.widths_in_units;
             m.lights = v.lights.clone();
-            let dir = p.parent().unwrap_or(Path::new("."));
+            let dir = p.parent().unwrap_or(Path::new(""));
             for s in &v.surfaces {
                 let sp = dir.join(&s.file);
                 if !sp.is_file() {

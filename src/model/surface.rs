@@ -102,11 +102,7 @@ pub fn read_s(path: &str, name: &str, text: &str) -> Result<Surface, Error> {
         });
     }
     if patches.is_empty() {
-        return Err(Error::File {
-            path: path.to_string(),
-            line: Some(lines.line_no().max(1)),
-            message: "the surface has no patch".into(),
-        });
+        return Err(lines.error_at_end("the surface has no patch after its header"));
     }
     Ok(Surface {
         name: name.to_string(),

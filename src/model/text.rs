@@ -52,6 +52,9 @@ pub struct Word<'a> {
 pub struct Lines<'a> {
     pub path: &'a str,
     lines: Vec<&'a str>,
+    /// The lines as messages show them (the file's own text, where the
+    /// parsed lines have comments blanked out).
+    shown: Vec<&'a str>,
     /// The index of the next line.
     next: usize,
 }
@@ -85,9 +88,16 @@ pub fn words(line: &str) -> Vec<Word<'_>> {
 
 impl<'a> Lines<'a> {
     pub fn new(path: &'a str, text: &'a str) -> Lines<'a> {
+        Lines::shown_as(path, text, text)
+    }
+
+    /// Lines of `parsed`, shown in messages as the same lines of `shown`
+    /// (which has the same line breaks).
+    pub fn shown_as(path: &'a str, parsed: &'a str, shown: &'a str) -> Lines<'a> {
         Lines {
             path,
-            lines: text.lines().collect(),
+            lines: parsed.lines().collect(),
+            shown: shown.lines().collect(),
             next: 0,
         }
     }
@@ -123,11 +133,26 @@ impl<'a> Lines<'a> {
                 return Ok(l);
             }
         }
-        Err(Error::File {
-            path: self.path.to_string(),
-            line: Some(self.lines.len().max(1)),
-            message: format!("the file ends where {what} was expected"),
-        })
+        // The caret goes after the last word of the file.
+        let message = format!("the file ends where {what} was expected");
+        match self.lines.iter().rposition(|l| !l.trim().is_empty()) {
+            Some(i) => {
+                let n = self.lines[i].trim_end().len();
+                let text = self.shown.get(i).copied().unwrap_or("");
+                Err(Error::FileAt {
+                    path: self.path.to_string(),
+                    line: i + 1,
+                    text: text.to_string(),
+                    start: n,
+                    end: n,
+                    message,
+                })
+            }
+            None => Err(Error::file(
+                self.path,
+                format!("the file is empty: {message}"),
+            )),
+        }
     }
 
     /// The next line without consuming it (blank lines skipped).
@@ -140,7 +165,12 @@ impl<'a> Lines<'a> {
 
     /// An error at bytes `start..end` of the line last read.
     pub fn error_at(&self, start: usize, end: usize, message: impl Into<String>) -> Error {
-        let text = self.current();
+        let text = self
+            .next
+            .checked_sub(1)
+            .and_then(|i| self.shown.get(i))
+            .copied()
+            .unwrap_or("");
         let (start, end) = if start >= text.len() {
             (text.len(), text.len())
         } else {

@@ -135,13 +135,15 @@ fn light(lines: &Lines<'_>, line: &str, after: usize) -> Result<Light, Error> {
         let n = match w.text {
             "V:" | "O:" | "A:" | "D:" | "S:" | "T:" => 3,
             "P:" => 5,
-            _ => return Err(lines.error(
-                w,
-                format!(
+            _ => {
+                return Err(lines.error(
+                    w,
+                    format!(
                     "expected a light field `V:`, `O:`, `P:`, `A:`, `D:`, `S:` or `T:`, found `{}`",
                     w.text
                 ),
-            )),
+                ))
+            }
         };
         let mut v = [0.0; 5];
         for (k, slot) in v.iter_mut().enumerate().take(n) {
@@ -215,7 +217,7 @@ fn line_start(text: &str, n: usize) -> usize {
 /// subgram does not act on or does not know.
 pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile, Error> {
     let clean = blank_comments(text);
-    let mut lines = Lines::new(path, &clean);
+    let mut lines = Lines::shown_as(path, &clean, text);
     let mut view = ViewFile::default();
     let mut ignored: Vec<(String, usize, usize, usize)> = Vec::new();
     while !lines.at_end() {
@@ -261,11 +263,14 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
                 Some("pixel") => false,
                 Some("polygon") | Some("cylinder") => true,
                 _ => {
+                    let (s, e) = ws.first().map_or((line.len(), line.len()), |w| {
+                        (w.start + after, w.end + after)
+                    });
                     return Err(lines.error_at(
-                        after,
-                        line.len(),
+                        s,
+                        e,
                         "expected `pixel`, `polygon` or `cylinder` after `line style:`",
-                    ))
+                    ));
                 }
             };
             continue;
@@ -324,7 +329,7 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
 /// Checks an animation file: `command: value` lines of §8.2.
 pub fn read_a(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<(), Error> {
     let clean = blank_comments(text);
-    let mut lines = Lines::new(path, &clean);
+    let mut lines = Lines::shown_as(path, &clean, text);
     while !lines.at_end() {
         let line = lines.next_line("")?;
         let n = lines.line_no();

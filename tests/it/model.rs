@@ -25,7 +25,8 @@ fn curve(path: &PathBuf) -> subgram::Curve {
 
 /// The first parameter of every module, as numbers, in word order.
 fn values(c: &subgram::Curve) -> Vec<f64> {
-    let d = subgram::derive(&c.program, Default::default()).unwrap_or_else(|e| panic!("{}", c.error(e)));
+    let d = subgram::derive(&c.program, Default::default())
+        .unwrap_or_else(|e| panic!("{}", c.error(e)));
     d.word
         .modules(&c.program.alphabet, &c.program.structs)
         .map(|(_, ps)| match ps.first() {
@@ -94,7 +95,11 @@ fn accessors_give_lpfgs_values() {
 /// recursion, written out for the test.
 fn basis(knots: &[f64], k: usize, t: usize, u: f64) -> f64 {
     if t == 1 {
-        return if knots[k] <= u && u < knots[k + 1] { 1.0 } else { 0.0 };
+        return if knots[k] <= u && u < knots[k + 1] {
+            1.0
+        } else {
+            0.0
+        };
     }
     let mut s = 0.0;
     let d1 = knots[k + t - 1] - knots[k];
@@ -166,7 +171,10 @@ fn contours_by_hand() {
     let m = load_model("accessors");
     let blade = m.contours.iter().find(|c| c.name == "blade").unwrap();
     let end = blade.point(1.0);
-    assert!((end[0] - 1.0).abs() < 1e-3 && (end[1] as f64 - 23.0 / 6.0).abs() < 2e-3, "{end:?}");
+    assert!(
+        (end[0] - 1.0).abs() < 1e-3 && (end[1] as f64 - 23.0 / 6.0).abs() < 2e-3,
+        "{end:?}"
+    );
 }
 
 fn load_model(name: &str) -> Model {
@@ -181,8 +189,16 @@ fn names_are_numbered_as_lpfg_numbers_them() {
     // .func; contours from 0, lpfg's default circle first.
     let d = m.defines();
     for want in [
-        "rise=1", "bump=2", "grow=3", "LEN=4", "WIDTH=5", "lone=6", "def_contour=0", "ring=1",
-        "wave=2", "blade=3",
+        "rise=1",
+        "bump=2",
+        "grow=3",
+        "LEN=4",
+        "WIDTH=5",
+        "lone=6",
+        "def_contour=0",
+        "ring=1",
+        "wave=2",
+        "blade=3",
     ] {
         assert!(d.contains(&want.to_string()), "{want} not in {d:?}");
     }
@@ -225,13 +241,18 @@ fn materials_and_colour_maps_by_the_manual() {
     map[3..6].copy_from_slice(&[1, 2, 3]);
     let c = model::colours::read_map("c.map", &map).unwrap();
     assert!(matches!(c, Colours::Map(_)));
-    assert_eq!((c.colour(1, &[]), c.colour(257, &[])), ([1, 2, 3], [1, 2, 3]));
+    assert_eq!(
+        (c.colour(1, &[]), c.colour(257, &[])),
+        ([1, 2, 3], [1, 2, 3])
+    );
 }
 
 #[test]
 fn a_model_without_the_named_function_says_which_files_it_read() {
     let dir = models("missing-function");
-    let e = subgram::load(&dir, &LoadOptions::default()).unwrap_err().to_string();
+    let e = subgram::load(&dir, &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("lsystem.l:"), "{e}");
     assert!(e.contains("`stem` names no function"), "{e}");
     assert!(e.contains("`functions.fset`"), "{e}");
