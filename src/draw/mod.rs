@@ -33,7 +33,10 @@ pub enum Event {
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Cmd {
     None,
-    Forward { draw: bool, record: bool },
+    Forward {
+        draw: bool,
+        record: bool,
+    },
     MoveTo,
     MoveRel,
     LineTo,
@@ -380,7 +383,9 @@ pub fn draw_with_queries(
             }
             Cmd::Surface => {
                 let id = int_arg();
-                let surface = usize::try_from(id).ok().and_then(|k| opts.model.surfaces.get(k));
+                let surface = usize::try_from(id)
+                    .ok()
+                    .and_then(|k| opts.model.surfaces.get(k));
                 let Some(s) = surface else {
                     return Err(DrawError {
                         message: format!(
@@ -434,7 +439,10 @@ pub fn draw_with_queries(
 fn surface_events(s: &crate::model::Surface, t: &Turtle, scale: DVec3, out: &mut Vec<Event>) {
     const STEPS: usize = 8;
     let v = |a: [f64; 3]| DVec3::from_array(a);
-    let (h, u) = (v(s.heading).normalize_or_zero(), v(s.up).normalize_or_zero());
+    let (h, u) = (
+        v(s.heading).normalize_or_zero(),
+        v(s.up).normalize_or_zero(),
+    );
     let l = u.cross(h);
     let k = scale * (s.scale / s.size);
     let place = |p: [f64; 3]| {

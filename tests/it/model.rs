@@ -257,3 +257,100 @@ fn a_model_without_the_named_function_says_which_files_it_read() {
     assert!(e.contains("`stem` names no function"), "{e}");
     assert!(e.contains("`functions.fset`"), "{e}");
 }
+
+#[test]
+fn surfaces_are_placed_on_the_turtle() {
+    use glam::DVec3;
+    use subgram::draw::Event;
+    let c = curve(&models("surface"));
+    let mut run = c.run(Default::default()).unwrap();
+    let polygons: Vec<Vec<DVec3>> = run
+        .events()
+        .unwrap()
+        .into_iter()
+        .filter_map(|e| match e {
+            Event::Polygon { points, .. } => Some(points),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(polygons.len(), 2, "one patch, drawn twice");
+    let has = |ps: &[DVec3], want: DVec3| {
+        assert!(
+            ps.iter().any(|p| p.distance(want) < 1e-9),
+            "{want} not among {ps:?}"
+        )
+    };
+    // `Surface(square, 2)`, `surface: square.s 3`, `SIZE: 2`: the surface
+    // is scaled by 2 × 3 / 2 = 3; the turtle's frame is the surface's
+    // (heading +y, up +z). Corners (-1,0,0), (1,0,0), (-1,3,0) and the
+    // last row's middle, with Bernstein weights 1/8 3/8 3/8 1/8:
+    // x = (-1 - 0.99 + 0.99 + 1)/8 = 0, z = (0 + 3 + 3 + 0)/8 = 0.75.
+    let first = &polygons[0];
+    has(first, DVec3::new(-3.0, 0.0, 0.0));
+    has(first, DVec3::new(3.0, 0.0, 0.0));
+    has(first, DVec3::new(-3.0, 9.0, 0.0));
+    has(first, DVec3::new(0.0, 9.0, 2.25));
+    // After `f(10) Left(90)` the turtle is at (0,10,0) heading -x, its
+    // left -y; `Surface(square, 1)` scales by 1.5. The corner (-1,0,0) is
+    // one unit to the surface's left: (0, 10 - 1.5, 0); (-1,3,0) is three
+    // units ahead too: (-4.5, 8.5, 0).
+    let second = &polygons[1];
+    has(second, DVec3::new(0.0, 8.5, 0.0));
+    has(second, DVec3::new(-4.5, 8.5, 0.0));
+}
+
+#[test]
+fn a_surface_the_model_lacks_is_an_error() {
+    let dir = models("surface");
+    let text = "#include <lpfgall.h>\nderivation length: 0;\nAxiom: Surface(1, 1);\n";
+    let tmp = std::env::temp_dir().join(format!("subgram-model-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    for f in ["square.s", "view.v"] {
+        std::fs::copy(dir.join(f), tmp.join(f)).unwrap();
+    }
+    std::fs::write(tmp.join("lsystem.l"), text).unwrap();
+    let c = curve(&tmp);
+    let e = c
+        .run(Default::default())
+        .unwrap()
+        .events()
+        .unwrap_err()
+        .to_string();
+    std::fs::remove_dir_all(&tmp).unwrap();
+    assert!(
+        e.contains("draws surface 1, but the model has surfaces 0 to 0"),
+        "{e}"
+    );
+}
+
+#[test]
+fn specifications_name_the_files_and_a_missing_one_is_an_error() {
+    let tmp = std::env::temp_dir().join(format!("subgram-spec-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let src = models("accessors");
+    for f in ["lsystem.l", "functions.fset"] {
+        std::fs::copy(src.join(f), tmp.join(f)).unwrap();
+    }
+    std::fs::write(
+        tmp.join("specifications"),
+        "lsystem.l\n*\nmodel:\n\tgenerate:\n\t\tlpfg -rmode cont lsystem.l functions.fset params.vset\n",
+    )
+    .unwrap();
+    let e = subgram::load(&tmp, &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
+    std::fs::remove_dir_all(&tmp).unwrap();
+    // The caret is under the missing file's name on the lpfg line.
+    assert!(e.contains("specifications:5:"), "{e}");
+    assert!(e.contains("names `params.vset`, but"), "{e}");
+    assert!(
+        e.lines()
+            .last()
+            .unwrap()
+            .trim_start()
+            .trim_start_matches('|')
+            .trim()
+            == "^^^^^^^^^^^",
+        "{e}"
+    );
+}
