@@ -111,7 +111,7 @@ pub fn read_map(path: &str, bytes: &[u8]) -> Result<Colours, Error> {
 
 /// Reads a material file: whole 15-byte records, at most one per index.
 pub fn read_mat(path: &str, bytes: &[u8]) -> Result<Colours, Error> {
-    if bytes.is_empty() || bytes.len() % RECORD != 0 {
+    if bytes.is_empty() || !bytes.len().is_multiple_of(RECORD) {
         return Err(Error::file(
             path,
             format!(

@@ -77,7 +77,7 @@ impl Contour {
         }
     }
 
-    /// The point at normalised arc length `s` (clamped to [0,1]).
+    /// The point at normalised arc length `s` (clamped to \[0,1\]).
     pub fn point(&self, s: f32) -> V3 {
         let s = if s.is_nan() { 0.0 } else { s.clamp(0.0, 1.0) };
         let last = self.vertices.len() - 1;
@@ -91,7 +91,7 @@ impl Contour {
         }
     }
 
-    /// The normal at normalised arc length `s` (clamped to [0,1]).
+    /// The normal at normalised arc length `s` (clamped to \[0,1\]).
     pub fn normal(&self, s: f32) -> V3 {
         let s = if s.is_nan() { 0.0 } else { s.clamp(0.0, 1.0) };
         let last = self.normals.len() - 1;

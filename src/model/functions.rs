@@ -4,7 +4,7 @@
 //!
 //! A function's curve is the uniform cubic B-spline of its control points
 //! with the end points interpolated (knots 0,0,0,0,1,…,n−2,n−2,n−2,n−2),
-//! whose parameter d runs over [0,1]. As lpfg does, the curve is sampled
+//! whose parameter d runs over \[0,1\]. As lpfg does, the curve is sampled
 //! once: sample i holds y at x = i/(samples−1), the parameter of that x
 //! found by bisection to within 0.01/samples, and a value between samples
 //! is interpolated linearly. The arithmetic is lpfg's single precision.
@@ -25,8 +25,8 @@ pub struct Function {
     /// The file it came from, for messages.
     pub file: String,
     pub kind: Kind,
-    /// The interval that `tfunc` maps onto [0,1] (a timeline's start and
-    /// end; [0,1] for other functions).
+    /// The interval that `tfunc` maps onto \[0,1\] (a timeline's start and
+    /// end; \[0,1\] for other functions).
     pub low: f32,
     pub up: f32,
 }
@@ -43,7 +43,7 @@ pub enum Kind {
 }
 
 impl Function {
-    /// The value at `x`, clamped to [0,1] (`func`).
+    /// The value at `x`, clamped to \[0,1\] (`func`).
     pub fn value(&self, x: f32) -> Option<f32> {
         let Kind::Curve { values, .. } = &self.kind else {
             return None;
@@ -53,7 +53,7 @@ impl Function {
         }))
     }
 
-    /// The tangent at `x`, clamped to [0,1] after `x` is mapped from the
+    /// The tangent at `x`, clamped to \[0,1\] after `x` is mapped from the
     /// function's interval (`funcTangent`).
     pub fn tangent(&self, x: f32) -> Option<[f32; 2]> {
         let Kind::Curve { tangents, .. } = &self.kind else {
@@ -84,7 +84,7 @@ fn clamp01(x: f32) -> f32 {
 }
 
 /// lpfg's look-up in a table of samples: linear between the two samples
-/// around `v` (in [0,1]), the last sample at 1.
+/// around `v` (in \[0,1\]), the last sample at 1.
 fn interpolate<T: Copy>(table: &[T], v: f32, mix: impl Fn(T, f32, T, f32) -> T) -> T {
     let last = table.len() - 1;
     let index = v * last as f32;
@@ -133,7 +133,7 @@ fn basis(k: usize, t: usize, u: f32, n: usize) -> f32 {
     sum
 }
 
-/// The curve's point at parameter `d` in [0,1].
+/// The curve's point at parameter `d` in \[0,1\].
 pub(crate) fn point(pts: &[[f32; 2]], d: f32) -> [f32; 2] {
     let n = pts.len() - 1;
     let u = d * (n - 2) as f32;
@@ -224,8 +224,7 @@ fn read_function(lines: &mut Lines<'_>, file: &str, low: f32, up: f32) -> Result
     no_more(lines, &ws, 1, "the number of samples")?;
     let samples = samples.clamp(MIN_SAMPLES, MAX_SAMPLES) as usize;
     // Optional lines before `points:`: flip, background, its offset.
-    loop {
-        let Some(next) = lines.peek() else { break };
+    while let Some(next) = lines.peek() {
         let first = words(next).first().map(|w| w.text.to_ascii_lowercase());
         match first.as_deref() {
             Some("flip:") | Some("background:") | Some("backgroundxy:") => {

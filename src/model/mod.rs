@@ -93,7 +93,8 @@ const KINDS: &[&str] = &[
 pub struct ModelFiles {
     pub lsystem: PathBuf,
     /// The files, in the order lpfg's command line gives them (or the
-    /// order of [`KINDS`], then by name).
+    /// order `.v`, `.a`, `.fset`, `.func`, `.tset`, `.vset`, `.cset`,
+    /// `.con`, `.map`, `.mat`, `.e`, then by name).
     pub files: Vec<PathBuf>,
 }
 

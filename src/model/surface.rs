@@ -124,7 +124,7 @@ fn bernstein(t: f64) -> [f64; 4] {
 }
 
 impl Patch {
-    /// The point at (u, v) in [0,1]²: u along a row, v down the rows.
+    /// The point at (u, v) in \[0,1\]²: u along a row, v down the rows.
     pub fn point(&self, u: f64, v: f64) -> V3 {
         let (bu, bv) = (bernstein(u), bernstein(v));
         let mut p = [0.0; 3];
