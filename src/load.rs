@@ -171,7 +171,8 @@ fn load_text_as(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Er
 }
 
 /// Loads a file as a curve L-system, whatever its syntax says; `defines`
-/// are `NAME=VALUE` overrides.
+/// are `NAME=VALUE` overrides. The file is read alone: [`load`] reads an
+/// lpfg model folder, or a `.l` file with the files beside it.
 pub fn load_file(path: impl AsRef<Path>, defines: &[String]) -> Result<Curve, Error> {
     let path = path.as_ref();
     let text = read(path)?;

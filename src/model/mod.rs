@@ -339,6 +339,18 @@ impl Model {
             let (n, t) = text_of(p)?;
             view::read_a(&n, &t, &mut m.notes)?;
         }
+        for p in by("e") {
+            let (n, t) = text_of(p)?;
+            let first = t.lines().next().unwrap_or("").trim_end().len();
+            m.notes.push(Note::at(
+                &n,
+                &t,
+                0..first,
+                "this file sets up an environmental program, which subgram does not run: \
+                 the modules that talk to it get no answers, and the picture will differ from lpfg's"
+                    .into(),
+            ));
+        }
         m.files.extend(files.iter().cloned());
         Ok(m)
     }

@@ -354,3 +354,40 @@ fn specifications_name_the_files_and_a_missing_one_is_an_error() {
         "{e}"
     );
 }
+
+#[test]
+fn check_warns_about_view_commands_and_environmental_programs() {
+    let tmp = std::env::temp_dir().join(format!("subgram-notes-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    std::fs::copy(
+        root().join("tests/data/bad/common/model.l"),
+        tmp.join("lsystem.l"),
+    )
+    .unwrap();
+    std::fs::write(
+        tmp.join("view.v"),
+        "// a comment\nz buffer: on\nlight: V: 0 0 1\nzoom: 3\n",
+    )
+    .unwrap();
+    std::fs::write(tmp.join("field.e"), "executable: field -e\n").unwrap();
+    let out = subgram::command::check(&tmp.display().to_string(), &[]).unwrap();
+    std::fs::remove_dir_all(&tmp).unwrap();
+    // `light:` is acted on; `z buffer:` is named as not acted on, at its
+    // line; `zoom:` is not a command of the manual.
+    assert!(
+        out.contains(
+            "view.v:2:1: warning: subgram draws flat, in 2D, and does not act on `z buffer:`"
+        ),
+        "{out}"
+    );
+    assert!(!out.contains("`light:`"), "{out}");
+    assert!(
+        out.contains("view.v:4:1: warning: `zoom:` is not a view-file command"),
+        "{out}"
+    );
+    assert!(
+        out.contains("field.e:1:1: warning: this file sets up an environmental program"),
+        "{out}"
+    );
+    assert!(out.ends_with(": ok (1 rules, 89 module kinds)"), "{out}");
+}
