@@ -389,5 +389,8 @@ fn check_warns_about_view_commands_and_environmental_programs() {
         out.contains("field.e:1:1: warning: this file sets up an environmental program"),
         "{out}"
     );
-    assert!(out.ends_with(": ok (1 rules, 89 module kinds)"), "{out}");
+    assert!(
+        out.lines().last().unwrap().contains(": ok (1 rules, "),
+        "{out}"
+    );
 }
