@@ -271,6 +271,10 @@ pub static LIBRARY: &[Builtin] = &[
     model!("curveXYZf", CurveXYZ, 2, Ty::V3),
     model!("curveXYZd", CurveXYZ, 2, Ty::V3),
     model!("curveNormal", CurveNormal, 2, Ty::V3),
+    model!("curveScale", CurveScale, 4, Ty::Void),
+    model!("curveSetPoint", CurveSetPoint, 5, Ty::Void),
+    model!("curveRecalculate", CurveRecalculate, 1, Ty::Void),
+    model!("curveReset", CurveReset, 1, Ty::Void),
     Builtin {
         name: "ran",
         resolve: |a| {

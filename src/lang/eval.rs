@@ -648,6 +648,10 @@ impl<'p> Interp<'p> {
                 let u = (x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64;
                 Value::Float(u * num(0))
             }
+            Func::Model(a) if a.changes_the_model() => {
+                // The run's own copy, made on the first change.
+                return std::sync::Arc::make_mut(&mut cx.env.model).call_mut(a, vals);
+            }
             Func::Model(a) => return cx.env.model.call(a, vals),
             Func::NoOp => {
                 let _ = span;

@@ -32,6 +32,8 @@ pub struct Contour {
     /// Control points with multiplicities expanded (and, for a closed
     /// regular contour, its last three points first).
     pub controls: Vec<[f32; 3]>,
+    /// The control points as the file gives them, for `curveReset`.
+    pub original: Vec<[f32; 3]>,
     pub end_points: bool,
     pub samples: usize,
     pub vertices: Vec<[f32; 3]>,
@@ -70,6 +72,7 @@ impl Contour {
             file: String::new(),
             closed: true,
             controls: Vec::new(),
+            original: Vec::new(),
             end_points: false,
             samples: n,
             normals: vertices.clone(),
@@ -103,6 +106,38 @@ impl Contour {
         } else {
             self.normals[i]
         }
+    }
+
+    /// `curveScale`: scales the control points and recomputes the samples.
+    pub fn scale(&mut self, s: [f32; 3]) {
+        for p in &mut self.controls {
+            *p = [p[0] * s[0], p[1] * s[1], p[2] * s[2]];
+        }
+        self.calculate();
+    }
+
+    /// `curveSetPoint`: moves control point `i` (counted in the expanded
+    /// list: multiplicities repeated, and a closed contour's three leading
+    /// copies first); the samples stay until [`Contour::recalculate`].
+    pub fn set_point(&mut self, i: usize, p: [f32; 3]) -> bool {
+        match self.controls.get_mut(i) {
+            Some(slot) => {
+                *slot = p;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// `curveRecalculate`: the samples from the current control points.
+    pub fn recalculate(&mut self) {
+        self.calculate();
+    }
+
+    /// `curveReset`: the file's control points back; as in lpfg, the
+    /// samples stay until [`Contour::recalculate`].
+    pub fn reset(&mut self) {
+        self.controls = self.original.clone();
     }
 
     /// Computes the samples from the control points.
@@ -324,6 +359,7 @@ fn read_contour(lines: &mut Lines<'_>, file: &str) -> Result<Contour, Error> {
         name,
         file: file.to_string(),
         closed,
+        original: controls.clone(),
         controls,
         end_points,
         samples,

@@ -454,13 +454,14 @@ impl Model {
                 let f = self.curve_fn("func", id)?;
                 float(f.value(x(1)).unwrap_or(0.0))
             }
-            Accessor::PFunc => {
-                let f = self.curve_fn("pfunc", id)?;
-                let (lo, hi) = (x(2), x(3));
-                if lo == hi {
-                    return Err(format!("`pfunc`: the interval [{lo}, {hi}] has no length"));
-                }
-                float(f.value((x(1) - lo) / (hi - lo)).unwrap_or(0.0))
+            Accessor::PFunc
+            | Accessor::CurveScale
+            | Accessor::CurveSetPoint
+            | Accessor::CurveRecalculate
+            | Accessor::CurveReset => {
+                return Err(format!(
+                    "`{f:?}` changes the model: it is evaluated by `call_mut`"
+                ))
             }
             Accessor::TFunc => {
                 let f = self.curve_fn("tfunc", id)?;
@@ -496,6 +497,69 @@ impl Model {
     }
 }
 
+impl Model {
+    /// Evaluates an accessor that changes the model ([`Accessor::changes_the_model`]);
+    /// the others as [`Model::call`] does.
+    pub fn call_mut(&mut self, f: Accessor, args: &[Value]) -> Result<Value, String> {
+        let id = args[0].as_f64();
+        let id = if id.is_finite() { id as i64 } else { -1 };
+        let x = |i: usize| args[i].as_f64() as f32;
+        let editable = |m: &mut Model, who: &str| -> Result<usize, String> {
+            m.contour(who, id)?;
+            if id == 0 {
+                return Err(format!(
+                    "`{who}`: contour 0 is lpfg's default circle, which has no control points to change"
+                ));
+            }
+            Ok(id as usize)
+        };
+        match f {
+            Accessor::PFunc => {
+                let (lo, hi) = (x(2), x(3));
+                if lo == hi {
+                    return Err(format!("`pfunc`: the interval [{lo}, {hi}] has no length"));
+                }
+                self.curve_fn("pfunc", id)?;
+                let f = &mut self.functions[id as usize - 1];
+                // As lpfg does: the interval stays the function's.
+                (f.low, f.up) = (lo, hi);
+                Ok(Value::Float(f.timeline_value(x(1)).unwrap_or(0.0) as f64))
+            }
+            Accessor::CurveScale => {
+                let k = editable(self, "curveScale")?;
+                self.contours[k].scale([x(1), x(2), x(3)]);
+                Ok(Value::Void)
+            }
+            Accessor::CurveSetPoint => {
+                let k = editable(self, "curveSetPoint")?;
+                let p = args[1].as_f64();
+                let c = &mut self.contours[k];
+                let n = c.controls.len();
+                if !(p >= 0.0 && p < n as f64) || !c.set_point(p as usize, [x(2), x(3), x(4)]) {
+                    return Err(format!(
+                        "`curveSetPoint`: contour `{}` has control points 0 to {} (multiplicities counted{}), not {p}",
+                        c.name,
+                        n - 1,
+                        if c.closed && !c.end_points { ", and the three copies that close it first" } else { "" }
+                    ));
+                }
+                Ok(Value::Void)
+            }
+            Accessor::CurveRecalculate => {
+                let k = editable(self, "curveRecalculate")?;
+                self.contours[k].recalculate();
+                Ok(Value::Void)
+            }
+            Accessor::CurveReset => {
+                let k = editable(self, "curveReset")?;
+                self.contours[k].reset();
+                Ok(Value::Void)
+            }
+            other => self.call(other, args),
+        }
+    }
+}
+
 /// The accessors of a model's functions, parameters and contours.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Accessor {
@@ -510,6 +574,26 @@ pub enum Accessor {
     CurveXY,
     CurveXYZ,
     CurveNormal,
+    CurveScale,
+    CurveSetPoint,
+    CurveRecalculate,
+    CurveReset,
+}
+
+impl Accessor {
+    /// True for the accessors that change the model: the contour
+    /// editing functions, and `pfunc`, which in lpfg sets the function's
+    /// interval for later calls of `tfunc` and `funcTangent` too.
+    pub fn changes_the_model(self) -> bool {
+        matches!(
+            self,
+            Accessor::PFunc
+                | Accessor::CurveScale
+                | Accessor::CurveSetPoint
+                | Accessor::CurveRecalculate
+                | Accessor::CurveReset
+        )
+    }
 }
 
 /// The accessors' names, for messages about a name the model lacks.
@@ -529,4 +613,8 @@ pub const ACCESSOR_NAMES: &[&str] = &[
     "curveXYZf",
     "curveXYZd",
     "curveNormal",
+    "curveScale",
+    "curveSetPoint",
+    "curveRecalculate",
+    "curveReset",
 ];

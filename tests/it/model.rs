@@ -394,3 +394,62 @@ fn check_warns_about_view_commands_and_environmental_programs() {
         "{out}"
     );
 }
+
+/// lpfg's final string for `tests/data/models/editing` (run_lpfg.sh, vlab
+/// commit 9bf820d): a contour scaled, a point moved, recalculated, reset
+/// (which keeps the samples until the next recalculation, as in lpfg),
+/// and `pfunc` setting the interval that a later `tfunc` uses.
+const LPFG_EDITING: [f64; 9] = [
+    -0.6666667,
+    -1.3333334,
+    -0.6666667,
+    -0.53746164,
+    -1.3333334,
+    -0.6666667,
+    0.49998987,
+    0.49998987,
+    0.49998987,
+];
+
+#[test]
+fn contours_and_intervals_change_as_in_lpfg() {
+    let c = curve(&models("editing"));
+    let got = values(&c);
+    assert_eq!(got.len(), LPFG_EDITING.len());
+    for (i, (g, w)) in got.iter().zip(LPFG_EDITING).enumerate() {
+        assert!(
+            (g - w).abs() <= 1e-5 * w.abs().max(1.0),
+            "value {i}: subgram {g}, lpfg {w}"
+        );
+    }
+    // Scaling x by 2 doubles the contour's first sample, -2/3 (see
+    // contours_by_hand): -4/3.
+    assert!((got[1] + 4.0 / 3.0).abs() < 1e-6);
+    // The program's model is not changed by a run: a second run starts
+    // from the files' contour.
+    assert_eq!(values(&c), got);
+}
+
+#[test]
+fn a_control_point_out_of_range_is_named() {
+    let mut m = load_model("editing");
+    let args = [
+        Value::Int(1),
+        Value::Int(7),
+        Value::Float(0.0),
+        Value::Float(0.0),
+        Value::Float(0.0),
+    ];
+    let e = m
+        .call_mut(model::Accessor::CurveSetPoint, &args)
+        .unwrap_err();
+    assert!(
+        e.contains("contour `ring` has control points 0 to 6"),
+        "{e}"
+    );
+    assert!(e.contains("the three copies that close it first"), "{e}");
+    let e = m
+        .call_mut(model::Accessor::CurveReset, &[Value::Int(0)])
+        .unwrap_err();
+    assert!(e.contains("default circle"), "{e}");
+}
