@@ -535,7 +535,8 @@ impl Model {
                 let p = args[1].as_f64();
                 let c = &mut self.contours[k];
                 let n = c.controls.len();
-                if !(p >= 0.0 && p < n as f64) || !c.set_point(p as usize, [x(2), x(3), x(4)]) {
+                let inside = p >= 0.0 && p < n as f64;
+                if !(inside && c.set_point(p as usize, [x(2), x(3), x(4)])) {
                     return Err(format!(
                         "`curveSetPoint`: contour `{}` has control points 0 to {} (multiplicities counted{}), not {p}",
                         c.name,
