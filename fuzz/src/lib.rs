@@ -367,7 +367,10 @@ pub fn model_files(data: &[u8]) {
             Ok(v) => {
                 let mut map = vec![0u8; 768];
                 map.iter_mut().zip(rest).for_each(|(m, b)| *m = *b);
-                for c in [colours::read_map("m", &map), colours::read_mat("m", &map[..750])] {
+                for c in [
+                    colours::read_map("m", &map),
+                    colours::read_mat("m", &map[..750]),
+                ] {
                     let c = c.expect("well-sized colour files read");
                     for i in [-1, 0, 1, 255, 256] {
                         std::hint::black_box(c.colour(i, &v.lights));
@@ -379,7 +382,9 @@ pub fn model_files(data: &[u8]) {
             }
         },
         8 => {
-            std::hint::black_box(view::read_a("fuzz.a", &text, &mut notes).map_err(|e| e.to_string()));
+            std::hint::black_box(
+                view::read_a("fuzz.a", &text, &mut notes).map_err(|e| e.to_string()),
+            );
         }
         9 => {
             std::hint::black_box(colours::read_map("fuzz.map", rest).map_err(|e| e.to_string()));

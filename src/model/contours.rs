@@ -393,6 +393,7 @@ fn read_points(lines: &mut Lines<'_>, n1: i64, n2: i64, name: &str) -> Result<Ve
         let z = number(lines, &ws, 2, "the point's z")? as f32;
         let m = count(lines, &ws, 3, "the point's multiplicity", 1, 3)?;
         no_more(lines, &ws, 4, "the point's multiplicity")?;
+        lines.spend(m as usize, "control points")?;
         for _ in 0..m {
             pts.push([x, y, z]);
         }

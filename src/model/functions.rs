@@ -139,6 +139,11 @@ pub(crate) fn point(pts: &[[f32; 2]], d: f32) -> [f32; 2] {
     let u = d * (n - 2) as f32;
     let mut s = [0.0f32; 2];
     for (k, p) in pts.iter().enumerate() {
+        // Outside its knots a basis function is exactly 0: skipping it
+        // changes no bit of the sum.
+        if u < knot(k, n) as f32 || u >= knot(k + 4, n) as f32 {
+            continue;
+        }
         let b = basis(k, 4, u, n);
         s[0] += p[0] * b;
         s[1] += p[1] * b;
@@ -154,6 +159,10 @@ fn tangent_at(pts: &[[f32; 2]], d: f32) -> [f32; 2] {
     let u = d * (n - 2) as f32;
     let mut s = [0.0f32; 2];
     for (k, p) in pts.iter().enumerate() {
+        // The derivative's two terms lie within knots k to k + 4.
+        if u < knot(k, n) as f32 || u >= knot(k + 4, n) as f32 {
+            continue;
+        }
         let mut prime = 0.0f32;
         let span = knot(k + 3, n) as i64 - knot(k, n) as i64;
         if span > 0 {
@@ -267,6 +276,7 @@ fn read_function(lines: &mut Lines<'_>, file: &str, low: f32, up: f32) -> Result
             ));
         }
         last_x = x;
+        lines.spend(m as usize, "control points")?;
         for _ in 0..m {
             pts.push([x, y]);
         }
@@ -416,9 +426,7 @@ pub fn read_vset(path: &str, text: &str) -> Result<Vec<Function>, Error> {
         check_name(&lines, name.text, name.start, "a parameter")?;
         let v = number(&lines, &ws, 2, "the parameter's value")? as f32;
         no_more(&lines, &ws, 3, "the parameter's value")?;
-        if out.len() >= MAX_POINTS {
-            return Err(lines.error(ws[0], format!("more than {MAX_POINTS} parameters")));
-        }
+        lines.spend(1, "parameters")?;
         out.push(Function {
             name: name.text.to_string(),
             file: path.to_string(),

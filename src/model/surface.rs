@@ -7,7 +7,7 @@
 //! turtle, its heading and up vectors on the turtle's, scaled by s divided
 //! by `SIZE:`.
 
-use super::text::{number, words, Lines, MAX_POINTS};
+use super::text::{number, words, Lines};
 use crate::error::Error;
 
 pub type V3 = [f64; 3];
@@ -93,9 +93,7 @@ pub fn read_s(path: &str, name: &str, text: &str) -> Result<Surface, Error> {
             }
             super::text::no_more(&lines, &ws, 12, "the row's four points")?;
         }
-        if patches.len() >= MAX_POINTS {
-            return Err(lines.error_at(0, 1, format!("more than {MAX_POINTS} patches")));
-        }
+        lines.spend(1, "patches")?;
         patches.push(Patch {
             name: pname,
             points,

@@ -8,9 +8,14 @@ use crate::error::Error;
 /// a contour or a function with a million points is not a model's.
 pub const MAX_MODEL_FILE_BYTES: u64 = 4 << 20;
 
-/// The most control points (counting multiplicities) one function,
-/// contour or surface may have, and the most items of one set.
-pub const MAX_POINTS: usize = 100_000;
+/// The most control points one function or contour may have (the
+/// editors' curves have a few dozen). Sampling costs grow with them: a
+/// contour is measured at 1000 points per control point.
+pub const MAX_POINTS: usize = 1_000;
+
+/// The most control points (multiplicities counted), parameters or
+/// patches one file may hold in all.
+pub const MAX_FILE_POINTS: usize = 20_000;
 
 /// Reads a model file whole, refusing one over [`MAX_MODEL_FILE_BYTES`].
 pub fn read_bytes(path: &std::path::Path) -> Result<Vec<u8>, Error> {
@@ -57,6 +62,8 @@ pub struct Lines<'a> {
     shown: Vec<&'a str>,
     /// The index of the next line.
     next: usize,
+    /// Control points, parameters or patches read so far.
+    points: usize,
 }
 
 /// The words of `line` with their ranges, split at blanks.
@@ -99,7 +106,26 @@ impl<'a> Lines<'a> {
             lines: parsed.lines().collect(),
             shown: shown.lines().collect(),
             next: 0,
+            points: 0,
         }
+    }
+
+    /// Counts `n` more points (or parameters, or patches) of the file; an
+    /// error at the line last read when the file holds more than
+    /// [`MAX_FILE_POINTS`].
+    pub fn spend(&mut self, n: usize, what: &str) -> Result<(), Error> {
+        self.points += n;
+        if self.points > MAX_FILE_POINTS {
+            let len = self.current().trim_end().len();
+            return Err(self.error_at(
+                0,
+                len,
+                format!(
+                    "the file holds more than {MAX_FILE_POINTS} {what}, more than a model file may"
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// The number (1-based) of the line last read.

@@ -453,3 +453,23 @@ fn a_control_point_out_of_range_is_named() {
         .unwrap_err();
     assert!(e.contains("default circle"), "{e}");
 }
+
+#[test]
+fn a_file_may_hold_only_so_many_points() {
+    // 20,001 parameters: one more than a file may hold (MAX_FILE_POINTS).
+    let text: String = (0..=model::text::MAX_FILE_POINTS)
+        .map(|i| format!("#define P{i} {i}\n"))
+        .collect();
+    let e = model::functions::read_vset("big.vset", &text)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("big.vset:20001:1: error: the file holds more than 20000 parameters"),
+        "{e}"
+    );
+    // A contour of more control points than one may have.
+    let e = model::contours::read_con("big.con", "cver 1 3\nname: c\npoints: 1001 1001\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("must be from 1 to 1000"), "{e}");
+}
