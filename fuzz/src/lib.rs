@@ -382,15 +382,19 @@ pub fn model_files(data: &[u8]) {
             }
         },
         8 => {
-            std::hint::black_box(
+            let _ = std::hint::black_box(
                 view::read_a("fuzz.a", &text, &mut notes).map_err(|e| e.to_string()),
             );
         }
         9 => {
-            std::hint::black_box(colours::read_map("fuzz.map", rest).map_err(|e| e.to_string()));
+            let _ = std::hint::black_box(
+                colours::read_map("fuzz.map", rest).map_err(|e| e.to_string()),
+            );
         }
         _ => {
-            std::hint::black_box(colours::read_mat("fuzz.mat", rest).map_err(|e| e.to_string()));
+            let _ = std::hint::black_box(
+                colours::read_mat("fuzz.mat", rest).map_err(|e| e.to_string()),
+            );
         }
     }
     std::hint::black_box(notes);
