@@ -127,7 +127,9 @@ pub struct RenderArgs {
     pub size: (u32, u32),
     /// Draw every step 0..=N side by side (curves).
     pub each: bool,
-    pub background: Rgba,
+    /// The background; `None`: colour 0 of the model's colour map or
+    /// material 0's emission when the program comes with one, else white.
+    pub background: Option<Rgba>,
     /// Curves: xy (the default), xz or yz. Meshes: iso, front, back, left,
     /// right, top or bottom.
     pub view: Option<String>,
@@ -152,7 +154,7 @@ impl RenderArgs {
             steps: None,
             size: (800, 800),
             each: false,
-            background: Rgba(255, 255, 255, 255),
+            background: None,
             view: None,
             wireframe: true,
             defines: Vec::new(),
@@ -172,9 +174,10 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
     refuse_overwrite(&[output], &[file], a.force)?;
+    let white = Rgba(255, 255, 255, 255);
     let looks = MeshLooks {
         size: a.size,
-        background: a.background,
+        background: a.background.unwrap_or(white),
         view: a.view.as_deref(),
         wireframe: a.wireframe,
     };
@@ -212,6 +215,14 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                 base_mesh: None,
                 deadline,
             };
+            let model = &c.program.model;
+            let palette = model
+                .palette()
+                .map(|p| std::sync::Arc::new(p.map(|[r, g, b]| Rgba(r, g, b, 255))));
+            let model_background = model.colours.as_ref().map(|m| {
+                let [r, g, b] = m.background();
+                Rgba(r, g, b, 255)
+            });
             let figure = FigureOptions {
                 derive: opts.derive_options(),
                 each: a.each,
@@ -219,8 +230,10 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                 render: render::RenderOptions {
                     width: a.size.0,
                     height: a.size.1,
-                    background: a.background,
+                    background: a.background.or(model_background).unwrap_or(white),
                     view,
+                    palette,
+                    widths_in_units: model.widths_in_units,
                     ..Default::default()
                 },
             };

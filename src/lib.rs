@@ -42,6 +42,7 @@ mod system;
 pub mod command;
 pub mod draw;
 pub mod mesh;
+pub mod model;
 pub mod output;
 pub mod render;
 pub mod reverse;

@@ -65,9 +65,10 @@ enum Command {
         /// Draw every step 0..N side by side.
         #[arg(long)]
         each: bool,
-        /// white, black, none, #rrggbb.
-        #[arg(long, default_value = "white", value_parser = parse_color)]
-        background: subgram::render::Rgba,
+        /// white, black, none, #rrggbb; by default a model's colour 0, else
+        /// white.
+        #[arg(long, value_parser = parse_color)]
+        background: Option<subgram::render::Rgba>,
         /// The projection of 3D drawings: xy, xz or yz for L-systems;
         /// iso, front, back, left, right, top or bottom for meshes.
         #[arg(long)]

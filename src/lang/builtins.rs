@@ -137,6 +137,20 @@ macro_rules! nullary {
     };
 }
 
+/// An accessor of the model's files: `n` number arguments (the first an
+/// id that the model's names `#define`).
+macro_rules! model {
+    ($name:literal, $acc:ident, $n:expr, $t:expr) => {
+        Builtin {
+            name: $name,
+            resolve: |a| {
+                numbers(a, $n)?;
+                Ok((Func::Model(crate::model::Accessor::$acc), $t))
+            },
+        }
+    };
+}
+
 fn vector(a: &[Ty], name: &str) -> Result<Ty, SigError> {
     match a {
         [t] if t.is_vector() => Ok(*t),
@@ -242,6 +256,25 @@ pub static LIBRARY: &[Builtin] = &[
             Ok((Func::UseGroup, Ty::Void))
         },
     },
+    model!("func", Func, 2, Ty::Float),
+    model!("pfunc", PFunc, 4, Ty::Float),
+    model!("tfunc", TFunc, 2, Ty::Float),
+    model!("funcTangent", FuncTangent, 2, Ty::V2),
+    model!("val", Val, 1, Ty::Float),
+    model!("curveX", CurveX, 2, Ty::Float),
+    model!("curveY", CurveY, 2, Ty::Float),
+    model!("curveZ", CurveZ, 2, Ty::Float),
+    model!("curveXY", CurveXY, 2, Ty::V2),
+    model!("curveXYf", CurveXY, 2, Ty::V2),
+    model!("curveXYd", CurveXY, 2, Ty::V2),
+    model!("curveXYZ", CurveXYZ, 2, Ty::V3),
+    model!("curveXYZf", CurveXYZ, 2, Ty::V3),
+    model!("curveXYZd", CurveXYZ, 2, Ty::V3),
+    model!("curveNormal", CurveNormal, 2, Ty::V3),
+    model!("curveScale", CurveScale, 4, Ty::Void),
+    model!("curveSetPoint", CurveSetPoint, 5, Ty::Void),
+    model!("curveRecalculate", CurveRecalculate, 1, Ty::Void),
+    model!("curveReset", CurveReset, 1, Ty::Void),
     Builtin {
         name: "ran",
         resolve: |a| {

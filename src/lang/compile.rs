@@ -655,6 +655,7 @@ impl Compiler {
             rules: Vec::new(),
             control: Vec::new(),
             warnings: Vec::new(),
+            model: Default::default(),
         };
         let mut section = Section::Productions;
         let mut group = 0i64;

@@ -25,6 +25,8 @@ pub struct Env {
     pub forward: bool,
     pub stop: bool,
     pub rng: u64,
+    /// The model folder's functions and contours, for `func` and its kin.
+    pub model: std::sync::Arc<crate::model::Model>,
 }
 
 impl Env {
@@ -37,6 +39,7 @@ impl Env {
             forward: true,
             stop: false,
             rng: 0x9E37_79B9_7F4A_7C15,
+            model: Default::default(),
         }
     }
 }
@@ -645,6 +648,11 @@ impl<'p> Interp<'p> {
                 let u = (x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64;
                 Value::Float(u * num(0))
             }
+            Func::Model(a) if a.changes_the_model() => {
+                // The run's own copy, made on the first change.
+                return std::sync::Arc::make_mut(&mut cx.env.model).call_mut(a, vals);
+            }
+            Func::Model(a) => return cx.env.model.call(a, vals),
             Func::NoOp => {
                 let _ = span;
                 Value::Void

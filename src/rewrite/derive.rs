@@ -170,6 +170,7 @@ impl<'p> Derivation<'p> {
     ) -> Result<Derivation<'p>, DeriveError> {
         let mut interp = Interp::with_deadline(&program.structs, opts.deadline);
         let mut env = Env::new(Vec::new());
+        env.model = program.model.clone();
         for g in &program.globals {
             let v = match &g.init {
                 Some(e) => interp

@@ -16,6 +16,7 @@ mod mesh;
 mod mesh_bounds;
 mod mesh_draw;
 mod mesh_io;
+mod model;
 mod one_language;
 mod precision;
 mod render;
