@@ -393,20 +393,33 @@ def leaves(v):
     return [v]
 
 
-def decode_hex(data, fields):
+def decode_hex(data, fields, rel=1e-5, abs_=1e-9):
     """Decode raw struct bytes with subgram's field values as the types, or
-    None when no layout fits the byte count."""
-    for float_size in (4, 8):
+    None when no layout fits the byte count. subgram's JSON does not say
+    whether a float field is a float or a double: every choice whose C
+    layout has the byte count is tried, and the one that agrees best with
+    subgram's values is taken."""
+    floats = [i for i, f in enumerate(fields)
+              if not isinstance(f, (bool, int)) and (isinstance(f, float) or f is None)]
+    if any(not isinstance(f, (bool, int, float)) and f is not None for f in fields):
+        return None
+    if len(floats) > 12:
+        choices = [0, (1 << len(floats)) - 1]  # all float, all double
+    else:
+        choices = range(1 << len(floats))
+    best, best_bad = None, None
+    for mask in choices:
+        doubles = {floats[k] for k in range(len(floats)) if mask >> k & 1}
         off, vals, align_max = 0, [], 1
-        for f in fields:
+        for i, f in enumerate(fields):
             if isinstance(f, bool):
                 size, fmt = 1, "<?"
             elif isinstance(f, int):
                 size, fmt = 4, "<i"
-            elif isinstance(f, float) or f is None:
-                size, fmt = float_size, "<f" if float_size == 4 else "<d"
+            elif i in doubles:
+                size, fmt = 8, "<d"
             else:
-                return None
+                size, fmt = 4, "<f"
             off = (off + size - 1) // size * size
             align_max = max(align_max, size)
             if off + size > len(data):
@@ -414,10 +427,12 @@ def decode_hex(data, fields):
             vals.append(struct.unpack_from(fmt, data, off)[0])
             off += size
         else:
-            total = (off + align_max - 1) // align_max * align_max
-            if total == len(data):
-                return vals
-    return None
+            if (off + align_max - 1) // align_max * align_max != len(data):
+                continue
+            bad = sum(1 for a, b in zip(vals, fields) if not close(a, b, rel, abs_))
+            if best is None or bad < best_bad:
+                best, best_bad = vals, bad
+    return best
 
 
 def close(a, b, rel, abs_):
@@ -439,9 +454,9 @@ def param_same(lp, sg, rel, abs_):
     """(same, relative difference) of one parameter."""
     sl = leaves(sg)
     if isinstance(lp, Hex):
-        vals = decode_hex(lp.data, sl)
+        vals = decode_hex(lp.data, sl, rel, abs_)
         if vals is None:
-            return False, None
+            return False, "struct"
         ll = vals
     else:
         ll = leaves(lp)
@@ -514,7 +529,10 @@ def compare(lmods, smods, rel, abs_):
             ok, d = param_same(a, b, rel, abs_)
             if not ok:
                 bad = True
-                why = "parameter" + ("" if d is None else " (relative difference %.3g)" % d)
+                if d == "struct":
+                    why = "struct bytes fit no layout of subgram's fields"
+                else:
+                    why = "parameter" + ("" if d is None else " (relative difference %.3g)" % d)
                 break
             worst = max(worst, d or 0.0)
         if bad:
