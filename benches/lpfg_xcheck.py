@@ -118,7 +118,7 @@ class Program:
             with open(self.path, encoding="utf-8") as f:
                 text = f.read()
             if "lpfgall.h" not in text:
-                text = "#include <lpfgall.h>\n" + text
+                text = "#include <lpfgall.h>\n#line 1\n" + text
             self.lpfg_file = os.path.join(d, base + ".l")
             with open(self.lpfg_file, "w", encoding="utf-8") as f:
                 f.write(text)
