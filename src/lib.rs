@@ -50,7 +50,7 @@ pub mod surface;
 pub use curve::{Curve, CurveRun, FigureOptions};
 pub use deadline::{Deadline, DEFAULT_TIMEOUT};
 pub use error::Error;
-pub use lang::{Program, Value};
+pub use lang::{Program, ProgramOutput, Stream, Value};
 pub use load::{load, load_file, load_str, load_text, LoadOptions};
 pub use rewrite::derive::{DEFAULT_MAX_MODULES, MAX_STEPS};
 pub use rewrite::{derive, Derivation, DeriveError, DeriveOptions, Derived, Word};
