@@ -1719,34 +1719,8 @@ impl Compiler {
                 }
                 Some((Ex::Convert(ty, Box::new(x)), ty))
             }
-            ExprKind::Field(base, f) => {
-                if self.indexes_a_variable(e, scope) {
-                    let p = self.place_of(e, scope, false)?;
-                    let ty = p.ty;
-                    return Some((Ex::Load(p), ty));
-                }
-                let (x, t) = self.expr(base, scope)?;
-                let (idx, ft) = self.field_of(t, f)?;
-                Some((Ex::Field(Box::new(x), idx), ft))
-            }
-            ExprKind::Index(base, index) => {
-                if self.indexes_a_variable(e, scope) {
-                    let p = self.place_of(e, scope, false)?;
-                    let ty = p.ty;
-                    return Some((Ex::Load(p), ty));
-                }
-                let b = self.expr(base, scope);
-                let i = self.index(index, scope);
-                let ((bx, bt), i) = (b?, i?);
-                let elem = self.elem_of(bt, span)?;
-                Some((Ex::Index(Box::new(bx), Box::new(i), span), elem))
-            }
-            ExprKind::List(_) => {
-                self.err(
-                    span,
-                    "a `{...}` list is an initializer: it may only follow `=` in a declaration",
-                );
-                None
+            ExprKind::Field(..) | ExprKind::Index(..) | ExprKind::List(_) => {
+                self.access(e, scope)
             }
             ExprKind::Method(recv, name, args) => self.method(recv, name, args, span, scope),
             ExprKind::Gather { op, var, set, cond } => {
@@ -1794,6 +1768,44 @@ impl Compiler {
                     });
                 }
                 Some((Ex::InContext(*kind, out, all_places), Ty::Bool))
+            }
+        }
+    }
+
+    /// A field, an element of an array, or a misplaced `{...}`; out of
+    /// `expr_inner`, so that its frame stays small for deep nesting.
+    #[inline(never)]
+    fn access(&mut self, e: &ast::Expr, scope: &mut Scope) -> Typed {
+        let span = e.span;
+        match &e.kind {
+            ExprKind::Field(base, f) => {
+                if self.indexes_a_variable(e, scope) {
+                    let p = self.place_of(e, scope, false)?;
+                    let ty = p.ty;
+                    return Some((Ex::Load(p), ty));
+                }
+                let (x, t) = self.expr(base, scope)?;
+                let (idx, ft) = self.field_of(t, f)?;
+                Some((Ex::Field(Box::new(x), idx), ft))
+            }
+            ExprKind::Index(base, index) => {
+                if self.indexes_a_variable(e, scope) {
+                    let p = self.place_of(e, scope, false)?;
+                    let ty = p.ty;
+                    return Some((Ex::Load(p), ty));
+                }
+                let b = self.expr(base, scope);
+                let i = self.index(index, scope);
+                let ((bx, bt), i) = (b?, i?);
+                let elem = self.elem_of(bt, span)?;
+                Some((Ex::Index(Box::new(bx), Box::new(i), span), elem))
+            }
+            _ => {
+                self.err(
+                    span,
+                    "a `{...}` list is an initializer: it may only follow `=` in a declaration",
+                );
+                None
             }
         }
     }
@@ -1868,17 +1880,7 @@ impl Compiler {
         if let ("int" | "float" | "double" | "bool" | "long" | "short" | "unsigned" | "char", [a]) =
             (n, args)
         {
-            let t = ast::TypeRef {
-                name: n.to_string(),
-                span: name.span,
-                pointer: false,
-                reference: false,
-            };
-            let cast = ast::Expr {
-                kind: ExprKind::Cast(t, Box::new(a.clone())),
-                span,
-            };
-            return self.expr_inner(&cast, scope);
+            return self.functional_cast(name, a, span, scope);
         }
         let mut typed = Vec::new();
         let mut ok = true;
@@ -2097,6 +2099,7 @@ impl Compiler {
     }
 
     /// An array index: an integer.
+    #[inline(never)]
     fn index(&mut self, e: &ast::Expr, scope: &mut Scope) -> Option<Ex> {
         let (x, t) = self.expr(e, scope)?;
         if !matches!(t, Ty::Int | Ty::Bool) {
@@ -2112,6 +2115,7 @@ impl Compiler {
     /// True when `e` is a chain of fields and indices with at least one
     /// index, on a variable: read through a place, without copying the
     /// whole variable.
+    #[inline(never)]
     fn indexes_a_variable(&self, e: &ast::Expr, scope: &Scope) -> bool {
         let mut indexed = false;
         let mut e = e;
@@ -2181,6 +2185,7 @@ impl Compiler {
     /// arrays of 2 floats); a `char` array is a string. A first `[]` takes
     /// its length from `init_len` (the initializer's), or stays open (a
     /// parameter's).
+    #[inline(never)]
     fn with_dims(
         &mut self,
         mut ty: Ty,
@@ -2220,6 +2225,7 @@ impl Compiler {
 
     /// The type a declarator gives its variable: `char *s` is a string,
     /// `FILE *f` a handle, `float a[3]` an array.
+    #[inline(never)]
     fn declarator_type(&mut self, base: Ty, tref: &ast::TypeRef, d: &ast::Declarator) -> Option<Ty> {
         let mut base = base;
         if d.pointer || tref.pointer {
@@ -2272,6 +2278,7 @@ impl Compiler {
 
     /// `{1, 2, 3}` for an array or a struct, nested lists for their
     /// elements; missing elements are zero, as in C.
+    #[inline(never)]
     fn list_init(&mut self, ty: Ty, items: &[ast::Expr], span: Span, scope: &mut Scope) -> Option<Ex> {
         let want: Vec<Ty> = match ty {
             Ty::Struct(i) => self.structs[i as usize].fields.iter().map(|f| f.1).collect(),
@@ -2328,6 +2335,7 @@ impl Compiler {
 
     /// An integer constant: a literal, an enumerator, a `const` global
     /// with a constant initializer, or arithmetic of those.
+    #[inline(never)]
     fn const_int(&mut self, e: &ast::Expr, what: &str) -> Option<i64> {
         let mut scope = Scope::default();
         let (ex, _) = self.expr(e, &mut scope)?;
@@ -2396,6 +2404,7 @@ impl Compiler {
 
     /// `static int n = 0;` in a body: a global that only this body names,
     /// initialised once before the run.
+    #[inline(never)]
     fn static_local(&mut self, d: &ast::VarDecl, v: &ast::Declarator, ty: Ty, scope: &mut Scope) {
         let mut init_scope = Scope::default();
         let init = self.initializer(ty, &v.init, &mut init_scope);
@@ -2417,6 +2426,7 @@ impl Compiler {
         scope.bind_static(&v.name.text, ty, slot);
     }
 
+    #[inline(never)]
     fn return_stmt(
         &mut self,
         value: Option<&ast::Expr>,
@@ -2626,6 +2636,7 @@ impl Compiler {
 
     /// A call of a user-defined function: arguments checked against the
     /// parameters, arrays and references passed as places.
+    #[inline(never)]
     fn user_call(
         &mut self,
         id: u16,
@@ -2738,7 +2749,24 @@ impl Compiler {
         ))
     }
 
+    /// `float(x)`: the cast `(float) x`.
+    #[inline(never)]
+    fn functional_cast(&mut self, name: &ast::Name, a: &ast::Expr, span: Span, scope: &mut Scope) -> Typed {
+        let t = ast::TypeRef {
+            name: name.text.clone(),
+            span: name.span,
+            pointer: false,
+            reference: false,
+        };
+        let cast = ast::Expr {
+            kind: ExprKind::Cast(t, Box::new(a.clone())),
+            span,
+        };
+        self.expr_inner(&cast, scope)
+    }
+
     /// C's standard I/O and string functions; `None` for another name.
+    #[inline(never)]
     fn stdio_call(
         &mut self,
         name: &ast::Name,

@@ -400,6 +400,7 @@ impl<'p> Interp<'p> {
     }
 
     /// The array indices of a place's path, evaluated in order.
+    #[inline(never)]
     fn indices(&mut self, place: &Place, cx: &mut Cx) -> R<Vec<i64>> {
         let mut out = Vec::new();
         for step in &place.path {
@@ -541,6 +542,7 @@ impl<'p> Interp<'p> {
 
     /// Runs function `f`'s body on `frame`, on a new stack segment when
     /// this one is used up.
+    #[inline(never)]
     fn invoke(&mut self, f: &'p Function, frame: &mut [Value], env: &mut Env, span: Span) -> R<Value> {
         let here = stack_address();
         if self.stack_base == 0 {
@@ -571,6 +573,7 @@ impl<'p> Interp<'p> {
         self.run_function(f, frame, env)
     }
 
+    #[inline(never)]
     fn run_function(&mut self, f: &'p Function, frame: &mut [Value], env: &mut Env) -> R<Value> {
         let mut sink = NoSink;
         let mut cx = Cx {
@@ -666,25 +669,7 @@ impl<'p> Interp<'p> {
                 self.store(place, v.clone(), cx)?;
                 v
             }
-            Ex::Load(place) => self.load(place, cx)?,
-            Ex::Index(base, index, span) => {
-                let b = self.expr(base, cx)?;
-                let i = self.expr(index, cx)?.as_i64();
-                match b {
-                    Value::Struct(fs) => match usize::try_from(i).ok().and_then(|k| fs.get(k)) {
-                        Some(v) => v.clone(),
-                        None => return Err(out_of_range(i, fs.len(), *span)),
-                    },
-                    Value::Str(s) => char_at(&s, i, *span)?,
-                    _ => Value::Void,
-                }
-            }
-            Ex::CallUser {
-                id,
-                args,
-                back,
-                span,
-            } => self.call_user(*id, args, back, *span, cx)?,
+            Ex::Load(..) | Ex::Index(..) | Ex::CallUser { .. } => self.expr_c(e, cx)?,
             Ex::IncDec(place, d, prefix) => {
                 let cur = self.load(place, cx)?;
                 let new = binary(BinOp::Add, cur.clone(), Value::Int(*d as i64))
@@ -732,6 +717,34 @@ impl<'p> Interp<'p> {
                 }
             }
             // `expr` handles every other expression.
+            _ => Value::Void,
+        })
+    }
+
+    /// Arrays and user function calls, kept out of `expr_rare` so that
+    /// its frame stays small too.
+    #[inline(never)]
+    fn expr_c(&mut self, e: &Ex, cx: &mut Cx) -> R<Value> {
+        Ok(match e {
+            Ex::Load(place) => self.load(place, cx)?,
+            Ex::Index(base, index, span) => {
+                let b = self.expr(base, cx)?;
+                let i = self.expr(index, cx)?.as_i64();
+                match b {
+                    Value::Struct(fs) => match usize::try_from(i).ok().and_then(|k| fs.get(k)) {
+                        Some(v) => v.clone(),
+                        None => return Err(out_of_range(i, fs.len(), *span)),
+                    },
+                    Value::Str(s) => char_at(&s, i, *span)?,
+                    _ => Value::Void,
+                }
+            }
+            Ex::CallUser {
+                id,
+                args,
+                back,
+                span,
+            } => self.call_user(*id, args, back, *span, cx)?,
             _ => Value::Void,
         })
     }

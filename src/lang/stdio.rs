@@ -85,6 +85,11 @@ impl ProgramOutput {
         out
     }
 
+    /// Lets the program write files from now on.
+    pub fn allow_writes(&self) {
+        self.state().writes_allowed = true;
+    }
+
     fn state(&self) -> std::sync::MutexGuard<'_, State> {
         self.0.lock().unwrap_or_else(|e| e.into_inner())
     }

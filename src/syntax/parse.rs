@@ -1492,19 +1492,10 @@ impl<'t> Parser<'t> {
             {
                 reached = self.wrap(reached, self.span_here())?;
             }
-            if self.eat_punct("[") {
-                let outer = self.measure();
-                self.descend()?;
-                let index = self.expr();
-                self.ascend();
-                let index = index?;
-                reached = reached.max(self.reached(outer));
-                self.expect_punct("]", "to close the index")?;
-                let span = e.span.to(self.prev_span());
-                e = Expr {
-                    kind: ExprKind::Index(Box::new(e), Box::new(index)),
-                    span,
-                };
+            if self.peek_punct("[") {
+                let (indexed, r) = self.index_of(e)?;
+                e = indexed;
+                reached = reached.max(r);
             } else if self.eat_punct(".") {
                 let name = self.name("a field or method name after `.`")?;
                 if self.eat_punct("(") {
@@ -1538,6 +1529,28 @@ impl<'t> Parser<'t> {
                 return Ok(e);
             }
         }
+    }
+
+    /// `e[i]`: the index of `e`, at `[`; with the deepest level the index
+    /// reached. Out of `postfix`, so that its frame stays small.
+    #[inline(never)]
+    fn index_of(&mut self, e: Expr) -> PResult<(Expr, usize)> {
+        self.pos += 1;
+        let outer = self.measure();
+        self.descend()?;
+        let index = self.expr();
+        self.ascend();
+        let index = index?;
+        let reached = self.reached(outer);
+        self.expect_punct("]", "to close the index")?;
+        let span = e.span.to(self.prev_span());
+        Ok((
+            Expr {
+                kind: ExprKind::Index(Box::new(e), Box::new(index)),
+                span,
+            },
+            reached,
+        ))
     }
 
     /// primary := NUMBER | STRING | NAME | NAME '(' args ')' | '(' expr ')'
