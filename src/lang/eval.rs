@@ -147,12 +147,14 @@ const DEADLINE_EVERY: u32 = 1 << 16;
 pub const MAX_CALL_DEPTH: u32 = 10_000;
 
 /// The interpreter recurses on the Rust stack. Once a chain of user
-/// function calls has used this much of the stack, the next call runs on
-/// a new thread with a stack of its own ([`SEGMENT_STACK`] bytes), so that
-/// [`MAX_CALL_DEPTH`] calls fit whatever stack the caller has (a test
-/// thread has 2 MiB).
+/// function calls has used this much of the caller's stack (whose size is
+/// not known: a test thread has 2 MiB), the next call runs on a new thread
+/// with a stack of [`SEGMENT_STACK`] bytes (reserved, and used as it is
+/// needed), which it may use up to [`SEGMENT_MARGIN`] from its end before
+/// it moves on to another. [`MAX_CALL_DEPTH`] calls fit in one or two.
 const STACK_SEGMENT: usize = 256 << 10;
-const SEGMENT_STACK: usize = 16 << 20;
+const SEGMENT_STACK: usize = 512 << 20;
+const SEGMENT_MARGIN: usize = 4 << 20;
 
 /// Runs bodies. Holds scratch space reused across calls.
 pub struct Interp<'p> {
@@ -164,8 +166,9 @@ pub struct Interp<'p> {
     /// The value of the `return` that ended the running function.
     ret: Option<Value>,
     /// The stack address where the current stack segment started (0: not
-    /// yet known).
+    /// yet known), and how much of it calls may use.
     stack_base: usize,
+    stack_room: usize,
     scratch: Vec<Value>,
     fuel: u64,
     /// The run stops once this passes; looked at every
@@ -183,6 +186,7 @@ impl<'p> Interp<'p> {
             calls: 0,
             ret: None,
             stack_base: 0,
+            stack_room: STACK_SEGMENT,
             scratch: Vec::new(),
             fuel: LOOP_LIMIT,
             deadline: None,
@@ -548,19 +552,20 @@ impl<'p> Interp<'p> {
         if self.stack_base == 0 {
             self.stack_base = here;
         }
-        if self.stack_base.abs_diff(here) > STACK_SEGMENT {
-            let saved = self.stack_base;
+        if self.stack_base.abs_diff(here) > self.stack_room {
+            let saved = (self.stack_base, self.stack_room);
             let spawned = std::thread::scope(|s| {
                 std::thread::Builder::new()
                     .name("subgram-calls".into())
                     .stack_size(SEGMENT_STACK)
                     .spawn_scoped(s, || {
                         self.stack_base = 0;
+                        self.stack_room = SEGMENT_STACK - SEGMENT_MARGIN;
                         self.run_function(f, frame, env)
                     })
                     .map(|h| h.join())
             });
-            self.stack_base = saved;
+            (self.stack_base, self.stack_room) = saved;
             return match spawned {
                 Ok(Ok(r)) => r,
                 Ok(Err(panic)) => std::panic::resume_unwind(panic),
