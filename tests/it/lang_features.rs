@@ -330,3 +330,29 @@ fn functions_agree_with_lpfg() {
     let x: f64 = head.trim_start_matches("A(3, ").parse().unwrap();
     assert!(((x - 4167.502) / 4167.502).abs() < 1e-6, "{word}");
 }
+
+/// `lsystems/lplusc/table-tree.lsys`: 7 steps of a binary tree make
+/// 2^7 - 1 = 127 internodes and 128 apices numbered 127 to 254 (the
+/// static counter gave 0 to the axiom, then 1, 2, ... in the order the
+/// apices grew); an internode of order 6 is 10 times the product of the
+/// ratios 0.82, 0.7, 0.76, 0.66, 0.82, 0.7 (the table read cyclically),
+/// 1.6022... long.
+#[test]
+fn the_table_tree_example() {
+    let l = load(&lsys("lplusc/table-tree.lsys"));
+    let d = derive(&l, DeriveOptions::default());
+    let word = text(&l, &d);
+    assert_eq!(word.matches("I(").count(), 127);
+    let apices: Vec<&str> = word.split("A(").skip(1).collect();
+    assert_eq!(apices.len(), 128);
+    assert!(apices[0].starts_with("7, 127)"), "{}", apices[0]);
+    assert!(apices[127].starts_with("7, 254)"), "{}", apices[127]);
+    let order6 = 10.0 * 0.82 * 0.7 * 0.76 * 0.66 * 0.82 * 0.7;
+    let len: f64 = word
+        .split("I(")
+        .nth(7)
+        .and_then(|s| s.split(')').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap();
+    assert!((len - order6).abs() < 1e-9, "{len} {order6}");
+}
