@@ -269,7 +269,11 @@ fn writes_folder(dir: &Option<PathBuf>, output: &ProgramOutput) -> Result<Option
 /// all or none, never over one of `inputs`, and never outside `dir`
 /// (the paths were checked when opened; a link inside `dir` that leads out
 /// is refused here).
-fn write_program_files(output: &ProgramOutput, dir: Option<&Path>, inputs: &[&Path]) -> Result<(), Error> {
+fn write_program_files(
+    output: &ProgramOutput,
+    dir: Option<&Path>,
+    inputs: &[&Path],
+) -> Result<(), Error> {
     let files = output.files();
     let Some(dir) = dir else { return Ok(()) };
     if files.is_empty() {
@@ -283,7 +287,9 @@ fn write_program_files(output: &ProgramOutput, dir: Option<&Path>, inputs: &[&Pa
         let path = root.join(&name);
         let parent = path.parent().unwrap_or(&root).to_path_buf();
         std::fs::create_dir_all(&parent).map_err(|e| Error::write(&parent, e))?;
-        let real = parent.canonicalize().map_err(|e| Error::write(&parent, e))?;
+        let real = parent
+            .canonicalize()
+            .map_err(|e| Error::write(&parent, e))?;
         if !real.starts_with(&root) {
             return Err(Error::Failed(format!(
                 "the program's file `{name}` would be written outside {}",

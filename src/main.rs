@@ -532,7 +532,11 @@ fn print_program_output(output: &subgram::ProgramOutput, to_stderr: bool) -> Res
         match r {
             Ok(()) => {}
             Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(()),
-            Err(e) => return Err(Error::Failed(format!("cannot write the program's output: {e}"))),
+            Err(e) => {
+                return Err(Error::Failed(format!(
+                    "cannot write the program's output: {e}"
+                )))
+            }
         }
     }
     Ok(())

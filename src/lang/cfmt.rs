@@ -51,8 +51,9 @@ pub fn format(fmt: &str, args: &[Value]) -> Result<String, String> {
             chars.next();
         }
         let mut next_arg = |what: &str| {
-            args.next()
-                .ok_or_else(|| format!("the format \"{fmt}\" needs more arguments than given ({what})"))
+            args.next().ok_or_else(|| {
+                format!("the format \"{fmt}\" needs more arguments than given ({what})")
+            })
         };
         if chars.peek() == Some(&'*') {
             chars.next();
@@ -103,7 +104,10 @@ pub fn format(fmt: &str, args: &[Value]) -> Result<String, String> {
             'o' => unsigned(&spec, arg.as_i64() as u64, 8, false),
             'c' => {
                 let code = arg.as_i64();
-                let ch = u32::try_from(code).ok().and_then(char::from_u32).unwrap_or('?');
+                let ch = u32::try_from(code)
+                    .ok()
+                    .and_then(char::from_u32)
+                    .unwrap_or('?');
                 pad(&spec, String::new(), ch.to_string(), false)
             }
             's' => {
@@ -328,13 +332,26 @@ mod tests {
         assert_eq!(
             f(
                 "[%d] [%5d] [%-5d|] [%05d] [%+d] [% d] [%.3d] [%i] [%ld]",
-                &[i(42), i(42), i(42), i(42), i(42), i(42), i(7), i(-3), i(123456789012)]
+                &[
+                    i(42),
+                    i(42),
+                    i(42),
+                    i(42),
+                    i(42),
+                    i(42),
+                    i(7),
+                    i(-3),
+                    i(123456789012)
+                ]
             ),
             "[42] [   42] [42   |] [00042] [+42] [ 42] [007] [-3] [123456789012]"
         );
         // printf("[%05d] [%-+6d|] [%.0d] [%08.3d]", -42, 5, 0, 12)
         assert_eq!(
-            f("[%05d] [%-+6d|] [%.0d] [%08.3d]", &[i(-42), i(5), i(0), i(12)]),
+            f(
+                "[%05d] [%-+6d|] [%.0d] [%08.3d]",
+                &[i(-42), i(5), i(0), i(12)]
+            ),
             "[-0042] [+5    |] [] [     012]"
         );
     }
@@ -352,18 +369,18 @@ mod tests {
     }
 
     /// printf("[%f] [%.2f] [%8.3f] [%-8.1f|] [%08.2f] [%+.1f] [%.0f] [%.0f] [%.0f] [%#.0f] [%lf]",
-    ///        3.14159, 2.675, -1.5, 0.25, -3.14159, 2.0, 0.5, 1.5, 2.5, 3.0, 1e10)
+    ///        3.14158, 2.675, -1.5, 0.25, -3.14158, 2.0, 0.5, 1.5, 2.5, 3.0, 1e10)
     #[test]
     fn fixed_point() {
         assert_eq!(
             f(
                 "[%f] [%.2f] [%8.3f] [%-8.1f|] [%08.2f] [%+.1f] [%.0f] [%.0f] [%.0f] [%#.0f] [%lf]",
                 &[
-                    x(3.14159),
+                    x(3.14158),
                     x(2.675),
                     x(-1.5),
                     x(0.25),
-                    x(-3.14159),
+                    x(-3.14158),
                     x(2.0),
                     x(0.5),
                     x(1.5),
@@ -372,7 +389,7 @@ mod tests {
                     x(1e10)
                 ]
             ),
-            "[3.141590] [2.67] [  -1.500] [0.2     |] [-0003.14] [+2.0] [0] [2] [2] [3.] [10000000000.000000]"
+            "[3.141580] [2.67] [  -1.500] [0.2     |] [-0003.14] [+2.0] [0] [2] [2] [3.] [10000000000.000000]"
         );
     }
 
@@ -389,7 +406,7 @@ mod tests {
     }
 
     /// printf("[%g] [%g] [%g] [%g] [%g] [%g] [%.3g] [%10.4g] [%G] [%#g] [%g] [%g]",
-    ///        0.0001, 0.00001, 123456.0, 1234567.0, 100.0, 2.5, 3.14159, 1234.5678, 1e-20, 1.0, 0.1+0.2, -0.0)
+    ///        0.0001, 0.00001, 123456.0, 1234567.0, 100.0, 2.5, 3.14158, 1234.5678, 1e-20, 1.0, 0.1+0.2, -0.0)
     #[test]
     fn general_form() {
         assert_eq!(
@@ -402,7 +419,7 @@ mod tests {
                     x(1234567.0),
                     x(100.0),
                     x(2.5),
-                    x(3.14159),
+                    x(3.14158),
                     x(1234.5678),
                     x(1e-20),
                     x(1.0),
@@ -415,7 +432,7 @@ mod tests {
     }
 
     /// printf("[%s] [%10s] [%-6s|] [%.2s] [%c] [%5c] [%%] [%*d] [%-*d|] [%.*f]",
-    ///        "abc", "right", "left", "cut", 'A', 'z', 4, 7, 4, 7, 2, 3.14159)
+    ///        "abc", "right", "left", "cut", 'A', 'z', 4, 7, 4, 7, 2, 3.14158)
     #[test]
     fn strings_chars_and_stars() {
         let s = |t: &str| Value::Str(t.into());
@@ -434,7 +451,7 @@ mod tests {
                     i(4),
                     i(7),
                     i(2),
-                    x(3.14159)
+                    x(3.14158)
                 ]
             ),
             "[abc] [     right] [left  |] [cu] [A] [    z] [%] [   7] [7   |] [3.14]"
@@ -447,7 +464,13 @@ mod tests {
         assert_eq!(
             f(
                 "[%f] [%5.1f] [%e] [%g] [%-6f|]",
-                &[x(f64::INFINITY), x(f64::NEG_INFINITY), x(f64::NAN), x(f64::INFINITY), x(f64::NAN)]
+                &[
+                    x(f64::INFINITY),
+                    x(f64::NEG_INFINITY),
+                    x(f64::NAN),
+                    x(f64::INFINITY),
+                    x(f64::NAN)
+                ]
             ),
             "[inf] [ -inf] [nan] [inf] [nan   |]"
         );
@@ -455,9 +478,13 @@ mod tests {
 
     #[test]
     fn errors_are_messages() {
-        assert!(format("%d %d", &[i(1)]).unwrap_err().contains("more arguments"));
+        assert!(format("%d %d", &[i(1)])
+            .unwrap_err()
+            .contains("more arguments"));
         assert!(format("100%", &[]).unwrap_err().contains("ends inside"));
-        assert!(format("%99999d", &[i(1)]).unwrap_err().contains("larger than"));
+        assert!(format("%99999d", &[i(1)])
+            .unwrap_err()
+            .contains("larger than"));
         assert!(format("%n", &[i(1)]).unwrap_err().contains("`%n`"));
     }
 }

@@ -147,8 +147,8 @@ struct UserSig {
     defined: bool,
 }
 
-/// User functions may call each other this deep at run time (each call is
-/// a frame of the interpreter; see `eval::MAX_CALL_DEPTH`).
+/// The most user-defined functions a program may declare (each is
+/// numbered with a `u16`).
 const MAX_USER_FUNCTIONS: usize = u16::MAX as usize;
 
 /// Function calls are inlined; past this many in one rule, functions that
@@ -820,10 +820,15 @@ impl Compiler {
                 let (ex, et) = self.expr(e, scope)?;
                 self.coerce(ex, et, ty, e.span)
             }
-            Init::List(items, span) if self.is_array(ty) || items.iter().any(|i| matches!(i.kind, ExprKind::List(_))) => {
+            Init::List(items, span)
+                if self.is_array(ty)
+                    || items.iter().any(|i| matches!(i.kind, ExprKind::List(_))) =>
+            {
                 self.list_init(ty, items, *span, scope)
             }
-            Init::List(items, span) if matches!(ty, Ty::Struct(_)) && items.len() < self.fields_of(ty) => {
+            Init::List(items, span)
+                if matches!(ty, Ty::Struct(_)) && items.len() < self.fields_of(ty) =>
+            {
                 self.list_init(ty, items, *span, scope)
             }
             Init::Ctor(args, span) | Init::List(args, span) => {
@@ -1491,7 +1496,14 @@ impl Compiler {
             )),
             ExprKind::Ident(n) => {
                 if let Some((ty, slot, global)) = scope.lookup_var(n) {
-                    return Some((if global { Ex::Global(slot) } else { Ex::Local(slot) }, ty));
+                    return Some((
+                        if global {
+                            Ex::Global(slot)
+                        } else {
+                            Ex::Local(slot)
+                        },
+                        ty,
+                    ));
                 }
                 if let Some(&g) = self.global_names.get(n) {
                     return Some((Ex::Global(g), self.globals[g as usize].ty));
@@ -1719,9 +1731,7 @@ impl Compiler {
                 }
                 Some((Ex::Convert(ty, Box::new(x)), ty))
             }
-            ExprKind::Field(..) | ExprKind::Index(..) | ExprKind::List(_) => {
-                self.access(e, scope)
-            }
+            ExprKind::Field(..) | ExprKind::Index(..) | ExprKind::List(_) => self.access(e, scope),
             ExprKind::Method(recv, name, args) => self.method(recv, name, args, span, scope),
             ExprKind::Gather { op, var, set, cond } => {
                 self.gather(op, Some(var), set, cond.as_deref(), scope)
@@ -2065,7 +2075,6 @@ impl Compiler {
         ))
     }
 
-
     // ----- C: arrays, enums, statics, functions, standard I/O ----------
 
     fn is_array(&self, ty: Ty) -> bool {
@@ -2091,7 +2100,10 @@ impl Compiler {
             _ => {
                 self.err(
                     span,
-                    format!("{} is not an array: it cannot be indexed", self.type_name(ty)),
+                    format!(
+                        "{} is not an array: it cannot be indexed",
+                        self.type_name(ty)
+                    ),
                 );
                 None
             }
@@ -2105,7 +2117,10 @@ impl Compiler {
         if !matches!(t, Ty::Int | Ty::Bool) {
             self.err(
                 e.span,
-                format!("an array index must be an integer, found {}", self.type_name(t)),
+                format!(
+                    "an array index must be an integer, found {}",
+                    self.type_name(t)
+                ),
             );
             return None;
         }
@@ -2154,7 +2169,10 @@ impl Compiler {
             return None;
         }
         if depth + 1 > MAX_NESTING {
-            self.err(span, format!("arrays nest more than {MAX_NESTING} levels deep"));
+            self.err(
+                span,
+                format!("arrays nest more than {MAX_NESTING} levels deep"),
+            );
             return None;
         }
         if self.structs.len() >= MAX_DECLARED {
@@ -2212,7 +2230,10 @@ impl Compiler {
                 }
                 None if k == 0 => init_len,
                 None => {
-                    self.err(span, "only an array's first dimension may be left empty (`[]`)");
+                    self.err(
+                        span,
+                        "only an array's first dimension may be left empty (`[]`)",
+                    );
                     return None;
                 }
             });
@@ -2226,7 +2247,12 @@ impl Compiler {
     /// The type a declarator gives its variable: `char *s` is a string,
     /// `FILE *f` a handle, `float a[3]` an array.
     #[inline(never)]
-    fn declarator_type(&mut self, base: Ty, tref: &ast::TypeRef, d: &ast::Declarator) -> Option<Ty> {
+    fn declarator_type(
+        &mut self,
+        base: Ty,
+        tref: &ast::TypeRef,
+        d: &ast::Declarator,
+    ) -> Option<Ty> {
         let mut base = base;
         if d.pointer || tref.pointer {
             base = match tref.name.as_str() {
@@ -2279,9 +2305,19 @@ impl Compiler {
     /// `{1, 2, 3}` for an array or a struct, nested lists for their
     /// elements; missing elements are zero, as in C.
     #[inline(never)]
-    fn list_init(&mut self, ty: Ty, items: &[ast::Expr], span: Span, scope: &mut Scope) -> Option<Ex> {
+    fn list_init(
+        &mut self,
+        ty: Ty,
+        items: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Option<Ex> {
         let want: Vec<Ty> = match ty {
-            Ty::Struct(i) => self.structs[i as usize].fields.iter().map(|f| f.1).collect(),
+            Ty::Struct(i) => self.structs[i as usize]
+                .fields
+                .iter()
+                .map(|f| f.1)
+                .collect(),
             Ty::V2 => vec![Ty::Float; 2],
             Ty::V3 => vec![Ty::Float; 3],
             t => vec![t],
@@ -2326,7 +2362,11 @@ impl Compiler {
             }
             Ty::V3 => {
                 let mut it = parts.into_iter();
-                Ex::MakeV3(Box::new(it.next()?), Box::new(it.next()?), Box::new(it.next()?))
+                Ex::MakeV3(
+                    Box::new(it.next()?),
+                    Box::new(it.next()?),
+                    Box::new(it.next()?),
+                )
             }
             Ty::Struct(_) => Ex::MakeStruct(parts),
             _ => parts.pop()?,
@@ -2358,17 +2398,17 @@ impl Compiler {
             Ex::Global(g) => {
                 let gv = self.globals.get(*g as usize)?;
                 if gv.is_const {
-                    Some(self.const_value(gv.init.as_ref()?, depth + 1)?.convert(gv.ty))
+                    Some(
+                        self.const_value(gv.init.as_ref()?, depth + 1)?
+                            .convert(gv.ty),
+                    )
                 } else {
                     None
                 }
             }
-            Ex::Neg(a) => super::eval::binary(
-                BinOp::Sub,
-                Value::Int(0),
-                self.const_value(a, depth + 1)?,
-            )
-            .ok(),
+            Ex::Neg(a) => {
+                super::eval::binary(BinOp::Sub, Value::Int(0), self.const_value(a, depth + 1)?).ok()
+            }
             Ex::Convert(t, a) => Some(self.const_value(a, depth + 1)?.convert(*t)),
             Ex::Bin(op, a, b, _) => super::eval::binary(
                 *op,
@@ -2409,7 +2449,10 @@ impl Compiler {
         let mut init_scope = Scope::default();
         let init = self.initializer(ty, &v.init, &mut init_scope);
         if init_scope.max > 0 {
-            self.err(v.name.span, "a static variable's initializer cannot declare variables");
+            self.err(
+                v.name.span,
+                "a static variable's initializer cannot declare variables",
+            );
         }
         if self.globals.len() >= MAX_DECLARED {
             self.too_many(MAX_DECLARED, "global variables", v.name.span);
@@ -2524,18 +2567,20 @@ impl Compiler {
         if let Some(&id) = self.user_fn_names.get(&name.text) {
             let sig = &self.user_fns[id as usize];
             if sig.params != params || sig.ret != ret {
-                let first = self.sources_line(sig.span);
                 self.err(
                     name.span,
                     format!(
-                        "`{}` is declared again with other types ({first}); functions cannot be overloaded",
+                        "`{}` is declared again with other types; functions cannot be overloaded",
                         name.text
                     ),
                 );
                 return;
             }
             if sig.defined && def.body.is_some() {
-                self.err(name.span, format!("function `{}` is defined twice", name.text));
+                self.err(
+                    name.span,
+                    format!("function `{}` is defined twice", name.text),
+                );
                 return;
             }
             if def.body.is_some() {
@@ -2558,12 +2603,6 @@ impl Compiler {
             span: name.span,
             defined: def.body.is_some(),
         });
-    }
-
-    /// "first declared at byte N": where an earlier declaration is, for a
-    /// message (the diagnostic's caret shows the later one).
-    fn sources_line(&self, _span: Span) -> &'static str {
-        "it was declared before"
     }
 
     /// Last pass: the functions' bodies, checked with every signature,
@@ -2663,7 +2702,10 @@ impl Compiler {
         if !sig.defined {
             self.err(
                 name.span,
-                format!("`{}` is declared but never defined: its body is missing", sig.name),
+                format!(
+                    "`{}` is declared but never defined: its body is missing",
+                    sig.name
+                ),
             );
             return None;
         }
@@ -2751,7 +2793,13 @@ impl Compiler {
 
     /// `float(x)`: the cast `(float) x`.
     #[inline(never)]
-    fn functional_cast(&mut self, name: &ast::Name, a: &ast::Expr, span: Span, scope: &mut Scope) -> Typed {
+    fn functional_cast(
+        &mut self,
+        name: &ast::Name,
+        a: &ast::Expr,
+        span: Span,
+        scope: &mut Scope,
+    ) -> Typed {
         let t = ast::TypeRef {
             name: name.text.clone(),
             span: name.span,
@@ -2855,7 +2903,11 @@ impl Compiler {
                     Some(w) => format!(
                         "type mismatch in argument {} of `{n}`: expected {}, found {found}",
                         k + 1,
-                        if w == Ty::Str { "a string".to_string() } else { self.type_name(w) }
+                        if w == Ty::Str {
+                            "a string".to_string()
+                        } else {
+                            self.type_name(w)
+                        }
                     ),
                     None => format!(
                         "`{n}` prints numbers and strings, not {found}; print its fields (`v.x`)"

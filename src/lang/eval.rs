@@ -438,10 +438,12 @@ impl<'p> Interp<'p> {
                     let i = idx[k];
                     k += 1;
                     match v {
-                        Value::Struct(fs) => match usize::try_from(i).ok().and_then(|i| fs.get(i)) {
-                            Some(e) => v = e,
-                            None => return Err(out_of_range(i, fs.len(), *span)),
-                        },
+                        Value::Struct(fs) => {
+                            match usize::try_from(i).ok().and_then(|i| fs.get(i)) {
+                                Some(e) => v = e,
+                                None => return Err(out_of_range(i, fs.len(), *span)),
+                            }
+                        }
                         Value::Str(s) => return char_at(s, i, *span),
                         _ => return Ok(Value::Void),
                     }
@@ -547,7 +549,13 @@ impl<'p> Interp<'p> {
     /// Runs function `f`'s body on `frame`, on a new stack segment when
     /// this one is used up.
     #[inline(never)]
-    fn invoke(&mut self, f: &'p Function, frame: &mut [Value], env: &mut Env, span: Span) -> R<Value> {
+    fn invoke(
+        &mut self,
+        f: &'p Function,
+        frame: &mut [Value],
+        env: &mut Env,
+        span: Span,
+    ) -> R<Value> {
         let here = stack_address();
         if self.stack_base == 0 {
             self.stack_base = here;
@@ -934,7 +942,10 @@ fn field(v: &Value, i: u16) -> Value {
 fn out_of_range(i: i64, len: usize, span: Span) -> Box<RuntimeError> {
     rt(
         Some(span),
-        format!("index {i} is out of range: the array has {len} element(s), indices 0 to {}", len as i64 - 1),
+        format!(
+            "index {i} is out of range: the array has {len} element(s), indices 0 to {}",
+            len as i64 - 1
+        ),
     )
 }
 

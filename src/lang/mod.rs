@@ -6,8 +6,8 @@ pub mod compile;
 pub mod eval;
 pub mod ir;
 pub mod modules;
-pub mod stencil;
 pub mod stdio;
+pub mod stencil;
 pub mod value;
 
 pub use compile::compile;

@@ -164,9 +164,12 @@ impl ProgramOutput {
         }
         let path = std::path::Path::new(name);
         let inside = !name.is_empty()
-            && path
-                .components()
-                .all(|c| matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir));
+            && path.components().all(|c| {
+                matches!(
+                    c,
+                    std::path::Component::Normal(_) | std::path::Component::CurDir
+                )
+            });
         if !inside {
             return Err(format!(
                 "fopen(\"{name}\"): a program may write only inside the --allow-writes folder: \
@@ -324,7 +327,10 @@ mod tests {
         }
         let h = call(IoFunc::Fopen, &[s("d/x.txt"), s("w")], &out).unwrap();
         call(IoFunc::Fprintf, &[h.clone(), s("%d;"), Value::Int(5)], &out).unwrap();
-        assert_eq!(call(IoFunc::Fclose, &[h.clone()], &out).unwrap(), Value::Int(0));
+        assert_eq!(
+            call(IoFunc::Fclose, std::slice::from_ref(&h), &out).unwrap(),
+            Value::Int(0)
+        );
         let after = call(IoFunc::Fprintf, &[h, s("late")], &out).unwrap_err();
         assert!(after.contains("not open"));
         assert_eq!(out.files(), vec![("d/x.txt".to_string(), "5;".to_string())]);

@@ -16,7 +16,9 @@ const TYPE_KEYWORDS: &[&str] = &[
 ];
 
 /// Words that may come before a declaration's type and mean nothing here.
-const QUALIFIERS: &[&str] = &["static", "inline", "extern", "const", "register", "volatile"];
+const QUALIFIERS: &[&str] = &[
+    "static", "inline", "extern", "const", "register", "volatile",
+];
 
 pub struct Parser<'t> {
     toks: &'t [Token],
@@ -382,15 +384,19 @@ impl<'t> Parser<'t> {
     /// `void h();`), the offset of its name. `V2f v(0, 1);` is a variable.
     fn function_ahead(&self) -> Option<usize> {
         let mut k = 0;
-        while self
-            .peek_at(k)
-            .is_some_and(|t| QUALIFIERS.iter().any(|q| t.tok.is_ident(q)) || t.tok.is_ident("struct") || t.tok.is_ident("enum"))
-        {
+        while self.peek_at(k).is_some_and(|t| {
+            QUALIFIERS.iter().any(|q| t.tok.is_ident(q))
+                || t.tok.is_ident("struct")
+                || t.tok.is_ident("enum")
+        }) {
             k += 1;
         }
         // The type: one or more words (`unsigned int`), then `*`s, then
         // the name.
-        let is_ident = |k: usize| self.peek_at(k).is_some_and(|t| matches!(t.tok, Tok::Ident(_)));
+        let is_ident = |k: usize| {
+            self.peek_at(k)
+                .is_some_and(|t| matches!(t.tok, Tok::Ident(_)))
+        };
         let mut words = 0;
         while is_ident(k) {
             k += 1;
@@ -448,7 +454,10 @@ impl<'t> Parser<'t> {
     /// param := TYPE [NAME] { '[' [expr] ']' }
     fn function(&mut self, items: &mut Vec<Item>, name_at: usize) -> PResult<()> {
         let end = self.pos + name_at;
-        while self.peek().is_some_and(|t| QUALIFIERS.iter().any(|q| t.tok.is_ident(q))) {
+        while self
+            .peek()
+            .is_some_and(|t| QUALIFIERS.iter().any(|q| t.tok.is_ident(q)))
+        {
             self.pos += 1;
         }
         let ret = self.type_ref()?;
@@ -510,6 +519,13 @@ impl<'t> Parser<'t> {
 
     /// enum-decl := 'enum' [NAME] '{' NAME ['=' expr] {',' NAME ['=' expr]} [','] '}' ';'
     fn enum_decl(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        self.enum_body(items)?;
+        self.expect_punct(";", "after the enum declaration")?;
+        Ok(())
+    }
+
+    /// 'enum' [NAME] '{' NAME ['=' expr] {',' NAME ['=' expr]} [','] '}'
+    fn enum_body(&mut self, items: &mut Vec<Item>) -> PResult<()> {
         self.pos += 1;
         let name = if self.peek_punct("{") {
             None
@@ -533,7 +549,6 @@ impl<'t> Parser<'t> {
                 break;
             }
         }
-        self.expect_punct(";", "after the enum declaration")?;
         items.push(Item::Enum { name, variants });
         Ok(())
     }
@@ -641,6 +656,15 @@ impl<'t> Parser<'t> {
         self.pos += 1;
         let name = self.name("a struct name")?;
         self.type_names.insert(name.text.clone());
+        let fields = self.struct_fields()?;
+        self.expect_punct(";", "after the struct declaration")?;
+        items.push(Item::Struct { name, fields });
+        Ok(())
+    }
+
+    /// struct-fields := '{' { TYPE NAME dims {',' NAME dims} ';' } '}'
+    #[allow(clippy::type_complexity)]
+    fn struct_fields(&mut self) -> PResult<Vec<(TypeRef, Name, Vec<Option<Expr>>)>> {
         self.expect_punct("{", "to open the struct body")?;
         let mut fields = Vec::new();
         while !self.eat_punct("}") {
@@ -658,19 +682,76 @@ impl<'t> Parser<'t> {
             }
             self.expect_punct(";", "after the field declaration")?;
         }
-        self.expect_punct(";", "after the struct declaration")?;
-        items.push(Item::Struct { name, fields });
-        Ok(())
+        Ok(fields)
     }
 
     /// typedef := 'typedef' TYPE NAME ';'
     fn typedef(&mut self, items: &mut Vec<Item>) -> PResult<()> {
         self.pos += 1;
+        let braces_at = |k: usize| self.peek_at(k).is_some_and(|t| t.tok.is_punct("{"));
+        if (self.peek_ident("struct") || self.peek_ident("enum")) && (braces_at(1) || braces_at(2))
+        {
+            return self.typedef_of_a_body(items);
+        }
         let ty = self.type_ref()?;
         let name = self.name("the new type name")?;
         self.type_names.insert(name.text.clone());
         self.expect_punct(";", "after the typedef")?;
         items.push(Item::Typedef { ty, name });
+        Ok(())
+    }
+
+    /// typedef := 'typedef' ('struct' | 'enum') [TAG] BODY NAME ';'  — C's
+    /// way to name a struct or an enum: both names name the type.
+    fn typedef_of_a_body(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        let is_struct = self.bump().tok.is_ident("struct");
+        let tag = if self.peek_punct("{") {
+            None
+        } else {
+            Some(self.name("a struct or enum name")?)
+        };
+        if is_struct {
+            if let Some(t) = &tag {
+                self.type_names.insert(t.text.clone());
+            }
+            let fields = self.struct_fields()?;
+            let name = self.name("the new type name")?;
+            self.type_names.insert(name.text.clone());
+            self.expect_punct(";", "after the typedef")?;
+            items.push(Item::Struct {
+                name: name.clone(),
+                fields,
+            });
+            if let Some(tag) = tag {
+                if tag.text != name.text {
+                    let span = name.span;
+                    items.push(Item::Typedef {
+                        ty: TypeRef {
+                            name: name.text,
+                            span,
+                            pointer: false,
+                            reference: false,
+                        },
+                        name: tag,
+                    });
+                }
+            }
+            return Ok(());
+        }
+        // An enum: its body, then the name of the type.
+        let mut body = Vec::new();
+        // Back to `enum`, which `enum_body` reads again.
+        self.pos -= 1 + usize::from(tag.is_some());
+        self.enum_body(&mut body)?;
+        let name = self.name("the new type name")?;
+        self.type_names.insert(name.text.clone());
+        self.expect_punct(";", "after the typedef")?;
+        if let Some(Item::Enum { variants, .. }) = body.pop() {
+            items.push(Item::Enum {
+                name: Some(name),
+                variants,
+            });
+        }
         Ok(())
     }
 

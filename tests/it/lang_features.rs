@@ -152,7 +152,10 @@ fn an_index_out_of_range_is_a_runtime_error_naming_the_line() {
                 A(i) -> A(a[i])\n";
     let e = run_error(read);
     assert!(e.contains("test.lsys:5:11"), "{e}");
-    assert!(e.contains("index 3 is out of range: the array has 3 element(s)"), "{e}");
+    assert!(
+        e.contains("index 3 is out of range: the array has 3 element(s)"),
+        "{e}"
+    );
     let write = "module A(int);\nderivation length: 1;\nAxiom: A(-1);\n\
                  A(i) : {\n  float b[2];\n  b[i] = 1;\n  produce A(i);\n}\n";
     let e = run_error(write);
@@ -272,10 +275,15 @@ fn fopen_needs_allow_writes_and_a_path_inside_the_folder() {
     let mut args = subgram::command::DeriveArgs::new(file.to_str().unwrap());
     args.allow_writes = Some(dir.clone());
     assert_eq!(subgram::command::derive(&args, |_| {}).unwrap(), "A(1)");
-    assert_eq!(std::fs::read_to_string(dir.join("sub/out.txt")).unwrap(), "1\n");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("sub/out.txt")).unwrap(),
+        "1\n"
+    );
 
     std::fs::write(&file, src.replace("NAME", "../escape.txt")).unwrap();
-    let e = subgram::command::derive(&args, |_| {}).unwrap_err().to_string();
+    let e = subgram::command::derive(&args, |_| {})
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("only inside the --allow-writes folder"), "{e}");
     assert!(!dir.join("../escape.txt").exists());
     std::fs::remove_dir_all(&dir).unwrap();
@@ -288,15 +296,26 @@ fn calls_are_checked_where_they_are_written() {
                 derivation length: 1;\nAxiom: A(1);\n";
     let e = load_error(&format!("{base}A(x) -> A(f(x))\n"));
     assert!(e.contains("test.lsys:5:11"), "{e}");
-    assert!(e.contains("`f` takes 2 argument(s) (float, V2f), but 1 were given"), "{e}");
+    assert!(
+        e.contains("`f` takes 2 argument(s) (float, V2f), but 1 were given"),
+        "{e}"
+    );
     let e = load_error(&format!("{base}A(x) -> A(f(x, x))\n"));
     assert!(e.contains("test.lsys:5:16"), "{e}");
-    assert!(e.contains("type mismatch in argument 2 of `f`: expected V2f, found float"), "{e}");
+    assert!(
+        e.contains("type mismatch in argument 2 of `f`: expected V2f, found float"),
+        "{e}"
+    );
     let e = load_error(&format!("{base}A(x) -> A(g(x))\n"));
     assert!(e.contains("unknown function `g`"), "{e}");
-    let e = load_error("module A(float);\nV2f g(float x) { return x; }\nderivation length: 1;\nAxiom: A(1);\n");
+    let e = load_error(
+        "module A(float);\nV2f g(float x) { return x; }\nderivation length: 1;\nAxiom: A(1);\n",
+    );
     assert!(e.contains("test.lsys:2:25"), "{e}");
-    assert!(e.contains("type mismatch: expected V2f, found float"), "{e}");
+    assert!(
+        e.contains("type mismatch: expected V2f, found float"),
+        "{e}"
+    );
 }
 
 /// The same program run by lpfg (vlab commit 9bf820d, through
@@ -355,4 +374,18 @@ fn the_table_tree_example() {
         .and_then(|s| s.parse().ok())
         .unwrap();
     assert!((len - order6).abs() < 1e-9, "{len} {order6}");
+}
+
+#[test]
+fn typedefs_of_structs_and_enums_and_arrays_of_strings() {
+    let src = "typedef struct SegTag { float len; int kind; } Seg;\n\
+               typedef enum { Short, Long } Size;\n\
+               module A(Seg, int, int);\n\
+               const char *names[] = {\"apex\", \"node\"};\n\
+               struct SegTag twice(Seg s) { s.len *= 2; return s; }\n\
+               Seg first = {1.5, 1};\n\
+               derivation length: 1;\nAxiom: A(first, 0, 0);\n\
+               A(s, a, b) : { Size z = Long; produce A(twice(s), z, strlen(names[1]) * 10 + strlen(names[0])); }\n";
+    // 1.5 doubled; Long is 1; "node" and "apex" have 4 characters each.
+    assert_eq!(run(src), "A({3, 1}, 1, 44)");
 }
