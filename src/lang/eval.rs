@@ -139,7 +139,8 @@ pub enum Flow {
 /// Loop iterations one body may run before it is stopped.
 pub const LOOP_LIMIT: u64 = 10_000_000;
 
-/// Loop iterations, over all bodies, between two looks at the deadline.
+/// Loop iterations and function calls, over all bodies, between two looks
+/// at the deadline.
 const DEADLINE_EVERY: u32 = 1 << 16;
 
 /// Calls of user-defined functions may nest this deep (a recursion); a
@@ -534,6 +535,13 @@ impl<'p> Interp<'p> {
                     f.name
                 ),
             ));
+        }
+        // A recursion without loops looks at the deadline too.
+        self.ticks = self.ticks.wrapping_add(1);
+        if self.ticks.is_multiple_of(DEADLINE_EVERY) {
+            if let Err(m) = crate::deadline::check(self.deadline) {
+                return Err(rt(Some(span), m));
+            }
         }
         self.calls += 1;
         let r = self.invoke(f, &mut frame, cx.env, span);

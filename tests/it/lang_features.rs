@@ -389,3 +389,60 @@ fn typedefs_of_structs_and_enums_and_arrays_of_strings() {
     // 1.5 doubled; Long is 1; "node" and "apex" have 4 characters each.
     assert_eq!(run(src), "A({3, 1}, 1, 44)");
 }
+
+/// A recursion without loops (fib(40) makes about 300 million calls)
+/// stops at the run's deadline: calls look at it as loops do.
+#[test]
+fn a_long_recursion_stops_at_the_deadline() {
+    let src = "module A(float);\n\
+               float fib(int n) { return n < 2 ? n : fib(n - 1) + fib(n - 2); }\n\
+               derivation length: 1;\nAxiom: A(40);\nA(n) -> A(fib(n))\n";
+    let l = load_text(src);
+    let opts = DeriveOptions::default().with_deadline(Some(subgram::Deadline::after(
+        std::time::Duration::from_millis(300),
+    )));
+    let start = std::time::Instant::now();
+    let e = l
+        .error(subgram::derive(&l.program, opts).unwrap_err())
+        .to_string();
+    assert!(e.contains("time limit"), "{e}");
+    assert!(e.contains("test.lsys:2:"), "{e}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(10));
+}
+
+/// `--format json` keeps standard output for the word alone: what the
+/// program prints goes to standard error there, and before the word in
+/// text mode.
+#[test]
+fn printed_text_and_the_json_word_do_not_mix() {
+    let dir = std::env::temp_dir().join(format!("subgram-printf-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("p.lsys");
+    std::fs::write(
+        &file,
+        "module A(int);\nderivation length: 1;\nAxiom: A(1);\n\
+         A(n) : { printf(\"n is %d\\n\", n); fprintf(stderr, \"to stderr\\n\"); produce A(n + 1); }\n",
+    )
+    .unwrap();
+    let run = |json: bool| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"));
+        c.arg("derive").arg(&file);
+        if json {
+            c.args(["--format", "json"]);
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success());
+        (
+            String::from_utf8(o.stdout).unwrap(),
+            String::from_utf8(o.stderr).unwrap(),
+        )
+    };
+    let (out, err) = run(false);
+    assert_eq!(out, "n is 1\nA(2)\n");
+    assert_eq!(err, "to stderr\n");
+    let (out, err) = run(true);
+    let word: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(word["modules"][0]["params"][0], 2);
+    assert_eq!(err, "n is 1\nto stderr\n");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
