@@ -239,7 +239,7 @@ pub struct Program {
     pub alphabet: Alphabet,
     pub structs: Vec<StructDef>,
     pub globals: Vec<GlobalVar>,
-    /// User-defined functions, called by [`Ex::CallUser`].
+    /// User-defined functions, called by `Ex::CallUser`.
     pub functions: Vec<Function>,
     pub axiom: Vec<Succ>,
     /// The directives, each with the span of the whole directive.
