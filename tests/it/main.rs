@@ -10,6 +10,7 @@ mod front_limits;
 mod fuzz_replay;
 mod golden;
 mod golden_tests;
+mod lang_features;
 mod limits;
 mod lsystems;
 mod mesh;
