@@ -375,6 +375,28 @@ impl<'p> Interp<'p> {
             }
             St::Break => Ok(Flow::Break),
             St::Continue => Ok(Flow::Continue),
+            St::Switch {
+                value,
+                cases,
+                default,
+                body,
+            } => {
+                let v = self.expr(value, cx)?.as_i64();
+                let start = match cases.binary_search_by_key(&v, |c| c.0) {
+                    Ok(k) => Some(cases[k].1),
+                    Err(_) => *default,
+                };
+                if let Some(start) = start {
+                    for s in &body[start as usize..] {
+                        match self.stmt(s, cx)? {
+                            Flow::Normal => {}
+                            Flow::Break => break,
+                            f => return Ok(f),
+                        }
+                    }
+                }
+                Ok(Flow::Normal)
+            }
         }
     }
 
@@ -612,6 +634,9 @@ impl<'p> Interp<'p> {
                 Flow::Normal => {}
                 _ => break,
             }
+        }
+        if let Some(r) = &f.result {
+            return self.expr(r, &mut cx);
         }
         match self.ret.take() {
             Some(v) => Ok(v),

@@ -466,6 +466,23 @@ impl<'t> Parser<'t> {
         }
         let name = self.name("the function's name")?;
         self.expect_punct("(", "after the function's name")?;
+        let params = self.params()?;
+        let body = if self.eat_punct(";") {
+            None
+        } else {
+            Some(self.block()?)
+        };
+        items.push(Item::Function(FunctionDef {
+            ret,
+            name,
+            params,
+            body,
+        }));
+        Ok(())
+    }
+
+    /// params := ( 'void' | [param {',' param}] ) ')'   (the `(` is consumed)
+    fn params(&mut self) -> PResult<Vec<Param>> {
         let mut params = Vec::new();
         if self.peek_ident("void") && self.peek_at(1).is_some_and(|t| t.tok.is_punct(")")) {
             self.pos += 1;
@@ -489,18 +506,7 @@ impl<'t> Parser<'t> {
                 self.expect_punct(",", "or `)` between the function's parameters")?;
             }
         }
-        let body = if self.eat_punct(";") {
-            None
-        } else {
-            Some(self.block()?)
-        };
-        items.push(Item::Function(FunctionDef {
-            ret,
-            name,
-            params,
-            body,
-        }));
-        Ok(())
+        Ok(params)
     }
 
     /// dims := { '[' [expr] ']' }
@@ -526,6 +532,14 @@ impl<'t> Parser<'t> {
 
     /// 'enum' [NAME] '{' NAME ['=' expr] {',' NAME ['=' expr]} [','] '}'
     fn enum_body(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        let (name, variants) = self.enum_parts()?;
+        items.push(Item::Enum { name, variants });
+        Ok(())
+    }
+
+    /// The name and the enumerators of an enum's body, from `enum`.
+    #[allow(clippy::type_complexity)]
+    fn enum_parts(&mut self) -> PResult<(Option<Name>, Vec<(Name, Option<Expr>)>)> {
         self.pos += 1;
         let name = if self.peek_punct("{") {
             None
@@ -549,8 +563,7 @@ impl<'t> Parser<'t> {
                 break;
             }
         }
-        items.push(Item::Enum { name, variants });
-        Ok(())
+        Ok((name, variants))
     }
 
     /// directive := KEY ':' expr ';'
@@ -651,38 +664,120 @@ impl<'t> Parser<'t> {
         }
     }
 
-    /// struct-decl := 'struct' NAME '{' { TYPE NAME {',' NAME} ';' } '}' ';'
+    /// struct-decl := 'struct' NAME struct-body ';'
     fn struct_decl(&mut self, items: &mut Vec<Item>) -> PResult<()> {
         self.pos += 1;
         let name = self.name("a struct name")?;
         self.type_names.insert(name.text.clone());
-        let fields = self.struct_fields()?;
+        let body = self.struct_body(Some(&name.text))?;
         self.expect_punct(";", "after the struct declaration")?;
-        items.push(Item::Struct { name, fields });
+        items.push(Item::Struct { name, body });
         Ok(())
     }
 
-    /// struct-fields := '{' { TYPE NAME dims {',' NAME dims} ';' } '}'
-    #[allow(clippy::type_complexity)]
-    fn struct_fields(&mut self) -> PResult<Vec<(TypeRef, Name, Vec<Option<Expr>>)>> {
+    /// struct-body := '{' { member } '}'
+    /// member := TYPE NAME dims {',' NAME dims} ';'
+    ///         | 'enum' [NAME] '{' ... '}' [NAME {',' NAME}] ';'
+    ///         | NAME '(' params ')' [':' NAME '(' args ')' {',' ...}] block   (a constructor)
+    ///         | ('public' | 'private' | 'protected') ':'
+    fn struct_body(&mut self, struct_name: Option<&str>) -> PResult<StructBody> {
         self.expect_punct("{", "to open the struct body")?;
-        let mut fields = Vec::new();
+        let mut body = StructBody::default();
         while !self.eat_punct("}") {
             if self.at_end() {
                 return self.error("`}` to close the struct");
             }
-            let ty = self.type_ref()?;
+            if ["public", "private", "protected"]
+                .iter()
+                .any(|w| self.peek_ident(w))
+                && self.peek_at(1).is_some_and(|t| t.tok.is_punct(":"))
+            {
+                self.pos += 2;
+                continue;
+            }
+            if self.peek_punct("~") {
+                return Err(Diagnostic::new(
+                    self.span_here(),
+                    "destructors are not supported: a struct here is a plain value",
+                ));
+            }
+            let is_ctor = struct_name.is_some_and(|n| self.peek_ident(n))
+                && self.peek_at(1).is_some_and(|t| t.tok.is_punct("("));
+            if is_ctor {
+                body.ctors.push(self.constructor()?);
+                continue;
+            }
+            let ty = if self.peek_ident("enum")
+                && (self.peek_at(1).is_some_and(|t| t.tok.is_punct("{"))
+                    || self.peek_at(2).is_some_and(|t| t.tok.is_punct("{")))
+            {
+                let (name, variants) = self.enum_parts()?;
+                let ty = TypeRef {
+                    name: name.as_ref().map_or("int", |n| &n.text).to_string(),
+                    span: name.as_ref().map_or(self.prev_span(), |n| n.span),
+                    pointer: false,
+                    reference: false,
+                };
+                body.enums.push((name, variants));
+                if self.eat_punct(";") {
+                    continue;
+                }
+                ty
+            } else {
+                self.type_ref()?
+            };
+            if self.peek_at(1).is_some_and(|t| t.tok.is_punct("(")) {
+                let at = self.span_here();
+                return Err(Diagnostic::new(
+                    at,
+                    "methods in structs are not supported: write a function that takes the struct as a parameter",
+                ));
+            }
             loop {
                 let f = self.name("a field name")?;
                 let dims = self.dims()?;
-                fields.push((ty.clone(), f, dims));
+                body.fields.push((ty.clone(), f, dims));
                 if !self.eat_punct(",") {
                     break;
                 }
             }
             self.expect_punct(";", "after the field declaration")?;
         }
-        Ok(fields)
+        Ok(body)
+    }
+
+    /// constructor := NAME '(' params ')' [':' NAME '(' args ')' {',' NAME '(' args ')'}] block
+    fn constructor(&mut self) -> PResult<Ctor> {
+        let name = self.name("the constructor's name")?;
+        self.pos += 1;
+        let params = self.params()?;
+        let mut inits = Vec::new();
+        if self.eat_punct(":") {
+            loop {
+                let field = self.name("a field to initialise")?;
+                self.expect_punct("(", "after the field's name in the initialiser list")?;
+                let open = self.prev_span();
+                let args = self.args(")")?;
+                inits.push((field, args, open.to(self.prev_span())));
+                if !self.eat_punct(",") {
+                    break;
+                }
+            }
+        }
+        if self.peek_punct(";") {
+            return Err(Diagnostic::new(
+                self.span_here(),
+                "a constructor needs its body here, e.g. `{}`: declarations of constructors defined elsewhere are not supported",
+            ));
+        }
+        let body = self.block()?;
+        self.eat_punct(";");
+        Ok(Ctor {
+            name,
+            params,
+            inits,
+            body,
+        })
     }
 
     /// typedef := 'typedef' TYPE NAME ';'
@@ -714,13 +809,13 @@ impl<'t> Parser<'t> {
             if let Some(t) = &tag {
                 self.type_names.insert(t.text.clone());
             }
-            let fields = self.struct_fields()?;
+            let body = self.struct_body(tag.as_ref().map(|t| t.text.as_str()))?;
             let name = self.name("the new type name")?;
             self.type_names.insert(name.text.clone());
             self.expect_punct(";", "after the typedef")?;
             items.push(Item::Struct {
                 name: name.clone(),
-                fields,
+                body,
             });
             if let Some(tag) = tag {
                 if tag.text != name.text {
@@ -1374,6 +1469,36 @@ impl<'t> Parser<'t> {
                     self.eat_punct(";");
                     return Ok(Stmt::Return(value, t.span));
                 }
+                "switch" => {
+                    self.pos += 1;
+                    let value = self.expr()?;
+                    let open = self.expect_punct("{", "to open the body of `switch`")?;
+                    let mut body = Vec::new();
+                    while !self.eat_punct("}") {
+                        if self.at_end() {
+                            return Err(Diagnostic::new(
+                                open,
+                                "unclosed `{`: expected `}` before the end of the file",
+                            ));
+                        }
+                        body.push(self.stmt()?);
+                    }
+                    return Ok(Stmt::Switch {
+                        value,
+                        body,
+                        span: t.span,
+                    });
+                }
+                "case" => {
+                    self.pos += 1;
+                    let value = self.cond_expr()?;
+                    self.expect_punct(":", "after the `case` label's value")?;
+                    return Ok(Stmt::Case(value, t.span));
+                }
+                "default" if self.peek_at(1).is_some_and(|n| n.tok.is_punct(":")) => {
+                    self.pos += 2;
+                    return Ok(Stmt::Default(t.span));
+                }
                 "break" | "continue" => {
                     self.pos += 1;
                     self.expect_punct(";", &format!("after `{w}`"))?;
@@ -1689,6 +1814,18 @@ impl<'t> Parser<'t> {
                     set: Box::new(set),
                     cond,
                 }
+            }
+            Tok::Ident(n)
+                if self.peek_at(1).is_some_and(|t| t.tok.is_punct("::"))
+                    && self
+                        .peek_at(2)
+                        .is_some_and(|t| matches!(t.tok, Tok::Ident(_))) =>
+            {
+                // `Shape::Circle`: an enumerator declared in a struct.
+                let scope = self.name("a name")?;
+                self.pos += 1;
+                let member = self.name("a name after `::`")?;
+                ExprKind::Ident(format!("{}::{}", scope.text, member.text))
             }
             Tok::Ident(n) => {
                 let name = self.name("a name")?;

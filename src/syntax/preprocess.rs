@@ -24,6 +24,14 @@ const KNOWN_HEADERS: &[&str] = &[
     "lintrfc.h",
 ];
 
+/// The standard C and C++ headers whose functions programs call: the
+/// library is built in, so an `#include <...>` of one of them is a no-op
+/// (a function that subgram lacks is refused where it is called).
+const STANDARD_HEADERS: &[&str] = &[
+    "assert.h", "ctype.h", "float.h", "limits.h", "memory.h", "string.h", "time.h", "cassert",
+    "cctype", "cfloat", "climits", "cstdio", "cstdlib", "cstring", "ctime", "iostream",
+];
+
 #[derive(Clone, Debug)]
 struct Macro {
     /// Tells a macro's expansions apart from those of an earlier
@@ -226,6 +234,7 @@ fn parse_define(name_tok: &Token, args: &[Token]) -> Result<Define, Diagnostic> 
 
 fn check_include(span: Span, args: &[Token]) -> Result<(), Diagnostic> {
     let mut name = String::new();
+    let angled = args.first().is_some_and(|t| t.tok.is_punct("<"));
     for t in args {
         match &t.tok {
             Tok::Ident(s) => name.push_str(s),
@@ -234,13 +243,20 @@ fn check_include(span: Span, args: &[Token]) -> Result<(), Diagnostic> {
             _ => {}
         }
     }
-    if KNOWN_HEADERS.contains(&name.as_str()) {
+    if KNOWN_HEADERS.contains(&name.as_str())
+        || (angled && STANDARD_HEADERS.contains(&name.as_str()))
+    {
         Ok(())
     } else {
+        let own = if angled {
+            ""
+        } else {
+            "; a program's own header files are not read"
+        };
         Err(Diagnostic::new(
             span,
             format!(
-                "cannot include `{name}`: only the built-in headers ({}) are available",
+                "cannot include `{name}`: only lpfg's headers ({}) and the standard C and C++ headers (<string.h>, <cstdlib>, ...) are available{own}",
                 KNOWN_HEADERS.join(", ")
             ),
         ))
