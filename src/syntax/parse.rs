@@ -1472,8 +1472,23 @@ impl<'t> Parser<'t> {
                 "switch" => {
                     self.pos += 1;
                     let value = self.expr()?;
-                    let open = self.expect_punct("{", "to open the body of `switch`")?;
                     let mut body = Vec::new();
+                    if !self.peek_punct("{") {
+                        // `switch (n) case 1: stmt;`: labels and one statement.
+                        while self.peek_ident("case")
+                            || (self.peek_ident("default")
+                                && self.peek_at(1).is_some_and(|t| t.tok.is_punct(":")))
+                        {
+                            body.push(self.stmt()?);
+                        }
+                        body.push(self.stmt_or_end()?);
+                        return Ok(Stmt::Switch {
+                            value,
+                            body,
+                            span: t.span,
+                        });
+                    }
+                    let open = self.bump().span;
                     while !self.eat_punct("}") {
                         if self.at_end() {
                             return Err(Diagnostic::new(
