@@ -171,6 +171,10 @@ struct UserSig {
     defined: bool,
 }
 
+/// The most elements of an array whose structs a constructor builds, one
+/// call each.
+const MAX_BUILT_ELEMENTS: usize = 1 << 16;
+
 /// The most user-defined functions a program may declare (each is
 /// numbered with a `u16`).
 const MAX_USER_FUNCTIONS: usize = u16::MAX as usize;
@@ -850,7 +854,7 @@ impl Compiler {
                 continue;
             };
             let mut scope = Scope::default();
-            let init = self.initializer(ty, &d.init, &mut scope);
+            let init = self.initializer(ty, &d.init, d.name.span, &mut scope);
             if scope.max > 0 {
                 self.err(d.name.span, "a global initializer cannot declare variables");
             }
@@ -879,15 +883,20 @@ impl Compiler {
         }
     }
 
-    /// The expression that initialises a variable of type `ty`.
-    fn initializer(&mut self, ty: Ty, init: &Init, scope: &mut Scope) -> Option<Ex> {
+    /// The expression that initialises a variable of type `ty`, declared
+    /// at `at`.
+    fn initializer(&mut self, ty: Ty, init: &Init, at: Span, scope: &mut Scope) -> Option<Ex> {
         let has_ctor = match ty {
             Ty::Struct(si) => self.ctors.contains_key(&self.structs[si as usize].name),
             _ => false,
         };
         match init {
-            // `S s;` and `S s(1, 2);` call `S`'s constructors.
-            Init::None if has_ctor => Some(self.default_value(ty, Span::default())),
+            // `S s;` and `S s(1, 2);` call `S`'s constructors; the structs
+            // of a plain struct or an array are built by theirs.
+            Init::None => match self.default_value(ty, at) {
+                Ex::Const(_) => None,
+                built => Some(built),
+            },
             Init::Ctor(args, span) if has_ctor => {
                 let name = ast::Name {
                     text: self.structs[pt_index(ty)].name.clone(),
@@ -895,7 +904,6 @@ impl Compiler {
                 };
                 self.ctor_call(&name, args, *span, scope)?.map(|t| t.0)
             }
-            Init::None => None,
             Init::Expr(e) => {
                 let (ex, et) = self.expr(e, scope)?;
                 self.coerce(ex, et, ty, e.span)
@@ -1290,7 +1298,7 @@ impl Compiler {
                         self.static_local(d, v, ty, scope);
                         continue;
                     }
-                    let init = self.initializer(ty, &v.init, scope);
+                    let init = self.initializer(ty, &v.init, v.name.span, scope);
                     let slot = self.local(scope, &v.name.text, ty, v.name.span);
                     if d.is_const {
                         scope.consts.insert(slot);
@@ -2745,7 +2753,7 @@ impl Compiler {
     #[inline(never)]
     fn static_local(&mut self, d: &ast::VarDecl, v: &ast::Declarator, ty: Ty, scope: &mut Scope) {
         let mut init_scope = Scope::default();
-        let init = self.initializer(ty, &v.init, &mut init_scope);
+        let init = self.initializer(ty, &v.init, v.name.span, &mut init_scope);
         if init_scope.max > 0 {
             self.err(
                 v.name.span,
@@ -2964,7 +2972,7 @@ impl Compiler {
             let value = if args.is_empty() {
                 Some(self.default_value(ty, span))
             } else {
-                self.initializer(ty, &Init::Ctor(args.clone(), span), &mut scope)
+                self.initializer(ty, &Init::Ctor(args.clone(), span), span, &mut scope)
             };
             if let Some(v) = value {
                 stmts.push(St::Init(slots[k], v));
@@ -2984,26 +2992,58 @@ impl Compiler {
     }
 
     /// The value a variable of type `ty` starts with when nothing
-    /// initialises it: zero, or for a struct with a constructor without
-    /// parameters, what that constructor makes.
+    /// initialises it, as C++ makes it: for a struct with a constructor
+    /// without parameters, what that constructor makes; for another struct
+    /// or an array, its fields or elements made so; otherwise zero (a
+    /// constant).
     fn default_value(&mut self, ty: Ty, span: Span) -> Ex {
-        if let Ty::Struct(si) = ty {
-            let name = &self.structs[si as usize].name;
-            let id = self.ctors.get(name).and_then(|ids| {
-                ids.iter()
-                    .copied()
-                    .find(|&id| self.user_fns[id as usize].params.is_empty())
-            });
-            if let Some(id) = id {
-                return Ex::CallUser {
-                    id,
-                    args: Vec::new(),
-                    back: Vec::new(),
-                    span,
-                };
-            }
+        let Ty::Struct(si) = ty else {
+            return Ex::Const(Value::zero(ty, &self.structs));
+        };
+        let zero = |c: &Compiler| Ex::Const(Value::zero(ty, &c.structs));
+        if self.ctors.is_empty() {
+            return zero(self);
         }
-        Ex::Const(Value::zero(ty, &self.structs))
+        let def = &self.structs[si as usize];
+        let id = self.ctors.get(&def.name).and_then(|ids| {
+            ids.iter()
+                .copied()
+                .find(|&id| self.user_fns[id as usize].params.is_empty())
+        });
+        if let Some(id) = id {
+            return Ex::CallUser {
+                id,
+                args: Vec::new(),
+                back: Vec::new(),
+                span,
+            };
+        }
+        let fields: Vec<Ty> = def.fields.iter().map(|f| f.1).collect();
+        if fields.len() > MAX_BUILT_ELEMENTS {
+            // Only the first field tells whether the elements of a long
+            // array are built: they all have its type.
+            if matches!(
+                fields.first().map(|&t| self.default_value(t, span)),
+                Some(Ex::Const(_)) | None
+            ) {
+                return zero(self);
+            }
+            self.err(
+                span,
+                format!(
+                    "an array of more than {MAX_BUILT_ELEMENTS} structs with constructors is not supported"
+                ),
+            );
+            return zero(self);
+        }
+        let parts: Vec<Ex> = fields
+            .iter()
+            .map(|&t| self.default_value(t, span))
+            .collect();
+        if parts.iter().all(|p| matches!(p, Ex::Const(_))) {
+            return zero(self);
+        }
+        Ex::MakeStruct(parts)
     }
 
     /// `S(args)` in an expression: the constructor of struct `S` that takes

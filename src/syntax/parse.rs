@@ -242,7 +242,7 @@ impl<'t> Parser<'t> {
             let next_colon = self.peek_at(1).is_some_and(|n| n.tok.is_punct(":"));
             match word.as_str() {
                 "module" => return self.module_decl(items),
-                "struct" if self.peek_at(2).is_some_and(|n| n.tok.is_punct("{")) => {
+                "struct" | "class" if self.peek_at(2).is_some_and(|n| n.tok.is_punct("{")) => {
                     return self.struct_decl(items)
                 }
                 "typedef" => return self.typedef(items),

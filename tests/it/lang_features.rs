@@ -697,5 +697,48 @@ fn standard_headers_are_accepted() {
         assert_eq!(run(&src), "A(2)", "{h}");
     }
     let e = load_error("#include \"growth.h\"\nmodule A;\nAxiom: A;\n");
-    assert!(e.contains("a program's own header files are not read"), "{e}");
+    assert!(
+        e.contains("a program's own header files are not read"),
+        "{e}"
+    );
+}
+
+/// C++ builds every struct that has a constructor without parameters,
+/// wherever one is made without an initialiser: in arrays, as fields of a
+/// struct without constructors (itself in a local, a global, or made by
+/// `Node()`), and as fields of a `class` with `public:`. By hand, every
+/// `Bud` is kind 7, size 0.5; `a(4)` has n 4. lpfg 9bf820d prints the
+/// same string. (`nd.w` is not read: C++ leaves it undefined, subgram
+/// makes it zero.)
+#[test]
+fn default_constructors_build_arrays_and_fields() {
+    let src = "struct Bud {\n\
+                 int kind;\n\
+                 float size;\n\
+                 Bud() : size(0.5) { kind = 7; }\n\
+               };\n\
+               struct Node { float w; Bud buds[3]; Bud main; };\n\
+               class Apex {\n\
+               public:\n\
+                 int n;\n\
+                 Bud b;\n\
+                 Apex(int k) : n(k) {}\n\
+               };\n\
+               Bud global_buds[2];\n\
+               Node gnode;\n\
+               module B(int, float, int, float, float);\n\
+               derivation length: 1;\n\
+               Axiom: B(0, 0, 0, 0, 0);\n\
+               B(x1, x2, x3, x4, x5) : {\n\
+                 Node nd;\n\
+                 Bud bs[2];\n\
+                 Apex a(4);\n\
+                 nproduce B(nd.buds[2].kind, nd.buds[1].size, nd.main.kind, nd.main.size, bs[1].size);\n\
+                 nproduce B(global_buds[1].kind, gnode.main.size, a.n, a.b.size, a.b.kind);\n\
+                 produce B(Node().buds[0].kind, 0, 0, 0, 0);\n\
+               }\n";
+    assert_eq!(
+        run(src),
+        "B(7, 0.5, 7, 0.5, 0.5) B(7, 0.5, 4, 0.5, 7) B(7, 0, 0, 0, 0)"
+    );
 }
