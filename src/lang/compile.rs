@@ -902,7 +902,7 @@ impl Compiler {
                     text: self.structs[pt_index(ty)].name.clone(),
                     span: *span,
                 };
-                self.ctor_call(&name, args, *span, scope)?.map(|t| t.0)
+                self.ctor_call(ty, &name, args, *span, scope).map(|t| t.0)
             }
             Init::Expr(e) => {
                 let (ex, et) = self.expr(e, scope)?;
@@ -1410,17 +1410,14 @@ impl Compiler {
                 out.push(St::Continue);
             }
             ast::Stmt::Switch { value, body, span } => self.switch(value, body, *span, scope, out),
-            ast::Stmt::Case(_, span) | ast::Stmt::Default(span) => {
-                let what = if matches!(s, ast::Stmt::Case(..)) {
-                    "case"
-                } else {
-                    "default"
-                };
-                self.err(
-                    *span,
-                    format!("a `{what}` label belongs directly in the body of a `switch`"),
-                );
-            }
+            ast::Stmt::Case(_, span) => self.err(
+                *span,
+                "a `case` label belongs directly in the body of a `switch`",
+            ),
+            ast::Stmt::Default(span) => self.err(
+                *span,
+                "a `default` label belongs directly in the body of a `switch`",
+            ),
             ast::Stmt::Empty => {}
         }
     }
@@ -2131,8 +2128,8 @@ impl Compiler {
         if let Some(&id) = self.user_fn_names.get(n) {
             return self.user_call(id, name, args, span, scope);
         }
-        if let Some(r) = self.ctor_call(name, args, span, scope) {
-            return r;
+        if let Some(ty) = self.struct_named(n) {
+            return self.ctor_call(ty, name, args, span, scope);
         }
         if let Some(r) = self.stdio_call(name, args, span, scope) {
             return r;
@@ -3046,45 +3043,46 @@ impl Compiler {
         Ex::MakeStruct(parts)
     }
 
-    /// `S(args)` in an expression: the constructor of struct `S` that takes
-    /// as many arguments; without constructors, `S()` is zero and `S(a, b)`
-    /// sets the fields in order. `None` when `name` is not a struct.
+    /// The struct type that `name` names (not an array's typedef).
+    fn struct_named(&self, name: &str) -> Option<Ty> {
+        match self.struct_names.get(name) {
+            Some(&si) => Some(Ty::Struct(si)),
+            None => match self.typedefs.get(name) {
+                Some(t @ Ty::Struct(si)) if self.structs[*si as usize].elem.is_none() => Some(*t),
+                _ => None,
+            },
+        }
+    }
+
+    /// `S(args)` in an expression, `S` naming struct type `ty`: the
+    /// constructor of `S` that takes as many arguments; without
+    /// constructors, `S()` is zero and `S(a, b)` sets the fields in order.
     #[inline(never)]
     fn ctor_call(
         &mut self,
+        ty: Ty,
         name: &ast::Name,
         args: &[ast::Expr],
         span: Span,
         scope: &mut Scope,
-    ) -> Option<Typed> {
-        let ty = match self.struct_names.get(&name.text) {
-            Some(&si) => Ty::Struct(si),
-            None => match self.typedefs.get(&name.text) {
-                Some(t @ Ty::Struct(si)) if self.structs[*si as usize].elem.is_none() => *t,
-                _ => return None,
-            },
-        };
-        let Ty::Struct(si) = ty else { return None };
-        let sname = self.structs[si as usize].name.clone();
+    ) -> Typed {
+        let sname = self.structs[pt_index(ty)].name.clone();
         let Some(ids) = self.ctors.get(&sname).cloned() else {
             if args.is_empty() {
-                return Some(Some((self.default_value(ty, span), ty)));
+                return Some((self.default_value(ty, span), ty));
             }
             let mut exs = Vec::new();
             for a in args {
-                exs.push(match self.expr(a, scope) {
-                    Some(t) => t,
-                    None => return Some(None),
-                });
+                exs.push(self.expr(a, scope)?);
             }
-            return Some(self.construct(ty, exs, args, span).map(|ex| (ex, ty)));
+            return self.construct(ty, exs, args, span).map(|ex| (ex, ty));
         };
         match ids
             .iter()
             .copied()
             .find(|&id| self.user_fns[id as usize].params.len() == args.len())
         {
-            Some(id) => Some(self.user_call(id, name, args, span, scope)),
+            Some(id) => self.user_call(id, name, args, span, scope),
             None => {
                 let mut counts: Vec<usize> = ids
                     .iter()
@@ -3100,7 +3098,7 @@ impl Compiler {
                         counts.join(" or ")
                     ),
                 );
-                Some(None)
+                None
             }
         }
     }

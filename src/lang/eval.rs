@@ -380,24 +380,36 @@ impl<'p> Interp<'p> {
                 cases,
                 default,
                 body,
-            } => {
-                let v = self.expr(value, cx)?.as_i64();
-                let start = match cases.binary_search_by_key(&v, |c| c.0) {
-                    Ok(k) => Some(cases[k].1),
-                    Err(_) => *default,
-                };
-                if let Some(start) = start {
-                    for s in &body[start as usize..] {
-                        match self.stmt(s, cx)? {
-                            Flow::Normal => {}
-                            Flow::Break => break,
-                            f => return Ok(f),
-                        }
-                    }
+            } => self.switch(value, cases, *default, body, cx),
+        }
+    }
+
+    /// Runs a `switch`'s body from the label of its value's; a `break`
+    /// ends it. Out of `stmt`, so that its frame stays small.
+    #[inline(never)]
+    fn switch(
+        &mut self,
+        value: &Ex,
+        cases: &[(i64, u32)],
+        default: Option<u32>,
+        body: &[St],
+        cx: &mut Cx,
+    ) -> R<Flow> {
+        let v = self.expr(value, cx)?.as_i64();
+        let start = match cases.binary_search_by_key(&v, |c| c.0) {
+            Ok(k) => Some(cases[k].1),
+            Err(_) => default,
+        };
+        if let Some(start) = start {
+            for s in &body[start as usize..] {
+                match self.stmt(s, cx)? {
+                    Flow::Normal => {}
+                    Flow::Break => break,
+                    f => return Ok(f),
                 }
-                Ok(Flow::Normal)
             }
         }
+        Ok(Flow::Normal)
     }
 
     fn produce(&mut self, modules: &[Succ], cx: &mut Cx) -> R<()> {

@@ -94,6 +94,9 @@ pub enum Item {
     },
 }
 
+/// An enum's enumerators, each with its value if one is written.
+pub type Enumerators = Vec<(Name, Option<Expr>)>;
+
 /// What a struct's braces hold.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StructBody {
@@ -101,7 +104,7 @@ pub struct StructBody {
     pub fields: Vec<(TypeRef, Name, Vec<Option<Expr>>)>,
     /// `enum { A, B } kind;`: enums declared inside, whose enumerators are
     /// constants, also as `Struct::A`.
-    pub enums: Vec<(Option<Name>, Vec<(Name, Option<Expr>)>)>,
+    pub enums: Vec<(Option<Name>, Enumerators)>,
     pub ctors: Vec<Ctor>,
 }
 

@@ -76,7 +76,38 @@ impl<'t> Parser<'t> {
     }
 }
 
+/// `Shape::Circle` as one name token (an enumerator declared in a struct,
+/// `Struct::Enum` as a type): no other use of `::` is part of the language.
+fn scoped_names(toks: &[Token]) -> Vec<Token> {
+    let mut out: Vec<Token> = Vec::with_capacity(toks.len());
+    let mut k = 0;
+    while k < toks.len() {
+        if let (Some(Tok::Ident(a)), Some(Tok::Ident(b))) =
+            (out.last().map(|t| &t.tok), toks.get(k + 1).map(|t| &t.tok))
+        {
+            if toks[k].tok.is_punct("::") {
+                let joined = format!("{a}::{b}");
+                let last = out.last_mut().expect("checked");
+                last.span = last.span.to(toks[k + 1].span);
+                last.tok = Tok::Ident(joined);
+                k += 2;
+                continue;
+            }
+        }
+        out.push(toks[k].clone());
+        k += 1;
+    }
+    out
+}
+
 pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<File> {
+    let scoped;
+    let toks = if toks.iter().any(|t| t.tok.is_punct("::")) {
+        scoped = scoped_names(toks);
+        &scoped[..]
+    } else {
+        toks
+    };
     // `angle:` anywhere switches on the single-character turtle.
     let abop = toks
         .windows(2)
@@ -1471,38 +1502,7 @@ impl<'t> Parser<'t> {
                 }
                 "switch" => {
                     self.pos += 1;
-                    let value = self.expr()?;
-                    let mut body = Vec::new();
-                    if !self.peek_punct("{") {
-                        // `switch (n) case 1: stmt;`: labels and one statement.
-                        while self.peek_ident("case")
-                            || (self.peek_ident("default")
-                                && self.peek_at(1).is_some_and(|t| t.tok.is_punct(":")))
-                        {
-                            body.push(self.stmt()?);
-                        }
-                        body.push(self.stmt_or_end()?);
-                        return Ok(Stmt::Switch {
-                            value,
-                            body,
-                            span: t.span,
-                        });
-                    }
-                    let open = self.bump().span;
-                    while !self.eat_punct("}") {
-                        if self.at_end() {
-                            return Err(Diagnostic::new(
-                                open,
-                                "unclosed `{`: expected `}` before the end of the file",
-                            ));
-                        }
-                        body.push(self.stmt()?);
-                    }
-                    return Ok(Stmt::Switch {
-                        value,
-                        body,
-                        span: t.span,
-                    });
+                    return self.switch_stmt(t.span);
                 }
                 "case" => {
                     self.pos += 1;
@@ -1536,6 +1536,37 @@ impl<'t> Parser<'t> {
             self.expect_punct(";", "after the expression")?;
         }
         Ok(Stmt::Expr(e))
+    }
+
+    /// switch := 'switch' expr ( '{' { stmt } '}' | { label } stmt ), from
+    /// after `switch`; labels are statements of the body. Out of
+    /// `stmt_inner`, so that its frame stays small.
+    #[inline(never)]
+    fn switch_stmt(&mut self, span: Span) -> PResult<Stmt> {
+        let value = self.expr()?;
+        let mut body = Vec::new();
+        if !self.peek_punct("{") {
+            // `switch (n) case 1: stmt;`: labels and one statement.
+            while self.peek_ident("case")
+                || (self.peek_ident("default")
+                    && self.peek_at(1).is_some_and(|t| t.tok.is_punct(":")))
+            {
+                body.push(self.stmt()?);
+            }
+            body.push(self.stmt_or_end()?);
+            return Ok(Stmt::Switch { value, body, span });
+        }
+        let open = self.bump().span;
+        while !self.eat_punct("}") {
+            if self.at_end() {
+                return Err(Diagnostic::new(
+                    open,
+                    "unclosed `{`: expected `}` before the end of the file",
+                ));
+            }
+            body.push(self.stmt()?);
+        }
+        Ok(Stmt::Switch { value, body, span })
     }
 
     fn stmt_or_end(&mut self) -> PResult<Stmt> {
@@ -1829,18 +1860,6 @@ impl<'t> Parser<'t> {
                     set: Box::new(set),
                     cond,
                 }
-            }
-            Tok::Ident(n)
-                if self.peek_at(1).is_some_and(|t| t.tok.is_punct("::"))
-                    && self
-                        .peek_at(2)
-                        .is_some_and(|t| matches!(t.tok, Tok::Ident(_))) =>
-            {
-                // `Shape::Circle`: an enumerator declared in a struct.
-                let scope = self.name("a name")?;
-                self.pos += 1;
-                let member = self.name("a name after `::`")?;
-                ExprKind::Ident(format!("{}::{}", scope.text, member.text))
             }
             Tok::Ident(n) => {
                 let name = self.name("a name")?;
