@@ -1282,7 +1282,7 @@ impl<'t> Parser<'t> {
                 self.pos += 1;
                 ExprKind::Int(*i)
             }
-            Tok::Float(f) => {
+            Tok::Float { value: f, .. } => {
                 self.pos += 1;
                 ExprKind::Float(*f)
             }

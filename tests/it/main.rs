@@ -17,6 +17,7 @@ mod mesh_bounds;
 mod mesh_draw;
 mod mesh_io;
 mod one_language;
+mod preprocessor;
 mod render;
 mod reverse;
 mod semantics;
