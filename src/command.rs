@@ -53,6 +53,9 @@ pub struct DeriveArgs {
     pub phase: usize,
     /// Print the word after interpretation rules.
     pub interpreted: bool,
+    /// `--seed`: seeds every random number generator (see
+    /// [`RunOptions::seed`]).
+    pub seed: Option<u32>,
     /// `--timeout`: the command stops with an error after this long.
     pub timeout: Option<Duration>,
 }
@@ -67,6 +70,7 @@ impl DeriveArgs {
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             interpreted: false,
+            seed: None,
             timeout: Some(DEFAULT_TIMEOUT),
         }
     }
@@ -81,6 +85,7 @@ pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, 
         steps: a.steps,
         max_modules: a.max_modules,
         phase: a.phase,
+        seed: a.seed,
         base_mesh: None,
         deadline,
     };
@@ -135,6 +140,9 @@ pub struct RenderArgs {
     pub defines: Vec<String>,
     pub max_modules: usize,
     pub phase: usize,
+    /// `--seed`: seeds every random number generator (see
+    /// [`RunOptions::seed`]).
+    pub seed: Option<u32>,
     /// `--timeout`: the command stops with an error after this long.
     pub timeout: Option<Duration>,
     /// Write the picture even over one of the inputs.
@@ -155,6 +163,7 @@ impl RenderArgs {
             defines: Vec::new(),
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
+            seed: None,
             timeout: Some(DEFAULT_TIMEOUT),
             force: false,
         }
@@ -205,6 +214,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                 steps: a.steps,
                 max_modules: a.max_modules,
                 phase: a.phase,
+                seed: a.seed,
                 base_mesh: None,
                 deadline,
             };

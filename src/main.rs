@@ -43,6 +43,11 @@ enum Command {
         /// Print the word after interpretation rules instead.
         #[arg(long)]
         interpreted: bool,
+        /// Seed every random number generator (ran, rand, drand48,
+        /// Gillespie groups) as if Start began with sran(N); srand(N);
+        /// srand48(N); SeedGillespie(N). Without it, lpfg's starting state.
+        #[arg(long, value_name = "N")]
+        seed: Option<u32>,
         /// Stop with an error after this many seconds (0: no limit).
         #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
@@ -78,6 +83,11 @@ enum Command {
         max_modules: usize,
         #[arg(long, default_value_t = 0)]
         phase: usize,
+        /// Seed every random number generator (ran, rand, drand48,
+        /// Gillespie groups) as if Start began with sran(N); srand(N);
+        /// srand48(N); SeedGillespie(N). Without it, lpfg's starting state.
+        #[arg(long, value_name = "N")]
+        seed: Option<u32>,
         /// Stop with an error after this many seconds (0: no limit).
         #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
@@ -334,6 +344,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             max_modules,
             phase,
             interpreted,
+            seed,
             timeout,
         } => {
             let args = DeriveArgs {
@@ -344,6 +355,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 max_modules,
                 phase,
                 interpreted,
+                seed,
                 timeout: timeout.0,
             };
             print_out(&with_progress(|p| command::derive(&args, p))?)
@@ -360,6 +372,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             define,
             max_modules,
             phase,
+            seed,
             timeout,
             force,
         } => {
@@ -375,6 +388,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 defines: define,
                 max_modules,
                 phase,
+                seed,
                 timeout: timeout.0,
                 force,
             };

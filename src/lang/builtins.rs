@@ -5,6 +5,7 @@
 //! same in a curve and in a surface grammar.
 
 use super::ir::Func;
+use super::random::Op;
 use super::value::Ty;
 
 /// Why a call does not fit a built-in's signature.
@@ -137,6 +138,19 @@ macro_rules! nullary {
     };
 }
 
+/// A random function of `random.rs` taking `$n` numbers.
+macro_rules! random {
+    ($name:literal, $n:literal, $op:expr, $t:expr) => {
+        Builtin {
+            name: $name,
+            resolve: |a| {
+                numbers(a, $n)?;
+                Ok((Func::Random($op), $t))
+            },
+        }
+    };
+}
+
 fn vector(a: &[Ty], name: &str) -> Result<Ty, SigError> {
     match a {
         [t] if t.is_vector() => Ok(*t),
@@ -242,11 +256,17 @@ pub static LIBRARY: &[Builtin] = &[
             Ok((Func::UseGroup, Ty::Void))
         },
     },
-    Builtin {
-        name: "ran",
-        resolve: |a| {
-            numbers(a, 1)?;
-            Ok((Func::Ran, Ty::Float))
-        },
-    },
+    random!("ran", 1, Op::Ran, Ty::Float),
+    random!("sran", 1, Op::SRan, Ty::Void),
+    random!("rand", 0, Op::Rand, Ty::Int),
+    random!("random", 0, Op::Rand, Ty::Int),
+    random!("srand", 1, Op::SRand, Ty::Void),
+    random!("srandom", 1, Op::SRand, Ty::Void),
+    random!("drand48", 0, Op::Drand48, Ty::Float),
+    random!("lrand48", 0, Op::Lrand48, Ty::Int),
+    random!("mrand48", 0, Op::Mrand48, Ty::Int),
+    random!("srand48", 1, Op::SRand48, Ty::Void),
+    random!("GillespieTime", 0, Op::GillespieTime, Ty::Float),
+    random!("SeedGillespie", 1, Op::SeedGillespie, Ty::Void),
+    random!("ResetGillespie", 0, Op::ResetGillespie, Ty::Void),
 ];

@@ -1399,6 +1399,7 @@ impl Compiler {
                     "M_PI_2" => Value::Float(std::f64::consts::FRAC_PI_2),
                     "M_E" => Value::Float(std::f64::consts::E),
                     "M_SQRT2" => Value::Float(std::f64::consts::SQRT_2),
+                    "RAND_MAX" => Value::Int(super::random::RAND_MAX),
                     _ => {
                         let hint = if self.alphabet.lookup(n).is_some() {
                             format!(": `{n}` is a module, not a value")
@@ -1411,6 +1412,7 @@ impl Compiler {
                 };
                 let ty = match c {
                     Value::Bool(_) => Ty::Bool,
+                    Value::Int(_) => Ty::Int,
                     _ => Ty::Float,
                 };
                 Some((Ex::Const(c), ty))

@@ -12,6 +12,7 @@ use crate::syntax::span::Span;
 
 use super::ir::*;
 use super::modules::Sym;
+use super::random::Random;
 use super::value::{StructDef, Ty, Value};
 
 /// Global state shared by all bodies of one derivation.
@@ -24,7 +25,9 @@ pub struct Env {
     /// Direction requested for the next step (`Forward()` / `Backward()`).
     pub forward: bool,
     pub stop: bool,
-    pub rng: u64,
+    /// The run's random number generators (`ran`, `rand`, `drand48`,
+    /// Gillespie steps).
+    pub random: Random,
 }
 
 impl Env {
@@ -36,7 +39,7 @@ impl Env {
             next_group: 0,
             forward: true,
             stop: false,
-            rng: 0x9E37_79B9_7F4A_7C15,
+            random: Random::default(),
         }
     }
 }
@@ -635,16 +638,7 @@ impl<'p> Interp<'p> {
                 cx.env.stop = true;
                 Value::Void
             }
-            Func::Ran => {
-                // xorshift64*: reproducible from run to run.
-                let mut x = cx.env.rng;
-                x ^= x >> 12;
-                x ^= x << 25;
-                x ^= x >> 27;
-                cx.env.rng = x;
-                let u = (x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64;
-                Value::Float(u * num(0))
-            }
+            Func::Random(op) => cx.env.random.call(op, vals),
             Func::NoOp => {
                 let _ = span;
                 Value::Void

@@ -85,7 +85,8 @@ pub enum Func {
     Backward,
     IsForward,
     Stop,
-    Ran,
+    /// `ran`, `rand`, `drand48`, their seeding, the Gillespie time.
+    Random(super::random::Op),
     NoOp,
     /// A built-in of the topology the program runs on, by its number in
     /// the topology's [`HostTable`](super::builtins::HostTable); the

@@ -5,6 +5,7 @@ pub mod compile;
 pub mod eval;
 pub mod ir;
 pub mod modules;
+pub mod random;
 pub mod stencil;
 pub mod value;
 

@@ -5,6 +5,7 @@
 use crate::deadline::Deadline;
 use crate::lang::eval::{Env, Interp, NoHost, RuntimeError};
 use crate::lang::ir::{Program, St};
+use crate::lang::random::Random;
 use crate::lang::{Sym, Value};
 use crate::syntax::ast::{ControlKind, Section};
 use crate::syntax::span::Span;
@@ -24,6 +25,9 @@ pub struct DeriveOptions {
     /// The derivation, its decomposition and interpretation stop with an
     /// error once this passes. Default: none.
     pub deadline: Option<Deadline>,
+    /// Seeds every random number generator before the globals and `Start`
+    /// (see `lang::random`); without it they start as lpfg's do.
+    pub seed: Option<u32>,
 }
 
 impl Default for DeriveOptions {
@@ -33,6 +37,7 @@ impl Default for DeriveOptions {
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             deadline: None,
+            seed: None,
         }
     }
 }
@@ -61,6 +66,11 @@ impl DeriveOptions {
 
     pub fn with_deadline(mut self, d: Option<Deadline>) -> Self {
         self.deadline = d;
+        self
+    }
+
+    pub fn with_seed(mut self, seed: u32) -> Self {
+        self.seed = Some(seed);
         self
     }
 }
@@ -170,6 +180,7 @@ impl<'p> Derivation<'p> {
     ) -> Result<Derivation<'p>, DeriveError> {
         let mut interp = Interp::with_deadline(&program.structs, opts.deadline);
         let mut env = Env::new(Vec::new());
+        env.random = Random::new(opts.seed);
         for g in &program.globals {
             let v = match &g.init {
                 Some(e) => interp

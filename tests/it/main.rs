@@ -18,6 +18,7 @@ mod mesh_draw;
 mod mesh_io;
 mod one_language;
 mod preprocessor;
+mod random;
 mod render;
 mod reverse;
 mod semantics;
