@@ -608,8 +608,12 @@ impl Compiler {
             angle: None,
             rules: Vec::new(),
             control: Vec::new(),
+            gillespie_groups: Vec::new(),
             warnings: Vec::new(),
         };
+        // Group numbers seen with `group` (false) and `ggroup` (true), and
+        // where first.
+        let mut group_kinds: Vec<(i64, bool, Span)> = Vec::new();
         let mut section = Section::Productions;
         let mut group = 0i64;
         let mut filter = Filter::All;
@@ -678,13 +682,38 @@ impl Compiler {
                     section = *s;
                     group = 0;
                 }
-                Item::Group { id, .. } => group = *id,
+                Item::Group {
+                    id,
+                    gillespie,
+                    span,
+                } => {
+                    group = *id;
+                    if *gillespie && *id <= 0 {
+                        self.err(
+                            *span,
+                            "a Gillespie group needs a number greater than 0: group 0 is the default group",
+                        );
+                    } else if *id != 0 {
+                        self.group_kind(*id, *gillespie, *span, &mut group_kinds);
+                    }
+                }
                 Item::Control { kind, body, .. } => {
                     let mut scope = Scope::default();
                     let stmts = self.block_stmts(&body.stmts, &mut scope);
                     program.control.push((*kind, stmts, scope.max as usize));
                 }
                 Item::Production(p) => {
+                    let gillespie = group_kinds.iter().any(|(g, k, _)| *g == group && *k);
+                    if gillespie && (!p.new_left.is_empty() || !p.new_right.is_empty()) {
+                        self.err(
+                            p.span,
+                            format!(
+                                "a production of a Gillespie group (`ggroup {group}:`) cannot \
+                                 have a new context (`<<` or `>>`): a Gillespie step rewrites \
+                                 one module in place (manual 7.2)"
+                            ),
+                        );
+                    }
                     if let Some(rule) = self.rule(p, section, group, &filter) {
                         program.rules.push(rule);
                     }
@@ -692,6 +721,11 @@ impl Compiler {
                 Item::Module { .. } | Item::Struct { .. } | Item::Typedef { .. } => {}
             }
         }
+        program.gillespie_groups = group_kinds
+            .iter()
+            .filter(|(_, g, _)| *g)
+            .map(|(id, _, span)| (*id, *span))
+            .collect();
         if !axiom_seen {
             let end = file
                 .items
@@ -852,6 +886,35 @@ impl Compiler {
             ),
         );
         None
+    }
+
+    /// Records group `id` as a Gillespie group or a regular one; the two
+    /// kinds share the numbers (manual 7.2), so one number cannot be both.
+    fn group_kind(
+        &mut self,
+        id: i64,
+        gillespie: bool,
+        span: Span,
+        seen: &mut Vec<(i64, bool, Span)>,
+    ) {
+        if let Some(&(_, was, _)) = seen.iter().find(|(g, _, _)| *g == id) {
+            if was != gillespie {
+                let (this, other) = if gillespie {
+                    ("ggroup", "group")
+                } else {
+                    ("group", "ggroup")
+                };
+                self.err(
+                    span,
+                    format!(
+                        "`{this} {id}:` reuses the number of an earlier `{other} {id}:`: a \
+                         regular group and a Gillespie group cannot have the same number"
+                    ),
+                );
+            }
+            return;
+        }
+        seen.push((id, gillespie, span));
     }
 
     fn rule(

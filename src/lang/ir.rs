@@ -208,6 +208,10 @@ pub struct Program {
     pub angle: Option<(Ex, Span)>,
     pub rules: Vec<Rule>,
     pub control: Vec<(ControlKind, Vec<St>, usize)>,
+    /// The numbers of the Gillespie groups (`ggroup N:`, manual 7.2),
+    /// whose steps apply one reaction (`rewrite/gillespie.rs`), each with
+    /// the span of its first `ggroup`.
+    pub gillespie_groups: Vec<(i64, Span)>,
     /// What `check` reports without refusing the program.
     pub warnings: Vec<Diagnostic>,
 }

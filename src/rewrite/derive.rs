@@ -408,15 +408,35 @@ impl<'p> Derivation<'p> {
         let step = self.step + 1;
         let mut origin = Vec::new();
         let traced = self.makers.is_some();
-        let result = self.rewriter.step(
-            &rules,
-            &self.word,
-            &mut dst,
-            &mut self.env,
-            &opts,
-            None,
-            traced.then_some(&mut origin),
-        );
+        let gillespie = self
+            .program
+            .gillespie_groups
+            .iter()
+            .find(|(g, _)| *g == self.env.current_group);
+        if let (Some((_, at)), false) = (gillespie, self.env.forward) {
+            return Err(DeriveError {
+                span: Some(*at),
+                message: format!(
+                    "at step {step}, group {} is a Gillespie group, which derives forward \
+                     only: `Backward()` cannot be used with it",
+                    self.env.current_group
+                ),
+                step,
+            });
+        }
+        let result = if gillespie.is_some() {
+            self.gillespie_step(&mut dst, traced.then_some(&mut origin))
+        } else {
+            self.rewriter.step(
+                &rules,
+                &self.word,
+                &mut dst,
+                &mut self.env,
+                &opts,
+                None,
+                traced.then_some(&mut origin),
+            )
+        };
         if let Err(e) = result {
             return Err(self.step_error(e, step));
         }
@@ -430,6 +450,33 @@ impl<'p> Derivation<'p> {
         self.answer_queries()?;
         self.control(ControlKind::EndEach)?;
         Ok(())
+    }
+
+    /// A step of the current group, a Gillespie group: its productions
+    /// only (no fall-back to group 0), one reaction in the whole word.
+    fn gillespie_step(
+        &mut self,
+        dst: &mut Word,
+        origin: Option<&mut Vec<u32>>,
+    ) -> Result<usize, StepError> {
+        let g = self.env.current_group;
+        let rules: Vec<usize> = self
+            .program
+            .rules_of(Section::Productions)
+            .filter(|(_, r)| r.group == g)
+            .map(|(i, _)| i)
+            .collect();
+        let opts = self.step_options();
+        super::gillespie::step(
+            &mut self.rewriter,
+            self.program,
+            &rules,
+            &self.word,
+            dst,
+            &mut self.env,
+            &opts,
+            origin,
+        )
     }
 
     /// Runs the remaining steps and `End`.

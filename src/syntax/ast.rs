@@ -66,9 +66,11 @@ pub enum Item {
         section: Section,
         span: Span,
     },
-    /// `group 1:`; `endgroup` is `Group { id: 0 }`.
+    /// `group 1:`, or `ggroup 1:` (`gillespie`, manual 7.2); `endgroup`
+    /// is `Group { id: 0 }`.
     Group {
         id: i64,
+        gillespie: bool,
         span: Span,
     },
     /// `Start: { ... }` and friends.

@@ -194,13 +194,23 @@ impl<'t> Parser<'t> {
         TYPE_KEYWORDS.contains(&s) || self.type_names.contains(s)
     }
 
+    /// True when `propensity` at the cursor starts a Gillespie statement,
+    /// not an expression about a variable of that name.
+    fn at_propensity(&self) -> bool {
+        !self.peek_at(1).is_some_and(|t| {
+            ["=", "+=", "-=", "*=", "/=", "++", "--", ".", "[", ";", ","]
+                .iter()
+                .any(|p| t.tok.is_punct(p))
+        })
+    }
+
     /// True when the tokens at the cursor begin a declaration:
     /// `const ...`, `struct Name ...`, `TYPE name`, or `Name name`.
     fn at_declaration(&self) -> bool {
         match (self.peek().map(|t| &t.tok), self.peek_at(1).map(|t| &t.tok)) {
             (Some(Tok::Ident(a)), Some(Tok::Ident(_))) => !matches!(
                 a.as_str(),
-                "produce" | "nproduce" | "return" | "else" | "if" | "while"
+                "produce" | "nproduce" | "return" | "else" | "if" | "while" | "propensity"
             ),
             (Some(Tok::Ident(a)), _) => a == "const",
             _ => false,
@@ -300,7 +310,8 @@ impl<'t> Parser<'t> {
                     });
                     return Ok(());
                 }
-                "group" => {
+                "group" | "ggroup" => {
+                    let gillespie = word == "ggroup";
                     self.pos += 1;
                     let id = match self.peek().map(|t| &t.tok) {
                         Some(Tok::Int(i)) => *i,
@@ -308,14 +319,22 @@ impl<'t> Parser<'t> {
                     };
                     self.pos += 1;
                     self.expect_punct(":", "after the group number")?;
-                    items.push(Item::Group { id, span: start });
+                    items.push(Item::Group {
+                        id,
+                        gillespie,
+                        span: start,
+                    });
                     return Ok(());
                 }
                 "endgroup" => {
                     self.pos += 1;
                     self.eat_punct(":");
                     self.eat_punct(";");
-                    items.push(Item::Group { id: 0, span: start });
+                    items.push(Item::Group {
+                        id: 0,
+                        gillespie: false,
+                        span: start,
+                    });
                     return Ok(());
                 }
                 "Start" | "StartEach" | "EndEach" | "End" if next_colon => {
@@ -959,6 +978,32 @@ impl<'t> Parser<'t> {
                     return Ok(Stmt::Produce {
                         modules,
                         last,
+                        span: t.span,
+                    });
+                }
+                "propensity" if self.at_propensity() => {
+                    // `propensity E produce W;` (manual 7.2) is lpfg's
+                    // `nproduce Propensity(E) W;`: a Gillespie step reads
+                    // the reactions back from the successor.
+                    self.pos += 1;
+                    let value = self.expr()?;
+                    if !self.eat_ident("produce") {
+                        return self.error("`produce` after the propensity");
+                    }
+                    let mut modules = vec![ModuleCall {
+                        name: Name {
+                            text: "Propensity".into(),
+                            span: t.span,
+                        },
+                        args: vec![value],
+                    }];
+                    modules.extend(self.module_calls(&[";"], true)?);
+                    if !self.peek_punct("}") {
+                        self.expect_punct(";", "after the successor")?;
+                    }
+                    return Ok(Stmt::Produce {
+                        modules,
+                        last: false,
                         span: t.span,
                     });
                 }

@@ -8,6 +8,7 @@ mod curves;
 mod errors;
 mod front_limits;
 mod fuzz_replay;
+mod gillespie;
 mod golden;
 mod golden_tests;
 mod limits;
