@@ -124,6 +124,7 @@ fn the_first_step_follows_gillespies_method_exactly() {
 /// Contexts are matched as in any step; a module whose productions give
 /// no propensity (or zero) never reacts, and with no propensity at all the
 /// word and the time stand still.
+/// lpfg gives the first word too (A() C() B()).
 #[test]
 fn contexts_and_zero_propensities() {
     let src = "module A; module B; module C;\nderivation length: 1;\nStart: { UseGroup(1); }\n\
@@ -140,7 +141,8 @@ fn contexts_and_zero_propensities() {
 }
 
 /// Modules after a `Cut` in its branch do not react; a group chosen with
-/// UseGroup in StartEach alternates with a regular one.
+/// UseGroup in StartEach alternates with a regular one. lpfg gives both
+/// words (SB() Cut() A(0) EB() A(1), and A(10)).
 #[test]
 fn cut_branches_and_alternating_groups() {
     let src = "module A(int);\nderivation length: 1;\nStart: { UseGroup(1); }\n\
@@ -155,4 +157,61 @@ fn cut_branches_and_alternating_groups() {
                endgroup\ngroup 2:\nA(c) : { produce A(2 * c); }\n";
     // 1 -> 2 -> 4 -> 5 -> 10
     assert_eq!(run(src, DeriveOptions::default()).0, "A(10)");
+}
+
+/// Programs run by lpfg (vlab 9bf820d, built headless by
+/// ../shared/tools/lpfg) give these words, to the last printed digit:
+/// three places with two reactions each, several productions of a module
+/// with contexts, and a run seeded with `SeedGillespie` whose reactions
+/// record `GillespieTime()` in the word.
+#[test]
+fn words_agree_with_lpfg() {
+    let three = "#include <lpfgall.h>\nmodule S(int, int);\nderivation length: 20;\n\
+        Start: { UseGroup(1); }\nAxiom: S(0, 0) S(0, 0) S(5, 5);\nggroup 1:\n\
+        S(l, r) :\n{\n  propensity 1 + 0.1 * r produce S(l + 1, r);\n\
+          propensity 3 produce S(l, r + 1);\n}\nendgroup\n";
+    assert_eq!(
+        run(three, DeriveOptions::default()).0,
+        "S(2, 3) S(2, 5) S(8, 10)"
+    );
+    // Every matching production of a module adds its reactions, contexts
+    // included.
+    let several = "#include <lpfgall.h>\nmodule A(int);\nmodule B(int);\n\
+        derivation length: 6;\nStart: { UseGroup(1); }\nAxiom: A(0) B(0) A(0);\n\
+        ggroup 1:\nA(n) : { propensity 1 produce A(n + 1); }\n\
+        A(n) : { propensity 2 produce A(n + 10); }\n\
+        B(n) > A(m) : { propensity 0.5 produce B(n + 100); }\n\
+        B(n) : { propensity 0.25 produce B(n + 1000) A(7); }\nendgroup\n";
+    assert_eq!(
+        run(several, DeriveOptions::default()).0,
+        "A(11) B(100) A(12)"
+    );
+    let timed = "#include <lpfgall.h>\nmodule S(int, int);\nmodule T(double);\ndouble t;\n\
+        derivation length: 30;\nStart: { UseGroup(1); SeedGillespie(11); }\n\
+        EndEach: { t = GillespieTime(); }\nAxiom: S(0, 0) T(0);\nggroup 1:\n\
+        S(l, r) :\n{\n  propensity 0.7 produce S(l + 1, r) T(GillespieTime());\n\
+          propensity 2.5 produce S(l, r + 1);\n}\n\
+        T(x) : { propensity 0.2 produce T(x + 1); }\nendgroup\n";
+    let l = load_text(timed);
+    let d = derive(&l, DeriveOptions::default());
+    let params: Vec<f64> = d
+        .word
+        .modules(&l.program.alphabet, &l.program.structs)
+        .flat_map(|(_, ps)| ps)
+        .map(|v| float(&v))
+        .collect();
+    let lpfg = [
+        8.0,
+        16.0,
+        6.918141504050389,
+        5.705261415355819,
+        4.617231955235017,
+        2.6557186817432186,
+        4.291484576947559,
+        1.1384799482112737,
+        0.012506588086982729,
+        0.0,
+        0.0,
+    ];
+    assert_eq!(params, lpfg);
 }

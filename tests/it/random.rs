@@ -138,3 +138,37 @@ fn the_binary_takes_a_seed() {
     assert_eq!(o.status.code(), Some(2), "a negative seed is a usage error");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// lpfg (vlab 9bf820d, built headless by ../shared/tools/lpfg) prints these
+/// words for the same two programs, unseeded and seeded in Start.
+#[test]
+fn numbers_agree_with_lpfg() {
+    let unseeded = "#include <lpfgall.h>\nmodule X(double);\nmodule I(int);\n\
+        Axiom: X(ran(1)) X(ran(10)) I(rand()) I(rand()) I(RAND_MAX) X(drand48()) I(lrand48());\n";
+    assert_eq!(
+        numbers(unseeded, DeriveOptions::default()),
+        [
+            0.17082803610628972,
+            7.499019804849638,
+            1804289383.0,
+            846930886.0,
+            2147483647.0,
+            3.907985046680551e-14,
+            2116118.0
+        ]
+    );
+    let seeded = "#include <lpfgall.h>\nmodule X(double);\nmodule I(int);\n\
+        Start: { sran(5); srand(42); srand48(7); }\n\
+        Axiom: X(ran(1)) X(ran(1)) I(rand()) I(rand()) X(drand48()) I(lrand48());\n";
+    assert_eq!(
+        numbers(seeded, DeriveOptions::default()),
+        [
+            0.000447906670316911,
+            0.655824306910997,
+            71876166.0,
+            708592740.0,
+            0.2664441967654092,
+            1464659504.0
+        ]
+    );
+}
