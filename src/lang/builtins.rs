@@ -197,6 +197,45 @@ pub static LIBRARY: &[Builtin] = &[
     math2!("hypot", f64::hypot),
     math2!("fmin", f64::min),
     math2!("fmax", f64::max),
+    // C's single-precision functions: the argument rounded to a float, the
+    // float function (Rust's f32 functions are the platform's libm ones,
+    // as lpfg's program calls them), the result a float's value.
+    math1!("sinf", |x: f64| f64::from((x as f32).sin())),
+    math1!("cosf", |x: f64| f64::from((x as f32).cos())),
+    math1!("tanf", |x: f64| f64::from((x as f32).tan())),
+    math1!("asinf", |x: f64| f64::from((x as f32).asin())),
+    math1!("acosf", |x: f64| f64::from((x as f32).acos())),
+    math1!("atanf", |x: f64| f64::from((x as f32).atan())),
+    math1!("sinhf", |x: f64| f64::from((x as f32).sinh())),
+    math1!("coshf", |x: f64| f64::from((x as f32).cosh())),
+    math1!("tanhf", |x: f64| f64::from((x as f32).tanh())),
+    math1!("sqrtf", |x: f64| f64::from((x as f32).sqrt())),
+    math1!("cbrtf", |x: f64| f64::from((x as f32).cbrt())),
+    math1!("expf", |x: f64| f64::from((x as f32).exp())),
+    math1!("logf", |x: f64| f64::from((x as f32).ln())),
+    math1!("log10f", |x: f64| f64::from((x as f32).log10())),
+    math1!("log2f", |x: f64| f64::from((x as f32).log2())),
+    math1!("fabsf", |x: f64| f64::from((x as f32).abs())),
+    math1!("floorf", |x: f64| f64::from((x as f32).floor())),
+    math1!("ceilf", |x: f64| f64::from((x as f32).ceil())),
+    math1!("roundf", |x: f64| f64::from((x as f32).round())),
+    math1!("truncf", |x: f64| f64::from((x as f32).trunc())),
+    math2!("atan2f", |y: f64, x: f64| f64::from(
+        (y as f32).atan2(x as f32)
+    )),
+    math2!("powf", |x: f64, y: f64| f64::from(
+        (x as f32).powf(y as f32)
+    )),
+    math2!("fmodf", |x: f64, y: f64| f64::from((x as f32) % (y as f32))),
+    math2!("hypotf", |x: f64, y: f64| f64::from(
+        (x as f32).hypot(y as f32)
+    )),
+    math2!("fminf", |x: f64, y: f64| f64::from(
+        (x as f32).min(y as f32)
+    )),
+    math2!("fmaxf", |x: f64, y: f64| f64::from(
+        (x as f32).max(y as f32)
+    )),
     Builtin {
         name: "abs",
         resolve: |a| int_or_float(a, 1, Func::AbsInt, Func::Math1(f64::abs)),

@@ -1,5 +1,5 @@
-//! The preprocessor's conditionals with `#define` and `-D`, and C's
-//! literal forms, on whole programs. The expected words follow from C's
+//! The preprocessor's conditionals with `#define` and `-D`, C's literal
+//! forms and C's single-precision maths functions, on whole programs. The expected words follow from C's
 //! rules for `#if` (one group of each conditional is kept, the first whose
 //! condition is true) worked out by hand in each test.
 
@@ -128,4 +128,38 @@ fn c_literals_in_programs() {
     ];
     assert_eq!(params, want);
     assert!(params[8] > 1e-9, "0.1f is not rounded to a float");
+}
+
+/// C's `float` functions (`expf`, `sqrtf`, …) as lpfg's programs call
+/// them: on the argument rounded to a float, giving a float. The expected
+/// values are what a C program compiled with gcc (glibc 2.36) printed with
+/// "%.17g" for the same calls on float arguments.
+#[test]
+#[allow(clippy::excessive_precision)]
+fn c_float_functions() {
+    let src = "module X(double);\n\
+               Axiom: X(expf(1)) X(sqrtf(2)) X(sinf(0.5)) X(logf(3.3)) X(powf(0.7, 3.3)) \
+               X(atan2f(0.7, 3.3)) X(fmodf(3.3, 0.7));";
+    let l = load_text(src);
+    let d = derive(&l, DeriveOptions::default());
+    let got: Vec<f64> = d
+        .word
+        .modules(&l.program.alphabet, &l.program.structs)
+        .map(|(_, ps)| match ps[0] {
+            Value::Float(f) => f,
+            ref other => panic!("{other:?}"),
+        })
+        .collect();
+    let gcc = [
+        2.7182817459106445,
+        1.4142135381698608,
+        0.47942554950714111,
+        1.1939224004745483,
+        0.30819353461265564,
+        0.20902295410633087,
+        0.5,
+    ];
+    assert_eq!(got, gcc);
+    // Not the double functions' values.
+    assert_ne!(got[0], std::f64::consts::E);
 }
