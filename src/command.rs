@@ -9,7 +9,7 @@ use std::time::Duration;
 use crate::curve::FigureOptions;
 use crate::deadline::{Deadline, DEFAULT_TIMEOUT};
 use crate::error::Error;
-use crate::load::{load, LoadOptions};
+use crate::load::{load, LoadOptions, Precision};
 use crate::mesh::{self, Mesh};
 use crate::render::{self, Rgba, Scene, View};
 use crate::reverse::{self, Phase, ReverseOptions, Scheme};
@@ -18,10 +18,8 @@ use crate::system::{load_mesh, Progress, RunOptions, Surface, System};
 
 /// `subgram check FILE [-D NAME=VALUE]…`: reports every diagnostic, or one
 /// line that says what the file holds.
-pub fn check(file: &str, defines: &[String]) -> Result<String, Error> {
-    let opts = LoadOptions {
-        defines: defines.to_vec(),
-    };
+pub fn check(file: &str, defines: &[String], double: bool) -> Result<String, Error> {
+    let opts = load_options(defines, double);
     let system = load(file, &opts)?;
     let ok = match &system {
         System::Surface(s) => format!(
@@ -49,6 +47,8 @@ pub struct DeriveArgs {
     /// `--format json` instead of text.
     pub json: bool,
     pub defines: Vec<String>,
+    /// `--double`: `float` in double precision instead of lpfg's single.
+    pub double: bool,
     pub max_modules: usize,
     pub phase: usize,
     /// Print the word after interpretation rules.
@@ -67,6 +67,7 @@ impl DeriveArgs {
             steps: None,
             json: false,
             defines: Vec::new(),
+            double: false,
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             interpreted: false,
@@ -80,7 +81,7 @@ impl DeriveArgs {
 /// or JSON; for a surface grammar, the subdivided mesh's description.
 pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, Error> {
     let deadline = a.timeout.map(Deadline::after);
-    let system = load(&a.file, &load_options(&a.defines))?;
+    let system = load(&a.file, &load_options(&a.defines, a.double))?;
     let opts = RunOptions {
         steps: a.steps,
         max_modules: a.max_modules,
@@ -131,13 +132,17 @@ pub struct RenderArgs {
     pub size: (u32, u32),
     /// Draw every step 0..=N side by side (curves).
     pub each: bool,
-    pub background: Rgba,
+    /// The background; `None`: colour 0 of the model's colour map or
+    /// material 0's emission when the program comes with one, else white.
+    pub background: Option<Rgba>,
     /// Curves: xy (the default), xz or yz. Meshes: iso, front, back, left,
     /// right, top or bottom.
     pub view: Option<String>,
     /// Meshes: draw the edges over the faces.
     pub wireframe: bool,
     pub defines: Vec<String>,
+    /// `--double`: `float` in double precision instead of lpfg's single.
+    pub double: bool,
     pub max_modules: usize,
     pub phase: usize,
     /// `--seed`: seeds every random number generator (see
@@ -157,10 +162,11 @@ impl RenderArgs {
             steps: None,
             size: (800, 800),
             each: false,
-            background: Rgba(255, 255, 255, 255),
+            background: None,
             view: None,
             wireframe: true,
             defines: Vec::new(),
+            double: false,
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             seed: None,
@@ -177,9 +183,10 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
     refuse_overwrite(&[output], &[file], a.force)?;
+    let white = Rgba(255, 255, 255, 255);
     let looks = MeshLooks {
         size: a.size,
-        background: a.background,
+        background: a.background.unwrap_or(white),
         view: a.view.as_deref(),
         wireframe: a.wireframe,
     };
@@ -187,7 +194,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
         return write_mesh_picture(&load_mesh(file)?, output, &looks);
     }
     let format = Picture::from_path(output)?;
-    match load(file, &load_options(&a.defines))? {
+    match load(file, &load_options(&a.defines, a.double))? {
         System::Surface(s) => {
             looks.check()?;
             let opts = RunOptions {
@@ -218,6 +225,14 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                 base_mesh: None,
                 deadline,
             };
+            let model = &c.program.model;
+            let palette = model
+                .palette()
+                .map(|p| std::sync::Arc::new(p.map(|[r, g, b]| Rgba(r, g, b, 255))));
+            let model_background = model.colours.as_ref().map(|m| {
+                let [r, g, b] = m.background();
+                Rgba(r, g, b, 255)
+            });
             let figure = FigureOptions {
                 derive: opts.derive_options(),
                 each: a.each,
@@ -225,8 +240,10 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                 render: render::RenderOptions {
                     width: a.size.0,
                     height: a.size.1,
-                    background: a.background,
+                    background: a.background.or(model_background).unwrap_or(white),
                     view,
+                    palette,
+                    widths_in_units: model.widths_in_units,
                     ..Default::default()
                 },
             };
@@ -590,9 +607,14 @@ fn json(value: &impl serde::Serialize) -> Result<String, Error> {
     serde_json::to_string_pretty(value).map_err(|e| Error::Failed(e.to_string()))
 }
 
-fn load_options(defines: &[String]) -> LoadOptions {
+fn load_options(defines: &[String], double: bool) -> LoadOptions {
     LoadOptions {
         defines: defines.to_vec(),
+        precision: if double {
+            Precision::Double
+        } else {
+            Precision::Single
+        },
     }
 }
 

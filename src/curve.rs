@@ -137,6 +137,7 @@ impl Curve {
         let fail = |e| self.error(e);
         let mut d = Derivation::new(p, opts.derive.clone()).map_err(fail)?;
         let mut draw_opts = opts.draw.clone();
+        draw_opts.model = p.model.clone();
         if let Some(a) = d.angle().map_err(fail)? {
             draw_opts.angle = a;
         }
@@ -225,7 +226,10 @@ impl<'c> CurveRun<'c> {
     /// polygons, in 3D.
     pub fn events(&mut self) -> Result<Vec<Event>, Error> {
         let curve = self.curve;
-        let mut opts = draw::DrawOptions::default();
+        let mut opts = draw::DrawOptions {
+            model: curve.program.model.clone(),
+            ..Default::default()
+        };
         if let Some(a) = self.d.angle().map_err(|e| curve.error(e))? {
             opts.angle = a;
         }

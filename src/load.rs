@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 use crate::curve::Curve;
 use crate::error::Error;
 use crate::lang;
+pub use crate::lang::compile::Precision;
+use crate::model::{self, Model};
 use crate::surface;
 use crate::syntax::lex::{self, Token};
 use crate::syntax::{parse, preprocess, Diagnostic, FileId, SourceFile, SourceMap, Span};
@@ -18,6 +20,9 @@ pub struct LoadOptions {
     /// `#define` overrides, each `NAME=VALUE` (the binary's `-D`); they win
     /// over the file's own `#define`s and `angle:` values.
     pub defines: Vec<String>,
+    /// What C's `float` is: single precision as in lpfg (the default), or
+    /// double (`--double`). Surface grammars compute in double always.
+    pub precision: Precision,
 }
 
 impl LoadOptions {
@@ -47,13 +52,113 @@ pub fn load(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<System, Error>
 }
 
 fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
+    if let Some(files) = model::find(path)? {
+        let m = Model::read(&files.files)?;
+        let c = load_model_file(&files.lsystem, m, &opts.defines, opts.precision)?;
+        return Ok(System::Curve(c));
+    }
     let text = read(path)?;
     let front = front(&path.display().to_string(), text, &opts.defines)?;
     if surface::is_surface(&front.tokens) {
         let grammar = surface::from_front(front)?;
         Ok(System::Surface(Surface::new(grammar, Some(path))))
     } else {
-        Ok(System::Curve(curve(front)?))
+        Ok(System::Curve(curve(front, opts.precision)?))
+    }
+}
+
+/// Loads an lpfg program with its model: the model's names are defined
+/// first (`-D` overrides win over them), the program is checked as a
+/// curve, and the model goes with it; what the model's files say without
+/// refusing the program joins the checker's warnings.
+fn load_model_file(
+    path: &Path,
+    m: Model,
+    user: &[String],
+    precision: Precision,
+) -> Result<Curve, Error> {
+    let text = read(path)?;
+    let mut defines = m.defines();
+    defines.retain(|d| {
+        let name = d.split('=').next().unwrap_or("");
+        !user
+            .iter()
+            .any(|u| u.split('=').next().map(str::trim) == Some(name))
+    });
+    defines.extend(user.iter().cloned());
+    let front = front(&path.display().to_string(), text, &defines)?;
+    let mut c = match curve(front, precision) {
+        Ok(c) => c,
+        Err(e) => return Err(name_missing_entities(e, &m)),
+    };
+    for note in &m.notes {
+        let file = c
+            .sources
+            .add(SourceFile::new(note.file.clone(), note.text.clone()));
+        c.program.warnings.push(Diagnostic::new(
+            Span::new(file, note.start, note.end),
+            note.message.clone(),
+        ));
+    }
+    c.program.model = std::sync::Arc::new(m);
+    Ok(c)
+}
+
+/// A check that failed because the program names a function, contour or
+/// parameter that no model file defines (`func(leaf_length, x)` with no
+/// `leaf_length` in the `.fset`): the diagnostic at that name says so.
+fn name_missing_entities(e: Error, m: &Model) -> Error {
+    let Error::Program {
+        sources,
+        mut diagnostics,
+    } = e
+    else {
+        return e;
+    };
+    for d in &mut diagnostics {
+        let text = &sources.get(d.span.file).text;
+        let (a, b) = (d.span.start as usize, d.span.end as usize);
+        let Some(name) = text.get(a..b) else { continue };
+        if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            continue;
+        }
+        // The call around the name: `accessor (` just before it.
+        let before = text[..a].trim_end();
+        let Some(before) = before.strip_suffix('(') else {
+            continue;
+        };
+        let before = before.trim_end();
+        let Some(acc) = model::ACCESSOR_NAMES.iter().find(|n| {
+            before.ends_with(*n)
+                && !before[..before.len() - n.len()]
+                    .ends_with(|c: char| c.is_ascii_alphanumeric() || c == '_')
+        }) else {
+            continue;
+        };
+        let what = if acc.starts_with("curve") {
+            "contour: no `.cset` or `.con` file of the model defines it".to_string()
+        } else if *acc == "val" {
+            "parameter: no `.vset` file of the model defines it".to_string()
+        } else {
+            "function: no `.fset`, `.func` or `.tset` file of the model defines it".to_string()
+        };
+        let read: Vec<String> = m
+            .files
+            .iter()
+            .filter_map(|p| p.file_name().map(|n| format!("`{}`", n.to_string_lossy())))
+            .collect();
+        d.message = format!(
+            "`{name}` names no {what} ({})",
+            if read.is_empty() {
+                "the model has no files beside the program".to_string()
+            } else {
+                format!("the files read are {}", read.join(", "))
+            }
+        );
+    }
+    Error::Program {
+        sources,
+        diagnostics,
     }
 }
 
@@ -70,16 +175,29 @@ fn load_text_as(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Er
         let grammar = surface::from_front(front)?;
         Ok(System::Surface(Surface::new(grammar, None)))
     } else {
-        Ok(System::Curve(curve(front)?))
+        Ok(System::Curve(curve(front, opts.precision)?))
     }
 }
 
 /// Loads a file as a curve L-system, whatever its syntax says; `defines`
-/// are `NAME=VALUE` overrides.
+/// are `NAME=VALUE` overrides. The file is read alone: [`load`] reads an
+/// lpfg model folder, or a `.l` file with the files beside it.
 pub fn load_file(path: impl AsRef<Path>, defines: &[String]) -> Result<Curve, Error> {
-    let path = path.as_ref();
+    load_file_with(path.as_ref(), defines, Precision::Single)
+}
+
+/// [`load_file`] with `float` in the given precision.
+pub fn load_file_with(
+    path: &Path,
+    defines: &[String],
+    precision: Precision,
+) -> Result<Curve, Error> {
     let text = read(path)?;
-    curve(front(&path.display().to_string(), text, defines)?).map_err(at_most_some)
+    curve(
+        front(&path.display().to_string(), text, defines)?,
+        precision,
+    )
+    .map_err(at_most_some)
 }
 
 /// Checks text as a curve L-system; `name` is the file name in messages.
@@ -98,7 +216,17 @@ pub fn load_file(path: impl AsRef<Path>, defines: &[String]) -> Result<Curve, Er
 /// assert_eq!(derived.word.len(), 16); // 4 points, doubled twice
 /// ```
 pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Curve, Error> {
-    curve(front(name, text.to_string(), defines)?).map_err(at_most_some)
+    load_str_with(name, text, defines, Precision::Single)
+}
+
+/// [`load_str`] with `float` in the given precision.
+pub fn load_str_with(
+    name: &str,
+    text: &str,
+    defines: &[String],
+    precision: Precision,
+) -> Result<Curve, Error> {
+    curve(front(name, text.to_string(), defines)?, precision).map_err(at_most_some)
 }
 
 /// The most diagnostics a check reports; the count of the others follows
@@ -290,7 +418,7 @@ pub(crate) fn front(name: &str, text: String, defines: &[String]) -> Result<Fron
 }
 
 /// Parses and checks preprocessed tokens as a curve L-system.
-pub(crate) fn curve(front: Front) -> Result<Curve, Error> {
+pub(crate) fn curve(front: Front, precision: Precision) -> Result<Curve, Error> {
     let eof = front.eof();
     let Front {
         sources, tokens, ..
@@ -305,7 +433,7 @@ pub(crate) fn curve(front: Front) -> Result<Curve, Error> {
             })
         }
     };
-    match lang::compile(&file) {
+    match lang::compile::compile_with(&file, precision) {
         Ok(program) => Ok(Curve { program, sources }),
         Err(mut diagnostics) => {
             for d in &mut diagnostics {

@@ -34,6 +34,9 @@ enum Command {
         /// Override a #define: -D NAME=VALUE (repeatable).
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
+        /// Compute float, V2f and V3f in double precision (lpfg: single).
+        #[arg(long)]
+        double: bool,
         /// Stop with an error when a word grows past this many modules.
         #[arg(long, default_value_t = subgram::DEFAULT_MAX_MODULES)]
         max_modules: usize,
@@ -67,9 +70,10 @@ enum Command {
         /// Draw every step 0..N side by side.
         #[arg(long)]
         each: bool,
-        /// white, black, none, #rrggbb.
-        #[arg(long, default_value = "white", value_parser = parse_color)]
-        background: subgram::render::Rgba,
+        /// white, black, none, #rrggbb; by default a model's colour 0, else
+        /// white.
+        #[arg(long, value_parser = parse_color)]
+        background: Option<subgram::render::Rgba>,
         /// The projection of 3D drawings: xy, xz or yz for L-systems;
         /// iso, front, back, left, right, top or bottom for meshes.
         #[arg(long)]
@@ -79,6 +83,9 @@ enum Command {
         no_wireframe: bool,
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
+        /// Compute float, V2f and V3f in double precision (lpfg: single).
+        #[arg(long)]
+        double: bool,
         #[arg(long, default_value_t = subgram::DEFAULT_MAX_MODULES)]
         max_modules: usize,
         #[arg(long, default_value_t = 0)]
@@ -194,6 +201,9 @@ enum Command {
         file: String,
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
+        /// Compute float, V2f and V3f in double precision (lpfg: single).
+        #[arg(long)]
+        double: bool,
     },
 }
 
@@ -335,12 +345,17 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
-        Command::Check { file, define } => print_out(&command::check(&file, &define)?),
+        Command::Check {
+            file,
+            define,
+            double,
+        } => print_out(&command::check(&file, &define, double)?),
         Command::Derive {
             file,
             steps,
             format,
             define,
+            double,
             max_modules,
             phase,
             interpreted,
@@ -352,6 +367,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 steps,
                 json: matches!(format, Format::Json),
                 defines: define,
+                double,
                 max_modules,
                 phase,
                 interpreted,
@@ -370,6 +386,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             view,
             no_wireframe,
             define,
+            double,
             max_modules,
             phase,
             seed,
@@ -386,6 +403,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 view,
                 wireframe: !no_wireframe,
                 defines: define,
+                double,
                 max_modules,
                 phase,
                 seed,

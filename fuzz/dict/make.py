@@ -71,3 +71,12 @@ write('surface_run', 'surface grammars: directives, rule forms, host built-ins, 
 write('mesh_read', 'OBJ, OFF and PLY keywords, types and numbers', mesh)
 write('contour_reverse', 'contours: point lists, SVG elements and path commands, PNG signature and chunk names', contour)
 write('details_reconstruct', 'details files (JSON): keys, values, extreme numbers', details)
+model = ["funcgalleryver 1 1\n", "contourgalleryver 1 1\n", "timeEdit 1 2\n", "fver 1 1\n", "cver 1 3\n", "cver 1 2\n", "cver 1 1\n",
+         "items: ", "name: ", "samples: ", "flip: off\n", "points: ", "type: ", "or", "cr", "oe", "ce", "open", "closed",
+         "start: ", "end: ", "color: ", "startLabel: ", "endLabel: ", "timelineFunceditFileStart:\n", "timelineFunceditFileEnd:\n",
+         "background: ", "backgroundXY: ", "markers: ", "#define ", "CONTACT POINT X: ", "END POINT X: ", "HEADING X: ", "UP X: ",
+         " Y: ", " Z: ", "SIZE: ", "TOP COLOR: 0 DIFFUSE: 0.00 BOTTOM COLOR: 0 DIFFUSE: 0.00\n", "AL: ~ A: ~ AR: ~\n",
+         "L: ~ R: ~\n", "BL: ~ B: ~ BR: ~\n", "surface: ", "light: ", "V: ", "A: ", "D: ", "line style: ", "cylinder", "pixel",
+         "render mode: ", "first frame: ", "//", "/*", "*/", "0.000000 0.000000\n", "1.000000 1.000000\n", "1 2 3 1\n",
+         "nan", "inf", "1e308", "-1", "0", "3", "1000000", "\n", " "]
+write('model_files', 'lpfg model files: function, contour, timeline, parameter, surface, view and animation keywords', model)

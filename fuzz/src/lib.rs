@@ -37,6 +37,7 @@ pub const TARGETS: &[(&str, Body)] = &[
     ("surface_run", surface_run),
     ("contour_reverse", contour_reverse),
     ("details_reconstruct", details_reconstruct),
+    ("model_files", model_files),
 ];
 
 /// Steps of a curve derivation.
@@ -302,4 +303,99 @@ pub fn details_reconstruct(data: &[u8]) {
             }
         }
     }
+}
+
+/// (g) A model file of lpfg's folders: the first byte chooses the format
+/// (`.fset`, `.func`, `.tset`, `.vset`, `.cset`, `.con`, `.s`, `.v`, `.a`,
+/// `.map`, `.mat`), the rest is the file. What reads is evaluated: every
+/// function at a few x (clamped, NaN and infinities too), every contour's
+/// points and normals, scaled, edited and recalculated, every surface's
+/// triangles, every colour lit by the file's lights.
+pub fn model_files(data: &[u8]) {
+    use subgram::model::{colours, contours, functions, surface, view};
+    let Some((&kind, rest)) = data.split_first() else {
+        return;
+    };
+    let text = text(rest);
+    let xs = [-1.0f32, 0.0, 0.3, 0.5, 1.0, 2.0, f32::NAN, f32::INFINITY];
+    let funcs = |r: Result<Vec<functions::Function>, subgram::Error>| match r {
+        Ok(fs) => {
+            for f in fs {
+                for x in xs {
+                    std::hint::black_box((f.value(x), f.tangent(x), f.timeline_value(x)));
+                }
+            }
+        }
+        Err(e) => {
+            std::hint::black_box(e.to_string());
+        }
+    };
+    let conts = |r: Result<Vec<contours::Contour>, subgram::Error>| match r {
+        Ok(cs) => {
+            for mut c in cs {
+                for x in xs {
+                    std::hint::black_box((c.point(x), c.normal(x)));
+                }
+                c.scale([2.0, 0.5, f32::NAN]);
+                c.set_point(0, [1.0, 1.0, 1.0]);
+                c.recalculate();
+                c.reset();
+                std::hint::black_box(c.point(0.5));
+            }
+        }
+        Err(e) => {
+            std::hint::black_box(e.to_string());
+        }
+    };
+    let mut notes = Vec::new();
+    match kind % 11 {
+        0 => funcs(functions::read_fset("fuzz.fset", &text)),
+        1 => funcs(functions::read_func("fuzz.func", &text)),
+        2 => funcs(functions::read_tset("fuzz.tset", &text)),
+        3 => funcs(functions::read_vset("fuzz.vset", &text)),
+        4 => conts(contours::read_cset("fuzz.cset", &text)),
+        5 => conts(contours::read_con("fuzz.con", &text)),
+        6 => match surface::read_s("fuzz.s", "fuzz", &text) {
+            Ok(s) => {
+                std::hint::black_box(s.triangles(3));
+            }
+            Err(e) => {
+                std::hint::black_box(e.to_string());
+            }
+        },
+        7 => match view::read_v("fuzz.v", &text, &mut notes) {
+            Ok(v) => {
+                let mut map = vec![0u8; 768];
+                map.iter_mut().zip(rest).for_each(|(m, b)| *m = *b);
+                for c in [
+                    colours::read_map("m", &map),
+                    colours::read_mat("m", &map[..750]),
+                ] {
+                    let c = c.expect("well-sized colour files read");
+                    for i in [-1, 0, 1, 255, 256] {
+                        std::hint::black_box(c.colour(i, &v.lights));
+                    }
+                }
+            }
+            Err(e) => {
+                std::hint::black_box(e.to_string());
+            }
+        },
+        8 => {
+            let _ = std::hint::black_box(
+                view::read_a("fuzz.a", &text, &mut notes).map_err(|e| e.to_string()),
+            );
+        }
+        9 => {
+            let _ = std::hint::black_box(
+                colours::read_map("fuzz.map", rest).map_err(|e| e.to_string()),
+            );
+        }
+        _ => {
+            let _ = std::hint::black_box(
+                colours::read_mat("fuzz.mat", rest).map_err(|e| e.to_string()),
+            );
+        }
+    }
+    std::hint::black_box(notes);
 }

@@ -33,7 +33,10 @@ pub enum Event {
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Cmd {
     None,
-    Forward { draw: bool, record: bool },
+    Forward {
+        draw: bool,
+        record: bool,
+    },
     MoveTo,
     MoveRel,
     LineTo,
@@ -54,6 +57,9 @@ enum Cmd {
     StartPolygon,
     PolygonPoint,
     EndPolygon,
+    /// `Surface(id, s)`, `Surface3(id, sx, sy, sz)`: a model's Bézier
+    /// surface.
+    Surface,
     Query(u8),
 }
 
@@ -110,6 +116,8 @@ pub struct DrawOptions {
     pub angle: f64,
     /// Length of `F` without an argument.
     pub step: f64,
+    /// The model the word came with: its surfaces for `Surface`.
+    pub model: std::sync::Arc<crate::model::Model>,
 }
 
 impl Default for DrawOptions {
@@ -117,6 +125,7 @@ impl Default for DrawOptions {
         DrawOptions {
             angle: 90.0,
             step: 1.0,
+            model: Default::default(),
         }
     }
 }
@@ -181,6 +190,7 @@ fn command(name: &str) -> Cmd {
         "SP" => Cmd::StartPolygon,
         "PP" => Cmd::PolygonPoint,
         "EP" => Cmd::EndPolygon,
+        "Surface" | "Surface3" => Cmd::Surface,
         "GetPos" => Cmd::Query(0),
         "GetHead" => Cmd::Query(1),
         "GetLeft" => Cmd::Query(2),
@@ -371,6 +381,32 @@ pub fn draw_with_queries(
                     qs.push([v.x, v.y, v.z]);
                 }
             }
+            Cmd::Surface => {
+                let id = int_arg();
+                let surface = usize::try_from(id)
+                    .ok()
+                    .and_then(|k| opts.model.surfaces.get(k));
+                let Some(s) = surface else {
+                    return Err(DrawError {
+                        message: format!(
+                            "module {} of the interpreted word, `{}`, draws surface {id}, but the model has {}",
+                            i + 1,
+                            alphabet.name(sym),
+                            match opts.model.surfaces.len() {
+                                0 => "no surface (a view file's `surface:` lines name them)".to_string(),
+                                n => format!("surfaces 0 to {}", n - 1),
+                            }
+                        ),
+                        module: Some(i),
+                    });
+                };
+                let scale = if d.len() >= 4 {
+                    DVec3::new(d[1], d[2], d[3])
+                } else {
+                    DVec3::splat(arg(1, 1.0))
+                };
+                surface_events(s, &t, scale, &mut out);
+            }
             Cmd::StartPolygon => polygons.push(Vec::new()),
             Cmd::PolygonPoint => {
                 if let Some(p) = polygons.last_mut() {
@@ -395,6 +431,38 @@ pub fn draw_with_queries(
         i += 1;
     }
     Ok(out)
+}
+
+/// Each patch of surface `s` as a filled polygon, its outline: the
+/// surface's contact point at the turtle, its heading and up vectors on
+/// the turtle's, scaled by `scale` × the view file's scale / `SIZE:`.
+fn surface_events(s: &crate::model::Surface, t: &Turtle, scale: DVec3, out: &mut Vec<Event>) {
+    const STEPS: usize = 8;
+    let v = |a: [f64; 3]| DVec3::from_array(a);
+    let (h, u) = (
+        v(s.heading).normalize_or_zero(),
+        v(s.up).normalize_or_zero(),
+    );
+    let l = u.cross(h);
+    let k = scale * (s.scale / s.size);
+    let place = |p: [f64; 3]| {
+        let q = v(p) - v(s.contact);
+        t.pos + t.head * (q.dot(h) * k.y) + t.left * (q.dot(l) * k.x) + t.up * (q.dot(u) * k.z)
+    };
+    for patch in &s.patches {
+        // Around the patch: along the first row, down the last column,
+        // back along the last row, up the first column.
+        let f = |i: usize| i as f64 / STEPS as f64;
+        let mut ring = Vec::with_capacity(4 * STEPS);
+        ring.extend((0..STEPS).map(|i| patch.point(f(i), 0.0)));
+        ring.extend((0..STEPS).map(|i| patch.point(1.0, f(i))));
+        ring.extend((0..STEPS).map(|i| patch.point(1.0 - f(i), 1.0)));
+        ring.extend((0..STEPS).map(|i| patch.point(0.0, 1.0 - f(i))));
+        out.push(Event::Polygon {
+            points: ring.into_iter().map(place).collect(),
+            color: t.pen.color,
+        });
+    }
 }
 
 /// Module `i` took the drawing to an infinite coordinate: which one, with

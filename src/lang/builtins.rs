@@ -81,6 +81,20 @@ pub static WORD_HOST: HostTable = HostTable {
     members: |_| None,
 };
 
+/// C's single-precision maths functions of [`LIBRARY`]: each is its
+/// double-precision twin's name and `f`, and gives a `float` whatever its
+/// argument.
+pub const FLOAT_FUNCTIONS: &[&str] = &[
+    "sinf", "cosf", "tanf", "asinf", "acosf", "atanf", "sinhf", "coshf", "tanhf", "sqrtf", "cbrtf",
+    "expf", "logf", "log10f", "log2f", "fabsf", "floorf", "ceilf", "roundf", "truncf", "atan2f",
+    "powf", "fmodf", "hypotf", "fminf", "fmaxf",
+];
+
+/// True for `expf`, `sqrtf` and the other [`FLOAT_FUNCTIONS`].
+pub fn is_float_function(name: &str) -> bool {
+    FLOAT_FUNCTIONS.contains(&name)
+}
+
 /// Looks a function up: the library first, then the host's table.
 pub fn lookup<'h>(name: &str, host: &'h HostTable) -> Option<&'h Builtin> {
     LIBRARY
@@ -133,6 +147,20 @@ macro_rules! nullary {
                 } else {
                     Err(SigError::Arity(0))
                 }
+            },
+        }
+    };
+}
+
+/// An accessor of the model's files: `n` number arguments (the first an
+/// id that the model's names `#define`).
+macro_rules! model {
+    ($name:literal, $acc:ident, $n:expr, $t:expr) => {
+        Builtin {
+            name: $name,
+            resolve: |a| {
+                numbers(a, $n)?;
+                Ok((Func::Model(crate::model::Accessor::$acc), $t))
             },
         }
     };
@@ -250,7 +278,7 @@ pub static LIBRARY: &[Builtin] = &[
     },
     Builtin {
         name: "Length",
-        resolve: |a| vector(a, "Length").map(|_| (Func::Length, Ty::Float)),
+        resolve: |a| vector(a, "Length").map(|t| (Func::Length, t.scalar())),
     },
     Builtin {
         name: "Normalize",
@@ -259,7 +287,7 @@ pub static LIBRARY: &[Builtin] = &[
     Builtin {
         name: "Dot",
         resolve: |a| match a {
-            [x, y] if x == y && x.is_vector() => Ok((Func::Dot, Ty::Float)),
+            [x, y] if x.is_vector() && x.dim() == y.dim() => Ok((Func::Dot, x.wider(*y).scalar())),
             _ => Err(SigError::Message(
                 "`Dot` takes two vectors of the same type".into(),
             )),
@@ -268,7 +296,7 @@ pub static LIBRARY: &[Builtin] = &[
     Builtin {
         name: "Cross",
         resolve: |a| match a {
-            [Ty::V3, Ty::V3] => Ok((Func::Cross, Ty::V3)),
+            [x, y] if x.dim() == 3 && y.dim() == 3 => Ok((Func::Cross, x.wider(*y))),
             [x, y] if x == y && x.is_vector() => {
                 Err(SigError::Message("`Cross` takes two V3f vectors".into()))
             }
@@ -295,17 +323,52 @@ pub static LIBRARY: &[Builtin] = &[
             Ok((Func::UseGroup, Ty::Void))
         },
     },
-    random!("ran", 1, Op::Ran, Ty::Float),
+    model!("func", Func, 2, Ty::Float),
+    model!("pfunc", PFunc, 4, Ty::Float),
+    model!("tfunc", TFunc, 2, Ty::Float),
+    model!("funcTangent", FuncTangent, 2, Ty::V2),
+    model!("val", Val, 1, Ty::Float),
+    model!("curveX", CurveX, 2, Ty::Float),
+    model!("curveY", CurveY, 2, Ty::Float),
+    model!("curveZ", CurveZ, 2, Ty::Float),
+    model!("curveXY", CurveXY, 2, Ty::V2),
+    model!("curveXYf", CurveXY, 2, Ty::V2),
+    model!("curveXYd", CurveXY, 2, Ty::V2),
+    model!("curveXYZ", CurveXYZ, 2, Ty::V3),
+    model!("curveXYZf", CurveXYZ, 2, Ty::V3),
+    model!("curveXYZd", CurveXYZ, 2, Ty::V3),
+    model!("curveNormal", CurveNormal, 2, Ty::V3),
+    model!("curveScale", CurveScale, 4, Ty::Void),
+    model!("curveSetPoint", CurveSetPoint, 5, Ty::Void),
+    model!("curveRecalculate", CurveRecalculate, 1, Ty::Void),
+    model!("curveReset", CurveReset, 1, Ty::Void),
+    random!("ran", 1, Op::Ran, Ty::Double),
     random!("sran", 1, Op::SRan, Ty::Void),
     random!("rand", 0, Op::Rand, Ty::Int),
     random!("random", 0, Op::Rand, Ty::Int),
     random!("srand", 1, Op::SRand, Ty::Void),
     random!("srandom", 1, Op::SRand, Ty::Void),
-    random!("drand48", 0, Op::Drand48, Ty::Float),
+    random!("drand48", 0, Op::Drand48, Ty::Double),
     random!("lrand48", 0, Op::Lrand48, Ty::Int),
     random!("mrand48", 0, Op::Mrand48, Ty::Int),
     random!("srand48", 1, Op::SRand48, Ty::Void),
-    random!("GillespieTime", 0, Op::GillespieTime, Ty::Float),
+    random!("GillespieTime", 0, Op::GillespieTime, Ty::Double),
     random!("SeedGillespie", 1, Op::SeedGillespie, Ty::Void),
     random!("ResetGillespie", 0, Op::ResetGillespie, Ty::Void),
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every float function is in the library with its double twin, which
+    /// `--double` calls instead.
+    #[test]
+    fn float_functions_have_double_twins() {
+        for f in FLOAT_FUNCTIONS {
+            assert!(LIBRARY.iter().any(|b| b.name == *f), "{f}");
+            let twin = &f[..f.len() - 1];
+            assert!(LIBRARY.iter().any(|b| b.name == twin), "{twin}");
+        }
+    }
+}

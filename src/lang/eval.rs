@@ -28,6 +28,8 @@ pub struct Env {
     /// The run's random number generators (`ran`, `rand`, `drand48`,
     /// Gillespie steps).
     pub random: Random,
+    /// The model folder's functions and contours, for `func` and its kin.
+    pub model: std::sync::Arc<crate::model::Model>,
 }
 
 impl Env {
@@ -40,6 +42,7 @@ impl Env {
             forward: true,
             stop: false,
             random: Random::default(),
+            model: Default::default(),
         }
     }
 }
@@ -639,6 +642,11 @@ impl<'p> Interp<'p> {
                 Value::Void
             }
             Func::Random(op) => cx.env.random.call(op, vals),
+            Func::Model(a) if a.changes_the_model() => {
+                // The run's own copy, made on the first change.
+                return std::sync::Arc::make_mut(&mut cx.env.model).call_mut(a, vals);
+            }
+            Func::Model(a) => return cx.env.model.call(a, vals),
             Func::NoOp => {
                 let _ = span;
                 Value::Void

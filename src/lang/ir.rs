@@ -88,6 +88,9 @@ pub enum Func {
     /// `ran`, `rand`, `drand48`, their seeding, the Gillespie time.
     Random(super::random::Op),
     NoOp,
+    /// An accessor of the model's files (`func`, `curveX`, `val`, …),
+    /// evaluated by the [`Model`](crate::model::Model) of the run.
+    Model(crate::model::Accessor),
     /// A built-in of the topology the program runs on, by its number in
     /// the topology's [`HostTable`](super::builtins::HostTable); the
     /// [`Host`](super::eval::Host) evaluates it.
@@ -214,6 +217,9 @@ pub struct Program {
     pub gillespie_groups: Vec<(i64, Span)>,
     /// What `check` reports without refusing the program.
     pub warnings: Vec<Diagnostic>,
+    /// The functions, contours and colours of the model folder the program
+    /// came with (empty for a program alone).
+    pub model: std::sync::Arc<crate::model::Model>,
 }
 
 impl Program {

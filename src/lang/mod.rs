@@ -9,7 +9,6 @@ pub mod random;
 pub mod stencil;
 pub mod value;
 
-pub use compile::compile;
 pub use ir::Program;
 pub use modules::{Alphabet, Sym};
 pub use value::{Ty, Value};

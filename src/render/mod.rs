@@ -103,6 +103,12 @@ pub struct RenderOptions {
     /// Margin on every side, as a fraction of the smaller image side.
     pub margin: f64,
     pub view: View,
+    /// The colours that colour indices choose (a model's colour map or
+    /// materials); `None`: the default palette.
+    pub palette: Option<std::sync::Arc<[Rgba; 256]>>,
+    /// Line widths are in the drawing's units (lpfg's `line style:
+    /// polygon` or `cylinder`), not in pixels.
+    pub widths_in_units: bool,
 }
 
 impl Default for RenderOptions {
@@ -113,6 +119,8 @@ impl Default for RenderOptions {
             background: Rgba(255, 255, 255, 255),
             margin: 0.04,
             view: View::Xy,
+            palette: None,
+            widths_in_units: false,
         }
     }
 }
@@ -276,6 +284,17 @@ fn fit_panel(
         ));
     }
     let fit = Fit::new(lo, hi, x0, cell_w, opts.height as f64, opts.margin);
+    let width = |w: f64| {
+        if opts.widths_in_units {
+            w * fit.scale
+        } else {
+            w
+        }
+    };
+    let palette = |i: i64| match &opts.palette {
+        Some(p) => p[i.rem_euclid(256) as usize],
+        None => palette(i),
+    };
     let scale = fit.scale;
     let px = |p: DVec3| fit.pixel(v.project(p));
     let mut run: Option<(Vec<DVec2>, Rgba, f64)> = None;
@@ -293,14 +312,14 @@ fn fit_panel(
             let (pa, pb) = (px(*a), px(*b));
             let color = palette(pen.color);
             let joined = matches!(&run, Some((pts, c, w))
-                if *c == color && *w == pen.width && pts.last().is_some_and(|l| l.distance(pa) < 1e-9));
+                if *c == color && *w == width(pen.width) && pts.last().is_some_and(|l| l.distance(pa) < 1e-9));
             if joined {
                 if let Some((pts, _, _)) = run.as_mut() {
                     pts.push(pb);
                 }
             } else {
                 flush(&mut run, items);
-                run = Some((vec![pa, pb], color, pen.width));
+                run = Some((vec![pa, pb], color, width(pen.width)));
             }
             continue;
         }
@@ -313,14 +332,14 @@ fn fit_panel(
             },
             Event::Dot { c, pen } => Item::Disc {
                 c: px(*c),
-                r: pen.width * 0.5,
+                r: width(pen.width) * 0.5,
                 color: palette(pen.color),
             },
             Event::Ring { c, r, pen } => Item::Ring {
                 c: px(*c),
                 r: r.abs() * scale,
                 color: palette(pen.color),
-                width: pen.width,
+                width: width(pen.width),
             },
             Event::Polygon { points, color } => Item::Polygon {
                 points: points.iter().map(|p| px(*p)).collect(),

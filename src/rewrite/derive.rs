@@ -181,6 +181,7 @@ impl<'p> Derivation<'p> {
         let mut interp = Interp::with_deadline(&program.structs, opts.deadline);
         let mut env = Env::new(Vec::new());
         env.random = Random::new(opts.seed);
+        env.model = program.model.clone();
         for g in &program.globals {
             let v = match &g.init {
                 Some(e) => interp

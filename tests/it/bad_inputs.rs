@@ -270,6 +270,7 @@ fn lsys_run_line(path: &Path) -> Option<String> {
 const MESH_KINDS: &[&str] = &["obj", "off", "ply-ascii", "ply-binary"];
 const CONTOUR_KINDS: &[&str] = &["points", "svg", "png"];
 const DETAILS_KINDS: &[&str] = &["details"];
+const MODEL_KINDS: &[&str] = &["model"];
 
 // ---------------------------------------------------------------------------
 // Generated cases
@@ -1102,6 +1103,11 @@ fn details_files() {
 }
 
 #[test]
+fn model_files() {
+    check("model", kinds_cases(MODEL_KINDS));
+}
+
+#[test]
 fn generated_inputs() {
     let cases = generated();
     let made: Vec<&str> = cases.iter().map(|c| c.stem.as_str()).collect();
@@ -1127,6 +1133,7 @@ fn the_corpus_is_complete() {
                 .iter()
                 .chain(CONTOUR_KINDS)
                 .chain(DETAILS_KINDS)
+                .chain(MODEL_KINDS)
                 .map(|k| format!("{BAD}/{k}")),
         )
         .collect();

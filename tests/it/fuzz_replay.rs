@@ -125,6 +125,11 @@ fn details_reconstruct() {
     replay("details_reconstruct");
 }
 
+#[test]
+fn model_files() {
+    replay("model_files");
+}
+
 /// Every body has a `[[bin]]` in fuzz/Cargo.toml, a target file, seeds and
 /// a dictionary, and every folder of findings names a target.
 #[test]

@@ -101,7 +101,7 @@ fn the_binary_passes_defines_to_conditionals() {
 /// (`0.1f` is 0.100000001490116…, not 0.1).
 #[test]
 fn c_literals_in_programs() {
-    let src = "module I(int); module X(float);\n\
+    let src = "module I(int); module X(double);\n\
                Axiom: I(0x1F) I(017) I(10L) I(3u) X(1.f) X(.5f) X(1e-3f) X(2.5e1) X(0.1f - 0.1);";
     let l = load_text(src);
     let d = derive(&l, DeriveOptions::default());

@@ -20,6 +20,7 @@ mod render;
 #[allow(dead_code)]
 #[path = "../it/support.rs"]
 mod support;
+mod vlab;
 
 /// The shared folder that `SUBGRAM_SHARED` names; panics when the variable
 /// is not set or the folder has no `corpus/lpfg`.

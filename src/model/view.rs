@@ -1,0 +1,354 @@
+//! lpfg's view file (`.v`, manual §8.1) and animation file (`.a`, §8.2).
+//!
+//! Every command of the manual is recognised. subgram acts on `surface:`
+//! (the Bézier surfaces that `Surface(id, s)` draws, numbered from 0 in
+//! the order given, with their scale) and `line style:` (with `polygon`
+//! or `cylinder`, line widths are in the model's units) and `light:`
+//! (materials are lit by the lights, as on a surface facing the viewer);
+//! the others set up lpfg's OpenGL
+//! window (projection, lights, shading, tropisms, fonts, …) and are
+//! reported as not acted on. The animation file only matters in lpfg's
+//! animate mode, which a still picture is not: it is checked and kept.
+
+use super::text::{number, words, Lines};
+use super::Note;
+use crate::error::Error;
+
+/// The commands of §8.1 (including the deprecated ones), as their
+/// lower-case keys before the colon.
+const VIEW_COMMANDS: &[&str] = &[
+    "projection",
+    "scale",
+    "scale factor",
+    "min zoom",
+    "max zoom",
+    "generate on view change",
+    "view",
+    "box",
+    "window",
+    "window border",
+    "front distance",
+    "back distance",
+    "z buffer",
+    "render mode",
+    "shadow map",
+    "light",
+    "stationary lights",
+    "concave polygons",
+    "auto normals",
+    "antialiasing",
+    "line style",
+    "wireframe line width",
+    "contour sides",
+    "capped cylinders",
+    "backface culling",
+    "corrected rotation",
+    "tropism",
+    "torque",
+    "stropism",
+    "surface",
+    "mesh",
+    "texture",
+    "font",
+    "winfont",
+    "ps linecap",
+    "gradient",
+    "initial color",
+    "color increment",
+    "initial line width",
+    "line width increment",
+    "tropism direction",
+    "initial elasticity",
+    "elasticity increment",
+    "bsurface",
+];
+
+const ANIMATION_COMMANDS: &[&str] = &[
+    "first frame",
+    "last frame",
+    "step",
+    "swap interval",
+    "double buffer",
+    "clear between frames",
+    "hcenter between frames",
+    "scale between frames",
+    "new view between frames",
+    "display on request",
+];
+
+/// A `surface:` command: the file, its line, the scale.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceRef {
+    pub file: String,
+    pub line: usize,
+    /// The file name's byte range in the view file's text.
+    pub at: (usize, usize),
+    pub scale: f64,
+}
+
+/// What subgram keeps of a view file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ViewFile {
+    pub surfaces: Vec<SurfaceRef>,
+    /// `line style: polygon` or `cylinder`: `SetWidth` is in the model's
+    /// units; `pixel` (the default): in pixels.
+    pub widths_in_units: bool,
+    /// `light:` commands, in order.
+    pub lights: Vec<Light>,
+}
+
+/// A light source of the view file: its direction (towards the light),
+/// and its ambient and diffuse colours (each 0 to 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    pub direction: [f64; 3],
+    pub ambient: [f64; 3],
+    pub diffuse: [f64; 3],
+}
+
+impl Default for Light {
+    /// lpfg's default light: from the viewer (0 0 1), white.
+    fn default() -> Self {
+        Light {
+            direction: [0.0, 0.0, 1.0],
+            ambient: [1.0; 3],
+            diffuse: [1.0; 3],
+        }
+    }
+}
+
+/// Reads the fields of a `light:` command (`V: x y z`, `O: x y z`,
+/// `P: x y z e c`, `A:`, `D:`, `S: r g b`, `T: c l q`).
+fn light(lines: &Lines<'_>, line: &str, after: usize) -> Result<Light, Error> {
+    let ws: Vec<_> = words(&line[after..])
+        .into_iter()
+        .map(|w| super::text::Word {
+            text: w.text,
+            start: w.start + after,
+            end: w.end + after,
+        })
+        .collect();
+    let mut l = Light::default();
+    let mut i = 0;
+    while i < ws.len() {
+        let w = ws[i];
+        let n = match w.text {
+            "V:" | "O:" | "A:" | "D:" | "S:" | "T:" => 3,
+            "P:" => 5,
+            _ => {
+                return Err(lines.error(
+                    w,
+                    format!(
+                    "expected a light field `V:`, `O:`, `P:`, `A:`, `D:`, `S:` or `T:`, found `{}`",
+                    w.text
+                ),
+                ))
+            }
+        };
+        let mut v = [0.0; 5];
+        for (k, slot) in v.iter_mut().enumerate().take(n) {
+            *slot = number(lines, &ws, i + 1 + k, &format!("a value of `{}`", w.text))?;
+        }
+        match w.text {
+            "V:" | "O:" => l.direction = [v[0], v[1], v[2]],
+            "A:" => l.ambient = [v[0], v[1], v[2]],
+            "D:" => l.diffuse = [v[0], v[1], v[2]],
+            _ => {}
+        }
+        i += 1 + n;
+    }
+    Ok(l)
+}
+
+/// The text with C and C++ comments blanked out (newlines and byte
+/// offsets kept), as the preprocessor that lpfg runs on the file removes
+/// them.
+fn blank_comments(text: &str) -> String {
+    let b = text.as_bytes();
+    let mut out = b.to_vec();
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'/' && b.get(i + 1) == Some(&b'/') {
+            while i < b.len() && b[i] != b'\n' {
+                out[i] = b' ';
+                i += 1;
+            }
+        } else if b[i] == b'/' && b.get(i + 1) == Some(&b'*') {
+            out[i] = b' ';
+            out[i + 1] = b' ';
+            i += 2;
+            while i < b.len() && !(b[i] == b'*' && b.get(i + 1) == Some(&b'/')) {
+                if b[i] != b'\n' {
+                    out[i] = b' ';
+                }
+                i += 1;
+            }
+            if i < b.len() {
+                out[i] = b' ';
+                out[i + 1] = b' ';
+                i += 2;
+            }
+        } else {
+            i += 1;
+        }
+    }
+    // Blanking replaced whole bytes of comments only, so the text is
+    // still UTF-8 wherever it was; a stray byte reads as U+FFFD.
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The command key of a line (the text before its first colon, lower
+/// case, single-spaced) and the byte offset after the colon.
+fn key(line: &str) -> Option<(String, usize)> {
+    let colon = line.find(':')?;
+    let k = line[..colon]
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    Some((k.to_ascii_lowercase(), colon + 1))
+}
+
+/// Byte offset of line `n` (0-based) in `text`.
+fn line_start(text: &str, n: usize) -> usize {
+    text.split_inclusive('\n').take(n).map(str::len).sum()
+}
+
+/// Reads a view file: the surfaces, and a note for every command that
+/// subgram does not act on or does not know.
+pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile, Error> {
+    let clean = blank_comments(text);
+    let mut lines = Lines::shown_as(path, &clean, text);
+    let mut view = ViewFile::default();
+    let mut ignored: Vec<(String, usize, usize, usize)> = Vec::new();
+    while !lines.at_end() {
+        let line = lines.next_line("")?;
+        let n = lines.line_no();
+        let base = line_start(text, n - 1);
+        let first = words(line)[0];
+        if first.text.starts_with('#') {
+            notes.push(Note::at(
+                path,
+                text,
+                base + first.start..base + first.end,
+                "the view file's preprocessor directives are not run: the line is left out".into(),
+            ));
+            continue;
+        }
+        let Some((k, after)) = key(line) else {
+            return Err(lines.error(
+                first,
+                "expected a command such as `surface: leaf.s` (a name, a colon, values)",
+            ));
+        };
+        if !VIEW_COMMANDS.contains(&k.as_str()) {
+            notes.push(Note::at(
+                path,
+                text,
+                base + first.start..base + after,
+                format!(
+                    "`{k}:` is not a view-file command that lpfg's manual lists: it is left out"
+                ),
+            ));
+            continue;
+        }
+        if k == "light" {
+            view.lights.push(light(&lines, line, after)?);
+            // Lights shade the materials' colours; their positions and the
+            // shading of curved surfaces are beyond a flat picture.
+            continue;
+        }
+        if k == "line style" {
+            let ws = words(&line[after..]);
+            view.widths_in_units = match ws.first().map(|w| w.text) {
+                Some("pixel") => false,
+                Some("polygon") | Some("cylinder") => true,
+                _ => {
+                    let (s, e) = ws.first().map_or((line.len(), line.len()), |w| {
+                        (w.start + after, w.end + after)
+                    });
+                    return Err(lines.error_at(
+                        s,
+                        e,
+                        "expected `pixel`, `polygon` or `cylinder` after `line style:`",
+                    ));
+                }
+            };
+            continue;
+        }
+        if k == "surface" {
+            let ws = words(&line[after..]);
+            let Some(f) = ws.first() else {
+                return Err(lines.error_at_end("expected the surface's file after `surface:`"));
+            };
+            let shifted: Vec<_> = ws
+                .iter()
+                .map(|w| super::text::Word {
+                    text: w.text,
+                    start: w.start + after,
+                    end: w.end + after,
+                })
+                .collect();
+            let scale = if shifted.len() > 1 {
+                number(&lines, &shifted, 1, "the surface's scale")?
+            } else {
+                1.0
+            };
+            view.surfaces.push(SurfaceRef {
+                file: f.text.to_string(),
+                line: n,
+                at: (base + f.start + after, base + f.end + after),
+                scale,
+            });
+            continue;
+        }
+        ignored.push((k, n, base + first.start, base + after));
+    }
+    if !ignored.is_empty() {
+        let mut seen: Vec<&str> = Vec::new();
+        for (k, _, _, _) in &ignored {
+            if !seen.contains(&k.as_str()) {
+                seen.push(k);
+            }
+        }
+        let (_, _, s, e) = ignored[0];
+        let list = seen
+            .iter()
+            .map(|k| format!("`{k}:`"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        notes.push(Note::at(
+            path,
+            text,
+            s..e,
+            format!("subgram draws flat, in 2D, and does not act on {list}"),
+        ));
+    }
+    Ok(view)
+}
+
+/// Checks an animation file: `command: value` lines of §8.2.
+pub fn read_a(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<(), Error> {
+    let clean = blank_comments(text);
+    let mut lines = Lines::shown_as(path, &clean, text);
+    while !lines.at_end() {
+        let line = lines.next_line("")?;
+        let n = lines.line_no();
+        let first = words(line)[0];
+        let Some((k, after)) = key(line) else {
+            return Err(lines.error(
+                first,
+                "expected a command such as `step: 1` (a name, a colon, a value)",
+            ));
+        };
+        if !ANIMATION_COMMANDS.contains(&k.as_str()) {
+            let base = line_start(text, n - 1);
+            notes.push(Note::at(
+                path,
+                text,
+                base + first.start..base + after,
+                format!("`{k}:` is not an animation-file command that lpfg's manual lists"),
+            ));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,1 @@
+surface: s-not-a-number.s

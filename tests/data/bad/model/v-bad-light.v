@@ -1,0 +1,2 @@
+line style: cylinder
+light: V: 1 x 0

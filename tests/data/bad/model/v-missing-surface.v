@@ -1,0 +1,2 @@
+render mode: shaded
+surface: nothere.s

@@ -1,0 +1,1 @@
+surface: square.s 3
