@@ -438,6 +438,12 @@ impl<'p> Derivation<'p> {
         Ok(())
     }
 
+    /// Runs `End`, as lpfg does after the final derivation step. A caller
+    /// that drives the steps itself calls this once it has taken the last.
+    pub fn end(&mut self) -> Result<(), DeriveError> {
+        self.control(ControlKind::End)
+    }
+
     /// Runs the remaining steps and `End`.
     pub fn run(mut self) -> Result<Derived, DeriveError> {
         while self.has_next() {

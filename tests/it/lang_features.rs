@@ -451,3 +451,32 @@ fn printed_text_and_the_json_word_do_not_mix() {
     assert_eq!(err, "n is 1\nto stderr\n");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `End` runs after the final derivation step (manual §4.1) on every path
+/// a user takes: `derive` and `render` print what it prints. lpfg 9bf820d
+/// prints `end after 2 steps` for this program.
+#[test]
+fn end_runs_after_the_final_step_for_derive_and_render() {
+    let dir = std::env::temp_dir().join(format!("subgram-end-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("end.l");
+    std::fs::write(
+        &file,
+        "derivation length: 2;\nint n;\nmodule A;\nStart: { n = 0; }\nEndEach: { n = n + 1; }\n\
+         End: { printf(\"end after %d steps\\n\", n); }\nAxiom: A;\nA : { produce A F; }\n",
+    )
+    .unwrap();
+    let run = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+            .args(args)
+            .arg(&file)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    assert_eq!(run(&["derive"]), "end after 2 steps\nA F F\n");
+    assert_eq!(run(&["render", "-o", "end.png"]), "end after 2 steps\n");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
