@@ -9,6 +9,7 @@ use std::time::Duration;
 use crate::curve::FigureOptions;
 use crate::deadline::{Deadline, DEFAULT_TIMEOUT};
 use crate::error::Error;
+use crate::lang::ProgramOutput;
 use crate::load::{load, LoadOptions, Precision};
 use crate::mesh::{self, Mesh};
 use crate::render::{self, Rgba, Scene, View};
@@ -58,6 +59,10 @@ pub struct DeriveArgs {
     pub seed: Option<u32>,
     /// `--timeout`: the command stops with an error after this long.
     pub timeout: Option<Duration>,
+    /// `--allow-writes DIR`: the program may write files, under DIR.
+    pub allow_writes: Option<PathBuf>,
+    /// What the program prints: the caller keeps a clone and prints it.
+    pub output: ProgramOutput,
 }
 
 impl DeriveArgs {
@@ -73,6 +78,8 @@ impl DeriveArgs {
             interpreted: false,
             seed: None,
             timeout: Some(DEFAULT_TIMEOUT),
+            allow_writes: None,
+            output: ProgramOutput::default(),
         }
     }
 }
@@ -81,6 +88,7 @@ impl DeriveArgs {
 /// or JSON; for a surface grammar, the subdivided mesh's description.
 pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, Error> {
     let deadline = a.timeout.map(Deadline::after);
+    let dir = writes_folder(&a.allow_writes, &a.output)?;
     let system = load(&a.file, &load_options(&a.defines, a.double))?;
     let opts = RunOptions {
         steps: a.steps,
@@ -89,6 +97,7 @@ pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, 
         seed: a.seed,
         base_mesh: None,
         deadline,
+        output: a.output.clone(),
     };
     match system {
         System::Surface(s) => {
@@ -107,15 +116,22 @@ pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, 
         System::Curve(c) => {
             check_steps(a.steps)?;
             let mut run = c.run(opts.derive_options())?;
-            if !a.interpreted {
-                return Ok(if a.json { run.json() } else { run.text() });
-            }
-            let word = run.interpreted()?;
-            Ok(if a.json {
-                c.word_json(&word, run.ring(), run.step())
+            let word = if !a.interpreted {
+                if a.json {
+                    run.json()
+                } else {
+                    run.text()
+                }
             } else {
-                c.word_text(&word)
-            })
+                let word = run.interpreted()?;
+                if a.json {
+                    c.word_json(&word, run.ring(), run.step())
+                } else {
+                    c.word_text(&word)
+                }
+            };
+            write_program_files(&a.output, dir.as_deref(), &[Path::new(&a.file)])?;
+            Ok(word)
         }
     }
 }
@@ -152,6 +168,10 @@ pub struct RenderArgs {
     pub timeout: Option<Duration>,
     /// Write the picture even over one of the inputs.
     pub force: bool,
+    /// `--allow-writes DIR`: the program may write files, under DIR.
+    pub allow_writes: Option<PathBuf>,
+    /// What the program prints: the caller keeps a clone and prints it.
+    pub program_output: ProgramOutput,
 }
 
 impl RenderArgs {
@@ -172,6 +192,8 @@ impl RenderArgs {
             seed: None,
             timeout: Some(DEFAULT_TIMEOUT),
             force: false,
+            allow_writes: None,
+            program_output: ProgramOutput::default(),
         }
     }
 }
@@ -217,6 +239,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                 }
             };
             check_steps(a.steps)?;
+            let dir = writes_folder(&a.allow_writes, &a.program_output)?;
             let opts = RunOptions {
                 steps: a.steps,
                 max_modules: a.max_modules,
@@ -224,6 +247,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                 seed: a.seed,
                 base_mesh: None,
                 deadline,
+                output: a.program_output.clone(),
             };
             let model = &c.program.model;
             let palette = model
@@ -247,9 +271,64 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                     ..Default::default()
                 },
             };
-            write_picture(&c.figure(&figure)?, output, format)
+            let scene = c.figure(&figure)?;
+            write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
+            write_picture(&scene, output, format)
         }
     }
+}
+
+/// The folder of `--allow-writes`, checked to be one, and `output` told
+/// that the program may write files.
+fn writes_folder(dir: &Option<PathBuf>, output: &ProgramOutput) -> Result<Option<PathBuf>, Error> {
+    let Some(dir) = dir else { return Ok(None) };
+    if !dir.is_dir() {
+        return Err(Error::Usage(format!(
+            "--allow-writes {}: not a folder; create it first",
+            dir.display()
+        )));
+    }
+    output.allow_writes();
+    Ok(Some(dir.clone()))
+}
+
+/// Writes the files the program wrote (`fopen`, `fprintf`) under `dir`,
+/// all or none, never over one of `inputs`, and never outside `dir`
+/// (the paths were checked when opened; a link inside `dir` that leads out
+/// is refused here).
+fn write_program_files(
+    output: &ProgramOutput,
+    dir: Option<&Path>,
+    inputs: &[&Path],
+) -> Result<(), Error> {
+    let files = output.files();
+    let Some(dir) = dir else { return Ok(()) };
+    if files.is_empty() {
+        return Ok(());
+    }
+    let root = dir
+        .canonicalize()
+        .map_err(|e| Error::Failed(format!("cannot read the folder {}: {e}", dir.display())))?;
+    let mut out: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    for (name, text) in files {
+        let path = root.join(&name);
+        let parent = path.parent().unwrap_or(&root).to_path_buf();
+        std::fs::create_dir_all(&parent).map_err(|e| Error::write(&parent, e))?;
+        let real = parent
+            .canonicalize()
+            .map_err(|e| Error::write(&parent, e))?;
+        if !real.starts_with(&root) {
+            return Err(Error::Failed(format!(
+                "the program's file `{name}` would be written outside {}",
+                dir.display()
+            )));
+        }
+        out.push((path, text.into_bytes()));
+    }
+    let paths: Vec<&Path> = out.iter().map(|(p, _)| p.as_path()).collect();
+    refuse_overwrite(&paths, inputs, false)?;
+    let files: Vec<(&Path, Vec<u8>)> = out.iter().map(|(p, b)| (p.as_path(), b.clone())).collect();
+    write_files(&files)
 }
 
 /// The arguments of `subgram subdivide`.

@@ -51,7 +51,7 @@ pub mod surface;
 pub use curve::{Curve, CurveRun, FigureOptions};
 pub use deadline::{Deadline, DEFAULT_TIMEOUT};
 pub use error::Error;
-pub use lang::{Program, Value};
+pub use lang::{Program, ProgramOutput, Stream, Value};
 pub use load::{
     load, load_file, load_file_with, load_str, load_str_with, load_text, LoadOptions, Precision,
 };

@@ -51,6 +51,9 @@ enum Command {
         /// srand48(N); SeedGillespie(N). Without it, lpfg's starting state.
         #[arg(long, value_name = "N")]
         seed: Option<u32>,
+        /// Let the program write files (fopen), under this folder.
+        #[arg(long, value_name = "DIR")]
+        allow_writes: Option<std::path::PathBuf>,
         /// Stop with an error after this many seconds (0: no limit).
         #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
@@ -95,6 +98,9 @@ enum Command {
         /// srand48(N); SeedGillespie(N). Without it, lpfg's starting state.
         #[arg(long, value_name = "N")]
         seed: Option<u32>,
+        /// Let the program write files (fopen), under this folder.
+        #[arg(long, value_name = "DIR")]
+        allow_writes: Option<std::path::PathBuf>,
         /// Stop with an error after this many seconds (0: no limit).
         #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
@@ -361,11 +367,13 @@ fn run(cli: Cli) -> Result<(), Error> {
             interpreted,
             seed,
             timeout,
+            allow_writes,
         } => {
+            let json = matches!(format, Format::Json);
             let args = DeriveArgs {
                 file,
                 steps,
-                json: matches!(format, Format::Json),
+                json,
                 defines: define,
                 double,
                 max_modules,
@@ -373,8 +381,14 @@ fn run(cli: Cli) -> Result<(), Error> {
                 interpreted,
                 seed,
                 timeout: timeout.0,
+                allow_writes,
+                output: subgram::ProgramOutput::new(),
             };
-            print_out(&with_progress(|p| command::derive(&args, p))?)
+            let result = with_progress(|p| command::derive(&args, p));
+            // The program's standard output goes before the word, or to
+            // standard error when the word is JSON, which must stay whole.
+            print_program_output(&args.output, json)?;
+            print_out(&result?)
         }
         Command::Render {
             file,
@@ -392,6 +406,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             seed,
             timeout,
             force,
+            allow_writes,
         } => {
             let args = RenderArgs {
                 file,
@@ -409,8 +424,12 @@ fn run(cli: Cli) -> Result<(), Error> {
                 seed,
                 timeout: timeout.0,
                 force,
+                allow_writes,
+                program_output: subgram::ProgramOutput::new(),
             };
-            with_progress(|p| command::render(&args, p))
+            let result = with_progress(|p| command::render(&args, p));
+            print_program_output(&args.program_output, false)?;
+            result
         }
         Command::Subdivide {
             mesh,
@@ -527,6 +546,32 @@ fn with_progress<T>(f: impl FnOnce(&mut dyn FnMut(Progress)) -> T) -> T {
         b.finish_and_clear();
     }
     result
+}
+
+/// Writes what an L+C program printed (`printf`, `fprintf(stderr, …)`):
+/// its standard output to ours (or to standard error with `to_stderr`),
+/// its standard error to ours.
+fn print_program_output(output: &subgram::ProgramOutput, to_stderr: bool) -> Result<(), Error> {
+    use std::io::Write;
+    for (stream, text) in output.take_text() {
+        let r = if stream == subgram::Stream::Stderr || to_stderr {
+            let mut e = std::io::stderr().lock();
+            e.write_all(text.as_bytes()).and_then(|_| e.flush())
+        } else {
+            let mut o = std::io::stdout().lock();
+            o.write_all(text.as_bytes()).and_then(|_| o.flush())
+        };
+        match r {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(()),
+            Err(e) => {
+                return Err(Error::Failed(format!(
+                    "cannot write the program's output: {e}"
+                )))
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Writes a line to stdout; a closed pipe (`subgram derive f | head`) is not an error.

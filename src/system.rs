@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use crate::curve::{Curve, CurveRun};
 use crate::deadline::Deadline;
 use crate::error::Error;
+use crate::lang::ProgramOutput;
 use crate::mesh::Mesh;
 use crate::rewrite::derive::DEFAULT_MAX_MODULES;
 use crate::rewrite::{DeriveOptions, Word};
@@ -42,6 +43,8 @@ pub struct RunOptions {
     pub base_mesh: Option<PathBuf>,
     /// The run stops with an error once this passes. Default: none.
     pub deadline: Option<Deadline>,
+    /// Curves: where the program's `printf`s and files go.
+    pub output: ProgramOutput,
 }
 
 impl Default for RunOptions {
@@ -53,6 +56,7 @@ impl Default for RunOptions {
             seed: None,
             base_mesh: None,
             deadline: None,
+            output: ProgramOutput::default(),
         }
     }
 }
@@ -69,7 +73,8 @@ impl RunOptions {
         let mut d = DeriveOptions::default()
             .with_max_modules(self.max_modules)
             .with_phase(self.phase)
-            .with_deadline(self.deadline);
+            .with_deadline(self.deadline)
+            .with_output(self.output.clone());
         d.steps = self.steps;
         d.seed = self.seed;
         d

@@ -141,7 +141,32 @@ struct Compiler {
     /// `float` is single precision (lpfg's); otherwise every `float`,
     /// `V2f` and `V3f` is read as `double`, `V2d`, `V3d`.
     single: bool,
+    /// User-defined C functions' signatures, by number, and their numbers
+    /// by name.
+    user_fns: Vec<UserSig>,
+    user_fn_names: HashMap<String, u16>,
+    /// `enum` constants.
+    enum_consts: HashMap<String, i64>,
+    /// The array types made so far, by element type and length.
+    array_types: HashMap<(Ty, Option<usize>), u16>,
 }
+
+/// A user-defined function as its callers see it.
+#[derive(Clone, Debug)]
+struct UserSig {
+    name: String,
+    /// Each parameter's type, and whether it is passed by reference (an
+    /// array, or C++'s `float &x`): written back to the caller's variable.
+    params: Vec<(Ty, bool)>,
+    ret: Ty,
+    span: Span,
+    /// Whether a body has been given.
+    defined: bool,
+}
+
+/// The most user-defined functions a program may declare (each is
+/// numbered with a `u16`).
+const MAX_USER_FUNCTIONS: usize = u16::MAX as usize;
 
 /// Function calls are inlined; past this many in one rule, functions that
 /// call each other twice over would take exponential time.
@@ -174,6 +199,10 @@ struct Scope {
     full: bool,
     /// ... and that has been reported.
     full_reported: bool,
+    /// Indices in `vars` of `static` locals, whose slots are globals'.
+    statics: HashSet<usize>,
+    /// In a function: its return type and name.
+    ret: Option<(Ty, String)>,
 }
 
 /// The most local variables one body may have (their slots are `u16`s).
@@ -206,6 +235,7 @@ impl Scope {
 
     /// Forgets the variables from the `len`th on.
     fn truncate(&mut self, len: usize) {
+        self.statics.retain(|&i| i < len);
         for (name, _, _) in self.vars.drain(len.min(self.vars.len())..) {
             if let Some(at) = self.by_name.get_mut(&name) {
                 at.pop();
@@ -247,12 +277,27 @@ impl Scope {
     }
 
     fn lookup(&self, name: &str) -> Option<(Ty, u16)> {
+        match self.lookup_var(name) {
+            Some((t, s, false)) => Some((t, s)),
+            _ => None,
+        }
+    }
+
+    /// A variable's type and slot, and whether the slot is a global's (a
+    /// `static` local).
+    fn lookup_var(&self, name: &str) -> Option<(Ty, u16, bool)> {
         let &i = self.by_name.get(name)?.last()?;
         if i < self.barrier {
             return None;
         }
         let (_, t, s) = &self.vars[i];
-        Some((*t, *s))
+        Some((*t, *s, self.statics.contains(&i)))
+    }
+
+    /// Names global `slot` `name` in this scope: a `static` local.
+    fn bind_static(&mut self, name: &str, ty: Ty, slot: u16) {
+        self.statics.insert(self.vars.len());
+        self.bind(name, ty, slot);
     }
 
     /// Whether `name` is declared, visible or not.
@@ -289,6 +334,10 @@ impl Compiler {
             inlined: 0,
             int_divisions: Vec::new(),
             truncating: Vec::new(),
+            user_fns: Vec::new(),
+            user_fn_names: HashMap::new(),
+            enum_consts: HashMap::new(),
+            array_types: HashMap::new(),
             single: false,
         }
     }
@@ -446,7 +495,11 @@ impl Compiler {
 
     fn resolve_type(&mut self, t: &ast::TypeRef) -> Option<Ty> {
         let ty = match t.name.as_str() {
-            "int" | "long" | "unsigned" | "short" => Ty::Int,
+            // `char *s` is a string; a `FILE *` is a handle, an int.
+            "char" if t.pointer => Ty::Str,
+            "int" | "long" | "unsigned" | "short" | "signed" | "char" | "size_t" | "FILE" => {
+                Ty::Int
+            }
             "float" => self.prec(Ty::Float),
             "double" => Ty::Double,
             "bool" => Ty::Bool,
@@ -463,7 +516,7 @@ impl Compiler {
                 } else {
                     self.err(
                         t.span,
-                        format!("unknown type `{other}`: expected int, float, double, bool, V2f, V3f or a declared struct"),
+                        format!("unknown type `{other}`: expected int, float, double, bool, V2f, V3f, a declared struct or enum"),
                     );
                     return None;
                 }
@@ -492,7 +545,7 @@ impl Compiler {
                     let mut index: HashMap<String, u16> = HashMap::new();
                     // The struct itself, then its fields'.
                     let (mut values, mut depth) = (1usize, 1usize);
-                    for (t, n) in fields {
+                    for (t, n, dims) in fields {
                         if index.contains_key(&n.text) {
                             self.err(
                                 n.span,
@@ -510,7 +563,10 @@ impl Compiler {
                             );
                             break;
                         }
-                        if let Some(ty) = self.resolve_type(t) {
+                        if let Some(ty) = self
+                            .resolve_type(t)
+                            .and_then(|ty| self.with_dims(ty, t, dims, None, n.span))
+                        {
                             let (v, d) = match ty {
                                 Ty::Struct(i) => self.struct_shapes[i as usize],
                                 _ => (1, 0),
@@ -546,6 +602,7 @@ impl Compiler {
                     self.structs.push(StructDef {
                         name: name.text.clone(),
                         fields: fs,
+                        elem: None,
                     });
                 }
                 Item::Typedef { ty, name } => {
@@ -553,6 +610,8 @@ impl Compiler {
                         self.typedefs.insert(name.text.clone(), t);
                     }
                 }
+                Item::Enum { name, variants } => self.enum_decl(name.as_ref(), variants),
+                Item::Function(def) => self.function_sig(def),
                 Item::Module { name, params } => {
                     if let Some(s) = self.alphabet.lookup(&name.text) {
                         let what = if self.alphabet.get(s).builtin {
@@ -646,6 +705,7 @@ impl Compiler {
             alphabet: Alphabet::new(),
             structs: Vec::new(),
             globals: Vec::new(),
+            functions: Vec::new(),
             axiom: Vec::new(),
             derivation_length: None,
             ring: None,
@@ -765,7 +825,11 @@ impl Compiler {
                         program.rules.push(rule);
                     }
                 }
-                Item::Module { .. } | Item::Struct { .. } | Item::Typedef { .. } => {}
+                Item::Module { .. }
+                | Item::Struct { .. }
+                | Item::Typedef { .. }
+                | Item::Enum { .. }
+                | Item::Function(_) => {}
             }
         }
         program.gillespie_groups = group_kinds
@@ -773,6 +837,7 @@ impl Compiler {
             .filter(|(_, g, _)| *g)
             .map(|(id, _, span)| (*id, *span))
             .collect();
+        program.functions = self.function_bodies(file);
         if !axiom_seen {
             let end = file
                 .items
@@ -791,10 +856,13 @@ impl Compiler {
     }
 
     fn global(&mut self, decl: &ast::VarDecl) {
-        let Some(ty) = self.resolve_type(&decl.ty) else {
+        let Some(base) = self.resolve_type(&decl.ty) else {
             return;
         };
         for d in &decl.vars {
+            let Some(ty) = self.declarator_type(base, &decl.ty, d) else {
+                continue;
+            };
             let mut scope = Scope::default();
             let init = self.initializer(ty, &d.init, &mut scope);
             if scope.max > 0 {
@@ -807,16 +875,9 @@ impl Compiler {
                 );
                 continue;
             }
-            if self.alphabet.lookup(&d.name.text).is_some() {
-                self.err(
-                    d.name.span,
-                    format!(
-                        "`{}` is a module name and cannot also name a variable",
-                        d.name.text
-                    ),
-                );
-                continue;
-            }
+            // A variable may be named like a module (`V2f f(6, 0);`): in
+            // L+C modules appear only in predecessors, successors and the
+            // axiom, variables only in expressions.
             if self.globals.len() >= MAX_DECLARED {
                 self.too_many(MAX_DECLARED, "global variables", d.name.span);
                 continue;
@@ -839,6 +900,17 @@ impl Compiler {
             Init::Expr(e) => {
                 let (ex, et) = self.expr(e, scope)?;
                 self.coerce(ex, et, ty, e.span)
+            }
+            Init::List(items, span)
+                if self.is_array(ty)
+                    || items.iter().any(|i| matches!(i.kind, ExprKind::List(_))) =>
+            {
+                self.list_init(ty, items, *span, scope)
+            }
+            Init::List(items, span)
+                if matches!(ty, Ty::Struct(_)) && items.len() < self.fields_of(ty) =>
+            {
+                self.list_init(ty, items, *span, scope)
             }
             Init::Ctor(args, span) | Init::List(args, span) => {
                 let mut exs = Vec::new();
@@ -1237,10 +1309,17 @@ impl Compiler {
                 }
             }
             ast::Stmt::Decl(d) => {
-                let Some(ty) = self.resolve_type(&d.ty) else {
+                let Some(base) = self.resolve_type(&d.ty) else {
                     return;
                 };
                 for v in &d.vars {
+                    let Some(ty) = self.declarator_type(base, &d.ty, v) else {
+                        continue;
+                    };
+                    if d.is_static {
+                        self.static_local(d, v, ty, scope);
+                        continue;
+                    }
                     let init = self.initializer(ty, &v.init, scope);
                     let slot = self.local(scope, &v.name.text, ty, v.name.span);
                     if d.is_const {
@@ -1337,7 +1416,7 @@ impl Compiler {
                     last: *last,
                 });
             }
-            ast::Stmt::Return(_) => out.push(St::Return),
+            ast::Stmt::Return(value, span) => self.return_stmt(value.as_ref(), *span, scope, out),
             ast::Stmt::Break(span) | ast::Stmt::Continue(span) => {
                 if scope.loops == 0 {
                     self.err(
@@ -1396,10 +1475,31 @@ impl Compiler {
     }
 
     fn place(&mut self, e: &ast::Expr, scope: &mut Scope) -> Option<Place> {
+        self.place_of(e, scope, true)
+    }
+
+    /// The place `e` names; `write` when it is to be assigned (a `const`
+    /// is refused).
+    fn place_of(&mut self, e: &ast::Expr, scope: &mut Scope, write: bool) -> Option<Place> {
         match &e.kind {
             ExprKind::Ident(n) => {
+                if let Some((ty, slot, true)) = scope.lookup_var(n) {
+                    if self.globals[slot as usize].is_const && write {
+                        self.err(
+                            e.span,
+                            format!("cannot assign to `{n}`: it is declared const"),
+                        );
+                        return None;
+                    }
+                    return Some(Place {
+                        global: true,
+                        slot,
+                        path: Vec::new(),
+                        ty,
+                    });
+                }
                 if let Some((ty, slot)) = scope.lookup(n) {
-                    if scope.consts.contains(&slot) {
+                    if write && scope.consts.contains(&slot) {
                         self.err(
                             e.span,
                             format!("cannot assign to `{n}`: it is declared const"),
@@ -1415,7 +1515,7 @@ impl Compiler {
                 }
                 if let Some(&g) = self.global_names.get(n) {
                     let gv = &self.globals[g as usize];
-                    if gv.is_const {
+                    if write && gv.is_const {
                         self.err(
                             e.span,
                             format!("cannot assign to `{n}`: it is declared const"),
@@ -1433,10 +1533,19 @@ impl Compiler {
                 None
             }
             ExprKind::Field(base, f) => {
-                let mut p = self.place(base, scope)?;
+                let mut p = self.place_of(base, scope, write)?;
                 let (idx, ty) = self.field_of(p.ty, f)?;
-                p.path.push(idx);
+                p.path.push(Step::Field(idx));
                 p.ty = ty;
+                Some(p)
+            }
+            ExprKind::Index(base, index) => {
+                let p = self.place_of(base, scope, write);
+                let i = self.index(index, scope);
+                let (mut p, i) = (p?, i?);
+                let elem = self.elem_of(p.ty, e.span)?;
+                p.path.push(Step::Index(Box::new(i), e.span));
+                p.ty = elem;
                 Some(p)
             }
             _ => {
@@ -1498,13 +1607,35 @@ impl Compiler {
             ExprKind::Int(i) => Some((Ex::Const(Value::Int(*i)), Ty::Int)),
             // A literal without a suffix is a `double`, as in C.
             ExprKind::Float(f) => Some((Ex::Const(Value::Float(*f)), Ty::Double)),
-            ExprKind::Str(s) => Some((Ex::Const(Value::Str(s.as_str().into())), Ty::Str)),
+            ExprKind::Str(s) => Some((
+                Ex::Const(Value::Str(super::stdio::unescape(s).into())),
+                Ty::Str,
+            )),
             ExprKind::Ident(n) => {
-                if let Some((ty, slot)) = scope.lookup(n) {
-                    return Some((Ex::Local(slot), ty));
+                if let Some((ty, slot, global)) = scope.lookup_var(n) {
+                    return Some((
+                        if global {
+                            Ex::Global(slot)
+                        } else {
+                            Ex::Local(slot)
+                        },
+                        ty,
+                    ));
                 }
                 if let Some(&g) = self.global_names.get(n) {
                     return Some((Ex::Global(g), self.globals[g as usize].ty));
+                }
+                if let Some(&v) = self.enum_consts.get(n) {
+                    return Some((Ex::Const(Value::Int(v)), Ty::Int));
+                }
+                let handle = match n.as_str() {
+                    "NULL" => Some(0),
+                    "stdout" => Some(super::stdio::STDOUT),
+                    "stderr" => Some(super::stdio::STDERR),
+                    _ => None,
+                };
+                if let Some(h) = handle {
+                    return Some((Ex::Const(Value::Int(h)), Ty::Int));
                 }
                 if let Some((f, ty)) = self.host.value(n) {
                     return Some((Ex::Call(f, Vec::new(), span), self.prec(ty)));
@@ -1747,11 +1878,7 @@ impl Compiler {
                 }
                 Some((fold_unary(Ex::Convert(ty, Box::new(x))), ty))
             }
-            ExprKind::Field(base, f) => {
-                let (x, t) = self.expr(base, scope)?;
-                let (idx, ft) = self.field_of(t, f)?;
-                Some((Ex::Field(Box::new(x), idx), ft))
-            }
+            ExprKind::Field(..) | ExprKind::Index(..) | ExprKind::List(_) => self.access(e, scope),
             ExprKind::Method(recv, name, args) => self.method(recv, name, args, span, scope),
             ExprKind::Gather { op, var, set, cond } => {
                 self.gather(op, Some(var), set, cond.as_deref(), scope)
@@ -1800,6 +1927,44 @@ impl Compiler {
                     });
                 }
                 Some((Ex::InContext(*kind, out, all_places), Ty::Bool))
+            }
+        }
+    }
+
+    /// A field, an element of an array, or a misplaced `{...}`; out of
+    /// `expr_inner`, so that its frame stays small for deep nesting.
+    #[inline(never)]
+    fn access(&mut self, e: &ast::Expr, scope: &mut Scope) -> Typed {
+        let span = e.span;
+        match &e.kind {
+            ExprKind::Field(base, f) => {
+                if self.indexes_a_variable(e, scope) {
+                    let p = self.place_of(e, scope, false)?;
+                    let ty = p.ty;
+                    return Some((Ex::Load(p), ty));
+                }
+                let (x, t) = self.expr(base, scope)?;
+                let (idx, ft) = self.field_of(t, f)?;
+                Some((Ex::Field(Box::new(x), idx), ft))
+            }
+            ExprKind::Index(base, index) => {
+                if self.indexes_a_variable(e, scope) {
+                    let p = self.place_of(e, scope, false)?;
+                    let ty = p.ty;
+                    return Some((Ex::Load(p), ty));
+                }
+                let b = self.expr(base, scope);
+                let i = self.index(index, scope);
+                let ((bx, bt), i) = (b?, i?);
+                let elem = self.elem_of(bt, span)?;
+                Some((Ex::Index(Box::new(bx), Box::new(i), span), elem))
+            }
+            _ => {
+                self.err(
+                    span,
+                    "a `{...}` list is an initializer: it may only follow `=` in a declaration",
+                );
+                None
             }
         }
     }
@@ -1866,6 +2031,18 @@ impl Compiler {
         let n = name.text.as_str();
         if let Some(&f) = self.function_names.get(n) {
             return self.inline(f, args, span, scope);
+        }
+        if let Some(&id) = self.user_fn_names.get(n) {
+            return self.user_call(id, name, args, span, scope);
+        }
+        if let Some(r) = self.stdio_call(name, args, span, scope) {
+            return r;
+        }
+        // A functional cast: `float(x)`, `int(x)`.
+        if let ("int" | "float" | "double" | "bool" | "long" | "short" | "unsigned" | "char", [a]) =
+            (n, args)
+        {
+            return self.functional_cast(name, a, span, scope);
         }
         let mut typed = Vec::new();
         let mut ok = true;
@@ -2081,6 +2258,863 @@ impl Compiler {
         ))
     }
 
+    // ----- C: arrays, enums, statics, functions, standard I/O ----------
+
+    fn is_array(&self, ty: Ty) -> bool {
+        matches!(ty, Ty::Struct(i) if self.structs[i as usize].elem.is_some())
+    }
+
+    /// The number of fields (or elements) of a struct type; 0 otherwise.
+    fn fields_of(&self, ty: Ty) -> usize {
+        match ty {
+            Ty::Struct(i) => self.structs[i as usize].fields.len(),
+            _ => 0,
+        }
+    }
+
+    /// The element type of an array (a string's elements are `char`s,
+    /// ints), or the error that `ty` has none.
+    fn elem_of(&mut self, ty: Ty, span: Span) -> Option<Ty> {
+        match ty {
+            Ty::Struct(i) if self.structs[i as usize].elem.is_some() => {
+                self.structs[i as usize].elem
+            }
+            Ty::Str => Some(Ty::Int),
+            _ => {
+                self.err(
+                    span,
+                    format!(
+                        "{} is not an array: it cannot be indexed",
+                        self.type_name(ty)
+                    ),
+                );
+                None
+            }
+        }
+    }
+
+    /// An array index: an integer.
+    #[inline(never)]
+    fn index(&mut self, e: &ast::Expr, scope: &mut Scope) -> Option<Ex> {
+        let (x, t) = self.expr(e, scope)?;
+        if !matches!(t, Ty::Int | Ty::Bool) {
+            self.err(
+                e.span,
+                format!(
+                    "an array index must be an integer, found {}",
+                    self.type_name(t)
+                ),
+            );
+            return None;
+        }
+        Some(x)
+    }
+
+    /// True when `e` is a chain of fields and indices with at least one
+    /// index, on a variable: read through a place, without copying the
+    /// whole variable.
+    #[inline(never)]
+    fn indexes_a_variable(&self, e: &ast::Expr, scope: &Scope) -> bool {
+        let mut indexed = false;
+        let mut e = e;
+        loop {
+            match &e.kind {
+                ExprKind::Index(b, _) => {
+                    indexed = true;
+                    e = b;
+                }
+                ExprKind::Field(b, _) => e = b,
+                ExprKind::Ident(n) => {
+                    return indexed
+                        && (scope.lookup_var(n).is_some() || self.global_names.contains_key(n))
+                }
+                _ => return false,
+            }
+        }
+    }
+
+    /// The array type of `len` elements of `elem` (`None`: any length, a
+    /// parameter's `float a[]`), made once.
+    fn array_type(&mut self, elem: Ty, len: Option<usize>, span: Span) -> Option<Ty> {
+        if let Some(&id) = self.array_types.get(&(elem, len)) {
+            return Some(Ty::Struct(id));
+        }
+        let (values, depth) = match elem {
+            Ty::Struct(i) => self.struct_shapes[i as usize],
+            _ => (1, 0),
+        };
+        let total = values.saturating_mul(len.unwrap_or(0)).saturating_add(1);
+        if total > MAX_ARRAY_VALUES {
+            self.err(
+                span,
+                format!("this array holds more than {MAX_ARRAY_VALUES} values, the limit"),
+            );
+            return None;
+        }
+        if depth + 1 > MAX_NESTING {
+            self.err(
+                span,
+                format!("arrays nest more than {MAX_NESTING} levels deep"),
+            );
+            return None;
+        }
+        if self.structs.len() >= MAX_DECLARED {
+            self.too_many(MAX_DECLARED, "structs and array types", span);
+            return None;
+        }
+        let elem_name = self.type_name(elem);
+        let (head, tail) = match elem_name.find('[') {
+            Some(k) if self.is_array(elem) => (&elem_name[..k], &elem_name[k..]),
+            _ => (elem_name.as_str(), ""),
+        };
+        let dim = len.map(|n| n.to_string()).unwrap_or_default();
+        let name = format!("{head}[{dim}]{tail}");
+        let id = self.structs.len() as u16;
+        self.array_types.insert((elem, len), id);
+        self.struct_names.insert(name.clone(), id);
+        self.struct_fields.push(HashMap::new());
+        self.struct_shapes.push((total, depth + 1));
+        self.structs.push(StructDef {
+            name,
+            fields: vec![(String::new(), elem); len.unwrap_or(0)],
+            elem: Some(elem),
+        });
+        Some(Ty::Struct(id))
+    }
+
+    /// `ty` with the dimensions written after a name (`float a[3][2]`: 3
+    /// arrays of 2 floats); a `char` array is a string. A first `[]` takes
+    /// its length from `init_len` (the initializer's), or stays open (a
+    /// parameter's).
+    #[inline(never)]
+    fn with_dims(
+        &mut self,
+        mut ty: Ty,
+        base: &ast::TypeRef,
+        dims: &[Option<ast::Expr>],
+        init_len: Option<usize>,
+        span: Span,
+    ) -> Option<Ty> {
+        let mut dims = dims;
+        if base.name == "char" && !base.pointer && !dims.is_empty() {
+            ty = Ty::Str;
+            dims = &dims[..dims.len() - 1];
+        }
+        let mut lens = Vec::with_capacity(dims.len());
+        for (k, d) in dims.iter().enumerate() {
+            lens.push(match d {
+                Some(e) => {
+                    let n = self.const_int(e, "an array size")?;
+                    if n <= 0 {
+                        self.err(e.span, format!("an array size must be positive, found {n}"));
+                        return None;
+                    }
+                    Some(n as usize)
+                }
+                None if k == 0 => init_len,
+                None => {
+                    self.err(
+                        span,
+                        "only an array's first dimension may be left empty (`[]`)",
+                    );
+                    return None;
+                }
+            });
+        }
+        for len in lens.into_iter().rev() {
+            ty = self.array_type(ty, len, span)?;
+        }
+        Some(ty)
+    }
+
+    /// The type a declarator gives its variable: `char *s` is a string,
+    /// `FILE *f` a handle, `float a[3]` an array.
+    #[inline(never)]
+    fn declarator_type(
+        &mut self,
+        base: Ty,
+        tref: &ast::TypeRef,
+        d: &ast::Declarator,
+    ) -> Option<Ty> {
+        let mut base = base;
+        if d.pointer || tref.pointer {
+            base = match tref.name.as_str() {
+                "char" => Ty::Str,
+                "FILE" => Ty::Int,
+                _ => {
+                    self.err(
+                        d.name.span,
+                        format!(
+                            "pointers are not supported (`{} *{}`); use an array, or a reference parameter",
+                            tref.name, d.name.text
+                        ),
+                    );
+                    return None;
+                }
+            };
+        }
+        if base == Ty::Void {
+            self.err(d.name.span, "a variable cannot have type void");
+            return None;
+        }
+        let init_len = match &d.init {
+            Init::List(items, _) => Some(items.len()),
+            Init::Expr(ast::Expr {
+                kind: ExprKind::Str(s),
+                ..
+            }) => Some(s.len() + 1),
+            _ => None,
+        };
+        if d.dims.first().is_some_and(|d| d.is_none()) && init_len.is_none() {
+            self.err(
+                d.name.span,
+                format!("`{}[]` needs a size or an initializer list", d.name.text),
+            );
+            return None;
+        }
+        let char_tref;
+        let tref = if d.pointer && tref.name == "char" {
+            char_tref = ast::TypeRef {
+                pointer: true,
+                ..tref.clone()
+            };
+            &char_tref
+        } else {
+            tref
+        };
+        self.with_dims(base, tref, &d.dims, init_len, d.name.span)
+    }
+
+    /// `{1, 2, 3}` for an array or a struct, nested lists for their
+    /// elements; missing elements are zero, as in C.
+    #[inline(never)]
+    fn list_init(
+        &mut self,
+        ty: Ty,
+        items: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Option<Ex> {
+        let want: Vec<Ty> = match ty {
+            Ty::Struct(i) => self.structs[i as usize]
+                .fields
+                .iter()
+                .map(|f| f.1)
+                .collect(),
+            t if t.is_vector() => vec![t.scalar(); t.dim()],
+            t => vec![t],
+        };
+        if items.len() > want.len() || (!matches!(ty, Ty::Struct(_)) && items.len() != want.len()) {
+            self.err(
+                span,
+                format!(
+                    "{} takes {} value(s) here, but {} were given",
+                    self.type_name(ty),
+                    want.len(),
+                    items.len()
+                ),
+            );
+            return None;
+        }
+        let mut parts = Vec::with_capacity(want.len());
+        let mut ok = true;
+        for (k, w) in want.iter().enumerate() {
+            let part = match items.get(k) {
+                None => Some(Ex::Const(Value::zero(*w, &self.structs))),
+                Some(ast::Expr {
+                    kind: ExprKind::List(inner),
+                    span,
+                }) => self.list_init(*w, inner, *span, scope),
+                Some(e) => self
+                    .expr(e, scope)
+                    .and_then(|(x, t)| self.coerce(x, t, *w, e.span)),
+            };
+            match part {
+                Some(p) => parts.push(p),
+                None => ok = false,
+            }
+        }
+        if !ok {
+            return None;
+        }
+        Some(match ty {
+            Ty::V2 | Ty::V2d => {
+                let mut it = parts.into_iter();
+                Ex::MakeV2(Box::new(it.next()?), Box::new(it.next()?))
+            }
+            Ty::V3 | Ty::V3d => {
+                let mut it = parts.into_iter();
+                Ex::MakeV3(
+                    Box::new(it.next()?),
+                    Box::new(it.next()?),
+                    Box::new(it.next()?),
+                )
+            }
+            Ty::Struct(_) => Ex::MakeStruct(parts),
+            _ => parts.pop()?,
+        })
+    }
+
+    /// An integer constant: a literal, an enumerator, a `const` global
+    /// with a constant initializer, or arithmetic of those.
+    #[inline(never)]
+    fn const_int(&mut self, e: &ast::Expr, what: &str) -> Option<i64> {
+        let mut scope = Scope::default();
+        let (ex, _) = self.expr(e, &mut scope)?;
+        match self.const_value(&ex, 0) {
+            Some(Value::Int(i)) => Some(i),
+            Some(Value::Bool(b)) => Some(b as i64),
+            _ => {
+                self.err(e.span, format!("{what} must be an integer constant"));
+                None
+            }
+        }
+    }
+
+    fn const_value(&self, ex: &Ex, depth: usize) -> Option<Value> {
+        if depth > MAX_NESTING {
+            return None;
+        }
+        match ex {
+            Ex::Const(v) => Some(v.clone()),
+            Ex::Global(g) => {
+                let gv = self.globals.get(*g as usize)?;
+                if gv.is_const {
+                    Some(
+                        self.const_value(gv.init.as_ref()?, depth + 1)?
+                            .convert(gv.ty),
+                    )
+                } else {
+                    None
+                }
+            }
+            Ex::Neg(a) => {
+                super::eval::binary(BinOp::Sub, Value::Int(0), self.const_value(a, depth + 1)?).ok()
+            }
+            Ex::Convert(t, a) => Some(self.const_value(a, depth + 1)?.convert(*t)),
+            Ex::Bin(op, a, b, _) => super::eval::binary(
+                *op,
+                self.const_value(a, depth + 1)?,
+                self.const_value(b, depth + 1)?,
+            )
+            .ok(),
+            _ => None,
+        }
+    }
+
+    /// `enum Kind { A, B = 5, C };`: int constants, and `Kind` an int type.
+    fn enum_decl(&mut self, name: Option<&ast::Name>, variants: &[(ast::Name, Option<ast::Expr>)]) {
+        if let Some(n) = name {
+            self.typedefs.insert(n.text.clone(), Ty::Int);
+        }
+        let mut next = 0i64;
+        for (v, value) in variants {
+            if let Some(e) = value {
+                match self.const_int(e, "an enumerator's value") {
+                    Some(x) => next = x,
+                    None => continue,
+                }
+            }
+            if self.enum_consts.contains_key(&v.text) || self.global_names.contains_key(&v.text) {
+                self.err(v.span, format!("`{}` is already declared", v.text));
+                continue;
+            }
+            self.enum_consts.insert(v.text.clone(), next);
+            next = next.wrapping_add(1);
+        }
+    }
+
+    /// `static int n = 0;` in a body: a global that only this body names,
+    /// initialised once before the run.
+    #[inline(never)]
+    fn static_local(&mut self, d: &ast::VarDecl, v: &ast::Declarator, ty: Ty, scope: &mut Scope) {
+        let mut init_scope = Scope::default();
+        let init = self.initializer(ty, &v.init, &mut init_scope);
+        if init_scope.max > 0 {
+            self.err(
+                v.name.span,
+                "a static variable's initializer cannot declare variables",
+            );
+        }
+        if self.globals.len() >= MAX_DECLARED {
+            self.too_many(MAX_DECLARED, "global variables", v.name.span);
+            return;
+        }
+        let owner = scope.ret.as_ref().map_or("a body", |(_, n)| n.as_str());
+        let slot = self.globals.len() as u16;
+        self.globals.push(GlobalVar {
+            name: format!("{}::{}", owner, v.name.text),
+            ty,
+            is_const: d.is_const,
+            init,
+        });
+        scope.bind_static(&v.name.text, ty, slot);
+    }
+
+    #[inline(never)]
+    fn return_stmt(
+        &mut self,
+        value: Option<&ast::Expr>,
+        span: Span,
+        scope: &mut Scope,
+        out: &mut Vec<St>,
+    ) {
+        match (scope.ret.clone(), value) {
+            (None, None) | (Some((Ty::Void, _)), None) => out.push(St::Return),
+            (None, Some(v)) => self.err(
+                v.span,
+                "only a function returns a value; a production or a control block ends with a plain `return;`",
+            ),
+            (Some((Ty::Void, name)), Some(v)) => self.err(
+                v.span,
+                format!("`{name}` returns void: its `return` takes no value"),
+            ),
+            (Some((t, name)), None) => {
+                let t = self.type_name(t);
+                self.err(span, format!("`{name}` returns {t}: `return` needs a value"));
+            }
+            (Some((t, _)), Some(v)) => {
+                if let Some((x, xt)) = self.expr(v, scope) {
+                    if let Some(x) = self.coerce(x, xt, t, v.span) {
+                        out.push(St::ReturnValue(x));
+                    }
+                }
+            }
+        }
+    }
+
+    /// A function's parameter types as its callers see them.
+    fn param_types(&mut self, def: &ast::FunctionDef) -> Option<Vec<(Ty, bool)>> {
+        let mut out = Vec::with_capacity(def.params.len());
+        let mut ok = true;
+        for p in &def.params {
+            let at = p.name.as_ref().map_or(p.ty.span, |n| n.span);
+            let Some(mut ty) = self.resolve_type(&p.ty) else {
+                ok = false;
+                continue;
+            };
+            let mut by_ref = p.ty.reference;
+            if p.ty.pointer {
+                match p.ty.name.as_str() {
+                    "char" => ty = Ty::Str,
+                    "FILE" => ty = Ty::Int,
+                    // `float *a`: an array of any length.
+                    _ => {
+                        ty = match self.array_type(ty, None, at) {
+                            Some(t) => t,
+                            None => {
+                                ok = false;
+                                continue;
+                            }
+                        };
+                    }
+                }
+            }
+            if ty == Ty::Void {
+                self.err(at, "a parameter cannot have type void");
+                ok = false;
+                continue;
+            }
+            match self.with_dims(ty, &p.ty, &p.dims, None, at) {
+                Some(t) => ty = t,
+                None => {
+                    ok = false;
+                    continue;
+                }
+            }
+            // C passes arrays as pointers: the callee's writes are the
+            // caller's.
+            by_ref |= self.is_array(ty);
+            out.push((ty, by_ref));
+        }
+        ok.then_some(out)
+    }
+
+    /// First pass: a function's signature, so that calls may come before
+    /// its definition.
+    fn function_sig(&mut self, def: &ast::FunctionDef) {
+        let ret = match self.resolve_type(&def.ret) {
+            Some(_) if def.ret.pointer && def.ret.name == "char" => Ty::Str,
+            Some(_) if def.ret.pointer && def.ret.name != "FILE" => {
+                self.err(def.ret.span, "a function cannot return a pointer here");
+                return;
+            }
+            Some(t) => t,
+            None => return,
+        };
+        let Some(params) = self.param_types(def) else {
+            return;
+        };
+        let name = &def.name;
+        if let Some(&id) = self.user_fn_names.get(&name.text) {
+            let sig = &self.user_fns[id as usize];
+            if sig.params != params || sig.ret != ret {
+                self.err(
+                    name.span,
+                    format!(
+                        "`{}` is declared again with other types; functions cannot be overloaded",
+                        name.text
+                    ),
+                );
+                return;
+            }
+            if sig.defined && def.body.is_some() {
+                self.err(
+                    name.span,
+                    format!("function `{}` is defined twice", name.text),
+                );
+                return;
+            }
+            if def.body.is_some() {
+                let sig = &mut self.user_fns[id as usize];
+                sig.defined = true;
+                sig.span = name.span;
+            }
+            return;
+        }
+        if self.user_fns.len() >= MAX_USER_FUNCTIONS {
+            self.too_many(MAX_USER_FUNCTIONS, "functions", name.span);
+            return;
+        }
+        self.user_fn_names
+            .insert(name.text.clone(), self.user_fns.len() as u16);
+        self.user_fns.push(UserSig {
+            name: name.text.clone(),
+            params,
+            ret,
+            span: name.span,
+            defined: def.body.is_some(),
+        });
+    }
+
+    /// Last pass: the functions' bodies, checked with every signature,
+    /// global and struct known.
+    fn function_bodies(&mut self, file: &ast::File) -> Vec<Function> {
+        let mut out: Vec<Function> = self
+            .user_fns
+            .iter()
+            .map(|s| Function {
+                name: s.name.clone(),
+                params: s.params.iter().map(|p| p.0).collect(),
+                ret: s.ret,
+                body: Vec::new(),
+                frame_size: s.params.len(),
+                end: s.span,
+            })
+            .collect();
+        for item in &file.items {
+            let Item::Function(def) = item else { continue };
+            let Some(body) = &def.body else { continue };
+            let Some(&id) = self.user_fn_names.get(&def.name.text) else {
+                continue;
+            };
+            let sig = self.user_fns[id as usize].clone();
+            if sig.span != def.name.span {
+                continue; // refused as a second definition
+            }
+            let mut scope = Scope {
+                ret: Some((sig.ret, sig.name.clone())),
+                ..Scope::default()
+            };
+            for (p, (t, _)) in def.params.iter().zip(&sig.params) {
+                match &p.name {
+                    Some(n) => {
+                        if scope.lookup(&n.text).is_some() {
+                            self.err(
+                                n.span,
+                                format!("the parameter name `{}` is used twice", n.text),
+                            );
+                        }
+                        self.local(&mut scope, &n.text, *t, n.span);
+                    }
+                    None => {
+                        scope.reserve(1);
+                    }
+                }
+            }
+            let stmts = self.block_stmts(&body.stmts, &mut scope);
+            let end = body.span.end as usize;
+            out[id as usize] = Function {
+                name: sig.name.clone(),
+                params: sig.params.iter().map(|p| p.0).collect(),
+                ret: sig.ret,
+                body: stmts,
+                frame_size: (scope.max as usize).max(sig.params.len()),
+                end: Span::new(body.span.file, end.saturating_sub(1), end),
+            };
+        }
+        out
+    }
+
+    /// Whether assigning to `p` is refused (a `const` variable).
+    fn is_const_place(&self, p: &Place, scope: &Scope) -> bool {
+        if p.global {
+            self.globals[p.slot as usize].is_const
+        } else {
+            scope.consts.contains(&p.slot)
+        }
+    }
+
+    /// A call of a user-defined function: arguments checked against the
+    /// parameters, arrays and references passed as places.
+    #[inline(never)]
+    fn user_call(
+        &mut self,
+        id: u16,
+        name: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Typed {
+        let sig = self.user_fns[id as usize].clone();
+        if args.len() != sig.params.len() {
+            let types: Vec<String> = sig.params.iter().map(|p| self.type_name(p.0)).collect();
+            self.err(
+                span,
+                format!(
+                    "`{}` takes {} argument(s) ({}), but {} were given",
+                    sig.name,
+                    sig.params.len(),
+                    types.join(", "),
+                    args.len()
+                ),
+            );
+            return None;
+        }
+        if !sig.defined {
+            self.err(
+                name.span,
+                format!(
+                    "`{}` is declared but never defined: its body is missing",
+                    sig.name
+                ),
+            );
+            return None;
+        }
+        let mut exs = Vec::with_capacity(args.len());
+        let mut back = Vec::new();
+        let mut ok = true;
+        for (k, (a, &(pt, by_ref))) in args.iter().zip(&sig.params).enumerate() {
+            let mismatch = |c: &mut Compiler, found: Ty| {
+                let (w, f) = (c.type_name(pt), c.type_name(found));
+                c.err(
+                    a.span,
+                    format!(
+                        "type mismatch in argument {} of `{}`: expected {w}, found {f}",
+                        k + 1,
+                        sig.name
+                    ),
+                );
+            };
+            if by_ref {
+                let is_place = matches!(
+                    a.kind,
+                    ExprKind::Ident(_) | ExprKind::Field(..) | ExprKind::Index(..)
+                );
+                if !is_place {
+                    self.err(
+                        a.span,
+                        format!(
+                            "argument {} of `{}` is passed by reference: it must be a variable",
+                            k + 1,
+                            sig.name
+                        ),
+                    );
+                    ok = false;
+                    continue;
+                }
+                let Some(p) = self.place_of(a, scope, false) else {
+                    ok = false;
+                    continue;
+                };
+                let open_array = matches!(pt, Ty::Struct(i) if self.structs[i as usize].elem.is_some()
+                    && self.structs[i as usize].fields.is_empty());
+                let fits = p.ty == pt
+                    || (open_array
+                        && matches!(p.ty, Ty::Struct(j)
+                            if self.structs[j as usize].elem == self.structs[pt_index(pt)].elem));
+                if !fits {
+                    mismatch(self, p.ty);
+                    ok = false;
+                    continue;
+                }
+                if !self.is_const_place(&p, scope) {
+                    back.push((k as u16, p.clone()));
+                }
+                exs.push(Ex::Load(p));
+            } else {
+                let Some((x, t)) = self.expr(a, scope) else {
+                    ok = false;
+                    continue;
+                };
+                let (x, t) = self.arith(x, t, a.span);
+                if !(t == pt || (t.is_numeric() && pt.is_numeric())) {
+                    mismatch(self, t);
+                    ok = false;
+                    continue;
+                }
+                match self.coerce(x, t, pt, a.span) {
+                    Some(x) => exs.push(x),
+                    None => ok = false,
+                }
+            }
+        }
+        if !ok {
+            return None;
+        }
+        Some((
+            Ex::CallUser {
+                id,
+                args: exs,
+                back,
+                span,
+            },
+            sig.ret,
+        ))
+    }
+
+    /// `float(x)`: the cast `(float) x`.
+    #[inline(never)]
+    fn functional_cast(
+        &mut self,
+        name: &ast::Name,
+        a: &ast::Expr,
+        span: Span,
+        scope: &mut Scope,
+    ) -> Typed {
+        let t = ast::TypeRef {
+            name: name.text.clone(),
+            span: name.span,
+            pointer: false,
+            reference: false,
+        };
+        let cast = ast::Expr {
+            kind: ExprKind::Cast(t, Box::new(a.clone())),
+            span,
+        };
+        self.expr_inner(&cast, scope)
+    }
+
+    /// C's standard I/O and string functions; `None` for another name.
+    #[inline(never)]
+    fn stdio_call(
+        &mut self,
+        name: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Option<Typed> {
+        use super::stdio::IoFunc;
+        let n = name.text.as_str();
+        // (function, fixed leading argument types, whether more follow, result)
+        let (f, fixed, varargs, ret): (IoFunc, &[Ty], bool, Ty) = match n {
+            "printf" | "Printf" => (IoFunc::Printf, &[Ty::Str], true, Ty::Int),
+            "fprintf" => (IoFunc::Fprintf, &[Ty::Int, Ty::Str], true, Ty::Int),
+            "sprintf" => (IoFunc::Format, &[Ty::Str, Ty::Str], true, Ty::Str),
+            "puts" => (IoFunc::Puts, &[Ty::Str], false, Ty::Int),
+            "fputs" => (IoFunc::Fputs, &[Ty::Str, Ty::Int], false, Ty::Int),
+            "fopen" => (IoFunc::Fopen, &[Ty::Str, Ty::Str], false, Ty::Int),
+            "fclose" => (IoFunc::Fclose, &[Ty::Int], false, Ty::Int),
+            "fflush" => (IoFunc::Fflush, &[Ty::Int], false, Ty::Int),
+            "strlen" => (IoFunc::Strlen, &[Ty::Str], false, Ty::Int),
+            "strcmp" => (IoFunc::Strcmp, &[Ty::Str, Ty::Str], false, Ty::Int),
+            "strcpy" => (IoFunc::Concat, &[Ty::Str, Ty::Str], false, Ty::Str),
+            "strcat" => (IoFunc::Concat, &[Ty::Str, Ty::Str], false, Ty::Str),
+            "scanf" | "fscanf" | "sscanf" | "fgets" | "fgetc" | "getc" | "fread" | "gets"
+            | "getchar" => {
+                self.err(
+                    name.span,
+                    format!("`{n}` reads input, which a program may not do here"),
+                );
+                return Some(None);
+            }
+            _ => return None,
+        };
+        let count_ok = if varargs {
+            args.len() >= fixed.len()
+        } else {
+            args.len() == fixed.len()
+        };
+        if !count_ok {
+            let more = if varargs { " or more" } else { "" };
+            self.err(
+                span,
+                format!(
+                    "`{n}` takes {}{more} argument(s), but {} were given",
+                    fixed.len(),
+                    args.len()
+                ),
+            );
+            return Some(None);
+        }
+        // `sprintf`, `strcpy` and `strcat` write their first argument.
+        let target = if matches!(n, "sprintf" | "strcpy" | "strcat") {
+            let p = self.place(&args[0], scope);
+            match p {
+                Some(p) if p.ty == Ty::Str => Some(p),
+                Some(p) => {
+                    let t = self.type_name(p.ty);
+                    self.err(
+                        args[0].span,
+                        format!("`{n}` writes a string (a `char` array), found {t}"),
+                    );
+                    return Some(None);
+                }
+                None => return Some(None),
+            }
+        } else {
+            None
+        };
+        let mut exs = Vec::with_capacity(args.len());
+        let mut ok = true;
+        let skip = usize::from(target.is_some() && n != "strcat");
+        for (k, a) in args.iter().enumerate().skip(skip) {
+            let Some((x, t)) = self.expr(a, scope) else {
+                ok = false;
+                continue;
+            };
+            let want = fixed.get(k).copied();
+            let fits = match want {
+                Some(Ty::Str) => t == Ty::Str,
+                Some(w) => t.is_numeric() && w.is_numeric(),
+                None => t.is_numeric() || t == Ty::Str,
+            };
+            if !fits {
+                let found = self.type_name(t);
+                let m = match want {
+                    Some(w) => format!(
+                        "type mismatch in argument {} of `{n}`: expected {}, found {found}",
+                        k + 1,
+                        if w == Ty::Str {
+                            "a string".to_string()
+                        } else {
+                            self.type_name(w)
+                        }
+                    ),
+                    None => format!(
+                        "`{n}` prints numbers and strings, not {found}; print its fields (`v.x`)"
+                    ),
+                };
+                self.err(a.span, m);
+                ok = false;
+                continue;
+            }
+            exs.push(x);
+        }
+        if !ok {
+            return Some(None);
+        }
+        let call = if n == "strcpy" {
+            exs.pop()?
+        } else {
+            Ex::Call(Func::Io(f), exs, span)
+        };
+        Some(Some(match target {
+            Some(p) => (Ex::Assign(p, None, Box::new(call), Ty::Str), Ty::Str),
+            None => (call, ret),
+        }))
+    }
+
     /// A call of a `define` function: the arguments bind fresh locals,
     /// reserved before the arguments are compiled so that no argument's
     /// own locals overwrite a parameter already set; then the body sees
@@ -2194,6 +3228,17 @@ impl Compiler {
         Some((x, t))
     }
 }
+
+/// The index in `Program::structs` of a struct or array type.
+fn pt_index(t: Ty) -> usize {
+    match t {
+        Ty::Struct(i) => i as usize,
+        _ => 0,
+    }
+}
+
+/// The most values an array may hold (counting those of its elements).
+const MAX_ARRAY_VALUES: usize = 1 << 22;
 
 /// `a op b` of two constants, computed once at compile time. Divisions of
 /// integers are left alone: `check` warns about those that truncate, and

@@ -13,6 +13,7 @@ use crate::syntax::span::Span;
 use super::ir::*;
 use super::modules::Sym;
 use super::random::Random;
+use super::stdio::ProgramOutput;
 use super::value::{StructDef, Ty, Value};
 
 /// Global state shared by all bodies of one derivation.
@@ -30,6 +31,8 @@ pub struct Env {
     pub random: Random,
     /// The model folder's functions and contours, for `func` and its kin.
     pub model: std::sync::Arc<crate::model::Model>,
+    /// What the program prints and the files it writes.
+    pub output: ProgramOutput,
 }
 
 impl Env {
@@ -43,6 +46,7 @@ impl Env {
             stop: false,
             random: Random::default(),
             model: Default::default(),
+            output: ProgramOutput::default(),
         }
     }
 }
@@ -141,12 +145,37 @@ pub enum Flow {
 /// Loop iterations one body may run before it is stopped.
 pub const LOOP_LIMIT: u64 = 10_000_000;
 
-/// Loop iterations, over all bodies, between two looks at the deadline.
+/// Loop iterations and function calls, over all bodies, between two looks
+/// at the deadline.
 const DEADLINE_EVERY: u32 = 1 << 16;
+
+/// Calls of user-defined functions may nest this deep (a recursion); a
+/// deeper call is an error at the call.
+pub const MAX_CALL_DEPTH: u32 = 10_000;
+
+/// The interpreter recurses on the Rust stack. Once a chain of user
+/// function calls has used this much of the caller's stack (whose size is
+/// not known: a test thread has 2 MiB), the next call runs on a new thread
+/// with a stack of [`SEGMENT_STACK`] bytes (reserved, and used as it is
+/// needed), which it may use up to [`SEGMENT_MARGIN`] from its end before
+/// it moves on to another. [`MAX_CALL_DEPTH`] calls fit in one or two.
+const STACK_SEGMENT: usize = 256 << 10;
+const SEGMENT_STACK: usize = 512 << 20;
+const SEGMENT_MARGIN: usize = 4 << 20;
 
 /// Runs bodies. Holds scratch space reused across calls.
 pub struct Interp<'p> {
     pub structs: &'p [StructDef],
+    /// The program's user-defined functions.
+    funcs: &'p [Function],
+    /// User function calls in progress.
+    calls: u32,
+    /// The value of the `return` that ended the running function.
+    ret: Option<Value>,
+    /// The stack address where the current stack segment started (0: not
+    /// yet known), and how much of it calls may use.
+    stack_base: usize,
+    stack_room: usize,
     scratch: Vec<Value>,
     fuel: u64,
     /// The run stops once this passes; looked at every
@@ -160,10 +189,24 @@ impl<'p> Interp<'p> {
     pub fn new(structs: &'p [StructDef]) -> Interp<'p> {
         Interp {
             structs,
+            funcs: &[],
+            calls: 0,
+            ret: None,
+            stack_base: 0,
+            stack_room: STACK_SEGMENT,
             scratch: Vec::new(),
             fuel: LOOP_LIMIT,
             deadline: None,
             ticks: 0,
+        }
+    }
+
+    /// An interpreter of `program`'s bodies (its structs and its
+    /// functions) that stops once `deadline` passes.
+    pub fn for_program(program: &'p Program, deadline: Option<Deadline>) -> Interp<'p> {
+        Interp {
+            funcs: &program.functions,
+            ..Interp::with_deadline(&program.structs, deadline)
         }
     }
 
@@ -185,6 +228,7 @@ impl<'p> Interp<'p> {
         sink: &mut dyn Emit,
     ) -> Result<Flow, RuntimeError> {
         self.fuel = LOOP_LIMIT;
+        self.stack_base = 0;
         let mut cx = Cx {
             frame,
             env,
@@ -210,6 +254,7 @@ impl<'p> Interp<'p> {
         host: &mut dyn Host,
     ) -> Result<Value, RuntimeError> {
         let mut sink = NoSink;
+        self.stack_base = 0;
         let mut cx = Cx {
             frame,
             env,
@@ -221,6 +266,7 @@ impl<'p> Interp<'p> {
 
     /// Evaluates an expression with no locals (initialisers, directives).
     pub fn eval_global(&mut self, e: &Ex, env: &mut Env) -> Result<Value, RuntimeError> {
+        self.stack_base = 0;
         let mut frame: Vec<Value> = Vec::new();
         let mut sink: Vec<(Sym, Vec<Value>)> = Vec::new();
         let mut cx = Cx {
@@ -240,6 +286,7 @@ impl<'p> Interp<'p> {
         sink: &mut dyn Emit,
     ) -> Result<(), RuntimeError> {
         let mut frame: Vec<Value> = Vec::new();
+        self.stack_base = 0;
         let mut cx = Cx {
             frame: &mut frame,
             env,
@@ -324,6 +371,11 @@ impl<'p> Interp<'p> {
                 Ok(if *last { Flow::Produced } else { Flow::Normal })
             }
             St::Return => Ok(Flow::Return),
+            St::ReturnValue(e) => {
+                let v = self.expr(e, cx)?;
+                self.ret = Some(v);
+                Ok(Flow::Return)
+            }
             St::Break => Ok(Flow::Break),
             St::Continue => Ok(Flow::Continue),
         }
@@ -358,28 +410,223 @@ impl<'p> Interp<'p> {
         Ok(())
     }
 
+    /// The array indices of a place's path, evaluated in order.
     #[inline(never)]
-    fn load(&self, place: &Place, cx: &Cx) -> Value {
+    fn indices(&mut self, place: &Place, cx: &mut Cx) -> R<Vec<i64>> {
+        let mut out = Vec::new();
+        for step in &place.path {
+            if let Step::Index(e, _) = step {
+                out.push(self.expr(e, cx)?.as_i64());
+            }
+        }
+        Ok(out)
+    }
+
+    #[inline(never)]
+    fn load(&mut self, place: &Place, cx: &mut Cx) -> R<Value> {
+        let idx = if place.path.is_empty() {
+            Vec::new()
+        } else {
+            self.indices(place, cx)?
+        };
         let mut v = if place.global {
             &cx.env.globals[place.slot as usize]
         } else {
             &cx.frame[place.slot as usize]
+        };
+        let mut k = 0;
+        for step in &place.path {
+            match step {
+                Step::Field(i) => match v {
+                    Value::Struct(fs) => v = &fs[*i as usize],
+                    other => return Ok(field(other, *i)),
+                },
+                Step::Index(_, span) => {
+                    let i = idx[k];
+                    k += 1;
+                    match v {
+                        Value::Struct(fs) => {
+                            match usize::try_from(i).ok().and_then(|i| fs.get(i)) {
+                                Some(e) => v = e,
+                                None => return Err(out_of_range(i, fs.len(), *span)),
+                            }
+                        }
+                        Value::Str(s) => return char_at(s, i, *span),
+                        _ => return Ok(Value::Void),
+                    }
+                }
+            }
         }
-        .clone();
-        for &i in &place.path {
-            v = field(&v, i);
-        }
-        v
+        Ok(v.clone())
     }
 
     #[inline(never)]
-    fn store(&self, place: &Place, value: Value, cx: &mut Cx) {
+    fn store(&mut self, place: &Place, value: Value, cx: &mut Cx) -> R<()> {
+        if place.path.iter().all(|s| matches!(s, Step::Field(_))) {
+            let root = if place.global {
+                &mut cx.env.globals[place.slot as usize]
+            } else {
+                &mut cx.frame[place.slot as usize]
+            };
+            set_path(root, &place.path, value);
+            return Ok(());
+        }
+        let idx = self.indices(place, cx)?;
         let root = if place.global {
             &mut cx.env.globals[place.slot as usize]
         } else {
             &mut cx.frame[place.slot as usize]
         };
-        set_path(root, &place.path, value);
+        let mut v = root;
+        let mut k = 0;
+        for step in &place.path {
+            match step {
+                Step::Field(i) => match v {
+                    Value::Struct(fs) => v = &mut fs[*i as usize],
+                    other => {
+                        // The last step: a vector's component.
+                        set_path(other, std::slice::from_ref(step), value);
+                        return Ok(());
+                    }
+                },
+                Step::Index(_, span) => {
+                    let i = idx[k];
+                    k += 1;
+                    match v {
+                        Value::Struct(fs) => {
+                            let n = fs.len();
+                            match usize::try_from(i).ok().and_then(|i| fs.get_mut(i)) {
+                                Some(e) => v = e,
+                                None => return Err(out_of_range(i, n, *span)),
+                            }
+                        }
+                        Value::Str(_) => {
+                            return Err(rt(
+                                Some(*span),
+                                "a character of a string cannot be assigned; build the string with sprintf, strcpy or strcat",
+                            ))
+                        }
+                        _ => return Ok(()),
+                    }
+                }
+            }
+        }
+        *v = value;
+        Ok(())
+    }
+
+    /// A call of a user-defined function: the arguments go into a new
+    /// frame, the body runs, parameters passed by reference are written
+    /// back.
+    #[inline(never)]
+    fn call_user(
+        &mut self,
+        id: u16,
+        args: &[Ex],
+        back: &[(u16, Place)],
+        span: Span,
+        cx: &mut Cx,
+    ) -> R<Value> {
+        let funcs = self.funcs;
+        let f = &funcs[id as usize];
+        let mut frame = vec![Value::Void; f.frame_size.max(args.len())];
+        for (slot, a) in frame.iter_mut().zip(args) {
+            *slot = self.expr(a, cx)?;
+        }
+        if self.calls >= MAX_CALL_DEPTH {
+            return Err(rt(
+                Some(span),
+                format!(
+                    "calls of functions nest more than {MAX_CALL_DEPTH} deep here (a recursion that does not end?), calling `{}`",
+                    f.name
+                ),
+            ));
+        }
+        // A recursion without loops looks at the deadline too.
+        self.ticks = self.ticks.wrapping_add(1);
+        if self.ticks.is_multiple_of(DEADLINE_EVERY) {
+            if let Err(m) = crate::deadline::check(self.deadline) {
+                return Err(rt(Some(span), m));
+            }
+        }
+        self.calls += 1;
+        let r = self.invoke(f, &mut frame, cx.env, span);
+        self.calls -= 1;
+        let v = r?;
+        for (k, place) in back {
+            let value = std::mem::replace(&mut frame[*k as usize], Value::Void);
+            self.store(place, value, cx)?;
+        }
+        Ok(v)
+    }
+
+    /// Runs function `f`'s body on `frame`, on a new stack segment when
+    /// this one is used up.
+    #[inline(never)]
+    fn invoke(
+        &mut self,
+        f: &'p Function,
+        frame: &mut [Value],
+        env: &mut Env,
+        span: Span,
+    ) -> R<Value> {
+        let here = stack_address();
+        if self.stack_base == 0 {
+            self.stack_base = here;
+        }
+        if self.stack_base.abs_diff(here) > self.stack_room {
+            let saved = (self.stack_base, self.stack_room);
+            let spawned = std::thread::scope(|s| {
+                std::thread::Builder::new()
+                    .name("subgram-calls".into())
+                    .stack_size(SEGMENT_STACK)
+                    .spawn_scoped(s, || {
+                        self.stack_base = 0;
+                        self.stack_room = SEGMENT_STACK - SEGMENT_MARGIN;
+                        self.run_function(f, frame, env)
+                    })
+                    .map(|h| h.join())
+            });
+            (self.stack_base, self.stack_room) = saved;
+            return match spawned {
+                Ok(Ok(r)) => r,
+                Ok(Err(panic)) => std::panic::resume_unwind(panic),
+                Err(e) => Err(rt(
+                    Some(span),
+                    format!("no stack for deeper function calls: {e}"),
+                )),
+            };
+        }
+        self.run_function(f, frame, env)
+    }
+
+    #[inline(never)]
+    fn run_function(&mut self, f: &'p Function, frame: &mut [Value], env: &mut Env) -> R<Value> {
+        let mut sink = NoSink;
+        let mut cx = Cx {
+            frame,
+            env,
+            host: &mut NoHost,
+            sink: &mut sink,
+        };
+        self.ret = None;
+        for s in &f.body {
+            match self.stmt(s, &mut cx)? {
+                Flow::Normal => {}
+                _ => break,
+            }
+        }
+        match self.ret.take() {
+            Some(v) => Ok(v),
+            None if f.ret == Ty::Void => Ok(Value::Void),
+            None => Err(rt(
+                Some(f.end),
+                format!(
+                    "`{}` reached its end without a `return`; it must return a value",
+                    f.name
+                ),
+            )),
+        }
     }
 
     fn expr(&mut self, e: &Ex, cx: &mut Cx) -> R<Value> {
@@ -441,20 +688,21 @@ impl<'p> Interp<'p> {
                 let v = match op {
                     None => r,
                     Some(op) => {
-                        let cur = self.load(place, cx);
+                        let cur = self.load(place, cx)?;
                         binary(*op, cur, r).map_err(|m| rt(None, m))?
                     }
                 }
                 .convert(*ty);
-                self.store(place, v.clone(), cx);
+                self.store(place, v.clone(), cx)?;
                 v
             }
+            Ex::Load(..) | Ex::Index(..) | Ex::CallUser { .. } => self.expr_c(e, cx)?,
             Ex::IncDec(place, d, prefix) => {
-                let cur = self.load(place, cx);
+                let cur = self.load(place, cx)?;
                 let new = binary(BinOp::Add, cur.clone(), Value::Int(*d as i64))
                     .map_err(|m| rt(None, m))?
                     .convert(place.ty);
-                self.store(place, new.clone(), cx);
+                self.store(place, new.clone(), cx)?;
                 if *prefix {
                     new
                 } else {
@@ -488,7 +736,7 @@ impl<'p> Interp<'p> {
                 let mut vals = Vec::new();
                 if cx.host.in_context(*kind, pats, &mut vals) {
                     for (place, v) in places.iter().zip(vals) {
-                        self.store(place, v.convert(place.ty), cx);
+                        self.store(place, v.convert(place.ty), cx)?;
                     }
                     Value::Bool(true)
                 } else {
@@ -496,6 +744,34 @@ impl<'p> Interp<'p> {
                 }
             }
             // `expr` handles every other expression.
+            _ => Value::Void,
+        })
+    }
+
+    /// Arrays and user function calls, kept out of `expr_rare` so that
+    /// its frame stays small too.
+    #[inline(never)]
+    fn expr_c(&mut self, e: &Ex, cx: &mut Cx) -> R<Value> {
+        Ok(match e {
+            Ex::Load(place) => self.load(place, cx)?,
+            Ex::Index(base, index, span) => {
+                let b = self.expr(base, cx)?;
+                let i = self.expr(index, cx)?.as_i64();
+                match b {
+                    Value::Struct(fs) => match usize::try_from(i).ok().and_then(|k| fs.get(k)) {
+                        Some(v) => v.clone(),
+                        None => return Err(out_of_range(i, fs.len(), *span)),
+                    },
+                    Value::Str(s) => char_at(&s, i, *span)?,
+                    _ => Value::Void,
+                }
+            }
+            Ex::CallUser {
+                id,
+                args,
+                back,
+                span,
+            } => self.call_user(*id, args, back, *span, cx)?,
             _ => Value::Void,
         })
     }
@@ -651,6 +927,7 @@ impl<'p> Interp<'p> {
                 let _ = span;
                 Value::Void
             }
+            Func::Io(f) => return super::stdio::call(f, vals, &cx.env.output),
         })
     }
 }
@@ -671,9 +948,46 @@ fn field(v: &Value, i: u16) -> Value {
     }
 }
 
-fn set_path(root: &mut Value, path: &[u16], value: Value) {
-    let Some((&first, rest)) = path.split_first() else {
+/// An index out of an array's range, as a run-time error.
+fn out_of_range(i: i64, len: usize, span: Span) -> Box<RuntimeError> {
+    rt(
+        Some(span),
+        format!(
+            "index {i} is out of range: the array has {len} element(s), indices 0 to {}",
+            len as i64 - 1
+        ),
+    )
+}
+
+/// Character `i` of a string, as C reads a `char` array (0 at the end).
+fn char_at(s: &str, i: i64, span: Span) -> R<Value> {
+    let b = s.as_bytes();
+    match usize::try_from(i).ok() {
+        Some(k) if k < b.len() => Ok(Value::Int(b[k] as i64)),
+        Some(k) if k == b.len() => Ok(Value::Int(0)),
+        _ => Err(rt(
+            Some(span),
+            format!(
+                "index {i} is out of range: the string has {} character(s)",
+                b.len()
+            ),
+        )),
+    }
+}
+
+/// The address of a local variable: how deep the stack is here.
+#[inline(never)]
+fn stack_address() -> usize {
+    let marker = 0u8;
+    std::hint::black_box(&marker) as *const u8 as usize
+}
+
+fn set_path(root: &mut Value, path: &[Step], value: Value) {
+    let Some((first, rest)) = path.split_first() else {
         *root = value;
+        return;
+    };
+    let Step::Field(first) = *first else {
         return;
     };
     match root {

@@ -26,6 +26,22 @@ pub enum Ex {
     Logic(bool, Box<Ex>, Box<Ex>),
     Cond(Box<Ex>, Box<Ex>, Box<Ex>),
     Convert(Ty, Box<Ex>),
+    /// Reads a place whose path indexes an array (`a[i].x`), without
+    /// copying the whole variable.
+    Load(Place),
+    /// `e[i]` of a value that is not a variable (a function's result);
+    /// the span locates an index out of range.
+    Index(Box<Ex>, Box<Ex>, Span),
+    /// A user-defined function: its number in `Program::functions`, the
+    /// arguments, and the places to which the parameters passed by
+    /// reference (arrays, `float &x`) are written back after the call,
+    /// by parameter number.
+    CallUser {
+        id: u16,
+        args: Vec<Ex>,
+        back: Vec<(u16, Place)>,
+        span: Span,
+    },
     Assign(Place, Option<BinOp>, Box<Ex>, Ty),
     IncDec(Place, i8, bool),
     Call(Func, Vec<Ex>, Span),
@@ -58,13 +74,21 @@ pub enum FoldOp {
     Count,
 }
 
-/// An assignable location: a variable and a path of field indices.
+/// An assignable location: a variable and a path of fields and indices.
 #[derive(Clone, Debug)]
 pub struct Place {
     pub global: bool,
     pub slot: u16,
-    pub path: Vec<u16>,
+    pub path: Vec<Step>,
     pub ty: Ty,
+}
+
+/// One step into a value: a field (or vector component), or an element
+/// of an array (the span locates an index out of range).
+#[derive(Clone, Debug)]
+pub enum Step {
+    Field(u16),
+    Index(Box<Ex>, Span),
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -91,6 +115,9 @@ pub enum Func {
     /// An accessor of the model's files (`func`, `curveX`, `val`, …),
     /// evaluated by the [`Model`](crate::model::Model) of the run.
     Model(crate::model::Accessor),
+    /// C's standard input and output (`printf`, `fopen`, `strlen`, …);
+    /// see [`super::stdio`].
+    Io(super::stdio::IoFunc),
     /// A built-in of the topology the program runs on, by its number in
     /// the topology's [`HostTable`](super::builtins::HostTable); the
     /// [`Host`](super::eval::Host) evaluates it.
@@ -117,6 +144,8 @@ pub enum St {
         last: bool,
     },
     Return,
+    /// `return e;` in a function.
+    ReturnValue(Ex),
     Break,
     Continue,
 }
@@ -195,12 +224,27 @@ pub struct GlobalVar {
     pub init: Option<Ex>,
 }
 
+/// A user-defined C function, checked.
+#[derive(Clone, Debug)]
+pub struct Function {
+    pub name: String,
+    pub params: Vec<Ty>,
+    pub ret: Ty,
+    pub body: Vec<St>,
+    pub frame_size: usize,
+    /// The closing brace: where a function that must return a value and
+    /// reaches its end without one is reported.
+    pub end: Span,
+}
+
 /// A checked, executable program.
 #[derive(Clone, Debug)]
 pub struct Program {
     pub alphabet: Alphabet,
     pub structs: Vec<StructDef>,
     pub globals: Vec<GlobalVar>,
+    /// User-defined functions, called by `Ex::CallUser`.
+    pub functions: Vec<Function>,
     pub axiom: Vec<Succ>,
     /// The directives, each with the span of the whole directive.
     pub derivation_length: Option<(Ex, Span)>,

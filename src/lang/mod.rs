@@ -1,14 +1,17 @@
 //! The language's meaning: types, values, checking and the interpreter.
 
 pub mod builtins;
+pub mod cfmt;
 pub mod compile;
 pub mod eval;
 pub mod ir;
 pub mod modules;
 pub mod random;
+pub mod stdio;
 pub mod stencil;
 pub mod value;
 
 pub use ir::Program;
 pub use modules::{Alphabet, Sym};
+pub use stdio::{ProgramOutput, Stream};
 pub use value::{Ty, Value};

@@ -252,6 +252,10 @@ pub fn round32(x: f64) -> f64 {
 pub struct StructDef {
     pub name: String,
     pub fields: Vec<(String, Ty)>,
+    /// An array type (`float[3]`) is a struct whose fields are its
+    /// elements, all of this type, unnamed; `float[]` (a parameter that
+    /// takes an array of any length) has no fields.
+    pub elem: Option<Ty>,
 }
 
 /// The number of `f64` slots a value of type `ty` takes in a word.

@@ -6,7 +6,7 @@ use crate::deadline::Deadline;
 use crate::lang::eval::{Env, Interp, NoHost, RuntimeError};
 use crate::lang::ir::{Program, St};
 use crate::lang::random::Random;
-use crate::lang::{Sym, Value};
+use crate::lang::{ProgramOutput, Sym, Value};
 use crate::syntax::ast::{ControlKind, Section};
 use crate::syntax::span::Span;
 
@@ -28,6 +28,10 @@ pub struct DeriveOptions {
     /// Seeds every random number generator before the globals and `Start`
     /// (see `lang::random`); without it they start as lpfg's do.
     pub seed: Option<u32>,
+    /// Where what the program prints (`printf`) and the files it writes
+    /// go; the caller reads them from its clone. Default: a new one,
+    /// which refuses `fopen` for writing.
+    pub output: ProgramOutput,
 }
 
 impl Default for DeriveOptions {
@@ -38,6 +42,7 @@ impl Default for DeriveOptions {
             phase: 0,
             deadline: None,
             seed: None,
+            output: ProgramOutput::default(),
         }
     }
 }
@@ -71,6 +76,11 @@ impl DeriveOptions {
 
     pub fn with_seed(mut self, seed: u32) -> Self {
         self.seed = Some(seed);
+        self
+    }
+
+    pub fn with_output(mut self, output: ProgramOutput) -> Self {
+        self.output = output;
         self
     }
 }
@@ -178,19 +188,25 @@ impl<'p> Derivation<'p> {
         opts: DeriveOptions,
         traced: bool,
     ) -> Result<Derivation<'p>, DeriveError> {
-        let mut interp = Interp::with_deadline(&program.structs, opts.deadline);
-        let mut env = Env::new(Vec::new());
+        let mut interp = Interp::for_program(program, opts.deadline);
+        // Every global exists, zero, before the initialisers run: one may
+        // call a function that reads a global declared after it.
+        let zeros = program
+            .globals
+            .iter()
+            .map(|g| Value::zero(g.ty, &program.structs))
+            .collect();
+        let mut env = Env::new(zeros);
+        env.output = opts.output.clone();
         env.random = Random::new(opts.seed);
         env.model = program.model.clone();
-        for g in &program.globals {
-            let v = match &g.init {
-                Some(e) => interp
+        for (k, g) in program.globals.iter().enumerate() {
+            if let Some(e) = &g.init {
+                env.globals[k] = interp
                     .eval_global(e, &mut env)
                     .map_err(|e| runtime(e, None, 0))?
-                    .convert(g.ty),
-                None => Value::zero(g.ty, &program.structs),
-            };
-            env.globals.push(v);
+                    .convert(g.ty);
+            }
         }
         type Directive = Option<(crate::lang::ir::Ex, Span)>;
         let mut number =
@@ -344,7 +360,7 @@ impl<'p> Derivation<'p> {
     }
 
     fn control(&mut self, kind: ControlKind) -> Result<(), DeriveError> {
-        let mut interp = Interp::with_deadline(&self.program.structs, self.opts.deadline);
+        let mut interp = Interp::for_program(self.program, self.opts.deadline);
         for (k, body, frame) in &self.program.control {
             if *k == kind {
                 let mut frame = vec![Value::Void; *frame];
@@ -480,6 +496,12 @@ impl<'p> Derivation<'p> {
         )
     }
 
+    /// Runs `End`, as lpfg does after the final derivation step. A caller
+    /// that drives the steps itself calls this once it has taken the last.
+    pub fn end(&mut self) -> Result<(), DeriveError> {
+        self.control(ControlKind::End)
+    }
+
     /// Runs the remaining steps and `End`.
     pub fn run(mut self) -> Result<Derived, DeriveError> {
         while self.has_next() {
@@ -539,7 +561,7 @@ impl<'p> Derivation<'p> {
             _ => &self.program.decomposition_depth,
         };
         let Some((e, span)) = e else { return Ok(1) };
-        let mut interp = Interp::new(&self.program.structs);
+        let mut interp = Interp::for_program(self.program, None);
         let v = interp
             .eval_global(e, &mut self.env)
             .map_err(|e| runtime(e, Some(*span), self.step))?
@@ -606,7 +628,7 @@ impl<'p> Derivation<'p> {
         let Some((e, span)) = &self.program.angle else {
             return Ok(None);
         };
-        let mut interp = Interp::new(&self.program.structs);
+        let mut interp = Interp::for_program(self.program, None);
         let v = interp
             .eval_global(e, &mut self.env)
             .map_err(|e| runtime(e, Some(*span), self.step))?;

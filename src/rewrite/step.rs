@@ -101,7 +101,7 @@ impl<'p> Rewriter<'p> {
     pub fn new(program: &'p Program) -> Rewriter<'p> {
         Rewriter {
             program,
-            interp: Interp::new(&program.structs),
+            interp: Interp::for_program(program, None),
             sb: program.alphabet.builtin("SB"),
             eb: program.alphabet.builtin("EB"),
             frame: Vec::new(),

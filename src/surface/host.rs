@@ -599,7 +599,15 @@ pub fn specialise(e: &mut Ex) {
                 specialise(v);
             }
         }
-        Ex::Const(_) | Ex::Local(_) | Ex::Global(_) | Ex::IncDec(..) | Ex::InContext(..) => {}
+        // Arrays and user functions are not part of surface grammars.
+        Ex::Const(_)
+        | Ex::Local(_)
+        | Ex::Global(_)
+        | Ex::IncDec(..)
+        | Ex::InContext(..)
+        | Ex::Load(_)
+        | Ex::Index(..)
+        | Ex::CallUser { .. } => {}
     }
     if let Some(fused) = fused(e) {
         *e = fused;
@@ -804,7 +812,15 @@ fn walk(e: &Ex, f: &mut dyn FnMut(&Ex)) {
                 walk(v, f);
             }
         }
-        Ex::Const(_) | Ex::Local(_) | Ex::Global(_) | Ex::IncDec(..) | Ex::InContext(..) => {}
+        // Arrays and user functions are not part of surface grammars.
+        Ex::Const(_)
+        | Ex::Local(_)
+        | Ex::Global(_)
+        | Ex::IncDec(..)
+        | Ex::InContext(..)
+        | Ex::Load(_)
+        | Ex::Index(..)
+        | Ex::CallUser { .. } => {}
     }
 }
 
@@ -1217,7 +1233,14 @@ fn rewrite(e: &mut Ex, alias: &mut Vec<(u16, u16)>) {
         Ex::Call(_, args, _) | Ex::MakeStruct(args) => {
             args.iter_mut().for_each(|a| rewrite(a, alias))
         }
-        Ex::Const(_) | Ex::Global(_) | Ex::IncDec(..) | Ex::InContext(..) => {}
+        // Arrays and user functions are not part of surface grammars.
+        Ex::Const(_)
+        | Ex::Global(_)
+        | Ex::IncDec(..)
+        | Ex::InContext(..)
+        | Ex::Load(_)
+        | Ex::Index(..)
+        | Ex::CallUser { .. } => {}
     }
 }
 

@@ -153,7 +153,15 @@ fn visit(e: &Ex, f: &mut dyn FnMut(&Ex)) {
                 visit(v, f);
             }
         }
-        Ex::Const(_) | Ex::Local(_) | Ex::Global(_) | Ex::IncDec(..) | Ex::InContext(..) => {}
+        // Arrays and user functions are not part of surface grammars.
+        Ex::Const(_)
+        | Ex::Local(_)
+        | Ex::Global(_)
+        | Ex::IncDec(..)
+        | Ex::InContext(..)
+        | Ex::Load(_)
+        | Ex::Index(..)
+        | Ex::CallUser { .. } => {}
     }
 }
 

@@ -14,6 +14,11 @@ pub struct Name {
 pub struct TypeRef {
     pub name: String,
     pub span: Span,
+    /// Written with a `*`: `char *s` (a string), `FILE *f`, `float *a` (a
+    /// parameter that takes an array).
+    pub pointer: bool,
+    /// Written with C++'s `&`: a parameter passed by reference.
+    pub reference: bool,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -32,10 +37,11 @@ pub enum Item {
         name: Name,
         params: Vec<TypeRef>,
     },
-    /// `struct Data { float length, area; };`
+    /// `struct Data { float length, area; float v[3]; };`: each field with
+    /// its array dimensions.
     Struct {
         name: Name,
-        fields: Vec<(TypeRef, Name)>,
+        fields: Vec<(TypeRef, Name, Vec<Option<Expr>>)>,
     },
     /// `typedef float real;`
     Typedef {
@@ -80,6 +86,34 @@ pub enum Item {
         span: Span,
     },
     Production(Production),
+    /// `float f(float x, V2f p) { ... }`, or a declaration without a body
+    /// (`float f(float);`).
+    Function(FunctionDef),
+    /// `enum Kind { A, B = 5, C };`
+    Enum {
+        name: Option<Name>,
+        variants: Vec<(Name, Option<Expr>)>,
+    },
+}
+
+/// A user-defined C function.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FunctionDef {
+    pub ret: TypeRef,
+    pub name: Name,
+    pub params: Vec<Param>,
+    /// `None` for a forward declaration.
+    pub body: Option<Block>,
+}
+
+/// A function parameter: `float x`, `float a[]`, `int m[3][3]`, `V2f &p`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Param {
+    pub ty: TypeRef,
+    /// Absent in a declaration such as `float f(float);`.
+    pub name: Option<Name>,
+    /// Array dimensions; `None` for `[]`.
+    pub dims: Vec<Option<Expr>>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -110,12 +144,19 @@ pub enum ControlKind {
 pub struct VarDecl {
     pub ty: TypeRef,
     pub is_const: bool,
+    /// `static`: a local keeps its value from call to call.
+    pub is_static: bool,
     pub vars: Vec<Declarator>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Declarator {
     pub name: Name,
+    /// Array dimensions (`float a[3][2]`); `None` for `[]`, sized by the
+    /// initializer.
+    pub dims: Vec<Option<Expr>>,
+    /// Written `*name`: a pointer (a string or a file handle).
+    pub pointer: bool,
     pub init: Init,
 }
 
@@ -203,7 +244,8 @@ pub enum Stmt {
         last: bool,
         span: Span,
     },
-    Return(Span),
+    /// `return;` or `return expr;`
+    Return(Option<Expr>, Span),
     Break(Span),
     Continue(Span),
     Empty,
@@ -293,6 +335,10 @@ pub enum ExprKind {
     Call(Name, Vec<Expr>),
     Method(Box<Expr>, Name, Vec<Expr>),
     Field(Box<Expr>, Name),
+    /// `a[i]`
+    Index(Box<Expr>, Box<Expr>),
+    /// `{1, 2}` inside an aggregate initializer.
+    List(Vec<Expr>),
     Cast(TypeRef, Box<Expr>),
     InContext(ContextKind, Vec<PatModule>),
     /// `sum(w in SET where COND)` (also `avg`, `count`): an aggregate over

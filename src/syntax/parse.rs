@@ -12,6 +12,12 @@ use super::span::{Diagnostic, Span};
 /// Names that start a declaration in statement or item position.
 const TYPE_KEYWORDS: &[&str] = &[
     "int", "float", "double", "bool", "V2f", "V2d", "V3f", "V3d", "long", "unsigned", "char",
+    "short", "signed", "void", "FILE", "size_t",
+];
+
+/// Words that may come before a declaration's type and mean nothing here.
+const QUALIFIERS: &[&str] = &[
+    "static", "inline", "extern", "const", "register", "volatile",
 ];
 
 pub struct Parser<'t> {
@@ -31,8 +37,11 @@ pub struct Parser<'t> {
     /// b`, `a.x`, `c ? a : b`, `a = b`) moves that operand one level down,
     /// so the operand's deepest level is what must stay under the limit.
     peak: usize,
-    /// Struct and typedef names seen so far.
+    /// Struct, enum and typedef names seen so far.
     type_names: HashSet<String>,
+    /// Declared and predefined module names: a line that starts with one
+    /// is a production, not a declaration (`B P(vl) < P(v) : ...`).
+    module_names: HashSet<String>,
     eof: Span,
 }
 
@@ -61,6 +70,7 @@ impl<'t> Parser<'t> {
             depth: 0,
             peak: 0,
             type_names: HashSet::new(),
+            module_names: HashSet::new(),
             eof,
         }
     }
@@ -79,11 +89,13 @@ pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<Fil
             }
         }
     }
+    let module_names = whole_names.clone();
     let mut p = Parser {
         toks,
         pos: 0,
         abop,
         whole_names,
+        module_names,
         split_last: None,
         depth: 0,
         peak: 0,
@@ -205,14 +217,30 @@ impl<'t> Parser<'t> {
     }
 
     /// True when the tokens at the cursor begin a declaration:
-    /// `const ...`, `struct Name ...`, `TYPE name`, or `Name name`.
+    /// `const ...`, `static ...`, `struct Name ...`, `TYPE name`, `TYPE
+    /// *name`, or `Name name` (unless `Name` is a module: a production).
     fn at_declaration(&self) -> bool {
         match (self.peek().map(|t| &t.tok), self.peek_at(1).map(|t| &t.tok)) {
-            (Some(Tok::Ident(a)), Some(Tok::Ident(_))) => !matches!(
-                a.as_str(),
-                "produce" | "nproduce" | "return" | "else" | "if" | "while" | "propensity"
-            ),
-            (Some(Tok::Ident(a)), _) => a == "const",
+            (Some(Tok::Ident(a)), _) if QUALIFIERS.contains(&a.as_str()) => true,
+            (Some(Tok::Ident(a)), Some(Tok::Ident(_))) => {
+                !matches!(
+                    a.as_str(),
+                    "produce"
+                        | "nproduce"
+                        | "return"
+                        | "else"
+                        | "if"
+                        | "while"
+                        | "do"
+                        | "propensity"
+                ) && (self.is_type_name(a) || !self.module_names.contains(a))
+            }
+            (Some(Tok::Ident(a)), Some(Tok::Punct("*" | "&"))) => {
+                self.is_type_name(a)
+                    && self
+                        .peek_at(2)
+                        .is_some_and(|t| matches!(t.tok, Tok::Ident(_)))
+            }
             _ => false,
         }
     }
@@ -356,16 +384,15 @@ impl<'t> Parser<'t> {
                 }
                 _ => {}
             }
+            if word == "enum"
+                && (self.peek_at(1).is_some_and(|t| t.tok.is_punct("{"))
+                    || self.peek_at(2).is_some_and(|t| t.tok.is_punct("{")))
+            {
+                return self.enum_decl(items);
+            }
             if self.at_declaration() {
-                // `float f(float x) { ... }` is a function definition.
-                let k = if word == "const" { 2 } else { 1 };
-                if self.peek_at(k + 1).is_some_and(|t| t.tok.is_punct("("))
-                    && self.function_follows(k + 1)
-                {
-                    return Err(Diagnostic::new(
-                        self.peek_at(k).map(|t| t.span).unwrap_or(start),
-                        "function definitions are not supported yet; use a #define macro or write the expression in the production",
-                    ));
+                if let Some(k) = self.function_ahead() {
+                    return self.function(items, k);
                 }
                 let decl = self.var_decl()?;
                 self.expect_punct(";", "after the declaration")?;
@@ -378,22 +405,178 @@ impl<'t> Parser<'t> {
         Ok(())
     }
 
-    /// Looks past a parenthesised list at `k` for a `{` (a function body).
-    fn function_follows(&self, k: usize) -> bool {
+    /// When the tokens at the cursor begin a function definition or
+    /// declaration (`float f(float x) {`, `static inline V2f g(V2f);`,
+    /// `void h();`), the offset of its name. `V2f v(0, 1);` is a variable.
+    fn function_ahead(&self) -> Option<usize> {
+        let mut k = 0;
+        while self.peek_at(k).is_some_and(|t| {
+            QUALIFIERS.iter().any(|q| t.tok.is_ident(q))
+                || t.tok.is_ident("struct")
+                || t.tok.is_ident("enum")
+        }) {
+            k += 1;
+        }
+        // The type: one or more words (`unsigned int`), then `*`s, then
+        // the name.
+        let is_ident = |k: usize| {
+            self.peek_at(k)
+                .is_some_and(|t| matches!(t.tok, Tok::Ident(_)))
+        };
+        let mut words = 0;
+        while is_ident(k) {
+            k += 1;
+            words += 1;
+        }
+        let mut stars = 0;
+        while self
+            .peek_at(k)
+            .is_some_and(|t| t.tok.is_punct("*") || t.tok.is_punct("&"))
+        {
+            k += 1;
+            stars += 1;
+        }
+        let name = if stars > 0 && words >= 1 && is_ident(k) {
+            k
+        } else if stars == 0 && words >= 2 {
+            k - 1
+        } else {
+            return None;
+        };
+        if !self.peek_at(name + 1).is_some_and(|t| t.tok.is_punct("(")) {
+            return None;
+        }
+        // After the parenthesised list: `{` (a body), or `;` when the list
+        // is empty or starts with a type (a declaration).
         let mut depth = 0;
-        let mut j = self.pos + k;
+        let mut j = self.pos + name + 1;
         while let Some(t) = self.toks.get(j) {
             if t.tok.is_punct("(") {
                 depth += 1;
             } else if t.tok.is_punct(")") {
                 depth -= 1;
                 if depth == 0 {
-                    return self.toks.get(j + 1).is_some_and(|t| t.tok.is_punct("{"));
+                    let next = self.toks.get(j + 1);
+                    if next.is_some_and(|t| t.tok.is_punct("{")) {
+                        return Some(name);
+                    }
+                    let first = self.toks.get(self.pos + name + 2).map(|t| &t.tok);
+                    let typed = match first {
+                        Some(Tok::Punct(")")) => true,
+                        Some(Tok::Ident(w)) => {
+                            self.is_type_name(w) || w == "const" || w == "struct"
+                        }
+                        _ => false,
+                    };
+                    return (typed && next.is_some_and(|t| t.tok.is_punct(";"))).then_some(name);
                 }
             }
             j += 1;
         }
-        false
+        None
+    }
+
+    /// function := QUALIFIERS TYPE NAME '(' [param {',' param}] ')' ( block | ';' )
+    /// param := TYPE [NAME] { '[' [expr] ']' }
+    fn function(&mut self, items: &mut Vec<Item>, name_at: usize) -> PResult<()> {
+        let end = self.pos + name_at;
+        while self
+            .peek()
+            .is_some_and(|t| QUALIFIERS.iter().any(|q| t.tok.is_ident(q)))
+        {
+            self.pos += 1;
+        }
+        let ret = self.type_ref()?;
+        if self.pos != end {
+            return self.error("the function's name");
+        }
+        let name = self.name("the function's name")?;
+        self.expect_punct("(", "after the function's name")?;
+        let mut params = Vec::new();
+        if self.peek_ident("void") && self.peek_at(1).is_some_and(|t| t.tok.is_punct(")")) {
+            self.pos += 1;
+        }
+        if !self.eat_punct(")") {
+            loop {
+                let ty = self.type_ref()?;
+                let pname = match self.peek().map(|t| &t.tok) {
+                    Some(Tok::Ident(_)) => Some(self.name("a parameter name")?),
+                    _ => None,
+                };
+                let dims = self.dims()?;
+                params.push(Param {
+                    ty,
+                    name: pname,
+                    dims,
+                });
+                if self.eat_punct(")") {
+                    break;
+                }
+                self.expect_punct(",", "or `)` between the function's parameters")?;
+            }
+        }
+        let body = if self.eat_punct(";") {
+            None
+        } else {
+            Some(self.block()?)
+        };
+        items.push(Item::Function(FunctionDef {
+            ret,
+            name,
+            params,
+            body,
+        }));
+        Ok(())
+    }
+
+    /// dims := { '[' [expr] ']' }
+    fn dims(&mut self) -> PResult<Vec<Option<Expr>>> {
+        let mut dims = Vec::new();
+        while self.eat_punct("[") {
+            if self.eat_punct("]") {
+                dims.push(None);
+            } else {
+                dims.push(Some(self.expr()?));
+                self.expect_punct("]", "to close the array size")?;
+            }
+        }
+        Ok(dims)
+    }
+
+    /// enum-decl := 'enum' [NAME] '{' NAME ['=' expr] {',' NAME ['=' expr]} [','] '}' ';'
+    fn enum_decl(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        self.enum_body(items)?;
+        self.expect_punct(";", "after the enum declaration")?;
+        Ok(())
+    }
+
+    /// 'enum' [NAME] '{' NAME ['=' expr] {',' NAME ['=' expr]} [','] '}'
+    fn enum_body(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        self.pos += 1;
+        let name = if self.peek_punct("{") {
+            None
+        } else {
+            let n = self.name("the enum's name")?;
+            self.type_names.insert(n.text.clone());
+            Some(n)
+        };
+        self.expect_punct("{", "to open the enum")?;
+        let mut variants = Vec::new();
+        while !self.eat_punct("}") {
+            let v = self.name("an enumerator name or `}`")?;
+            let value = if self.eat_punct("=") {
+                Some(self.cond_expr()?)
+            } else {
+                None
+            };
+            variants.push((v, value));
+            if !self.eat_punct(",") {
+                self.expect_punct("}", "or `,` after the enumerator")?;
+                break;
+            }
+        }
+        items.push(Item::Enum { name, variants });
+        Ok(())
     }
 
     /// directive := KEY ':' expr ';'
@@ -448,16 +631,41 @@ impl<'t> Parser<'t> {
     }
 
     fn type_ref(&mut self) -> PResult<TypeRef> {
-        self.eat_ident("const");
-        self.eat_ident("struct");
+        while self.eat_ident("const") || self.eat_ident("volatile") {}
+        if !self.eat_ident("struct") {
+            self.eat_ident("enum");
+        }
         let n = self.name("a type name")?;
         let mut name = n.text;
-        // `unsigned int`, `long int`
-        if matches!(name.as_str(), "unsigned" | "long") && self.peek_ident("int") {
-            self.pos += 1;
-            name = "int".into();
+        // `unsigned int`, `long long`, `unsigned char`, `long double`: the
+        // last word decides (`unsigned` and `signed` alone are ints).
+        while matches!(name.as_str(), "unsigned" | "signed" | "long" | "short")
+            && self.peek().is_some_and(|t| {
+                ["int", "long", "short", "char", "double"]
+                    .iter()
+                    .any(|w| t.tok.is_ident(w))
+            })
+        {
+            name = self.name("a type name")?.text;
         }
-        Ok(TypeRef { name, span: n.span })
+        self.eat_ident("const");
+        let (mut pointer, mut reference) = (false, false);
+        loop {
+            if self.eat_punct("*") {
+                pointer = true;
+            } else if self.eat_punct("&") {
+                reference = true;
+            } else {
+                break;
+            }
+            self.eat_ident("const");
+        }
+        Ok(TypeRef {
+            name,
+            span: n.span,
+            pointer,
+            reference,
+        })
     }
 
     pub(crate) fn eat_ident(&mut self, s: &str) -> bool {
@@ -474,6 +682,15 @@ impl<'t> Parser<'t> {
         self.pos += 1;
         let name = self.name("a struct name")?;
         self.type_names.insert(name.text.clone());
+        let fields = self.struct_fields()?;
+        self.expect_punct(";", "after the struct declaration")?;
+        items.push(Item::Struct { name, fields });
+        Ok(())
+    }
+
+    /// struct-fields := '{' { TYPE NAME dims {',' NAME dims} ';' } '}'
+    #[allow(clippy::type_complexity)]
+    fn struct_fields(&mut self) -> PResult<Vec<(TypeRef, Name, Vec<Option<Expr>>)>> {
         self.expect_punct("{", "to open the struct body")?;
         let mut fields = Vec::new();
         while !self.eat_punct("}") {
@@ -483,21 +700,25 @@ impl<'t> Parser<'t> {
             let ty = self.type_ref()?;
             loop {
                 let f = self.name("a field name")?;
-                fields.push((ty.clone(), f));
+                let dims = self.dims()?;
+                fields.push((ty.clone(), f, dims));
                 if !self.eat_punct(",") {
                     break;
                 }
             }
             self.expect_punct(";", "after the field declaration")?;
         }
-        self.expect_punct(";", "after the struct declaration")?;
-        items.push(Item::Struct { name, fields });
-        Ok(())
+        Ok(fields)
     }
 
     /// typedef := 'typedef' TYPE NAME ';'
     fn typedef(&mut self, items: &mut Vec<Item>) -> PResult<()> {
         self.pos += 1;
+        let braces_at = |k: usize| self.peek_at(k).is_some_and(|t| t.tok.is_punct("{"));
+        if (self.peek_ident("struct") || self.peek_ident("enum")) && (braces_at(1) || braces_at(2))
+        {
+            return self.typedef_of_a_body(items);
+        }
         let ty = self.type_ref()?;
         let name = self.name("the new type name")?;
         self.type_names.insert(name.text.clone());
@@ -506,14 +727,85 @@ impl<'t> Parser<'t> {
         Ok(())
     }
 
-    /// var-decl := ['const'] TYPE declarator {',' declarator}
-    /// declarator := NAME [ '(' args ')' | '=' expr | '=' '{' args '}' ]
+    /// typedef := 'typedef' ('struct' | 'enum') [TAG] BODY NAME ';'  — C's
+    /// way to name a struct or an enum: both names name the type.
+    fn typedef_of_a_body(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        let is_struct = self.bump().tok.is_ident("struct");
+        let tag = if self.peek_punct("{") {
+            None
+        } else {
+            Some(self.name("a struct or enum name")?)
+        };
+        if is_struct {
+            if let Some(t) = &tag {
+                self.type_names.insert(t.text.clone());
+            }
+            let fields = self.struct_fields()?;
+            let name = self.name("the new type name")?;
+            self.type_names.insert(name.text.clone());
+            self.expect_punct(";", "after the typedef")?;
+            items.push(Item::Struct {
+                name: name.clone(),
+                fields,
+            });
+            if let Some(tag) = tag {
+                if tag.text != name.text {
+                    let span = name.span;
+                    items.push(Item::Typedef {
+                        ty: TypeRef {
+                            name: name.text,
+                            span,
+                            pointer: false,
+                            reference: false,
+                        },
+                        name: tag,
+                    });
+                }
+            }
+            return Ok(());
+        }
+        // An enum: its body, then the name of the type.
+        let mut body = Vec::new();
+        // Back to `enum`, which `enum_body` reads again.
+        self.pos -= 1 + usize::from(tag.is_some());
+        self.enum_body(&mut body)?;
+        let name = self.name("the new type name")?;
+        self.type_names.insert(name.text.clone());
+        self.expect_punct(";", "after the typedef")?;
+        if let Some(Item::Enum { variants, .. }) = body.pop() {
+            items.push(Item::Enum {
+                name: Some(name),
+                variants,
+            });
+        }
+        Ok(())
+    }
+
+    /// var-decl := {QUALIFIER} TYPE declarator {',' declarator}
+    /// declarator := ['*'] NAME { '[' [expr] ']' } [ '(' args ')' | '=' expr | '=' init-list ]
     fn var_decl(&mut self) -> PResult<VarDecl> {
-        let is_const = self.eat_ident("const");
+        let (mut is_const, mut is_static) = (false, false);
+        while let Some(q) = self
+            .peek()
+            .and_then(|t| QUALIFIERS.iter().find(|q| t.tok.is_ident(q)))
+        {
+            self.pos += 1;
+            is_const |= *q == "const";
+            is_static |= *q == "static";
+        }
+        let type_start = self.pos;
         let ty = self.type_ref()?;
+        is_const |= self.toks[type_start..self.pos]
+            .iter()
+            .any(|t| t.tok.is_ident("const"));
         let mut vars = Vec::new();
         loop {
+            let mut pointer = false;
+            while self.eat_punct("*") {
+                pointer = true;
+            }
             let name = self.name("a variable name")?;
+            let dims = self.dims()?;
             let init = if self.peek_punct("(") {
                 let open = self.bump().span;
                 let args = self.args(")")?;
@@ -521,7 +813,7 @@ impl<'t> Parser<'t> {
             } else if self.eat_punct("=") {
                 if self.peek_punct("{") {
                     let open = self.bump().span;
-                    let args = self.args("}")?;
+                    let args = self.init_list()?;
                     Init::List(args, open.to(self.prev_span()))
                 } else {
                     Init::Expr(self.assign_expr()?)
@@ -529,12 +821,49 @@ impl<'t> Parser<'t> {
             } else {
                 Init::None
             };
-            vars.push(Declarator { name, init });
+            vars.push(Declarator {
+                name,
+                dims,
+                pointer,
+                init,
+            });
             if !self.eat_punct(",") {
                 break;
             }
         }
-        Ok(VarDecl { ty, is_const, vars })
+        Ok(VarDecl {
+            ty,
+            is_const,
+            is_static,
+            vars,
+        })
+    }
+
+    /// init-list := [ item {',' item} [','] ] '}'   (the `{` is consumed)
+    /// item := expr | '{' init-list
+    fn init_list(&mut self) -> PResult<Vec<Expr>> {
+        let mut out = Vec::new();
+        loop {
+            if self.eat_punct("}") {
+                return Ok(out);
+            }
+            if self.peek_punct("{") {
+                let open = self.bump().span;
+                self.descend()?;
+                let inner = self.init_list();
+                self.ascend();
+                out.push(Expr {
+                    kind: ExprKind::List(inner?),
+                    span: open.to(self.prev_span()),
+                });
+            } else {
+                out.push(self.assign_expr()?);
+            }
+            if !self.eat_punct(",") {
+                self.expect_punct("}", "or `,` in the initializer list")?;
+                return Ok(out);
+            }
+        }
     }
 
     /// args := [ expr {',' expr} ] CLOSE   (the opening bracket is consumed)
@@ -687,8 +1016,18 @@ impl<'t> Parser<'t> {
             prod.body = Body::Arrow(succ, arrow);
         } else {
             self.expect_punct(":", "after the predecessor")?;
-            prod.body = Body::Block(self.block()?);
-            self.eat_punct(";");
+            if self.peek_punct("{") {
+                prod.body = Body::Block(self.block()?);
+                self.eat_punct(";");
+            } else {
+                // `A(t) : produce A(t+1);`: one statement as the body.
+                let start = self.span_here();
+                let s = self.stmt_or_end()?;
+                prod.body = Body::Block(Block {
+                    stmts: vec![s],
+                    span: start.to(self.prev_span()),
+                });
+            }
         }
         Ok(prod)
     }
@@ -1079,11 +1418,13 @@ impl<'t> Parser<'t> {
                 }
                 "return" => {
                     self.pos += 1;
-                    if !self.peek_punct(";") && !self.peek_punct("}") {
-                        self.expr()?;
-                    }
+                    let value = if !self.peek_punct(";") && !self.peek_punct("}") {
+                        Some(self.expr()?)
+                    } else {
+                        None
+                    };
                     self.eat_punct(";");
-                    return Ok(Stmt::Return(t.span));
+                    return Ok(Stmt::Return(value, t.span));
                 }
                 "break" | "continue" => {
                     self.pos += 1;
@@ -1277,10 +1618,18 @@ impl<'t> Parser<'t> {
         let mut e = self.primary()?;
         let mut reached = self.reached(outer);
         loop {
-            if self.peek_punct(".") || self.peek_punct("++") || self.peek_punct("--") {
+            if self.peek_punct(".")
+                || self.peek_punct("++")
+                || self.peek_punct("--")
+                || self.peek_punct("[")
+            {
                 reached = self.wrap(reached, self.span_here())?;
             }
-            if self.eat_punct(".") {
+            if self.peek_punct("[") {
+                let (indexed, r) = self.index_of(e)?;
+                e = indexed;
+                reached = reached.max(r);
+            } else if self.eat_punct(".") {
                 let name = self.name("a field or method name after `.`")?;
                 if self.eat_punct("(") {
                     let outer = self.measure();
@@ -1313,6 +1662,28 @@ impl<'t> Parser<'t> {
                 return Ok(e);
             }
         }
+    }
+
+    /// `e[i]`: the index of `e`, at `[`; with the deepest level the index
+    /// reached. Out of `postfix`, so that its frame stays small.
+    #[inline(never)]
+    fn index_of(&mut self, e: Expr) -> PResult<(Expr, usize)> {
+        self.pos += 1;
+        let outer = self.measure();
+        self.descend()?;
+        let index = self.expr();
+        self.ascend();
+        let index = index?;
+        let reached = self.reached(outer);
+        self.expect_punct("]", "to close the index")?;
+        let span = e.span.to(self.prev_span());
+        Ok((
+            Expr {
+                kind: ExprKind::Index(Box::new(e), Box::new(index)),
+                span,
+            },
+            reached,
+        ))
     }
 
     /// primary := NUMBER | STRING | NAME | NAME '(' args ')' | '(' expr ')'

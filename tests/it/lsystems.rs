@@ -26,7 +26,7 @@ use crate::support::root;
 
 /// The folders of `lsystems/`, each checked by its own test below.
 const FOLDERS: &[&str] = &[
-    "abop", "curves", "figures", "meshes", "paper", "reverse", "surfaces",
+    "abop", "curves", "figures", "lplusc", "meshes", "paper", "reverse", "surfaces",
 ];
 
 /// Surface grammars with boundary rules, run on the open grid as well.
@@ -223,6 +223,11 @@ fn curves() {
 #[test]
 fn figures() {
     check_folder("figures");
+}
+
+#[test]
+fn lplusc() {
+    check_folder("lplusc");
 }
 
 #[test]

@@ -1,0 +1,345 @@
+//! C's standard input and output as L+C programs use it: `printf` (and
+//! lpfg's `Printf`), `fprintf` to `stdout`, `stderr` or a file, `puts`,
+//! `fopen`/`fclose`, and the string functions `strlen`, `strcmp`, and the
+//! formatting behind `sprintf`, `strcpy`, `strcat`.
+//!
+//! The library prints nothing itself: what a program prints and the files
+//! it writes are collected in a [`ProgramOutput`], which the caller (the
+//! `subgram` binary) writes out. A program may open files for writing
+//! only when the output allows it (`--allow-writes DIR`), and only at
+//! relative paths that stay inside that folder; reading files is refused.
+
+use std::sync::{Arc, Mutex};
+
+use super::cfmt;
+use super::value::Value;
+
+/// The C library functions a program calls, as the interpreter runs them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IoFunc {
+    /// `printf(fmt, ...)`: to standard output.
+    Printf,
+    /// `fprintf(f, fmt, ...)`.
+    Fprintf,
+    /// The string that `sprintf(buf, fmt, ...)` writes into `buf`.
+    Format,
+    /// `puts(s)`: `s` and a newline to standard output.
+    Puts,
+    /// `fputs(s, f)`.
+    Fputs,
+    Fopen,
+    Fclose,
+    Fflush,
+    Strlen,
+    Strcmp,
+    /// `a` followed by `b`: what `strcat(a, b)` leaves in `a`.
+    Concat,
+}
+
+/// Where printed text goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stream {
+    Stdout,
+    Stderr,
+}
+
+/// The handle `stdout` names; `stderr` is the next one, files follow.
+pub const STDOUT: i64 = 1;
+pub const STDERR: i64 = 2;
+const FIRST_FILE: i64 = 3;
+
+/// A program may print, and write to files, this many bytes in all; past
+/// it the run stops with a message (a runaway loop of `printf`s).
+pub const MAX_OUTPUT_BYTES: usize = 256 << 20;
+
+/// A program may open this many files in a run.
+pub const MAX_FILES: usize = 1024;
+
+/// What a program printed and the files it wrote, shared between the run
+/// (which appends) and its caller (which writes it out). Clones share it.
+#[derive(Clone, Debug, Default)]
+pub struct ProgramOutput(Arc<Mutex<State>>);
+
+#[derive(Debug, Default)]
+struct State {
+    text: Vec<(Stream, String)>,
+    /// Files by path relative to the output folder, with their contents.
+    files: Vec<(String, String)>,
+    /// Open handles, from [`FIRST_FILE`] on: the file each writes to.
+    handles: Vec<Option<usize>>,
+    bytes: usize,
+    writes_allowed: bool,
+}
+
+impl ProgramOutput {
+    /// An output that refuses `fopen` for writing.
+    pub fn new() -> ProgramOutput {
+        ProgramOutput::default()
+    }
+
+    /// An output that lets the program write files (which the caller
+    /// then writes under its `--allow-writes` folder).
+    pub fn allowing_writes() -> ProgramOutput {
+        let out = ProgramOutput::default();
+        out.state().writes_allowed = true;
+        out
+    }
+
+    /// Lets the program write files from now on.
+    pub fn allow_writes(&self) {
+        self.state().writes_allowed = true;
+    }
+
+    fn state(&self) -> std::sync::MutexGuard<'_, State> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The text printed so far, in order, each piece with its stream;
+    /// taken, so the next call returns only what came after.
+    pub fn take_text(&self) -> Vec<(Stream, String)> {
+        std::mem::take(&mut self.state().text)
+    }
+
+    /// The files the program wrote: paths relative to the output folder
+    /// (checked to stay inside it) and contents.
+    pub fn files(&self) -> Vec<(String, String)> {
+        self.state().files.clone()
+    }
+
+    fn count(&self, st: &mut State, n: usize) -> Result<(), String> {
+        st.bytes = st.bytes.saturating_add(n);
+        if st.bytes > MAX_OUTPUT_BYTES {
+            return Err(format!(
+                "the program printed or wrote more than {} MiB; is a loop printing without end?",
+                MAX_OUTPUT_BYTES >> 20
+            ));
+        }
+        Ok(())
+    }
+
+    /// Appends `s` to the stream or file that handle `h` names.
+    fn write(&self, h: i64, s: &str, what: &str) -> Result<(), String> {
+        let mut st = self.state();
+        self.count(&mut st, s.len())?;
+        let stream = match h {
+            STDOUT => Stream::Stdout,
+            STDERR => Stream::Stderr,
+            _ => {
+                let file = usize::try_from(h - FIRST_FILE)
+                    .ok()
+                    .and_then(|k| st.handles.get(k).copied().flatten());
+                let Some(file) = file else {
+                    return Err(format!(
+                        "`{what}` writes to a file that is not open (fopen failed, or it was closed)"
+                    ));
+                };
+                st.files[file].1.push_str(s);
+                return Ok(());
+            }
+        };
+        match st.text.last_mut() {
+            Some((last, text)) if *last == stream => text.push_str(s),
+            _ => st.text.push((stream, s.to_string())),
+        }
+        Ok(())
+    }
+
+    fn open(&self, name: &str, mode: &str) -> Result<i64, String> {
+        let mut st = self.state();
+        if mode.starts_with('r') {
+            return Err(format!(
+                "fopen(\"{name}\", \"{mode}\"): reading files from a program is not supported"
+            ));
+        }
+        if !(mode.starts_with('w') || mode.starts_with('a')) {
+            return Err(format!(
+                "fopen(\"{name}\", \"{mode}\"): the mode must be \"w\" or \"a\""
+            ));
+        }
+        if !st.writes_allowed {
+            return Err(format!(
+                "fopen(\"{name}\", \"{mode}\") writes a file, which a program may do only when \
+                 subgram runs with `--allow-writes DIR` (the file then goes under DIR)"
+            ));
+        }
+        let path = std::path::Path::new(name);
+        let inside = !name.is_empty()
+            && path.components().all(|c| {
+                matches!(
+                    c,
+                    std::path::Component::Normal(_) | std::path::Component::CurDir
+                )
+            });
+        if !inside {
+            return Err(format!(
+                "fopen(\"{name}\"): a program may write only inside the --allow-writes folder: \
+                 the path must be relative, without `..`"
+            ));
+        }
+        let file = match st.files.iter().position(|(p, _)| p == name) {
+            Some(i) => {
+                if mode.starts_with('w') {
+                    st.files[i].1.clear();
+                }
+                i
+            }
+            None => {
+                if st.files.len() >= MAX_FILES {
+                    return Err(format!("the program opens more than {MAX_FILES} files"));
+                }
+                st.files.push((name.to_string(), String::new()));
+                st.files.len() - 1
+            }
+        };
+        st.handles.push(Some(file));
+        Ok(FIRST_FILE + st.handles.len() as i64 - 1)
+    }
+
+    fn close(&self, h: i64) -> i64 {
+        let mut st = self.state();
+        match usize::try_from(h - FIRST_FILE)
+            .ok()
+            .and_then(|k| st.handles.get_mut(k))
+        {
+            Some(slot @ Some(_)) => {
+                *slot = None;
+                0
+            }
+            // C's EOF.
+            _ => -1,
+        }
+    }
+}
+
+fn text(v: &Value) -> std::borrow::Cow<'_, str> {
+    match v {
+        Value::Str(s) => std::borrow::Cow::Borrowed(&**s),
+        other => std::borrow::Cow::Owned(other.to_string()),
+    }
+}
+
+/// Runs `f` on checked arguments; an error says what went wrong, for the
+/// interpreter to report at the call.
+pub fn call(f: IoFunc, args: &[Value], out: &ProgramOutput) -> Result<Value, String> {
+    let arg = |i: usize| args.get(i).cloned().unwrap_or(Value::Void);
+    Ok(match f {
+        IoFunc::Printf => {
+            let s = cfmt::format(&text(&arg(0)), &args[1.min(args.len())..])?;
+            out.write(STDOUT, &s, "printf")?;
+            Value::Int(s.len() as i64)
+        }
+        IoFunc::Fprintf => {
+            let s = cfmt::format(&text(&arg(1)), &args[2.min(args.len())..])?;
+            out.write(arg(0).as_i64(), &s, "fprintf")?;
+            Value::Int(s.len() as i64)
+        }
+        IoFunc::Format => {
+            let s = cfmt::format(&text(&arg(0)), &args[1.min(args.len())..])?;
+            if s.len() > MAX_OUTPUT_BYTES {
+                return Err("sprintf makes a string longer than the output limit".into());
+            }
+            Value::Str(s.into())
+        }
+        IoFunc::Puts => {
+            out.write(STDOUT, &format!("{}\n", text(&arg(0))), "puts")?;
+            Value::Int(0)
+        }
+        IoFunc::Fputs => {
+            out.write(arg(1).as_i64(), &text(&arg(0)), "fputs")?;
+            Value::Int(0)
+        }
+        IoFunc::Fopen => Value::Int(out.open(&text(&arg(0)), &text(&arg(1)))?),
+        IoFunc::Fclose => Value::Int(out.close(arg(0).as_i64())),
+        IoFunc::Fflush => Value::Int(0),
+        IoFunc::Strlen => Value::Int(text(&arg(0)).len() as i64),
+        IoFunc::Strcmp => Value::Int(match text(&arg(0)).cmp(&text(&arg(1))) {
+            std::cmp::Ordering::Less => -1,
+            std::cmp::Ordering::Equal => 0,
+            std::cmp::Ordering::Greater => 1,
+        }),
+        IoFunc::Concat => {
+            let s = format!("{}{}", text(&arg(0)), text(&arg(1)));
+            if s.len() > MAX_OUTPUT_BYTES {
+                return Err("strcat makes a string longer than the output limit".into());
+            }
+            Value::Str(s.into())
+        }
+    })
+}
+
+/// A string literal's text with C's escapes (`\n`, `\t`, `\\`, `\"`,
+/// `\0`…) replaced by the characters they stand for.
+pub fn unescape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    let mut chars = s.chars();
+    while let Some(c) = chars.next() {
+        if c != '\\' {
+            out.push(c);
+            continue;
+        }
+        match chars.next() {
+            Some('n') => out.push('\n'),
+            Some('t') => out.push('\t'),
+            Some('r') => out.push('\r'),
+            Some('0') => out.push('\0'),
+            Some('a') => out.push('\x07'),
+            Some('b') => out.push('\x08'),
+            Some('f') => out.push('\x0c'),
+            Some('v') => out.push('\x0b'),
+            Some(other) => out.push(other),
+            None => out.push('\\'),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn printed_text_keeps_its_order_and_stream() {
+        let out = ProgramOutput::new();
+        let s = |t: &str| Value::Str(t.into());
+        call(IoFunc::Printf, &[s("a=%d\n"), Value::Int(1)], &out).unwrap();
+        call(IoFunc::Fprintf, &[Value::Int(STDERR), s("e\n")], &out).unwrap();
+        call(IoFunc::Puts, &[s("b")], &out).unwrap();
+        assert_eq!(
+            out.take_text(),
+            vec![
+                (Stream::Stdout, "a=1\n".to_string()),
+                (Stream::Stderr, "e\n".to_string()),
+                (Stream::Stdout, "b\n".to_string())
+            ]
+        );
+        assert!(out.take_text().is_empty());
+    }
+
+    #[test]
+    fn files_need_permission_and_stay_inside() {
+        let s = |t: &str| Value::Str(t.into());
+        let refused = call(IoFunc::Fopen, &[s("x.txt"), s("w")], &ProgramOutput::new());
+        assert!(refused.unwrap_err().contains("--allow-writes"));
+        let out = ProgramOutput::allowing_writes();
+        for bad in ["../x", "/tmp/x", "a/../../x", ""] {
+            let e = call(IoFunc::Fopen, &[s(bad), s("w")], &out).unwrap_err();
+            assert!(e.contains("inside"), "{bad}: {e}");
+        }
+        let h = call(IoFunc::Fopen, &[s("d/x.txt"), s("w")], &out).unwrap();
+        call(IoFunc::Fprintf, &[h.clone(), s("%d;"), Value::Int(5)], &out).unwrap();
+        assert_eq!(
+            call(IoFunc::Fclose, std::slice::from_ref(&h), &out).unwrap(),
+            Value::Int(0)
+        );
+        let after = call(IoFunc::Fprintf, &[h, s("late")], &out).unwrap_err();
+        assert!(after.contains("not open"));
+        assert_eq!(out.files(), vec![("d/x.txt".to_string(), "5;".to_string())]);
+        let r = call(IoFunc::Fopen, &[s("x.txt"), s("r")], &out).unwrap_err();
+        assert!(r.contains("reading"));
+    }
+
+    #[test]
+    fn escapes() {
+        assert_eq!(unescape(r#"a\tb\n\\ \"q\""#), "a\tb\n\\ \"q\"");
+    }
+}
