@@ -29,6 +29,12 @@ const KNOWN_HEADERS: &[&str] = &[
     "stdio.h",
     "cmath",
     "lintrfc.h",
+    // C's string functions (`strcpy`, `strlen`, …) are built in too.
+    "string.h",
+    "memory.h",
+    "cstdlib",
+    "cstdio",
+    "cstring",
 ];
 
 #[derive(Clone, Debug)]
