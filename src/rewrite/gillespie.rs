@@ -19,6 +19,9 @@
 //! As the manual says, a ring is ignored and new contexts are refused (by
 //! the checker). A negative or non-finite propensity is an error here,
 //! where lpfg prints a message and takes 0.
+//!
+//! The successors of all reactions are held at once, before one is chosen:
+//! together they count against the word's module limit (`--max-modules`).
 
 use crate::lang::eval::{Env, RuntimeError};
 use crate::lang::ir::Program;
