@@ -1606,7 +1606,10 @@ impl Compiler {
         match &e.kind {
             ExprKind::Int(i) => Some((Ex::Const(Value::Int(*i)), Ty::Int)),
             // A literal without a suffix is a `double`, as in C.
-            ExprKind::Float(f) => Some((Ex::Const(Value::Float(*f)), Ty::Double)),
+            // A literal with an `f` suffix is a `float` (its value is
+            // already the nearest single-precision one).
+            ExprKind::Float(f, true) => Some((Ex::Const(Value::Float(*f)), self.prec(Ty::Float))),
+            ExprKind::Float(f, false) => Some((Ex::Const(Value::Float(*f)), Ty::Double)),
             ExprKind::Str(s) => Some((
                 Ex::Const(Value::Str(super::stdio::unescape(s).into())),
                 Ty::Str,

@@ -318,7 +318,9 @@ pub struct Expr {
 #[derive(Clone, Debug, PartialEq)]
 pub enum ExprKind {
     Int(i64),
-    Float(f64),
+    /// A floating literal; `true` when it has an `f` suffix (a `float`,
+    /// its value the nearest single-precision one), else a `double`.
+    Float(f64, bool),
     Str(String),
     Ident(String),
     Unary(UnOp, Box<Expr>),

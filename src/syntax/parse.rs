@@ -1698,9 +1698,9 @@ impl<'t> Parser<'t> {
                 self.pos += 1;
                 ExprKind::Int(*i)
             }
-            Tok::Float { value: f, .. } => {
+            Tok::Float { value: f, single } => {
                 self.pos += 1;
-                ExprKind::Float(*f)
+                ExprKind::Float(*f, *single)
             }
             Tok::Str(s) => {
                 self.pos += 1;
