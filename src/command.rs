@@ -54,6 +54,9 @@ pub struct DeriveArgs {
     pub phase: usize,
     /// Print the word after interpretation rules.
     pub interpreted: bool,
+    /// `--seed`: seeds every random number generator (see
+    /// [`RunOptions::seed`]).
+    pub seed: Option<u32>,
     /// `--timeout`: the command stops with an error after this long.
     pub timeout: Option<Duration>,
     /// `--allow-writes DIR`: the program may write files, under DIR.
@@ -73,6 +76,7 @@ impl DeriveArgs {
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             interpreted: false,
+            seed: None,
             timeout: Some(DEFAULT_TIMEOUT),
             allow_writes: None,
             output: ProgramOutput::default(),
@@ -90,6 +94,7 @@ pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, 
         steps: a.steps,
         max_modules: a.max_modules,
         phase: a.phase,
+        seed: a.seed,
         base_mesh: None,
         deadline,
         output: a.output.clone(),
@@ -156,6 +161,9 @@ pub struct RenderArgs {
     pub double: bool,
     pub max_modules: usize,
     pub phase: usize,
+    /// `--seed`: seeds every random number generator (see
+    /// [`RunOptions::seed`]).
+    pub seed: Option<u32>,
     /// `--timeout`: the command stops with an error after this long.
     pub timeout: Option<Duration>,
     /// Write the picture even over one of the inputs.
@@ -181,6 +189,7 @@ impl RenderArgs {
             double: false,
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
+            seed: None,
             timeout: Some(DEFAULT_TIMEOUT),
             force: false,
             allow_writes: None,
@@ -235,6 +244,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                 steps: a.steps,
                 max_modules: a.max_modules,
                 phase: a.phase,
+                seed: a.seed,
                 base_mesh: None,
                 deadline,
                 output: a.program_output.clone(),

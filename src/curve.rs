@@ -103,12 +103,14 @@ impl Curve {
         crate::rewrite::derive(&self.program, opts).map_err(|e| self.error(e))
     }
 
-    /// Derives the axiom to the derivation length (or `opts.steps`) and keeps
-    /// the derivation, so that its word can be interpreted and drawn.
+    /// Derives the axiom to the derivation length (or `opts.steps`), runs
+    /// `End` and keeps the derivation, so that its word can be interpreted
+    /// and drawn.
     pub fn run(&self, opts: DeriveOptions) -> Result<CurveRun<'_>, Error> {
         check_steps(opts.steps)?;
         let mut d = Derivation::new(&self.program, opts).map_err(|e| self.error(e))?;
         crate::production::run(&mut d, |_| {}).map_err(|e| self.error(e))?;
+        d.end().map_err(|e| self.error(e))?;
         Ok(CurveRun { curve: self, d })
     }
 
@@ -161,6 +163,7 @@ impl Curve {
                 panel(&mut d)?;
             }
         }
+        d.end().map_err(fail)?;
         if !opts.each {
             panel(&mut d)?;
         }
@@ -178,8 +181,7 @@ fn check_steps(steps: Option<u64>) -> Result<(), Error> {
     }
 }
 
-/// A curve L-system derived to its last step. `End` has not run, so the
-/// globals are as the last step left them.
+/// A curve L-system derived to its last step, after `End`.
 pub struct CurveRun<'c> {
     curve: &'c Curve,
     d: Derivation<'c>,

@@ -407,7 +407,7 @@ pub(crate) fn front(name: &str, text: String, defines: &[String]) -> Result<Fron
         let toks = lex::lex(id, v).map_err(|e| Error::at(&sources, e))?;
         overrides.push((n.to_string(), toks));
     }
-    let tokens = lex::lex(main, &sources.get(main).text)
+    let tokens = lex::lex_all(main, &sources.get(main).text)
         .and_then(|t| preprocess::preprocess(t, &overrides))
         .map_err(|e| Error::at(&sources, e))?;
     Ok(Front {

@@ -46,6 +46,11 @@ enum Command {
         /// Print the word after interpretation rules instead.
         #[arg(long)]
         interpreted: bool,
+        /// Seed every random number generator (ran, rand, drand48,
+        /// Gillespie groups) as if Start began with sran(N); srand(N);
+        /// srand48(N); SeedGillespie(N). Without it, lpfg's starting state.
+        #[arg(long, value_name = "N")]
+        seed: Option<u32>,
         /// Let the program write files (fopen), under this folder.
         #[arg(long, value_name = "DIR")]
         allow_writes: Option<std::path::PathBuf>,
@@ -88,6 +93,11 @@ enum Command {
         max_modules: usize,
         #[arg(long, default_value_t = 0)]
         phase: usize,
+        /// Seed every random number generator (ran, rand, drand48,
+        /// Gillespie groups) as if Start began with sran(N); srand(N);
+        /// srand48(N); SeedGillespie(N). Without it, lpfg's starting state.
+        #[arg(long, value_name = "N")]
+        seed: Option<u32>,
         /// Let the program write files (fopen), under this folder.
         #[arg(long, value_name = "DIR")]
         allow_writes: Option<std::path::PathBuf>,
@@ -355,6 +365,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             max_modules,
             phase,
             interpreted,
+            seed,
             timeout,
             allow_writes,
         } => {
@@ -368,6 +379,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 max_modules,
                 phase,
                 interpreted,
+                seed,
                 timeout: timeout.0,
                 allow_writes,
                 output: subgram::ProgramOutput::new(),
@@ -391,6 +403,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             double,
             max_modules,
             phase,
+            seed,
             timeout,
             force,
             allow_writes,
@@ -408,6 +421,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 double,
                 max_modules,
                 phase,
+                seed,
                 timeout: timeout.0,
                 force,
                 allow_writes,

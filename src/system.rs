@@ -34,6 +34,11 @@ pub struct RunOptions {
     /// Curves: where the partition into multi-module strict predecessors
     /// starts.
     pub phase: usize,
+    /// Curves: seeds every random number generator as if `Start` began
+    /// with `sran(N); srand(N); srand48(N); SeedGillespie(N);`. Without
+    /// it the generators start as lpfg's do. Runs are reproducible either
+    /// way.
+    pub seed: Option<u32>,
     /// Surfaces: the base mesh file, instead of the grammar's `mesh:`.
     pub base_mesh: Option<PathBuf>,
     /// The run stops with an error once this passes. Default: none.
@@ -48,6 +53,7 @@ impl Default for RunOptions {
             steps: None,
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
+            seed: None,
             base_mesh: None,
             deadline: None,
             output: ProgramOutput::default(),
@@ -70,6 +76,7 @@ impl RunOptions {
             .with_deadline(self.deadline)
             .with_output(self.output.clone());
         d.steps = self.steps;
+        d.seed = self.seed;
         d
     }
 }

@@ -11,13 +11,16 @@ InLeftContext InRightContext InNewLeftContext InNewRightContext
 SB EB SP PP EP F f G g Left Right Up Down RollL RollR TurnAround MoveTo2f MoveTo3f LineTo2f LineTo3f Line2f Line3f LineRel2f LineRel3f
 MoveTo LineTo Cut SetColor IncColor DecColor SetWidth Circle Sphere Circle0 CircleB GetPos GetHead GetLeft GetUp Label Surface
 Length Normalized Normalize sqrt sin cos tan asin acos atan atan2 exp log pow fabs abs floor ceil fmod fmin fmax min max hypot ran round trunc
-PI M_PI""".split() + ["derivation length:", "ring L-system:", "maximum depth:", "produce;"]
+PI M_PI
+ggroup propensity GillespieTime SeedGillespie ResetGillespie sran rand srand RAND_MAX drand48 srand48 lrand48 random srandom
+defined #error 1.f 1e-3f .5f 0x1F 017 10UL 3u""".split() + ["derivation length:", "ring L-system:", "maximum depth:", "produce;"]
 punct = ["<", ">", "<<", ">>", "->", "-->", ":", ";", ",", "(", ")", "{", "}", "[", "]", "?", "==", "!=", "<=", ">=", "&&", "||", "!",
          "+=", "-=", "*=", "/=", "%=", "++", "--", "=", "+", "-", "*", "/", "%", "^", "&", "|", ".", "'", "\"", "//", "/*", "*/", "\\", "#",
          "1e308", "-1", "0.5", "2147483648", "9223372036854775807", "1e-320", "0x10", "\n"]
 curve_snippets = ["module P(V2f);", "Axiom: P(v1) P(v2);", "derivation length: 3;", "ring L-system: 1;",
                   "P(vl) < P(v) > P(vr) : { produce P(v) P(v); }", "P(v) -> P(v) P(v)", "V2f v1(0, 0), v2(1, 1);",
-                  "#define N 4", "#define M(x) ((x)+(x))", "maximum depth: 2;", "Start: { }", "group 1:",
+                  "#define N 4", "#define M(x) ((x)+(x))", "#if N > 2\n", "#ifdef N\n", "#else\n", "#endif\n",
+                  "#if defined(N) && !defined M\n", "ggroup 1:", "propensity 1 produce P(v);", "maximum depth: 2;", "Start: { }", "group 1:",
                   "struct S { int a; float b; };", "typedef struct S T;", "for (int i = 0; i < 3; i++) { }", "x ? y : z", "(float) 1"]
 surface = """mesh: blocks: dual bisection quadrisection define init: F(f) V(v E(e F^2 F^3 F^4 E^3 E^4 || | ^
 l( c step valence( boundary( new( block( center( centre( transversal( avg( sum( count( ring( boundary_ring( verts( tail( head( bnext( bprev( pos(

@@ -5,6 +5,7 @@
 //! same in a curve and in a surface grammar.
 
 use super::ir::Func;
+use super::random::Op;
 use super::value::Ty;
 
 /// Why a call does not fit a built-in's signature.
@@ -80,6 +81,20 @@ pub static WORD_HOST: HostTable = HostTable {
     members: |_| None,
 };
 
+/// C's single-precision maths functions of [`LIBRARY`]: each is its
+/// double-precision twin's name and `f`, and gives a `float` whatever its
+/// argument.
+pub const FLOAT_FUNCTIONS: &[&str] = &[
+    "sinf", "cosf", "tanf", "asinf", "acosf", "atanf", "sinhf", "coshf", "tanhf", "sqrtf", "cbrtf",
+    "expf", "logf", "log10f", "log2f", "fabsf", "floorf", "ceilf", "roundf", "truncf", "atan2f",
+    "powf", "fmodf", "hypotf", "fminf", "fmaxf",
+];
+
+/// True for `expf`, `sqrtf` and the other [`FLOAT_FUNCTIONS`].
+pub fn is_float_function(name: &str) -> bool {
+    FLOAT_FUNCTIONS.contains(&name)
+}
+
 /// Looks a function up: the library first, then the host's table.
 pub fn lookup<'h>(name: &str, host: &'h HostTable) -> Option<&'h Builtin> {
     LIBRARY
@@ -151,6 +166,19 @@ macro_rules! model {
     };
 }
 
+/// A random function of `random.rs` taking `$n` numbers.
+macro_rules! random {
+    ($name:literal, $n:literal, $op:expr, $t:expr) => {
+        Builtin {
+            name: $name,
+            resolve: |a| {
+                numbers(a, $n)?;
+                Ok((Func::Random($op), $t))
+            },
+        }
+    };
+}
+
 fn vector(a: &[Ty], name: &str) -> Result<Ty, SigError> {
     match a {
         [t] if t.is_vector() => Ok(*t),
@@ -197,6 +225,45 @@ pub static LIBRARY: &[Builtin] = &[
     math2!("hypot", f64::hypot),
     math2!("fmin", f64::min),
     math2!("fmax", f64::max),
+    // C's single-precision functions: the argument rounded to a float, the
+    // float function (Rust's f32 functions are the platform's libm ones,
+    // as lpfg's program calls them), the result a float's value.
+    math1!("sinf", |x: f64| f64::from((x as f32).sin())),
+    math1!("cosf", |x: f64| f64::from((x as f32).cos())),
+    math1!("tanf", |x: f64| f64::from((x as f32).tan())),
+    math1!("asinf", |x: f64| f64::from((x as f32).asin())),
+    math1!("acosf", |x: f64| f64::from((x as f32).acos())),
+    math1!("atanf", |x: f64| f64::from((x as f32).atan())),
+    math1!("sinhf", |x: f64| f64::from((x as f32).sinh())),
+    math1!("coshf", |x: f64| f64::from((x as f32).cosh())),
+    math1!("tanhf", |x: f64| f64::from((x as f32).tanh())),
+    math1!("sqrtf", |x: f64| f64::from((x as f32).sqrt())),
+    math1!("cbrtf", |x: f64| f64::from((x as f32).cbrt())),
+    math1!("expf", |x: f64| f64::from((x as f32).exp())),
+    math1!("logf", |x: f64| f64::from((x as f32).ln())),
+    math1!("log10f", |x: f64| f64::from((x as f32).log10())),
+    math1!("log2f", |x: f64| f64::from((x as f32).log2())),
+    math1!("fabsf", |x: f64| f64::from((x as f32).abs())),
+    math1!("floorf", |x: f64| f64::from((x as f32).floor())),
+    math1!("ceilf", |x: f64| f64::from((x as f32).ceil())),
+    math1!("roundf", |x: f64| f64::from((x as f32).round())),
+    math1!("truncf", |x: f64| f64::from((x as f32).trunc())),
+    math2!("atan2f", |y: f64, x: f64| f64::from(
+        (y as f32).atan2(x as f32)
+    )),
+    math2!("powf", |x: f64, y: f64| f64::from(
+        (x as f32).powf(y as f32)
+    )),
+    math2!("fmodf", |x: f64, y: f64| f64::from((x as f32) % (y as f32))),
+    math2!("hypotf", |x: f64, y: f64| f64::from(
+        (x as f32).hypot(y as f32)
+    )),
+    math2!("fminf", |x: f64, y: f64| f64::from(
+        (x as f32).min(y as f32)
+    )),
+    math2!("fmaxf", |x: f64, y: f64| f64::from(
+        (x as f32).max(y as f32)
+    )),
     Builtin {
         name: "abs",
         resolve: |a| int_or_float(a, 1, Func::AbsInt, Func::Math1(f64::abs)),
@@ -275,11 +342,33 @@ pub static LIBRARY: &[Builtin] = &[
     model!("curveSetPoint", CurveSetPoint, 5, Ty::Void),
     model!("curveRecalculate", CurveRecalculate, 1, Ty::Void),
     model!("curveReset", CurveReset, 1, Ty::Void),
-    Builtin {
-        name: "ran",
-        resolve: |a| {
-            numbers(a, 1)?;
-            Ok((Func::Ran, Ty::Float))
-        },
-    },
+    random!("ran", 1, Op::Ran, Ty::Double),
+    random!("sran", 1, Op::SRan, Ty::Void),
+    random!("rand", 0, Op::Rand, Ty::Int),
+    random!("random", 0, Op::Rand, Ty::Int),
+    random!("srand", 1, Op::SRand, Ty::Void),
+    random!("srandom", 1, Op::SRand, Ty::Void),
+    random!("drand48", 0, Op::Drand48, Ty::Double),
+    random!("lrand48", 0, Op::Lrand48, Ty::Int),
+    random!("mrand48", 0, Op::Mrand48, Ty::Int),
+    random!("srand48", 1, Op::SRand48, Ty::Void),
+    random!("GillespieTime", 0, Op::GillespieTime, Ty::Double),
+    random!("SeedGillespie", 1, Op::SeedGillespie, Ty::Void),
+    random!("ResetGillespie", 0, Op::ResetGillespie, Ty::Void),
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every float function is in the library with its double twin, which
+    /// `--double` calls instead.
+    #[test]
+    fn float_functions_have_double_twins() {
+        for f in FLOAT_FUNCTIONS {
+            assert!(LIBRARY.iter().any(|b| b.name == *f), "{f}");
+            let twin = &f[..f.len() - 1];
+            assert!(LIBRARY.iter().any(|b| b.name == twin), "{twin}");
+        }
+    }
+}

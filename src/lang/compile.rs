@@ -738,9 +738,13 @@ impl Compiler {
             angle: None,
             rules: Vec::new(),
             control: Vec::new(),
+            gillespie_groups: Vec::new(),
             warnings: Vec::new(),
             model: Default::default(),
         };
+        // Group numbers seen with `group` (false) and `ggroup` (true), and
+        // where first.
+        let mut group_kinds: Vec<(i64, bool, Span)> = Vec::new();
         let mut section = Section::Productions;
         let mut group = 0i64;
         let mut filter = Filter::All;
@@ -809,13 +813,38 @@ impl Compiler {
                     section = *s;
                     group = 0;
                 }
-                Item::Group { id, .. } => group = *id,
+                Item::Group {
+                    id,
+                    gillespie,
+                    span,
+                } => {
+                    group = *id;
+                    if *gillespie && *id <= 0 {
+                        self.err(
+                            *span,
+                            "a Gillespie group needs a number greater than 0: group 0 is the default group",
+                        );
+                    } else if *id != 0 {
+                        self.group_kind(*id, *gillespie, *span, &mut group_kinds);
+                    }
+                }
                 Item::Control { kind, body, .. } => {
                     let mut scope = Scope::default();
                     let stmts = self.block_stmts(&body.stmts, &mut scope);
                     program.control.push((*kind, stmts, scope.max as usize));
                 }
                 Item::Production(p) => {
+                    let gillespie = group_kinds.iter().any(|(g, k, _)| *g == group && *k);
+                    if gillespie && (!p.new_left.is_empty() || !p.new_right.is_empty()) {
+                        self.err(
+                            p.span,
+                            format!(
+                                "a production of a Gillespie group (`ggroup {group}:`) cannot \
+                                 have a new context (`<<` or `>>`): a Gillespie step rewrites \
+                                 one module in place (manual 7.2)"
+                            ),
+                        );
+                    }
                     if let Some(rule) = self.rule(p, section, group, &filter) {
                         program.rules.push(rule);
                     }
@@ -827,6 +856,11 @@ impl Compiler {
                 | Item::Function(_) => {}
             }
         }
+        program.gillespie_groups = group_kinds
+            .iter()
+            .filter(|(_, g, _)| *g)
+            .map(|(id, _, span)| (*id, *span))
+            .collect();
         program.functions = self.function_bodies(file);
         if !axiom_seen {
             let end = file
@@ -1017,6 +1051,35 @@ impl Compiler {
             ),
         );
         None
+    }
+
+    /// Records group `id` as a Gillespie group or a regular one; the two
+    /// kinds share the numbers (manual 7.2), so one number cannot be both.
+    fn group_kind(
+        &mut self,
+        id: i64,
+        gillespie: bool,
+        span: Span,
+        seen: &mut Vec<(i64, bool, Span)>,
+    ) {
+        if let Some(&(_, was, _)) = seen.iter().find(|(g, _, _)| *g == id) {
+            if was != gillespie {
+                let (this, other) = if gillespie {
+                    ("ggroup", "group")
+                } else {
+                    ("group", "ggroup")
+                };
+                self.err(
+                    span,
+                    format!(
+                        "`{this} {id}:` reuses the number of an earlier `{other} {id}:`: a \
+                         regular group and a Gillespie group cannot have the same number"
+                    ),
+                );
+            }
+            return;
+        }
+        seen.push((id, gillespie, span));
     }
 
     fn rule(
@@ -1694,7 +1757,10 @@ impl Compiler {
         match &e.kind {
             ExprKind::Int(i) => Some((Ex::Const(Value::Int(*i)), Ty::Int)),
             // A literal without a suffix is a `double`, as in C.
-            ExprKind::Float(f) => Some((Ex::Const(Value::Float(*f)), Ty::Double)),
+            // A literal with an `f` suffix is a `float` (its value is
+            // already the nearest single-precision one).
+            ExprKind::Float(f, true) => Some((Ex::Const(Value::Float(*f)), self.prec(Ty::Float))),
+            ExprKind::Float(f, false) => Some((Ex::Const(Value::Float(*f)), Ty::Double)),
             ExprKind::Str(s) => Some((
                 Ex::Const(Value::Str(super::stdio::unescape(s).into())),
                 Ty::Str,
@@ -1742,6 +1808,7 @@ impl Compiler {
                     "M_PI_2" => Value::Float(std::f64::consts::FRAC_PI_2),
                     "M_E" => Value::Float(std::f64::consts::E),
                     "M_SQRT2" => Value::Float(std::f64::consts::SQRT_2),
+                    "RAND_MAX" => Value::Int(super::random::RAND_MAX),
                     _ => {
                         let hint = if self.alphabet.lookup(n).is_some() {
                             format!(": `{n}` is a module, not a value")
@@ -1754,6 +1821,7 @@ impl Compiler {
                 };
                 let ty = match c {
                     Value::Bool(_) => Ty::Bool,
+                    Value::Int(_) => Ty::Int,
                     _ => Ty::Double,
                 };
                 Some((Ex::Const(c), ty))
@@ -2168,6 +2236,13 @@ impl Compiler {
                 return self.fold(name, set, ty, args[0].span, None, None, scope);
             }
         }
+        // With `float` computed in double (`--double`), C's float
+        // functions are their double twins: `expf` is `exp`.
+        let float_function = builtins::is_float_function(n);
+        let n = match (float_function, self.single) {
+            (true, false) => &n[..n.len() - 1],
+            _ => n,
+        };
         let Some(b) = builtins::lookup(n, self.host) else {
             let hint = if self.alphabet.lookup(n).is_some() {
                 format!(": `{n}` is a module; modules go after `produce`, not in expressions")
@@ -2201,6 +2276,8 @@ impl Compiler {
                 // library declares `float` (lpfg's `ran`, `func`) is a
                 // single-precision result.
                 let ty = match f {
+                    // `expf`, `sqrtf`, …: a float whatever the argument.
+                    Func::Math1(_) | Func::Math2(_) if float_function => self.prec(Ty::Float),
                     Func::Math1(_) | Func::Math2(_) => {
                         if tys.iter().all(|t| *t == Ty::Float) {
                             Ty::Float

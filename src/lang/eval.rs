@@ -12,6 +12,7 @@ use crate::syntax::span::Span;
 
 use super::ir::*;
 use super::modules::Sym;
+use super::random::Random;
 use super::stdio::ProgramOutput;
 use super::value::{StructDef, Ty, Value};
 
@@ -25,7 +26,9 @@ pub struct Env {
     /// Direction requested for the next step (`Forward()` / `Backward()`).
     pub forward: bool,
     pub stop: bool,
-    pub rng: u64,
+    /// The run's random number generators (`ran`, `rand`, `drand48`,
+    /// Gillespie steps).
+    pub random: Random,
     /// The model folder's functions and contours, for `func` and its kin.
     pub model: std::sync::Arc<crate::model::Model>,
     /// What the program prints and the files it writes.
@@ -41,7 +44,7 @@ impl Env {
             next_group: 0,
             forward: true,
             stop: false,
-            rng: 0x9E37_79B9_7F4A_7C15,
+            random: Random::default(),
             model: Default::default(),
             output: ProgramOutput::default(),
         }
@@ -951,16 +954,7 @@ impl<'p> Interp<'p> {
                 cx.env.stop = true;
                 Value::Void
             }
-            Func::Ran => {
-                // xorshift64*: reproducible from run to run.
-                let mut x = cx.env.rng;
-                x ^= x >> 12;
-                x ^= x << 25;
-                x ^= x >> 27;
-                cx.env.rng = x;
-                let u = (x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64;
-                Value::Float(u * num(0))
-            }
+            Func::Random(op) => cx.env.random.call(op, vals),
             Func::Model(a) if a.changes_the_model() => {
                 // The run's own copy, made on the first change.
                 return std::sync::Arc::make_mut(&mut cx.env.model).call_mut(a, vals);

@@ -109,7 +109,8 @@ pub enum Func {
     Backward,
     IsForward,
     Stop,
-    Ran,
+    /// `ran`, `rand`, `drand48`, their seeding, the Gillespie time.
+    Random(super::random::Op),
     NoOp,
     /// An accessor of the model's files (`func`, `curveX`, `val`, …),
     /// evaluated by the [`Model`](crate::model::Model) of the run.
@@ -266,6 +267,10 @@ pub struct Program {
     pub angle: Option<(Ex, Span)>,
     pub rules: Vec<Rule>,
     pub control: Vec<(ControlKind, Vec<St>, usize)>,
+    /// The numbers of the Gillespie groups (`ggroup N:`, manual 7.2),
+    /// whose steps apply one reaction (`rewrite/gillespie.rs`), each with
+    /// the span of its first `ggroup`.
+    pub gillespie_groups: Vec<(i64, Span)>,
     /// What `check` reports without refusing the program.
     pub warnings: Vec<Diagnostic>,
     /// The functions, contours and colours of the model folder the program

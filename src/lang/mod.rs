@@ -6,6 +6,7 @@ pub mod compile;
 pub mod eval;
 pub mod ir;
 pub mod modules;
+pub mod random;
 pub mod stdio;
 pub mod stencil;
 pub mod value;

@@ -108,6 +108,9 @@ pub const PREDEFINED: &[(&str, &[&[Ty]])] = &[
     ("SB", NONE),
     ("EB", NONE),
     ("Cut", NONE),
+    // What `propensity E produce ...;` emits before its successor
+    // (manual 7.2): a Gillespie step reads the reactions back from it.
+    ("Propensity", ONE_F),
     ("Circle0", NONE),
     ("CircleFront0", NONE),
     ("Circle", ONE_F),

@@ -5,6 +5,7 @@
 use crate::deadline::Deadline;
 use crate::lang::eval::{Env, Interp, NoHost, RuntimeError};
 use crate::lang::ir::{Program, St};
+use crate::lang::random::Random;
 use crate::lang::{ProgramOutput, Sym, Value};
 use crate::syntax::ast::{ControlKind, Section};
 use crate::syntax::span::Span;
@@ -24,6 +25,9 @@ pub struct DeriveOptions {
     /// The derivation, its decomposition and interpretation stop with an
     /// error once this passes. Default: none.
     pub deadline: Option<Deadline>,
+    /// Seeds every random number generator before the globals and `Start`
+    /// (see `lang::random`); without it they start as lpfg's do.
+    pub seed: Option<u32>,
     /// Where what the program prints (`printf`) and the files it writes
     /// go; the caller reads them from its clone. Default: a new one,
     /// which refuses `fopen` for writing.
@@ -37,6 +41,7 @@ impl Default for DeriveOptions {
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             deadline: None,
+            seed: None,
             output: ProgramOutput::default(),
         }
     }
@@ -66,6 +71,11 @@ impl DeriveOptions {
 
     pub fn with_deadline(mut self, d: Option<Deadline>) -> Self {
         self.deadline = d;
+        self
+    }
+
+    pub fn with_seed(mut self, seed: u32) -> Self {
+        self.seed = Some(seed);
         self
     }
 
@@ -188,6 +198,7 @@ impl<'p> Derivation<'p> {
             .collect();
         let mut env = Env::new(zeros);
         env.output = opts.output.clone();
+        env.random = Random::new(opts.seed);
         env.model = program.model.clone();
         for (k, g) in program.globals.iter().enumerate() {
             if let Some(e) = &g.init {
@@ -414,15 +425,35 @@ impl<'p> Derivation<'p> {
         let step = self.step + 1;
         let mut origin = Vec::new();
         let traced = self.makers.is_some();
-        let result = self.rewriter.step(
-            &rules,
-            &self.word,
-            &mut dst,
-            &mut self.env,
-            &opts,
-            None,
-            traced.then_some(&mut origin),
-        );
+        let gillespie = self
+            .program
+            .gillespie_groups
+            .iter()
+            .find(|(g, _)| *g == self.env.current_group);
+        if let (Some((_, at)), false) = (gillespie, self.env.forward) {
+            return Err(DeriveError {
+                span: Some(*at),
+                message: format!(
+                    "at step {step}, group {} is a Gillespie group, which derives forward \
+                     only: `Backward()` cannot be used with it",
+                    self.env.current_group
+                ),
+                step,
+            });
+        }
+        let result = if gillespie.is_some() {
+            self.gillespie_step(&mut dst, traced.then_some(&mut origin))
+        } else {
+            self.rewriter.step(
+                &rules,
+                &self.word,
+                &mut dst,
+                &mut self.env,
+                &opts,
+                None,
+                traced.then_some(&mut origin),
+            )
+        };
         if let Err(e) = result {
             return Err(self.step_error(e, step));
         }
@@ -436,6 +467,39 @@ impl<'p> Derivation<'p> {
         self.answer_queries()?;
         self.control(ControlKind::EndEach)?;
         Ok(())
+    }
+
+    /// A step of the current group, a Gillespie group: its productions
+    /// only (no fall-back to group 0), one reaction in the whole word.
+    fn gillespie_step(
+        &mut self,
+        dst: &mut Word,
+        origin: Option<&mut Vec<u32>>,
+    ) -> Result<usize, StepError> {
+        let g = self.env.current_group;
+        let rules: Vec<usize> = self
+            .program
+            .rules_of(Section::Productions)
+            .filter(|(_, r)| r.group == g)
+            .map(|(i, _)| i)
+            .collect();
+        let opts = self.step_options();
+        super::gillespie::step(
+            &mut self.rewriter,
+            self.program,
+            &rules,
+            &self.word,
+            dst,
+            &mut self.env,
+            &opts,
+            origin,
+        )
+    }
+
+    /// Runs `End`, as lpfg does after the final derivation step. A caller
+    /// that drives the steps itself calls this once it has taken the last.
+    pub fn end(&mut self) -> Result<(), DeriveError> {
+        self.control(ControlKind::End)
     }
 
     /// Runs the remaining steps and `End`.

@@ -3,6 +3,7 @@
 
 pub mod context;
 pub mod derive;
+pub mod gillespie;
 pub mod step;
 pub mod word;
 

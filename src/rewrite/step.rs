@@ -209,7 +209,7 @@ impl<'p> Rewriter<'p> {
                     } else {
                         i + 1 - len
                     };
-                    if self.try_rule(r, rule, src, start, dst, env, opts)? {
+                    if self.try_rule(r, rule, src, start, dst, env, opts, false)? {
                         used = len;
                         last_rule = Some(r);
                         break;
@@ -577,11 +577,22 @@ impl<'p> Rewriter<'p> {
             .all(|c| c.iter().fold(true, |ok, x| ok & x.is_finite()))
     }
 
+    /// Prepares a step on a word that [`Rewriter::step`] did not start (a
+    /// Gillespie step, which calls [`Rewriter::try_rule`] itself): the
+    /// deadline, and no tables of the last step's word.
+    pub(super) fn begin(&mut self, opts: &StepOptions) {
+        self.interp.deadline = opts.deadline;
+        self.tables.clear();
+    }
+
     /// Tries one rule with its strict predecessor starting at `start`.
     /// On success the successor is appended to `dst` (reversed when the step
-    /// runs backward) and `true` is returned.
+    /// runs backward) and `true` is returned. With `any_flow` (a Gillespie
+    /// step's reactions) the body applies whenever the predecessor matches,
+    /// and everything it emitted is the successor, whether it ended with
+    /// `produce` or not.
     #[allow(clippy::too_many_arguments)]
-    fn try_rule(
+    pub(super) fn try_rule(
         &mut self,
         r: usize,
         rule: &Rule,
@@ -590,6 +601,7 @@ impl<'p> Rewriter<'p> {
         dst: &mut Word,
         env: &mut Env,
         opts: &StepOptions,
+        any_flow: bool,
     ) -> Result<bool, StepError> {
         let n = src.len();
         let len = rule.strict.len();
@@ -749,7 +761,7 @@ impl<'p> Rewriter<'p> {
                     StepError::Runtime { rule: r, error }
                 }
             })?;
-        if flow != Flow::Produced {
+        if flow != Flow::Produced && !any_flow {
             return Ok(false);
         }
         if opts.forward {

@@ -779,7 +779,7 @@ fn invariant(e: &Ex) -> bool {
             ok = false
         }
         Ex::Call(Func::Host(f), ..) if !matches!(*f, id::CURRENT | id::STEP) => ok = false,
-        Ex::Call(Func::Ran | Func::UseGroup | Func::Stop, ..) => ok = false,
+        Ex::Call(Func::Random(_) | Func::UseGroup | Func::Stop, ..) => ok = false,
         _ => {}
     });
     ok
@@ -979,7 +979,7 @@ fn scalar(e: &Ex) -> bool {
         | Ex::MakeV2(..)
         | Ex::MakeV3(..)
         | Ex::MakeStruct(..)
-        | Ex::Call(Func::Ran | Func::UseGroup | Func::Stop, ..) => ok = false,
+        | Ex::Call(Func::Random(_) | Func::UseGroup | Func::Stop, ..) => ok = false,
         _ => {}
     });
     ok

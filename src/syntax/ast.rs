@@ -72,9 +72,11 @@ pub enum Item {
         section: Section,
         span: Span,
     },
-    /// `group 1:`; `endgroup` is `Group { id: 0 }`.
+    /// `group 1:`, or `ggroup 1:` (`gillespie`, manual 7.2); `endgroup`
+    /// is `Group { id: 0 }`.
     Group {
         id: i64,
+        gillespie: bool,
         span: Span,
     },
     /// `Start: { ... }` and friends.
@@ -353,7 +355,9 @@ pub struct Expr {
 #[derive(Clone, Debug, PartialEq)]
 pub enum ExprKind {
     Int(i64),
-    Float(f64),
+    /// A floating literal; `true` when it has an `f` suffix (a `float`,
+    /// its value the nearest single-precision one), else a `double`.
+    Float(f64, bool),
     Str(String),
     Ident(String),
     Unary(UnOp, Box<Expr>),

@@ -4,6 +4,16 @@
 //! line (preprocessor directives and the one-line arrow form are line based)
 //! and whether whitespace precedes it (a function-like `#define NAME(` has no
 //! space before the parenthesis).
+//!
+//! Numbers are C's: decimal, octal (`017`) and hexadecimal (`0x1F`)
+//! integers with `u`/`l` suffixes, floating constants with an exponent and an
+//! `f`/`l` suffix. A float with `f` is single precision: its value is the
+//! nearest `f32`, and the token says so.
+//!
+//! A character that starts no token, or a number C would refuse, is not fatal
+//! here: [`lex_all`] records it and goes on, and the preprocessor reports it
+//! only when it lies outside a group that `#if` skips (a skipped group may
+//! hold anything). An unterminated comment is fatal, as in C.
 
 use nom::{
     branch::alt,
@@ -20,7 +30,12 @@ use super::span::{Diagnostic, FileId, Span};
 pub enum Tok {
     Ident(String),
     Int(i64),
-    Float(f64),
+    /// A floating constant; `single` when it had an `f`/`F` suffix (C's
+    /// `float`), and then `value` is already rounded to the nearest `f32`.
+    Float {
+        value: f64,
+        single: bool,
+    },
     Str(String),
     Punct(&'static str),
 }
@@ -39,7 +54,7 @@ impl Tok {
         match self {
             Tok::Ident(s) => format!("`{s}`"),
             Tok::Int(i) => format!("number `{i}`"),
-            Tok::Float(f) => format!("number `{f}`"),
+            Tok::Float { value, .. } => format!("number `{value}`"),
             Tok::Str(s) => format!("string \"{s}\""),
             Tok::Punct(p) => format!("`{p}`"),
         }
@@ -70,8 +85,37 @@ fn ident(i: &str) -> IResult<&str, &str> {
     ))(i)
 }
 
-/// `1`, `1.5`, `.5`, `1.`, `1e-3`, `2.0f`
-fn number(i: &str) -> IResult<&str, (&str, bool)> {
+/// A number as C reads it: its digits, its kind and its suffix.
+struct Number<'a> {
+    /// The digits without the suffix: `0x1F`, `1.5e3`.
+    text: &'a str,
+    /// A floating constant (a `.` or an exponent).
+    float: bool,
+    /// The letters after the digits: `f`, `UL`, or what C would refuse.
+    suffix: &'a str,
+}
+
+/// `1`, `017`, `0x1F`, `10UL`, `1.5`, `.5`, `1.`, `1e-3`, `2.0f`, `1.F`:
+/// the digits and then every letter, digit, `_` or `.` that follows, as C's
+/// preprocessing number takes them, so that `1abc` is one bad number and
+/// not a number and a name.
+fn number(i: &str) -> IResult<&str, Number<'_>> {
+    let digits = |r: &str| r.find(|c: char| !c.is_ascii_hexdigit()).unwrap_or(r.len());
+    if let Some(r) = i.strip_prefix("0x").or_else(|| i.strip_prefix("0X")) {
+        if digits(r) > 0 {
+            let (text, rest) = i.split_at(2 + digits(r));
+            let (rest, suffix) =
+                take_while(|c: char| c.is_ascii_alphanumeric() || c == '_' || c == '.')(rest)?;
+            return Ok((
+                rest,
+                Number {
+                    text,
+                    float: false,
+                    suffix,
+                },
+            ));
+        }
+    }
     let exponent = recognize(tuple((one_of("eE"), opt(one_of("+-")), digit1)));
     let with_dot = recognize(tuple((digit0, char('.'), digit0)));
     let (rest, text) = recognize(pair(alt((with_dot, digit1)), opt(exponent)))(i)?;
@@ -81,9 +125,97 @@ fn number(i: &str) -> IResult<&str, (&str, bool)> {
             nom::error::ErrorKind::Digit,
         )));
     }
-    let (rest, suffix) = opt(one_of("fFlLuU"))(rest)?;
-    let is_float = text.contains(['.', 'e', 'E']) || matches!(suffix, Some('f' | 'F'));
-    Ok((rest, (text, is_float)))
+    let (rest, suffix) =
+        take_while(|c: char| c.is_ascii_alphanumeric() || c == '_' || c == '.')(rest)?;
+    Ok((
+        rest,
+        Number {
+            text,
+            float: text.contains(['.', 'e', 'E']),
+            suffix,
+        },
+    ))
+}
+
+/// C's integer suffixes: an optional `u` and an optional `l` or `ll` (one
+/// case), in either order.
+fn integer_suffix(s: &str) -> bool {
+    let l = match s.find(['u', 'U']) {
+        None => s,
+        Some(0) => &s[1..],
+        Some(k) if k == s.len() - 1 => &s[..k],
+        Some(_) => return false,
+    };
+    matches!(l, "" | "l" | "L" | "ll" | "LL")
+}
+
+/// The token of a lexed number, or why C would refuse it.
+fn number_token(n: &Number) -> Result<Tok, String> {
+    let whole = format!("{}{}", n.text, n.suffix);
+    if n.float {
+        let single = match n.suffix {
+            "" | "l" | "L" => false,
+            "f" | "F" => true,
+            s => return Err(format!("`{whole}` has the suffix `{s}`, which a floating constant cannot have (C allows `f` and `l`)")),
+        };
+        let value = if single {
+            let v: f32 = n
+                .text
+                .parse()
+                .map_err(|_| format!("`{whole}` is not a valid number"))?;
+            if v.is_infinite() {
+                return Err(format!(
+                    "`{whole}` is too large for a float (the largest is about 3.4e38)"
+                ));
+            }
+            f64::from(v)
+        } else {
+            let v: f64 = n
+                .text
+                .parse()
+                .map_err(|_| format!("`{whole}` is not a valid number"))?;
+            if v.is_infinite() {
+                return Err(format!(
+                    "`{whole}` is too large for a double (the largest is about 1.8e308)"
+                ));
+            }
+            v
+        };
+        return Ok(Tok::Float { value, single });
+    }
+    if !integer_suffix(n.suffix) {
+        return Err(
+            if n.suffix.starts_with(['f', 'F'])
+                && !n.text.starts_with("0x")
+                && !n.text.starts_with("0X")
+            {
+                format!("`{whole}` is not a valid number: the suffix `f` needs a floating constant, as in `{}.f`", n.text)
+            } else {
+                format!("`{whole}` is not a valid number: `{}` is not a suffix C allows on an integer (`u`, `l`, `ul`, `ll`, `ull`)", n.suffix)
+            },
+        );
+    }
+    let too_large = || {
+        format!(
+            "`{whole}` is too large for an integer (the largest is {})",
+            i64::MAX
+        )
+    };
+    let value = if let Some(hex) = n
+        .text
+        .strip_prefix("0x")
+        .or_else(|| n.text.strip_prefix("0X"))
+    {
+        i64::from_str_radix(hex, 16).map_err(|_| too_large())?
+    } else if n.text.len() > 1 && n.text.starts_with('0') {
+        if let Some(bad) = n.text.chars().find(|c| !('0'..='7').contains(c)) {
+            return Err(format!("`{whole}` is not a valid number: a number that starts with 0 is octal, and `{bad}` is not an octal digit"));
+        }
+        i64::from_str_radix(&n.text[1..], 8).map_err(|_| too_large())?
+    } else {
+        n.text.parse().map_err(|_| too_large())?
+    };
+    Ok(Tok::Int(value))
 }
 
 fn string_lit(i: &str) -> IResult<&str, &str> {
@@ -174,8 +306,30 @@ fn punct(i: &str) -> IResult<&str, &'static str> {
     }
 }
 
-/// Splits `text` into tokens. Comments and line continuations are whitespace.
+/// The tokens of a text, and the places where no token could be made.
+#[derive(Clone, Debug, Default)]
+pub struct Lexed {
+    pub tokens: Vec<Token>,
+    /// What could not be lexed, each with the number of tokens before it.
+    pub errors: Vec<(usize, Diagnostic)>,
+}
+
+/// Splits `text` into tokens; the first thing that is not a token is an
+/// error.
 pub fn lex(file: FileId, text: &str) -> Result<Vec<Token>, Diagnostic> {
+    let lexed = lex_all(file, text)?;
+    match lexed.errors.into_iter().next() {
+        Some((_, d)) => Err(d),
+        None => Ok(lexed.tokens),
+    }
+}
+
+/// Splits `text` into tokens. Comments and line continuations are
+/// whitespace. A character that starts no token or a number C refuses is
+/// recorded in [`Lexed::errors`] and skipped; only an unterminated comment
+/// stops the lexer.
+pub fn lex_all(file: FileId, text: &str) -> Result<Lexed, Diagnostic> {
+    let mut errors = Vec::new();
     let mut out = Vec::new();
     let mut rest = text;
     let mut line_start = true;
@@ -221,37 +375,60 @@ pub fn lex(file: FileId, text: &str) -> Result<Vec<Token>, Diagnostic> {
             }
         }
         if rest.is_empty() {
-            return Ok(out);
+            return Ok(Lexed {
+                tokens: out,
+                errors,
+            });
         }
         let at = text.len() - rest.len();
         let (r, tok) = if let Ok((r, s)) = ident(rest) {
             (r, Tok::Ident(s.to_string()))
-        } else if let Ok((r, (s, is_float))) = number(rest) {
-            let bad = || {
-                Diagnostic::new(
-                    Span::new(file, at, at + s.len()),
-                    format!("`{s}` is not a valid number"),
-                )
-            };
-            if is_float {
-                (r, Tok::Float(s.parse().map_err(|_| bad())?))
-            } else {
-                (r, Tok::Int(s.parse().map_err(|_| bad())?))
+        } else if let Ok((r, n)) = number(rest) {
+            match number_token(&n) {
+                Ok(tok) => (r, tok),
+                Err(message) => {
+                    let end = text.len() - r.len();
+                    errors.push((
+                        out.len(),
+                        Diagnostic::new(Span::new(file, at, end), message),
+                    ));
+                    rest = r;
+                    line_start = false;
+                    space_before = false;
+                    continue;
+                }
             }
         } else if rest.starts_with('\'') {
-            let (r, code) = char_lit(rest)
-                .map_err(|(len, msg)| Diagnostic::new(Span::new(file, at, at + len.max(1)), msg))?;
-            (r, Tok::Int(code))
+            match char_lit(rest) {
+                Ok((r, code)) => (r, Tok::Int(code)),
+                Err((len, message)) => {
+                    errors.push((
+                        out.len(),
+                        Diagnostic::new(Span::new(file, at, at + len), message),
+                    ));
+                    rest = &rest[len..];
+                    line_start = false;
+                    space_before = false;
+                    continue;
+                }
+            }
         } else if let Ok((r, s)) = string_lit(rest) {
             (r, Tok::Str(s.to_string()))
         } else if let Ok((r, p)) = punct(rest) {
             (r, Tok::Punct(p))
         } else {
             let c = rest.chars().next().unwrap_or(' ');
-            return Err(Diagnostic::new(
-                Span::new(file, at, at + c.len_utf8()),
-                format!("unexpected character `{c}`"),
+            errors.push((
+                out.len(),
+                Diagnostic::new(
+                    Span::new(file, at, at + c.len_utf8()),
+                    format!("unexpected character `{c}`"),
+                ),
             ));
+            rest = &rest[c.len_utf8()..];
+            line_start = false;
+            space_before = false;
+            continue;
         };
         let end = text.len() - r.len();
         out.push(Token {
@@ -263,5 +440,118 @@ pub fn lex(file: FileId, text: &str) -> Result<Vec<Token>, Diagnostic> {
         rest = r;
         line_start = false;
         space_before = false;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn one(text: &str) -> Result<Tok, String> {
+        let toks = lex(FileId(0), text).map_err(|d| d.message)?;
+        assert_eq!(toks.len(), 1, "{text}: {toks:?}");
+        Ok(toks[0].tok.clone())
+    }
+
+    /// Character constants (C11 6.4.4.4) are ints: ASCII codes, the
+    /// simple escapes, octal and hexadecimal ones.
+    #[test]
+    fn character_constants() {
+        let cases = [
+            ("'a'", 97),
+            ("' '", 32),
+            ("'\\n'", 10),
+            ("'\\t'", 9),
+            ("'\\0'", 0),
+            ("'\\''", 39),
+            ("'\\\\'", 92),
+            ("'\\\"'", 34),
+            ("'\"'", 34),
+            ("'\\x41'", 65),
+            ("'\\101'", 65),
+            ("'\\177'", 127),
+        ];
+        for (text, want) in cases {
+            assert_eq!(one(text), Ok(Tok::Int(want)), "{text}");
+        }
+        for bad in ["'ab'", "''", "'\\q'", "'\\x123'", "'é'", "'a"] {
+            assert!(one(bad).is_err(), "{bad}");
+        }
+    }
+
+    fn float(value: f64, single: bool) -> Tok {
+        Tok::Float { value, single }
+    }
+
+    /// C's constants (C11 6.4.4.1 and 6.4.4.2): the value and kind of each
+    /// form. `0.1f` is the `f32` nearest 0.1: 0.1 × 2^27 = 13421772.8, so
+    /// it is 13421773 / 2^27 (0x3DCCCCCD), not the `f64` 0.1.
+    #[test]
+    fn numbers_as_c_reads_them() {
+        let cases = [
+            ("1", Tok::Int(1)),
+            ("017", Tok::Int(15)),
+            ("0", Tok::Int(0)),
+            ("0x1F", Tok::Int(31)),
+            ("0XfF", Tok::Int(255)),
+            ("10L", Tok::Int(10)),
+            ("1u", Tok::Int(1)),
+            ("10UL", Tok::Int(10)),
+            ("7lu", Tok::Int(7)),
+            ("3ll", Tok::Int(3)),
+            ("3ULL", Tok::Int(3)),
+            ("1.5", float(1.5, false)),
+            ("1.", float(1.0, false)),
+            (".5", float(0.5, false)),
+            ("1e5", float(100000.0, false)),
+            ("1e-3", float(0.001, false)),
+            ("2.5L", float(2.5, false)),
+            ("1.f", float(1.0, true)),
+            ("1.0f", float(1.0, true)),
+            ("2.F", float(2.0, true)),
+            (".5f", float(0.5, true)),
+            ("1e-3f", float(f64::from(0.001f32), true)),
+            ("0.1f", float(13421773.0 / 134217728.0, true)),
+            ("017.5", float(17.5, false)),
+        ];
+        for (text, want) in cases {
+            assert_eq!(one(text), Ok(want), "{text}");
+        }
+        assert_ne!(13421773.0 / 134217728.0, 0.1);
+    }
+
+    #[test]
+    fn numbers_c_refuses() {
+        let cases = [
+            (
+                "1f",
+                "the suffix `f` needs a floating constant, as in `1.f`",
+            ),
+            ("1abc", "`abc` is not a suffix C allows"),
+            ("08", "`8` is not an octal digit"),
+            ("1.5x", "which a floating constant cannot have"),
+            ("1uu", "not a suffix C allows"),
+            ("1lL", "not a suffix C allows"),
+            ("1e39f", "too large for a float"),
+            ("1e309", "too large for a double"),
+            ("99999999999999999999", "too large for an integer"),
+            ("0x8000000000000000", "too large for an integer"),
+        ];
+        for (text, want) in cases {
+            let e = one(text).unwrap_err();
+            assert!(e.contains(want), "{text}: {e}");
+        }
+    }
+
+    /// What cannot be lexed is recorded with its place among the tokens,
+    /// and lexing goes on.
+    #[test]
+    fn lex_all_goes_on_after_a_bad_character() {
+        let l = lex_all(FileId(0), "a ` b 1x c").unwrap();
+        let names: Vec<String> = l.tokens.iter().map(|t| t.tok.describe()).collect();
+        assert_eq!(names, ["`a`", "`b`", "`c`"]);
+        let at: Vec<usize> = l.errors.iter().map(|(k, _)| *k).collect();
+        assert_eq!(at, [1, 2]);
+        assert!(lex_all(FileId(0), "a /* b").is_err());
     }
 }

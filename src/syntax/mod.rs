@@ -1,6 +1,7 @@
 //! The `.lsys` language as text: lexing, preprocessing, parsing, spans.
 
 pub mod ast;
+pub mod ifexpr;
 pub mod lex;
 pub mod parse;
 pub mod preprocess;

@@ -237,6 +237,16 @@ impl<'t> Parser<'t> {
         TYPE_KEYWORDS.contains(&s) || self.type_names.contains(s)
     }
 
+    /// True when `propensity` at the cursor starts a Gillespie statement,
+    /// not an expression about a variable of that name.
+    fn at_propensity(&self) -> bool {
+        !self.peek_at(1).is_some_and(|t| {
+            ["=", "+=", "-=", "*=", "/=", "++", "--", ".", "[", ";", ","]
+                .iter()
+                .any(|p| t.tok.is_punct(p))
+        })
+    }
+
     /// True when the tokens at the cursor begin a declaration:
     /// `const ...`, `static ...`, `struct Name ...`, `TYPE name`, `TYPE
     /// *name`, or `Name name` (unless `Name` is a module: a production).
@@ -246,7 +256,14 @@ impl<'t> Parser<'t> {
             (Some(Tok::Ident(a)), Some(Tok::Ident(_))) => {
                 !matches!(
                     a.as_str(),
-                    "produce" | "nproduce" | "return" | "else" | "if" | "while" | "do"
+                    "produce"
+                        | "nproduce"
+                        | "return"
+                        | "else"
+                        | "if"
+                        | "while"
+                        | "do"
+                        | "propensity"
                 ) && (self.is_type_name(a) || !self.module_names.contains(a))
             }
             (Some(Tok::Ident(a)), Some(Tok::Punct("*" | "&"))) => {
@@ -352,7 +369,8 @@ impl<'t> Parser<'t> {
                     });
                     return Ok(());
                 }
-                "group" => {
+                "group" | "ggroup" => {
+                    let gillespie = word == "ggroup";
                     self.pos += 1;
                     let id = match self.peek().map(|t| &t.tok) {
                         Some(Tok::Int(i)) => *i,
@@ -360,14 +378,22 @@ impl<'t> Parser<'t> {
                     };
                     self.pos += 1;
                     self.expect_punct(":", "after the group number")?;
-                    items.push(Item::Group { id, span: start });
+                    items.push(Item::Group {
+                        id,
+                        gillespie,
+                        span: start,
+                    });
                     return Ok(());
                 }
                 "endgroup" => {
                     self.pos += 1;
                     self.eat_punct(":");
                     self.eat_punct(";");
-                    items.push(Item::Group { id: 0, span: start });
+                    items.push(Item::Group {
+                        id: 0,
+                        gillespie: false,
+                        span: start,
+                    });
                     return Ok(());
                 }
                 "Start" | "StartEach" | "EndEach" | "End" if next_colon => {
@@ -1420,6 +1446,32 @@ impl<'t> Parser<'t> {
                         span: t.span,
                     });
                 }
+                "propensity" if self.at_propensity() => {
+                    // `propensity E produce W;` (manual 7.2) is lpfg's
+                    // `nproduce Propensity(E) W;`: a Gillespie step reads
+                    // the reactions back from the successor.
+                    self.pos += 1;
+                    let value = self.expr()?;
+                    if !self.eat_ident("produce") {
+                        return self.error("`produce` after the propensity");
+                    }
+                    let mut modules = vec![ModuleCall {
+                        name: Name {
+                            text: "Propensity".into(),
+                            span: t.span,
+                        },
+                        args: vec![value],
+                    }];
+                    modules.extend(self.module_calls(&[";"], true)?);
+                    if !self.peek_punct("}") {
+                        self.expect_punct(";", "after the successor")?;
+                    }
+                    return Ok(Stmt::Produce {
+                        modules,
+                        last: false,
+                        span: t.span,
+                    });
+                }
                 "if" => {
                     self.pos += 1;
                     let cond = self.expr()?;
@@ -1817,9 +1869,9 @@ impl<'t> Parser<'t> {
                 self.pos += 1;
                 ExprKind::Int(*i)
             }
-            Tok::Float(f) => {
+            Tok::Float { value: f, single } => {
                 self.pos += 1;
-                ExprKind::Float(*f)
+                ExprKind::Float(*f, *single)
             }
             Tok::Str(s) => {
                 self.pos += 1;

@@ -1,12 +1,19 @@
 //! The C-like preprocessor: `#include` of the lpfg headers, `#define` with
-//! object-like and function-like macros, and `-D NAME=VALUE` overrides.
+//! object-like and function-like macros, `#undef`, the conditionals `#if`,
+//! `#ifdef`, `#ifndef`, `#elif`, `#else` and `#endif` (the expressions in
+//! [`super::ifexpr`]), `#error`, and `-D NAME=VALUE` overrides.
+//!
+//! A group that a conditional skips may hold anything: its directives other
+//! than the conditionals are not run, and what the lexer could not read
+//! there is no error. An override wins over the file: a `#define` or
+//! `#undef` of its name is ignored.
 //!
 //! A `#` that starts a line but is not followed by a directive name is left
 //! alone: it is the endmarker module, as in `# P(vl) < P(v) > P(vr) : {...}`.
 
 use std::collections::{HashMap, HashSet};
 
-use super::lex::{Tok, Token};
+use super::lex::{Lexed, Tok, Token};
 use super::span::{Diagnostic, Span};
 
 const DIRECTIVES: &[&str] = &[
@@ -14,22 +21,18 @@ const DIRECTIVES: &[&str] = &[
     "error",
 ];
 
-/// Headers that stand for lpfg's built-in library and are accepted as no-ops.
-const KNOWN_HEADERS: &[&str] = &[
-    "lpfgall.h",
-    "math.h",
-    "stdlib.h",
-    "stdio.h",
-    "cmath",
-    "lintrfc.h",
-];
+/// lpfg's own headers: its library is built in, so including them does
+/// nothing.
+const KNOWN_HEADERS: &[&str] = &["lpfgall.h", "lintrfc.h"];
 
 /// The standard C and C++ headers whose functions programs call: the
-/// library is built in, so an `#include <...>` of one of them is a no-op
-/// (a function that subgram lacks is refused where it is called).
+/// library is built in, so including one of them (`<string.h>` or, as C's
+/// search falls back to them, `"string.h"`) does nothing; a function that
+/// subgram lacks is refused where it is called.
 const STANDARD_HEADERS: &[&str] = &[
-    "assert.h", "ctype.h", "float.h", "limits.h", "memory.h", "string.h", "time.h", "cassert",
-    "cctype", "cfloat", "climits", "cstdio", "cstdlib", "cstring", "ctime", "iostream",
+    "math.h", "stdlib.h", "stdio.h", "string.h", "memory.h", "assert.h", "ctype.h", "float.h",
+    "limits.h", "time.h", "cmath", "cstdlib", "cstdio", "cstring", "cassert", "cctype", "cfloat",
+    "climits", "ctime", "iostream",
 ];
 
 #[derive(Clone, Debug)]
@@ -76,12 +79,31 @@ pub const EXPANSION_BUDGET: usize = 2_000_000;
 /// each level's arguments are expanded before the level around it.
 pub const MAX_MACRO_NESTING: usize = 100;
 
-/// Runs the preprocessor over `tokens`. `overrides` are `-D` definitions,
+/// An open conditional: `#if` … `#endif`.
+struct Cond {
+    /// `#if` and its name, for "without `#endif`".
+    span: Span,
+    /// The group around it emits tokens.
+    outer: bool,
+    /// The current group emits tokens.
+    active: bool,
+    /// A group of this conditional has been taken: later `#elif`s and the
+    /// `#else` are skipped.
+    taken: bool,
+    /// Its `#else` has been seen.
+    seen_else: bool,
+}
+
+/// Runs the preprocessor over `lexed`. `overrides` are `-D` definitions,
 /// already lexed; they replace a `#define` of the same name in the file.
+/// What the lexer could not read is an error here unless a conditional
+/// skips it.
 pub fn preprocess(
-    tokens: Vec<Token>,
+    lexed: Lexed,
     overrides: &[(String, Vec<Token>)],
 ) -> Result<Vec<Token>, Diagnostic> {
+    let Lexed { tokens, errors } = lexed;
+    let mut errors = errors.into_iter().peekable();
     let mut macros: HashMap<String, Macro> = HashMap::new();
     // Ids of definitions, from 0 up.
     let mut next_id = 0;
@@ -96,17 +118,30 @@ pub fn preprocess(
         nesting: 0,
         disabled: Vec::new(),
     };
+    let mut conds: Vec<Cond> = Vec::new();
     // Tokens between directives are expanded together, with the macros
     // defined so far.
     let mut pending: Vec<Token> = Vec::new();
-    let mut tokens = tokens.into_iter().peekable();
-    while let Some(t) = tokens.next() {
+    let mut tokens = tokens.into_iter().enumerate().peekable();
+    loop {
+        let active = conds.last().is_none_or(|c| c.active);
+        // What the lexer could not read before the next token.
+        let next = tokens.peek().map_or(usize::MAX, |(i, _)| *i);
+        while let Some((_, d)) = errors.next_if(|(k, _)| *k <= next) {
+            if active {
+                return Err(d);
+            }
+        }
+        let Some((_, t)) = tokens.next() else { break };
         let is_directive = t.tok.is_punct("#")
             && t.line_start
-            && tokens.peek().is_some_and(|n| {
+            && tokens.peek().is_some_and(|(_, n)| {
                 !n.line_start && matches!(&n.tok, Tok::Ident(s) if DIRECTIVES.contains(&s.as_str()))
             });
         if !is_directive {
+            if !active {
+                continue;
+            }
             if macros.is_empty() {
                 // Nothing to expand: straight to the output.
                 out.push(t);
@@ -115,20 +150,82 @@ pub fn preprocess(
             }
             continue;
         }
-        out.extend(expander.expand(std::mem::take(&mut pending), &macros, next_id)?);
         let hash_span = t.span;
-        let name_tok = tokens.next().expect("peeked");
+        let (_, name_tok) = tokens.next().expect("peeked");
         let Tok::Ident(name) = &name_tok.tok else {
             unreachable!("checked above")
         };
+        let at = hash_span.to(name_tok.span);
         // The directive's tokens run to the end of the line.
         let mut args = Vec::new();
-        while let Some(a) = tokens.next_if(|a| !a.line_start) {
+        while let Some((_, a)) = tokens.next_if(|(_, a)| !a.line_start) {
             args.push(a);
         }
         match name.as_str() {
-            "include" => check_include(hash_span.to(name_tok.span), &args)?,
+            "if" | "ifdef" | "ifndef" => {
+                let value = if !active {
+                    false
+                } else if name == "if" {
+                    if_value(&args, at, "#if", &macros, &mut expander, next_id)?
+                } else {
+                    let Some(Token {
+                        tok: Tok::Ident(m), ..
+                    }) = args.first()
+                    else {
+                        let span = args.first().map_or(at, |a| a.span);
+                        return Err(Diagnostic::new(
+                            span,
+                            format!("expected a macro name after `#{name}`"),
+                        ));
+                    };
+                    macros.contains_key(m) == (name == "ifdef")
+                };
+                conds.push(Cond {
+                    span: at,
+                    outer: active,
+                    active: value,
+                    taken: value,
+                    seen_else: false,
+                });
+            }
+            "elif" | "else" => {
+                let Some(c) = conds.last_mut() else {
+                    return Err(Diagnostic::new(
+                        at,
+                        format!("`#{name}` without `#if`: no conditional is open here"),
+                    ));
+                };
+                if c.seen_else {
+                    return Err(Diagnostic::new(
+                        at,
+                        format!("`#{name}` after `#else`: the `#else` must be the conditional's last group"),
+                    ));
+                }
+                if name == "else" {
+                    c.seen_else = true;
+                    c.active = c.outer && !c.taken;
+                    c.taken = true;
+                } else if c.outer && !c.taken {
+                    let v = if_value(&args, at, "#elif", &macros, &mut expander, next_id)?;
+                    let c = conds.last_mut().expect("checked above");
+                    c.active = v;
+                    c.taken = v;
+                } else {
+                    c.active = false;
+                }
+            }
+            "endif" => {
+                if conds.pop().is_none() {
+                    return Err(Diagnostic::new(
+                        at,
+                        "`#endif` without `#if`: no conditional is open here",
+                    ));
+                }
+            }
+            _ if !active => {}
+            "include" => check_include(at, &args)?,
             "define" => {
+                out.extend(expander.expand(std::mem::take(&mut pending), &macros, next_id)?);
                 let (mname, params, body) = parse_define(&name_tok, &args)?;
                 if !overridden.contains(mname.as_str()) {
                     let id = next_id;
@@ -137,21 +234,109 @@ pub fn preprocess(
                 }
             }
             "undef" => {
-                if let Some(Token { tok: Tok::Ident(m), .. }) = args.first() {
-                    macros.remove(m);
+                out.extend(expander.expand(std::mem::take(&mut pending), &macros, next_id)?);
+                match args.first() {
+                    Some(Token {
+                        tok: Tok::Ident(m), ..
+                    }) => {
+                        if !overridden.contains(m.as_str()) {
+                            macros.remove(m);
+                        }
+                    }
+                    other => {
+                        return Err(Diagnostic::new(
+                            other.map_or(at, |a| a.span),
+                            "expected a macro name after `#undef`",
+                        ))
+                    }
                 }
+            }
+            "error" => {
+                let mut text = String::new();
+                for a in &args {
+                    if a.space_before && !text.is_empty() {
+                        text.push(' ');
+                    }
+                    text += &spelling(&a.tok);
+                }
+                return Err(Diagnostic::new(at, format!("`#error`: {text}")));
             }
             "pragma" => {}
             other => {
                 return Err(Diagnostic::new(
-                    hash_span.to(name_tok.span),
+                    at,
                     format!("the preprocessor directive `#{other}` is not supported; use `#define` and `-D` instead"),
                 ))
             }
         }
     }
+    if let Some(c) = conds.last() {
+        return Err(Diagnostic::new(
+            c.span,
+            "this conditional has no `#endif`: the file ends inside it",
+        ));
+    }
     out.extend(expander.expand(pending, &macros, next_id)?);
     Ok(out)
+}
+
+/// A token as the source spells it, near enough for `#error`'s message.
+fn spelling(t: &Tok) -> String {
+    match t {
+        Tok::Ident(s) => s.clone(),
+        Tok::Int(i) => i.to_string(),
+        Tok::Float { value, .. } => value.to_string(),
+        Tok::Str(s) => format!("\"{s}\""),
+        Tok::Punct(p) => p.to_string(),
+    }
+}
+
+/// Whether the expression of `#if` or `#elif` (`directive`, at `at`) is
+/// true: `defined` answered first, the rest macro-expanded, then
+/// evaluated as C does.
+fn if_value(
+    args: &[Token],
+    at: Span,
+    directive: &str,
+    macros: &HashMap<String, Macro>,
+    expander: &mut Expander,
+    ids: usize,
+) -> Result<bool, Diagnostic> {
+    // `defined X` and `defined(X)` are answered before expansion, so that
+    // X is not expanded.
+    let mut toks = Vec::with_capacity(args.len());
+    let mut i = 0;
+    while i < args.len() {
+        let t = &args[i];
+        if t.tok.is_ident("defined") {
+            let paren = args.get(i + 1).is_some_and(|p| p.tok.is_punct("("));
+            let k = i + 1 + usize::from(paren);
+            let closed = !paren || args.get(k + 1).is_some_and(|p| p.tok.is_punct(")"));
+            if let (
+                Some(Token {
+                    tok: Tok::Ident(m),
+                    span,
+                    ..
+                }),
+                true,
+            ) = (args.get(k), closed)
+            {
+                let end = if paren { args[k + 1].span } else { *span };
+                toks.push(Token {
+                    tok: Tok::Int(i64::from(macros.contains_key(m))),
+                    span: t.span.to(end),
+                    ..t.clone()
+                });
+                i = k + 1 + usize::from(paren);
+                continue;
+            }
+        }
+        toks.push(t.clone());
+        i += 1;
+    }
+    let toks = expander.expand(toks, macros, ids)?;
+    let v = super::ifexpr::eval(&toks, at, directive, &|m| macros.contains_key(m))?;
+    Ok(v != 0)
 }
 
 /// A `#define`'s name, parameters (for a function-like macro) and body.
@@ -243,9 +428,7 @@ fn check_include(span: Span, args: &[Token]) -> Result<(), Diagnostic> {
             _ => {}
         }
     }
-    if KNOWN_HEADERS.contains(&name.as_str())
-        || (angled && STANDARD_HEADERS.contains(&name.as_str()))
-    {
+    if KNOWN_HEADERS.contains(&name.as_str()) || STANDARD_HEADERS.contains(&name.as_str()) {
         Ok(())
     } else {
         let own = if angled {
@@ -256,7 +439,7 @@ fn check_include(span: Span, args: &[Token]) -> Result<(), Diagnostic> {
         Err(Diagnostic::new(
             span,
             format!(
-                "cannot include `{name}`: only lpfg's headers ({}) and the standard C and C++ headers (<string.h>, <cstdlib>, ...) are available{own}",
+                "cannot include `{name}`: only lpfg's headers ({}) and the standard C and C++ headers (<math.h>, <string.h>, <cstdlib>, ...) are available{own}",
                 KNOWN_HEADERS.join(", ")
             ),
         ))
@@ -489,19 +672,19 @@ impl Expander {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::syntax::lex::lex;
+    use crate::syntax::lex::{lex, lex_all};
     use crate::syntax::span::FileId;
 
     /// The expansion of `text`, tokens joined by spaces.
     fn expand(text: &str) -> Result<String, String> {
-        let toks = lex(FileId(0), text).map_err(|d| d.message)?;
+        let toks = lex_all(FileId(0), text).map_err(|d| d.message)?;
         let out = preprocess(toks, &[]).map_err(|d| d.message)?;
         let words: Vec<String> = out
             .iter()
             .map(|t| match &t.tok {
                 Tok::Ident(s) => s.clone(),
                 Tok::Int(i) => i.to_string(),
-                Tok::Float(f) => f.to_string(),
+                Tok::Float { value, .. } => value.to_string(),
                 Tok::Str(s) => format!("\"{s}\""),
                 Tok::Punct(p) => p.to_string(),
             })
@@ -546,6 +729,105 @@ mod tests {
         assert!(expand("#define F(x) x\nF(1, 2)")
             .unwrap_err()
             .contains("takes 1 argument(s) but 2 were given"));
+    }
+
+    /// Conditionals as C defines them: one group of each `#if` … `#endif`
+    /// is kept, the first whose condition is true, or the `#else`.
+    #[test]
+    fn conditionals_keep_one_group() {
+        let cases = [
+            ("#if 1\na\n#else\nb\n#endif", "a"),
+            ("#if 0\na\n#else\nb\n#endif", "b"),
+            (
+                "#if 0\na\n#elif 2 > 1\nb\n#elif 1\nc\n#else\nd\n#endif",
+                "b",
+            ),
+            ("#if 0\na\n#elif 0\nb\n#endif\nz", "z"),
+            ("#define N 3\n#if N * 2 == 6\nsix\n#endif", "six"),
+            (
+                "#define N 3\n#ifdef N\nyes\n#endif\n#ifndef N\nno\n#endif",
+                "yes",
+            ),
+            ("#ifdef N\nyes\n#else\nno\n#endif", "no"),
+            ("#define N\n#if defined(N) && !defined M\nok\n#endif", "ok"),
+            // Nested: the inner conditional of a skipped group is skipped
+            // whole, its `#else` included.
+            ("#if 0\n#if 1\na\n#else\nb\n#endif\n#else\nc\n#endif", "c"),
+            ("#if 1\n#if 0\na\n#elif 1\nb\n#endif\n#endif", "b"),
+            // `#undef` ends a definition.
+            (
+                "#define N 1\n#undef N\n#ifdef N\na\n#else\nb\n#endif\nN",
+                "b N",
+            ),
+            // A skipped group may hold anything, even what is no token, an
+            // unknown directive, an `#error` or a bad `#include`.
+            (
+                "#if 0\n`é 1abc \"\n#error no\n#include <windows.h>\n#foo\n#endif\nok",
+                "ok",
+            ),
+            ("#ifdef WIN32\n#include <windows.h>\n#endif\nok", "ok"),
+            // A definition continued with a backslash.
+            ("#define SUM(a, b) \\\n  a + \\\n  b\nSUM(1, 2)", "1 + 2"),
+            // A `#define` in a skipped group defines nothing.
+            (
+                "#if 0\n#define N 1\n#endif\n#ifdef N\nyes\n#else\nno\n#endif",
+                "no",
+            ),
+            // Directives inside a macro's arguments choose its tokens.
+            (
+                "#define F(x) [x]\nF(\n#if 1\na\n#else\nb\n#endif\n)",
+                "[ a ]",
+            ),
+        ];
+        for (text, want) in cases {
+            assert_eq!(expand(text).as_deref(), Ok(want), "{text}");
+        }
+    }
+
+    #[test]
+    fn conditional_errors() {
+        let cases = [
+            ("#if 1\na", "this conditional has no `#endif`"),
+            ("#if 0\n#if 1\n#endif", "this conditional has no `#endif`"),
+            ("#endif", "`#endif` without `#if`"),
+            ("#else", "`#else` without `#if`"),
+            ("#elif 1", "`#elif` without `#if`"),
+            ("#if 1\n#else\n#elif 1\n#endif", "`#elif` after `#else`"),
+            ("#if 1\n#else\n#else\n#endif", "`#else` after `#else`"),
+            ("#if\n#endif", "expected an expression after `#if`"),
+            ("#if 1 +\n#endif", "expected a number in `#if`"),
+            ("#if 1 / 0\n#endif", "division by zero in `#if`"),
+            ("#if 0\n#elif 2 % 0\n#endif", "division by zero in `#elif`"),
+            ("#ifdef\n#endif", "expected a macro name after `#ifdef`"),
+            ("#ifndef 3\n#endif", "expected a macro name after `#ifndef`"),
+            ("#undef", "expected a macro name after `#undef`"),
+            ("#error N is needed", "`#error`: N is needed"),
+            ("#if 1\n`\n#endif", "unexpected character"),
+            ("#if 0\n#else\n1abc\n#endif", "not a valid number"),
+        ];
+        for (text, want) in cases {
+            let e = expand(text).unwrap_err();
+            assert!(e.contains(want), "{text}: {e}");
+        }
+    }
+
+    /// `-D` overrides are defined for the conditionals and win over the
+    /// file's `#define` and `#undef`.
+    #[test]
+    fn overrides_meet_conditionals() {
+        let run = |text: &str, n: &str| {
+            let toks = lex_all(FileId(0), text).unwrap();
+            let over = vec![("N".to_string(), lex(FileId(1), n).unwrap())];
+            let out = preprocess(toks, &over).unwrap();
+            out.iter()
+                .map(|t| spelling(&t.tok))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        let text = "#ifndef N\n#define N 5\n#endif\n#if N > 4\nbig N\n#else\nsmall N\n#endif";
+        assert_eq!(run(text, "7"), "big 7");
+        assert_eq!(run(text, "2"), "small 2");
+        assert_eq!(run("#undef N\nN", "2"), "2");
     }
 
     /// Expansion is linear: a chain of 100,000 definitions, each naming

@@ -342,7 +342,7 @@ fn declarations_past_what_16_bits_number_are_refused() {
         (
             "modules.lsys",
             modules,
-            ":65448:8: error: more than 65447 modules are declared",
+            ":65447:8: error: more than 65446 modules are declared",
         ),
         (
             "fields.lsys",

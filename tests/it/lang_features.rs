@@ -452,6 +452,35 @@ fn printed_text_and_the_json_word_do_not_mix() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `End` runs after the final derivation step (manual §4.1) on every path
+/// a user takes: `derive` and `render` print what it prints. lpfg 9bf820d
+/// prints `end after 2 steps` for this program.
+#[test]
+fn end_runs_after_the_final_step_for_derive_and_render() {
+    let dir = std::env::temp_dir().join(format!("subgram-end-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("end.l");
+    std::fs::write(
+        &file,
+        "derivation length: 2;\nint n;\nmodule A;\nStart: { n = 0; }\nEndEach: { n = n + 1; }\n\
+         End: { printf(\"end after %d steps\\n\", n); }\nAxiom: A;\nA : { produce A F; }\n",
+    )
+    .unwrap();
+    let run = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+            .args(args)
+            .arg(&file)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    assert_eq!(run(&["derive"]), "end after 2 steps\nA F F\n");
+    assert_eq!(run(&["render", "-o", "end.png"]), "end after 2 steps\n");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 // ----- switch, character constants, C++ structs (issue 12, C++ forms) -----
 
 /// Fall-through, `break` leaving the switch, `continue` in a switch going
@@ -684,8 +713,8 @@ fn struct_values_without_constructors_and_scoped_enumerators() {
     );
 }
 
-/// The standard headers are accepted (their functions are built in); a
-/// program's own header is not.
+/// The standard headers are accepted (their functions are built in), in
+/// either form; a program's own header is not.
 #[test]
 fn standard_headers_are_accepted() {
     let headers = [
@@ -696,6 +725,12 @@ fn standard_headers_are_accepted() {
         let src = format!("#include <{h}>\nmodule A(float);\nAxiom: A(sqrt(4));\n");
         assert_eq!(run(&src), "A(2)", "{h}");
     }
+    // As in C, `"string.h"` finds the standard header when no file of
+    // the program has that name.
+    assert_eq!(
+        run("#include \"string.h\"\nmodule A(int);\nAxiom: A(strlen(\"abc\"));\n"),
+        "A(3)"
+    );
     let e = load_error("#include \"growth.h\"\nmodule A;\nAxiom: A;\n");
     assert!(
         e.contains("a program's own header files are not read"),

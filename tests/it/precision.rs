@@ -142,3 +142,19 @@ fn the_double_option_computes_floats_in_double() {
     assert!(run(&["--double"]).starts_with("B(2.0000000000000"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A literal with an `f` suffix is a `float`, as in C: `x * 3.3f` is a
+/// product of two floats, rounded to single precision, while `x * 3.3`
+/// is computed in double. (lpfg's translator refuses the suffix, so the
+/// expected values are C's, written out with Rust's `f32` and `f64`.)
+#[test]
+fn an_f_suffix_makes_a_float_literal() {
+    let src = "derivation length: 1;\nmodule A(double, double, float);\nAxiom: A(0, 0, 0);\n\
+               A(a, b, c) : { float x = 0.1f; produce A(x * 3.3f, x * 3.3, 1.f / 3.f + 1e-3f); }\n";
+    let x = 0.1f32;
+    let c = 1f32 / 3f32 + 1e-3f32;
+    assert_eq!(
+        words(src, Precision::Single),
+        format!("A({}, {}, {})", (x * 3.3f32) as f64, x as f64 * 3.3, c)
+    );
+}
