@@ -1458,21 +1458,29 @@ impl Compiler {
                 });
             }
             ast::Stmt::Return(value, span) => self.return_stmt(value.as_ref(), *span, scope, out),
-            ast::Stmt::Break(span) => {
-                if scope.loops == 0 && scope.switches == 0 {
-                    self.err(*span, "`break` is only allowed inside a loop or a `switch`");
-                    return;
-                }
-                out.push(St::Break);
-            }
-            ast::Stmt::Continue(span) => {
-                if scope.loops == 0 {
-                    self.err(*span, "`continue` is only allowed inside a loop");
-                    return;
-                }
-                out.push(St::Continue);
-            }
             ast::Stmt::Switch { value, body, span } => self.switch(value, body, *span, scope, out),
+            ast::Stmt::Break(_)
+            | ast::Stmt::Continue(_)
+            | ast::Stmt::Case(..)
+            | ast::Stmt::Default(_) => self.jump(s, scope, out),
+            ast::Stmt::Empty => {}
+        }
+    }
+
+    /// `break`, `continue`, and a `case` or `default` label found outside
+    /// a `switch`'s body. (Out of `stmt`, so that the frame of that
+    /// recursive function stays small.)
+    #[inline(never)]
+    fn jump(&mut self, s: &ast::Stmt, scope: &Scope, out: &mut Vec<St>) {
+        match s {
+            ast::Stmt::Break(span) if scope.loops == 0 && scope.switches == 0 => {
+                self.err(*span, "`break` is only allowed inside a loop or a `switch`")
+            }
+            ast::Stmt::Break(_) => out.push(St::Break),
+            ast::Stmt::Continue(span) if scope.loops == 0 => {
+                self.err(*span, "`continue` is only allowed inside a loop")
+            }
+            ast::Stmt::Continue(_) => out.push(St::Continue),
             ast::Stmt::Case(_, span) => self.err(
                 *span,
                 "a `case` label belongs directly in the body of a `switch`",
@@ -1481,7 +1489,7 @@ impl Compiler {
                 *span,
                 "a `default` label belongs directly in the body of a `switch`",
             ),
-            ast::Stmt::Empty => {}
+            _ => {}
         }
     }
 
@@ -1783,11 +1791,7 @@ impl Compiler {
                     return Some((Ex::Const(Value::Int(v)), Ty::Int));
                 }
                 if self.ambiguous_enums.contains(n) {
-                    self.err(
-                        span,
-                        format!("more than one struct declares an enumerator `{n}`: write `Struct::{n}`"),
-                    );
-                    return None;
+                    return self.ambiguous_enumerator(n, span);
                 }
                 let handle = match n.as_str() {
                     "NULL" => Some(0),
@@ -2196,10 +2200,7 @@ impl Compiler {
         if let Some(&id) = self.user_fn_names.get(n) {
             return self.user_call(id, name, args, span, scope);
         }
-        if let Some(ty) = self.struct_named(n) {
-            return self.ctor_call(ty, name, args, span, scope);
-        }
-        if let Some(r) = self.stdio_call(name, args, span, scope) {
+        if let Some(r) = self.ctor_or_stdio_call(name, args, span, scope) {
             return r;
         }
         // A functional cast: `float(x)`, `int(x)`.
@@ -3120,6 +3121,19 @@ impl Compiler {
         Ex::MakeStruct(parts)
     }
 
+    /// `A` that several structs declare: only `S::A` names it. (Out of
+    /// `expr_inner`, so that the frame of that recursive function stays
+    /// small.)
+    #[cold]
+    #[inline(never)]
+    fn ambiguous_enumerator(&mut self, n: &str, span: Span) -> Typed {
+        self.err(
+            span,
+            format!("more than one struct declares an enumerator `{n}`: write `Struct::{n}`"),
+        );
+        None
+    }
+
     /// The struct type that `name` names (not an array's typedef).
     fn struct_named(&self, name: &str) -> Option<Ty> {
         match self.struct_names.get(name) {
@@ -3458,6 +3472,23 @@ impl Compiler {
             span,
         };
         self.expr_inner(&cast, scope)
+    }
+
+    /// A struct's construction (`S(args)`) or one of C's standard I/O and
+    /// string functions; `None` for another name. (One call in `call`, so
+    /// that the frame of that recursive function stays small.)
+    #[inline(never)]
+    fn ctor_or_stdio_call(
+        &mut self,
+        name: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Option<Typed> {
+        if let Some(ty) = self.struct_named(&name.text) {
+            return Some(self.ctor_call(ty, name, args, span, scope));
+        }
+        self.stdio_call(name, args, span, scope)
     }
 
     /// C's standard I/O and string functions; `None` for another name.

@@ -1552,19 +1552,10 @@ impl<'t> Parser<'t> {
                     self.eat_punct(";");
                     return Ok(Stmt::Return(value, t.span));
                 }
-                "switch" => {
-                    self.pos += 1;
-                    return self.switch_stmt(t.span);
-                }
-                "case" => {
-                    self.pos += 1;
-                    let value = self.cond_expr()?;
-                    self.expect_punct(":", "after the `case` label's value")?;
-                    return Ok(Stmt::Case(value, t.span));
-                }
-                "default" if self.peek_at(1).is_some_and(|n| n.tok.is_punct(":")) => {
-                    self.pos += 2;
-                    return Ok(Stmt::Default(t.span));
+                "switch" | "case" | "default"
+                    if w != "default" || self.peek_at(1).is_some_and(|n| n.tok.is_punct(":")) =>
+                {
+                    return self.switch_part();
                 }
                 "break" | "continue" => {
                     self.pos += 1;
@@ -1590,11 +1581,16 @@ impl<'t> Parser<'t> {
         Ok(Stmt::Expr(e))
     }
 
-    /// switch := 'switch' expr ( '{' { stmt } '}' | { label } stmt ), from
-    /// after `switch`; labels are statements of the body. Out of
+    /// switch := 'switch' expr ( '{' { stmt } '}' | { label } stmt ), whose
+    /// labels are statements of the body; or one of those labels. Out of
     /// `stmt_inner`, so that its frame stays small.
     #[inline(never)]
-    fn switch_stmt(&mut self, span: Span) -> PResult<Stmt> {
+    fn switch_part(&mut self) -> PResult<Stmt> {
+        let span = self.bump().span;
+        if !self.toks[self.pos - 1].tok.is_ident("switch") {
+            self.pos -= 1;
+            return self.label();
+        }
         let value = self.expr()?;
         let mut body = Vec::new();
         if !self.peek_punct("{") {
@@ -1619,6 +1615,20 @@ impl<'t> Parser<'t> {
             body.push(self.stmt()?);
         }
         Ok(Stmt::Switch { value, body, span })
+    }
+
+    /// label := 'case' cond ':' | 'default' ':', a statement of a
+    /// `switch`'s body. Out of `stmt_inner`, so that its frame stays small.
+    #[inline(never)]
+    fn label(&mut self) -> PResult<Stmt> {
+        let t = self.bump();
+        if t.tok.is_ident("default") {
+            self.pos += 1;
+            return Ok(Stmt::Default(t.span));
+        }
+        let value = self.cond_expr()?;
+        self.expect_punct(":", "after the `case` label's value")?;
+        Ok(Stmt::Case(value, t.span))
     }
 
     fn stmt_or_end(&mut self) -> PResult<Stmt> {
