@@ -154,6 +154,9 @@ struct Compiler {
     ambiguous_enums: HashSet<String>,
     /// Each struct's constructors (user functions), by the struct's name.
     ctors: HashMap<String, Vec<u16>>,
+    /// Struct methods (user functions whose first parameter is the struct,
+    /// by reference), by the struct's number and the method's name.
+    methods: HashMap<(u16, String), u16>,
     /// The array types made so far, by element type and length.
     array_types: HashMap<(Ty, Option<usize>), u16>,
 }
@@ -353,6 +356,7 @@ impl Compiler {
             struct_enums: HashSet::new(),
             ambiguous_enums: HashSet::new(),
             ctors: HashMap::new(),
+            methods: HashMap::new(),
             array_types: HashMap::new(),
             single: false,
         }
@@ -626,6 +630,9 @@ impl Compiler {
                     });
                     for c in &body.ctors {
                         self.ctor_sig(name, c);
+                    }
+                    for m in &body.methods {
+                        self.method_sig(name, m);
                     }
                 }
                 Item::Typedef { ty, name } => {
@@ -2143,6 +2150,9 @@ impl Compiler {
         scope: &mut Scope,
     ) -> Typed {
         let (x, t) = self.expr(recv, scope)?;
+        if let (Ty::Struct(si), false) = (t, self.methods.is_empty()) {
+            return self.struct_method(si, recv, name, args, span, scope);
+        }
         if !t.is_vector() || !args.is_empty() {
             self.err(
                 name.span,
@@ -3063,7 +3073,167 @@ impl Compiler {
             frame_size: (scope.max as usize).max(sig.params.len()),
             end: Span::new(c.body.span.file, end.saturating_sub(1), end),
             result: Some(Ex::MakeStruct(slots.into_iter().map(Ex::Local).collect())),
+            this_back: None,
         })
+    }
+
+    /// A method of struct `s`: a user function `S::name` whose first
+    /// parameter is the struct, by reference; no overloads.
+    #[inline(never)]
+    fn method_sig(&mut self, s: &ast::Name, m: &ast::FunctionDef) {
+        let Some(&si) = self.struct_names.get(&s.text) else {
+            return;
+        };
+        let ret = match self.resolve_type(&m.ret) {
+            Some(_) if m.ret.pointer && m.ret.name == "char" => Ty::Str,
+            Some(_) if m.ret.pointer => {
+                self.err(m.ret.span, "a method cannot return a pointer here");
+                return;
+            }
+            Some(t) => t,
+            None => return,
+        };
+        let this = ast::Param {
+            ty: ast::TypeRef {
+                name: s.text.clone(),
+                span: s.span,
+                pointer: false,
+                reference: true,
+            },
+            name: None,
+            dims: Vec::new(),
+        };
+        let def = ast::FunctionDef {
+            params: std::iter::once(this)
+                .chain(m.params.iter().cloned())
+                .collect(),
+            ..m.clone()
+        };
+        let Some(params) = self.param_types(&def) else {
+            return;
+        };
+        let key = (si, m.name.text.clone());
+        if self.methods.contains_key(&key)
+            || self.struct_fields[si as usize].contains_key(&m.name.text)
+        {
+            self.err(
+                m.name.span,
+                format!(
+                    "struct `{}` already has a member `{}`; methods cannot be overloaded",
+                    s.text, m.name.text
+                ),
+            );
+            return;
+        }
+        if self.user_fns.len() >= MAX_USER_FUNCTIONS {
+            self.too_many(MAX_USER_FUNCTIONS, "functions", m.name.span);
+            return;
+        }
+        self.methods.insert(key, self.user_fns.len() as u16);
+        self.user_fns.push(UserSig {
+            name: format!("{}::{}", s.text, m.name.text),
+            params,
+            ret,
+            span: m.name.span,
+            defined: true,
+        });
+    }
+
+    /// A method's body: the struct is slot 0, the parameters follow; the
+    /// fields are locals, read from it first and written back to it when
+    /// the body ends, which the caller's variable then receives.
+    #[inline(never)]
+    fn method_body(&mut self, m: &ast::FunctionDef, id: u16) -> Option<Function> {
+        let sig = self.user_fns[id as usize].clone();
+        let Ty::Struct(si) = sig.params.first()?.0 else {
+            return None;
+        };
+        let body = m.body.as_ref()?;
+        let fields = self.structs[si as usize].fields.clone();
+        let mut scope = Scope {
+            ret: Some((sig.ret, sig.name.clone())),
+            ..Scope::default()
+        };
+        scope.reserve(sig.params.len());
+        let mut stmts = Vec::new();
+        let mut slots = Vec::with_capacity(fields.len());
+        for (k, (name, ty)) in fields.iter().enumerate() {
+            let slot = self.local(&mut scope, name, *ty, m.name.span);
+            stmts.push(St::Init(slot, Ex::Field(Box::new(Ex::Local(0)), k as u16)));
+            slots.push(slot);
+        }
+        scope.push();
+        for (k, p) in m.params.iter().enumerate() {
+            if let Some(n) = &p.name {
+                if scope.vars[fields.len()..].iter().any(|v| v.0 == n.text) {
+                    self.err(
+                        n.span,
+                        format!("the parameter name `{}` is used twice", n.text),
+                    );
+                }
+                scope.bind(&n.text, sig.params[k + 1].0, k as u16 + 1);
+            }
+        }
+        stmts.extend(self.block_stmts(&body.stmts, &mut scope));
+        let end = body.span.end as usize;
+        Some(Function {
+            name: sig.name.clone(),
+            params: sig.params.iter().map(|p| p.0).collect(),
+            ret: sig.ret,
+            body: stmts,
+            frame_size: (scope.max as usize).max(sig.params.len()),
+            end: Span::new(body.span.file, end.saturating_sub(1), end),
+            result: None,
+            this_back: Some(Ex::MakeStruct(slots.into_iter().map(Ex::Local).collect())),
+        })
+    }
+
+    /// `v.name(args)` on a struct `v`: its method `name`, `v` passed by
+    /// reference.
+    #[inline(never)]
+    fn struct_method(
+        &mut self,
+        si: u16,
+        recv: &ast::Expr,
+        name: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Typed {
+        let sname = self.structs[si as usize].name.clone();
+        let Some(&id) = self.methods.get(&(si, name.text.clone())) else {
+            self.err(
+                name.span,
+                format!("struct `{sname}` has no method `{}`", name.text),
+            );
+            return None;
+        };
+        let want = self.user_fns[id as usize].params.len() - 1;
+        if args.len() != want {
+            self.err(
+                span,
+                format!(
+                    "`{sname}::{}` takes {want} argument(s), but {} were given",
+                    name.text,
+                    args.len()
+                ),
+            );
+            return None;
+        }
+        if !matches!(
+            recv.kind,
+            ExprKind::Ident(_) | ExprKind::Field(..) | ExprKind::Index(..)
+        ) {
+            self.err(
+                recv.span,
+                "methods are called on a variable here (`leaf.area()`), not on a value made by an expression",
+            );
+            return None;
+        }
+        let all: Vec<ast::Expr> = std::iter::once(recv.clone())
+            .chain(args.iter().cloned())
+            .collect();
+        self.user_call(id, name, &all, span, scope)
     }
 
     /// The value a variable of type `ty` starts with when nothing
@@ -3265,6 +3435,7 @@ impl Compiler {
                 frame_size: s.params.len(),
                 end: s.span,
                 result: None,
+                this_back: None,
             })
             .collect();
         for item in &file.items {
@@ -3277,6 +3448,17 @@ impl Compiler {
                     });
                     if let Some(f) = id.and_then(|id| self.ctor_body(name, c, id).map(|f| (id, f)))
                     {
+                        out[f.0 as usize] = f.1;
+                    }
+                }
+                for m in &body.methods {
+                    let id = self.struct_names.get(&name.text).and_then(|&si| {
+                        self.methods
+                            .get(&(si, m.name.text.clone()))
+                            .copied()
+                            .filter(|&id| self.user_fns[id as usize].span == m.name.span)
+                    });
+                    if let Some(f) = id.and_then(|id| self.method_body(m, id).map(|f| (id, f))) {
                         out[f.0 as usize] = f.1;
                     }
                 }
@@ -3320,6 +3502,7 @@ impl Compiler {
                 frame_size: (scope.max as usize).max(sig.params.len()),
                 end: Span::new(body.span.file, end.saturating_sub(1), end),
                 result: None,
+                this_back: None,
             };
         }
         out

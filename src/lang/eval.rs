@@ -650,6 +650,9 @@ impl<'p> Interp<'p> {
                 _ => break,
             }
         }
+        if let Some(this) = &f.this_back {
+            cx.frame[0] = self.expr(this, &mut cx)?;
+        }
         if let Some(r) = &f.result {
             return self.expr(r, &mut cx);
         }

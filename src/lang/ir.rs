@@ -247,6 +247,10 @@ pub struct Function {
     /// A constructor's value, computed once its body has ended (it returns
     /// no value itself): the struct made of its fields' locals.
     pub result: Option<Ex>,
+    /// A method's struct, written back to its first parameter (by
+    /// reference) once its body has ended: the struct made of its fields'
+    /// locals.
+    pub this_back: Option<Ex>,
 }
 
 /// A checked, executable program.

@@ -108,6 +108,8 @@ pub struct StructBody {
     /// constants, also as `Struct::A`.
     pub enums: Vec<(Option<Name>, Enumerators)>,
     pub ctors: Vec<Ctor>,
+    /// Methods: functions whose body sees the fields by their names.
+    pub methods: Vec<FunctionDef>,
 }
 
 /// A C++ constructor: `S(float x) : v(x), n(2) { body }`.

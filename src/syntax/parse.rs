@@ -736,6 +736,7 @@ impl<'t> Parser<'t> {
     /// member := TYPE NAME dims {',' NAME dims} ';'
     ///         | 'enum' [NAME] '{' ... '}' [NAME {',' NAME}] ';'
     ///         | NAME '(' params ')' [':' NAME '(' args ')' {',' ...}] block   (a constructor)
+    ///         | TYPE NAME '(' params ')' ['const'] block   (a method)
     ///         | ('public' | 'private' | 'protected') ':'
     fn struct_body(&mut self, struct_name: Option<&str>) -> PResult<StructBody> {
         self.expect_punct("{", "to open the struct body")?;
@@ -784,11 +785,8 @@ impl<'t> Parser<'t> {
                 self.type_ref()?
             };
             if self.peek_at(1).is_some_and(|t| t.tok.is_punct("(")) {
-                let at = self.span_here();
-                return Err(Diagnostic::new(
-                    at,
-                    "methods in structs are not supported: write a function that takes the struct as a parameter",
-                ));
+                body.methods.push(self.method(ty)?);
+                continue;
             }
             loop {
                 let f = self.name("a field name")?;
@@ -801,6 +799,31 @@ impl<'t> Parser<'t> {
             self.expect_punct(";", "after the field declaration")?;
         }
         Ok(body)
+    }
+
+    /// method := TYPE NAME '(' params ')' ['const'] block   (the type is read)
+    fn method(&mut self, ret: TypeRef) -> PResult<FunctionDef> {
+        let name = self.name("the method's name")?;
+        self.pos += 1;
+        let params = self.params()?;
+        self.eat_ident("const");
+        if !self.peek_punct("{") {
+            return Err(Diagnostic::new(
+                self.span_here(),
+                format!(
+                    "expected the body of method `{}` here: methods are defined inside their struct",
+                    name.text
+                ),
+            ));
+        }
+        let body = self.block()?;
+        self.eat_punct(";");
+        Ok(FunctionDef {
+            ret,
+            name,
+            params,
+            body: Some(body),
+        })
     }
 
     /// constructor := NAME '(' params ')' [':' NAME '(' args ')' {',' NAME '(' args ')'}] block

@@ -777,3 +777,39 @@ fn default_constructors_build_arrays_and_fields() {
         "B(7, 0.5, 7, 0.5, 0.5) B(7, 0.5, 4, 0.5, 7) B(7, 0, 0, 0, 0)"
     );
 }
+
+/// Methods: the body reads and writes the fields by their names, and the
+/// variable it is called on keeps what it wrote (also an array element in
+/// a field); `const` after the parameters is accepted. By hand: p(3) has
+/// area 3 * 3 / 2 = 4.5; grow(1) and grow(0.5) make it 4.5 long and 2
+/// old, older(10) 12; its area is then 4.5 * 4.5 / 2 = 10.125. q.b[1]
+/// grows from 5 to 7 (age 1), whose area, 24.5, q.a grows by: 25.5;
+/// q.b[0] keeps 2. lpfg 9bf820d prints the same string.
+#[test]
+fn struct_methods_write_back_to_their_variable() {
+    let src = "struct Leaf {\n\
+                 float length;\n\
+                 int age;\n\
+                 float area() const { return length * length / 2; }\n\
+                 void grow(float by) { length += by; age++; }\n\
+                 int older(int years) { age = age + years; return age; }\n\
+                 Leaf(float l) : length(l), age(0) {}\n\
+               };\n\
+               struct Pair { Leaf a; Leaf b[2]; };\n\
+               module B(float, int, float, int, float);\n\
+               derivation length: 1;\n\
+               Axiom: B(0, 0, 0, 0, 0);\n\
+               B(x1, x2, x3, x4, x5) : {\n\
+                 Leaf p(3);\n\
+                 Pair q = { Leaf(1), { Leaf(2), Leaf(5) } };\n\
+                 float a0 = p.area();\n\
+                 p.grow(1);\n\
+                 p.grow(0.5);\n\
+                 int o = p.older(10);\n\
+                 q.b[1].grow(2);\n\
+                 q.a.grow(q.b[1].area());\n\
+                 produce B(p.length, p.age, a0, o, p.area()) \
+                   B(q.a.length, q.a.age, q.b[1].length, q.b[1].age, q.b[0].length);\n\
+               }\n";
+    assert_eq!(run(src), "B(4.5, 12, 4.5, 12, 10.125) B(25.5, 1, 7, 1, 2)");
+}
