@@ -72,11 +72,32 @@ impl DeriveArgs {
     }
 }
 
+/// What `derive` prints: the word (or the mesh's description) for standard
+/// output, and the checker's warnings for standard error.
+#[derive(Clone, Debug)]
+pub struct Printed {
+    pub text: String,
+    /// Each rendered with `file:line:col: warning:`, the line and a caret.
+    pub warnings: Vec<String>,
+}
+
 /// `subgram derive`: a curve's final word (or its interpretation) as text
-/// or JSON; for a surface grammar, the subdivided mesh's description.
-pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, Error> {
+/// or JSON; for a surface grammar, the subdivided mesh's description. The
+/// program's warnings come with it.
+pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<Printed, Error> {
     let deadline = a.timeout.map(Deadline::after);
     let system = load(&a.file, &load_options(&a.defines))?;
+    let warnings = system.warnings();
+    let text = derive_text(a, system, deadline, progress)?;
+    Ok(Printed { text, warnings })
+}
+
+fn derive_text(
+    a: &DeriveArgs,
+    system: System,
+    deadline: Option<Deadline>,
+    progress: impl FnMut(Progress),
+) -> Result<String, Error> {
     let opts = RunOptions {
         steps: a.steps,
         max_modules: a.max_modules,
@@ -162,8 +183,8 @@ impl RenderArgs {
 }
 
 /// `subgram render`: a curve's picture, a surface grammar's subdivided
-/// mesh, or a mesh file, as PNG or SVG.
-pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Error> {
+/// mesh, or a mesh file, as PNG or SVG. Returns the program's warnings.
+pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<String>, Error> {
     let deadline = a.timeout.map(Deadline::after);
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
@@ -175,10 +196,25 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
         wireframe: a.wireframe,
     };
     if mesh::io::Format::from_path(file).is_some() {
-        return write_mesh_picture(&load_mesh(file)?, output, &looks);
+        write_mesh_picture(&load_mesh(file)?, output, &looks)?;
+        return Ok(Vec::new());
     }
     let format = Picture::from_path(output)?;
-    match load(file, &load_options(&a.defines))? {
+    let system = load(file, &load_options(&a.defines))?;
+    let warnings = system.warnings();
+    render_system(a, system, (&looks, format), deadline, progress)?;
+    Ok(warnings)
+}
+
+fn render_system(
+    a: &RenderArgs,
+    system: System,
+    (looks, format): (&MeshLooks, Picture),
+    deadline: Option<Deadline>,
+    progress: impl FnMut(Progress),
+) -> Result<(), Error> {
+    let output = Path::new(&a.output);
+    match system {
         System::Surface(s) => {
             looks.check()?;
             let opts = RunOptions {

@@ -306,7 +306,16 @@ pub(crate) fn curve(front: Front) -> Result<Curve, Error> {
         }
     };
     match lang::compile(&file) {
-        Ok(program) => Ok(Curve { program, sources }),
+        Ok(mut program) => {
+            // What the turtle does not act on is said, not dropped.
+            program
+                .warnings
+                .extend(crate::draw::coverage::warnings(&program));
+            program
+                .warnings
+                .sort_by_key(|d| (d.span.file.0, d.span.start));
+            Ok(Curve { program, sources })
+        }
         Err(mut diagnostics) => {
             for d in &mut diagnostics {
                 if d.span == Span::default() {

@@ -346,7 +346,9 @@ fn run(cli: Cli) -> Result<(), Error> {
                 interpreted,
                 timeout: timeout.0,
             };
-            print_out(&with_progress(|p| command::derive(&args, p))?)
+            let printed = with_progress(|p| command::derive(&args, p))?;
+            print_warnings(&printed.warnings);
+            print_out(&printed.text)
         }
         Command::Render {
             file,
@@ -378,7 +380,8 @@ fn run(cli: Cli) -> Result<(), Error> {
                 timeout: timeout.0,
                 force,
             };
-            with_progress(|p| command::render(&args, p))
+            print_warnings(&with_progress(|p| command::render(&args, p))?);
+            Ok(())
         }
         Command::Subdivide {
             mesh,
@@ -495,6 +498,13 @@ fn with_progress<T>(f: impl FnOnce(&mut dyn FnMut(Progress)) -> T) -> T {
         b.finish_and_clear();
     }
     result
+}
+
+/// Writes a program's warnings to stderr, each followed by a blank line.
+fn print_warnings(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("{w}\n");
+    }
 }
 
 /// Writes a line to stdout; a closed pipe (`subgram derive f | head`) is not an error.

@@ -259,23 +259,38 @@ impl<'p> Derivation<'p> {
 
     /// lpfg's query modules (`GetPos`, `GetHead`, `GetLeft`, `GetUp`): when
     /// a production's predecessor mentions one, an interpretation step runs
-    /// after the axiom and after every step, and each query module in the
-    /// word receives the turtle's position (or heading, left, up vector)
-    /// at that point. The query modules of the word are matched in order to
-    /// those the turtle meets in the interpreted word, so interpretation
-    /// rules must not create or erase them.
+    /// after the axiom and after every step, and each query module of the
+    /// word that the turtle meets receives the turtle's position (or
+    /// heading, left, up vector) at that point. As in lpfg, the turtle
+    /// writes only into the word's own modules: a query module that an
+    /// interpretation rule rewrites keeps its parameters, and one that an
+    /// interpretation rule produces is answered in the interpreted word
+    /// alone.
     fn answer_queries(&mut self) -> Result<(), DeriveError> {
         let p = self.program;
         if !self.queries_used() {
             return Ok(());
         }
-        let shown = self.interpret()?;
+        // Which module of the word each interpreted module copies: a
+        // traced interpretation whose "axiom" is the word itself.
+        let depth = self.depth(Section::Interpretation)?;
+        let mut sources = Some((0..self.word.len()).map(Maker::Axiom).collect());
+        let shown = self.rewrite_to_depth(
+            Section::Interpretation,
+            self.word.clone(),
+            depth,
+            &mut sources,
+        )?;
+        let mut draw_opts = crate::draw::DrawOptions::default();
+        if let Some(a) = self.angle()? {
+            draw_opts.angle = a;
+        }
         let mut answers = Vec::new();
         crate::draw::draw_with_queries(
             &shown,
             &p.alphabet,
             &p.structs,
-            &crate::draw::DrawOptions::default(),
+            &draw_opts,
             Some(&mut answers),
         )
         .map_err(|e| DeriveError {
@@ -286,32 +301,22 @@ impl<'p> Derivation<'p> {
             ),
             step: self.step,
         })?;
-        let is_query = |s: Sym| crate::draw::is_query(p.alphabet.name(s));
-        let count = self.word.syms().iter().filter(|s| is_query(**s)).count();
-        if count != answers.len() {
-            return Err(DeriveError {
-                span: None,
-                message: format!(
-                    "at step {}, the word has {count} query modules but its interpretation has {}: interpretation rules must not create or erase GetPos, GetHead, GetLeft or GetUp",
-                    self.step,
-                    answers.len()
-                ),
-                step: self.step,
-            });
+        let sources = sources.unwrap_or_default();
+        let mut answer: Vec<Option<[f64; 3]>> = vec![None; self.word.len()];
+        for (j, v) in answers {
+            if let Some(Maker::Axiom(i)) = sources.get(j) {
+                answer[*i] = Some(v);
+            }
+        }
+        if answer.iter().all(Option::is_none) {
+            return Ok(());
         }
         let mut out = Word::new();
         out.reserve(self.word.len(), self.word.slot_count());
-        let mut k = 0;
-        for i in 0..self.word.len() {
-            let s = self.word.sym(i);
-            if is_query(s) && self.word.data(i).len() == 3 {
-                out.push_raw(s, &answers[k]);
-                k += 1;
-            } else {
-                if is_query(s) {
-                    k += 1;
-                }
-                out.push_from(&self.word, i);
+        for (i, a) in answer.iter().enumerate() {
+            match a {
+                Some(v) if self.word.data(i).len() == 3 => out.push_raw(self.word.sym(i), v),
+                _ => out.push_from(&self.word, i),
             }
         }
         self.word = out;
@@ -371,6 +376,7 @@ impl<'p> Derivation<'p> {
             phase: self.opts.phase,
             max_modules: self.opts.max_modules,
             deadline: self.opts.deadline,
+            cut: false,
         }
     }
 
@@ -392,7 +398,12 @@ impl<'p> Derivation<'p> {
         self.control(ControlKind::StartEach)?;
         self.env.current_group = self.env.next_group;
         let rules = self.candidates(Section::Productions);
-        let opts = self.step_options();
+        // Production steps cut branches; decomposition and interpretation
+        // do not (lpfg).
+        let opts = StepOptions {
+            cut: true,
+            ..self.step_options()
+        };
         let mut dst = std::mem::take(&mut self.spare);
         let step = self.step + 1;
         let mut origin = Vec::new();
