@@ -253,15 +253,16 @@ impl<'p> Derivation<'p> {
         }
         d.word = axiom;
         d.decompose()?;
-        d.answer_queries()?;
         Ok(d)
     }
 
     /// lpfg's query modules (`GetPos`, `GetHead`, `GetLeft`, `GetUp`): when
-    /// a production's predecessor mentions one, an interpretation step runs
-    /// after the axiom and after every step, and each query module of the
-    /// word that the turtle meets receives the turtle's position (or
-    /// heading, left, up vector) at that point. As in lpfg, the turtle
+    /// a rule's predecessor mentions one, an interpretation step runs at the
+    /// start of every derivation step, before `StartEach` (so on the axiom
+    /// and on every word but the last, as lpfg's "interpretation for the
+    /// environment" does), and each query module of the word that the
+    /// turtle meets receives the turtle's position (or heading, left, up
+    /// vector) at that point. As in lpfg, the turtle
     /// writes only into the word's own modules: a query module that an
     /// interpretation rule rewrites keeps its parameters, and one that an
     /// interpretation rule produces is answered in the interpreted word
@@ -323,15 +324,16 @@ impl<'p> Derivation<'p> {
         Ok(())
     }
 
+    /// True when a production, decomposition or interpretation rule of
+    /// any group has a query module in its strict predecessor or its
+    /// contexts (lpfg does not look at new contexts).
     fn queries_used(&self) -> bool {
         let p = self.program;
-        p.rules_of(Section::Productions).any(|(_, r)| {
-            r.new_left
+        p.rules.iter().any(|r| {
+            r.left
                 .iter()
-                .chain(&r.left)
                 .chain(&r.strict)
                 .chain(&r.right)
-                .chain(&r.new_right)
                 .any(|pat| crate::draw::is_query(p.alphabet.name(pat.sym)))
         })
     }
@@ -395,6 +397,7 @@ impl<'p> Derivation<'p> {
         if let Err(m) = crate::deadline::check(self.opts.deadline) {
             return Err(self.step_error(StepError::Timeout(m), self.step + 1));
         }
+        self.answer_queries()?;
         self.control(ControlKind::StartEach)?;
         self.env.current_group = self.env.next_group;
         let rules = self.candidates(Section::Productions);
@@ -427,7 +430,6 @@ impl<'p> Derivation<'p> {
         self.env.step = step as i64;
         self.step = step;
         self.decompose()?;
-        self.answer_queries()?;
         self.control(ControlKind::EndEach)?;
         Ok(())
     }
