@@ -16,8 +16,7 @@ fn gap(name: &str) -> Option<String> {
             "`{name}` is not drawn by subgram yet: {what} will be missing from the picture"
         ))
     };
-    let no_effect =
-        |why: &str| Some(format!("`{name}` has no effect in subgram yet: {why}"));
+    let no_effect = |why: &str| Some(format!("`{name}` has no effect in subgram yet: {why}"));
     match name {
         "Surface" | "Surface3" | "BSurface" | "DSurface" | "DBSurfaceS" | "DBSurfaceM" => {
             not_drawn("the surfaces it draws (leaves, petals)")
@@ -33,13 +32,15 @@ fn gap(name: &str) -> Option<String> {
             "`{name}`: subgram draws generalized cylinders (`StartGC` ... `EndGC`) as plain \
              lines, not as tubes"
         )),
-        "CurrentContour" | "BlendedContour" | "ScaleContour" | "ContourSides"
-        | "ContourNormal" => {
+        "CurrentContour" | "BlendedContour" | "ScaleContour" | "ContourSides" | "ContourNormal" => {
             no_effect("it shapes generalized cylinders, which subgram draws as plain lines")
         }
         "CurrentTexture" | "TextureVCoeff" => no_effect("subgram does not map textures"),
         "SetUPrecision" | "SetVPrecision" => no_effect("subgram does not draw surfaces yet"),
-        "Elasticity" | "SetElasticity" | "IncElasticity" | "DecElasticity"
+        "Elasticity"
+        | "SetElasticity"
+        | "IncElasticity"
+        | "DecElasticity"
         | "SetTropismDirection3f" => no_effect(
             "subgram does not apply tropisms (the view file's `tropism:` commands), \
              so branches that bend in lpfg stay straight",

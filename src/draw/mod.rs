@@ -35,7 +35,10 @@ pub enum Event {
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Cmd {
     None,
-    Forward { draw: bool, record: bool },
+    Forward {
+        draw: bool,
+        record: bool,
+    },
     MoveTo,
     MoveRel,
     LineTo,
@@ -139,7 +142,8 @@ impl Turtle {
         if h.length() < EPSILON || u.length() < EPSILON {
             return;
         }
-        let linear = |v: DVec3| -self.frame.x_axis * v.x + self.frame.y_axis * v.y + self.frame.z_axis * v.z;
+        let linear =
+            |v: DVec3| -self.frame.x_axis * v.x + self.frame.y_axis * v.y + self.frame.z_axis * v.z;
         let h = linear(h.normalize());
         let u = linear(u.normalize());
         let left = u.cross(h);
@@ -523,7 +527,13 @@ pub fn draw_with_queries(
                     vec![p + l * (a * 0.5), p + h * b, p - l * (a * 0.5)]
                 };
                 if points.iter().any(|q| !q.is_finite()) {
-                    return Err(beyond(word, i, alphabet, structs, "draws a shape that reaches"));
+                    return Err(beyond(
+                        word,
+                        i,
+                        alphabet,
+                        structs,
+                        "draws a shape that reaches",
+                    ));
                 }
                 out.push(Event::Polygon {
                     points,

@@ -234,3 +234,54 @@ fn an_output_that_is_an_input_is_refused_unless_forced() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Nothing silent (issue 12): a predefined module that subgram does not
+/// act on is a warning with its first place, from `check` on standard
+/// output and from `derive` and `render` on standard error, which still
+/// succeed. Modules the turtle draws are not warned about.
+#[test]
+fn modules_subgram_does_not_draw_are_warned_about_at_their_first_place() {
+    let dir = std::env::temp_dir().join(format!("subgram-cli-unsupported-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("leaf.lsys");
+    std::fs::write(
+        &file,
+        "module A(int);\nderivation length: 2;\nAxiom: A(1);\n\
+         A(x) : { produce F(1) SB() Left(30) Surface(0, 1) EB() E1(0) A(x+1); }\n\
+         interpretation:\nA(x) : { produce Surface(1, 2) Label(\"a\") F(1); }\n",
+    )
+    .unwrap();
+    let f = file.to_str().unwrap();
+    let check = subgram(&["check", f]);
+    assert!(check.status.success(), "{}", stderr(&check));
+    let out = stdout(&check);
+    let warned: Vec<&str> = out.lines().filter(|l| l.contains(": warning:")).collect();
+    assert_eq!(warned.len(), 3, "{out}");
+    // Surface first appears in the production (line 4, column 37), not in
+    // the interpretation rule.
+    assert!(
+        warned[0].starts_with(&format!(
+            "{f}:4:37: warning: `Surface` is not drawn by subgram yet"
+        )),
+        "{out}"
+    );
+    assert!(
+        warned[1].starts_with(&format!(
+            "{f}:4:56: warning: `E1` communicates with an environmental program"
+        )),
+        "{out}"
+    );
+    assert!(
+        warned[2].starts_with(&format!("{f}:6:32: warning: `Label` is not drawn")),
+        "{out}"
+    );
+    let derive = subgram(&["derive", f]);
+    assert!(derive.status.success(), "{}", stderr(&derive));
+    assert_eq!(stderr(&derive).matches(": warning:").count(), 3);
+    assert!(!stdout(&derive).contains("warning"));
+    let png = dir.join("leaf.png");
+    let render = subgram(&["render", f, "-o", png.to_str().unwrap()]);
+    assert!(render.status.success(), "{}", stderr(&render));
+    assert_eq!(stderr(&render).matches(": warning:").count(), 3);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -11,6 +11,7 @@ mod fuzz_replay;
 mod golden;
 mod golden_tests;
 mod limits;
+mod lpfg_semantics;
 mod lsystems;
 mod mesh;
 mod mesh_bounds;
