@@ -252,9 +252,28 @@ impl Compiler {
         for (i, f) in functions.iter().enumerate() {
             function_names.entry(f.name.clone()).or_insert(i);
         }
+        // lpfg's predefined structs come first, known by name like the
+        // user's.
+        let structs = super::value::predefined_structs();
+        let struct_names = structs
+            .iter()
+            .enumerate()
+            .map(|(i, d)| (d.name.clone(), i as u16))
+            .collect();
+        let struct_fields = structs
+            .iter()
+            .map(|d| {
+                d.fields
+                    .iter()
+                    .enumerate()
+                    .map(|(i, (n, _))| (n.clone(), i as u16))
+                    .collect()
+            })
+            .collect();
+        let struct_shapes = structs.iter().map(|d| (1 + d.fields.len(), 1)).collect();
         Compiler {
             alphabet: Alphabet::new(),
-            structs: Vec::new(),
+            structs,
             typedefs: HashMap::new(),
             globals: Vec::new(),
             global_names: HashMap::new(),
@@ -264,9 +283,9 @@ impl Compiler {
             functions: functions.into(),
             function_names,
             depth: 0,
-            struct_names: HashMap::new(),
-            struct_fields: Vec::new(),
-            struct_shapes: Vec::new(),
+            struct_names,
+            struct_fields,
+            struct_shapes,
             counts_reported: HashSet::new(),
             inlining: Vec::new(),
             inlined: 0,

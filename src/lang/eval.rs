@@ -649,7 +649,37 @@ impl<'p> Interp<'p> {
                 let _ = span;
                 Value::Void
             }
+            Func::Batch(b) => batch(b),
         })
+    }
+}
+
+/// What [`Func::Batch`] gives: see [`Batch`].
+fn batch(b: Batch) -> Value {
+    match b {
+        Batch::MouseStatus => Value::Struct(Box::new([
+            Value::Int(-1),
+            Value::Int(0),
+            Value::Int(0),
+            Value::V3(DVec3::ZERO),
+            Value::V3(DVec3::ZERO),
+            Value::V3(DVec3::ZERO),
+            Value::Bool(false),
+            Value::Bool(false),
+            Value::Bool(false),
+        ])),
+        Batch::MenuChoice => Value::Int(-1),
+        Batch::CameraPosition => Value::Struct(Box::new([
+            Value::V3(DVec3::Z),
+            Value::V3(DVec3::ZERO),
+            Value::V3(DVec3::NEG_Z),
+            Value::V3(DVec3::NEG_X),
+            Value::V3(DVec3::Y),
+            Value::Float(1.0),
+        ])),
+        Batch::ViewMin(_) => Value::Float(-1.0),
+        Batch::ViewMax(_) => Value::Float(1.0),
+        Batch::ViewScale => Value::Float(1.0),
     }
 }
 

@@ -87,10 +87,33 @@ pub enum Func {
     Stop,
     Ran,
     NoOp,
+    /// What lpfg's interactive functions give in a batch run: no mouse, no
+    /// menu choice, the default camera and view volume.
+    Batch(Batch),
     /// A built-in of the topology the program runs on, by its number in
     /// the topology's [`HostTable`](super::builtins::HostTable); the
     /// [`Host`](super::eval::Host) evaluates it.
     Host(u16),
+}
+
+/// lpfg's functions of the mouse, the menu and the views (manual 6.4,
+/// 6.5), as a run without a window answers them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Batch {
+    /// `GetMouseStatus()`: no view clicked (`viewNum` -1), no button down,
+    /// pushed or released, every position zero.
+    MouseStatus,
+    /// `UserMenuChoice()`: -1, no choice made.
+    MenuChoice,
+    /// `GetCameraPosition(view)`: lpfg's default view (`dir: 0 0 -1`,
+    /// `up: 0 1 0`): the camera at (0, 0, 1) looking at the origin, scale 1.
+    CameraPosition,
+    /// `vvXmin` … `vvZmin` (0, 1, 2: x, y, z): -1.
+    ViewMin(u8),
+    /// `vvXmax` … `vvZmax`: 1.
+    ViewMax(u8),
+    /// `vvScale`: 1.
+    ViewScale,
 }
 
 #[derive(Clone, Debug)]

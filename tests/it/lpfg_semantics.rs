@@ -221,3 +221,25 @@ fn frame_modules_turn_the_turtle_as_lpfg_does() {
         }
     }
 }
+
+#[test]
+fn a_batch_run_has_no_mouse_and_no_menu_choice() {
+    // The manual's SimpleDraw model (7.4): lines are drawn only while the
+    // left button is down. Without a window no button is ever pushed or
+    // down, so the cursor is copied and nothing is drawn. lpfg's batch mode
+    // cannot run it (GetMouseStatus needs a view); the values are those of
+    // lpfg's source when no view was clicked: viewNum -1, buttons false,
+    // and UserMenuChoice -1 when no item was chosen.
+    let simple_draw = "derivation length: 1;\nmodule Cursor();\nMouseStatus ms;\n\
+        StartEach: { ms = GetMouseStatus(); }\n\
+        Axiom: SetColor(2) SetWidth(0.3) Cursor();\n\
+        Cursor() : {\n  if(ms.lbPushed) produce MoveTo3d(ms.atMiddle) Cursor();\n\
+        if(ms.lbDown) produce LineTo3d(ms.atMiddle) Cursor();\n}\n";
+    assert_eq!(run(simple_draw), "SetColor(2) SetWidth(0.3) Cursor");
+    let menu = "derivation length: 1;\nmodule C(int, int, int);\nint choice;\nMouseStatus ms;\n\
+        Start: { UserMenuItem(\"First menu item\", 1); UserMenuItem(\"Second\", 2); }\n\
+        StartEach: { choice = UserMenuChoice(); ms = GetMouseStatus(); }\n\
+        Axiom: C(0, 0, 0);\n\
+        C(a, b, c) : { produce C(choice, ms.viewNum, ms.lbReleased); }\n";
+    assert_eq!(run(menu), "C(-1, -1, 0)");
+}
