@@ -201,8 +201,14 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<Stri
     }
     let format = Picture::from_path(output)?;
     let system = load(file, &load_options(&a.defines))?;
-    let warnings = system.warnings();
-    render_system(a, system, (&looks, format), deadline, progress)?;
+    let mut warnings = system.warnings();
+    warnings.extend(render_system(
+        a,
+        system,
+        (&looks, format),
+        deadline,
+        progress,
+    )?);
     Ok(warnings)
 }
 
@@ -212,7 +218,7 @@ fn render_system(
     (looks, format): (&MeshLooks, Picture),
     deadline: Option<Deadline>,
     progress: impl FnMut(Progress),
-) -> Result<(), Error> {
+) -> Result<Vec<String>, Error> {
     let output = Path::new(&a.output);
     match system {
         System::Surface(s) => {
@@ -223,7 +229,8 @@ fn render_system(
                 ..RunOptions::default()
             };
             let run = s.subdivide(&opts, progress)?;
-            write_mesh_picture(&run.mesh, output, &looks)
+            write_mesh_picture(&run.mesh, output, looks)?;
+            Ok(Vec::new())
         }
         System::Curve(c) => {
             let view = match a.view.as_deref().unwrap_or("xy") {
@@ -256,7 +263,8 @@ fn render_system(
                     ..Default::default()
                 },
             };
-            write_picture(&c.figure(&figure)?, output, format)
+            let figures = c.figures(&figure)?;
+            write_views(&figures, Path::new(&a.file), output, format, a.force)
         }
     }
 }
@@ -548,6 +556,55 @@ impl Picture {
 /// Draws `scene` in `format` and writes it to `path` whole, or not at all.
 pub fn write_picture(scene: &Scene, path: &Path, format: Picture) -> Result<(), Error> {
     write_file(path, &picture_bytes(scene, format)?)
+}
+
+/// Writes the main view to `output` and each other view that the view
+/// file names to `OUTPUT-NAME.EXT` beside it, all or none. Returns a
+/// warning for each view that `UseView` activated and the view file does
+/// not define (lpfg ignores those too).
+fn write_views(
+    figures: &crate::Figures,
+    program: &Path,
+    output: &Path,
+    format: Picture,
+    force: bool,
+) -> Result<Vec<String>, Error> {
+    let names = crate::load::window_names(program);
+    let mut files: Vec<(PathBuf, Vec<u8>)> =
+        vec![(output.to_path_buf(), picture_bytes(&figures.main, format)?)];
+    let mut warnings = Vec::new();
+    for (view, scene) in &figures.views {
+        let name = usize::try_from(*view)
+            .ok()
+            .and_then(|v| names.get(v))
+            .filter(|n| crate::load::is_identifier(n));
+        let Some(name) = name else {
+            warnings.push(format!(
+                "{}: warning: `UseView({view})`: the view file defines no view {view}, so it is not drawn",
+                program.display()
+            ));
+            continue;
+        };
+        files.push((view_path(output, name), picture_bytes(scene, format)?));
+    }
+    let outputs: Vec<&Path> = files.iter().map(|(p, _)| p.as_path()).collect();
+    refuse_overwrite(&outputs, &[program], force)?;
+    let all: Vec<(&Path, &[u8])> = files
+        .iter()
+        .map(|(p, b)| (p.as_path(), b.as_slice()))
+        .collect();
+    crate::atomic::write_all_atomic(&all).map_err(|(path, e)| Error::write(path, e))?;
+    Ok(warnings)
+}
+
+/// `out.png` and view `Top`: `out-Top.png`, in the same folder.
+fn view_path(output: &Path, name: &str) -> PathBuf {
+    let stem = output.file_stem().unwrap_or_default().to_string_lossy();
+    let file = match output.extension() {
+        Some(ext) => format!("{stem}-{name}.{}", ext.to_string_lossy()),
+        None => format!("{stem}-{name}"),
+    };
+    output.with_file_name(file)
 }
 
 /// `scene` drawn in `format`.

@@ -130,8 +130,18 @@ impl Curve {
         .to_string()
     }
 
-    /// Derives, interprets and lays out the program's picture.
+    /// Derives, interprets and lays out the program's picture: its main
+    /// view (see [`Curve::figures`] for the others).
     pub fn figure(&self, opts: &FigureOptions) -> Result<render::Scene, Error> {
+        Ok(self.figures(opts)?.main)
+    }
+
+    /// Derives once and lays out the picture of every view: the main view
+    /// (the interpretation rules outside any `vgroup`), and each view that
+    /// `UseView` activated (the rules after its `vgroup`), in the order of
+    /// their first `UseView`. With `each`, a view activated after the first
+    /// step has panels from that step on.
+    pub fn figures(&self, opts: &FigureOptions) -> Result<Figures, Error> {
         check_steps(opts.derive.steps)?;
         let p = &self.program;
         let fail = |e| self.error(e);
@@ -140,15 +150,25 @@ impl Curve {
         if let Some(a) = d.angle().map_err(fail)? {
             draw_opts.angle = a;
         }
-        let mut panels = Vec::new();
+        // Each view's panels, the main view's first.
+        let mut panels: Vec<(i64, Vec<Vec<Event>>)> = vec![(0, Vec::new())];
         let mut panel = |d: &mut Derivation| -> Result<(), Error> {
-            let word = d.interpret().map_err(fail)?;
-            let step = d.step;
-            let events = draw::draw(&word, &p.alphabet, &p.structs, &draw_opts).map_err(|e| {
-                let maker = (e.module).and_then(|m| self.maker_in_figure(opts, step, &word, m));
-                self.draw_error(e, step, maker)
-            })?;
-            panels.push(events);
+            let others: Vec<i64> = d.views().iter().copied().filter(|v| *v != 0).collect();
+            for view in std::iter::once(0).chain(others) {
+                let word = d.interpret_view(view).map_err(fail)?;
+                let step = d.step;
+                let events =
+                    draw::draw(&word, &p.alphabet, &p.structs, &draw_opts).map_err(|e| {
+                        let maker = (e.module)
+                            .filter(|_| view == 0)
+                            .and_then(|m| self.maker_in_figure(opts, step, &word, m));
+                        self.draw_error(e, step, maker)
+                    })?;
+                match panels.iter_mut().find(|(v, _)| *v == view) {
+                    Some((_, list)) => list.push(events),
+                    None => panels.push((view, vec![events])),
+                }
+            }
             Ok(())
         };
         if opts.each {
@@ -163,8 +183,24 @@ impl Curve {
         if !opts.each {
             panel(&mut d)?;
         }
-        Ok(render::scene(&panels, &opts.render)?)
+        let mut scenes = Vec::with_capacity(panels.len());
+        for (view, list) in &panels {
+            scenes.push((*view, render::scene(list, &opts.render)?));
+        }
+        let (_, main) = scenes.remove(0);
+        Ok(Figures {
+            main,
+            views: scenes,
+        })
     }
+}
+
+/// The pictures of a program's views (manual 7.3): the main one, and one
+/// per view that `UseView` activated, by view number.
+#[derive(Clone, Debug)]
+pub struct Figures {
+    pub main: render::Scene,
+    pub views: Vec<(i64, render::Scene)>,
 }
 
 /// More steps than this are refused before a derivation starts.

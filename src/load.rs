@@ -48,13 +48,62 @@ pub fn load(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<System, Error>
 
 fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
     let text = read(path)?;
-    let front = front(&path.display().to_string(), text, &opts.defines)?;
+    // The view names of the view file are numbers to the program, as lpfg
+    // defines them; `-D` comes after, so it wins.
+    let mut defines: Vec<String> = window_names(path)
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| is_identifier(n))
+        .map(|(i, n)| format!("{n}={i}"))
+        .collect();
+    defines.extend(opts.defines.iter().cloned());
+    let front = front(&path.display().to_string(), text, &defines)?;
     if surface::is_surface(&front.tokens) {
         let grammar = surface::from_front(front)?;
         Ok(System::Surface(Surface::new(grammar, Some(path))))
     } else {
         Ok(System::Curve(curve(front)?))
     }
+}
+
+/// The views of the view file (`*.v`, the first by name) beside the
+/// program at `path`, by number: the names of its `window:` commands in
+/// order (manual 8.1.1), after an unnamed view 0 when a `view:` command
+/// comes before the first window (lpfg's numbering). Empty without a view
+/// file. A minimal reading of the view file, for view names only.
+pub fn window_names(path: &Path) -> Vec<String> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut files: Vec<_> = entries
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "v") && p.is_file())
+        .collect();
+    files.sort();
+    let Some(text) = files.first().and_then(|f| std::fs::read_to_string(f).ok()) else {
+        return Vec::new();
+    };
+    let mut names = Vec::new();
+    for line in text.lines() {
+        let line = line.split("//").next().unwrap_or("").trim();
+        if let Some(rest) = line.strip_prefix("window:") {
+            names.push(rest.split_whitespace().next().unwrap_or("").to_string());
+        } else if line.starts_with("view:") && names.is_empty() {
+            names.push(String::new());
+        }
+    }
+    names
+}
+
+/// True for a C identifier: a view name the program can use.
+pub(crate) fn is_identifier(name: &str) -> bool {
+    name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && name.chars().next().is_some_and(|c| !c.is_ascii_digit())
 }
 
 /// Checks program text, as [`load`] does a file; `name` is the file name in

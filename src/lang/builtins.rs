@@ -278,6 +278,13 @@ pub static LIBRARY: &[Builtin] = &[
         Batch::CameraPosition,
         Ty::Struct(CAMERA_POSITION)
     ),
+    Builtin {
+        name: "UseView",
+        resolve: |a| {
+            numbers(a, 1)?;
+            Ok((Func::UseView, Ty::Void))
+        },
+    },
     view!("vvXmin", Batch::ViewMin(0), Ty::Float),
     view!("vvYmin", Batch::ViewMin(1), Ty::Float),
     view!("vvZmin", Batch::ViewMin(2), Ty::Float),

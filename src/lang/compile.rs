@@ -631,6 +631,7 @@ impl Compiler {
         };
         let mut section = Section::Productions;
         let mut group = 0i64;
+        let mut vgroup = 0i64;
         let mut filter = Filter::All;
         let mut axiom_seen = false;
         for item in &file.items {
@@ -696,15 +697,18 @@ impl Compiler {
                 Item::Section { section: s, .. } => {
                     section = *s;
                     group = 0;
+                    vgroup = 0;
                 }
                 Item::Group { id, .. } => group = *id,
+                Item::VGroup { id, .. } => vgroup = *id,
                 Item::Control { kind, body, .. } => {
                     let mut scope = Scope::default();
                     let stmts = self.block_stmts(&body.stmts, &mut scope);
                     program.control.push((*kind, stmts, scope.max as usize));
                 }
                 Item::Production(p) => {
-                    if let Some(rule) = self.rule(p, section, group, &filter) {
+                    if let Some(mut rule) = self.rule(p, section, group, &filter) {
+                        rule.vgroup = vgroup;
                         program.rules.push(rule);
                     }
                 }
@@ -925,6 +929,7 @@ impl Compiler {
             frame_size: scope.max as usize,
             section,
             group,
+            vgroup: 0,
             span: p.span,
             label,
             stencil: None,

@@ -25,7 +25,13 @@ pub struct Env {
     pub forward: bool,
     pub stop: bool,
     pub rng: u64,
+    /// The views `UseView` activated, in the order of their first call,
+    /// each once (at most [`MAX_VIEWS`]).
+    pub views: Vec<i64>,
 }
+
+/// More views than this are not recorded.
+pub const MAX_VIEWS: usize = 64;
 
 impl Env {
     pub fn new(globals: Vec<Value>) -> Env {
@@ -37,6 +43,7 @@ impl Env {
             forward: true,
             stop: false,
             rng: 0x9E37_79B9_7F4A_7C15,
+            views: Vec::new(),
         }
     }
 }
@@ -619,6 +626,13 @@ impl<'p> Interp<'p> {
             Func::StepNo => Value::Int(cx.env.step),
             Func::UseGroup => {
                 cx.env.next_group = vals[0].as_i64();
+                Value::Void
+            }
+            Func::UseView => {
+                let v = vals[0].as_i64();
+                if !cx.env.views.contains(&v) && cx.env.views.len() < MAX_VIEWS {
+                    cx.env.views.push(v);
+                }
                 Value::Void
             }
             Func::CurrentGroup => Value::Int(cx.env.current_group),

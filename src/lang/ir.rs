@@ -80,6 +80,8 @@ pub enum Func {
     Cross,
     StepNo,
     UseGroup,
+    /// `UseView(v)`: view `v` is drawn too.
+    UseView,
     CurrentGroup,
     Forward,
     Backward,
@@ -199,6 +201,8 @@ pub struct Rule {
     pub frame_size: usize,
     pub section: Section,
     pub group: i64,
+    /// The view (`vgroup`) of an interpretation rule; 0 for the main view.
+    pub vgroup: i64,
     pub span: Span,
     /// The rule as written, for messages: `P(vl) < P(v) > P(vr)`.
     pub label: String,

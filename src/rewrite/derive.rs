@@ -144,6 +144,9 @@ pub struct Derivation<'p> {
     opts: DeriveOptions,
     /// For a traced derivation, what made each module of the word.
     makers: Option<Vec<Maker>>,
+    /// The view whose interpretation rules (`vgroup`) interpretation uses:
+    /// 0, the main view, but while [`Derivation::interpret_view`] runs.
+    view: i64,
 }
 
 impl<'p> Derivation<'p> {
@@ -231,6 +234,7 @@ impl<'p> Derivation<'p> {
             step: 0,
             opts,
             makers: None,
+            view: 0,
         };
         d.control(ControlKind::Start)?;
         if let Some(m) = program.axiom.get(d.opts.max_modules) {
@@ -351,22 +355,19 @@ impl<'p> Derivation<'p> {
         Ok(())
     }
 
-    /// The rules of `section` usable now: the current group's, then group 0's.
+    /// The rules of `section` usable now: the current group's, then group
+    /// 0's; for interpretation, only those of the view being drawn.
     fn candidates(&self, section: Section) -> Vec<usize> {
         let g = self.env.current_group;
-        let mut v: Vec<usize> = self
-            .program
-            .rules_of(section)
-            .filter(|(_, r)| r.group == g)
-            .map(|(i, _)| i)
-            .collect();
+        let view = self.view;
+        let of = |group: i64| {
+            self.program.rules_of(section).filter(move |(_, r)| {
+                r.group == group && (section != Section::Interpretation || r.vgroup == view)
+            })
+        };
+        let mut v: Vec<usize> = of(g).map(|(i, _)| i).collect();
         if g != 0 {
-            v.extend(
-                self.program
-                    .rules_of(section)
-                    .filter(|(_, r)| r.group == 0)
-                    .map(|(i, _)| i),
-            );
+            v.extend(of(0).map(|(i, _)| i));
         }
         v
     }
@@ -570,6 +571,20 @@ impl<'p> Derivation<'p> {
     /// The word after interpretation rules: what the turtle draws.
     pub fn interpret(&mut self) -> Result<Word, DeriveError> {
         Ok(self.interpret_traced()?.0)
+    }
+
+    /// The word after the interpretation rules of view `view` (those after
+    /// `vgroup view:`; view 0 is the main view, [`Derivation::interpret`]).
+    pub fn interpret_view(&mut self, view: i64) -> Result<Word, DeriveError> {
+        self.view = view;
+        let word = self.interpret();
+        self.view = 0;
+        word
+    }
+
+    /// The views `UseView` activated so far, in order.
+    pub fn views(&self) -> &[i64] {
+        &self.env.views
     }
 
     /// [`Derivation::interpret`], with what made each module of the

@@ -285,3 +285,53 @@ fn modules_subgram_does_not_draw_are_warned_about_at_their_first_place() {
     assert_eq!(stderr(&render).matches(": warning:").count(), 3);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Views (manual 7.3): `UseView` activates the views that the view file's
+/// `window:` commands name (numbered from 0 in their order, so `Top` is
+/// view 0, the main view), and the rules after `vgroup Side:` interpret
+/// the word for `Side` only. `-o out.svg` writes the main view to out.svg
+/// and view `Side` to out-Side.svg; a view the view file does not define
+/// is a warning and no file.
+#[test]
+fn every_view_is_drawn_to_its_own_file() {
+    let dir = std::env::temp_dir().join(format!("subgram-cli-views-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("view.v"),
+        "window: Top 0.0 0.0 1.0 0.5\nwindow: Side 0.0 0.5 0.5 0.5\n",
+    )
+    .unwrap();
+    let file = dir.join("lsystem.l");
+    std::fs::write(
+        &file,
+        "module A(int);\nderivation length: 2;\n\
+         Start: { UseView(Top); UseView(Side); UseView(7); }\nAxiom: A(1);\n\
+         A(x) : { produce F(1) SB() Left(45) A(x+1) EB() A(x+1); }\n\
+         interpretation:\nvgroup Side:\nA(x) : { produce Circle(0.3); }\nendvgroup\n",
+    )
+    .unwrap();
+    let out = dir.join("out.svg");
+    let o = subgram(&[
+        "render",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("`UseView(7)`: the view file defines no view 7, so it is not drawn")
+    );
+    let main = std::fs::read_to_string(&out).unwrap();
+    let side = std::fs::read_to_string(dir.join("out-Side.svg")).unwrap();
+    // Two steps of A -> F [+A] A: three segments F; the four A modules
+    // are circles in Side only.
+    assert_eq!(svg_counts(&main), (3, 0, 0));
+    assert_eq!(svg_counts(&side), (3, 4, 0));
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["lsystem.l", "out-Side.svg", "out.svg", "view.v"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
