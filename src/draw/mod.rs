@@ -416,14 +416,19 @@ pub fn draw_with_queries(
                 } else {
                     t.pos + t.frame.place(point())
                 };
-                if t.pos.distance(to) >= 1e-5 {
+                // lpfg ignores a line shorter than epsilon; a drawn one
+                // moves as `F` does, and so records a polygon vertex.
+                if t.pos.distance(to) >= EPSILON {
                     out.push(Event::Line {
                         a: t.pos,
                         b: to,
                         pen: t.pen,
                     });
+                    t.pos = to;
+                    if let Some(p) = polygons.last_mut() {
+                        p.push(to);
+                    }
                 }
-                t.pos = to;
             }
             Cmd::Line => {
                 let (a, b) = if d.len() == 4 {
@@ -436,6 +441,9 @@ pub fn draw_with_queries(
                 if a.distance(b) >= EPSILON {
                     out.push(Event::Line { a, b, pen: t.pen });
                     t.pos = b;
+                    if let Some(p) = polygons.last_mut() {
+                        p.push(b);
+                    }
                 }
             }
             Cmd::Turn(axis, sign) => t.turn(axis, sign * arg(0, opts.angle)),

@@ -246,8 +246,8 @@ pub static LIBRARY: &[Builtin] = &[
     nullary!("RunSimulation", Func::NoOp, Ty::Void),
     nullary!("PauseSimulation", Func::NoOp, Ty::Void),
     nullary!("DisplayFrame", Func::NoOp, Ty::Void),
-    nullary!("Environment", Func::NoOp, Ty::Void),
-    nullary!("NoEnvironment", Func::NoOp, Ty::Void),
+    nullary!("Environment", Func::Environment(true), Ty::Void),
+    nullary!("NoEnvironment", Func::Environment(false), Ty::Void),
     Builtin {
         name: "UseGroup",
         resolve: |a| {

@@ -28,6 +28,8 @@ pub struct Env {
     /// The views `UseView` activated, in the order of their first call,
     /// each once (at most [`MAX_VIEWS`]).
     pub views: Vec<i64>,
+    /// False after `NoEnvironment()`: query modules are not answered.
+    pub environment: bool,
 }
 
 /// More views than this are not recorded.
@@ -44,6 +46,7 @@ impl Env {
             stop: false,
             rng: 0x9E37_79B9_7F4A_7C15,
             views: Vec::new(),
+            environment: true,
         }
     }
 }
@@ -633,6 +636,10 @@ impl<'p> Interp<'p> {
                 if !cx.env.views.contains(&v) && cx.env.views.len() < MAX_VIEWS {
                     cx.env.views.push(v);
                 }
+                Value::Void
+            }
+            Func::Environment(on) => {
+                cx.env.environment = on;
                 Value::Void
             }
             Func::CurrentGroup => Value::Int(cx.env.current_group),

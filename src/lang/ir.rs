@@ -82,6 +82,10 @@ pub enum Func {
     UseGroup,
     /// `UseView(v)`: view `v` is drawn too.
     UseView,
+    /// `Environment()` (true) or `NoEnvironment()`: whether the
+    /// interpretation that answers query modules runs before the next
+    /// steps (manual 6.1.3).
+    Environment(bool),
     CurrentGroup,
     Forward,
     Backward,

@@ -266,14 +266,14 @@ impl<'p> Derivation<'p> {
     /// and on every word but the last, as lpfg's "interpretation for the
     /// environment" does), and each query module of the word that the
     /// turtle meets receives the turtle's position (or heading, left, up
-    /// vector) at that point. As in lpfg, the turtle
+    /// vector) at that point, unless `NoEnvironment()` was called. As in lpfg, the turtle
     /// writes only into the word's own modules: a query module that an
     /// interpretation rule rewrites keeps its parameters, and one that an
     /// interpretation rule produces is answered in the interpreted word
     /// alone.
     fn answer_queries(&mut self) -> Result<(), DeriveError> {
         let p = self.program;
-        if !self.queries_used() {
+        if !self.env.environment || !self.queries_used() {
             return Ok(());
         }
         // Which module of the word each interpreted module copies: a

@@ -243,3 +243,83 @@ fn a_batch_run_has_no_mouse_and_no_menu_choice() {
         C(a, b, c) : { produce C(choice, ms.viewNum, ms.lbReleased); }\n";
     assert_eq!(run(menu), "C(-1, -1, 0)");
 }
+
+#[test]
+fn no_environment_stops_the_answers_to_queries() {
+    // Manual 6.1.3: NoEnvironment() turns the interpretation for the
+    // environment off, and query modules are answered by that
+    // interpretation. lpfg 9bf820d gives `F(1) GetPos(0,0,0)`; without the
+    // call, GetPos(0,1,0).
+    let src = "derivation length: 2;\nStart: { NoEnvironment(); }\n\
+               Axiom: F(1) GetPos(0,0,0);\nGetPos(x,y,z) : { produce GetPos(x,y,z); }\n";
+    assert_eq!(run(src), "F(1) GetPos(0, 0, 0)");
+    assert_eq!(
+        run(&src.replace("Start: { NoEnvironment(); }\n", "")),
+        "F(1) GetPos(0, 1, 0)"
+    );
+}
+
+#[test]
+fn line_modules_record_polygon_vertices_as_f_does() {
+    // lpfg draws LineTo and LineRel as a turn and an F, so inside SP() ...
+    // EP() each end is a vertex; a LineTo to where the turtle stands
+    // (shorter than epsilon, manual 5.1) is ignored. lpfg 9bf820d draws
+    // the two triangles (1,0) (1,1) (0,1) and (5,5) (6,5) (6,6) for this
+    // axiom (its picture, read by eye).
+    let src = "derivation length: 0;\n\
+        Axiom: SP() LineTo(1,0,0) LineTo(1,1,0) LineTo(0,1,0) EP() \
+        SP() MoveTo(5,5,0) LineTo(5,5,0) PP() LineRel3f(V3f(1,0,0)) LineRel3f(V3f(0,1,0)) EP();\n";
+    let l = load_text(src);
+    let mut run = l.run(DeriveOptions::default()).unwrap();
+    let polygons: Vec<Vec<[f64; 2]>> = run
+        .events()
+        .unwrap()
+        .into_iter()
+        .filter_map(|e| match e {
+            subgram::draw::Event::Polygon { points, .. } => {
+                Some(points.iter().map(|p| [p.x, p.y]).collect())
+            }
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        polygons,
+        [
+            vec![[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+            vec![[5.0, 5.0], [6.0, 5.0], [6.0, 6.0]]
+        ]
+    );
+}
+
+#[test]
+fn rhombus_and_triangle_are_polygons_in_the_hl_plane() {
+    // Manual 5.6: the turtle at the middle of the bottom edge, in the
+    // plane of heading and left. lpfg's OpenGL turtle draws
+    // Rhombus(length a, width b) through P, P + aH/2 + bL/2, P + aH,
+    // P + aH/2 - bL/2, and Triangle(width a, height b) through P + aL/2,
+    // P + bH, P - aL/2. lpfg 9bf820d's picture of these two (moved apart
+    // by MoveTo(3,0,0)) shows an upright rhombus 1 wide and 2 long and a
+    // triangle of base 4 and height 3. With H = +y and L = -x at the
+    // origin:
+    let src = "derivation length: 0;\nAxiom: Rhombus(2, 1) Triangle(4, 3);\n";
+    let l = load_text(src);
+    let mut run = l.run(DeriveOptions::default()).unwrap();
+    let polygons: Vec<Vec<[f64; 2]>> = run
+        .events()
+        .unwrap()
+        .into_iter()
+        .filter_map(|e| match e {
+            subgram::draw::Event::Polygon { points, .. } => {
+                Some(points.iter().map(|p| [p.x, p.y]).collect())
+            }
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        polygons,
+        [
+            vec![[0.0, 0.0], [-0.5, 1.0], [0.0, 2.0], [0.5, 1.0]],
+            vec![[-2.0, 0.0], [0.0, 3.0], [2.0, 0.0]]
+        ]
+    );
+}
