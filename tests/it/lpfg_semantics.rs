@@ -177,6 +177,8 @@ fn queries(src: &str) -> Vec<[f64; 3]> {
 }
 
 #[test]
+// lpfg's numbers as it printed them, some close to 1/sqrt(2).
+#[allow(clippy::approx_constant)]
 fn frame_modules_turn_the_turtle_as_lpfg_does() {
     // Manual 5.1 and 5.2 define SetHead, RollToVert, RotateXYZ, RotateHLU,
     // SetHead3f and SetCoordinateSystem; the expected vectors are lpfg's
