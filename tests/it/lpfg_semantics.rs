@@ -212,9 +212,14 @@ fn frame_modules_turn_the_turtle_as_lpfg_does() {
         [1.3103037, 3.359034, 2.0000002],
         [3.7677603, 5.079764, 2.0000002],
     ];
-    let got = queries(src);
+    assert_close(&queries(src), &lpfg);
+}
+
+/// Each query's vector within 1e-5 (relative above 1) of lpfg's single
+/// precision one.
+fn assert_close(got: &[[f64; 3]], lpfg: &[[f64; 3]]) {
     assert_eq!(got.len(), lpfg.len());
-    for (k, (g, w)) in got.iter().zip(&lpfg).enumerate() {
+    for (k, (g, w)) in got.iter().zip(lpfg).enumerate() {
         for c in 0..3 {
             assert!(
                 (g[c] - w[c]).abs() <= 1e-5 * w[c].abs().max(1.0),
@@ -222,6 +227,30 @@ fn frame_modules_turn_the_turtle_as_lpfg_does() {
             );
         }
     }
+}
+
+#[test]
+fn rotations_turn_the_turtle_as_lpfg_does() {
+    // Manual 5.2's rotations, in lpfg's default (uncorrected) sense.
+    // lpfg 9bf820d gives GetHead(0,0.8660254,0.5) GetUp(0,-0.5,0.8660254)
+    // ... as listed below.
+    let src = "derivation length: 1;
+        Axiom: Up(30) GetHead(0,0,0) GetUp(0,0,0) Down(50) GetHead(0,0,0)         RollL(40) GetLeft(0,0,0) GetUp(0,0,0) RollR(15) GetLeft(0,0,0)         Left(20) GetHead(0,0,0) Right(70) GetHead(0,0,0)         TurnAround() GetHead(0,0,0) GetLeft(0,0,0);
+        GetHead(x,y,z) : { produce GetHead(x,y,z); }
+";
+    let lpfg = [
+        [0.0, 0.8660254, 0.5],
+        [0.0, -0.5, 0.8660254],
+        [0.0, 0.9396926, -0.34202012],
+        [-0.76604444, -0.2198463, -0.60402274],
+        [-0.6427876, 0.26200262, 0.7198463],
+        [-0.90630776, -0.14454395, -0.3971312],
+        [-0.3099755, 0.83358526, -0.45722067],
+        [0.694272, 0.7147498, 0.08437383],
+        [-0.6942719, -0.7147499, -0.08437379],
+        [0.58256346, -0.6269352, 0.5172736],
+    ];
+    assert_close(&queries(src), &lpfg);
 }
 
 #[test]
