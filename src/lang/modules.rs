@@ -148,6 +148,8 @@ pub const PREDEFINED: &[(&str, &[&[Ty]])] = &[
     ("E2", FF),
     ("Camera", NONE),
     ("MouseIns", NONE),
+    ("MouseInsPos", &[&[Ty::Struct(super::value::MOUSE_STATUS)]]),
+    ("Terrain", &[&[Ty::Struct(super::value::CAMERA_POSITION)]]),
     ("SetUPrecision", ONE_F),
     ("SetVPrecision", ONE_F),
     ("InitSurface", ONE_I),
