@@ -3,7 +3,8 @@
 //!
 //! 1. Closed Chaikin (production 13) from a 1,000-point axiom to 1,024,000
 //!    points: the engine running the `.lsys` text versus a Rust loop doing
-//!    the same arithmetic with double buffers.
+//!    the same arithmetic with double buffers, in lpfg's single precision
+//!    (the default) and in double (`--double`).
 //! 2. A context-sensitive rewrite without geometry: a signal moving through
 //!    a word of a million modules, in million modules per second.
 //! 3. The interpreter on a branching word: 50,000 modules, each with a
@@ -13,7 +14,7 @@
 mod common;
 
 use common::best_of;
-use glam::DVec2;
+use glam::{DVec2, Vec2};
 use subgram::DeriveOptions;
 
 fn polygon(n: usize) -> Vec<DVec2> {
@@ -26,8 +27,29 @@ fn polygon(n: usize) -> Vec<DVec2> {
         .collect()
 }
 
-/// The reference: Chaikin with index arithmetic, two reused buffers.
+/// The reference: Chaikin with index arithmetic, two reused buffers, in
+/// double precision (the engine with `--double`).
 fn chaikin_loop(start: &[DVec2], steps: usize) -> Vec<DVec2> {
+    let mut src = start.to_vec();
+    let mut dst = Vec::with_capacity(start.len() << steps);
+    for _ in 0..steps {
+        dst.clear();
+        let n = src.len();
+        for i in 0..n {
+            let vl = src[(i + n - 1) % n];
+            let v = src[i];
+            let vr = src[(i + 1) % n];
+            dst.push(0.25 * vl + 0.75 * v);
+            dst.push(0.75 * v + 0.25 * vr);
+        }
+        std::mem::swap(&mut src, &mut dst);
+    }
+    src
+}
+
+/// The same loop in single precision, as lpfg computes `V2f` (and the
+/// engine by default).
+fn chaikin_loop_f32(start: &[Vec2], steps: usize) -> Vec<Vec2> {
     let mut src = start.to_vec();
     let mut dst = Vec::with_capacity(start.len() << steps);
     for _ in 0..steps {
@@ -58,32 +80,43 @@ fn main() {
          P(vl) < P(v) > P(vr) -> P(0.25*vl + 0.75*v) P(0.75*v + 0.25*vr)\n",
         axiom.join(" ")
     );
-    let loaded = subgram::load_str("bench.lsys", &src, &[]).expect("loads");
-    assert!(loaded.program.rules[0].stencil.is_some());
-
-    let (t_loop, reference) = best_of(runs, || chaikin_loop(&pts, steps));
-    let (t_engine, derived) = best_of(runs, || {
-        subgram::derive(&loaded.program, DeriveOptions::default()).expect("derives")
-    });
-    let out = derived.word.len();
-    assert_eq!(out, reference.len());
-    // Same arithmetic, same order: the results agree exactly.
-    for (i, r) in reference.iter().enumerate() {
-        assert_eq!(derived.word.data(i), &[r.x, r.y]);
+    for precision in [subgram::Precision::Single, subgram::Precision::Double] {
+        let loaded = subgram::load_str_with("bench.lsys", &src, &[], precision).expect("loads");
+        assert!(loaded.program.rules[0].stencil.is_some());
+        let (t_engine, derived) = best_of(runs, || {
+            subgram::derive(&loaded.program, DeriveOptions::default()).expect("derives")
+        });
+        // Same arithmetic, same order: the results agree exactly.
+        let (t_loop, out) = if precision == subgram::Precision::Single {
+            let start: Vec<Vec2> = pts.iter().map(|p| p.as_vec2()).collect();
+            let (t, reference) = best_of(runs, || chaikin_loop_f32(&start, steps));
+            assert_eq!(derived.word.len(), reference.len());
+            for (i, r) in reference.iter().enumerate() {
+                assert_eq!(derived.word.data(i), &[r.x as f64, r.y as f64]);
+            }
+            (t, reference.len())
+        } else {
+            let (t, reference) = best_of(runs, || chaikin_loop(&pts, steps));
+            assert_eq!(derived.word.len(), reference.len());
+            for (i, r) in reference.iter().enumerate() {
+                assert_eq!(derived.word.data(i), &[r.x, r.y]);
+            }
+            (t, reference.len())
+        };
+        println!("chaikin 1000 -> {out} points, {precision:?} precision, best of {runs}");
+        println!(
+            "  hand-written loop   {:>9.2} ms",
+            t_loop.as_secs_f64() * 1e3
+        );
+        println!(
+            "  engine (.lsys)      {:>9.2} ms",
+            t_engine.as_secs_f64() * 1e3
+        );
+        println!(
+            "  ratio engine/loop   {:>9.2}",
+            t_engine.as_secs_f64() / t_loop.as_secs_f64()
+        );
     }
-    println!("chaikin 1000 -> {out} points, best of {runs}");
-    println!(
-        "  hand-written loop   {:>9.2} ms",
-        t_loop.as_secs_f64() * 1e3
-    );
-    println!(
-        "  engine (.lsys)      {:>9.2} ms",
-        t_engine.as_secs_f64() * 1e3
-    );
-    println!(
-        "  ratio engine/loop   {:>9.2}",
-        t_engine.as_secs_f64() / t_loop.as_secs_f64()
-    );
 
     if std::env::args().any(|a| a == "--chaikin-only") {
         return;

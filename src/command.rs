@@ -9,7 +9,7 @@ use std::time::Duration;
 use crate::curve::FigureOptions;
 use crate::deadline::{Deadline, DEFAULT_TIMEOUT};
 use crate::error::Error;
-use crate::load::{load, LoadOptions};
+use crate::load::{load, LoadOptions, Precision};
 use crate::mesh::{self, Mesh};
 use crate::render::{self, Rgba, Scene, View};
 use crate::reverse::{self, Phase, ReverseOptions, Scheme};
@@ -18,10 +18,8 @@ use crate::system::{load_mesh, Progress, RunOptions, Surface, System};
 
 /// `subgram check FILE [-D NAME=VALUE]…`: reports every diagnostic, or one
 /// line that says what the file holds.
-pub fn check(file: &str, defines: &[String]) -> Result<String, Error> {
-    let opts = LoadOptions {
-        defines: defines.to_vec(),
-    };
+pub fn check(file: &str, defines: &[String], double: bool) -> Result<String, Error> {
+    let opts = load_options(defines, double);
     let system = load(file, &opts)?;
     let ok = match &system {
         System::Surface(s) => format!(
@@ -49,6 +47,8 @@ pub struct DeriveArgs {
     /// `--format json` instead of text.
     pub json: bool,
     pub defines: Vec<String>,
+    /// `--double`: `float` in double precision instead of lpfg's single.
+    pub double: bool,
     pub max_modules: usize,
     pub phase: usize,
     /// Print the word after interpretation rules.
@@ -64,6 +64,7 @@ impl DeriveArgs {
             steps: None,
             json: false,
             defines: Vec::new(),
+            double: false,
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             interpreted: false,
@@ -86,7 +87,7 @@ pub struct Printed {
 /// program's warnings come with it.
 pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<Printed, Error> {
     let deadline = a.timeout.map(Deadline::after);
-    let system = load(&a.file, &load_options(&a.defines))?;
+    let system = load(&a.file, &load_options(&a.defines, a.double))?;
     let warnings = system.warnings();
     let text = derive_text(a, system, deadline, progress)?;
     Ok(Printed { text, warnings })
@@ -154,6 +155,8 @@ pub struct RenderArgs {
     /// Meshes: draw the edges over the faces.
     pub wireframe: bool,
     pub defines: Vec<String>,
+    /// `--double`: `float` in double precision instead of lpfg's single.
+    pub double: bool,
     pub max_modules: usize,
     pub phase: usize,
     /// `--timeout`: the command stops with an error after this long.
@@ -174,6 +177,7 @@ impl RenderArgs {
             view: None,
             wireframe: true,
             defines: Vec::new(),
+            double: false,
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             timeout: Some(DEFAULT_TIMEOUT),
@@ -200,7 +204,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<Stri
         return Ok(Vec::new());
     }
     let format = Picture::from_path(output)?;
-    let system = load(file, &load_options(&a.defines))?;
+    let system = load(file, &load_options(&a.defines, a.double))?;
     let mut warnings = system.warnings();
     warnings.extend(render_system(
         a,
@@ -673,9 +677,14 @@ fn json(value: &impl serde::Serialize) -> Result<String, Error> {
     serde_json::to_string_pretty(value).map_err(|e| Error::Failed(e.to_string()))
 }
 
-fn load_options(defines: &[String]) -> LoadOptions {
+fn load_options(defines: &[String], double: bool) -> LoadOptions {
     LoadOptions {
         defines: defines.to_vec(),
+        precision: if double {
+            Precision::Double
+        } else {
+            Precision::Single
+        },
     }
 }
 

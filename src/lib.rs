@@ -51,7 +51,9 @@ pub use curve::{Curve, CurveRun, FigureOptions, Figures};
 pub use deadline::{Deadline, DEFAULT_TIMEOUT};
 pub use error::Error;
 pub use lang::{Program, Value};
-pub use load::{load, load_file, load_str, load_text, LoadOptions};
+pub use load::{
+    load, load_file, load_file_with, load_str, load_str_with, load_text, LoadOptions, Precision,
+};
 pub use rewrite::derive::{DEFAULT_MAX_MODULES, MAX_STEPS};
 pub use rewrite::{derive, Derivation, DeriveError, DeriveOptions, Derived, Word};
 pub use syntax::{Diagnostic, FileId, SourceFile, SourceMap, Span};

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::curve::Curve;
 use crate::error::Error;
 use crate::lang;
+pub use crate::lang::compile::Precision;
 use crate::surface;
 use crate::syntax::lex::{self, Token};
 use crate::syntax::{parse, preprocess, Diagnostic, FileId, SourceFile, SourceMap, Span};
@@ -18,6 +19,9 @@ pub struct LoadOptions {
     /// `#define` overrides, each `NAME=VALUE` (the binary's `-D`); they win
     /// over the file's own `#define`s and `angle:` values.
     pub defines: Vec<String>,
+    /// What C's `float` is: single precision as in lpfg (the default), or
+    /// double (`--double`). Surface grammars compute in double always.
+    pub precision: Precision,
 }
 
 impl LoadOptions {
@@ -62,7 +66,7 @@ fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
         let grammar = surface::from_front(front)?;
         Ok(System::Surface(Surface::new(grammar, Some(path))))
     } else {
-        Ok(System::Curve(curve(front)?))
+        Ok(System::Curve(curve(front, opts.precision)?))
     }
 }
 
@@ -119,16 +123,28 @@ fn load_text_as(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Er
         let grammar = surface::from_front(front)?;
         Ok(System::Surface(Surface::new(grammar, None)))
     } else {
-        Ok(System::Curve(curve(front)?))
+        Ok(System::Curve(curve(front, opts.precision)?))
     }
 }
 
 /// Loads a file as a curve L-system, whatever its syntax says; `defines`
 /// are `NAME=VALUE` overrides.
 pub fn load_file(path: impl AsRef<Path>, defines: &[String]) -> Result<Curve, Error> {
-    let path = path.as_ref();
+    load_file_with(path.as_ref(), defines, Precision::Single)
+}
+
+/// [`load_file`] with `float` in the given precision.
+pub fn load_file_with(
+    path: &Path,
+    defines: &[String],
+    precision: Precision,
+) -> Result<Curve, Error> {
     let text = read(path)?;
-    curve(front(&path.display().to_string(), text, defines)?).map_err(at_most_some)
+    curve(
+        front(&path.display().to_string(), text, defines)?,
+        precision,
+    )
+    .map_err(at_most_some)
 }
 
 /// Checks text as a curve L-system; `name` is the file name in messages.
@@ -147,7 +163,17 @@ pub fn load_file(path: impl AsRef<Path>, defines: &[String]) -> Result<Curve, Er
 /// assert_eq!(derived.word.len(), 16); // 4 points, doubled twice
 /// ```
 pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Curve, Error> {
-    curve(front(name, text.to_string(), defines)?).map_err(at_most_some)
+    load_str_with(name, text, defines, Precision::Single)
+}
+
+/// [`load_str`] with `float` in the given precision.
+pub fn load_str_with(
+    name: &str,
+    text: &str,
+    defines: &[String],
+    precision: Precision,
+) -> Result<Curve, Error> {
+    curve(front(name, text.to_string(), defines)?, precision).map_err(at_most_some)
 }
 
 /// The most diagnostics a check reports; the count of the others follows
@@ -339,7 +365,7 @@ pub(crate) fn front(name: &str, text: String, defines: &[String]) -> Result<Fron
 }
 
 /// Parses and checks preprocessed tokens as a curve L-system.
-pub(crate) fn curve(front: Front) -> Result<Curve, Error> {
+pub(crate) fn curve(front: Front, precision: Precision) -> Result<Curve, Error> {
     let eof = front.eof();
     let Front {
         sources, tokens, ..
@@ -354,7 +380,7 @@ pub(crate) fn curve(front: Front) -> Result<Curve, Error> {
             })
         }
     };
-    match lang::compile(&file) {
+    match lang::compile::compile_with(&file, precision) {
         Ok(mut program) => {
             // What the turtle does not act on is said, not dropped.
             program

@@ -34,6 +34,9 @@ enum Command {
         /// Override a #define: -D NAME=VALUE (repeatable).
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
+        /// Compute float, V2f and V3f in double precision (lpfg: single).
+        #[arg(long)]
+        double: bool,
         /// Stop with an error when a word grows past this many modules.
         #[arg(long, default_value_t = subgram::DEFAULT_MAX_MODULES)]
         max_modules: usize,
@@ -74,6 +77,9 @@ enum Command {
         no_wireframe: bool,
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
+        /// Compute float, V2f and V3f in double precision (lpfg: single).
+        #[arg(long)]
+        double: bool,
         #[arg(long, default_value_t = subgram::DEFAULT_MAX_MODULES)]
         max_modules: usize,
         #[arg(long, default_value_t = 0)]
@@ -184,6 +190,9 @@ enum Command {
         file: String,
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
+        /// Compute float, V2f and V3f in double precision (lpfg: single).
+        #[arg(long)]
+        double: bool,
     },
 }
 
@@ -325,12 +334,17 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
-        Command::Check { file, define } => print_out(&command::check(&file, &define)?),
+        Command::Check {
+            file,
+            define,
+            double,
+        } => print_out(&command::check(&file, &define, double)?),
         Command::Derive {
             file,
             steps,
             format,
             define,
+            double,
             max_modules,
             phase,
             interpreted,
@@ -341,6 +355,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 steps,
                 json: matches!(format, Format::Json),
                 defines: define,
+                double,
                 max_modules,
                 phase,
                 interpreted,
@@ -360,6 +375,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             view,
             no_wireframe,
             define,
+            double,
             max_modules,
             phase,
             timeout,
@@ -375,6 +391,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 view,
                 wireframe: !no_wireframe,
                 defines: define,
+                double,
                 max_modules,
                 phase,
                 timeout: timeout.0,

@@ -210,7 +210,7 @@ pub static LIBRARY: &[Builtin] = &[
     },
     Builtin {
         name: "Length",
-        resolve: |a| vector(a, "Length").map(|_| (Func::Length, Ty::Float)),
+        resolve: |a| vector(a, "Length").map(|t| (Func::Length, t.scalar())),
     },
     Builtin {
         name: "Normalize",
@@ -219,7 +219,7 @@ pub static LIBRARY: &[Builtin] = &[
     Builtin {
         name: "Dot",
         resolve: |a| match a {
-            [x, y] if x == y && x.is_vector() => Ok((Func::Dot, Ty::Float)),
+            [x, y] if x.is_vector() && x.dim() == y.dim() => Ok((Func::Dot, x.wider(*y).scalar())),
             _ => Err(SigError::Message(
                 "`Dot` takes two vectors of the same type".into(),
             )),
@@ -228,7 +228,7 @@ pub static LIBRARY: &[Builtin] = &[
     Builtin {
         name: "Cross",
         resolve: |a| match a {
-            [Ty::V3, Ty::V3] => Ok((Func::Cross, Ty::V3)),
+            [x, y] if x.dim() == 3 && y.dim() == 3 => Ok((Func::Cross, x.wider(*y))),
             [x, y] if x == y && x.is_vector() => {
                 Err(SigError::Message("`Cross` takes two V3f vectors".into()))
             }

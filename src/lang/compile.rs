@@ -15,8 +15,30 @@ use super::ir::*;
 use super::modules::{Alphabet, Signature, Sym};
 use super::value::{StructDef, Ty, Value};
 
-pub fn compile(file: &ast::File) -> Result<Program, Vec<Diagnostic>> {
+/// How a program computes C's `float` (and `V2f`, `V3f`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Precision {
+    /// Single precision, as lpfg compiles L+C: every `float` result and
+    /// every conversion to `float` is rounded where C rounds it.
+    #[default]
+    Single,
+    /// Every `float` is a `double`: for precision work, and for topologies
+    /// whose coordinates are doubles (surface grammars).
+    Double,
+}
+
+/// Compiles a program whose `float` has the given precision.
+pub fn compile_with(file: &ast::File, precision: Precision) -> Result<Program, Vec<Diagnostic>> {
     let mut c = Compiler::new(&WORD_HOST, Vec::new());
+    c.single = precision == Precision::Single;
+    // The predefined structs' single-precision fields follow too.
+    if !c.single {
+        for d in &mut c.structs {
+            for (_, t) in &mut d.fields {
+                *t = t.widened();
+            }
+        }
+    }
     c.declarations(file);
     if file.abop {
         c.declare_from_use(file);
@@ -124,6 +146,9 @@ struct Compiler {
     /// division of integer constants that truncates, with that division:
     /// the truncation warning follows them into the body.
     truncating: Vec<(u16, Ex)>,
+    /// `float` is single precision (lpfg's); otherwise every `float`,
+    /// `V2f` and `V3f` is read as `double`, `V2d`, `V3d`.
+    single: bool,
 }
 
 /// Function calls are inlined; past this many in one rule, functions that
@@ -291,6 +316,28 @@ impl Compiler {
             inlined: 0,
             int_divisions: Vec::new(),
             truncating: Vec::new(),
+            single: false,
+        }
+    }
+
+    /// A type as this program computes it: without single precision,
+    /// `float`, `V2f` and `V3f` are `double`, `V2d` and `V3d`.
+    fn prec(&self, ty: Ty) -> Ty {
+        if self.single {
+            ty
+        } else {
+            ty.widened()
+        }
+    }
+
+    /// A value of single-precision type `ty` rounded as C rounds the
+    /// result of `float` arithmetic or a conversion to `float`; values of
+    /// other types are left as they are.
+    fn round(&self, ex: Ex, ty: Ty) -> Ex {
+        if ty.is_single() {
+            fold_unary(Ex::Convert(ty, Box::new(ex)))
+        } else {
+            ex
         }
     }
 
@@ -386,7 +433,7 @@ impl Compiler {
     fn arith(&self, ex: Ex, ty: Ty, span: Span) -> (Ex, Ty) {
         if let Ty::Elem(k) = ty {
             if let Some((f, t)) = (self.host.arith)(k) {
-                return (Ex::Call(f, vec![ex], span), t);
+                return (Ex::Call(f, vec![ex], span), self.prec(t));
             }
         }
         (ex, ty)
@@ -411,9 +458,12 @@ impl Compiler {
         match ty {
             Ty::Int => "int".into(),
             Ty::Float => "float".into(),
+            Ty::Double => "double".into(),
             Ty::Bool => "bool".into(),
             Ty::V2 => "V2f".into(),
             Ty::V3 => "V3f".into(),
+            Ty::V2d => "V2d".into(),
+            Ty::V3d => "V3d".into(),
             Ty::Struct(i) => self.structs[i as usize].name.clone(),
             Ty::Str => "string".into(),
             Ty::Void => "void".into(),
@@ -424,10 +474,13 @@ impl Compiler {
     fn resolve_type(&mut self, t: &ast::TypeRef) -> Option<Ty> {
         let ty = match t.name.as_str() {
             "int" | "long" | "unsigned" | "short" => Ty::Int,
-            "float" | "double" => Ty::Float,
+            "float" => self.prec(Ty::Float),
+            "double" => Ty::Double,
             "bool" => Ty::Bool,
-            "V2f" | "V2d" => Ty::V2,
-            "V3f" | "V3d" => Ty::V3,
+            "V2f" => self.prec(Ty::V2),
+            "V3f" => self.prec(Ty::V3),
+            "V2d" => Ty::V2d,
+            "V3d" => Ty::V3d,
             "void" => Ty::Void,
             other => {
                 if let Some(t) = self.typedefs.get(other) {
@@ -609,7 +662,8 @@ impl Compiler {
                     self.too_many(limit, "modules", Span::default());
                     return;
                 }
-                self.alphabet.declare(&name, vec![Ty::Float; arity]);
+                let f = self.prec(Ty::Float);
+                self.alphabet.declare(&name, vec![f; arity]);
             }
         }
     }
@@ -628,6 +682,7 @@ impl Compiler {
             rules: Vec::new(),
             control: Vec::new(),
             warnings: Vec::new(),
+            single: self.single,
         };
         let mut section = Section::Productions;
         let mut group = 0i64;
@@ -801,8 +856,7 @@ impl Compiler {
         span: Span,
     ) -> Option<Ex> {
         let want: Vec<Ty> = match ty {
-            Ty::V2 => vec![Ty::Float; 2],
-            Ty::V3 => vec![Ty::Float; 3],
+            t if t.is_vector() => vec![t.scalar(); t.dim()],
             Ty::Struct(i) => self.structs[i as usize]
                 .fields
                 .iter()
@@ -810,8 +864,9 @@ impl Compiler {
                 .collect(),
             t => vec![t],
         };
-        if exs.len() == 1 && exs[0].1 == ty {
-            return Some(exs.pop().expect("one").0);
+        if exs.len() == 1 && (exs[0].1 == ty || ty.is_vector() && exs[0].1.dim() == ty.dim()) {
+            let (ex, from) = exs.pop().expect("one");
+            return self.coerce(ex, from, ty, span);
         }
         if exs.len() != want.len() {
             self.err(
@@ -830,11 +885,11 @@ impl Compiler {
             parts.push(self.coerce(ex, et, *w, a.span)?);
         }
         Some(match ty {
-            Ty::V2 => {
+            Ty::V2 | Ty::V2d => {
                 let mut it = parts.into_iter();
                 Ex::MakeV2(Box::new(it.next()?), Box::new(it.next()?))
             }
-            Ty::V3 => {
+            Ty::V3 | Ty::V3d => {
                 let mut it = parts.into_iter();
                 Ex::MakeV3(
                     Box::new(it.next()?),
@@ -861,10 +916,15 @@ impl Compiler {
             return Some(ex);
         }
         if from.is_numeric() && to.is_numeric() {
-            if from == Ty::Int && to == Ty::Float {
+            if from == Ty::Int && to.is_floating() {
                 self.check_truncation(&ex);
             }
-            return Some(Ex::Convert(to, Box::new(ex)));
+            // To `float`, the conversion rounds to single precision.
+            return Some(fold_unary(Ex::Convert(to, Box::new(ex))));
+        }
+        if from.is_vector() && from.dim() == to.dim() {
+            // `V2d` to `V2f` rounds each component; the other way is exact.
+            return Some(fold_unary(Ex::Convert(to, Box::new(ex))));
         }
         self.err(
             span,
@@ -1001,7 +1061,7 @@ impl Compiler {
                     );
                     return None;
                 }
-                Some((sym, tys.clone(), None))
+                Some((sym, tys.iter().map(|t| self.prec(*t)).collect(), None))
             }
             Signature::Overloads(ovs) => match ovs.iter().find(|o| o.len() == count) {
                 Some(o) => {
@@ -1009,7 +1069,7 @@ impl Compiler {
                         .iter()
                         .map(|t| super::value::width(*t, &self.structs))
                         .sum();
-                    Some((sym, o.to_vec(), Some(w)))
+                    Some((sym, o.iter().map(|t| self.prec(*t)).collect(), Some(w)))
                 }
                 None => {
                     let counts: Vec<String> = ovs.iter().map(|o| o.len().to_string()).collect();
@@ -1058,21 +1118,25 @@ impl Compiler {
             };
             let candidates: Vec<Vec<Ty>> = match &self.alphabet.get(sym).sig {
                 Signature::Fixed(t) => vec![t.clone()],
-                Signature::Overloads(o) => o.iter().map(|v| v.to_vec()).collect(),
+                Signature::Overloads(o) => o
+                    .iter()
+                    .map(|v| v.iter().map(|t| self.prec(*t)).collect())
+                    .collect(),
+            };
+            let converts = |w: &Ty, t: &Ty| {
+                w == t
+                    || (w.is_numeric() && t.is_numeric())
+                    || (w.is_vector() && w.dim() == t.dim())
             };
             let fits = |want: &[Ty]| {
-                want.len() == args.len()
-                    && want
-                        .iter()
-                        .zip(&args)
-                        .all(|(w, (_, t))| w == t || (w.is_numeric() && t.is_numeric()))
+                want.len() == args.len() && want.iter().zip(&args).all(|(w, (_, t))| converts(w, t))
             };
             let Some(want) = candidates.iter().find(|w| fits(w)).cloned() else {
                 let same_arity = candidates.iter().find(|w| w.len() == args.len());
                 match same_arity {
                     Some(want) => {
                         for ((_, t), (w, a)) in args.iter().zip(want.iter().zip(&m.args)) {
-                            if !(w == t || (w.is_numeric() && t.is_numeric())) {
+                            if !converts(w, t) {
                                 self.err(
                                     a.span,
                                     format!(
@@ -1109,7 +1173,8 @@ impl Compiler {
                     if t == *w {
                         ex
                     } else {
-                        Ex::Convert(*w, Box::new(ex))
+                        // To a `float` parameter: rounded, as lpfg stores it.
+                        fold_unary(Ex::Convert(*w, Box::new(ex)))
                     }
                 })
                 .collect();
@@ -1352,14 +1417,10 @@ impl Compiler {
 
     fn field_of(&mut self, ty: Ty, f: &ast::Name) -> Option<(u16, Ty)> {
         let found = match ty {
-            Ty::V2 => ["x", "y"]
+            t if t.is_vector() => ["x", "y", "z"][..t.dim()]
                 .iter()
                 .position(|c| *c == f.text)
-                .map(|i| (i as u16, Ty::Float)),
-            Ty::V3 => ["x", "y", "z"]
-                .iter()
-                .position(|c| *c == f.text)
-                .map(|i| (i as u16, Ty::Float)),
+                .map(|i| (i as u16, t.scalar())),
             Ty::Struct(s) => self.struct_fields[s as usize]
                 .get(&f.text)
                 .map(|&i| (i, self.structs[s as usize].fields[i as usize].1)),
@@ -1404,7 +1465,8 @@ impl Compiler {
         let span = e.span;
         match &e.kind {
             ExprKind::Int(i) => Some((Ex::Const(Value::Int(*i)), Ty::Int)),
-            ExprKind::Float(f) => Some((Ex::Const(Value::Float(*f)), Ty::Float)),
+            // A literal without a suffix is a `double`, as in C.
+            ExprKind::Float(f) => Some((Ex::Const(Value::Float(*f)), Ty::Double)),
             ExprKind::Str(s) => Some((Ex::Const(Value::Str(s.as_str().into())), Ty::Str)),
             ExprKind::Ident(n) => {
                 if let Some((ty, slot)) = scope.lookup(n) {
@@ -1414,7 +1476,7 @@ impl Compiler {
                     return Some((Ex::Global(g), self.globals[g as usize].ty));
                 }
                 if let Some((f, ty)) = self.host.value(n) {
-                    return Some((Ex::Call(f, Vec::new(), span), ty));
+                    return Some((Ex::Call(f, Vec::new(), span), self.prec(ty)));
                 }
                 let c = match n.as_str() {
                     "true" => Value::Bool(true),
@@ -1435,7 +1497,7 @@ impl Compiler {
                 };
                 let ty = match c {
                     Value::Bool(_) => Ty::Bool,
-                    _ => Ty::Float,
+                    _ => Ty::Double,
                 };
                 Some((Ex::Const(c), ty))
             }
@@ -1484,15 +1546,34 @@ impl Compiler {
                     );
                     return None;
                 };
-                if *op == BinOp::Div && lt != Ty::Float && rt != Ty::Float && ty == Ty::Int {
+                if *op == BinOp::Div && !lt.is_floating() && !rt.is_floating() && ty == Ty::Int {
                     self.int_divisions.push(span);
                 }
                 // A float result, or a float on either side (a comparison):
                 // the integers are read as floats.
-                if !matches!(ty, Ty::Int | Ty::Bool) || lt == Ty::Float || rt == Ty::Float {
+                if !matches!(ty, Ty::Int | Ty::Bool) || lt.is_floating() || rt.is_floating() {
                     self.check_truncation(&lx);
                     self.check_truncation(&rx);
                 }
+                // Single-precision arithmetic: C converts a scalar operand
+                // to `float` first (lpfg's `V2f * s` takes a float), then
+                // rounds the result.
+                let arithmetic = matches!(
+                    op,
+                    BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div | BinOp::Rem
+                );
+                let (lx, rx) = if arithmetic && ty.is_single() {
+                    let to_float = |x: Ex, t: Ty| {
+                        if t.is_numeric() && t != Ty::Float {
+                            fold_unary(Ex::Convert(Ty::Float, Box::new(x)))
+                        } else {
+                            x
+                        }
+                    };
+                    (to_float(lx, lt), to_float(rx, rt))
+                } else {
+                    (lx, rx)
+                };
                 if let Some(c) = fold_constants(*op, &lx, &rx) {
                     return Some((Ex::Convert(ty, Box::new(c)), ty))
                         .map(|(x, t)| (fold_unary(x), t));
@@ -1502,15 +1583,16 @@ impl Compiler {
                     BinOp::Or => Ex::Logic(false, Box::new(lx), Box::new(rx)),
                     _ => Ex::Bin(*op, Box::new(lx), Box::new(rx), span),
                 };
+                let ex = if arithmetic { self.round(ex, ty) } else { ex };
                 Some((ex, ty))
             }
             ExprKind::Assign(op, lhs, rhs) => {
                 let place = self.place(lhs, scope);
-                let (rx, rt) = self.expr(rhs, scope)?;
+                let (rx, rhs_ty) = self.expr(rhs, scope)?;
                 let place = place?;
                 let rt = match op {
-                    None => rt,
-                    Some(o) => match binary_type(*o, place.ty, rt) {
+                    None => rhs_ty,
+                    Some(o) => match binary_type(*o, place.ty, rhs_ty) {
                         Some(t) => t,
                         None => {
                             self.err(
@@ -1519,14 +1601,15 @@ impl Compiler {
                                     "type error: cannot apply `{}=` to {} and {}",
                                     o.symbol(),
                                     self.type_name(place.ty),
-                                    self.type_name(rt)
+                                    self.type_name(rhs_ty)
                                 ),
                             );
                             return None;
                         }
                     },
                 };
-                if !(rt == place.ty || (rt.is_numeric() && place.ty.is_numeric())) {
+                let vectors = rt.is_vector() && rt.dim() == place.ty.dim();
+                if !(rt == place.ty || (rt.is_numeric() && place.ty.is_numeric()) || vectors) {
                     self.err(
                         span,
                         format!(
@@ -1538,6 +1621,14 @@ impl Compiler {
                     return None;
                 }
                 let ty = place.ty;
+                // `v *= s` on a `V2f` takes a float `s`, as lpfg's operator
+                // does; the store rounds the result (`Value::convert`).
+                let rx = if op.is_some() && ty.is_vector() && ty.is_single() && rhs_ty.is_numeric()
+                {
+                    fold_unary(Ex::Convert(Ty::Float, Box::new(rx)))
+                } else {
+                    rx
+                };
                 Some((Ex::Assign(place, *op, Box::new(rx), ty), ty))
             }
             ExprKind::IncDec {
@@ -1572,11 +1663,9 @@ impl Compiler {
                 let ty = if lt == rt {
                     lt
                 } else if lt.is_numeric() && rt.is_numeric() {
-                    if lt == Ty::Float || rt == Ty::Float {
-                        Ty::Float
-                    } else {
-                        Ty::Int
-                    }
+                    lt.wider(rt).wider(Ty::Int)
+                } else if lt.is_vector() && lt.dim() == rt.dim() {
+                    lt.wider(rt)
                 } else {
                     self.err(
                         span,
@@ -1588,19 +1677,19 @@ impl Compiler {
                     );
                     return None;
                 };
-                if ty == Ty::Float {
+                if ty.is_floating() {
                     self.check_truncation(&lx);
                     self.check_truncation(&rx);
                 }
                 let lx = if lt == ty {
                     lx
                 } else {
-                    Ex::Convert(ty, Box::new(lx))
+                    fold_unary(Ex::Convert(ty, Box::new(lx)))
                 };
                 let rx = if rt == ty {
                     rx
                 } else {
-                    Ex::Convert(ty, Box::new(rx))
+                    fold_unary(Ex::Convert(ty, Box::new(rx)))
                 };
                 Some((Ex::Cond(Box::new(c), Box::new(lx), Box::new(rx)), ty))
             }
@@ -1611,7 +1700,8 @@ impl Compiler {
                 if xt == ty {
                     return Some((x, ty));
                 }
-                if !(xt.is_numeric() && ty.is_numeric()) {
+                let vectors = xt.is_vector() && xt.dim() == ty.dim();
+                if !(xt.is_numeric() && ty.is_numeric() || vectors) {
                     self.err(
                         span,
                         format!(
@@ -1622,7 +1712,7 @@ impl Compiler {
                     );
                     return None;
                 }
-                Some((Ex::Convert(ty, Box::new(x)), ty))
+                Some((fold_unary(Ex::Convert(ty, Box::new(x))), ty))
             }
             ExprKind::Field(base, f) => {
                 let (x, t) = self.expr(base, scope)?;
@@ -1652,7 +1742,9 @@ impl Compiler {
                             span: n.span,
                         };
                         let place = self.place(&ident, scope)?;
-                        if !(place.ty == t || (place.ty.is_numeric() && t.is_numeric())) {
+                        let vectors = t.is_vector() && place.ty.dim() == t.dim();
+                        if !(place.ty == t || (place.ty.is_numeric() && t.is_numeric()) || vectors)
+                        {
                             self.err(
                                 n.span,
                                 format!(
@@ -1701,8 +1793,11 @@ impl Compiler {
             return None;
         }
         match name.text.as_str() {
-            "Length" => Some((Ex::Call(Func::Length, vec![x], span), Ty::Float)),
-            "Normalized" => Some((Ex::Call(Func::Normalized, vec![x], span), t)),
+            "Length" => Some((
+                self.round(Ex::Call(Func::Length, vec![x], span), t.scalar()),
+                t.scalar(),
+            )),
+            "Normalized" => Some((self.round(Ex::Call(Func::Normalized, vec![x], span), t), t)),
             "Normalize" => {
                 let place = self.place(recv, scope)?;
                 Some((
@@ -1751,7 +1846,12 @@ impl Compiler {
             return None;
         }
         if matches!(n, "V2f" | "V2d" | "V3f" | "V3d") {
-            let ty = if n.starts_with("V2") { Ty::V2 } else { Ty::V3 };
+            let ty = match n {
+                "V2f" => self.prec(Ty::V2),
+                "V3f" => self.prec(Ty::V3),
+                "V2d" => Ty::V2d,
+                _ => Ty::V3d,
+            };
             let ex = self.construct(ty, typed, args, span)?;
             return Some((ex, ty));
         }
@@ -1789,8 +1889,25 @@ impl Compiler {
                         self.check_truncation(x);
                     }
                 }
+                // C's overloads: `sqrt` of a `float` is a `float`, of a
+                // `double` or an `int` a `double`; a vector's length or
+                // dot product has its components' precision. What the
+                // library declares `float` (lpfg's `ran`, `func`) is a
+                // single-precision result.
+                let ty = match f {
+                    Func::Math1(_) | Func::Math2(_) => {
+                        if tys.iter().all(|t| *t == Ty::Float) {
+                            Ty::Float
+                        } else {
+                            Ty::Double
+                        }
+                    }
+                    Func::Length | Func::Dot => tys.first().map_or(ty, |t| t.scalar()),
+                    Func::Normalized | Func::Cross => tys.first().map_or(ty, |t| *t),
+                    _ => self.prec(ty),
+                };
                 let exs = typed.into_iter().map(|(e, _)| e).collect();
-                Some((fold_unary(Ex::Call(f, exs, span)), ty))
+                Some((self.round(fold_unary(Ex::Call(f, exs, span)), ty), ty))
             }
             Err(SigError::Arity(want)) => {
                 self.err(
@@ -1907,7 +2024,7 @@ impl Compiler {
         let ty = match (&value, fold_op) {
             (Some((_, t)), FoldOp::Sum) => *t,
             (Some((_, t)), FoldOp::Avg) if t.is_vector() => *t,
-            (Some(_), FoldOp::Avg) => Ty::Float,
+            (Some(_), FoldOp::Avg) => self.prec(Ty::Float),
             _ => Ty::Int,
         };
         Some((
@@ -2079,23 +2196,20 @@ fn fold_unary(e: Ex) -> Ex {
     }
 }
 
-/// The result type of `a op b`, or `None` for a type error.
+/// The result type of `a op b`, or `None` for a type error. Numbers
+/// follow C's usual arithmetic conversions (`double` over `float` over
+/// `int`); vectors of one size but two precisions give the double one.
 pub fn binary_type(op: BinOp, a: Ty, b: Ty) -> Option<Ty> {
     let num = a.is_numeric() && b.is_numeric();
-    let promote = || {
-        if a == Ty::Float || b == Ty::Float {
-            Ty::Float
-        } else {
-            Ty::Int
-        }
-    };
+    let promote = || a.wider(b).wider(Ty::Int);
+    let vectors = a.is_vector() && a.dim() == b.dim();
     use BinOp::*;
     match op {
         Add | Sub => {
             if num {
                 Some(promote())
-            } else if a == b && a.is_vector() {
-                Some(a)
+            } else if vectors {
+                Some(a.wider(b))
             } else {
                 None
             }
@@ -2107,8 +2221,9 @@ pub fn binary_type(op: BinOp, a: Ty, b: Ty) -> Option<Ty> {
                 Some(b)
             } else if a.is_vector() && b.is_numeric() {
                 Some(a)
-            } else if a == b && a.is_vector() {
-                Some(Ty::Float)
+            } else if vectors {
+                // The dot product.
+                Some(a.wider(b).scalar())
             } else {
                 None
             }
@@ -2125,18 +2240,17 @@ pub fn binary_type(op: BinOp, a: Ty, b: Ty) -> Option<Ty> {
         Rem => {
             if num {
                 Some(promote())
-            } else if a == Ty::V3 && b == Ty::V3 {
-                Some(Ty::V3)
+            } else if vectors && a.dim() == 3 {
+                // The cross product.
+                Some(a.wider(b))
             } else {
                 None
             }
         }
         Lt | Le | Gt | Ge => num.then_some(Ty::Bool),
-        Eq | Ne => (num || (a == b && a.is_vector())).then_some(Ty::Bool),
+        Eq | Ne => (num || vectors).then_some(Ty::Bool),
         And | Or => num.then_some(Ty::Bool),
-        BitAnd | BitOr | BitXor => (a == Ty::Int && b == Ty::Int
-            || num && a != Ty::Float && b != Ty::Float)
-            .then_some(Ty::Int),
+        BitAnd | BitOr | BitXor => (num && !a.is_floating() && !b.is_floating()).then_some(Ty::Int),
     }
 }
 

@@ -240,6 +240,9 @@ pub struct Program {
     pub control: Vec<(ControlKind, Vec<St>, usize)>,
     /// What `check` reports without refusing the program.
     pub warnings: Vec<Diagnostic>,
+    /// `float` is single precision (lpfg's): what the turtle writes into
+    /// `float` parameters (query modules' answers) is rounded to it.
+    pub single: bool,
 }
 
 impl Program {

@@ -8,7 +8,6 @@ pub mod modules;
 pub mod stencil;
 pub mod value;
 
-pub use compile::compile;
 pub use ir::Program;
 pub use modules::{Alphabet, Sym};
 pub use value::{Ty, Value};

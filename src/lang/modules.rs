@@ -43,6 +43,10 @@ const ONE_I: &[&[Ty]] = &[&[I]];
 const XYZ: &[&[Ty]] = &[&[F, F, F], &[V2]];
 const P2: &[&[Ty]] = &[&[V2]];
 const P3: &[&[Ty]] = &[&[V3]];
+const P2D: &[&[Ty]] = &[&[Ty::V2d]];
+const P3D: &[&[Ty]] = &[&[Ty::V3d]];
+const L2D: &[&[Ty]] = &[&[Ty::V2d, Ty::V2d]];
+const L3D: &[&[Ty]] = &[&[Ty::V3d, Ty::V3d]];
 const L2: &[&[Ty]] = &[&[V2, V2]];
 const L3: &[&[Ty]] = &[&[V3, V3]];
 const FF: &[&[Ty]] = &[&[F, F]];
@@ -64,26 +68,26 @@ pub const PREDEFINED: &[(&str, &[&[Ty]])] = &[
     ("g", OPT_F),
     ("MoveTo", XYZ),
     ("MoveTo2f", P2),
-    ("MoveTo2d", P2),
+    ("MoveTo2d", P2D),
     ("MoveTo3f", P3),
-    ("MoveTo3d", P3),
+    ("MoveTo3d", P3D),
     ("MoveRel2f", P2),
-    ("MoveRel2d", P2),
+    ("MoveRel2d", P2D),
     ("MoveRel3f", P3),
-    ("MoveRel3d", P3),
+    ("MoveRel3d", P3D),
     ("LineTo", XYZ),
     ("LineTo2f", P2),
-    ("LineTo2d", P2),
+    ("LineTo2d", P2D),
     ("LineTo3f", P3),
-    ("LineTo3d", P3),
+    ("LineTo3d", P3D),
     ("LineRel2f", P2),
-    ("LineRel2d", P2),
+    ("LineRel2d", P2D),
     ("LineRel3f", P3),
-    ("LineRel3d", P3),
+    ("LineRel3d", P3D),
     ("Line2f", L2),
-    ("Line2d", L2),
+    ("Line2d", L2D),
     ("Line3f", L3),
-    ("Line3d", L3),
+    ("Line3d", L3D),
     ("SetCoordinateSystem", ONE_F),
     ("Left", OPT_F),
     ("Right", OPT_F),

@@ -94,7 +94,7 @@ fn constant(e: &Ex) -> Option<Value> {
             Value::Float(f) => Some(Value::Float(-f)),
             _ => None,
         },
-        Ex::Convert(t @ (Ty::Int | Ty::Float), a) => Some(constant(a)?.convert(*t)),
+        Ex::Convert(t @ (Ty::Int | Ty::Float | Ty::Double), a) => Some(constant(a)?.convert(*t)),
         Ex::Bin(op @ (BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div), a, b, _) => {
             super::eval::binary(*op, constant(a)?, constant(b)?).ok()
         }
@@ -105,10 +105,25 @@ fn constant(e: &Ex) -> Option<Value> {
 /// A local slot of a float or vector pattern parameter.
 fn slot(e: &Ex, slot_ty: &[Ty]) -> Option<u16> {
     match e {
-        Ex::Local(s) if matches!(slot_ty.get(*s as usize), Some(Ty::Float | Ty::V2 | Ty::V3)) => {
+        Ex::Local(s)
+            if slot_ty
+                .get(*s as usize)
+                .is_some_and(|t| t.is_floating() || t.is_vector()) =>
+        {
             Some(*s)
         }
         _ => None,
+    }
+}
+
+/// The operation under a single-precision rounding: the checker wraps every
+/// `float`, `V2f` and `V3f` product, quotient and sum in a conversion to its
+/// own type, and the stencil rounds each of them in the same places
+/// (`Combination::ty` says whether it is single precision).
+fn unrounded(e: &Ex) -> &Ex {
+    match e {
+        Ex::Convert(t, a) if t.is_single() && matches!(**a, Ex::Bin(..)) => a,
+        _ => e,
     }
 }
 
@@ -124,6 +139,7 @@ fn signed_slot(e: &Ex, slot_ty: &[Ty]) -> Option<(u16, bool)> {
 /// A term: `x`, `c*x`, `x*c`, `x/c`, `c`, `-term`. Slots are local slots
 /// here; `compile` maps them to matched modules.
 fn term(e: &Ex, slot_ty: &[Ty]) -> Option<(Option<u16>, f64, bool, bool)> {
+    let e = unrounded(e);
     if let Some(c) = constant(e) {
         return Some((None, c.as_f64(), false, false));
     }
@@ -157,6 +173,7 @@ fn term(e: &Ex, slot_ty: &[Ty]) -> Option<(Option<u16>, f64, bool, bool)> {
 
 /// A sum `term (+|- term)*`, left-associated as the parser builds it.
 fn sum(e: &Ex, slot_ty: &[Ty], out: &mut Vec<(Option<u16>, f64, bool, bool, bool)>) -> Option<()> {
+    let e = unrounded(e);
     if constant(e).is_none() {
         if let Ex::Bin(op @ (BinOp::Add | BinOp::Sub), a, b, _) = e {
             sum(a, slot_ty, out)?;
@@ -194,9 +211,8 @@ impl Stencil {
                 }
                 sources.push((k as u16, off));
                 off += match ty {
-                    Ty::V2 => 2,
-                    Ty::V3 => 3,
-                    Ty::Int | Ty::Float | Ty::Bool => 1,
+                    t if t.is_vector() => t.dim() as u16,
+                    Ty::Int | Ty::Float | Ty::Double | Ty::Bool => 1,
                     // Struct widths need the struct table; keep it simple.
                     _ => return None,
                 };

@@ -8,10 +8,23 @@ use glam::{DVec2, DVec3};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Ty {
     Int,
+    /// C's `float`: single precision, as in lpfg. Its values are `f64`s
+    /// that a single-precision float represents exactly: converting to it
+    /// rounds ([`Value::convert`]), and the checker converts wherever C
+    /// rounds. A program run with floats in double precision has no
+    /// `Float` anywhere: its `float` is `Double`.
     Float,
+    /// C's `double`.
+    Double,
     Bool,
+    /// `V2f`: two single-precision components.
     V2,
+    /// `V3f`.
     V3,
+    /// `V2d`: two double-precision components.
+    V2d,
+    /// `V3d`.
+    V3d,
     /// Index into `Program::structs`.
     Struct(u16),
     Str,
@@ -24,11 +37,69 @@ pub enum Ty {
 
 impl Ty {
     pub fn is_numeric(self) -> bool {
-        matches!(self, Ty::Int | Ty::Float | Ty::Bool)
+        matches!(self, Ty::Int | Ty::Float | Ty::Double | Ty::Bool)
+    }
+
+    /// `float` or `double`.
+    pub fn is_floating(self) -> bool {
+        matches!(self, Ty::Float | Ty::Double)
     }
 
     pub fn is_vector(self) -> bool {
-        matches!(self, Ty::V2 | Ty::V3)
+        matches!(self, Ty::V2 | Ty::V3 | Ty::V2d | Ty::V3d)
+    }
+
+    /// The number of components of a vector type (0 for other types).
+    pub fn dim(self) -> usize {
+        match self {
+            Ty::V2 | Ty::V2d => 2,
+            Ty::V3 | Ty::V3d => 3,
+            _ => 0,
+        }
+    }
+
+    /// Single precision: `float`, `V2f`, `V3f`. Values of these types are
+    /// rounded to `f32` where C rounds them.
+    pub fn is_single(self) -> bool {
+        matches!(self, Ty::Float | Ty::V2 | Ty::V3)
+    }
+
+    /// The scalar type of a vector's components (`float` for `V2f`,
+    /// `double` for `V2d`); other types are their own scalar.
+    pub fn scalar(self) -> Ty {
+        match self {
+            Ty::V2 | Ty::V3 => Ty::Float,
+            Ty::V2d | Ty::V3d => Ty::Double,
+            t => t,
+        }
+    }
+
+    /// The double-precision type of a single-precision one (`double` for
+    /// `float`, `V2d` for `V2f`); other types are left as they are.
+    pub fn widened(self) -> Ty {
+        match self {
+            Ty::Float => Ty::Double,
+            Ty::V2 => Ty::V2d,
+            Ty::V3 => Ty::V3d,
+            t => t,
+        }
+    }
+
+    /// The wider of two numeric or vector types of the same kind, as C's
+    /// usual arithmetic conversions choose (`double` over `float` over
+    /// `int`; `V2d` over `V2f`).
+    pub fn wider(self, other: Ty) -> Ty {
+        let rank = |t: Ty| match t {
+            Ty::Double | Ty::V2d | Ty::V3d => 3,
+            Ty::Float | Ty::V2 | Ty::V3 => 2,
+            Ty::Int => 1,
+            _ => 0,
+        };
+        if rank(other) > rank(self) {
+            other
+        } else {
+            self
+        }
     }
 }
 
@@ -85,11 +156,16 @@ impl Value {
         }
     }
 
-    /// Converts a value to `ty` as C does for numbers; other values pass.
+    /// Converts a value to `ty` as C does for numbers: to `float` (and
+    /// `V2f`, `V3f`) rounds to single precision. Other values pass.
     pub fn convert(self, ty: Ty) -> Value {
         match (ty, &self) {
             (Ty::Int, Value::Float(_) | Value::Bool(_)) => Value::Int(self.as_i64()),
-            (Ty::Float, Value::Int(_) | Value::Bool(_)) => Value::Float(self.as_f64()),
+            (Ty::Float, Value::Int(_) | Value::Bool(_) | Value::Float(_)) => {
+                Value::Float(round32(self.as_f64()))
+            }
+            (Ty::Double, Value::Int(_) | Value::Bool(_)) => Value::Float(self.as_f64()),
+            (Ty::V2 | Ty::V3, Value::V2(_) | Value::V3(_)) => self.round32(),
             (Ty::Bool, Value::Int(_) | Value::Float(_)) => Value::Bool(self.truthy()),
             _ => self,
         }
@@ -99,10 +175,10 @@ impl Value {
     pub fn zero(ty: Ty, structs: &[StructDef]) -> Value {
         match ty {
             Ty::Int => Value::Int(0),
-            Ty::Float => Value::Float(0.0),
+            Ty::Float | Ty::Double => Value::Float(0.0),
             Ty::Bool => Value::Bool(false),
-            Ty::V2 => Value::V2(DVec2::ZERO),
-            Ty::V3 => Value::V3(DVec3::ZERO),
+            Ty::V2 | Ty::V2d => Value::V2(DVec2::ZERO),
+            Ty::V3 | Ty::V3d => Value::V3(DVec3::ZERO),
             Ty::Struct(id) => Value::Struct(
                 structs[id as usize]
                     .fields
@@ -112,6 +188,18 @@ impl Value {
             ),
             Ty::Str => Value::Str("".into()),
             Ty::Void | Ty::Elem(_) => Value::Void,
+        }
+    }
+
+    /// Rounds a float, or each component of a vector, to the nearest
+    /// single-precision float, as C does when it stores into a `float`.
+    /// Other values pass unchanged.
+    pub fn round32(self) -> Value {
+        match self {
+            Value::Float(x) => Value::Float(round32(x)),
+            Value::V2(v) => Value::V2(DVec2::new(round32(v.x), round32(v.y))),
+            Value::V3(v) => Value::V3(DVec3::new(round32(v.x), round32(v.y), round32(v.z))),
+            other => other,
         }
     }
 
@@ -152,6 +240,13 @@ impl fmt::Display for Value {
     }
 }
 
+/// `x` rounded to the nearest single-precision float (ties to even), as an
+/// `f64`. Overflow gives an infinity, as in C.
+#[inline]
+pub fn round32(x: f64) -> f64 {
+    x as f32 as f64
+}
+
 /// A user `struct` declaration.
 #[derive(Clone, Debug)]
 pub struct StructDef {
@@ -165,8 +260,9 @@ pub const MOUSE_STATUS: u16 = 0;
 pub const CAMERA_POSITION: u16 = 1;
 
 /// lpfg's predefined struct types, which every program has before its own:
-/// `MouseStatus` and `CameraPosition`, with the manual's fields (`V3d` and
-/// `V3f` fields are vectors, as everywhere).
+/// `MouseStatus` and `CameraPosition`, with the manual's fields and their
+/// precisions (`V3d` positions of the mouse, `V3f` and `float` of the
+/// camera).
 pub fn predefined_structs() -> Vec<StructDef> {
     let def = |name: &str, fields: &[(&str, Ty)]| StructDef {
         name: name.to_string(),
@@ -179,9 +275,9 @@ pub fn predefined_structs() -> Vec<StructDef> {
                 ("viewNum", Ty::Int),
                 ("viewX", Ty::Int),
                 ("viewY", Ty::Int),
-                ("atFront", Ty::V3),
-                ("atRear", Ty::V3),
-                ("atMiddle", Ty::V3),
+                ("atFront", Ty::V3d),
+                ("atRear", Ty::V3d),
+                ("atMiddle", Ty::V3d),
                 ("lbDown", Ty::Bool),
                 ("lbPushed", Ty::Bool),
                 ("lbReleased", Ty::Bool),
@@ -204,8 +300,8 @@ pub fn predefined_structs() -> Vec<StructDef> {
 /// The number of `f64` slots a value of type `ty` takes in a word.
 pub fn width(ty: Ty, structs: &[StructDef]) -> usize {
     match ty {
-        Ty::V2 => 2,
-        Ty::V3 => 3,
+        Ty::V2 | Ty::V2d => 2,
+        Ty::V3 | Ty::V3d => 3,
         Ty::Struct(id) => structs[id as usize]
             .fields
             .iter()
@@ -237,10 +333,10 @@ pub fn decode(ty: Ty, slots: &[f64], structs: &[StructDef]) -> (Value, usize) {
     let at = |i: usize| slots.get(i).copied().unwrap_or(0.0);
     match ty {
         Ty::Int => (Value::Int(at(0).to_bits() as i64), 1),
-        Ty::Float => (Value::Float(at(0)), 1),
+        Ty::Float | Ty::Double => (Value::Float(at(0)), 1),
         Ty::Bool => (Value::Bool(at(0) != 0.0), 1),
-        Ty::V2 => (Value::V2(DVec2::new(at(0), at(1))), 2),
-        Ty::V3 => (Value::V3(DVec3::new(at(0), at(1), at(2))), 3),
+        Ty::V2 | Ty::V2d => (Value::V2(DVec2::new(at(0), at(1))), 2),
+        Ty::V3 | Ty::V3d => (Value::V3(DVec3::new(at(0), at(1), at(2))), 3),
         Ty::Struct(id) => {
             let mut used = 0;
             let mut fs = Vec::new();

@@ -43,7 +43,10 @@ impl Scheme {
         } else {
             ("builtin:chaikin-open", OPEN_SCHEME)
         };
-        let loaded = crate::load_str(name, text, &[]).expect("the built-in schemes are valid");
+        // Reverse subdivision is precision work: its schemes compute in
+        // double whatever their `V2f` says.
+        let loaded = crate::load_str_with(name, text, &[], crate::Precision::Double)
+            .expect("the built-in schemes are valid");
         Scheme {
             loaded,
             name: name.to_string(),
@@ -55,11 +58,11 @@ impl Scheme {
     /// A scheme file: module `P(V2f)`, group 1 reverse, group 2 forward.
     /// Open schemes work between endmarkers `#`.
     pub fn from_file(path: &std::path::Path, closed: bool) -> Result<Scheme, Error> {
-        let loaded = crate::load_file(path, &[])?;
+        let loaded = crate::load_file_with(path, &[], crate::Precision::Double)?;
         let p = loaded.program.alphabet.lookup("P");
         let ok = p.is_some_and(|s| {
             matches!(&loaded.program.alphabet.get(s).sig,
-                crate::lang::modules::Signature::Fixed(t) if t == &[crate::lang::Ty::V2])
+                crate::lang::modules::Signature::Fixed(t) if t.len() == 1 && t[0].dim() == 2 && t[0].is_vector())
         });
         if !ok {
             return Err(Error::Failed(format!(

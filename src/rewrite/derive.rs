@@ -320,7 +320,14 @@ impl<'p> Derivation<'p> {
         out.reserve(self.word.len(), self.word.slot_count());
         for (i, a) in answer.iter().enumerate() {
             match a {
-                Some(v) if self.word.data(i).len() == 3 => out.push_raw(self.word.sym(i), v),
+                Some(v) if self.word.data(i).len() == 3 => {
+                    // A `float` parameter holds the answer as lpfg's does.
+                    let v = match p.single {
+                        true => v.map(|x| x as f32 as f64),
+                        false => *v,
+                    };
+                    out.push_raw(self.word.sym(i), &v)
+                }
                 _ => out.push_from(&self.word, i),
             }
         }

@@ -384,13 +384,7 @@ impl<'p> Rewriter<'p> {
         let slots_per_module: usize = st
             .outputs
             .iter()
-            .flat_map(|(_, cs)| {
-                cs.iter().map(|c| match c.ty {
-                    Ty::V2 => 2,
-                    Ty::V3 => 3,
-                    _ => 1,
-                })
-            })
+            .flat_map(|(_, cs)| cs.iter().map(|c| c.ty.dim().max(1)))
             .sum();
         dst.clear_with_capacity(n * out_per_module, n * slots_per_module);
         let (syms, starts, out) = dst.raw_parts_mut();
@@ -436,15 +430,7 @@ impl<'p> Rewriter<'p> {
             // them in bulk, and only the parameters in the loops below.
             let widths: Vec<usize> = plain
                 .iter()
-                .map(|(_, cs)| {
-                    cs.iter()
-                        .map(|c| match c.ty {
-                            Ty::V2 => 2,
-                            Ty::V3 => 3,
-                            _ => 1,
-                        })
-                        .sum()
-                })
+                .map(|(_, cs)| cs.iter().map(|c| c.ty.dim().max(1)).sum())
                 .collect();
             let pattern: Vec<Sym> = plain.iter().map(|(s, _)| *s).collect();
             let mut end = out.len() as u32;
@@ -463,10 +449,14 @@ impl<'p> Rewriter<'p> {
                     }
                     for (_, combos) in &plain {
                         for c in combos {
-                            match c.ty {
-                                Ty::V2 => plain_eval::<2>(&c.terms, data, base, out, guard),
-                                Ty::V3 => plain_eval::<3>(&c.terms, data, base, out, guard),
-                                _ => plain_eval::<1>(&c.terms, data, base, out, guard),
+                            let t = &c.terms;
+                            match (c.ty.dim(), c.ty.is_single()) {
+                                (2, true) => plain_eval::<2, true>(t, data, base, out, guard),
+                                (3, true) => plain_eval::<3, true>(t, data, base, out, guard),
+                                (_, true) => plain_eval::<1, true>(t, data, base, out, guard),
+                                (2, _) => plain_eval::<2, false>(t, data, base, out, guard),
+                                (3, _) => plain_eval::<3, false>(t, data, base, out, guard),
+                                _ => plain_eval::<1, false>(t, data, base, out, guard),
                             }
                         }
                     }
@@ -483,19 +473,31 @@ impl<'p> Rewriter<'p> {
                 let at = (i * w) as isize;
                 for (_, combos) in &fixed {
                     for (ty, terms) in combos {
-                        match ty {
-                            Ty::V2 => {
-                                let a = fixed_eval::<2>(terms, data, at);
+                        match (ty.dim(), ty.is_single()) {
+                            (2, single) => {
+                                let a = if single {
+                                    fixed_eval::<2, true>(terms, data, at)
+                                } else {
+                                    fixed_eval::<2, false>(terms, data, at)
+                                };
                                 g += a[0] * 0.0 + a[1] * 0.0;
                                 out.extend_from_slice(&a);
                             }
-                            Ty::V3 => {
-                                let a = fixed_eval::<3>(terms, data, at);
+                            (3, single) => {
+                                let a = if single {
+                                    fixed_eval::<3, true>(terms, data, at)
+                                } else {
+                                    fixed_eval::<3, false>(terms, data, at)
+                                };
                                 g += a[0] * 0.0 + a[1] * 0.0 + a[2] * 0.0;
                                 out.extend_from_slice(&a);
                             }
-                            _ => {
-                                let a = fixed_eval::<1>(terms, data, at);
+                            (_, single) => {
+                                let a = if single {
+                                    fixed_eval::<1, true>(terms, data, at)
+                                } else {
+                                    fixed_eval::<1, false>(terms, data, at)
+                                };
                                 g += a[0] * 0.0;
                                 out.push(a[0]);
                             }
@@ -520,11 +522,7 @@ impl<'p> Rewriter<'p> {
             for (sym, combos) in &st.outputs {
                 syms.push(*sym);
                 for c in combos {
-                    match c.ty {
-                        Ty::V2 => out.extend_from_slice(&combine::<2>(&c.terms, &slices)),
-                        Ty::V3 => out.extend_from_slice(&combine::<3>(&c.terms, &slices)),
-                        _ => out.push(combine::<1>(&c.terms, &slices)[0]),
-                    }
+                    combine_into(c, &slices, out);
                 }
                 starts.push(out.len() as u32);
             }
@@ -853,7 +851,7 @@ type FixedOutput = (Sym, Vec<(Ty, Vec<(isize, f64)>)>);
 
 /// One plain stencil output of `N` components: `Σ w·x` left to right.
 #[inline(always)]
-fn plain_eval<const N: usize>(
+fn plain_eval<const N: usize, const SINGLE: bool>(
     terms: &[(u16, u16, f64)],
     data: &[f64],
     base: &[usize],
@@ -865,8 +863,12 @@ fn plain_eval<const N: usize>(
         let at = base[k as usize] + off as usize;
         let x = &data[at..at + N];
         for i in 0..N {
-            let v = w * x[i];
-            acc[i] = if n == 0 { v } else { acc[i] + v };
+            let v = rounded::<SINGLE>(w * x[i]);
+            acc[i] = if n == 0 {
+                v
+            } else {
+                rounded::<SINGLE>(acc[i] + v)
+            };
         }
     }
     for v in acc {
@@ -878,7 +880,12 @@ fn plain_eval<const N: usize>(
 /// `plain_eval` for a module away from the seam: term `t` reads the slots
 /// at `at + delta_t`.
 #[inline(always)]
-fn fixed_eval<const N: usize>(terms: &[(isize, f64)], data: &[f64], at: isize) -> [f64; N] {
+fn fixed_eval<const N: usize, const SINGLE: bool>(
+    terms: &[(isize, f64)],
+    data: &[f64],
+    at: isize,
+) -> [f64; N] {
+    let r = rounded::<SINGLE>;
     #[inline(always)]
     fn load<const N: usize>(data: &[f64], at: isize, delta: isize) -> &[f64; N] {
         let p = (at + delta) as usize;
@@ -889,7 +896,7 @@ fn fixed_eval<const N: usize>(terms: &[(isize, f64)], data: &[f64], at: isize) -
     match *terms {
         [(d0, w0), (d1, w1)] => {
             let (x0, x1) = (load::<N>(data, at, d0), load::<N>(data, at, d1));
-            std::array::from_fn(|i| w0 * x0[i] + w1 * x1[i])
+            std::array::from_fn(|i| r(r(w0 * x0[i]) + r(w1 * x1[i])))
         }
         [(d0, w0), (d1, w1), (d2, w2)] => {
             let (x0, x1, x2) = (
@@ -897,15 +904,15 @@ fn fixed_eval<const N: usize>(terms: &[(isize, f64)], data: &[f64], at: isize) -
                 load::<N>(data, at, d1),
                 load::<N>(data, at, d2),
             );
-            std::array::from_fn(|i| w0 * x0[i] + w1 * x1[i] + w2 * x2[i])
+            std::array::from_fn(|i| r(r(r(w0 * x0[i]) + r(w1 * x1[i])) + r(w2 * x2[i])))
         }
         _ => {
             let mut acc = [0.0; N];
             for (n, &(delta, w)) in terms.iter().enumerate() {
                 let x = load::<N>(data, at, delta);
                 for i in 0..N {
-                    let v = w * x[i];
-                    acc[i] = if n == 0 { v } else { acc[i] + v };
+                    let v = r(w * x[i]);
+                    acc[i] = if n == 0 { v } else { r(acc[i] + v) };
                 }
             }
             acc
@@ -913,9 +920,37 @@ fn fixed_eval<const N: usize>(terms: &[(isize, f64)], data: &[f64], at: isize) -
     }
 }
 
+/// `x`, rounded to single precision when the stencil computes `float`s:
+/// the interpreter rounds every single-precision product and sum.
+#[inline(always)]
+fn rounded<const SINGLE: bool>(x: f64) -> f64 {
+    if SINGLE {
+        crate::lang::value::round32(x)
+    } else {
+        x
+    }
+}
+
+/// Appends one stencil output, with its type's size and precision.
+#[inline(always)]
+fn combine_into(c: &crate::lang::stencil::Combination, sources: &[&[f64]], out: &mut Vec<f64>) {
+    let t = &c.terms;
+    match (c.ty.dim(), c.ty.is_single()) {
+        (2, true) => out.extend_from_slice(&combine::<2, true>(t, sources)),
+        (3, true) => out.extend_from_slice(&combine::<3, true>(t, sources)),
+        (_, true) => out.push(combine::<1, true>(t, sources)[0]),
+        (2, _) => out.extend_from_slice(&combine::<2, false>(t, sources)),
+        (3, _) => out.extend_from_slice(&combine::<3, false>(t, sources)),
+        _ => out.push(combine::<1, false>(t, sources)[0]),
+    }
+}
+
 /// One stencil output of `N` components, the terms applied left to right.
 #[inline(always)]
-fn combine<const N: usize>(terms: &[crate::lang::stencil::Term], sources: &[&[f64]]) -> [f64; N] {
+fn combine<const N: usize, const SINGLE: bool>(
+    terms: &[crate::lang::stencil::Term],
+    sources: &[&[f64]],
+) -> [f64; N] {
     let mut acc = [0.0; N];
     for (n, t) in terms.iter().enumerate() {
         let x: [f64; N] = match t.source {
@@ -926,13 +961,13 @@ fn combine<const N: usize>(terms: &[crate::lang::stencil::Term], sources: &[&[f6
             None => [0.0; N],
         };
         for i in 0..N {
-            let v = t.apply(x[i]);
+            let v = rounded::<SINGLE>(t.apply(x[i]));
             acc[i] = if n == 0 {
                 v
             } else if t.sub {
-                acc[i] - v
+                rounded::<SINGLE>(acc[i] - v)
             } else {
-                acc[i] + v
+                rounded::<SINGLE>(acc[i] + v)
             };
         }
     }
@@ -958,11 +993,7 @@ fn apply_stencil(st: &Stencil, src: &Word, matched: &[usize], dst: &mut Word) ->
     for (sym, combos) in &st.outputs {
         dst.push_with(*sym, |out| {
             for c in combos {
-                match c.ty {
-                    Ty::V2 => out.extend_from_slice(&combine::<2>(&c.terms, sources)),
-                    Ty::V3 => out.extend_from_slice(&combine::<3>(&c.terms, sources)),
-                    _ => out.push(combine::<1>(&c.terms, sources)[0]),
-                }
+                combine_into(c, sources, out);
             }
         });
     }

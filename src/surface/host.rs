@@ -146,7 +146,7 @@ static FUNCTIONS: &[Builtin] = &[
         name: "pos",
         resolve: |a| {
             one(a, &[VERTEX], "`pos` takes a vertex")?;
-            Ok((Func::Host(id::POS), Ty::V3))
+            Ok((Func::Host(id::POS), Ty::V3d))
         },
     },
     Builtin {
@@ -241,7 +241,7 @@ static FUNCTIONS: &[Builtin] = &[
                 &[EDGE, FACE],
                 "`avg` takes an edge, a face or a set of vertices",
             )?;
-            Ok((Func::Host(id::AVG_OF), Ty::V3))
+            Ok((Func::Host(id::AVG_OF), Ty::V3d))
         },
     },
     Builtin {
@@ -304,7 +304,7 @@ static FUNCTIONS: &[Builtin] = &[
         name: "point",
         resolve: |a| match a {
             [x, y, z] if x.is_numeric() && y.is_numeric() && z.is_numeric() => {
-                Ok((Func::Host(id::POINT), Ty::V3))
+                Ok((Func::Host(id::POINT), Ty::V3d))
             }
             [_, _, _] => Err(SigError::Message("`point` takes three numbers".into())),
             _ => Err(SigError::Arity(3)),
@@ -321,7 +321,7 @@ pub static SURFACE_HOST: HostTable = HostTable {
         ("c", Func::Host(id::CURRENT), Ty::Int),
         ("step", Func::Host(id::STEP), Ty::Int),
     ],
-    arith: |k| (k == VERTEX).then_some((Func::Host(id::POS), Ty::V3)),
+    arith: |k| (k == VERTEX).then_some((Func::Host(id::POS), Ty::V3d)),
     members: |k| (k == SET).then_some(VERTEX),
 };
 

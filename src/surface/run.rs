@@ -194,7 +194,7 @@ pub(crate) fn compile_with(
                 } else {
                     c.bind(name, Ty::Elem(host::VERTEX))
                 };
-                (Some(s), Some(c.expr_as(e, Ty::V3)))
+                (Some(s), Some(c.expr_as(e, Ty::V3d)))
             }
             None => (None, None),
         };

@@ -6,6 +6,12 @@ use subgram::DeriveOptions;
 
 use crate::support::*;
 
+/// The tolerance against the matrices, which are computed in double
+/// precision. The programs compute in lpfg's single precision (`V2f`), yet
+/// they agree to 1e-12: the control polygons have small integer
+/// coordinates and every mask of paper 002 is a dyadic fraction (1/4, 3/4,
+/// 1/8, 9/16, …), so for these few steps every product and sum has fewer
+/// than 24 significant bits and single precision computes it exactly.
 const EPS: f64 = 1e-12;
 
 fn closed_case(file: &str, steps: usize, m: fn(usize) -> Matrix) {

@@ -377,7 +377,15 @@ fn a_drawing_that_overflows_names_its_module_step_and_maker() {
         "far.lsys",
         "module A(float);\nderivation length: 2;\nAxiom: A(1e308);\nA(x) -> F(x) A(x)\n",
     );
+    // In lpfg's single precision, 1e308 is no float at all: the axiom
+    // already holds an infinity.
     let r = subgram(&s.0, &["render", "far.lsys", "-o", "far.png"]);
+    fails_with(
+        &r,
+        "far.lsys:3:8: error: parameter 1 of this successor module is inf",
+    );
+    // In double precision it is a number, and the turtle overflows.
+    let r = subgram(&s.0, &["render", "far.lsys", "-o", "far.png", "--double"]);
     fails_with(
         &r,
         "far.lsys:4:1: error: at step 2, module 2 of the interpreted word, `F(1e308)`, \
@@ -385,13 +393,16 @@ fn a_drawing_that_overflows_names_its_module_step_and_maker() {
          production `A(x)` made that module\n  |\n4 | A(x) -> F(x) A(x)\n  | ^^^^",
     );
     // Each step drawn: step 1 draws, step 2 overflows.
-    let r = subgram(&s.0, &["render", "far.lsys", "-o", "far.png", "--each"]);
+    let r = subgram(
+        &s.0,
+        &["render", "far.lsys", "-o", "far.png", "--each", "--double"],
+    );
     fails_with(&r, "far.lsys:4:1: error: at step 2, module 2 ");
     s.write(
         "disc.lsys",
         "module A;\nderivation length: 0;\nAxiom: MoveTo2f(V2f(1e308, 0)) Circle(1e308);\n",
     );
-    let r = subgram(&s.0, &["render", "disc.lsys", "-o", "disc.svg"]);
+    let r = subgram(&s.0, &["render", "disc.lsys", "-o", "disc.svg", "--double"]);
     fails_with(
         &r,
         "disc.lsys:3:32: error: at step 0, module 2 of the interpreted word, `Circle(1e308)`, \
@@ -401,10 +412,14 @@ fn a_drawing_that_overflows_names_its_module_step_and_maker() {
     assert_eq!(s.files(), ["disc.lsys", "far.lsys"]);
 
     // The library says the same, through an interpretation rule.
-    let l = load_text(
+    let l = subgram::load_str_with(
+        "test.lsys",
         "module A; module B;\nderivation length: 2;\nAxiom: A;\nA -> B A\n\
          interpretation:\nB -> F(1e308)\n",
-    );
+        &[],
+        subgram::Precision::Double,
+    )
+    .unwrap();
     let mut run = l.run(DeriveOptions::default()).unwrap();
     let e = run.events().unwrap_err().to_string();
     assert!(

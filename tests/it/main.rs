@@ -18,6 +18,7 @@ mod mesh_bounds;
 mod mesh_draw;
 mod mesh_io;
 mod one_language;
+mod precision;
 mod render;
 mod reverse;
 mod semantics;

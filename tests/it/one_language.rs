@@ -213,7 +213,7 @@ fn the_same_type_errors_read_the_same() {
     let curve = write(
         &dir,
         "c.lsys",
-        "module A(V3f);\nderivation length: 1;\nAxiom: A(V3f(0, 0, 0));\nA(p) -> A(p + 1);\n",
+        "module A(V3d);\nderivation length: 1;\nAxiom: A(V3d(0, 0, 0));\nA(p) -> A(p + 1);\n",
     );
     let surface = write(
         &dir,
@@ -224,7 +224,8 @@ fn the_same_type_errors_read_the_same() {
     let s = subgram(&["check", &surface]);
     let (cm, _) = message_and_caret(&text(&c.stderr));
     let (sm, _) = message_and_caret(&text(&s.stderr));
-    assert_eq!(cm, "error: type error: cannot apply `+` to V3f and int");
+    // A mesh's positions are doubles: a vertex reads as a `V3d`.
+    assert_eq!(cm, "error: type error: cannot apply `+` to V3d and int");
     assert_eq!(sm, cm);
 }
 
@@ -239,7 +240,7 @@ fn the_most_negative_integer_divided_by_minus_one_is_checked_without_a_panic() {
         &dir,
         "c.lsys",
         &format!(
-            "module A(float);\nderivation length: 1;\nAxiom: A(1);\n\
+            "module A(double);\nderivation length: 1;\nAxiom: A(1);\n\
              A(x) : {{ produce A(x * ({min} / -1)); }}\n"
         ),
     );

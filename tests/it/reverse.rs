@@ -915,7 +915,7 @@ fn a_report_beyond_floating_point_is_refused() {
                 group 1:\nP(vl) < P(va) P(vb) > P(vr) -> P(va)\n\
                 group 2:\nP(v) -> P(V2f(-1.7e308, 0)) P(V2f(-1.7e308, 0))\n";
     let s = Scheme {
-        loaded: subgram::load_str("far.lsys", text, &[]).unwrap(),
+        loaded: subgram::load_str_with("far.lsys", text, &[], subgram::Precision::Double).unwrap(),
         name: "far.lsys".into(),
         closed: true,
         deadline: None,

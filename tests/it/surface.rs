@@ -240,7 +240,7 @@ fn grammar_errors_point_at_the_rule() {
         .unwrap_err()
         .to_string();
     assert!(
-        bad.contains("g.lsys:1:25: error: type error: cannot apply `+` to V3f and int"),
+        bad.contains("g.lsys:1:25: error: type error: cannot apply `+` to V3d and int"),
         "{bad}"
     );
     let bad = subgram::surface::load_str("g.lsys", "V(v) -> V(v = smooth(v));\n", &[])
@@ -456,7 +456,7 @@ fn surface_grammars_run_under_every_command() {
     let o = bin(&["check", bad.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr)
-        .contains("bad.lsys:2:15: error: type mismatch: expected V3f, found float"));
+        .contains("bad.lsys:2:15: error: type mismatch: expected V3d, found double"));
 }
 
 /// Valences and how many vertices have each.
