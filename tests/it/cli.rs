@@ -333,5 +333,17 @@ fn every_view_is_drawn_to_its_own_file() {
         .collect();
     names.sort();
     assert_eq!(names, ["lsystem.l", "out-Side.svg", "out.svg", "view.v"]);
+    // All or none: when one view's file cannot be written (a folder has
+    // its name), no file is written.
+    let again = dir.join("again.svg");
+    std::fs::create_dir(dir.join("again-Side.svg")).unwrap();
+    let o = subgram(&[
+        "render",
+        file.to_str().unwrap(),
+        "-o",
+        again.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(!again.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
