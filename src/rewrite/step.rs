@@ -201,9 +201,6 @@ impl<'p> Rewriter<'p> {
             }
             if cut && src.sym(i) == self.cut {
                 k = self.end_of_branch(src, k, at);
-                if opts.ring && wrapped_at.is_none() && k < n && at(k) < phase {
-                    wrapped_at = Some(dst.len());
-                }
                 continue;
             }
             let remaining = n - k;
@@ -277,12 +274,19 @@ impl<'p> Rewriter<'p> {
     }
 
     /// Where the scan goes on after a `Cut` scanned `k`-th: the matching
-    /// `EB` of its branch, or `n` (the end of the word) when there is none.
+    /// `EB` of its branch, or the end of the word when there is none. On a
+    /// ring scanned from a phase, the end of the word is where the scan
+    /// wraps to its first module (lpfg has no phase: the cut never goes
+    /// round), and the scan goes on there.
     fn end_of_branch(&self, src: &Word, mut k: usize, at: impl Fn(usize) -> usize) -> usize {
         let mut depth = 0usize;
         k += 1;
         while k < src.len() {
-            let s = src.sym(at(k));
+            let j = at(k);
+            if j == 0 {
+                break;
+            }
+            let s = src.sym(j);
             if s == self.sb {
                 depth += 1;
             } else if s == self.eb {
