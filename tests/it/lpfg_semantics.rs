@@ -90,6 +90,21 @@ fn cut_in_a_ring_removes_to_the_end_of_the_word() {
 }
 
 #[test]
+fn cut_on_a_ring_does_not_go_round_from_a_phase() {
+    // lpfg has no phase; subgram's `--phase` starts the scan elsewhere on
+    // a ring. A scan that starts at the Cut removes it with A(4) A(5), to
+    // the end of the word, and then rewrites A(1) A(2) A(3): the word of
+    // phase 0, which lpfg 9bf820d gives as `A(11) A(12) A(13)`.
+    let src = "module A(int);\nderivation length: 1;\nring L-system: 1;\n\
+               Axiom: A(1) A(2) A(3) Cut() A(4) A(5);\nA(x) : { produce A(x+10); }\n";
+    let l = load_text(src);
+    for phase in [0, 1, 3] {
+        let d = derive(&l, DeriveOptions::default().with_phase(phase));
+        assert_eq!(text(&l, &d), "A(11) A(12) A(13)", "phase {phase}");
+    }
+}
+
+#[test]
 fn cut_stays_when_deriving_backward() {
     // Manual 5.4: Cut "has no effect if the derivation direction is
     // Backward". lpfg 9bf820d gives `A(11) Cut() A(12)` (and says "Cut
