@@ -1032,12 +1032,7 @@ impl Compiler {
         let Some(sym) = self.alphabet.lookup(&name.text) else {
             self.err(
                 name.span,
-                format!(
-                    "undeclared module `{}`: declare it before use, e.g. `module {}({});`",
-                    name.text,
-                    name.text,
-                    vec!["float"; count].join(", ")
-                ),
+                super::modules::undeclared(&name.text, &vec!["float"; count].join(", ")),
             );
             return None;
         };
@@ -1107,12 +1102,7 @@ impl Compiler {
                 let types: Vec<String> = args.iter().map(|(_, t)| self.type_name(*t)).collect();
                 self.err(
                     m.name.span,
-                    format!(
-                        "undeclared module `{}`: declare it before use, e.g. `module {}({});`",
-                        m.name.text,
-                        m.name.text,
-                        types.join(", ")
-                    ),
+                    super::modules::undeclared(&m.name.text, &types.join(", ")),
                 );
                 continue;
             };

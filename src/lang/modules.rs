@@ -161,6 +161,39 @@ pub const PREDEFINED: &[(&str, &[&[Ty]])] = &[
     ("DrawSurface", ONE_I),
 ];
 
+/// lpfg's predefined modules that subgram does not have yet, with what
+/// they are for: a program that uses one is told so, not asked to declare
+/// it.
+pub const NOT_YET: &[(&str, &str)] = &[
+    ("DSurface", "it draws a dynamic surface (manual 7.1)"),
+    (
+        "DBSurfaceS",
+        "it draws a dynamic B-spline surface (manual 10.1)",
+    ),
+    (
+        "DBSurfaceM",
+        "it draws a dynamic B-spline surface (manual 10.1)",
+    ),
+    (
+        "EA20",
+        "it exchanges an array with an environmental program (manual 5.13), \
+         and subgram does not run environmental programs",
+    ),
+    ("PovRayStart", "it starts POV-Ray output"),
+];
+
+/// The message for a module that is neither declared nor predefined.
+pub fn undeclared(name: &str, params: &str) -> String {
+    match NOT_YET.iter().find(|(n, _)| *n == name) {
+        Some((_, what)) => {
+            format!("`{name}` is an lpfg module that subgram does not support yet: {what}")
+        }
+        None => format!(
+            "undeclared module `{name}`: declare it before use, e.g. `module {name}({params});`"
+        ),
+    }
+}
+
 impl Alphabet {
     pub fn new() -> Alphabet {
         let mut a = Alphabet {
