@@ -16,6 +16,9 @@ use crate::syntax::{Diagnostic, FileId, SourceMap};
 pub struct Curve {
     pub program: Program,
     pub sources: SourceMap,
+    /// What the view file beside the program sets for the turtle
+    /// (rotations, tropisms); the default without one.
+    pub view: draw::TurtleView,
 }
 
 /// Settings of a figure: how far to derive, how to draw, how to render.
@@ -74,7 +77,7 @@ impl Curve {
         drawn: &Word,
         module: usize,
     ) -> Option<Maker> {
-        let mut d = Derivation::traced(&self.program, opts.derive.clone()).ok()?;
+        let mut d = Derivation::traced(&self.program, self.with_view(opts.derive.clone())).ok()?;
         d.angle().ok()?;
         let mut shown = None;
         if opts.each {
@@ -100,14 +103,23 @@ impl Curve {
     /// `End`.
     pub fn derive(&self, opts: DeriveOptions) -> Result<Derived, Error> {
         check_steps(opts.steps)?;
-        crate::rewrite::derive(&self.program, opts).map_err(|e| self.error(e))
+        crate::rewrite::derive(&self.program, self.with_view(opts)).map_err(|e| self.error(e))
+    }
+
+    /// `opts` with this program's view file settings.
+    fn with_view(&self, opts: DeriveOptions) -> DeriveOptions {
+        DeriveOptions {
+            view: self.view.clone(),
+            ..opts
+        }
     }
 
     /// Derives the axiom to the derivation length (or `opts.steps`) and keeps
     /// the derivation, so that its word can be interpreted and drawn.
     pub fn run(&self, opts: DeriveOptions) -> Result<CurveRun<'_>, Error> {
         check_steps(opts.steps)?;
-        let mut d = Derivation::new(&self.program, opts).map_err(|e| self.error(e))?;
+        let mut d =
+            Derivation::new(&self.program, self.with_view(opts)).map_err(|e| self.error(e))?;
         crate::production::run(&mut d, |_| {}).map_err(|e| self.error(e))?;
         Ok(CurveRun { curve: self, d })
     }
@@ -145,8 +157,9 @@ impl Curve {
         check_steps(opts.derive.steps)?;
         let p = &self.program;
         let fail = |e| self.error(e);
-        let mut d = Derivation::new(p, opts.derive.clone()).map_err(fail)?;
+        let mut d = Derivation::new(p, self.with_view(opts.derive.clone())).map_err(fail)?;
         let mut draw_opts = opts.draw.clone();
+        draw_opts.view = self.view.clone();
         if let Some(a) = d.angle().map_err(fail)? {
             draw_opts.angle = a;
         }
@@ -261,7 +274,10 @@ impl<'c> CurveRun<'c> {
     /// polygons, in 3D.
     pub fn events(&mut self) -> Result<Vec<Event>, Error> {
         let curve = self.curve;
-        let mut opts = draw::DrawOptions::default();
+        let mut opts = draw::DrawOptions {
+            view: curve.view.clone(),
+            ..Default::default()
+        };
         if let Some(a) = self.d.angle().map_err(|e| curve.error(e))? {
             opts.angle = a;
         }

@@ -52,56 +52,118 @@ pub fn load(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<System, Error>
 
 fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
     let text = read(path)?;
-    // The view names of the view file are numbers to the program, as lpfg
-    // defines them; `-D` comes after, so it wins.
-    let mut defines: Vec<String> = window_names(path)
-        .iter()
-        .enumerate()
-        .filter(|(_, n)| is_identifier(n))
-        .map(|(i, n)| format!("{n}={i}"))
-        .collect();
-    defines.extend(opts.defines.iter().cloned());
+    let view = read_view_file(path)?;
+    let defines = view.defines(&opts.defines);
     let front = front(&path.display().to_string(), text, &defines)?;
     if surface::is_surface(&front.tokens) {
         let grammar = surface::from_front(front)?;
         Ok(System::Surface(Surface::new(grammar, Some(path))))
     } else {
-        Ok(System::Curve(curve(front, opts.precision)?))
+        let mut c = curve(front, opts.precision)?;
+        c.view = view.turtle;
+        Ok(System::Curve(c))
     }
 }
 
-/// The views of the view file (`*.v`, the first by name) beside the
-/// program at `path`, by number: the names of its `window:` commands in
-/// order (manual 8.1.1), after an unnamed view 0 when a `view:` command
-/// comes before the first window (lpfg's numbering). Empty without a view
-/// file. A minimal reading of the view file, for view names only.
-pub fn window_names(path: &Path) -> Vec<String> {
+/// What a program takes from the view file beside it (`*.v`, the first by
+/// name; manual 8.1): a minimal reading, of the view names and the
+/// turtle's settings only.
+#[derive(Clone, Debug, Default)]
+pub struct ViewFile {
+    /// The views by number: the names of the `window:` commands in order
+    /// (manual 8.1.1), after an unnamed view 0 when a `view:` command comes
+    /// before the first window (lpfg's numbering).
+    pub windows: Vec<String>,
+    /// `corrected rotation:`, `tropism:`, `torque:` and `stropism:`.
+    pub turtle: crate::draw::TurtleView,
+}
+
+impl ViewFile {
+    /// The view names defined as their numbers, as lpfg defines them for
+    /// the program, then `user`'s `-D`s, which win.
+    fn defines(&self, user: &[String]) -> Vec<String> {
+        let mut d: Vec<String> = self
+            .windows
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| is_identifier(n))
+            .map(|(i, n)| format!("{n}={i}"))
+            .collect();
+        d.extend(user.iter().cloned());
+        d
+    }
+}
+
+/// Reads the view file beside the program at `path` (see [`ViewFile`]);
+/// the default when there is none. A tropism command that cannot be read
+/// is an error at its line.
+pub fn read_view_file(path: &Path) -> Result<ViewFile, Error> {
+    use crate::draw::tropism::{SimpleTropism, Tropism};
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
+    let mut view = ViewFile::default();
     let Ok(entries) = std::fs::read_dir(dir) else {
-        return Vec::new();
+        return Ok(view);
     };
-    let mut files: Vec<_> = entries
+    let mut files: Vec<PathBuf> = entries
         .flatten()
         .map(|e| e.path())
         .filter(|p| p.extension().is_some_and(|e| e == "v") && p.is_file())
+        // Named as the program is: `view.v` beside `lsystem.l`.
+        .map(|p| match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => p,
+            _ => p.file_name().map(PathBuf::from).unwrap_or(p),
+        })
         .collect();
     files.sort();
-    let Some(text) = files.first().and_then(|f| std::fs::read_to_string(f).ok()) else {
-        return Vec::new();
+    let Some(file) = files.first() else {
+        return Ok(view);
     };
-    let mut names = Vec::new();
-    for line in text.lines() {
-        let line = line.split("//").next().unwrap_or("").trim();
+    let text = read(file)?;
+    for (n, raw) in text.lines().enumerate() {
+        let line = raw.split("//").next().unwrap_or("").trim();
+        let bad = |what: &str| {
+            let start = raw.find(line).unwrap_or(0);
+            Error::FileAt {
+                path: file.display().to_string(),
+                line: n + 1,
+                text: raw.to_string(),
+                start,
+                end: start + line.len(),
+                message: format!("cannot read this {what}"),
+            }
+        };
         if let Some(rest) = line.strip_prefix("window:") {
-            names.push(rest.split_whitespace().next().unwrap_or("").to_string());
-        } else if line.starts_with("view:") && names.is_empty() {
-            names.push(String::new());
+            view.windows
+                .push(rest.split_whitespace().next().unwrap_or("").to_string());
+        } else if line.starts_with("view:") && view.windows.is_empty() {
+            view.windows.push(String::new());
+        } else if let Some(rest) = line.strip_prefix("corrected rotation:") {
+            view.turtle.corrected_rotation = rest.trim() != "off";
+        } else if let Some(rest) = line.strip_prefix("tropism:") {
+            let t = Tropism::parse(rest, false).ok_or_else(|| {
+                bad("tropism: expected `T: x y z` (a vector that is not null), then any of `A: angle` (-180 to 180), `I: intensity` (not 0), `E: elasticity`, `S: step`")
+            })?;
+            view.turtle.tropisms.list.push(t);
+        } else if let Some(rest) = line.strip_prefix("torque:") {
+            let t = Tropism::parse(rest, true).ok_or_else(|| {
+                bad("torque: expected `T: x y z` (a vector that is not null), then any of `I: intensity` (not 0), `E: elasticity`, `S: step`")
+            })?;
+            view.turtle.tropisms.list.push(t);
+        } else if let Some(rest) = line.strip_prefix("stropism:") {
+            view.turtle.tropisms.simple = SimpleTropism::parse(rest)
+                .ok_or_else(|| bad("simple tropism: expected `x y z, elasticity`"))?;
         }
     }
-    names
+    Ok(view)
+}
+
+/// The names of the views of the view file beside the program at `path`
+/// (see [`ViewFile::windows`]); none when it cannot be read.
+pub fn window_names(path: &Path) -> Vec<String> {
+    read_view_file(path).map(|v| v.windows).unwrap_or_default()
 }
 
 /// True for a C identifier: a view name the program can use.
@@ -140,11 +202,15 @@ pub fn load_file_with(
     precision: Precision,
 ) -> Result<Curve, Error> {
     let text = read(path)?;
-    curve(
-        front(&path.display().to_string(), text, defines)?,
+    let view = read_view_file(path)?;
+    let defines = view.defines(defines);
+    let mut c = curve(
+        front(&path.display().to_string(), text, &defines)?,
         precision,
     )
-    .map_err(at_most_some)
+    .map_err(at_most_some)?;
+    c.view = view.turtle;
+    Ok(c)
 }
 
 /// Checks text as a curve L-system; `name` is the file name in messages.
@@ -389,7 +455,11 @@ pub(crate) fn curve(front: Front, precision: Precision) -> Result<Curve, Error> 
             program
                 .warnings
                 .sort_by_key(|d| (d.span.file.0, d.span.start));
-            Ok(Curve { program, sources })
+            Ok(Curve {
+                program,
+                sources,
+                view: Default::default(),
+            })
         }
         Err(mut diagnostics) => {
             for d in &mut diagnostics {

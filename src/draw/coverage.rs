@@ -37,14 +37,6 @@ fn gap(name: &str) -> Option<String> {
         }
         "CurrentTexture" | "TextureVCoeff" => no_effect("subgram does not map textures"),
         "SetUPrecision" | "SetVPrecision" => no_effect("subgram does not draw surfaces yet"),
-        "Elasticity"
-        | "SetElasticity"
-        | "IncElasticity"
-        | "DecElasticity"
-        | "SetTropismDirection3f" => no_effect(
-            "subgram does not apply tropisms (the view file's `tropism:` commands), \
-             so branches that bend in lpfg stay straight",
-        ),
         "Camera" => no_effect("subgram fits the view to the drawing"),
         "PovRayStart" => no_effect("subgram does not write POV-Ray files"),
         "E1" | "E2" | "EA20" => Some(format!(

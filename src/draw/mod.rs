@@ -3,6 +3,7 @@
 //! events, so the two always agree.
 
 pub(crate) mod coverage;
+pub mod tropism;
 
 use glam::DVec3;
 
@@ -67,6 +68,12 @@ enum Cmd {
     SetCoordinateSystem,
     Rhombus,
     Triangle,
+    /// `SetElasticity(id, e)`, `IncElasticity(id)` (1), `DecElasticity(id)`
+    /// (-1).
+    SetElasticity(i8),
+    /// `Elasticity(e)`: the simple tropism's.
+    Elasticity,
+    SetTropismDirection,
 }
 
 /// The turtle axis a rotation turns about.
@@ -77,13 +84,19 @@ enum DVec3Axis {
     Head,
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct Turtle {
     pos: DVec3,
     head: DVec3,
     left: DVec3,
     up: DVec3,
     pen: Pen,
+    /// The elasticity of each of the view file's tropisms, as this turtle
+    /// (and the branch it belongs to) set them.
+    elasticity: Vec<f64>,
+    /// The simple tropism (`stropism:`), which `Elasticity` and
+    /// `SetTropismDirection3f` change for this turtle.
+    simple: tropism::SimpleTropism,
     /// The coordinate system of `MoveTo`, `LineTo` and their kin, which
     /// `SetCoordinateSystem` sets (pushed and popped with the turtle).
     frame: Cartesian,
@@ -115,8 +128,10 @@ impl Cartesian {
 const EPSILON: f64 = 1e-5;
 
 impl Turtle {
-    fn new() -> Turtle {
+    fn new(elasticity: Vec<f64>, simple: tropism::SimpleTropism) -> Turtle {
         Turtle {
+            elasticity,
+            simple,
             pos: DVec3::ZERO,
             head: DVec3::Y,
             left: DVec3::NEG_X,
@@ -227,6 +242,8 @@ pub struct DrawOptions {
     pub angle: f64,
     /// Length of `F` without an argument.
     pub step: f64,
+    /// What the view file sets for the turtle.
+    pub view: TurtleView,
 }
 
 impl Default for DrawOptions {
@@ -234,6 +251,26 @@ impl Default for DrawOptions {
         DrawOptions {
             angle: 90.0,
             step: 1.0,
+            view: TurtleView::default(),
+        }
+    }
+}
+
+/// The view file's settings of the turtle (manual 8.1.3, 8.1.4).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TurtleView {
+    /// `corrected rotation:` (default on). Off, `Up`, `Down`, `RollL` and
+    /// `RollR` turn the other way, as lpfg's old versions did.
+    pub corrected_rotation: bool,
+    /// `tropism:`, `torque:` and `stropism:`.
+    pub tropisms: tropism::Tropisms,
+}
+
+impl Default for TurtleView {
+    fn default() -> Self {
+        TurtleView {
+            corrected_rotation: true,
+            tropisms: tropism::Tropisms::default(),
         }
     }
 }
@@ -309,6 +346,11 @@ fn command(name: &str) -> Cmd {
         "SetCoordinateSystem" => Cmd::SetCoordinateSystem,
         "Rhombus" => Cmd::Rhombus,
         "Triangle" => Cmd::Triangle,
+        "SetElasticity" => Cmd::SetElasticity(0),
+        "IncElasticity" => Cmd::SetElasticity(1),
+        "DecElasticity" => Cmd::SetElasticity(-1),
+        "Elasticity" => Cmd::Elasticity,
+        "SetTropismDirection3f" => Cmd::SetTropismDirection,
         // `Cut` is not here: lpfg's turtle ignores it, and derivation
         // steps remove it with the rest of its branch.
         _ => Cmd::None,
@@ -357,8 +399,16 @@ pub fn draw_with_queries(
             }
         })
         .collect();
-    let mut t = Turtle::new();
+    let tropisms = &opts.view.tropisms;
+    let mut field = tropism::Field::new(&tropisms.list);
+    let mut t = Turtle::new(field.initial(), tropisms.simple);
     let mut stack: Vec<Turtle> = Vec::new();
+    // lpfg's old rotations turn Up, Down, RollL and RollR the other way.
+    let sense = if opts.view.corrected_rotation {
+        1.0
+    } else {
+        -1.0
+    };
     let mut polygons: Vec<Vec<DVec3>> = Vec::new();
     let mut out = Vec::new();
     let mut i = 0;
@@ -393,6 +443,7 @@ pub fn draw_with_queries(
         match cmd {
             Cmd::None => {}
             Cmd::Forward { draw, record } => {
+                field.adjust(&mut t.head, &mut t.left, &mut t.up);
                 let to = t.pos + t.head * arg(0, opts.step);
                 if draw {
                     out.push(Event::Line {
@@ -407,6 +458,7 @@ pub fn draw_with_queries(
                         p.push(to);
                     }
                 }
+                tropism::bend(&t.simple, &mut t.head, &mut t.left, &mut t.up);
             }
             Cmd::MoveTo => t.pos = t.frame.place(point()),
             Cmd::MoveRel => t.pos += t.frame.place(point()),
@@ -446,7 +498,13 @@ pub fn draw_with_queries(
                     }
                 }
             }
-            Cmd::Turn(axis, sign) => t.turn(axis, sign * arg(0, opts.angle)),
+            Cmd::Turn(axis, sign) => {
+                let sign = match axis {
+                    DVec3Axis::Up => sign,
+                    DVec3Axis::Left | DVec3Axis::Head => sign * sense,
+                };
+                t.turn(axis, sign * arg(0, opts.angle))
+            }
             Cmd::TurnAround => t.turn(DVec3Axis::Up, 180.0),
             Cmd::SetColor => {
                 let c = int_arg();
@@ -457,12 +515,27 @@ pub fn draw_with_queries(
             Cmd::IncColor => t.pen.color += 1,
             Cmd::DecColor => t.pen.color -= 1,
             Cmd::SetWidth => t.pen.width = arg(0, 1.0),
-            Cmd::Push => stack.push(t),
+            Cmd::Push => stack.push(t.clone()),
             Cmd::Pop => {
                 if let Some(s) = stack.pop() {
                     t = s;
+                    field.restore(&t.elasticity);
                 }
             }
+            Cmd::SetElasticity(sign) => {
+                let id = int_arg();
+                let e = match sign {
+                    0 => Some(arg(1, 0.0)),
+                    _ => field.stepped(id, f64::from(sign)),
+                };
+                if let Some(e) = e {
+                    if field.set(id, e) {
+                        t.elasticity[id as usize] = e;
+                    }
+                }
+            }
+            Cmd::Elasticity => t.simple.elasticity = arg(0, 0.0),
+            Cmd::SetTropismDirection => t.simple.direction = point(),
             Cmd::Disc | Cmd::Ring => {
                 let r = arg(0, 1.0);
                 if !(t.pos.abs().max_element() + r.abs()).is_finite() {

@@ -24,6 +24,9 @@ pub struct DeriveOptions {
     /// The derivation, its decomposition and interpretation stop with an
     /// error once this passes. Default: none.
     pub deadline: Option<Deadline>,
+    /// The view file's turtle settings (rotations, tropisms), for the
+    /// interpretation that answers query modules. Default: none.
+    pub view: crate::draw::TurtleView,
 }
 
 impl Default for DeriveOptions {
@@ -33,6 +36,7 @@ impl Default for DeriveOptions {
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             deadline: None,
+            view: crate::draw::TurtleView::default(),
         }
     }
 }
@@ -286,7 +290,10 @@ impl<'p> Derivation<'p> {
             depth,
             &mut sources,
         )?;
-        let mut draw_opts = crate::draw::DrawOptions::default();
+        let mut draw_opts = crate::draw::DrawOptions {
+            view: self.opts.view.clone(),
+            ..Default::default()
+        };
         if let Some(a) = self.angle()? {
             draw_opts.angle = a;
         }

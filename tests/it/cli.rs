@@ -347,3 +347,30 @@ fn every_view_is_drawn_to_its_own_file() {
     assert!(!again.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A tropism of the view file that cannot be read (a null direction, which
+/// lpfg refuses too) is an error at its line, with the line and a caret.
+#[test]
+fn a_bad_tropism_in_the_view_file_is_an_error_at_its_line() {
+    let dir = std::env::temp_dir().join(format!("subgram-cli-bad-view-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let view = dir.join("view.v");
+    std::fs::write(&view, "corrected rotation: on\ntropism: T: 0 0 0 E: 1\n").unwrap();
+    let file = dir.join("lsystem.l");
+    std::fs::write(&file, "derivation length: 1;\nAxiom: F(1);\n").unwrap();
+    let o = subgram(&["check", file.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(
+        err.starts_with(&format!(
+            "{}:2:1: error: cannot read this tropism: expected `T: x y z`",
+            view.display()
+        )),
+        "{err}"
+    );
+    assert!(
+        err.contains("2 | tropism: T: 0 0 0 E: 1\n  | ^^^^^^^^^^^^^^^^^^^^^^"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -369,3 +369,76 @@ fn rhombus_and_triangle_are_polygons_in_the_hl_plane() {
         ]
     );
 }
+
+/// The query vectors of `program` derived beside a view file `view`.
+fn queries_with_view(name: &str, view: &str, program: &str) -> Vec<[f64; 3]> {
+    let dir = std::env::temp_dir().join(format!("subgram-lpfg-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("view.v"), view).unwrap();
+    let file = dir.join("lsystem.l");
+    std::fs::write(&file, program).unwrap();
+    let l = load(&file);
+    // The curve's own derive: it brings the view file's settings.
+    let d = l.derive(DeriveOptions::default()).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    d.word
+        .modules(&l.program.alphabet, &l.program.structs)
+        .filter(|(s, _)| l.program.alphabet.name(*s).starts_with("Get"))
+        .map(|(_, ps)| {
+            let f: Vec<f64> = ps.iter().map(Value::as_f64).collect();
+            [f[0], f[1], f[2]]
+        })
+        .collect()
+}
+
+#[test]
+fn tropisms_of_the_view_file_bend_the_turtle_as_lpfg_does() {
+    // Manual 5.11 and 8.1.4: two tropisms (the second with an angle, an
+    // intensity and a step), changed by SetElasticity inside a branch
+    // (undone at its end) and by IncElasticity and DecElasticity. lpfg
+    // 9bf820d gives GetPos(-0.41180086,0.7883673,0.45705268) ... as listed
+    // below.
+    let view = "tropism: T: 0 -1 0 E: 0.3\ntropism: T: 1 0 0 A: 45 I: 2 E: 0.1 S: 0.05\n";
+    let program = "derivation length: 1;\n\
+        Axiom: Left(30) Up(20) F(1) GetPos(0,0,0) GetHead(0,0,0) GetUp(0,0,0) \
+        SB() SetElasticity(0, 0.6) F(1) GetHead(0,0,0) IncElasticity(1) F(1) GetHead(0,0,0) EB() \
+        F(1) GetPos(0,0,0) GetHead(0,0,0) DecElasticity(1) f(2) GetPos(0,0,0) GetLeft(0,0,0);\n\
+        GetHead(x,y,z) : { produce GetHead(x,y,z); }\n";
+    let lpfg = [
+        [-0.41180086, 0.7883673, 0.45705268],
+        [-0.41180086, 0.7883673, 0.45705268],
+        [0.22659694, -0.39721283, 0.88931197],
+        [-0.41706395, 0.59466606, 0.6873355],
+        [-0.26911467, 0.23072453, 0.93506336],
+        [-0.7448687, 1.5186445, 1.05351],
+        [-0.33306783, 0.7302772, 0.5964573],
+        [-1.3749291, 2.720795, 2.5224752],
+        [-0.8827991, -0.4697159, 0.005754024],
+    ];
+    assert_close(&queries_with_view("tropism", view, program), &lpfg);
+}
+
+#[test]
+fn torque_simple_tropism_and_old_rotations_as_lpfg_does() {
+    // A torque, a simple tropism (stropism, then Elasticity and
+    // SetTropismDirection3f in a branch) and `corrected rotation: off`,
+    // under which Up and RollL turn the other way. lpfg 9bf820d gives
+    // GetPos(-0.4698463,0.81379765,-0.34202012) ... as listed below.
+    let view = "torque: T: 0 0 1 E: 0.4\nstropism: 0 -1 0, 0.2\ncorrected rotation: off\n";
+    let program = "derivation length: 1;\n\
+        Axiom: Left(30) Up(20) RollL(10) F(1) GetPos(0,0,0) GetHead(0,0,0) GetUp(0,0,0) \
+        SB() Elasticity(0.5) F(1) GetHead(0,0,0) SetTropismDirection3f(V3f(1,0,0)) G(1) \
+        GetHead(0,0,0) EB() F(1) GetPos(0,0,0) GetHead(0,0,0) GetLeft(0,0,0);\n\
+        GetHead(x,y,z) : { produce GetHead(x,y,z); }\n";
+    let lpfg = [
+        [-0.4698463, 0.81379765, -0.34202012],
+        [-0.5431325, 0.7408682, -0.39512172],
+        [0.00476411, 0.47329235, 0.88089263],
+        [-0.71307385, 0.47653702, -0.5142354],
+        [-0.4225716, 0.61358297, -0.66704506],
+        [-1.0129788, 1.5546658, -0.73714185],
+        [-0.61867213, 0.6441538, -0.44978946],
+        [-0.78450924, -0.47568265, 0.39783323],
+    ];
+    assert_close(&queries_with_view("torque", view, program), &lpfg);
+}
