@@ -60,7 +60,7 @@ fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
         Ok(System::Surface(Surface::new(grammar, Some(path))))
     } else {
         let mut c = curve(front, opts.precision)?;
-        c.view = view.turtle;
+        view.give_to(&mut c);
         Ok(System::Curve(c))
     }
 }
@@ -76,9 +76,32 @@ pub struct ViewFile {
     pub windows: Vec<String>,
     /// `corrected rotation:`, `tropism:`, `torque:` and `stropism:`.
     pub turtle: crate::draw::TurtleView,
+    /// The file's name and text, and the lines it could not read (their
+    /// byte ranges and what was expected), which are left out.
+    file: Option<(String, String)>,
+    problems: Vec<(usize, usize, String)>,
 }
 
 impl ViewFile {
+    /// Gives the turtle settings to `c`, and the lines that could not be
+    /// read as warnings at their place in the view file, which joins
+    /// `c`'s sources.
+    fn give_to(self, c: &mut Curve) {
+        c.view = self.turtle;
+        let Some((name, text)) = self.file.filter(|_| !self.problems.is_empty()) else {
+            return;
+        };
+        let id = c.sources.add(SourceFile::new(name, text));
+        for (start, end, message) in self.problems {
+            c.program
+                .warnings
+                .push(Diagnostic::new(Span::new(id, start, end), message));
+        }
+        c.program
+            .warnings
+            .sort_by_key(|d| (d.span.file.0, d.span.start));
+    }
+
     /// The view names defined as their numbers, as lpfg defines them for
     /// the program, then `user`'s `-D`s, which win.
     fn defines(&self, user: &[String]) -> Vec<String> {
@@ -96,7 +119,8 @@ impl ViewFile {
 
 /// Reads the view file beside the program at `path` (see [`ViewFile`]);
 /// the default when there is none. A tropism command that cannot be read
-/// is an error at its line.
+/// is left out, with a warning at its line (lpfg too says so and goes
+/// on).
 pub fn read_view_file(path: &Path) -> Result<ViewFile, Error> {
     use crate::draw::tropism::{SimpleTropism, Tropism};
     let dir = match path.parent() {
@@ -122,18 +146,21 @@ pub fn read_view_file(path: &Path) -> Result<ViewFile, Error> {
         return Ok(view);
     };
     let text = read(file)?;
-    for (n, raw) in text.lines().enumerate() {
+    let mut at = 0;
+    for raw in text.split_inclusive('\n') {
+        let line_start = at;
+        at += raw.len();
+        let raw = raw.trim_end_matches(['\n', '\r']);
         let line = raw.split("//").next().unwrap_or("").trim();
-        let bad = |what: &str| {
-            let start = raw.find(line).unwrap_or(0);
-            Error::FileAt {
-                path: file.display().to_string(),
-                line: n + 1,
-                text: raw.to_string(),
+        let start = line_start + raw.find(line).unwrap_or(0);
+        let mut bad = |kind: &str, expected: &str| {
+            view.problems.push((
                 start,
-                end: start + line.len(),
-                message: format!("cannot read this {what}"),
-            }
+                start + line.len(),
+                format!(
+                    "this {kind} cannot be read and is left out (lpfg refuses it too): expected {expected}"
+                ),
+            ))
         };
         if let Some(rest) = line.strip_prefix("window:") {
             view.windows
@@ -143,20 +170,23 @@ pub fn read_view_file(path: &Path) -> Result<ViewFile, Error> {
         } else if let Some(rest) = line.strip_prefix("corrected rotation:") {
             view.turtle.corrected_rotation = rest.trim() != "off";
         } else if let Some(rest) = line.strip_prefix("tropism:") {
-            let t = Tropism::parse(rest, false).ok_or_else(|| {
-                bad("tropism: expected `T: x y z` (a vector that is not null), then any of `A: angle` (-180 to 180), `I: intensity` (not 0), `E: elasticity`, `S: step`")
-            })?;
-            view.turtle.tropisms.list.push(t);
+            match Tropism::parse(rest, false) {
+                Some(t) => view.turtle.tropisms.list.push(t),
+                None => bad("tropism", "`T: x y z` (a vector that is not null), then any of `A: angle` (-180 to 180), `I: intensity` (not 0), `E: elasticity`, `S: step`, with numbers separated by blanks"),
+            }
         } else if let Some(rest) = line.strip_prefix("torque:") {
-            let t = Tropism::parse(rest, true).ok_or_else(|| {
-                bad("torque: expected `T: x y z` (a vector that is not null), then any of `I: intensity` (not 0), `E: elasticity`, `S: step`")
-            })?;
-            view.turtle.tropisms.list.push(t);
+            match Tropism::parse(rest, true) {
+                Some(t) => view.turtle.tropisms.list.push(t),
+                None => bad("torque", "`T: x y z` (a vector that is not null), then any of `I: intensity` (not 0), `E: elasticity`, `S: step`, with numbers separated by blanks"),
+            }
         } else if let Some(rest) = line.strip_prefix("stropism:") {
-            view.turtle.tropisms.simple = SimpleTropism::parse(rest)
-                .ok_or_else(|| bad("simple tropism: expected `x y z, elasticity`"))?;
+            match SimpleTropism::parse(rest) {
+                Some(t) => view.turtle.tropisms.simple = t,
+                None => bad("simple tropism", "`x y z, elasticity`"),
+            }
         }
     }
+    view.file = Some((file.display().to_string(), text));
     Ok(view)
 }
 
@@ -209,7 +239,7 @@ pub fn load_file_with(
         precision,
     )
     .map_err(at_most_some)?;
-    c.view = view.turtle;
+    view.give_to(&mut c);
     Ok(c)
 }
 

@@ -55,9 +55,12 @@ pub struct Tropisms {
 
 impl Tropism {
     /// The text after `tropism:` or `torque:`: `T: x y z` and optional
-    /// `A: a`, `I: i`, `E: e`, `S: s`. `None` when it cannot be read, or
-    /// when lpfg refuses it (a null direction, an angle beyond 180
-    /// degrees, a zero intensity, an angle for a torque).
+    /// `A: a`, `I: i`, `E: e`, `S: s`, read as lpfg reads them (a letter
+    /// and the character after it, then numbers, each the start of a
+    /// blank-separated word: `A:90` and `T: 1 0 0` are read, `T: 0,1,0` is
+    /// not). `None` when it cannot be read, or when lpfg refuses it (a null
+    /// direction, an angle beyond 180 degrees, a zero intensity, an angle
+    /// for a torque).
     pub fn parse(text: &str, torque: bool) -> Option<Tropism> {
         let mut t = Tropism {
             torque,
@@ -67,47 +70,61 @@ impl Tropism {
             step: 0.0,
         };
         let mut intensity = 1.0;
-        let words: Vec<&str> = text.split_whitespace().collect();
-        let mut k = 0;
-        let number = |k: usize| words.get(k)?.parse::<f64>().ok();
-        while k < words.len() {
-            match words[k] {
-                "T:" => {
-                    t.direction = DVec3::new(number(k + 1)?, number(k + 2)?, number(k + 3)?);
+        let mut rest = text.trim_start();
+        while let Some(letter) = rest.chars().next() {
+            // The letter and the character after it (the colon).
+            let after = rest.char_indices().nth(2).map_or("", |(i, _)| &rest[i..]);
+            let count = if letter == 'T' { 3 } else { 1 };
+            let (v, r) = read_floats(after, count)?;
+            rest = r;
+            match letter {
+                'T' => {
+                    t.direction = DVec3::new(v[0], v[1], v[2]);
                     if t.direction == DVec3::ZERO {
                         return None;
                     }
-                    k += 4;
                 }
-                "A:" if !torque => {
-                    let a = number(k + 1)?;
-                    if !(-180.0..=180.0).contains(&a) {
+                'A' if !torque => {
+                    if !(-180.0..=180.0).contains(&v[0]) {
                         return None;
                     }
-                    t.angle = a.to_radians();
-                    k += 2;
+                    t.angle = v[0].to_radians();
                 }
-                "I:" => {
-                    intensity = number(k + 1)?;
-                    if intensity == 0.0 {
-                        return None;
-                    }
-                    k += 2;
-                }
-                "E:" => {
-                    t.elasticity = number(k + 1)?;
-                    k += 2;
-                }
-                "S:" => {
-                    t.step = number(k + 1)?;
-                    k += 2;
-                }
+                'I' if v[0] != 0.0 => intensity = v[0],
+                'E' => t.elasticity = v[0],
+                'S' => t.step = v[0],
                 _ => return None,
             }
         }
         t.direction *= intensity;
         Some(t)
     }
+}
+
+/// `count` numbers at the start of `text`'s blank-separated words, as C's
+/// `sscanf("%f")` reads each (`0,1` reads 0), and the text after them.
+fn read_floats(text: &str, count: usize) -> Option<(Vec<f64>, &str)> {
+    let mut text = text.trim_start();
+    let mut v = Vec::with_capacity(count);
+    for _ in 0..count {
+        let end = text.find(char::is_whitespace).unwrap_or(text.len());
+        v.push(leading_float(&text[..end])?);
+        text = text[end..].trim_start();
+    }
+    Some((v, text))
+}
+
+/// The longest start of `word` that is a number.
+fn leading_float(word: &str) -> Option<f64> {
+    let ends: Vec<usize> = word
+        .char_indices()
+        .map(|(i, c)| i + c.len_utf8())
+        .take(64)
+        .collect();
+    ends.iter()
+        .rev()
+        .find_map(|&e| word[..e].parse::<f64>().ok())
+        .filter(|x| x.is_finite())
 }
 
 impl SimpleTropism {
