@@ -274,7 +274,10 @@ fn fopen_needs_allow_writes_and_a_path_inside_the_folder() {
     std::fs::write(&file, src.replace("NAME", "sub/out.txt")).unwrap();
     let mut args = subgram::command::DeriveArgs::new(file.to_str().unwrap());
     args.allow_writes = Some(dir.clone());
-    assert_eq!(subgram::command::derive(&args, |_| {}).unwrap(), "A(1)");
+    assert_eq!(
+        subgram::command::derive(&args, |_| {}).unwrap().text,
+        "A(1)"
+    );
     assert_eq!(
         std::fs::read_to_string(dir.join("sub/out.txt")).unwrap(),
         "1\n"
