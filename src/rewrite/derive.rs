@@ -215,6 +215,23 @@ impl<'p> Derivation<'p> {
                     .convert(g.ty);
             }
         }
+        let mut d = Derivation {
+            program,
+            rewriter: Rewriter::new(program),
+            env,
+            word: Word::new(),
+            spare: Word::new(),
+            ring: false,
+            length: 0,
+            step: 0,
+            opts,
+            makers: None,
+            view: 0,
+        };
+        // `Start` runs before the directives are read, as in lpfg, whose
+        // `derivation length:` may read what `Start` computed
+        // (`derivation length: (int)(simulation_ends/dt);`).
+        d.control(ControlKind::Start)?;
         type Directive = Option<(crate::lang::ir::Ex, Span)>;
         let mut number =
             |e: &Directive, env: &mut Env| -> Result<Option<(f64, Span)>, DeriveError> {
@@ -228,9 +245,9 @@ impl<'p> Derivation<'p> {
                     None => Ok(None),
                 }
             };
-        let stated = number(&program.derivation_length, &mut env)?;
-        let ring = number(&program.ring, &mut env)?.is_some_and(|(v, _)| v != 0.0);
-        let length = match (opts.steps, stated) {
+        let stated = number(&program.derivation_length, &mut d.env)?;
+        d.ring = number(&program.ring, &mut d.env)?.is_some_and(|(v, _)| v != 0.0);
+        d.length = match (d.opts.steps, stated) {
             (Some(n), _) => n,
             (None, None) => 0,
             (None, Some((v, span))) => {
@@ -246,29 +263,16 @@ impl<'p> Derivation<'p> {
                 v as u64
             }
         };
-        if length > MAX_STEPS {
+        if d.length > MAX_STEPS {
             return Err(DeriveError {
                 span: None,
                 message: format!(
-                    "a derivation length of {length} steps is beyond the limit of {MAX_STEPS}"
+                    "a derivation length of {} steps is beyond the limit of {MAX_STEPS}",
+                    d.length
                 ),
                 step: 0,
             });
         }
-        let mut d = Derivation {
-            program,
-            rewriter: Rewriter::new(program),
-            env,
-            word: Word::new(),
-            spare: Word::new(),
-            ring,
-            length,
-            step: 0,
-            opts,
-            makers: None,
-            view: 0,
-        };
-        d.control(ControlKind::Start)?;
         if let Some(m) = program.axiom.get(d.opts.max_modules) {
             return Err(DeriveError {
                 span: Some(m.span),
