@@ -84,12 +84,34 @@ impl DeriveArgs {
     }
 }
 
+/// What `derive` prints: the word (or the mesh's description) for standard
+/// output, and the checker's warnings for standard error.
+#[derive(Clone, Debug)]
+pub struct Printed {
+    pub text: String,
+    /// Each rendered with `file:line:col: warning:`, the line and a caret.
+    pub warnings: Vec<String>,
+}
+
 /// `subgram derive`: a curve's final word (or its interpretation) as text
-/// or JSON; for a surface grammar, the subdivided mesh's description.
-pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, Error> {
+/// or JSON; for a surface grammar, the subdivided mesh's description. The
+/// program's warnings come with it.
+pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<Printed, Error> {
     let deadline = a.timeout.map(Deadline::after);
     let dir = writes_folder(&a.allow_writes, &a.output)?;
     let system = load(&a.file, &load_options(&a.defines, a.double))?;
+    let warnings = system.warnings();
+    let text = derive_text(a, system, deadline, dir.as_deref(), progress)?;
+    Ok(Printed { text, warnings })
+}
+
+fn derive_text(
+    a: &DeriveArgs,
+    system: System,
+    deadline: Option<Deadline>,
+    dir: Option<&Path>,
+    progress: impl FnMut(Progress),
+) -> Result<String, Error> {
     let opts = RunOptions {
         steps: a.steps,
         max_modules: a.max_modules,
@@ -130,7 +152,7 @@ pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<String, 
                     c.word_text(&word)
                 }
             };
-            write_program_files(&a.output, dir.as_deref(), &[Path::new(&a.file)])?;
+            write_program_files(&a.output, dir, &[Path::new(&a.file)])?;
             Ok(word)
         }
     }
@@ -199,8 +221,8 @@ impl RenderArgs {
 }
 
 /// `subgram render`: a curve's picture, a surface grammar's subdivided
-/// mesh, or a mesh file, as PNG or SVG.
-pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Error> {
+/// mesh, or a mesh file, as PNG or SVG. Returns the program's warnings.
+pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<String>, Error> {
     let deadline = a.timeout.map(Deadline::after);
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
@@ -213,10 +235,33 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
         wireframe: a.wireframe,
     };
     if mesh::io::Format::from_path(file).is_some() {
-        return write_mesh_picture(&load_mesh(file)?, output, &looks);
+        write_mesh_picture(&load_mesh(file)?, output, &looks)?;
+        return Ok(Vec::new());
     }
     let format = Picture::from_path(output)?;
-    match load(file, &load_options(&a.defines, a.double))? {
+    let system = load(file, &load_options(&a.defines, a.double))?;
+    let mut warnings = system.warnings();
+    warnings.extend(render_system(
+        a,
+        system,
+        (&looks, format),
+        deadline,
+        progress,
+    )?);
+    Ok(warnings)
+}
+
+fn render_system(
+    a: &RenderArgs,
+    system: System,
+    (looks, format): (&MeshLooks, Picture),
+    deadline: Option<Deadline>,
+    progress: impl FnMut(Progress),
+) -> Result<Vec<String>, Error> {
+    let output = Path::new(&a.output);
+    let file = Path::new(&a.file);
+    let white = Rgba(255, 255, 255, 255);
+    match system {
         System::Surface(s) => {
             looks.check()?;
             let opts = RunOptions {
@@ -225,7 +270,8 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                 ..RunOptions::default()
             };
             let run = s.subdivide(&opts, progress)?;
-            write_mesh_picture(&run.mesh, output, &looks)
+            write_mesh_picture(&run.mesh, output, looks)?;
+            Ok(Vec::new())
         }
         System::Curve(c) => {
             let view = match a.view.as_deref().unwrap_or("xy") {
@@ -271,9 +317,9 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<(), Erro
                     ..Default::default()
                 },
             };
-            let scene = c.figure(&figure)?;
+            let figures = c.figures(&figure)?;
             write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
-            write_picture(&scene, output, format)
+            write_views(&figures, Path::new(&a.file), output, format, a.force)
         }
     }
 }
@@ -618,6 +664,55 @@ impl Picture {
 /// Draws `scene` in `format` and writes it to `path` whole, or not at all.
 pub fn write_picture(scene: &Scene, path: &Path, format: Picture) -> Result<(), Error> {
     write_file(path, &picture_bytes(scene, format)?)
+}
+
+/// Writes the main view to `output` and each other view that the view
+/// file names to `OUTPUT-NAME.EXT` beside it, all or none. Returns a
+/// warning for each view that `UseView` activated and the view file does
+/// not define (lpfg ignores those too).
+fn write_views(
+    figures: &crate::Figures,
+    program: &Path,
+    output: &Path,
+    format: Picture,
+    force: bool,
+) -> Result<Vec<String>, Error> {
+    let names = crate::load::window_names(program);
+    let mut files: Vec<(PathBuf, Vec<u8>)> =
+        vec![(output.to_path_buf(), picture_bytes(&figures.main, format)?)];
+    let mut warnings = Vec::new();
+    for (view, scene) in &figures.views {
+        let name = usize::try_from(*view)
+            .ok()
+            .and_then(|v| names.get(v))
+            .filter(|n| crate::load::is_identifier(n));
+        let Some(name) = name else {
+            warnings.push(format!(
+                "{}: warning: `UseView({view})`: the view file defines no view {view}, so it is not drawn",
+                program.display()
+            ));
+            continue;
+        };
+        files.push((view_path(output, name), picture_bytes(scene, format)?));
+    }
+    let outputs: Vec<&Path> = files.iter().map(|(p, _)| p.as_path()).collect();
+    refuse_overwrite(&outputs, &[program], force)?;
+    let all: Vec<(&Path, &[u8])> = files
+        .iter()
+        .map(|(p, b)| (p.as_path(), b.as_slice()))
+        .collect();
+    crate::atomic::write_all_atomic(&all).map_err(|(path, e)| Error::write(path, e))?;
+    Ok(warnings)
+}
+
+/// `out.png` and view `Top`: `out-Top.png`, in the same folder.
+fn view_path(output: &Path, name: &str) -> PathBuf {
+    let stem = output.file_stem().unwrap_or_default().to_string_lossy();
+    let file = match output.extension() {
+        Some(ext) => format!("{stem}-{name}.{}", ext.to_string_lossy()),
+        None => format!("{stem}-{name}"),
+    };
+    output.with_file_name(file)
 }
 
 /// `scene` drawn in `format`.

@@ -16,6 +16,9 @@ use crate::syntax::{Diagnostic, FileId, SourceMap};
 pub struct Curve {
     pub program: Program,
     pub sources: SourceMap,
+    /// What the view file beside the program sets for the turtle
+    /// (rotations, tropisms); the default without one.
+    pub view: draw::TurtleView,
 }
 
 /// Settings of a figure: how far to derive, how to draw, how to render.
@@ -74,7 +77,7 @@ impl Curve {
         drawn: &Word,
         module: usize,
     ) -> Option<Maker> {
-        let mut d = Derivation::traced(&self.program, opts.derive.clone()).ok()?;
+        let mut d = Derivation::traced(&self.program, self.with_view(opts.derive.clone())).ok()?;
         d.angle().ok()?;
         let mut shown = None;
         if opts.each {
@@ -100,7 +103,15 @@ impl Curve {
     /// `End`.
     pub fn derive(&self, opts: DeriveOptions) -> Result<Derived, Error> {
         check_steps(opts.steps)?;
-        crate::rewrite::derive(&self.program, opts).map_err(|e| self.error(e))
+        crate::rewrite::derive(&self.program, self.with_view(opts)).map_err(|e| self.error(e))
+    }
+
+    /// `opts` with this program's view file settings.
+    fn with_view(&self, opts: DeriveOptions) -> DeriveOptions {
+        DeriveOptions {
+            view: self.view.clone(),
+            ..opts
+        }
     }
 
     /// Derives the axiom to the derivation length (or `opts.steps`), runs
@@ -108,7 +119,8 @@ impl Curve {
     /// and drawn.
     pub fn run(&self, opts: DeriveOptions) -> Result<CurveRun<'_>, Error> {
         check_steps(opts.steps)?;
-        let mut d = Derivation::new(&self.program, opts).map_err(|e| self.error(e))?;
+        let mut d =
+            Derivation::new(&self.program, self.with_view(opts)).map_err(|e| self.error(e))?;
         crate::production::run(&mut d, |_| {}).map_err(|e| self.error(e))?;
         d.end().map_err(|e| self.error(e))?;
         Ok(CurveRun { curve: self, d })
@@ -132,26 +144,47 @@ impl Curve {
         .to_string()
     }
 
-    /// Derives, interprets and lays out the program's picture.
+    /// Derives, interprets and lays out the program's picture: its main
+    /// view (see [`Curve::figures`] for the others).
     pub fn figure(&self, opts: &FigureOptions) -> Result<render::Scene, Error> {
+        Ok(self.figures(opts)?.main)
+    }
+
+    /// Derives once and lays out the picture of every view: the main view
+    /// (the interpretation rules outside any `vgroup`), and each view that
+    /// `UseView` activated (the rules after its `vgroup`), in the order of
+    /// their first `UseView`. With `each`, a view activated after the first
+    /// step has panels from that step on.
+    pub fn figures(&self, opts: &FigureOptions) -> Result<Figures, Error> {
         check_steps(opts.derive.steps)?;
         let p = &self.program;
         let fail = |e| self.error(e);
-        let mut d = Derivation::new(p, opts.derive.clone()).map_err(fail)?;
+        let mut d = Derivation::new(p, self.with_view(opts.derive.clone())).map_err(fail)?;
         let mut draw_opts = opts.draw.clone();
         draw_opts.model = p.model.clone();
+        draw_opts.view = self.view.clone();
         if let Some(a) = d.angle().map_err(fail)? {
             draw_opts.angle = a;
         }
-        let mut panels = Vec::new();
+        // Each view's panels, the main view's first.
+        let mut panels: Vec<(i64, Vec<Vec<Event>>)> = vec![(0, Vec::new())];
         let mut panel = |d: &mut Derivation| -> Result<(), Error> {
-            let word = d.interpret().map_err(fail)?;
-            let step = d.step;
-            let events = draw::draw(&word, &p.alphabet, &p.structs, &draw_opts).map_err(|e| {
-                let maker = (e.module).and_then(|m| self.maker_in_figure(opts, step, &word, m));
-                self.draw_error(e, step, maker)
-            })?;
-            panels.push(events);
+            let others: Vec<i64> = d.views().iter().copied().filter(|v| *v != 0).collect();
+            for view in std::iter::once(0).chain(others) {
+                let word = d.interpret_view(view).map_err(fail)?;
+                let step = d.step;
+                let events =
+                    draw::draw(&word, &p.alphabet, &p.structs, &draw_opts).map_err(|e| {
+                        let maker = (e.module)
+                            .filter(|_| view == 0)
+                            .and_then(|m| self.maker_in_figure(opts, step, &word, m));
+                        self.draw_error(e, step, maker)
+                    })?;
+                match panels.iter_mut().find(|(v, _)| *v == view) {
+                    Some((_, list)) => list.push(events),
+                    None => panels.push((view, vec![events])),
+                }
+            }
             Ok(())
         };
         if opts.each {
@@ -167,8 +200,24 @@ impl Curve {
         if !opts.each {
             panel(&mut d)?;
         }
-        Ok(render::scene(&panels, &opts.render)?)
+        let mut scenes = Vec::with_capacity(panels.len());
+        for (view, list) in &panels {
+            scenes.push((*view, render::scene(list, &opts.render)?));
+        }
+        let (_, main) = scenes.remove(0);
+        Ok(Figures {
+            main,
+            views: scenes,
+        })
     }
+}
+
+/// The pictures of a program's views (manual 7.3): the main one, and one
+/// per view that `UseView` activated, by view number.
+#[derive(Clone, Debug)]
+pub struct Figures {
+    pub main: render::Scene,
+    pub views: Vec<(i64, render::Scene)>,
 }
 
 /// More steps than this are refused before a derivation starts.
@@ -230,6 +279,7 @@ impl<'c> CurveRun<'c> {
         let curve = self.curve;
         let mut opts = draw::DrawOptions {
             model: curve.program.model.clone(),
+            view: curve.view.clone(),
             ..Default::default()
         };
         if let Some(a) = self.d.angle().map_err(|e| curve.error(e))? {

@@ -48,7 +48,7 @@ pub mod render;
 pub mod reverse;
 pub mod surface;
 
-pub use curve::{Curve, CurveRun, FigureOptions};
+pub use curve::{Curve, CurveRun, FigureOptions, Figures};
 pub use deadline::{Deadline, DEFAULT_TIMEOUT};
 pub use error::Error;
 pub use lang::{Program, ProgramOutput, Stream, Value};

@@ -58,12 +58,16 @@ fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
         return Ok(System::Curve(c));
     }
     let text = read(path)?;
-    let front = front(&path.display().to_string(), text, &opts.defines)?;
+    let view = read_view_file(path)?;
+    let defines = view.defines(&opts.defines);
+    let front = front(&path.display().to_string(), text, &defines)?;
     if surface::is_surface(&front.tokens) {
-        let grammar = surface::from_front(front)?;
+        let grammar = with_stack(move || surface::from_front(front))?;
         Ok(System::Surface(Surface::new(grammar, Some(path))))
     } else {
-        Ok(System::Curve(curve(front, opts.precision)?))
+        let mut c = curve(front, opts.precision)?;
+        view.give_to(&mut c);
+        Ok(System::Curve(c))
     }
 }
 
@@ -78,6 +82,7 @@ fn load_model_file(
     precision: Precision,
 ) -> Result<Curve, Error> {
     let text = read(path)?;
+    let view = read_view_file(path)?;
     let mut defines = m.defines();
     defines.retain(|d| {
         let name = d.split('=').next().unwrap_or("");
@@ -85,7 +90,8 @@ fn load_model_file(
             .iter()
             .any(|u| u.split('=').next().map(str::trim) == Some(name))
     });
-    defines.extend(user.iter().cloned());
+    // The view names, then the user's `-D`s, which win.
+    defines.extend(view.defines(user));
     let front = front(&path.display().to_string(), text, &defines)?;
     let mut c = match curve(front, precision) {
         Ok(c) => c,
@@ -101,6 +107,7 @@ fn load_model_file(
         ));
     }
     c.program.model = std::sync::Arc::new(m);
+    view.give_to(&mut c);
     Ok(c)
 }
 
@@ -162,6 +169,149 @@ fn name_missing_entities(e: Error, m: &Model) -> Error {
     }
 }
 
+/// What a program takes from the view file beside it (`*.v`, the first by
+/// name; manual 8.1): a minimal reading, of the view names and the
+/// turtle's settings only.
+#[derive(Clone, Debug, Default)]
+pub struct ViewFile {
+    /// The views by number: the names of the `window:` commands in order
+    /// (manual 8.1.1), after an unnamed view 0 when a `view:` command comes
+    /// before the first window (lpfg's numbering).
+    pub windows: Vec<String>,
+    /// `corrected rotation:`, `tropism:`, `torque:` and `stropism:`.
+    pub turtle: crate::draw::TurtleView,
+    /// The file's name and text, and the lines it could not read (their
+    /// byte ranges and what was expected), which are left out.
+    file: Option<(String, String)>,
+    problems: Vec<(usize, usize, String)>,
+}
+
+impl ViewFile {
+    /// Gives the turtle settings to `c`, and the lines that could not be
+    /// read as warnings at their place in the view file, which joins
+    /// `c`'s sources.
+    fn give_to(self, c: &mut Curve) {
+        c.view = self.turtle;
+        let Some((name, text)) = self.file.filter(|_| !self.problems.is_empty()) else {
+            return;
+        };
+        let id = c.sources.add(SourceFile::new(name, text));
+        for (start, end, message) in self.problems {
+            c.program
+                .warnings
+                .push(Diagnostic::new(Span::new(id, start, end), message));
+        }
+        c.program
+            .warnings
+            .sort_by_key(|d| (d.span.file.0, d.span.start));
+    }
+
+    /// The view names defined as their numbers, as lpfg defines them for
+    /// the program, then `user`'s `-D`s, which win.
+    fn defines(&self, user: &[String]) -> Vec<String> {
+        let mut d: Vec<String> = self
+            .windows
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| is_identifier(n))
+            .map(|(i, n)| format!("{n}={i}"))
+            .collect();
+        d.extend(user.iter().cloned());
+        d
+    }
+}
+
+/// Reads the view file beside the program at `path` (see [`ViewFile`]);
+/// the default when there is none. A tropism command that cannot be read
+/// is left out, with a warning at its line (lpfg too says so and goes
+/// on).
+pub fn read_view_file(path: &Path) -> Result<ViewFile, Error> {
+    use crate::draw::tropism::{SimpleTropism, Tropism};
+    // A model folder holds its view file; a program has it beside it.
+    let dir = if path.is_dir() {
+        path
+    } else {
+        match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        }
+    };
+    let mut view = ViewFile::default();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(view);
+    };
+    let mut files: Vec<PathBuf> = entries
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "v") && p.is_file())
+        // Named as the program is: `view.v` beside `lsystem.l`.
+        .map(|p| match path.parent() {
+            _ if path.is_dir() => p,
+            Some(d) if !d.as_os_str().is_empty() => p,
+            _ => p.file_name().map(PathBuf::from).unwrap_or(p),
+        })
+        .collect();
+    files.sort();
+    let Some(file) = files.first() else {
+        return Ok(view);
+    };
+    let text = read(file)?;
+    let mut at = 0;
+    for raw in text.split_inclusive('\n') {
+        let line_start = at;
+        at += raw.len();
+        let raw = raw.trim_end_matches(['\n', '\r']);
+        let line = raw.split("//").next().unwrap_or("").trim();
+        let start = line_start + raw.find(line).unwrap_or(0);
+        let mut bad = |kind: &str, expected: &str| {
+            view.problems.push((
+                start,
+                start + line.len(),
+                format!(
+                    "this {kind} cannot be read and is left out (lpfg refuses it too): expected {expected}"
+                ),
+            ))
+        };
+        if let Some(rest) = line.strip_prefix("window:") {
+            view.windows
+                .push(rest.split_whitespace().next().unwrap_or("").to_string());
+        } else if line.starts_with("view:") && view.windows.is_empty() {
+            view.windows.push(String::new());
+        } else if let Some(rest) = line.strip_prefix("corrected rotation:") {
+            view.turtle.corrected_rotation = rest.trim() != "off";
+        } else if let Some(rest) = line.strip_prefix("tropism:") {
+            match Tropism::parse(rest, false) {
+                Some(t) => view.turtle.tropisms.list.push(t),
+                None => bad("tropism", "`T: x y z` (a vector that is not null), then any of `A: angle` (-180 to 180), `I: intensity` (not 0), `E: elasticity`, `S: step`, with numbers separated by blanks"),
+            }
+        } else if let Some(rest) = line.strip_prefix("torque:") {
+            match Tropism::parse(rest, true) {
+                Some(t) => view.turtle.tropisms.list.push(t),
+                None => bad("torque", "`T: x y z` (a vector that is not null), then any of `I: intensity` (not 0), `E: elasticity`, `S: step`, with numbers separated by blanks"),
+            }
+        } else if let Some(rest) = line.strip_prefix("stropism:") {
+            match SimpleTropism::parse(rest) {
+                Some(t) => view.turtle.tropisms.simple = t,
+                None => bad("simple tropism", "`x y z, elasticity`"),
+            }
+        }
+    }
+    view.file = Some((file.display().to_string(), text));
+    Ok(view)
+}
+
+/// The names of the views of the view file beside the program at `path`
+/// (see [`ViewFile::windows`]); none when it cannot be read.
+pub fn window_names(path: &Path) -> Vec<String> {
+    read_view_file(path).map(|v| v.windows).unwrap_or_default()
+}
+
+/// True for a C identifier: a view name the program can use.
+pub(crate) fn is_identifier(name: &str) -> bool {
+    name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && name.chars().next().is_some_and(|c| !c.is_ascii_digit())
+}
+
 /// Checks program text, as [`load`] does a file; `name` is the file name in
 /// messages. A surface grammar's `mesh:` is then relative to the current
 /// folder.
@@ -172,7 +322,7 @@ pub fn load_text(name: &str, text: &str, opts: &LoadOptions) -> Result<System, E
 fn load_text_as(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Error> {
     let front = front(name, text.to_string(), &opts.defines)?;
     if surface::is_surface(&front.tokens) {
-        let grammar = surface::from_front(front)?;
+        let grammar = with_stack(move || surface::from_front(front))?;
         Ok(System::Surface(Surface::new(grammar, None)))
     } else {
         Ok(System::Curve(curve(front, opts.precision)?))
@@ -193,11 +343,15 @@ pub fn load_file_with(
     precision: Precision,
 ) -> Result<Curve, Error> {
     let text = read(path)?;
-    curve(
-        front(&path.display().to_string(), text, defines)?,
+    let view = read_view_file(path)?;
+    let defines = view.defines(defines);
+    let mut c = curve(
+        front(&path.display().to_string(), text, &defines)?,
         precision,
     )
-    .map_err(at_most_some)
+    .map_err(at_most_some)?;
+    view.give_to(&mut c);
+    Ok(c)
 }
 
 /// Checks text as a curve L-system; `name` is the file name in messages.
@@ -419,6 +573,35 @@ pub(crate) fn front(name: &str, text: String, defines: &[String]) -> Result<Fron
 
 /// Parses and checks preprocessed tokens as a curve L-system.
 pub(crate) fn curve(front: Front, precision: Precision) -> Result<Curve, Error> {
+    with_stack(move || check_curve(front, precision))
+}
+
+/// Where the front end's recursion runs: parsing and checking descend once
+/// per level of nesting (up to the limit of 100 levels, each a chain of a
+/// dozen calls), which must not depend on how much stack the caller's
+/// thread has (a test thread has 2 MiB, and a debug build's frames are
+/// large).
+const FRONT_STACK: usize = 64 << 20;
+
+/// Runs `f` on a thread with [`FRONT_STACK`] bytes of stack (reserved, and
+/// used as needed), or on this thread when no thread can be made.
+pub(crate) fn with_stack<T: Send>(f: impl FnOnce() -> T + Send) -> T {
+    let mut f = Some(f);
+    let spawned = std::thread::scope(|s| {
+        std::thread::Builder::new()
+            .name("subgram-check".into())
+            .stack_size(FRONT_STACK)
+            .spawn_scoped(s, || (f.take().expect("not run yet"))())
+            .map(|h| h.join())
+    });
+    match spawned {
+        Ok(Ok(v)) => v,
+        Ok(Err(panic)) => std::panic::resume_unwind(panic),
+        Err(_) => (f.take().expect("not run: the thread was not made"))(),
+    }
+}
+
+fn check_curve(front: Front, precision: Precision) -> Result<Curve, Error> {
     let eof = front.eof();
     let Front {
         sources, tokens, ..
@@ -434,7 +617,20 @@ pub(crate) fn curve(front: Front, precision: Precision) -> Result<Curve, Error> 
         }
     };
     match lang::compile::compile_with(&file, precision) {
-        Ok(program) => Ok(Curve { program, sources }),
+        Ok(mut program) => {
+            // What the turtle does not act on is said, not dropped.
+            program
+                .warnings
+                .extend(crate::draw::coverage::warnings(&program));
+            program
+                .warnings
+                .sort_by_key(|d| (d.span.file.0, d.span.start));
+            Ok(Curve {
+                program,
+                sources,
+                view: Default::default(),
+            })
+        }
         Err(mut diagnostics) => {
             for d in &mut diagnostics {
                 if d.span == Span::default() {

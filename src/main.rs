@@ -388,7 +388,9 @@ fn run(cli: Cli) -> Result<(), Error> {
             // The program's standard output goes before the word, or to
             // standard error when the word is JSON, which must stay whole.
             print_program_output(&args.output, json)?;
-            print_out(&result?)
+            let printed = result?;
+            print_warnings(&printed.warnings);
+            print_out(&printed.text)
         }
         Command::Render {
             file,
@@ -429,7 +431,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             };
             let result = with_progress(|p| command::render(&args, p));
             print_program_output(&args.program_output, false)?;
-            result
+            print_warnings(&result?);
+            Ok(())
         }
         Command::Subdivide {
             mesh,
@@ -572,6 +575,13 @@ fn print_program_output(output: &subgram::ProgramOutput, to_stderr: bool) -> Res
         }
     }
     Ok(())
+}
+
+/// Writes a program's warnings to stderr, each followed by a blank line.
+fn print_warnings(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("{w}\n");
+    }
 }
 
 /// Writes a line to stdout; a closed pipe (`subgram derive f | head`) is not an error.

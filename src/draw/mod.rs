@@ -2,6 +2,9 @@
 //! emits renderer-neutral [`Event`]s in 3D. PNG and SVG both draw these
 //! events, so the two always agree.
 
+pub(crate) mod coverage;
+pub mod tropism;
+
 use glam::DVec3;
 
 use crate::lang::value::StructDef;
@@ -50,7 +53,6 @@ enum Cmd {
     SetWidth,
     Push,
     Pop,
-    Cut,
     Disc,
     Dot,
     Ring,
@@ -61,6 +63,20 @@ enum Cmd {
     /// surface.
     Surface,
     Query(u8),
+    SetHead,
+    SetHead3,
+    RollToVert,
+    /// `RotateXYZ` (`true`: about a global axis) or `RotateHLU`.
+    Rotate(bool),
+    SetCoordinateSystem,
+    Rhombus,
+    Triangle,
+    /// `SetElasticity(id, e)`, `IncElasticity(id)` (1), `DecElasticity(id)`
+    /// (-1).
+    SetElasticity(i8),
+    /// `Elasticity(e)`: the simple tropism's.
+    Elasticity,
+    SetTropismDirection,
 }
 
 /// The turtle axis a rotation turns about.
@@ -71,18 +87,54 @@ enum DVec3Axis {
     Head,
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct Turtle {
     pos: DVec3,
     head: DVec3,
     left: DVec3,
     up: DVec3,
     pen: Pen,
+    /// The elasticity of each of the view file's tropisms, as this turtle
+    /// (and the branch it belongs to) set them.
+    elasticity: Vec<f64>,
+    /// The simple tropism (`stropism:`), which `Elasticity` and
+    /// `SetTropismDirection3f` change for this turtle.
+    simple: tropism::SimpleTropism,
+    /// The coordinate system of `MoveTo`, `LineTo` and their kin, which
+    /// `SetCoordinateSystem` sets (pushed and popped with the turtle).
+    frame: Cartesian,
 }
 
+/// lpfg's coordinate system for the modules that take points: a point
+/// `(x, y, z)` is `origin + scale * (x * -x_axis + y * y_axis + z * z_axis)`.
+/// By default `x_axis` is the turtle's first left vector, so that the
+/// transformation is the identity.
+#[derive(Clone, Copy, Debug)]
+struct Cartesian {
+    origin: DVec3,
+    x_axis: DVec3,
+    y_axis: DVec3,
+    z_axis: DVec3,
+    scale: f64,
+}
+
+impl Cartesian {
+    /// Where the point `p` of the coordinate system lies. As in lpfg, the
+    /// relative modules (`MoveRel`, `LineRel`) add the origin too.
+    fn place(&self, p: DVec3) -> DVec3 {
+        let p = p * self.scale;
+        self.origin - self.x_axis * p.x + self.y_axis * p.y + self.z_axis * p.z
+    }
+}
+
+/// Lengths below this make lpfg ignore a module (manual 5.1, 5.2).
+const EPSILON: f64 = 1e-5;
+
 impl Turtle {
-    fn new() -> Turtle {
+    fn new(elasticity: Vec<f64>, simple: tropism::SimpleTropism) -> Turtle {
         Turtle {
+            elasticity,
+            simple,
             pos: DVec3::ZERO,
             head: DVec3::Y,
             left: DVec3::NEG_X,
@@ -91,7 +143,84 @@ impl Turtle {
                 color: 1,
                 width: 1.0,
             },
+            frame: Cartesian {
+                origin: DVec3::ZERO,
+                x_axis: DVec3::NEG_X,
+                y_axis: DVec3::Y,
+                z_axis: DVec3::Z,
+                scale: 1.0,
+            },
         }
+    }
+
+    /// `SetHead(h, u)` (manual 5.2): heading `h` and up `u`, normalised, in
+    /// the coordinate system; left is `u x h` and up becomes `h x left`.
+    /// Ignored when either is shorter than epsilon or they are parallel.
+    fn set_head(&mut self, h: DVec3, u: DVec3) {
+        if h.length() < EPSILON || u.length() < EPSILON {
+            return;
+        }
+        let linear =
+            |v: DVec3| -self.frame.x_axis * v.x + self.frame.y_axis * v.y + self.frame.z_axis * v.z;
+        let h = linear(h.normalize());
+        let u = linear(u.normalize());
+        let left = u.cross(h);
+        if left.length() < EPSILON {
+            return;
+        }
+        self.head = h;
+        self.left = left;
+        self.up = h.cross(left);
+    }
+
+    /// `SetHead3f(h)`: the frame turned by the smallest rotation that takes
+    /// the heading to `h` (parallel transport); a reversal turns it about
+    /// up by 180 degrees.
+    fn set_heading(&mut self, h: DVec3) {
+        if h.length() < EPSILON {
+            return;
+        }
+        let linear = -self.frame.x_axis * h.x + self.frame.y_axis * h.y + self.frame.z_axis * h.z;
+        let (old, new) = (self.head.normalize(), linear.normalize());
+        let cos = old.dot(new);
+        if cos.abs() < 1.0 - EPSILON {
+            let q = glam::DQuat::from_axis_angle(old.cross(new).normalize(), cos.acos());
+            self.head = q * self.head;
+            self.left = q * self.left;
+            self.up = q * self.up;
+        } else if cos < 0.0 {
+            self.turn(DVec3Axis::Up, 180.0);
+        }
+    }
+
+    /// `RollToVert()`: roll about the heading so that left is horizontal
+    /// (`left = Y x H`, normalised; `-X` when the heading is vertical) and
+    /// up is `H x left`.
+    fn roll_to_vert(&mut self) {
+        let left = DVec3::Y.cross(self.head);
+        self.left = if left.length() < EPSILON {
+            DVec3::NEG_X
+        } else {
+            left.normalize()
+        };
+        self.up = self.head.cross(self.left);
+    }
+
+    /// `RotateXYZ`/`RotateHLU`: the frame turned by `deg` degrees (right
+    /// hand) about `axis`, given in global or in turtle (H, L, U)
+    /// coordinates. Ignored for an axis shorter than epsilon.
+    fn rotate(&mut self, axis: DVec3, deg: f64, global: bool) {
+        if axis.length() < EPSILON {
+            return;
+        }
+        let axis = match global {
+            true => axis,
+            false => self.head * axis.x + self.left * axis.y + self.up * axis.z,
+        };
+        let q = glam::DQuat::from_axis_angle(axis.normalize(), deg.to_radians());
+        self.head = q * self.head;
+        self.left = q * self.left;
+        self.up = q * self.up;
     }
 
     /// Rotates by `deg` degrees about one of the turtle's own axes.
@@ -118,6 +247,8 @@ pub struct DrawOptions {
     pub step: f64,
     /// The model the word came with: its surfaces for `Surface`.
     pub model: std::sync::Arc<crate::model::Model>,
+    /// What the view file sets for the turtle.
+    pub view: TurtleView,
 }
 
 impl Default for DrawOptions {
@@ -126,6 +257,26 @@ impl Default for DrawOptions {
             angle: 90.0,
             step: 1.0,
             model: Default::default(),
+            view: TurtleView::default(),
+        }
+    }
+}
+
+/// The view file's settings of the turtle (manual 8.1.3, 8.1.4).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TurtleView {
+    /// `corrected rotation:` (default on). Off, `Up`, `Down`, `RollL` and
+    /// `RollR` turn the other way, as lpfg's old versions did.
+    pub corrected_rotation: bool,
+    /// `tropism:`, `torque:` and `stropism:`.
+    pub tropisms: tropism::Tropisms,
+}
+
+impl Default for TurtleView {
+    fn default() -> Self {
+        TurtleView {
+            corrected_rotation: true,
+            tropisms: tropism::Tropisms::default(),
         }
     }
 }
@@ -183,7 +334,6 @@ fn command(name: &str) -> Cmd {
         "SetWidth" => Cmd::SetWidth,
         "SB" => Cmd::Push,
         "EB" => Cmd::Pop,
-        "Cut" => Cmd::Cut,
         "Circle" | "CircleFront" | "Sphere" => Cmd::Disc,
         "Circle0" | "CircleFront0" | "Sphere0" => Cmd::Dot,
         "CircleB" | "CircleFrontB" => Cmd::Ring,
@@ -195,8 +345,29 @@ fn command(name: &str) -> Cmd {
         "GetHead" => Cmd::Query(1),
         "GetLeft" => Cmd::Query(2),
         "GetUp" => Cmd::Query(3),
+        "SetHead" => Cmd::SetHead,
+        "SetHead3f" => Cmd::SetHead3,
+        "RollToVert" => Cmd::RollToVert,
+        "RotateXYZ" | "Rotate" => Cmd::Rotate(true),
+        "RotateHLU" => Cmd::Rotate(false),
+        "SetCoordinateSystem" => Cmd::SetCoordinateSystem,
+        "Rhombus" => Cmd::Rhombus,
+        "Triangle" => Cmd::Triangle,
+        "SetElasticity" => Cmd::SetElasticity(0),
+        "IncElasticity" => Cmd::SetElasticity(1),
+        "DecElasticity" => Cmd::SetElasticity(-1),
+        "Elasticity" => Cmd::Elasticity,
+        "SetTropismDirection3f" => Cmd::SetTropismDirection,
+        // `Cut` is not here: lpfg's turtle ignores it, and derivation
+        // steps remove it with the rest of its branch.
         _ => Cmd::None,
     }
+}
+
+/// True when the turtle acts on the predefined module `name` (draws, moves,
+/// turns, sets the pen, answers a query).
+pub fn acts_on(name: &str) -> bool {
+    command(name) != Cmd::None
 }
 
 /// True for lpfg's query modules, which the turtle fills in.
@@ -214,14 +385,15 @@ pub fn draw(
     draw_with_queries(word, alphabet, structs, opts, None)
 }
 
-/// Like [`draw`]; also records, for every query module met, the vector it
-/// asks for (`GetPos`: position, `GetHead`/`GetLeft`/`GetUp`: the frame).
+/// Like [`draw`]; also records, for every query module met, its index in
+/// `word` and the vector it asks for (`GetPos`: position,
+/// `GetHead`/`GetLeft`/`GetUp`: the frame).
 pub fn draw_with_queries(
     word: &Word,
     alphabet: &Alphabet,
     structs: &[StructDef],
     opts: &DrawOptions,
-    mut queries: Option<&mut Vec<[f64; 3]>>,
+    mut queries: Option<&mut Vec<(usize, [f64; 3])>>,
 ) -> Result<Vec<Event>, DrawError> {
     let cmds: Vec<Cmd> = alphabet
         .kinds
@@ -234,8 +406,16 @@ pub fn draw_with_queries(
             }
         })
         .collect();
-    let mut t = Turtle::new();
+    let tropisms = &opts.view.tropisms;
+    let mut field = tropism::Field::new(&tropisms.list);
+    let mut t = Turtle::new(field.initial(), tropisms.simple);
     let mut stack: Vec<Turtle> = Vec::new();
+    // lpfg's old rotations turn Up, Down, RollL and RollR the other way.
+    let sense = if opts.view.corrected_rotation {
+        1.0
+    } else {
+        -1.0
+    };
     let mut polygons: Vec<Vec<DVec3>> = Vec::new();
     let mut out = Vec::new();
     let mut i = 0;
@@ -270,6 +450,7 @@ pub fn draw_with_queries(
         match cmd {
             Cmd::None => {}
             Cmd::Forward { draw, record } => {
+                field.adjust(&mut t.head, &mut t.left, &mut t.up);
                 let to = t.pos + t.head * arg(0, opts.step);
                 if draw {
                     out.push(Event::Line {
@@ -284,23 +465,29 @@ pub fn draw_with_queries(
                         p.push(to);
                     }
                 }
+                tropism::bend(&t.simple, &mut t.head, &mut t.left, &mut t.up);
             }
-            Cmd::MoveTo => t.pos = point(),
-            Cmd::MoveRel => t.pos += point(),
+            Cmd::MoveTo => t.pos = t.frame.place(point()),
+            Cmd::MoveRel => t.pos += t.frame.place(point()),
             Cmd::LineTo | Cmd::LineRel => {
                 let to = if cmd == Cmd::LineTo {
-                    point()
+                    t.frame.place(point())
                 } else {
-                    t.pos + point()
+                    t.pos + t.frame.place(point())
                 };
-                if t.pos.distance(to) >= 1e-5 {
+                // lpfg ignores a line shorter than epsilon; a drawn one
+                // moves as `F` does, and so records a polygon vertex.
+                if t.pos.distance(to) >= EPSILON {
                     out.push(Event::Line {
                         a: t.pos,
                         b: to,
                         pen: t.pen,
                     });
+                    t.pos = to;
+                    if let Some(p) = polygons.last_mut() {
+                        p.push(to);
+                    }
                 }
-                t.pos = to;
             }
             Cmd::Line => {
                 let (a, b) = if d.len() == 4 {
@@ -308,12 +495,23 @@ pub fn draw_with_queries(
                 } else {
                     (DVec3::new(d[0], d[1], d[2]), DVec3::new(d[3], d[4], d[5]))
                 };
-                if a.distance(b) >= 1e-5 {
+                let (a, b) = (t.frame.place(a), t.frame.place(b));
+                // lpfg ignores a line shorter than epsilon altogether.
+                if a.distance(b) >= EPSILON {
                     out.push(Event::Line { a, b, pen: t.pen });
+                    t.pos = b;
+                    if let Some(p) = polygons.last_mut() {
+                        p.push(b);
+                    }
                 }
-                t.pos = b;
             }
-            Cmd::Turn(axis, sign) => t.turn(axis, sign * arg(0, opts.angle)),
+            Cmd::Turn(axis, sign) => {
+                let sign = match axis {
+                    DVec3Axis::Up => sign,
+                    DVec3Axis::Left | DVec3Axis::Head => sign * sense,
+                };
+                t.turn(axis, sign * arg(0, opts.angle))
+            }
             Cmd::TurnAround => t.turn(DVec3Axis::Up, 180.0),
             Cmd::SetColor => {
                 let c = int_arg();
@@ -324,28 +522,27 @@ pub fn draw_with_queries(
             Cmd::IncColor => t.pen.color += 1,
             Cmd::DecColor => t.pen.color -= 1,
             Cmd::SetWidth => t.pen.width = arg(0, 1.0),
-            Cmd::Push => stack.push(t),
+            Cmd::Push => stack.push(t.clone()),
             Cmd::Pop => {
                 if let Some(s) = stack.pop() {
                     t = s;
+                    field.restore(&t.elasticity);
                 }
             }
-            Cmd::Cut => {
-                // Skip to the end of the current branch.
-                let mut depth = 0;
-                while i + 1 < n {
-                    let name = alphabet.name(word.sym(i + 1));
-                    if name == "SB" {
-                        depth += 1;
-                    } else if name == "EB" {
-                        if depth == 0 {
-                            break;
-                        }
-                        depth -= 1;
+            Cmd::SetElasticity(sign) => {
+                let id = int_arg();
+                let e = match sign {
+                    0 => Some(arg(1, 0.0)),
+                    _ => field.stepped(id, f64::from(sign)),
+                };
+                if let Some(e) = e {
+                    if field.set(id, e) {
+                        t.elasticity[id as usize] = e;
                     }
-                    i += 1;
                 }
             }
+            Cmd::Elasticity => t.simple.elasticity = arg(0, 0.0),
+            Cmd::SetTropismDirection => t.simple.direction = point(),
             Cmd::Disc | Cmd::Ring => {
                 let r = arg(0, 1.0);
                 if !(t.pos.abs().max_element() + r.abs()).is_finite() {
@@ -378,7 +575,7 @@ pub fn draw_with_queries(
             Cmd::Query(q) => {
                 if let Some(qs) = queries.as_deref_mut() {
                     let v = [t.pos, t.head, t.left, t.up][q as usize];
-                    qs.push([v.x, v.y, v.z]);
+                    qs.push((i, [v.x, v.y, v.z]));
                 }
             }
             Cmd::Surface => {
@@ -406,6 +603,56 @@ pub fn draw_with_queries(
                     DVec3::splat(arg(1, 1.0))
                 };
                 surface_events(s, &t, scale, &mut out);
+            }
+            Cmd::SetHead => t.set_head(
+                DVec3::new(arg(0, 0.0), arg(1, 0.0), arg(2, 0.0)),
+                DVec3::new(arg(3, 0.0), arg(4, 0.0), arg(5, 0.0)),
+            ),
+            Cmd::SetHead3 => t.set_heading(point()),
+            Cmd::RollToVert => t.roll_to_vert(),
+            Cmd::Rotate(global) => t.rotate(
+                DVec3::new(arg(0, 0.0), arg(1, 0.0), arg(2, 0.0)),
+                arg(3, 0.0),
+                global,
+            ),
+            Cmd::SetCoordinateSystem => {
+                t.frame = Cartesian {
+                    origin: t.pos,
+                    x_axis: t.left,
+                    y_axis: t.head,
+                    z_axis: t.up,
+                    scale: arg(0, 1.0),
+                }
+            }
+            Cmd::Rhombus | Cmd::Triangle => {
+                // lpfg's shapes in the HL plane, the turtle at the middle
+                // of the bottom edge (Rhombus(length, width),
+                // Triangle(width, height)).
+                let (a, b) = (arg(0, 0.0), arg(1, 0.0));
+                let (p, h, l) = (t.pos, t.head, t.left);
+                let points = if cmd == Cmd::Rhombus {
+                    vec![
+                        p,
+                        p + h * (a * 0.5) + l * (b * 0.5),
+                        p + h * a,
+                        p + h * (a * 0.5) - l * (b * 0.5),
+                    ]
+                } else {
+                    vec![p + l * (a * 0.5), p + h * b, p - l * (a * 0.5)]
+                };
+                if points.iter().any(|q| !q.is_finite()) {
+                    return Err(beyond(
+                        word,
+                        i,
+                        alphabet,
+                        structs,
+                        "draws a shape that reaches",
+                    ));
+                }
+                out.push(Event::Polygon {
+                    points,
+                    color: t.pen.color,
+                });
             }
             Cmd::StartPolygon => polygons.push(Vec::new()),
             Cmd::PolygonPoint => {

@@ -4,9 +4,9 @@
 //! through this table, so `fabs`, `%`, `/` and division by zero mean the
 //! same in a curve and in a surface grammar.
 
-use super::ir::Func;
+use super::ir::{Batch, Func};
 use super::random::Op;
-use super::value::Ty;
+use super::value::{Ty, CAMERA_POSITION, MOUSE_STATUS};
 
 /// Why a call does not fit a built-in's signature.
 #[derive(Clone, Debug, PartialEq)]
@@ -132,6 +132,19 @@ macro_rules! math2 {
             resolve: |a| {
                 numbers(a, 2)?;
                 Ok((Func::Math2($f), Ty::Float))
+            },
+        }
+    };
+}
+
+/// A function of one view number (manual 6.4).
+macro_rules! view {
+    ($name:literal, $b:expr, $t:expr) => {
+        Builtin {
+            name: $name,
+            resolve: |a| {
+                numbers(a, 1)?;
+                Ok((Func::Batch($b), $t))
             },
         }
     };
@@ -314,8 +327,8 @@ pub static LIBRARY: &[Builtin] = &[
     nullary!("RunSimulation", Func::NoOp, Ty::Void),
     nullary!("PauseSimulation", Func::NoOp, Ty::Void),
     nullary!("DisplayFrame", Func::NoOp, Ty::Void),
-    nullary!("Environment", Func::NoOp, Ty::Void),
-    nullary!("NoEnvironment", Func::NoOp, Ty::Void),
+    nullary!("Environment", Func::Environment(true), Ty::Void),
+    nullary!("NoEnvironment", Func::Environment(false), Ty::Void),
     Builtin {
         name: "UseGroup",
         resolve: |a| {
@@ -355,6 +368,43 @@ pub static LIBRARY: &[Builtin] = &[
     random!("GillespieTime", 0, Op::GillespieTime, Ty::Double),
     random!("SeedGillespie", 1, Op::SeedGillespie, Ty::Void),
     random!("ResetGillespie", 0, Op::ResetGillespie, Ty::Void),
+    // Mouse, menu and views (manual 6.4, 6.5): a batch run has no window.
+    nullary!(
+        "GetMouseStatus",
+        Func::Batch(Batch::MouseStatus),
+        Ty::Struct(MOUSE_STATUS)
+    ),
+    nullary!("UserMenuChoice", Func::Batch(Batch::MenuChoice), Ty::Int),
+    nullary!("UserMenuClear", Func::NoOp, Ty::Void),
+    Builtin {
+        name: "UserMenuItem",
+        resolve: |a| match a {
+            [Ty::Str, t] if t.is_numeric() => Ok((Func::NoOp, Ty::Void)),
+            [_, _] => Err(SigError::Message(
+                "`UserMenuItem` takes a label (a string) and an id (an integer)".to_string(),
+            )),
+            _ => Err(SigError::Arity(2)),
+        },
+    },
+    view!(
+        "GetCameraPosition",
+        Batch::CameraPosition,
+        Ty::Struct(CAMERA_POSITION)
+    ),
+    Builtin {
+        name: "UseView",
+        resolve: |a| {
+            numbers(a, 1)?;
+            Ok((Func::UseView, Ty::Void))
+        },
+    },
+    view!("vvXmin", Batch::ViewMin(0), Ty::Float),
+    view!("vvYmin", Batch::ViewMin(1), Ty::Float),
+    view!("vvZmin", Batch::ViewMin(2), Ty::Float),
+    view!("vvXmax", Batch::ViewMax(0), Ty::Float),
+    view!("vvYmax", Batch::ViewMax(1), Ty::Float),
+    view!("vvZmax", Batch::ViewMax(2), Ty::Float),
+    view!("vvScale", Batch::ViewScale, Ty::Float),
 ];
 
 #[cfg(test)]

@@ -31,6 +31,14 @@ pub enum Precision {
 pub fn compile_with(file: &ast::File, precision: Precision) -> Result<Program, Vec<Diagnostic>> {
     let mut c = Compiler::new(&WORD_HOST, Vec::new());
     c.single = precision == Precision::Single;
+    // The predefined structs' single-precision fields follow too.
+    if !c.single {
+        for d in &mut c.structs {
+            for (_, t) in &mut d.fields {
+                *t = t.widened();
+            }
+        }
+    }
     c.declarations(file);
     if file.abop {
         c.declare_from_use(file);
@@ -330,9 +338,28 @@ impl Compiler {
         for (i, f) in functions.iter().enumerate() {
             function_names.entry(f.name.clone()).or_insert(i);
         }
+        // lpfg's predefined structs come first, known by name like the
+        // user's.
+        let structs = super::value::predefined_structs();
+        let struct_names = structs
+            .iter()
+            .enumerate()
+            .map(|(i, d)| (d.name.clone(), i as u16))
+            .collect();
+        let struct_fields = structs
+            .iter()
+            .map(|d| {
+                d.fields
+                    .iter()
+                    .enumerate()
+                    .map(|(i, (n, _))| (n.clone(), i as u16))
+                    .collect()
+            })
+            .collect();
+        let struct_shapes = structs.iter().map(|d| (1 + d.fields.len(), 1)).collect();
         Compiler {
             alphabet: Alphabet::new(),
-            structs: Vec::new(),
+            structs,
             typedefs: HashMap::new(),
             globals: Vec::new(),
             global_names: HashMap::new(),
@@ -342,9 +369,9 @@ impl Compiler {
             functions: functions.into(),
             function_names,
             depth: 0,
-            struct_names: HashMap::new(),
-            struct_fields: Vec::new(),
-            struct_shapes: Vec::new(),
+            struct_names,
+            struct_fields,
+            struct_shapes,
             counts_reported: HashSet::new(),
             inlining: Vec::new(),
             inlined: 0,
@@ -748,12 +775,14 @@ impl Compiler {
             gillespie_groups: Vec::new(),
             warnings: Vec::new(),
             model: Default::default(),
+            single: self.single,
         };
         // Group numbers seen with `group` (false) and `ggroup` (true), and
         // where first.
         let mut group_kinds: Vec<(i64, bool, Span)> = Vec::new();
         let mut section = Section::Productions;
         let mut group = 0i64;
+        let mut vgroup = 0i64;
         let mut filter = Filter::All;
         let mut axiom_seen = false;
         for item in &file.items {
@@ -819,6 +848,7 @@ impl Compiler {
                 Item::Section { section: s, .. } => {
                     section = *s;
                     group = 0;
+                    vgroup = 0;
                 }
                 Item::Group {
                     id,
@@ -835,6 +865,7 @@ impl Compiler {
                         self.group_kind(*id, *gillespie, *span, &mut group_kinds);
                     }
                 }
+                Item::VGroup { id, .. } => vgroup = *id,
                 Item::Control { kind, body, .. } => {
                     let mut scope = Scope::default();
                     let stmts = self.block_stmts(&body.stmts, &mut scope);
@@ -852,7 +883,8 @@ impl Compiler {
                             ),
                         );
                     }
-                    if let Some(rule) = self.rule(p, section, group, &filter) {
+                    if let Some(mut rule) = self.rule(p, section, group, &filter) {
+                        rule.vgroup = vgroup;
                         program.rules.push(rule);
                     }
                 }
@@ -1141,6 +1173,7 @@ impl Compiler {
             frame_size: scope.max as usize,
             section,
             group,
+            vgroup: 0,
             span: p.span,
             label,
             stencil: None,
@@ -1183,12 +1216,7 @@ impl Compiler {
         let Some(sym) = self.alphabet.lookup(&name.text) else {
             self.err(
                 name.span,
-                format!(
-                    "undeclared module `{}`: declare it before use, e.g. `module {}({});`",
-                    name.text,
-                    name.text,
-                    vec!["float"; count].join(", ")
-                ),
+                super::modules::undeclared(&name.text, &vec!["float"; count].join(", ")),
             );
             return None;
         };
@@ -1258,12 +1286,7 @@ impl Compiler {
                 let types: Vec<String> = args.iter().map(|(_, t)| self.type_name(*t)).collect();
                 self.err(
                     m.name.span,
-                    format!(
-                        "undeclared module `{}`: declare it before use, e.g. `module {}({});`",
-                        m.name.text,
-                        m.name.text,
-                        types.join(", ")
-                    ),
+                    super::modules::undeclared(&m.name.text, &types.join(", ")),
                 );
                 continue;
             };

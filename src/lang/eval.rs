@@ -33,7 +33,15 @@ pub struct Env {
     pub model: std::sync::Arc<crate::model::Model>,
     /// What the program prints and the files it writes.
     pub output: ProgramOutput,
+    /// The views `UseView` activated, in the order of their first call,
+    /// each once (at most [`MAX_VIEWS`]).
+    pub views: Vec<i64>,
+    /// False after `NoEnvironment()`: query modules are not answered.
+    pub environment: bool,
 }
+
+/// More views than this are not recorded.
+pub const MAX_VIEWS: usize = 64;
 
 impl Env {
     pub fn new(globals: Vec<Value>) -> Env {
@@ -47,6 +55,8 @@ impl Env {
             random: Random::default(),
             model: Default::default(),
             output: ProgramOutput::default(),
+            views: Vec::new(),
+            environment: true,
         }
     }
 }
@@ -943,6 +953,17 @@ impl<'p> Interp<'p> {
                 cx.env.next_group = vals[0].as_i64();
                 Value::Void
             }
+            Func::UseView => {
+                let v = vals[0].as_i64();
+                if !cx.env.views.contains(&v) && cx.env.views.len() < MAX_VIEWS {
+                    cx.env.views.push(v);
+                }
+                Value::Void
+            }
+            Func::Environment(on) => {
+                cx.env.environment = on;
+                Value::Void
+            }
             Func::CurrentGroup => Value::Int(cx.env.current_group),
             Func::Forward => {
                 cx.env.forward = true;
@@ -968,7 +989,37 @@ impl<'p> Interp<'p> {
                 Value::Void
             }
             Func::Io(f) => return super::stdio::call(f, vals, &cx.env.output),
+            Func::Batch(b) => batch(b),
         })
+    }
+}
+
+/// What [`Func::Batch`] gives: see [`Batch`].
+fn batch(b: Batch) -> Value {
+    match b {
+        Batch::MouseStatus => Value::Struct(Box::new([
+            Value::Int(-1),
+            Value::Int(0),
+            Value::Int(0),
+            Value::V3(DVec3::ZERO),
+            Value::V3(DVec3::ZERO),
+            Value::V3(DVec3::ZERO),
+            Value::Bool(false),
+            Value::Bool(false),
+            Value::Bool(false),
+        ])),
+        Batch::MenuChoice => Value::Int(-1),
+        Batch::CameraPosition => Value::Struct(Box::new([
+            Value::V3(DVec3::Z),
+            Value::V3(DVec3::ZERO),
+            Value::V3(DVec3::NEG_Z),
+            Value::V3(DVec3::NEG_X),
+            Value::V3(DVec3::Y),
+            Value::Float(1.0),
+        ])),
+        Batch::ViewMin(_) => Value::Float(-1.0),
+        Batch::ViewMax(_) => Value::Float(1.0),
+        Batch::ViewScale => Value::Float(1.0),
     }
 }
 

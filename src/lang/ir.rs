@@ -104,6 +104,12 @@ pub enum Func {
     Cross,
     StepNo,
     UseGroup,
+    /// `UseView(v)`: view `v` is drawn too.
+    UseView,
+    /// `Environment()` (true) or `NoEnvironment()`: whether the
+    /// interpretation that answers query modules runs before the next
+    /// steps (manual 6.1.3).
+    Environment(bool),
     CurrentGroup,
     Forward,
     Backward,
@@ -118,10 +124,33 @@ pub enum Func {
     /// C's standard input and output (`printf`, `fopen`, `strlen`, …);
     /// see [`super::stdio`].
     Io(super::stdio::IoFunc),
+    /// What lpfg's interactive functions give in a batch run: no mouse, no
+    /// menu choice, the default camera and view volume.
+    Batch(Batch),
     /// A built-in of the topology the program runs on, by its number in
     /// the topology's [`HostTable`](super::builtins::HostTable); the
     /// [`Host`](super::eval::Host) evaluates it.
     Host(u16),
+}
+
+/// lpfg's functions of the mouse, the menu and the views (manual 6.4,
+/// 6.5), as a run without a window answers them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Batch {
+    /// `GetMouseStatus()`: no view clicked (`viewNum` -1), no button down,
+    /// pushed or released, every position zero.
+    MouseStatus,
+    /// `UserMenuChoice()`: -1, no choice made.
+    MenuChoice,
+    /// `GetCameraPosition(view)`: lpfg's default view (`dir: 0 0 -1`,
+    /// `up: 0 1 0`): the camera at (0, 0, 1) looking at the origin, scale 1.
+    CameraPosition,
+    /// `vvXmin` … `vvZmin` (0, 1, 2: x, y, z): -1.
+    ViewMin(u8),
+    /// `vvXmax` … `vvZmax`: 1.
+    ViewMax(u8),
+    /// `vvScale`: 1.
+    ViewScale,
 }
 
 #[derive(Clone, Debug)]
@@ -218,6 +247,8 @@ pub struct Rule {
     pub frame_size: usize,
     pub section: Section,
     pub group: i64,
+    /// The view (`vgroup`) of an interpretation rule; 0 for the main view.
+    pub vgroup: i64,
     pub span: Span,
     /// The rule as written, for messages: `P(vl) < P(v) > P(vr)`.
     pub label: String,
@@ -280,6 +311,9 @@ pub struct Program {
     /// The functions, contours and colours of the model folder the program
     /// came with (empty for a program alone).
     pub model: std::sync::Arc<crate::model::Model>,
+    /// `float` is single precision (lpfg's): what the turtle writes into
+    /// `float` parameters (query modules' answers) is rounded to it.
+    pub single: bool,
 }
 
 impl Program {

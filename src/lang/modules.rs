@@ -99,6 +99,7 @@ pub const PREDEFINED: &[(&str, &[&[Ty]])] = &[
     ("RollToVert", NONE),
     ("RotateXYZ", AXIS_ANGLE),
     ("RotateHLU", AXIS_ANGLE),
+    ("Rotate", AXIS_ANGLE),
     ("SetHead", HEAD),
     ("SetHead3f", P3),
     ("IncColor", NONE),
@@ -139,6 +140,13 @@ pub const PREDEFINED: &[(&str, &[&[Ty]])] = &[
     ("CurrentTexture", ONE_I),
     ("TextureVCoeff", ONE_F),
     ("Elasticity", ONE_F),
+    ("SetElasticity", IF),
+    ("IncElasticity", ONE_I),
+    ("DecElasticity", ONE_I),
+    ("SetTropismDirection3f", P3),
+    ("ContourNormal", P3),
+    ("BSurface", IF),
+    ("Orient", NONE),
     ("GetPos", FFF),
     ("GetHead", FFF),
     ("GetLeft", FFF),
@@ -147,12 +155,47 @@ pub const PREDEFINED: &[(&str, &[&[Ty]])] = &[
     ("E2", FF),
     ("Camera", NONE),
     ("MouseIns", NONE),
+    ("MouseInsPos", &[&[Ty::Struct(super::value::MOUSE_STATUS)]]),
+    ("Terrain", &[&[Ty::Struct(super::value::CAMERA_POSITION)]]),
     ("SetUPrecision", ONE_F),
     ("SetVPrecision", ONE_F),
     ("InitSurface", ONE_I),
     ("SurfacePoint", III),
     ("DrawSurface", ONE_I),
 ];
+
+/// lpfg's predefined modules that subgram does not have yet, with what
+/// they are for: a program that uses one is told so, not asked to declare
+/// it.
+pub const NOT_YET: &[(&str, &str)] = &[
+    ("DSurface", "it draws a dynamic surface (manual 7.1)"),
+    (
+        "DBSurfaceS",
+        "it draws a dynamic B-spline surface (manual 10.1)",
+    ),
+    (
+        "DBSurfaceM",
+        "it draws a dynamic B-spline surface (manual 10.1)",
+    ),
+    (
+        "EA20",
+        "it exchanges an array with an environmental program (manual 5.13), \
+         and subgram does not run environmental programs",
+    ),
+    ("PovRayStart", "it starts POV-Ray output"),
+];
+
+/// The message for a module that is neither declared nor predefined.
+pub fn undeclared(name: &str, params: &str) -> String {
+    match NOT_YET.iter().find(|(n, _)| *n == name) {
+        Some((_, what)) => {
+            format!("`{name}` is an lpfg module that subgram does not support yet: {what}")
+        }
+        None => format!(
+            "undeclared module `{name}`: declare it before use, e.g. `module {name}({params});`"
+        ),
+    }
+}
 
 impl Alphabet {
     pub fn new() -> Alphabet {

@@ -258,6 +258,50 @@ pub struct StructDef {
     pub elem: Option<Ty>,
 }
 
+/// `MouseStatus` (manual 7.4), the first of lpfg's predefined structs.
+pub const MOUSE_STATUS: u16 = 0;
+/// `CameraPosition` (manual 6.4), the second.
+pub const CAMERA_POSITION: u16 = 1;
+
+/// lpfg's predefined struct types, which every program has before its own:
+/// `MouseStatus` and `CameraPosition`, with the manual's fields and their
+/// precisions (`V3d` positions of the mouse, `V3f` and `float` of the
+/// camera).
+pub fn predefined_structs() -> Vec<StructDef> {
+    let def = |name: &str, fields: &[(&str, Ty)]| StructDef {
+        name: name.to_string(),
+        fields: fields.iter().map(|(n, t)| (n.to_string(), *t)).collect(),
+        elem: None,
+    };
+    vec![
+        def(
+            "MouseStatus",
+            &[
+                ("viewNum", Ty::Int),
+                ("viewX", Ty::Int),
+                ("viewY", Ty::Int),
+                ("atFront", Ty::V3d),
+                ("atRear", Ty::V3d),
+                ("atMiddle", Ty::V3d),
+                ("lbDown", Ty::Bool),
+                ("lbPushed", Ty::Bool),
+                ("lbReleased", Ty::Bool),
+            ],
+        ),
+        def(
+            "CameraPosition",
+            &[
+                ("position", Ty::V3),
+                ("lookat", Ty::V3),
+                ("head", Ty::V3),
+                ("left", Ty::V3),
+                ("up", Ty::V3),
+                ("scale", Ty::Float),
+            ],
+        ),
+    ]
+}
+
 /// The number of `f64` slots a value of type `ty` takes in a word.
 pub fn width(ty: Ty, structs: &[StructDef]) -> usize {
     match ty {

@@ -6,8 +6,10 @@
 //! or `cylinder`, line widths are in the model's units) and `light:`
 //! (materials are lit by the lights, as on a surface facing the viewer);
 //! the others set up lpfg's OpenGL
-//! window (projection, lights, shading, tropisms, fonts, …) and are
-//! reported as not acted on. The animation file only matters in lpfg's
+//! window (projection, lights, shading, fonts, …) and are reported as
+//! not acted on. The views' names (`window:`) and the turtle's settings
+//! (`corrected rotation:`, `tropism:`, `torque:`, `stropism:`) are read by
+//! `load::read_view_file`. The animation file only matters in lpfg's
 //! animate mode, which a still picture is not: it is checked and kept.
 
 use super::text::{number, words, Lines};
@@ -61,6 +63,15 @@ const VIEW_COMMANDS: &[&str] = &[
     "initial elasticity",
     "elasticity increment",
     "bsurface",
+];
+
+/// Commands that the turtle and the views act on (`load::read_view_file`).
+const ACTED_ON_BY_THE_TURTLE: &[&str] = &[
+    "window",
+    "corrected rotation",
+    "tropism",
+    "torque",
+    "stropism",
 ];
 
 const ANIMATION_COMMANDS: &[&str] = &[
@@ -299,6 +310,11 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
                 at: (base + f.start + after, base + f.end + after),
                 scale,
             });
+            continue;
+        }
+        // The turtle's settings and the views' names are read by the
+        // loader (`load::read_view_file`), which warns about its own lines.
+        if ACTED_ON_BY_THE_TURTLE.contains(&k.as_str()) {
             continue;
         }
         ignored.push((k, n, base + first.start, base + after));

@@ -32,6 +32,9 @@ pub struct DeriveOptions {
     /// go; the caller reads them from its clone. Default: a new one,
     /// which refuses `fopen` for writing.
     pub output: ProgramOutput,
+    /// The view file's turtle settings (rotations, tropisms), for the
+    /// interpretation that answers query modules. Default: none.
+    pub view: crate::draw::TurtleView,
 }
 
 impl Default for DeriveOptions {
@@ -43,6 +46,7 @@ impl Default for DeriveOptions {
             deadline: None,
             seed: None,
             output: ProgramOutput::default(),
+            view: crate::draw::TurtleView::default(),
         }
     }
 }
@@ -164,6 +168,9 @@ pub struct Derivation<'p> {
     opts: DeriveOptions,
     /// For a traced derivation, what made each module of the word.
     makers: Option<Vec<Maker>>,
+    /// The view whose interpretation rules (`vgroup`) interpretation uses:
+    /// 0, the main view, but while [`Derivation::interpret_view`] runs.
+    view: i64,
 }
 
 impl<'p> Derivation<'p> {
@@ -208,6 +215,23 @@ impl<'p> Derivation<'p> {
                     .convert(g.ty);
             }
         }
+        let mut d = Derivation {
+            program,
+            rewriter: Rewriter::new(program),
+            env,
+            word: Word::new(),
+            spare: Word::new(),
+            ring: false,
+            length: 0,
+            step: 0,
+            opts,
+            makers: None,
+            view: 0,
+        };
+        // `Start` runs before the directives are read, as in lpfg, whose
+        // `derivation length:` may read what `Start` computed
+        // (`derivation length: (int)(simulation_ends/dt);`).
+        d.control(ControlKind::Start)?;
         type Directive = Option<(crate::lang::ir::Ex, Span)>;
         let mut number =
             |e: &Directive, env: &mut Env| -> Result<Option<(f64, Span)>, DeriveError> {
@@ -221,9 +245,9 @@ impl<'p> Derivation<'p> {
                     None => Ok(None),
                 }
             };
-        let stated = number(&program.derivation_length, &mut env)?;
-        let ring = number(&program.ring, &mut env)?.is_some_and(|(v, _)| v != 0.0);
-        let length = match (opts.steps, stated) {
+        let stated = number(&program.derivation_length, &mut d.env)?;
+        d.ring = number(&program.ring, &mut d.env)?.is_some_and(|(v, _)| v != 0.0);
+        d.length = match (d.opts.steps, stated) {
             (Some(n), _) => n,
             (None, None) => 0,
             (None, Some((v, span))) => {
@@ -239,28 +263,16 @@ impl<'p> Derivation<'p> {
                 v as u64
             }
         };
-        if length > MAX_STEPS {
+        if d.length > MAX_STEPS {
             return Err(DeriveError {
                 span: None,
                 message: format!(
-                    "a derivation length of {length} steps is beyond the limit of {MAX_STEPS}"
+                    "a derivation length of {} steps is beyond the limit of {MAX_STEPS}",
+                    d.length
                 ),
                 step: 0,
             });
         }
-        let mut d = Derivation {
-            program,
-            rewriter: Rewriter::new(program),
-            env,
-            word: Word::new(),
-            spare: Word::new(),
-            ring,
-            length,
-            step: 0,
-            opts,
-            makers: None,
-        };
-        d.control(ControlKind::Start)?;
         if let Some(m) = program.axiom.get(d.opts.max_modules) {
             return Err(DeriveError {
                 span: Some(m.span),
@@ -281,29 +293,48 @@ impl<'p> Derivation<'p> {
         }
         d.word = axiom;
         d.decompose()?;
-        d.answer_queries()?;
         Ok(d)
     }
 
     /// lpfg's query modules (`GetPos`, `GetHead`, `GetLeft`, `GetUp`): when
-    /// a production's predecessor mentions one, an interpretation step runs
-    /// after the axiom and after every step, and each query module in the
-    /// word receives the turtle's position (or heading, left, up vector)
-    /// at that point. The query modules of the word are matched in order to
-    /// those the turtle meets in the interpreted word, so interpretation
-    /// rules must not create or erase them.
+    /// a rule's predecessor mentions one, an interpretation step runs at the
+    /// start of every derivation step, before `StartEach` (so on the axiom
+    /// and on every word but the last, as lpfg's "interpretation for the
+    /// environment" does), and each query module of the word that the
+    /// turtle meets receives the turtle's position (or heading, left, up
+    /// vector) at that point, unless `NoEnvironment()` was called. As in lpfg, the turtle
+    /// writes only into the word's own modules: a query module that an
+    /// interpretation rule rewrites keeps its parameters, and one that an
+    /// interpretation rule produces is answered in the interpreted word
+    /// alone.
     fn answer_queries(&mut self) -> Result<(), DeriveError> {
         let p = self.program;
-        if !self.queries_used() {
+        if !self.env.environment || !self.queries_used() {
             return Ok(());
         }
-        let shown = self.interpret()?;
+        // Which module of the word each interpreted module copies: a
+        // traced interpretation whose "axiom" is the word itself.
+        let depth = self.depth(Section::Interpretation)?;
+        let mut sources = Some((0..self.word.len()).map(Maker::Axiom).collect());
+        let shown = self.rewrite_to_depth(
+            Section::Interpretation,
+            self.word.clone(),
+            depth,
+            &mut sources,
+        )?;
+        let mut draw_opts = crate::draw::DrawOptions {
+            view: self.opts.view.clone(),
+            ..Default::default()
+        };
+        if let Some(a) = self.angle()? {
+            draw_opts.angle = a;
+        }
         let mut answers = Vec::new();
         crate::draw::draw_with_queries(
             &shown,
             &p.alphabet,
             &p.structs,
-            &crate::draw::DrawOptions::default(),
+            &draw_opts,
             Some(&mut answers),
         )
         .map_err(|e| DeriveError {
@@ -314,47 +345,45 @@ impl<'p> Derivation<'p> {
             ),
             step: self.step,
         })?;
-        let is_query = |s: Sym| crate::draw::is_query(p.alphabet.name(s));
-        let count = self.word.syms().iter().filter(|s| is_query(**s)).count();
-        if count != answers.len() {
-            return Err(DeriveError {
-                span: None,
-                message: format!(
-                    "at step {}, the word has {count} query modules but its interpretation has {}: interpretation rules must not create or erase GetPos, GetHead, GetLeft or GetUp",
-                    self.step,
-                    answers.len()
-                ),
-                step: self.step,
-            });
+        let sources = sources.unwrap_or_default();
+        let mut answer: Vec<Option<[f64; 3]>> = vec![None; self.word.len()];
+        for (j, v) in answers {
+            if let Some(Maker::Axiom(i)) = sources.get(j) {
+                answer[*i] = Some(v);
+            }
+        }
+        if answer.iter().all(Option::is_none) {
+            return Ok(());
         }
         let mut out = Word::new();
         out.reserve(self.word.len(), self.word.slot_count());
-        let mut k = 0;
-        for i in 0..self.word.len() {
-            let s = self.word.sym(i);
-            if is_query(s) && self.word.data(i).len() == 3 {
-                out.push_raw(s, &answers[k]);
-                k += 1;
-            } else {
-                if is_query(s) {
-                    k += 1;
+        for (i, a) in answer.iter().enumerate() {
+            match a {
+                Some(v) if self.word.data(i).len() == 3 => {
+                    // A `float` parameter holds the answer as lpfg's does.
+                    let v = match p.single {
+                        true => v.map(|x| x as f32 as f64),
+                        false => *v,
+                    };
+                    out.push_raw(self.word.sym(i), &v)
                 }
-                out.push_from(&self.word, i);
+                _ => out.push_from(&self.word, i),
             }
         }
         self.word = out;
         Ok(())
     }
 
+    /// True when a production, decomposition or interpretation rule of
+    /// any group has a query module in its strict predecessor or its
+    /// contexts (lpfg does not look at new contexts).
     fn queries_used(&self) -> bool {
         let p = self.program;
-        p.rules_of(Section::Productions).any(|(_, r)| {
-            r.new_left
+        p.rules.iter().any(|r| {
+            r.left
                 .iter()
-                .chain(&r.left)
                 .chain(&r.strict)
                 .chain(&r.right)
-                .chain(&r.new_right)
                 .any(|pat| crate::draw::is_query(p.alphabet.name(pat.sym)))
         })
     }
@@ -372,22 +401,19 @@ impl<'p> Derivation<'p> {
         Ok(())
     }
 
-    /// The rules of `section` usable now: the current group's, then group 0's.
+    /// The rules of `section` usable now: the current group's, then group
+    /// 0's; for interpretation, only those of the view being drawn.
     fn candidates(&self, section: Section) -> Vec<usize> {
         let g = self.env.current_group;
-        let mut v: Vec<usize> = self
-            .program
-            .rules_of(section)
-            .filter(|(_, r)| r.group == g)
-            .map(|(i, _)| i)
-            .collect();
+        let view = self.view;
+        let of = |group: i64| {
+            self.program.rules_of(section).filter(move |(_, r)| {
+                r.group == group && (section != Section::Interpretation || r.vgroup == view)
+            })
+        };
+        let mut v: Vec<usize> = of(g).map(|(i, _)| i).collect();
         if g != 0 {
-            v.extend(
-                self.program
-                    .rules_of(section)
-                    .filter(|(_, r)| r.group == 0)
-                    .map(|(i, _)| i),
-            );
+            v.extend(of(0).map(|(i, _)| i));
         }
         v
     }
@@ -399,6 +425,7 @@ impl<'p> Derivation<'p> {
             phase: self.opts.phase,
             max_modules: self.opts.max_modules,
             deadline: self.opts.deadline,
+            cut: false,
         }
     }
 
@@ -417,10 +444,16 @@ impl<'p> Derivation<'p> {
         if let Err(m) = crate::deadline::check(self.opts.deadline) {
             return Err(self.step_error(StepError::Timeout(m), self.step + 1));
         }
+        self.answer_queries()?;
         self.control(ControlKind::StartEach)?;
         self.env.current_group = self.env.next_group;
         let rules = self.candidates(Section::Productions);
-        let opts = self.step_options();
+        // Production steps cut branches; decomposition and interpretation
+        // do not (lpfg).
+        let opts = StepOptions {
+            cut: true,
+            ..self.step_options()
+        };
         let mut dst = std::mem::take(&mut self.spare);
         let step = self.step + 1;
         let mut origin = Vec::new();
@@ -464,7 +497,6 @@ impl<'p> Derivation<'p> {
         self.env.step = step as i64;
         self.step = step;
         self.decompose()?;
-        self.answer_queries()?;
         self.control(ControlKind::EndEach)?;
         Ok(())
     }
@@ -638,6 +670,20 @@ impl<'p> Derivation<'p> {
     /// The word after interpretation rules: what the turtle draws.
     pub fn interpret(&mut self) -> Result<Word, DeriveError> {
         Ok(self.interpret_traced()?.0)
+    }
+
+    /// The word after the interpretation rules of view `view` (those after
+    /// `vgroup view:`; view 0 is the main view, [`Derivation::interpret`]).
+    pub fn interpret_view(&mut self, view: i64) -> Result<Word, DeriveError> {
+        self.view = view;
+        let word = self.interpret();
+        self.view = 0;
+        word
+    }
+
+    /// The views `UseView` activated so far, in order.
+    pub fn views(&self) -> &[i64] {
+        &self.env.views
     }
 
     /// [`Derivation::interpret`], with what made each module of the

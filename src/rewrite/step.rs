@@ -29,6 +29,13 @@ pub struct StepOptions {
     pub max_modules: usize,
     /// The step fails once this passes.
     pub deadline: Option<Deadline>,
+    /// Remove every `Cut` and the rest of its branch, as lpfg's forward
+    /// production steps do (manual 5.4): a `Cut` and the modules after it
+    /// up to the `EB` that closes its branch (kept), or to the end of the
+    /// word, are neither rewritten nor copied. Contexts still see the
+    /// whole old word. Decomposition, interpretation and backward steps
+    /// leave `Cut` in place.
+    pub cut: bool,
 }
 
 /// Why a step failed.
@@ -85,6 +92,7 @@ pub struct Rewriter<'p> {
     interp: Interp<'p>,
     sb: Sym,
     eb: Sym,
+    cut: Sym,
     frame: Vec<Value>,
     /// The last step's growth (new length / old length), to size buffers.
     growth: f64,
@@ -104,6 +112,7 @@ impl<'p> Rewriter<'p> {
             interp: Interp::for_program(program, None),
             sb: program.alphabet.builtin("SB"),
             eb: program.alphabet.builtin("EB"),
+            cut: program.alphabet.builtin("Cut"),
             frame: Vec::new(),
             growth: 1.0,
             checked_finite: false,
@@ -172,20 +181,27 @@ impl<'p> Rewriter<'p> {
         // The rule that produced last, to blame for a word grown too long.
         let mut last_rule = None;
         let mut scanned: usize = 0;
+        // The scan position of the k-th module scanned; backward steps
+        // walk from the right end.
+        let at = |k: usize| match (opts.ring, opts.forward) {
+            (true, true) => wrap(phase + k, n),
+            (false, true) => k,
+            (true, false) => wrap(phase + n - 1 - k, n),
+            (false, false) => n - 1 - k,
+        };
+        let cut = opts.cut && opts.forward;
         while k < n {
             scanned += 1;
             if scanned.is_multiple_of(DEADLINE_EVERY) {
                 crate::deadline::check(opts.deadline).map_err(StepError::Timeout)?;
             }
-            // The scan position; backward steps walk from the right end.
-            let i = match (opts.ring, opts.forward) {
-                (true, true) => wrap(phase + k, n),
-                (false, true) => k,
-                (true, false) => wrap(phase + n - 1 - k, n),
-                (false, false) => n - 1 - k,
-            };
+            let i = at(k);
             if opts.ring && opts.forward && i < phase && wrapped_at.is_none() {
                 wrapped_at = Some(dst.len());
+            }
+            if cut && src.sym(i) == self.cut {
+                k = self.end_of_branch(src, k, at);
+                continue;
             }
             let remaining = n - k;
             let mut used = 0;
@@ -257,9 +273,37 @@ impl<'p> Rewriter<'p> {
         Ok(rewritten)
     }
 
+    /// Where the scan goes on after a `Cut` scanned `k`-th: the matching
+    /// `EB` of its branch, or the end of the word when there is none. On a
+    /// ring scanned from a phase, the end of the word is where the scan
+    /// wraps to its first module (lpfg has no phase: the cut never goes
+    /// round), and the scan goes on there.
+    fn end_of_branch(&self, src: &Word, mut k: usize, at: impl Fn(usize) -> usize) -> usize {
+        let mut depth = 0usize;
+        k += 1;
+        while k < src.len() {
+            let j = at(k);
+            if j == 0 {
+                break;
+            }
+            let s = src.sym(j);
+            if s == self.sb {
+                depth += 1;
+            } else if s == self.eb {
+                if depth == 0 {
+                    break;
+                }
+                depth -= 1;
+            }
+            k += 1;
+        }
+        k
+    }
+
     /// True when the step can take the compiled fast path: every rule is a
     /// stencil with a one-module strict predecessor, plain contexts (no
-    /// filter, no overloaded modules) and the word has no branches.
+    /// filter, no overloaded modules) and the word has no branches and no
+    /// `Cut`.
     fn stencils_only(&self, rules: &[usize], src: &Word) -> bool {
         let simple = |p: &Pattern| p.width.is_none() && p.sym != self.sb && p.sym != self.eb;
         let rules_ok = rules.iter().all(|&r| {
@@ -274,7 +318,11 @@ impl<'p> Rewriter<'p> {
                     .chain(&rule.right)
                     .all(simple)
         });
-        rules_ok && !src.syms().iter().any(|&s| s == self.sb || s == self.eb)
+        rules_ok
+            && !src
+                .syms()
+                .iter()
+                .any(|&s| s == self.sb || s == self.eb || s == self.cut)
     }
 
     /// On a ring whose modules are all of one kind and one width, the first

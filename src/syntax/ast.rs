@@ -79,6 +79,12 @@ pub enum Item {
         gillespie: bool,
         span: Span,
     },
+    /// `vgroup 1:` (or `window 1:`): the interpretation rules of a view
+    /// (manual 7.3); `endvgroup` is `VGroup { id: 0 }`.
+    VGroup {
+        id: i64,
+        span: Span,
+    },
     /// `Start: { ... }` and friends.
     Control {
         kind: ControlKind,

@@ -385,6 +385,34 @@ impl<'t> Parser<'t> {
                     });
                     return Ok(());
                 }
+                // `window N:` as lpfg's translator reads it; `window` alone
+                // may be a name.
+                "vgroup" | "window"
+                    if word == "vgroup"
+                        || (matches!(self.peek_at(1).map(|t| &t.tok), Some(Tok::Int(_)))
+                            && self.peek_at(2).is_some_and(|t| t.tok.is_punct(":"))) =>
+                {
+                    self.pos += 1;
+                    let id = match self.peek().map(|t| &t.tok) {
+                        Some(Tok::Int(i)) => *i,
+                        _ => {
+                            return self.error(
+                                "a view number (an integer constant, or a view name from the view file)",
+                            )
+                        }
+                    };
+                    self.pos += 1;
+                    self.expect_punct(":", "after the view number")?;
+                    items.push(Item::VGroup { id, span: start });
+                    return Ok(());
+                }
+                "endvgroup" | "endwindow" => {
+                    self.pos += 1;
+                    self.eat_punct(":");
+                    self.eat_punct(";");
+                    items.push(Item::VGroup { id: 0, span: start });
+                    return Ok(());
+                }
                 "endgroup" => {
                     self.pos += 1;
                     self.eat_punct(":");

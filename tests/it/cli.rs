@@ -234,3 +234,165 @@ fn an_output_that_is_an_input_is_refused_unless_forced() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Nothing silent (issue 12): a predefined module that subgram does not
+/// act on is a warning with its first place, from `check` on standard
+/// output and from `derive` and `render` on standard error, which still
+/// succeed. Modules the turtle draws are not warned about.
+#[test]
+fn modules_subgram_does_not_draw_are_warned_about_at_their_first_place() {
+    let dir = std::env::temp_dir().join(format!("subgram-cli-unsupported-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("leaf.lsys");
+    std::fs::write(
+        &file,
+        "module A(int);\nderivation length: 2;\nAxiom: A(1);\n\
+         A(x) : { produce F(1) SB() Left(30) Mesh(0, 1) EB() E1(0) A(x+1); }\n\
+         interpretation:\nA(x) : { produce Mesh(1, 2) Label(\"a\") F(1); }\n",
+    )
+    .unwrap();
+    let f = file.to_str().unwrap();
+    let check = subgram(&["check", f]);
+    assert!(check.status.success(), "{}", stderr(&check));
+    let out = stdout(&check);
+    let warned: Vec<&str> = out.lines().filter(|l| l.contains(": warning:")).collect();
+    assert_eq!(warned.len(), 3, "{out}");
+    // Mesh first appears in the production (line 4, column 37), not in
+    // the interpretation rule.
+    assert!(
+        warned[0].starts_with(&format!(
+            "{f}:4:37: warning: `Mesh` is not drawn by subgram yet"
+        )),
+        "{out}"
+    );
+    assert!(
+        warned[1].starts_with(&format!(
+            "{f}:4:53: warning: `E1` communicates with an environmental program"
+        )),
+        "{out}"
+    );
+    assert!(
+        warned[2].starts_with(&format!("{f}:6:29: warning: `Label` is not drawn")),
+        "{out}"
+    );
+    let derive = subgram(&["derive", f]);
+    assert!(derive.status.success(), "{}", stderr(&derive));
+    assert_eq!(stderr(&derive).matches(": warning:").count(), 3);
+    assert!(!stdout(&derive).contains("warning"));
+    let png = dir.join("leaf.png");
+    let render = subgram(&["render", f, "-o", png.to_str().unwrap()]);
+    assert!(render.status.success(), "{}", stderr(&render));
+    assert_eq!(stderr(&render).matches(": warning:").count(), 3);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Views (manual 7.3): `UseView` activates the views that the view file's
+/// `window:` commands name (numbered from 0 in their order, so `Top` is
+/// view 0, the main view), and the rules after `vgroup Side:` interpret
+/// the word for `Side` only. `-o out.svg` writes the main view to out.svg
+/// and view `Side` to out-Side.svg; a view the view file does not define
+/// is a warning and no file.
+#[test]
+fn every_view_is_drawn_to_its_own_file() {
+    let dir = std::env::temp_dir().join(format!("subgram-cli-views-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("view.v"),
+        "window: Top 0.0 0.0 1.0 0.5\nwindow: Side 0.0 0.5 0.5 0.5\n",
+    )
+    .unwrap();
+    let file = dir.join("lsystem.l");
+    std::fs::write(
+        &file,
+        "module A(int);\nderivation length: 2;\n\
+         Start: { UseView(Top); UseView(Side); UseView(7); }\nAxiom: A(1);\n\
+         A(x) : { produce F(1) SB() Left(45) A(x+1) EB() A(x+1); }\n\
+         interpretation:\nvgroup Side:\nA(x) : { produce Circle(0.3); }\nendvgroup\n",
+    )
+    .unwrap();
+    let out = dir.join("out.svg");
+    let o = subgram(&[
+        "render",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("`UseView(7)`: the view file defines no view 7, so it is not drawn")
+    );
+    let main = std::fs::read_to_string(&out).unwrap();
+    let side = std::fs::read_to_string(dir.join("out-Side.svg")).unwrap();
+    // Two steps of A -> F [+A] A: three segments F; the four A modules
+    // are circles in Side only.
+    assert_eq!(svg_counts(&main), (3, 0, 0));
+    assert_eq!(svg_counts(&side), (3, 4, 0));
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["lsystem.l", "out-Side.svg", "out.svg", "view.v"]);
+    // All or none: when one view's file cannot be written (a folder has
+    // its name), no file is written.
+    let again = dir.join("again.svg");
+    std::fs::create_dir(dir.join("again-Side.svg")).unwrap();
+    let o = subgram(&[
+        "render",
+        file.to_str().unwrap(),
+        "-o",
+        again.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(!again.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A tropism of the view file that cannot be read (a null direction, or a
+/// vector written with commas, which lpfg's reading refuses too) is left
+/// out with a warning at its line, with the line and a caret; the program
+/// runs, as lpfg runs it.
+#[test]
+fn a_bad_tropism_in_the_view_file_is_a_warning_at_its_line() {
+    let dir = std::env::temp_dir().join(format!("subgram-cli-bad-view-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let view = dir.join("view.v");
+    std::fs::write(
+        &view,
+        "corrected rotation: on
+tropism: T: 0 0 0 E: 1
+tropism: T: 0,1,0 E: 0.2
+",
+    )
+    .unwrap();
+    let file = dir.join("lsystem.l");
+    std::fs::write(
+        &file,
+        "derivation length: 1;
+Axiom: F(1);
+",
+    )
+    .unwrap();
+    let o = subgram(&["check", file.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let out = stdout(&o);
+    let v = view.display();
+    assert!(
+        out.starts_with(&format!(
+            "{v}:2:1: warning: this tropism cannot be read and is left out (lpfg refuses it too): expected `T: x y z`"
+        )),
+        "{out}"
+    );
+    assert!(
+        out.contains("2 | tropism: T: 0 0 0 E: 1\n  | ^^^^^^^^^^^^^^^^^^^^^^"),
+        "{out}"
+    );
+    assert!(
+        out.contains(&format!("{v}:3:1: warning: this tropism cannot be read")),
+        "{out}"
+    );
+    let o = subgram(&["derive", file.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0));
+    assert_eq!(stdout(&o).trim(), "F(1)");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

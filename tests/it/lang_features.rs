@@ -274,7 +274,10 @@ fn fopen_needs_allow_writes_and_a_path_inside_the_folder() {
     std::fs::write(&file, src.replace("NAME", "sub/out.txt")).unwrap();
     let mut args = subgram::command::DeriveArgs::new(file.to_str().unwrap());
     args.allow_writes = Some(dir.clone());
-    assert_eq!(subgram::command::derive(&args, |_| {}).unwrap(), "A(1)");
+    assert_eq!(
+        subgram::command::derive(&args, |_| {}).unwrap().text,
+        "A(1)"
+    );
     assert_eq!(
         std::fs::read_to_string(dir.join("sub/out.txt")).unwrap(),
         "1\n"
@@ -812,4 +815,25 @@ fn struct_methods_write_back_to_their_variable() {
                    B(q.a.length, q.a.age, q.b[1].length, q.b[1].age, q.b[0].length);\n\
                }\n";
     assert_eq!(run(src), "B(4.5, 12, 4.5, 12, 10.125) B(25.5, 1, 7, 1, 2)");
+}
+
+/// A module produced inside a `switch` is seen like any other: lpfg's
+/// `Label`, which subgram does not draw, is warned about at its place.
+#[test]
+fn modules_produced_in_a_switch_are_warned_about() {
+    let src = "module A(int);\n\
+               derivation length: 1;\n\
+               Axiom: A(1);\n\
+               A(n) : { switch (n) { case 1: produce Label(\"a\") A(2); } }\n";
+    let l = load_text(src);
+    let warned: Vec<String> = l
+        .program
+        .warnings
+        .iter()
+        .map(|d| d.message.clone())
+        .collect();
+    assert!(
+        warned.iter().any(|m| m.contains("`Label` is not drawn")),
+        "{warned:?}"
+    );
 }

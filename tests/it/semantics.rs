@@ -317,3 +317,13 @@ fn the_phase_does_not_rotate_the_word() {
         assert_eq!(run_phase(src, phase), want, "phase {phase}");
     }
 }
+
+/// `derivation length:` is read after `Start` has run: it may use what
+/// `Start` computed (the Lychnis model reads its length from a parameter
+/// file in `Start`). lpfg 9bf820d derives this program to `A(3)`.
+#[test]
+fn the_derivation_length_is_read_after_start() {
+    let src = "int n;\nStart: { n = 3; }\nderivation length: n;\nmodule A(int);\n\
+               Axiom: A(0);\nA(x) : { produce A(x + 1); }\n";
+    assert_eq!(run(src), "A(3)");
+}
