@@ -13,7 +13,8 @@ MoveTo LineTo Cut SetColor IncColor DecColor SetWidth Circle Sphere Circle0 Circ
 Length Normalized Normalize sqrt sin cos tan asin acos atan atan2 exp log pow fabs abs floor ceil fmod fmin fmax min max hypot ran round trunc
 PI M_PI
 ggroup propensity GillespieTime SeedGillespie ResetGillespie sran rand srand RAND_MAX drand48 srand48 lrand48 random srandom
-defined #error 1.f 1e-3f .5f 0x1F 017 10UL 3u""".split() + ["derivation length:", "ring L-system:", "maximum depth:", "produce;"]
+defined #error 1.f 1e-3f .5f 0x1F 017 10UL 3u
+switch case default class public: private: :: 'a' '\\n' '\\0' '\\'' <string.h> <memory.h> <cstdlib>""".split() + ["derivation length:", "ring L-system:", "maximum depth:", "produce;"]
 punct = ["<", ">", "<<", ">>", "->", "-->", ":", ";", ",", "(", ")", "{", "}", "[", "]", "?", "==", "!=", "<=", ">=", "&&", "||", "!",
          "+=", "-=", "*=", "/=", "%=", "++", "--", "=", "+", "-", "*", "/", "%", "^", "&", "|", ".", "'", "\"", "//", "/*", "*/", "\\", "#",
          "1e308", "-1", "0.5", "2147483648", "9223372036854775807", "1e-320", "0x10", "\n"]
@@ -21,7 +22,10 @@ curve_snippets = ["module P(V2f);", "Axiom: P(v1) P(v2);", "derivation length: 3
                   "P(vl) < P(v) > P(vr) : { produce P(v) P(v); }", "P(v) -> P(v) P(v)", "V2f v1(0, 0), v2(1, 1);",
                   "#define N 4", "#define M(x) ((x)+(x))", "#if N > 2\n", "#ifdef N\n", "#else\n", "#endif\n",
                   "#if defined(N) && !defined M\n", "ggroup 1:", "propensity 1 produce P(v);", "maximum depth: 2;", "Start: { }", "group 1:",
-                  "struct S { int a; float b; };", "typedef struct S T;", "for (int i = 0; i < 3; i++) { }", "x ? y : z", "(float) 1"]
+                  "struct S { int a; float b; };",
+                  "switch (n) { case 1: break; case 'a': default: continue; }",
+                  "struct L { enum { A, B } k; float w; L() : w(1) {} L(float x) { w = x; } float a() const { return w; } };",
+                  "L::A", "l.a()", "typedef struct S T;", "for (int i = 0; i < 3; i++) { }", "x ? y : z", "(float) 1"]
 surface = """mesh: blocks: dual bisection quadrisection define init: F(f) V(v E(e F^2 F^3 F^4 E^3 E^4 || | ^
 l( c step valence( boundary( new( block( center( centre( transversal( avg( sum( count( ring( boundary_ring( verts( tail( head( bnext( bprev( pos(
 where in interior boundary""".split() + ["derivation length:"]

@@ -112,7 +112,7 @@ fn successors(body: &[St], f: &mut impl FnMut(&Succ)) {
                 }
             }
             St::Loop { body, .. } => successors(std::slice::from_ref(body), f),
-            St::Block(b) => successors(b, f),
+            St::Block(b) | St::Switch { body: b, .. } => successors(b, f),
             St::Expr(_)
             | St::Init(..)
             | St::Return

@@ -153,8 +153,18 @@ struct Compiler {
     /// by name.
     user_fns: Vec<UserSig>,
     user_fn_names: HashMap<String, u16>,
-    /// `enum` constants.
+    /// `enum` constants; those declared in a struct also as `S::NAME`.
     enum_consts: HashMap<String, i64>,
+    /// Enumerators declared in a struct that `NAME` alone names (no
+    /// enumerator outside structs has that name), and those that more than
+    /// one struct declares, which only `S::NAME` names.
+    struct_enums: HashSet<String>,
+    ambiguous_enums: HashSet<String>,
+    /// Each struct's constructors (user functions), by the struct's name.
+    ctors: HashMap<String, Vec<u16>>,
+    /// Struct methods (user functions whose first parameter is the struct,
+    /// by reference), by the struct's number and the method's name.
+    methods: HashMap<(u16, String), u16>,
     /// The array types made so far, by element type and length.
     array_types: HashMap<(Ty, Option<usize>), u16>,
 }
@@ -171,6 +181,10 @@ struct UserSig {
     /// Whether a body has been given.
     defined: bool,
 }
+
+/// The most elements of an array whose structs a constructor builds, one
+/// call each.
+const MAX_BUILT_ELEMENTS: usize = 1 << 16;
 
 /// The most user-defined functions a program may declare (each is
 /// numbered with a `u16`).
@@ -199,6 +213,8 @@ struct Scope {
     next: u16,
     max: u16,
     loops: u32,
+    /// `switch`es around the statement being checked: `break` may end one.
+    switches: u32,
     in_rule: bool,
     /// Names before this index are not visible (the caller's locals,
     /// inside an inlined function's body).
@@ -364,6 +380,10 @@ impl Compiler {
             user_fns: Vec::new(),
             user_fn_names: HashMap::new(),
             enum_consts: HashMap::new(),
+            struct_enums: HashSet::new(),
+            ambiguous_enums: HashSet::new(),
+            ctors: HashMap::new(),
+            methods: HashMap::new(),
             array_types: HashMap::new(),
             single: false,
         }
@@ -556,7 +576,11 @@ impl Compiler {
     fn declarations(&mut self, file: &ast::File) {
         for item in &file.items {
             match item {
-                Item::Struct { name, fields } => {
+                Item::Struct { name, body } => {
+                    for (e, variants) in &body.enums {
+                        self.enum_decl(e.as_ref(), variants, Some(&name.text));
+                    }
+                    let fields = &body.fields;
                     if self.struct_names.contains_key(&name.text) {
                         self.err(
                             name.span,
@@ -631,13 +655,19 @@ impl Compiler {
                         fields: fs,
                         elem: None,
                     });
+                    for c in &body.ctors {
+                        self.ctor_sig(name, c);
+                    }
+                    for m in &body.methods {
+                        self.method_sig(name, m);
+                    }
                 }
                 Item::Typedef { ty, name } => {
                     if let Some(t) = self.resolve_type(ty) {
                         self.typedefs.insert(name.text.clone(), t);
                     }
                 }
-                Item::Enum { name, variants } => self.enum_decl(name.as_ref(), variants),
+                Item::Enum { name, variants } => self.enum_decl(name.as_ref(), variants, None),
                 Item::Function(def) => self.function_sig(def),
                 Item::Module { name, params } => {
                     if let Some(s) = self.alphabet.lookup(&name.text) {
@@ -683,6 +713,7 @@ impl Compiler {
                     ast::Stmt::While { body, .. }
                     | ast::Stmt::DoWhile { body, .. }
                     | ast::Stmt::For { body, .. } => stmts(std::slice::from_ref(body), out),
+                    ast::Stmt::Switch { body, .. } => stmts(body, out),
                     _ => {}
                 }
             }
@@ -896,7 +927,7 @@ impl Compiler {
                 continue;
             };
             let mut scope = Scope::default();
-            let init = self.initializer(ty, &d.init, &mut scope);
+            let init = self.initializer(ty, &d.init, d.name.span, &mut scope);
             if scope.max > 0 {
                 self.err(d.name.span, "a global initializer cannot declare variables");
             }
@@ -925,10 +956,27 @@ impl Compiler {
         }
     }
 
-    /// The expression that initialises a variable of type `ty`.
-    fn initializer(&mut self, ty: Ty, init: &Init, scope: &mut Scope) -> Option<Ex> {
+    /// The expression that initialises a variable of type `ty`, declared
+    /// at `at`.
+    fn initializer(&mut self, ty: Ty, init: &Init, at: Span, scope: &mut Scope) -> Option<Ex> {
+        let has_ctor = match ty {
+            Ty::Struct(si) => self.ctors.contains_key(&self.structs[si as usize].name),
+            _ => false,
+        };
         match init {
-            Init::None => None,
+            // `S s;` and `S s(1, 2);` call `S`'s constructors; the structs
+            // of a plain struct or an array are built by theirs.
+            Init::None => match self.default_value(ty, at) {
+                Ex::Const(_) => None,
+                built => Some(built),
+            },
+            Init::Ctor(args, span) if has_ctor => {
+                let name = ast::Name {
+                    text: self.structs[pt_index(ty)].name.clone(),
+                    span: *span,
+                };
+                self.ctor_call(ty, &name, args, *span, scope).map(|t| t.0)
+            }
             Init::Expr(e) => {
                 let (ex, et) = self.expr(e, scope)?;
                 self.coerce(ex, et, ty, e.span)
@@ -1343,7 +1391,7 @@ impl Compiler {
                         self.static_local(d, v, ty, scope);
                         continue;
                     }
-                    let init = self.initializer(ty, &v.init, scope);
+                    let init = self.initializer(ty, &v.init, v.name.span, scope);
                     let slot = self.local(scope, &v.name.text, ty, v.name.span);
                     if d.is_const {
                         scope.consts.insert(slot);
@@ -1440,21 +1488,139 @@ impl Compiler {
                 });
             }
             ast::Stmt::Return(value, span) => self.return_stmt(value.as_ref(), *span, scope, out),
-            ast::Stmt::Break(span) | ast::Stmt::Continue(span) => {
-                if scope.loops == 0 {
-                    self.err(
-                        *span,
-                        "`break` and `continue` are only allowed inside a loop",
-                    );
-                    return;
-                }
-                out.push(if matches!(s, ast::Stmt::Break(_)) {
-                    St::Break
-                } else {
-                    St::Continue
-                });
-            }
+            ast::Stmt::Switch { value, body, span } => self.switch(value, body, *span, scope, out),
+            ast::Stmt::Break(_)
+            | ast::Stmt::Continue(_)
+            | ast::Stmt::Case(..)
+            | ast::Stmt::Default(_) => self.jump(s, scope, out),
             ast::Stmt::Empty => {}
+        }
+    }
+
+    /// `break`, `continue`, and a `case` or `default` label found outside
+    /// a `switch`'s body. (Out of `stmt`, so that the frame of that
+    /// recursive function stays small.)
+    #[inline(never)]
+    fn jump(&mut self, s: &ast::Stmt, scope: &Scope, out: &mut Vec<St>) {
+        match s {
+            ast::Stmt::Break(span) if scope.loops == 0 && scope.switches == 0 => {
+                self.err(*span, "`break` is only allowed inside a loop or a `switch`")
+            }
+            ast::Stmt::Break(_) => out.push(St::Break),
+            ast::Stmt::Continue(span) if scope.loops == 0 => {
+                self.err(*span, "`continue` is only allowed inside a loop")
+            }
+            ast::Stmt::Continue(_) => out.push(St::Continue),
+            ast::Stmt::Case(_, span) => self.err(
+                *span,
+                "a `case` label belongs directly in the body of a `switch`",
+            ),
+            ast::Stmt::Default(span) => self.err(
+                *span,
+                "a `default` label belongs directly in the body of a `switch`",
+            ),
+            _ => {}
+        }
+    }
+
+    /// `switch (value) { case 1: ... default: ... }`: C's semantics. The
+    /// labels are integer constants, each value once; control enters at
+    /// the matching label and falls through the labels after it until a
+    /// `break`. A label may not jump past a declaration of the body.
+    #[inline(never)]
+    fn switch(
+        &mut self,
+        value: &ast::Expr,
+        body: &[ast::Stmt],
+        span: Span,
+        scope: &mut Scope,
+        out: &mut Vec<St>,
+    ) {
+        let checked = self.expr(value, scope).and_then(|(ex, ty)| {
+            if matches!(ty, Ty::Int | Ty::Bool) {
+                Some(ex)
+            } else {
+                let found = self.type_name(ty);
+                self.err(
+                    value.span,
+                    format!(
+                        "the value of `switch` must be an integer (an int, a char, a bool or an enumerator), found {found}"
+                    ),
+                );
+                None
+            }
+        });
+        scope.push();
+        scope.switches += 1;
+        let mut stmts: Vec<St> = Vec::new();
+        let mut cases: Vec<(i64, u32, Span)> = Vec::new();
+        let mut default: Option<(u32, Span)> = None;
+        let mut declared: Option<&ast::Name> = None;
+        for s in body {
+            let at = stmts.len() as u32;
+            match s {
+                ast::Stmt::Case(e, label) => {
+                    let value = self
+                        .expr(e, scope)
+                        .map(|(ex, _)| match self.const_value(&ex, 0) {
+                            Some(Value::Bool(b)) => Some(Value::Int(b as i64)),
+                            v => v,
+                        });
+                    match value {
+                        None => {}
+                        Some(Some(Value::Int(v))) if cases.iter().any(|c| c.0 == v) => {
+                            self.err(
+                                e.span,
+                                format!("this `case` is {v}, which is already a label of this `switch`"),
+                            );
+                        }
+                        Some(Some(Value::Int(v))) => cases.push((v, at, *label)),
+                        Some(_) => self.err(
+                            e.span,
+                            "a `case` label must be an integer constant: a number, a character, an enumerator or a `const int` global",
+                        ),
+                    }
+                }
+                ast::Stmt::Default(label) => {
+                    if default.is_some() {
+                        self.err(*label, "this `switch` already has a `default` label");
+                    } else {
+                        default = Some((at, *label));
+                    }
+                }
+                _ => {
+                    if let ast::Stmt::Decl(d) = s {
+                        declared = declared.or(d.vars.first().map(|v| &v.name));
+                    }
+                    self.stmt(s, scope, &mut stmts);
+                    continue;
+                }
+            }
+            if let Some(name) = declared {
+                let label = match s {
+                    ast::Stmt::Case(_, l) | ast::Stmt::Default(l) => *l,
+                    _ => span,
+                };
+                self.err(
+                    label,
+                    format!(
+                        "this label jumps past the declaration of `{}`; put the statements of the case in braces `{{ }}`",
+                        name.text
+                    ),
+                );
+            }
+        }
+        scope.switches -= 1;
+        scope.pop();
+        if let Some(value) = checked {
+            let mut cases: Vec<(i64, u32)> = cases.into_iter().map(|c| (c.0, c.1)).collect();
+            cases.sort_unstable();
+            out.push(St::Switch {
+                value,
+                cases,
+                default: default.map(|d| d.0),
+                body: stmts,
+            });
         }
     }
 
@@ -1653,6 +1819,9 @@ impl Compiler {
                 }
                 if let Some(&v) = self.enum_consts.get(n) {
                     return Some((Ex::Const(Value::Int(v)), Ty::Int));
+                }
+                if self.ambiguous_enums.contains(n) {
+                    return self.ambiguous_enumerator(n, span);
                 }
                 let handle = match n.as_str() {
                     "NULL" => Some(0),
@@ -2004,6 +2173,9 @@ impl Compiler {
         scope: &mut Scope,
     ) -> Typed {
         let (x, t) = self.expr(recv, scope)?;
+        if let (Ty::Struct(si), false) = (t, self.methods.is_empty()) {
+            return self.struct_method(si, recv, name, args, span, scope);
+        }
         if !t.is_vector() || !args.is_empty() {
             self.err(
                 name.span,
@@ -2061,7 +2233,7 @@ impl Compiler {
         if let Some(&id) = self.user_fn_names.get(n) {
             return self.user_call(id, name, args, span, scope);
         }
-        if let Some(r) = self.stdio_call(name, args, span, scope) {
+        if let Some(r) = self.ctor_or_stdio_call(name, args, span, scope) {
             return r;
         }
         // A functional cast: `float(x)`, `int(x)`.
@@ -2629,9 +2801,19 @@ impl Compiler {
     }
 
     /// `enum Kind { A, B = 5, C };`: int constants, and `Kind` an int type.
-    fn enum_decl(&mut self, name: Option<&ast::Name>, variants: &[(ast::Name, Option<ast::Expr>)]) {
+    /// Declared in struct `S` (`scope`), they are also `S::A` and `S::Kind`,
+    /// and `A` alone names them unless another struct declares an `A` too.
+    fn enum_decl(
+        &mut self,
+        name: Option<&ast::Name>,
+        variants: &[(ast::Name, Option<ast::Expr>)],
+        scope: Option<&str>,
+    ) {
         if let Some(n) = name {
             self.typedefs.insert(n.text.clone(), Ty::Int);
+            if let Some(s) = scope {
+                self.typedefs.insert(format!("{s}::{}", n.text), Ty::Int);
+            }
         }
         let mut next = 0i64;
         for (v, value) in variants {
@@ -2641,6 +2823,30 @@ impl Compiler {
                     None => continue,
                 }
             }
+            if let Some(s) = scope {
+                let scoped = format!("{s}::{}", v.text);
+                if self.enum_consts.contains_key(&scoped) {
+                    self.err(v.span, format!("`{scoped}` is already declared"));
+                    continue;
+                }
+                self.enum_consts.insert(scoped, next);
+                if self.struct_enums.remove(&v.text) {
+                    self.enum_consts.remove(&v.text);
+                    self.ambiguous_enums.insert(v.text.clone());
+                } else if !self.enum_consts.contains_key(&v.text)
+                    && !self.ambiguous_enums.contains(&v.text)
+                {
+                    self.enum_consts.insert(v.text.clone(), next);
+                    self.struct_enums.insert(v.text.clone());
+                }
+                next = next.wrapping_add(1);
+                continue;
+            }
+            // An enumerator outside structs hides those of structs.
+            if self.struct_enums.remove(&v.text) {
+                self.enum_consts.remove(&v.text);
+            }
+            self.ambiguous_enums.remove(&v.text);
             if self.enum_consts.contains_key(&v.text) || self.global_names.contains_key(&v.text) {
                 self.err(v.span, format!("`{}` is already declared", v.text));
                 continue;
@@ -2655,7 +2861,7 @@ impl Compiler {
     #[inline(never)]
     fn static_local(&mut self, d: &ast::VarDecl, v: &ast::Declarator, ty: Ty, scope: &mut Scope) {
         let mut init_scope = Scope::default();
-        let init = self.initializer(ty, &v.init, &mut init_scope);
+        let init = self.initializer(ty, &v.init, v.name.span, &mut init_scope);
         if init_scope.max > 0 {
             self.err(
                 v.name.span,
@@ -2756,6 +2962,431 @@ impl Compiler {
         ok.then_some(out)
     }
 
+    /// A constructor of struct `s`: a user function returning the struct.
+    /// Constructors of one struct are told apart by their number of
+    /// parameters.
+    #[inline(never)]
+    fn ctor_sig(&mut self, s: &ast::Name, c: &ast::Ctor) {
+        let Some(&si) = self.struct_names.get(&s.text) else {
+            return;
+        };
+        let def = ast::FunctionDef {
+            ret: ast::TypeRef {
+                name: s.text.clone(),
+                span: s.span,
+                pointer: false,
+                reference: false,
+            },
+            name: c.name.clone(),
+            params: c.params.clone(),
+            body: None,
+        };
+        let Some(params) = self.param_types(&def) else {
+            return;
+        };
+        let ids = self.ctors.get(&s.text).cloned().unwrap_or_default();
+        if ids
+            .iter()
+            .any(|&id| self.user_fns[id as usize].params.len() == params.len())
+        {
+            self.err(
+                c.name.span,
+                format!(
+                    "`{}` already has a constructor with {} parameter(s); constructors are told apart only by their number of parameters",
+                    s.text,
+                    params.len()
+                ),
+            );
+            return;
+        }
+        if self.user_fns.len() >= MAX_USER_FUNCTIONS {
+            self.too_many(MAX_USER_FUNCTIONS, "functions", c.name.span);
+            return;
+        }
+        self.ctors
+            .entry(s.text.clone())
+            .or_default()
+            .push(self.user_fns.len() as u16);
+        self.user_fns.push(UserSig {
+            name: s.text.clone(),
+            params,
+            ret: Ty::Struct(si),
+            span: c.name.span,
+            defined: true,
+        });
+    }
+
+    /// A constructor's body: the fields are locals, zero (or built by
+    /// their own default constructor), that the parameters hide; the
+    /// initialiser list sets them in the order they are declared, then the
+    /// body runs, and the struct is made of them.
+    #[inline(never)]
+    fn ctor_body(&mut self, s: &ast::Name, c: &ast::Ctor, id: u16) -> Option<Function> {
+        let sig = self.user_fns[id as usize].clone();
+        let Ty::Struct(si) = sig.ret else {
+            return None;
+        };
+        let fields = self.structs[si as usize].fields.clone();
+        let mut scope = Scope {
+            ret: Some((Ty::Void, sig.name.clone())),
+            ..Scope::default()
+        };
+        scope.reserve(sig.params.len());
+        let mut stmts = Vec::new();
+        let mut slots = Vec::with_capacity(fields.len());
+        for (name, ty) in &fields {
+            let slot = self.local(&mut scope, name, *ty, c.name.span);
+            let zero = self.default_value(*ty, c.name.span);
+            stmts.push(St::Init(slot, zero));
+            slots.push(slot);
+        }
+        scope.push();
+        for (k, p) in c.params.iter().enumerate() {
+            if let Some(n) = &p.name {
+                if scope.vars[fields.len()..].iter().any(|v| v.0 == n.text) {
+                    self.err(
+                        n.span,
+                        format!("the parameter name `{}` is used twice", n.text),
+                    );
+                }
+                scope.bind(&n.text, sig.params[k].0, k as u16);
+            }
+        }
+        let mut inits: Vec<(usize, &ast::Name, &Vec<ast::Expr>, Span)> = Vec::new();
+        for (f, args, span) in &c.inits {
+            let Some(k) = fields.iter().position(|(n, _)| *n == f.text) else {
+                self.err(
+                    f.span,
+                    format!(
+                        "struct `{}` has no field `{}` to initialise",
+                        s.text, f.text
+                    ),
+                );
+                continue;
+            };
+            if inits.iter().any(|i| i.0 == k) {
+                self.err(
+                    f.span,
+                    format!("the field `{}` is initialised twice", f.text),
+                );
+                continue;
+            }
+            inits.push((k, f, args, *span));
+        }
+        // C++ initialises the fields in the order they are declared.
+        inits.sort_by_key(|i| i.0);
+        for (k, _, args, span) in inits {
+            let ty = fields[k].1;
+            let value = if args.is_empty() {
+                Some(self.default_value(ty, span))
+            } else {
+                self.initializer(ty, &Init::Ctor(args.clone(), span), span, &mut scope)
+            };
+            if let Some(v) = value {
+                stmts.push(St::Init(slots[k], v));
+            }
+        }
+        stmts.extend(self.block_stmts(&c.body.stmts, &mut scope));
+        let end = c.body.span.end as usize;
+        Some(Function {
+            name: sig.name.clone(),
+            params: sig.params.iter().map(|p| p.0).collect(),
+            ret: sig.ret,
+            body: stmts,
+            frame_size: (scope.max as usize).max(sig.params.len()),
+            end: Span::new(c.body.span.file, end.saturating_sub(1), end),
+            result: Some(Ex::MakeStruct(slots.into_iter().map(Ex::Local).collect())),
+            this_back: None,
+        })
+    }
+
+    /// A method of struct `s`: a user function `S::name` whose first
+    /// parameter is the struct, by reference; no overloads.
+    #[inline(never)]
+    fn method_sig(&mut self, s: &ast::Name, m: &ast::FunctionDef) {
+        let Some(&si) = self.struct_names.get(&s.text) else {
+            return;
+        };
+        let ret = match self.resolve_type(&m.ret) {
+            Some(_) if m.ret.pointer && m.ret.name == "char" => Ty::Str,
+            Some(_) if m.ret.pointer => {
+                self.err(m.ret.span, "a method cannot return a pointer here");
+                return;
+            }
+            Some(t) => t,
+            None => return,
+        };
+        let this = ast::Param {
+            ty: ast::TypeRef {
+                name: s.text.clone(),
+                span: s.span,
+                pointer: false,
+                reference: true,
+            },
+            name: None,
+            dims: Vec::new(),
+        };
+        let def = ast::FunctionDef {
+            params: std::iter::once(this)
+                .chain(m.params.iter().cloned())
+                .collect(),
+            ..m.clone()
+        };
+        let Some(params) = self.param_types(&def) else {
+            return;
+        };
+        let key = (si, m.name.text.clone());
+        if self.methods.contains_key(&key)
+            || self.struct_fields[si as usize].contains_key(&m.name.text)
+        {
+            self.err(
+                m.name.span,
+                format!(
+                    "struct `{}` already has a member `{}`; methods cannot be overloaded",
+                    s.text, m.name.text
+                ),
+            );
+            return;
+        }
+        if self.user_fns.len() >= MAX_USER_FUNCTIONS {
+            self.too_many(MAX_USER_FUNCTIONS, "functions", m.name.span);
+            return;
+        }
+        self.methods.insert(key, self.user_fns.len() as u16);
+        self.user_fns.push(UserSig {
+            name: format!("{}::{}", s.text, m.name.text),
+            params,
+            ret,
+            span: m.name.span,
+            defined: true,
+        });
+    }
+
+    /// A method's body: the struct is slot 0, the parameters follow; the
+    /// fields are locals, read from it first and written back to it when
+    /// the body ends, which the caller's variable then receives.
+    #[inline(never)]
+    fn method_body(&mut self, m: &ast::FunctionDef, id: u16) -> Option<Function> {
+        let sig = self.user_fns[id as usize].clone();
+        let Ty::Struct(si) = sig.params.first()?.0 else {
+            return None;
+        };
+        let body = m.body.as_ref()?;
+        let fields = self.structs[si as usize].fields.clone();
+        let mut scope = Scope {
+            ret: Some((sig.ret, sig.name.clone())),
+            ..Scope::default()
+        };
+        scope.reserve(sig.params.len());
+        let mut stmts = Vec::new();
+        let mut slots = Vec::with_capacity(fields.len());
+        for (k, (name, ty)) in fields.iter().enumerate() {
+            let slot = self.local(&mut scope, name, *ty, m.name.span);
+            stmts.push(St::Init(slot, Ex::Field(Box::new(Ex::Local(0)), k as u16)));
+            slots.push(slot);
+        }
+        scope.push();
+        for (k, p) in m.params.iter().enumerate() {
+            if let Some(n) = &p.name {
+                if scope.vars[fields.len()..].iter().any(|v| v.0 == n.text) {
+                    self.err(
+                        n.span,
+                        format!("the parameter name `{}` is used twice", n.text),
+                    );
+                }
+                scope.bind(&n.text, sig.params[k + 1].0, k as u16 + 1);
+            }
+        }
+        stmts.extend(self.block_stmts(&body.stmts, &mut scope));
+        let end = body.span.end as usize;
+        Some(Function {
+            name: sig.name.clone(),
+            params: sig.params.iter().map(|p| p.0).collect(),
+            ret: sig.ret,
+            body: stmts,
+            frame_size: (scope.max as usize).max(sig.params.len()),
+            end: Span::new(body.span.file, end.saturating_sub(1), end),
+            result: None,
+            this_back: Some(Ex::MakeStruct(slots.into_iter().map(Ex::Local).collect())),
+        })
+    }
+
+    /// `v.name(args)` on a struct `v`: its method `name`, `v` passed by
+    /// reference.
+    #[inline(never)]
+    fn struct_method(
+        &mut self,
+        si: u16,
+        recv: &ast::Expr,
+        name: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Typed {
+        let sname = self.structs[si as usize].name.clone();
+        let Some(&id) = self.methods.get(&(si, name.text.clone())) else {
+            self.err(
+                name.span,
+                format!("struct `{sname}` has no method `{}`", name.text),
+            );
+            return None;
+        };
+        let want = self.user_fns[id as usize].params.len() - 1;
+        if args.len() != want {
+            self.err(
+                span,
+                format!(
+                    "`{sname}::{}` takes {want} argument(s), but {} were given",
+                    name.text,
+                    args.len()
+                ),
+            );
+            return None;
+        }
+        if !matches!(
+            recv.kind,
+            ExprKind::Ident(_) | ExprKind::Field(..) | ExprKind::Index(..)
+        ) {
+            self.err(
+                recv.span,
+                "methods are called on a variable here (`leaf.area()`), not on a value made by an expression",
+            );
+            return None;
+        }
+        let all: Vec<ast::Expr> = std::iter::once(recv.clone())
+            .chain(args.iter().cloned())
+            .collect();
+        self.user_call(id, name, &all, span, scope)
+    }
+
+    /// The value a variable of type `ty` starts with when nothing
+    /// initialises it, as C++ makes it: for a struct with a constructor
+    /// without parameters, what that constructor makes; for another struct
+    /// or an array, its fields or elements made so; otherwise zero (a
+    /// constant).
+    fn default_value(&mut self, ty: Ty, span: Span) -> Ex {
+        let Ty::Struct(si) = ty else {
+            return Ex::Const(Value::zero(ty, &self.structs));
+        };
+        let zero = |c: &Compiler| Ex::Const(Value::zero(ty, &c.structs));
+        if self.ctors.is_empty() {
+            return zero(self);
+        }
+        let def = &self.structs[si as usize];
+        let id = self.ctors.get(&def.name).and_then(|ids| {
+            ids.iter()
+                .copied()
+                .find(|&id| self.user_fns[id as usize].params.is_empty())
+        });
+        if let Some(id) = id {
+            return Ex::CallUser {
+                id,
+                args: Vec::new(),
+                back: Vec::new(),
+                span,
+            };
+        }
+        let fields: Vec<Ty> = def.fields.iter().map(|f| f.1).collect();
+        if fields.len() > MAX_BUILT_ELEMENTS {
+            // Only the first field tells whether the elements of a long
+            // array are built: they all have its type.
+            if matches!(
+                fields.first().map(|&t| self.default_value(t, span)),
+                Some(Ex::Const(_)) | None
+            ) {
+                return zero(self);
+            }
+            self.err(
+                span,
+                format!(
+                    "an array of more than {MAX_BUILT_ELEMENTS} structs with constructors is not supported"
+                ),
+            );
+            return zero(self);
+        }
+        let parts: Vec<Ex> = fields
+            .iter()
+            .map(|&t| self.default_value(t, span))
+            .collect();
+        if parts.iter().all(|p| matches!(p, Ex::Const(_))) {
+            return zero(self);
+        }
+        Ex::MakeStruct(parts)
+    }
+
+    /// `A` that several structs declare: only `S::A` names it. (Out of
+    /// `expr_inner`, so that the frame of that recursive function stays
+    /// small.)
+    #[cold]
+    #[inline(never)]
+    fn ambiguous_enumerator(&mut self, n: &str, span: Span) -> Typed {
+        self.err(
+            span,
+            format!("more than one struct declares an enumerator `{n}`: write `Struct::{n}`"),
+        );
+        None
+    }
+
+    /// The struct type that `name` names (not an array's typedef).
+    fn struct_named(&self, name: &str) -> Option<Ty> {
+        match self.struct_names.get(name) {
+            Some(&si) => Some(Ty::Struct(si)),
+            None => match self.typedefs.get(name) {
+                Some(t @ Ty::Struct(si)) if self.structs[*si as usize].elem.is_none() => Some(*t),
+                _ => None,
+            },
+        }
+    }
+
+    /// `S(args)` in an expression, `S` naming struct type `ty`: the
+    /// constructor of `S` that takes as many arguments; without
+    /// constructors, `S()` is zero and `S(a, b)` sets the fields in order.
+    #[inline(never)]
+    fn ctor_call(
+        &mut self,
+        ty: Ty,
+        name: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Typed {
+        let sname = self.structs[pt_index(ty)].name.clone();
+        let Some(ids) = self.ctors.get(&sname).cloned() else {
+            if args.is_empty() {
+                return Some((self.default_value(ty, span), ty));
+            }
+            let mut exs = Vec::new();
+            for a in args {
+                exs.push(self.expr(a, scope)?);
+            }
+            return self.construct(ty, exs, args, span).map(|ex| (ex, ty));
+        };
+        match ids
+            .iter()
+            .copied()
+            .find(|&id| self.user_fns[id as usize].params.len() == args.len())
+        {
+            Some(id) => self.user_call(id, name, args, span, scope),
+            None => {
+                let mut counts: Vec<usize> = ids
+                    .iter()
+                    .map(|&id| self.user_fns[id as usize].params.len())
+                    .collect();
+                counts.sort_unstable();
+                let counts: Vec<String> = counts.iter().map(|c| c.to_string()).collect();
+                self.err(
+                    span,
+                    format!(
+                        "`{sname}` has no constructor that takes {} argument(s); its constructors take {}",
+                        args.len(),
+                        counts.join(" or ")
+                    ),
+                );
+                None
+            }
+        }
+    }
+
     /// First pass: a function's signature, so that calls may come before
     /// its definition.
     fn function_sig(&mut self, def: &ast::FunctionDef) {
@@ -2826,9 +3457,35 @@ impl Compiler {
                 body: Vec::new(),
                 frame_size: s.params.len(),
                 end: s.span,
+                result: None,
+                this_back: None,
             })
             .collect();
         for item in &file.items {
+            if let Item::Struct { name, body } = item {
+                for c in &body.ctors {
+                    let id = self.ctors.get(&name.text).and_then(|ids| {
+                        ids.iter()
+                            .copied()
+                            .find(|&id| self.user_fns[id as usize].span == c.name.span)
+                    });
+                    if let Some(f) = id.and_then(|id| self.ctor_body(name, c, id).map(|f| (id, f)))
+                    {
+                        out[f.0 as usize] = f.1;
+                    }
+                }
+                for m in &body.methods {
+                    let id = self.struct_names.get(&name.text).and_then(|&si| {
+                        self.methods
+                            .get(&(si, m.name.text.clone()))
+                            .copied()
+                            .filter(|&id| self.user_fns[id as usize].span == m.name.span)
+                    });
+                    if let Some(f) = id.and_then(|id| self.method_body(m, id).map(|f| (id, f))) {
+                        out[f.0 as usize] = f.1;
+                    }
+                }
+            }
             let Item::Function(def) = item else { continue };
             let Some(body) = &def.body else { continue };
             let Some(&id) = self.user_fn_names.get(&def.name.text) else {
@@ -2867,6 +3524,8 @@ impl Compiler {
                 body: stmts,
                 frame_size: (scope.max as usize).max(sig.params.len()),
                 end: Span::new(body.span.file, end.saturating_sub(1), end),
+                result: None,
+                this_back: None,
             };
         }
         out
@@ -3019,6 +3678,23 @@ impl Compiler {
             span,
         };
         self.expr_inner(&cast, scope)
+    }
+
+    /// A struct's construction (`S(args)`) or one of C's standard I/O and
+    /// string functions; `None` for another name. (One call in `call`, so
+    /// that the frame of that recursive function stays small.)
+    #[inline(never)]
+    fn ctor_or_stdio_call(
+        &mut self,
+        name: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &mut Scope,
+    ) -> Option<Typed> {
+        if let Some(ty) = self.struct_named(&name.text) {
+            return Some(self.ctor_call(ty, name, args, span, scope));
+        }
+        self.stdio_call(name, args, span, scope)
     }
 
     /// C's standard I/O and string functions; `None` for another name.

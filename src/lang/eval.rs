@@ -388,7 +388,41 @@ impl<'p> Interp<'p> {
             }
             St::Break => Ok(Flow::Break),
             St::Continue => Ok(Flow::Continue),
+            St::Switch {
+                value,
+                cases,
+                default,
+                body,
+            } => self.switch(value, cases, *default, body, cx),
         }
+    }
+
+    /// Runs a `switch`'s body from the label of its value's; a `break`
+    /// ends it. Out of `stmt`, so that its frame stays small.
+    #[inline(never)]
+    fn switch(
+        &mut self,
+        value: &Ex,
+        cases: &[(i64, u32)],
+        default: Option<u32>,
+        body: &[St],
+        cx: &mut Cx,
+    ) -> R<Flow> {
+        let v = self.expr(value, cx)?.as_i64();
+        let start = match cases.binary_search_by_key(&v, |c| c.0) {
+            Ok(k) => Some(cases[k].1),
+            Err(_) => default,
+        };
+        if let Some(start) = start {
+            for s in &body[start as usize..] {
+                match self.stmt(s, cx)? {
+                    Flow::Normal => {}
+                    Flow::Break => break,
+                    f => return Ok(f),
+                }
+            }
+        }
+        Ok(Flow::Normal)
     }
 
     fn produce(&mut self, modules: &[Succ], cx: &mut Cx) -> R<()> {
@@ -625,6 +659,12 @@ impl<'p> Interp<'p> {
                 Flow::Normal => {}
                 _ => break,
             }
+        }
+        if let Some(this) = &f.this_back {
+            cx.frame[0] = self.expr(this, &mut cx)?;
+        }
+        if let Some(r) = &f.result {
+            return self.expr(r, &mut cx);
         }
         match self.ret.take() {
             Some(v) => Ok(v),

@@ -177,6 +177,15 @@ pub enum St {
     ReturnValue(Ex),
     Break,
     Continue,
+    /// `switch`: runs `body` from the statement that the value's label
+    /// points at (`cases`, sorted by value, then `default`, else nothing);
+    /// a `break` ends it.
+    Switch {
+        value: Ex,
+        cases: Vec<(i64, u32)>,
+        default: Option<u32>,
+        body: Vec<St>,
+    },
 }
 
 /// A successor module: a symbol and argument expressions of its types.
@@ -266,6 +275,13 @@ pub struct Function {
     /// The closing brace: where a function that must return a value and
     /// reaches its end without one is reported.
     pub end: Span,
+    /// A constructor's value, computed once its body has ended (it returns
+    /// no value itself): the struct made of its fields' locals.
+    pub result: Option<Ex>,
+    /// A method's struct, written back to its first parameter (by
+    /// reference) once its body has ended: the struct made of its fields'
+    /// locals.
+    pub this_back: Option<Ex>,
 }
 
 /// A checked, executable program.

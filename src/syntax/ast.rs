@@ -38,10 +38,10 @@ pub enum Item {
         params: Vec<TypeRef>,
     },
     /// `struct Data { float length, area; float v[3]; };`: each field with
-    /// its array dimensions.
+    /// its array dimensions, the enums declared inside, the constructors.
     Struct {
         name: Name,
-        fields: Vec<(TypeRef, Name, Vec<Option<Expr>>)>,
+        body: StructBody,
     },
     /// `typedef float real;`
     Typedef {
@@ -100,6 +100,33 @@ pub enum Item {
         name: Option<Name>,
         variants: Vec<(Name, Option<Expr>)>,
     },
+}
+
+/// An enum's enumerators, each with its value if one is written.
+pub type Enumerators = Vec<(Name, Option<Expr>)>;
+
+/// What a struct's braces hold.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StructBody {
+    /// Each field with its array dimensions.
+    pub fields: Vec<(TypeRef, Name, Vec<Option<Expr>>)>,
+    /// `enum { A, B } kind;`: enums declared inside, whose enumerators are
+    /// constants, also as `Struct::A`.
+    pub enums: Vec<(Option<Name>, Enumerators)>,
+    pub ctors: Vec<Ctor>,
+    /// Methods: functions whose body sees the fields by their names.
+    pub methods: Vec<FunctionDef>,
+}
+
+/// A C++ constructor: `S(float x) : v(x), n(2) { body }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ctor {
+    pub name: Name,
+    pub params: Vec<Param>,
+    /// The initialiser list: each field with its arguments and the span of
+    /// the parenthesised arguments.
+    pub inits: Vec<(Name, Vec<Expr>, Span)>,
+    pub body: Block,
 }
 
 /// A user-defined C function.
@@ -254,6 +281,18 @@ pub enum Stmt {
     Return(Option<Expr>, Span),
     Break(Span),
     Continue(Span),
+    /// `switch (value) { ... }`: the body's statements, among them its
+    /// `case` and `default` labels.
+    Switch {
+        value: Expr,
+        body: Vec<Stmt>,
+        /// The `switch` keyword.
+        span: Span,
+    },
+    /// `case expr:`, a label directly in a `switch`'s body.
+    Case(Expr, Span),
+    /// `default:`, a label directly in a `switch`'s body.
+    Default(Span),
     Empty,
 }
 

@@ -225,6 +225,77 @@ fn string_lit(i: &str) -> IResult<&str, &str> {
     Ok((rest, body))
 }
 
+/// A character constant, `'a'`, `'\n'`, `'\0'`, `'\x41'`: C's escapes,
+/// the value of one ASCII character as an `int`. The error gives how many
+/// bytes it covers.
+fn char_lit(i: &str) -> Result<(&str, i64), (usize, String)> {
+    let body = &i[1..];
+    let (code, len) = match body.chars().next() {
+        None | Some('\n') | Some('\'') => {
+            return Err((1, "expected a character and a closing `'` after `'`".into()))
+        }
+        Some('\\') => {
+            let esc = &body[1..];
+            let simple = |c: char| {
+                Some(match c {
+                    'n' => 10,
+                    't' => 9,
+                    'r' => 13,
+                    'a' => 7,
+                    'b' => 8,
+                    'f' => 12,
+                    'v' => 11,
+                    '\\' | '\'' | '"' | '?' => c as i64,
+                    _ => return None,
+                })
+            };
+            let octal = esc
+                .bytes()
+                .take(3)
+                .take_while(|b| (b'0'..=b'7').contains(b))
+                .count();
+            let hex = esc
+                .strip_prefix('x')
+                .map(|h| h.bytes().take_while(u8::is_ascii_hexdigit).count());
+            if octal > 0 {
+                let v = i64::from_str_radix(&esc[..octal], 8).unwrap_or(0);
+                (v, 1 + octal)
+            } else if let Some(n) = hex.filter(|n| (1..=2).contains(n)) {
+                let v = i64::from_str_radix(&esc[1..1 + n], 16).unwrap_or(0);
+                (v, 2 + n)
+            } else if let Some(n) = hex.filter(|n| *n > 2) {
+                return Err((
+                    3 + n,
+                    "a hexadecimal escape in a character constant takes one or two digits".into(),
+                ));
+            } else if let Some(v) = esc.chars().next().and_then(simple) {
+                (v, 2)
+            } else {
+                let shown: String = esc.chars().take(1).collect();
+                return Err((
+                    2 + shown.len(),
+                    format!("unknown escape `\\{shown}` in a character constant"),
+                ));
+            }
+        }
+        Some(c) if c.is_ascii() => (c as i64, 1),
+        Some(c) => {
+            return Err((
+                1 + c.len_utf8(),
+                format!("`{c}` is not an ASCII character: a character constant holds one byte"),
+            ))
+        }
+    };
+    match body[len..].strip_prefix('\'') {
+        Some(r) => Ok((r, code)),
+        None => Err((
+            1 + len,
+            "expected `'` to close the character constant (it holds one character; strings take `\"`)"
+                .into(),
+        )),
+    }
+}
+
 fn punct(i: &str) -> IResult<&str, &'static str> {
     match PUNCTS.iter().find(|p| i.starts_with(**p)) {
         Some(p) => Ok((&i[p.len()..], p)),
@@ -327,6 +398,20 @@ pub fn lex_all(file: FileId, text: &str) -> Result<Lexed, Diagnostic> {
                     continue;
                 }
             }
+        } else if rest.starts_with('\'') {
+            match char_lit(rest) {
+                Ok((r, code)) => (r, Tok::Int(code)),
+                Err((len, message)) => {
+                    errors.push((
+                        out.len(),
+                        Diagnostic::new(Span::new(file, at, at + len), message),
+                    ));
+                    rest = &rest[len..];
+                    line_start = false;
+                    space_before = false;
+                    continue;
+                }
+            }
         } else if let Ok((r, s)) = string_lit(rest) {
             (r, Tok::Str(s.to_string()))
         } else if let Ok((r, p)) = punct(rest) {
@@ -366,6 +451,32 @@ mod tests {
         let toks = lex(FileId(0), text).map_err(|d| d.message)?;
         assert_eq!(toks.len(), 1, "{text}: {toks:?}");
         Ok(toks[0].tok.clone())
+    }
+
+    /// Character constants (C11 6.4.4.4) are ints: ASCII codes, the
+    /// simple escapes, octal and hexadecimal ones.
+    #[test]
+    fn character_constants() {
+        let cases = [
+            ("'a'", 97),
+            ("' '", 32),
+            ("'\\n'", 10),
+            ("'\\t'", 9),
+            ("'\\0'", 0),
+            ("'\\''", 39),
+            ("'\\\\'", 92),
+            ("'\\\"'", 34),
+            ("'\"'", 34),
+            ("'\\x41'", 65),
+            ("'\\101'", 65),
+            ("'\\177'", 127),
+        ];
+        for (text, want) in cases {
+            assert_eq!(one(text), Ok(Tok::Int(want)), "{text}");
+        }
+        for bad in ["'ab'", "''", "'\\q'", "'\\x123'", "'é'", "'a"] {
+            assert!(one(bad).is_err(), "{bad}");
+        }
     }
 
     fn float(value: f64, single: bool) -> Tok {

@@ -76,7 +76,38 @@ impl<'t> Parser<'t> {
     }
 }
 
+/// `Shape::Circle` as one name token (an enumerator declared in a struct,
+/// `Struct::Enum` as a type): no other use of `::` is part of the language.
+fn scoped_names(toks: &[Token]) -> Vec<Token> {
+    let mut out: Vec<Token> = Vec::with_capacity(toks.len());
+    let mut k = 0;
+    while k < toks.len() {
+        if let (Some(Tok::Ident(a)), Some(Tok::Ident(b))) =
+            (out.last().map(|t| &t.tok), toks.get(k + 1).map(|t| &t.tok))
+        {
+            if toks[k].tok.is_punct("::") {
+                let joined = format!("{a}::{b}");
+                let last = out.last_mut().expect("checked");
+                last.span = last.span.to(toks[k + 1].span);
+                last.tok = Tok::Ident(joined);
+                k += 2;
+                continue;
+            }
+        }
+        out.push(toks[k].clone());
+        k += 1;
+    }
+    out
+}
+
 pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<File> {
+    let scoped;
+    let toks = if toks.iter().any(|t| t.tok.is_punct("::")) {
+        scoped = scoped_names(toks);
+        &scoped[..]
+    } else {
+        toks
+    };
     // `angle:` anywhere switches on the single-character turtle.
     let abop = toks
         .windows(2)
@@ -259,7 +290,7 @@ impl<'t> Parser<'t> {
             let next_colon = self.peek_at(1).is_some_and(|n| n.tok.is_punct(":"));
             match word.as_str() {
                 "module" => return self.module_decl(items),
-                "struct" if self.peek_at(2).is_some_and(|n| n.tok.is_punct("{")) => {
+                "struct" | "class" if self.peek_at(2).is_some_and(|n| n.tok.is_punct("{")) => {
                     return self.struct_decl(items)
                 }
                 "typedef" => return self.typedef(items),
@@ -520,6 +551,23 @@ impl<'t> Parser<'t> {
         }
         let name = self.name("the function's name")?;
         self.expect_punct("(", "after the function's name")?;
+        let params = self.params()?;
+        let body = if self.eat_punct(";") {
+            None
+        } else {
+            Some(self.block()?)
+        };
+        items.push(Item::Function(FunctionDef {
+            ret,
+            name,
+            params,
+            body,
+        }));
+        Ok(())
+    }
+
+    /// params := ( 'void' | [param {',' param}] ) ')'   (the `(` is consumed)
+    fn params(&mut self) -> PResult<Vec<Param>> {
         let mut params = Vec::new();
         if self.peek_ident("void") && self.peek_at(1).is_some_and(|t| t.tok.is_punct(")")) {
             self.pos += 1;
@@ -543,18 +591,7 @@ impl<'t> Parser<'t> {
                 self.expect_punct(",", "or `)` between the function's parameters")?;
             }
         }
-        let body = if self.eat_punct(";") {
-            None
-        } else {
-            Some(self.block()?)
-        };
-        items.push(Item::Function(FunctionDef {
-            ret,
-            name,
-            params,
-            body,
-        }));
-        Ok(())
+        Ok(params)
     }
 
     /// dims := { '[' [expr] ']' }
@@ -580,6 +617,14 @@ impl<'t> Parser<'t> {
 
     /// 'enum' [NAME] '{' NAME ['=' expr] {',' NAME ['=' expr]} [','] '}'
     fn enum_body(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        let (name, variants) = self.enum_parts()?;
+        items.push(Item::Enum { name, variants });
+        Ok(())
+    }
+
+    /// The name and the enumerators of an enum's body, from `enum`.
+    #[allow(clippy::type_complexity)]
+    fn enum_parts(&mut self) -> PResult<(Option<Name>, Vec<(Name, Option<Expr>)>)> {
         self.pos += 1;
         let name = if self.peek_punct("{") {
             None
@@ -603,8 +648,7 @@ impl<'t> Parser<'t> {
                 break;
             }
         }
-        items.push(Item::Enum { name, variants });
-        Ok(())
+        Ok((name, variants))
     }
 
     /// directive := KEY ':' expr ';'
@@ -705,38 +749,143 @@ impl<'t> Parser<'t> {
         }
     }
 
-    /// struct-decl := 'struct' NAME '{' { TYPE NAME {',' NAME} ';' } '}' ';'
+    /// struct-decl := 'struct' NAME struct-body ';'
     fn struct_decl(&mut self, items: &mut Vec<Item>) -> PResult<()> {
         self.pos += 1;
         let name = self.name("a struct name")?;
         self.type_names.insert(name.text.clone());
-        let fields = self.struct_fields()?;
+        let body = self.struct_body(Some(&name.text))?;
         self.expect_punct(";", "after the struct declaration")?;
-        items.push(Item::Struct { name, fields });
+        items.push(Item::Struct { name, body });
         Ok(())
     }
 
-    /// struct-fields := '{' { TYPE NAME dims {',' NAME dims} ';' } '}'
-    #[allow(clippy::type_complexity)]
-    fn struct_fields(&mut self) -> PResult<Vec<(TypeRef, Name, Vec<Option<Expr>>)>> {
+    /// struct-body := '{' { member } '}'
+    /// member := TYPE NAME dims {',' NAME dims} ';'
+    ///         | 'enum' [NAME] '{' ... '}' [NAME {',' NAME}] ';'
+    ///         | NAME '(' params ')' [':' NAME '(' args ')' {',' ...}] block   (a constructor)
+    ///         | TYPE NAME '(' params ')' ['const'] block   (a method)
+    ///         | ('public' | 'private' | 'protected') ':'
+    fn struct_body(&mut self, struct_name: Option<&str>) -> PResult<StructBody> {
         self.expect_punct("{", "to open the struct body")?;
-        let mut fields = Vec::new();
+        let mut body = StructBody::default();
         while !self.eat_punct("}") {
             if self.at_end() {
                 return self.error("`}` to close the struct");
             }
-            let ty = self.type_ref()?;
+            if ["public", "private", "protected"]
+                .iter()
+                .any(|w| self.peek_ident(w))
+                && self.peek_at(1).is_some_and(|t| t.tok.is_punct(":"))
+            {
+                self.pos += 2;
+                continue;
+            }
+            if self.peek_punct("~") {
+                return Err(Diagnostic::new(
+                    self.span_here(),
+                    "destructors are not supported: a struct here is a plain value",
+                ));
+            }
+            let is_ctor = struct_name.is_some_and(|n| self.peek_ident(n))
+                && self.peek_at(1).is_some_and(|t| t.tok.is_punct("("));
+            if is_ctor {
+                body.ctors.push(self.constructor()?);
+                continue;
+            }
+            let ty = if self.peek_ident("enum")
+                && (self.peek_at(1).is_some_and(|t| t.tok.is_punct("{"))
+                    || self.peek_at(2).is_some_and(|t| t.tok.is_punct("{")))
+            {
+                let (name, variants) = self.enum_parts()?;
+                let ty = TypeRef {
+                    name: name.as_ref().map_or("int", |n| &n.text).to_string(),
+                    span: name.as_ref().map_or(self.prev_span(), |n| n.span),
+                    pointer: false,
+                    reference: false,
+                };
+                body.enums.push((name, variants));
+                if self.eat_punct(";") {
+                    continue;
+                }
+                ty
+            } else {
+                self.type_ref()?
+            };
+            if self.peek_at(1).is_some_and(|t| t.tok.is_punct("(")) {
+                body.methods.push(self.method(ty)?);
+                continue;
+            }
             loop {
                 let f = self.name("a field name")?;
                 let dims = self.dims()?;
-                fields.push((ty.clone(), f, dims));
+                body.fields.push((ty.clone(), f, dims));
                 if !self.eat_punct(",") {
                     break;
                 }
             }
             self.expect_punct(";", "after the field declaration")?;
         }
-        Ok(fields)
+        Ok(body)
+    }
+
+    /// method := TYPE NAME '(' params ')' ['const'] block   (the type is read)
+    fn method(&mut self, ret: TypeRef) -> PResult<FunctionDef> {
+        let name = self.name("the method's name")?;
+        self.pos += 1;
+        let params = self.params()?;
+        self.eat_ident("const");
+        if !self.peek_punct("{") {
+            return Err(Diagnostic::new(
+                self.span_here(),
+                format!(
+                    "expected the body of method `{}` here: methods are defined inside their struct",
+                    name.text
+                ),
+            ));
+        }
+        let body = self.block()?;
+        self.eat_punct(";");
+        Ok(FunctionDef {
+            ret,
+            name,
+            params,
+            body: Some(body),
+        })
+    }
+
+    /// constructor := NAME '(' params ')' [':' NAME '(' args ')' {',' NAME '(' args ')'}] block
+    fn constructor(&mut self) -> PResult<Ctor> {
+        let name = self.name("the constructor's name")?;
+        self.pos += 1;
+        let params = self.params()?;
+        let mut inits = Vec::new();
+        if self.eat_punct(":") {
+            loop {
+                let field = self.name("a field to initialise")?;
+                self.expect_punct("(", "after the field's name in the initialiser list")?;
+                let open = self.prev_span();
+                let args = self.args(")")?;
+                inits.push((field, args, open.to(self.prev_span())));
+                if !self.eat_punct(",") {
+                    break;
+                }
+            }
+        }
+        if self.peek_punct(";") {
+            return Err(Diagnostic::new(
+                self.span_here(),
+                "a constructor needs its body here, e.g. `{}`: declarations of constructors defined elsewhere are not supported",
+            ));
+        }
+        let body = self.block()?;
+        self.eat_punct(";");
+        Ok(Ctor {
+            name,
+            params,
+            inits,
+            body,
+        })
     }
 
     /// typedef := 'typedef' TYPE NAME ';'
@@ -768,13 +917,13 @@ impl<'t> Parser<'t> {
             if let Some(t) = &tag {
                 self.type_names.insert(t.text.clone());
             }
-            let fields = self.struct_fields()?;
+            let body = self.struct_body(tag.as_ref().map(|t| t.text.as_str()))?;
             let name = self.name("the new type name")?;
             self.type_names.insert(name.text.clone());
             self.expect_punct(";", "after the typedef")?;
             items.push(Item::Struct {
                 name: name.clone(),
-                fields,
+                body,
             });
             if let Some(tag) = tag {
                 if tag.text != name.text {
@@ -1454,6 +1603,11 @@ impl<'t> Parser<'t> {
                     self.eat_punct(";");
                     return Ok(Stmt::Return(value, t.span));
                 }
+                "switch" | "case" | "default"
+                    if w != "default" || self.peek_at(1).is_some_and(|n| n.tok.is_punct(":")) =>
+                {
+                    return self.switch_part();
+                }
                 "break" | "continue" => {
                     self.pos += 1;
                     self.expect_punct(";", &format!("after `{w}`"))?;
@@ -1476,6 +1630,56 @@ impl<'t> Parser<'t> {
             self.expect_punct(";", "after the expression")?;
         }
         Ok(Stmt::Expr(e))
+    }
+
+    /// switch := 'switch' expr ( '{' { stmt } '}' | { label } stmt ), whose
+    /// labels are statements of the body; or one of those labels. Out of
+    /// `stmt_inner`, so that its frame stays small.
+    #[inline(never)]
+    fn switch_part(&mut self) -> PResult<Stmt> {
+        let span = self.bump().span;
+        if !self.toks[self.pos - 1].tok.is_ident("switch") {
+            self.pos -= 1;
+            return self.label();
+        }
+        let value = self.expr()?;
+        let mut body = Vec::new();
+        if !self.peek_punct("{") {
+            // `switch (n) case 1: stmt;`: labels and one statement.
+            while self.peek_ident("case")
+                || (self.peek_ident("default")
+                    && self.peek_at(1).is_some_and(|t| t.tok.is_punct(":")))
+            {
+                body.push(self.stmt()?);
+            }
+            body.push(self.stmt_or_end()?);
+            return Ok(Stmt::Switch { value, body, span });
+        }
+        let open = self.bump().span;
+        while !self.eat_punct("}") {
+            if self.at_end() {
+                return Err(Diagnostic::new(
+                    open,
+                    "unclosed `{`: expected `}` before the end of the file",
+                ));
+            }
+            body.push(self.stmt()?);
+        }
+        Ok(Stmt::Switch { value, body, span })
+    }
+
+    /// label := 'case' cond ':' | 'default' ':', a statement of a
+    /// `switch`'s body. Out of `stmt_inner`, so that its frame stays small.
+    #[inline(never)]
+    fn label(&mut self) -> PResult<Stmt> {
+        let t = self.bump();
+        if t.tok.is_ident("default") {
+            self.pos += 1;
+            return Ok(Stmt::Default(t.span));
+        }
+        let value = self.cond_expr()?;
+        self.expect_punct(":", "after the `case` label's value")?;
+        Ok(Stmt::Case(value, t.span))
     }
 
     fn stmt_or_end(&mut self) -> PResult<Stmt> {

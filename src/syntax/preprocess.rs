@@ -21,20 +21,18 @@ const DIRECTIVES: &[&str] = &[
     "error",
 ];
 
-/// Headers that stand for lpfg's built-in library and are accepted as no-ops.
-const KNOWN_HEADERS: &[&str] = &[
-    "lpfgall.h",
-    "math.h",
-    "stdlib.h",
-    "stdio.h",
-    "cmath",
-    "lintrfc.h",
-    // C's string functions (`strcpy`, `strlen`, …) are built in too.
-    "string.h",
-    "memory.h",
-    "cstdlib",
-    "cstdio",
-    "cstring",
+/// lpfg's own headers: its library is built in, so including them does
+/// nothing.
+const KNOWN_HEADERS: &[&str] = &["lpfgall.h", "lintrfc.h"];
+
+/// The standard C and C++ headers whose functions programs call: the
+/// library is built in, so including one of them (`<string.h>` or, as C's
+/// search falls back to them, `"string.h"`) does nothing; a function that
+/// subgram lacks is refused where it is called.
+const STANDARD_HEADERS: &[&str] = &[
+    "math.h", "stdlib.h", "stdio.h", "string.h", "memory.h", "assert.h", "ctype.h", "float.h",
+    "limits.h", "time.h", "cmath", "cstdlib", "cstdio", "cstring", "cassert", "cctype", "cfloat",
+    "climits", "ctime", "iostream",
 ];
 
 #[derive(Clone, Debug)]
@@ -421,6 +419,7 @@ fn parse_define(name_tok: &Token, args: &[Token]) -> Result<Define, Diagnostic> 
 
 fn check_include(span: Span, args: &[Token]) -> Result<(), Diagnostic> {
     let mut name = String::new();
+    let angled = args.first().is_some_and(|t| t.tok.is_punct("<"));
     for t in args {
         match &t.tok {
             Tok::Ident(s) => name.push_str(s),
@@ -429,13 +428,18 @@ fn check_include(span: Span, args: &[Token]) -> Result<(), Diagnostic> {
             _ => {}
         }
     }
-    if KNOWN_HEADERS.contains(&name.as_str()) {
+    if KNOWN_HEADERS.contains(&name.as_str()) || STANDARD_HEADERS.contains(&name.as_str()) {
         Ok(())
     } else {
+        let own = if angled {
+            ""
+        } else {
+            "; a program's own header files are not read"
+        };
         Err(Diagnostic::new(
             span,
             format!(
-                "cannot include `{name}`: only the built-in headers ({}) are available",
+                "cannot include `{name}`: only lpfg's headers ({}) and the standard C and C++ headers (<math.h>, <string.h>, <cstdlib>, ...) are available{own}",
                 KNOWN_HEADERS.join(", ")
             ),
         ))
