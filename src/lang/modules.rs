@@ -153,6 +153,7 @@ pub const PREDEFINED: &[(&str, &[&[Ty]])] = &[
     ("GetUp", FFF),
     ("E1", ONE_F),
     ("E2", FF),
+    ("EA20", &[&[Ty::Struct(super::value::EA20_ARRAY)]]),
     ("Camera", NONE),
     ("MouseIns", NONE),
     ("MouseInsPos", &[&[Ty::Struct(super::value::MOUSE_STATUS)]]),
@@ -176,11 +177,6 @@ pub const NOT_YET: &[(&str, &str)] = &[
     (
         "DBSurfaceM",
         "it draws a dynamic B-spline surface (manual 10.1)",
-    ),
-    (
-        "EA20",
-        "it exchanges an array with an environmental program (manual 5.13), \
-         and subgram does not run environmental programs",
     ),
     ("PovRayStart", "it starts POV-Ray output"),
 ];

@@ -262,6 +262,9 @@ pub struct StructDef {
 pub const MOUSE_STATUS: u16 = 0;
 /// `CameraPosition` (manual 6.4), the second.
 pub const CAMERA_POSITION: u16 = 1;
+/// `EA20Array` (manual 5.13), the third: the 20 floats that module `EA20`
+/// exchanges with an environmental program, an array type.
+pub const EA20_ARRAY: u16 = 2;
 
 /// lpfg's predefined struct types, which every program has before its own:
 /// `MouseStatus` and `CameraPosition`, with the manual's fields and their
@@ -299,6 +302,11 @@ pub fn predefined_structs() -> Vec<StructDef> {
                 ("scale", Ty::Float),
             ],
         ),
+        StructDef {
+            name: "EA20Array".to_string(),
+            fields: (0..20).map(|_| (String::new(), Ty::Float)).collect(),
+            elem: Some(Ty::Float),
+        },
     ]
 }
 

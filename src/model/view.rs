@@ -274,14 +274,21 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
                 Some("pixel") => false,
                 Some("polygon") | Some("cylinder") => true,
                 _ => {
+                    // lpfg reports another style (`wireframe` in vlab's
+                    // own models) and keeps its default, pixel lines: so
+                    // does subgram.
                     let (s, e) = ws.first().map_or((line.len(), line.len()), |w| {
                         (w.start + after, w.end + after)
                     });
-                    return Err(lines.error_at(
-                        s,
-                        e,
-                        "expected `pixel`, `polygon` or `cylinder` after `line style:`",
+                    notes.push(Note::at(
+                        path,
+                        text,
+                        base + s..base + e,
+                        "not a line style (`pixel`, `polygon` or `cylinder`): lines are drawn \
+                         in pixels, the default, as lpfg draws them"
+                            .into(),
                     ));
+                    false
                 }
             };
             continue;

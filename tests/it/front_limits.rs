@@ -343,7 +343,7 @@ fn declarations_past_what_16_bits_number_are_refused() {
         (
             "modules.lsys",
             modules,
-            ":65437:8: error: more than 65436 modules are declared",
+            ":65436:8: error: more than 65435 modules are declared",
         ),
         (
             "fields.lsys",

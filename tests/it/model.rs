@@ -366,7 +366,7 @@ fn check_warns_about_view_commands_and_environmental_programs() {
     .unwrap();
     std::fs::write(
         tmp.join("view.v"),
-        "// a comment\nz buffer: on\nlight: V: 0 0 1\nzoom: 3\n",
+        "// a comment\nz buffer: on\nlight: V: 0 0 1\nzoom: 3\nline style: wireframe\n",
     )
     .unwrap();
     std::fs::write(tmp.join("field.e"), "executable: field -e\n").unwrap();
@@ -387,6 +387,12 @@ fn check_warns_about_view_commands_and_environmental_programs() {
     );
     assert!(
         out.contains("field.e:1:1: warning: this file sets up an environmental program"),
+        "{out}"
+    );
+    // lpfg says "Invalid line style" and keeps its default (pixel lines);
+    // vlab's own 03-sierpinski-collide has this line.
+    assert!(
+        out.contains("view.v:5:13: warning: not a line style (`pixel`, `polygon` or `cylinder`)"),
         "{out}"
     );
     assert!(
@@ -472,4 +478,32 @@ fn a_file_may_hold_only_so_many_points() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("must be from 1 to 1000"), "{e}");
+}
+
+/// `EA20(EA20Array)` (manual 5.13): the array type exists and the module
+/// takes it, so a model that talks to an environmental program through
+/// EA20 runs, with the warning that no environmental program runs (its
+/// array comes back unchanged).
+#[test]
+fn ea20_arrays_are_modules_with_a_warning() {
+    let src = "EA20Array ea = {1, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 4};\n\
+               derivation length: 1;\nAxiom: EA20(ea) A;\nmodule A;\n\
+               EA20(x) < A : { produce A F(x[0] + x[19]); }\n";
+    let system = subgram::load_text("ea.l", src, &LoadOptions::default()).unwrap();
+    let warnings = system.warnings();
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("`EA20`") && w.contains("environmental program")),
+        "{warnings:?}"
+    );
+    let l = match system {
+        System::Curve(c) => c,
+        System::Surface(_) => panic!("a curve"),
+    };
+    let d = l.derive(Default::default()).unwrap();
+    assert_eq!(
+        l.word_text(&d.word),
+        "EA20({1, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 4}) A F(5)"
+    );
 }
