@@ -4039,7 +4039,9 @@ pub fn binary_type(op: BinOp, a: Ty, b: Ty) -> Option<Ty> {
         Lt | Le | Gt | Ge => num.then_some(Ty::Bool),
         Eq | Ne => (num || vectors).then_some(Ty::Bool),
         And | Or => num.then_some(Ty::Bool),
-        BitAnd | BitOr | BitXor => (num && !a.is_floating() && !b.is_floating()).then_some(Ty::Int),
+        BitAnd | BitOr | BitXor | Shl | Shr => {
+            (num && !a.is_floating() && !b.is_floating()).then_some(Ty::Int)
+        }
     }
 }
 

@@ -1158,6 +1158,13 @@ pub fn binary(op: BinOp, x: Value, y: Value) -> Result<Value, String> {
         (BitAnd, Int(a), Int(b)) => Int(a & b),
         (BitOr, Int(a), Int(b)) => Int(a | b),
         (BitXor, Int(a), Int(b)) => Int(a ^ b),
+        // C leaves a shift by a negative count or by the width or more
+        // undefined; here it is an error rather than a guess.
+        (Shl | Shr, Int(_), Int(b)) if !(0..64).contains(&b) => {
+            return Err(format!("a shift by {b} bits (C allows 0 to 63 here)"))
+        }
+        (Shl, Int(a), Int(b)) => Int(a.wrapping_shl(b as u32)),
+        (Shr, Int(a), Int(b)) => Int(a >> b),
         (Lt, Int(a), Int(b)) => Bool(a < b),
         (Le, Int(a), Int(b)) => Bool(a <= b),
         (Gt, Int(a), Int(b)) => Bool(a > b),

@@ -1695,7 +1695,7 @@ impl<'t> Parser<'t> {
         self.assign_expr()
     }
 
-    /// assign := cond [ ('=' | '+=' | '-=' | '*=' | '/=' | '%=') assign ]
+    /// assign := cond [ ('=' | '+=' | '-=' | '*=' | '/=' | '%=' | '<<=' | '>>=') assign ]
     fn assign_expr(&mut self) -> PResult<Expr> {
         let outer = self.measure();
         let lhs = self.cond_expr()?;
@@ -1707,6 +1707,8 @@ impl<'t> Parser<'t> {
             Some(Tok::Punct("*=")) => Some(Some(BinOp::Mul)),
             Some(Tok::Punct("/=")) => Some(Some(BinOp::Div)),
             Some(Tok::Punct("%=")) => Some(Some(BinOp::Rem)),
+            Some(Tok::Punct("<<=")) => Some(Some(BinOp::Shl)),
+            Some(Tok::Punct(">>=")) => Some(Some(BinOp::Shr)),
             _ => None,
         };
         if let Some(op) = op {
@@ -2050,11 +2052,13 @@ fn binop_of(t: &Tok) -> Option<(BinOp, u8)> {
         ">" => (BinOp::Gt, 7),
         "<=" => (BinOp::Le, 7),
         ">=" => (BinOp::Ge, 7),
-        "+" => (BinOp::Add, 8),
-        "-" => (BinOp::Sub, 8),
-        "*" => (BinOp::Mul, 9),
-        "/" => (BinOp::Div, 9),
-        "%" => (BinOp::Rem, 9),
+        "<<" => (BinOp::Shl, 8),
+        ">>" => (BinOp::Shr, 8),
+        "+" => (BinOp::Add, 9),
+        "-" => (BinOp::Sub, 9),
+        "*" => (BinOp::Mul, 10),
+        "/" => (BinOp::Div, 10),
+        "%" => (BinOp::Rem, 10),
         _ => return None,
     })
 }

@@ -1,0 +1,70 @@
+//! Small L+C programs on which subgram once disagreed with lpfg, found by
+//! the adversarial review of issue 12. Each expected word is lpfg's own
+//! final string for the same program (vlab commit 9bf820d, built headless
+//! with `shared/tools/lpfg`, printed by `run_lpfg.sh`; the programs had
+//! `#include <lpfgall.h>` in front for lpfg), written here in subgram's
+//! spelling (`A(1, 2)` for lpfg's `A(1,2)`).
+
+use subgram::{DeriveOptions, Precision};
+
+use crate::support::*;
+
+fn words(src: &str) -> String {
+    let l = subgram::load_str_with("p.l", src, &[], Precision::Single)
+        .unwrap_or_else(|e| panic!("the program does not load:\n{e}"));
+    let d = derive(&l, DeriveOptions::default());
+    text(&l, &d)
+}
+
+/// Character constants are `int`s with the character's code, escapes
+/// included; a digit's character minus `'0'` is its value.
+#[test]
+fn character_constants_are_their_codes() {
+    let src = r#"derivation length: 1;
+module A(int, int, int, int, int, float);
+Axiom: A(0, 0, 0, 0, 0, 0);
+production:
+A(a, b, c, d, e, x) : {
+  char buf[16]; sprintf(buf, "%d", 4096);
+  int ca = 'A', nl = '\n', bs = '\\', q = '\'';
+  int digit = buf[1] - '0' + 'z' - 'a';
+  produce A(ca, nl, bs, q, digit, 'a' * 0.5);
+}
+"#;
+    // lpfg: A(65,10,92,39,25,48.5)
+    assert_eq!(words(src), "A(65, 10, 92, 39, 25, 48.5)");
+}
+
+/// `<<` and `>>` are C's shifts inside expressions (also `<<=`, `>>=`),
+/// binding tighter than `<` and looser than `+`, while they still separate
+/// the new-context parts of a predecessor.
+#[test]
+fn shifts_are_operators_in_expressions() {
+    let src = r#"derivation length: 2;
+module A(int, int, int, int, int);
+module B(int);
+Axiom: B(3) A(1, 256, -7, 5, 3);
+production:
+B(s) < A(a, b, c, d, e) : {
+  int m = d; m <<= 2; m >>= 1;
+  produce A(a << s, b >> 2, c >> 1, m, 1 + 2 << e - 1 < 20);
+}
+B(s) : { produce B(s - 1); }
+"#;
+    // lpfg: B(1) A(32,16,-2,20,1)
+    assert_eq!(words(src), "B(1) A(32, 16, -2, 20, 1)");
+}
+
+#[test]
+fn shifts_inside_new_context_productions() {
+    let src = r#"derivation length: 1;
+module A(int);
+module B(int);
+Axiom: B(1) A(1) SB() A(2) EB() A(3);
+production:
+B(x) << A(y) : { produce A((x << 4) | (y >> 0)); }
+A(y) >> A(z) : { produce A(y + (z << 1)); }
+"#;
+    // lpfg: B(1) A(17) SB() A(2) EB() A(3)
+    assert_eq!(words(src), "B(1) A(17) SB A(2) EB A(3)");
+}
