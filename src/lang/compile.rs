@@ -2304,21 +2304,17 @@ impl Compiler {
                         self.check_truncation(x);
                     }
                 }
-                // C's overloads: `sqrt` of a `float` is a `float`, of a
-                // `double` or an `int` a `double`; a vector's length or
-                // dot product has its components' precision. What the
-                // library declares `float` (lpfg's `ran`, `func`) is a
-                // single-precision result.
+                // lpfg's programs call C's maths functions of <math.h>,
+                // not C++'s overloads: `sqrt` of a `float` is a `double`
+                // (lpfg 9bf820d: `sqrt(x) * sqrt(x) - 2` with a float
+                // `x = 2` is 4.4e-16, not the float -1.2e-7). A vector's
+                // length or dot product has its components' precision.
+                // What the library declares `float` (lpfg's `ran`,
+                // `func`) is a single-precision result.
                 let ty = match f {
                     // `expf`, `sqrtf`, …: a float whatever the argument.
                     Func::Math1(_) | Func::Math2(_) if float_function => self.prec(Ty::Float),
-                    Func::Math1(_) | Func::Math2(_) => {
-                        if tys.iter().all(|t| *t == Ty::Float) {
-                            Ty::Float
-                        } else {
-                            Ty::Double
-                        }
-                    }
+                    Func::Math1(_) | Func::Math2(_) => Ty::Double,
                     Func::Length | Func::Dot => tys.first().map_or(ty, |t| t.scalar()),
                     Func::Normalized | Func::Cross => tys.first().map_or(ty, |t| *t),
                     _ => self.prec(ty),

@@ -68,3 +68,24 @@ A(y) >> A(z) : { produce A(y + (z << 1)); }
     // lpfg: B(1) A(17) SB() A(2) EB() A(3)
     assert_eq!(words(src), "B(1) A(17) SB A(2) EB A(3)");
 }
+
+/// lpfg's programs call C's maths functions of <math.h>: `sqrt` or `sin`
+/// of a `float` is computed and returned in double precision, not as
+/// C++'s float overload. In single precision `sqrt(2.0f)` is 1.4142135f
+/// and its square less 2 is -2^-23; in double the square less 2 is
+/// 2^-51 = 4.44e-16, and 1.41421356237 × 10^7 rounds to the float
+/// 14142136.
+#[test]
+fn maths_functions_of_floats_compute_in_double() {
+    let src = r#"derivation length: 1;
+module A(float, double, double);
+Axiom: A(2, 0, 0);
+production:
+A(x, y, z) : {
+  float h = 0.3;
+  produce A(sqrt(x) * 1e7, (sqrt(x) * sqrt(x) - 2) * 1e16, (sin(h) - sin((double)h)) * 1e10);
+}
+"#;
+    // lpfg: A(14142136,4.440892098500626,0)
+    assert_eq!(words(src), "A(14142136, 4.440892098500626, 0)");
+}
