@@ -89,3 +89,26 @@ A(x, y, z) : {
     // lpfg: A(14142136,4.440892098500626,0)
     assert_eq!(words(src), "A(14142136, 4.440892098500626, 0)");
 }
+
+/// `StepNo()` counts the step under way from 1: in the first step's
+/// `StartEach`, productions and `EndEach` it is 1, in `Start` 0, in `End`
+/// the number of steps taken. lpfg prints, for this program with three
+/// steps, `Start 0`, then `StartEach k`, `prod k`, `EndEach k` for k = 1,
+/// 2, 3, then `End 3`; the word records the production's values.
+#[test]
+fn step_numbers_count_the_step_under_way() {
+    let src = r#"derivation length: 3;
+int at_start = -1, at_each = -1, at_end_each = -1;
+module A(int, int, int);
+module S(int, int, int);
+Start: { at_start = StepNo(); }
+StartEach: { at_each = StepNo(); }
+EndEach: { at_end_each = StepNo(); }
+Axiom: S(0, 0, 0) A(0, 0, 0);
+production:
+A(a, b, c) : { produce A(StepNo(), a, b); }
+S(a, b, c) : { produce S(at_start, at_each, at_end_each); }
+"#;
+    // lpfg: S(0,3,2) A(3,2,1)
+    assert_eq!(words(src), "S(0, 3, 2) A(3, 2, 1)");
+}
