@@ -473,35 +473,7 @@ impl<'p> Interp<'p> {
         } else {
             self.indices(place, cx)?
         };
-        let mut v = if place.global {
-            &cx.env.globals[place.slot as usize]
-        } else {
-            &cx.frame[place.slot as usize]
-        };
-        let mut k = 0;
-        for step in &place.path {
-            match step {
-                Step::Field(i) => match v {
-                    Value::Struct(fs) => v = &fs[*i as usize],
-                    other => return Ok(field(other, *i)),
-                },
-                Step::Index(_, span) => {
-                    let i = idx[k];
-                    k += 1;
-                    match v {
-                        Value::Struct(fs) => {
-                            match usize::try_from(i).ok().and_then(|i| fs.get(i)) {
-                                Some(e) => v = e,
-                                None => return Err(out_of_range(i, fs.len(), *span)),
-                            }
-                        }
-                        Value::Str(s) => return char_at(s, i, *span),
-                        _ => return Ok(Value::Void),
-                    }
-                }
-            }
-        }
-        Ok(v.clone())
+        load_at(place, &idx, cx)
     }
 
     #[inline(never)]
@@ -516,47 +488,28 @@ impl<'p> Interp<'p> {
             return Ok(());
         }
         let idx = self.indices(place, cx)?;
-        let root = if place.global {
-            &mut cx.env.globals[place.slot as usize]
+        store_at(place, &idx, value, cx)
+    }
+
+    /// Reads a place and writes `f` of its value back, the indices
+    /// evaluated once (C's `a[i++] += x` and `a[i++]++` step `i` once).
+    /// Returns the old and the new value.
+    #[inline(never)]
+    fn update(
+        &mut self,
+        place: &Place,
+        cx: &mut Cx,
+        f: impl FnOnce(Value) -> R<Value>,
+    ) -> R<(Value, Value)> {
+        let idx = if place.path.is_empty() {
+            Vec::new()
         } else {
-            &mut cx.frame[place.slot as usize]
+            self.indices(place, cx)?
         };
-        let mut v = root;
-        let mut k = 0;
-        for step in &place.path {
-            match step {
-                Step::Field(i) => match v {
-                    Value::Struct(fs) => v = &mut fs[*i as usize],
-                    other => {
-                        // The last step: a vector's component.
-                        set_path(other, std::slice::from_ref(step), value);
-                        return Ok(());
-                    }
-                },
-                Step::Index(_, span) => {
-                    let i = idx[k];
-                    k += 1;
-                    match v {
-                        Value::Struct(fs) => {
-                            let n = fs.len();
-                            match usize::try_from(i).ok().and_then(|i| fs.get_mut(i)) {
-                                Some(e) => v = e,
-                                None => return Err(out_of_range(i, n, *span)),
-                            }
-                        }
-                        Value::Str(_) => {
-                            return Err(rt(
-                                Some(*span),
-                                "a character of a string cannot be assigned; build the string with sprintf, strcpy or strcat",
-                            ))
-                        }
-                        _ => return Ok(()),
-                    }
-                }
-            }
-        }
-        *v = value;
-        Ok(())
+        let cur = load_at(place, &idx, cx)?;
+        let new = f(cur.clone())?;
+        store_at(place, &idx, new.clone(), cx)?;
+        Ok((cur, new))
     }
 
     /// A call of a user-defined function: the arguments go into a new
@@ -735,24 +688,27 @@ impl<'p> Interp<'p> {
         Ok(match e {
             Ex::Assign(place, op, rhs, ty) => {
                 let r = self.expr(rhs, cx)?;
-                let v = match op {
-                    None => r,
+                match op {
+                    None => {
+                        let v = r.convert(*ty);
+                        self.store(place, v.clone(), cx)?;
+                        v
+                    }
                     Some(op) => {
-                        let cur = self.load(place, cx)?;
-                        binary(*op, cur, r).map_err(|m| rt(None, m))?
+                        let update =
+                            |cur| Ok(binary(*op, cur, r).map_err(|m| rt(None, m))?.convert(*ty));
+                        self.update(place, cx, update)?.1
                     }
                 }
-                .convert(*ty);
-                self.store(place, v.clone(), cx)?;
-                v
             }
             Ex::Load(..) | Ex::Index(..) | Ex::CallUser { .. } => self.expr_c(e, cx)?,
             Ex::IncDec(place, d, prefix) => {
-                let cur = self.load(place, cx)?;
-                let new = binary(BinOp::Add, cur.clone(), Value::Int(*d as i64))
-                    .map_err(|m| rt(None, m))?
-                    .convert(place.ty);
-                self.store(place, new.clone(), cx)?;
+                let step = |cur| {
+                    Ok(binary(BinOp::Add, cur, Value::Int(*d as i64))
+                        .map_err(|m| rt(None, m))?
+                        .convert(place.ty))
+                };
+                let (cur, new) = self.update(place, cx, step)?;
                 if *prefix {
                     new
                 } else {
@@ -1218,3 +1174,79 @@ impl std::fmt::Display for RuntimeError {
 }
 
 impl std::error::Error for RuntimeError {}
+
+/// The value at a place whose array indices `idx` are evaluated.
+fn load_at(place: &Place, idx: &[i64], cx: &Cx) -> R<Value> {
+    let mut v = if place.global {
+        &cx.env.globals[place.slot as usize]
+    } else {
+        &cx.frame[place.slot as usize]
+    };
+    let mut k = 0;
+    for step in &place.path {
+        match step {
+            Step::Field(i) => match v {
+                Value::Struct(fs) => v = &fs[*i as usize],
+                other => return Ok(field(other, *i)),
+            },
+            Step::Index(_, span) => {
+                let i = idx[k];
+                k += 1;
+                match v {
+                    Value::Struct(fs) => match usize::try_from(i).ok().and_then(|i| fs.get(i)) {
+                        Some(e) => v = e,
+                        None => return Err(out_of_range(i, fs.len(), *span)),
+                    },
+                    Value::Str(s) => return char_at(s, i, *span),
+                    _ => return Ok(Value::Void),
+                }
+            }
+        }
+    }
+    Ok(v.clone())
+}
+
+/// Writes `value` at a place whose array indices `idx` are evaluated.
+fn store_at(place: &Place, idx: &[i64], value: Value, cx: &mut Cx) -> R<()> {
+    let root = if place.global {
+        &mut cx.env.globals[place.slot as usize]
+    } else {
+        &mut cx.frame[place.slot as usize]
+    };
+    let mut v = root;
+    let mut k = 0;
+    for step in &place.path {
+        match step {
+            Step::Field(i) => match v {
+                Value::Struct(fs) => v = &mut fs[*i as usize],
+                other => {
+                    // The last step: a vector's component.
+                    set_path(other, std::slice::from_ref(step), value);
+                    return Ok(());
+                }
+            },
+            Step::Index(_, span) => {
+                let i = idx[k];
+                k += 1;
+                match v {
+                    Value::Struct(fs) => {
+                        let n = fs.len();
+                        match usize::try_from(i).ok().and_then(|i| fs.get_mut(i)) {
+                            Some(e) => v = e,
+                            None => return Err(out_of_range(i, n, *span)),
+                        }
+                    }
+                    Value::Str(_) => {
+                        return Err(rt(
+                            Some(*span),
+                            "a character of a string cannot be assigned; build the string with sprintf, strcpy or strcat",
+                        ))
+                    }
+                    _ => return Ok(()),
+                }
+            }
+        }
+    }
+    *v = value;
+    Ok(())
+}

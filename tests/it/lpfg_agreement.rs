@@ -112,3 +112,28 @@ S(a, b, c) : { produce S(at_start, at_each, at_end_each); }
     // lpfg: S(0,3,2) A(3,2,1)
     assert_eq!(words(src), "S(0, 3, 2) A(3, 2, 1)");
 }
+
+/// A compound assignment or an increment evaluates its target's index
+/// once: `arr[k++] += 10` steps `k` once (it stepped twice, and
+/// `arr[++k] *= 3` then indexed past the end). By hand: arr = {1,2,3,4},
+/// k = 0; `arr[0] += 10` (k 1); `arr[2] *= 3` (k 2); `arr[2]++` (k 1);
+/// `--arr[1]` (k 2): {11, 1, 10, 4}; `fa[2] -= 0.25` gives 2.25, plus
+/// fa[1] 1.5 is 3.75, m 1; `s.b[0] <<= 2` is 20, plus i = 1.
+#[test]
+fn compound_assignment_evaluates_its_index_once() {
+    let src = r#"struct S { float a; int b[3]; };
+derivation length: 1;
+module A(int, int, int, int, int, int, float, int);
+Axiom: A(0, 0, 0, 0, 0, 0, 0, 0);
+production:
+A(a0, a1, a2, a3, k1, k2, fl, j) : {
+  int k = 0; int arr[4] = {1, 2, 3, 4};
+  arr[k++] += 10; arr[++k] *= 3; arr[k--]++; --arr[k++];
+  float fa[3] = {0.5, 1.5, 2.5}; int m = 2; fa[m--] -= 0.25;
+  S s; s.b[0] = 5; s.b[1] = 6; s.b[2] = 7; int i = 0; s.b[i++] <<= 2;
+  produce A(arr[0], arr[1], arr[2], arr[3], k, m, fa[2] + fa[1], s.b[0] + i);
+}
+"#;
+    // lpfg: A(11,1,10,4,2,1,3.75,21)
+    assert_eq!(words(src), "A(11, 1, 10, 4, 2, 1, 3.75, 21)");
+}
