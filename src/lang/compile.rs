@@ -138,6 +138,8 @@ struct Compiler {
     struct_names: HashMap<String, u16>,
     struct_fields: Vec<HashMap<String, u16>>,
     struct_shapes: Vec<(usize, usize)>,
+    /// The values the globals and `static` locals hold in all.
+    global_values: usize,
     /// The limits on counts already reported: each is reported once.
     counts_reported: HashSet<&'static str>,
     /// Where a division of two integers was compiled.
@@ -227,6 +229,8 @@ struct Scope {
     statics: HashSet<usize>,
     /// In a function: its return type and name.
     ret: Option<(Ty, String)>,
+    /// The values its locals hold in all (an array counts its elements).
+    values: usize,
 }
 
 /// The most local variables one body may have (their slots are `u16`s).
@@ -372,6 +376,7 @@ impl Compiler {
             struct_names,
             struct_fields,
             struct_shapes,
+            global_values: 0,
             counts_reported: HashSet::new(),
             inlining: Vec::new(),
             inlined: 0,
@@ -945,6 +950,7 @@ impl Compiler {
                 self.too_many(MAX_DECLARED, "global variables", d.name.span);
                 continue;
             }
+            self.count_global_values(ty, d.name.span);
             self.global_names
                 .insert(d.name.text.clone(), self.globals.len() as u16);
             self.globals.push(GlobalVar {
@@ -1642,6 +1648,21 @@ impl Compiler {
         let slot = scope.declare(name, ty);
         if scope.full {
             self.too_many_locals(scope, span);
+        }
+        let width = match ty {
+            Ty::Struct(i) => self.struct_shapes[i as usize].0,
+            _ => 1,
+        };
+        let before = scope.values;
+        scope.values = scope.values.saturating_add(width);
+        if before <= MAX_BODY_VALUES && scope.values > MAX_BODY_VALUES {
+            self.err(
+                span,
+                format!(
+                    "the local variables of this body hold more than {MAX_BODY_VALUES} \
+                     values (an array counts its elements), the limit"
+                ),
+            );
         }
         slot
     }
@@ -2852,6 +2873,26 @@ impl Compiler {
         }
     }
 
+    /// Adds a global's (or a `static` local's) values to the program's
+    /// total, which is limited as one body's locals are.
+    fn count_global_values(&mut self, ty: Ty, span: Span) {
+        let width = match ty {
+            Ty::Struct(i) => self.struct_shapes[i as usize].0,
+            _ => 1,
+        };
+        let before = self.global_values;
+        self.global_values = before.saturating_add(width);
+        if before <= MAX_BODY_VALUES && self.global_values > MAX_BODY_VALUES {
+            self.err(
+                span,
+                format!(
+                    "the global (and static) variables hold more than {MAX_BODY_VALUES} \
+                     values (an array counts its elements), the limit"
+                ),
+            );
+        }
+    }
+
     /// `static int n = 0;` in a body: a global that only this body names,
     /// initialised once before the run.
     #[inline(never)]
@@ -2868,6 +2909,7 @@ impl Compiler {
             self.too_many(MAX_DECLARED, "global variables", v.name.span);
             return;
         }
+        self.count_global_values(ty, v.name.span);
         let owner = scope.ret.as_ref().map_or("a body", |(_, n)| n.as_str());
         let slot = self.globals.len() as u16;
         self.globals.push(GlobalVar {
@@ -3090,6 +3132,7 @@ impl Compiler {
             ret: sig.ret,
             body: stmts,
             frame_size: (scope.max as usize).max(sig.params.len()),
+            frame_values: scope.values,
             end: Span::new(c.body.span.file, end.saturating_sub(1), end),
             result: Some(Ex::MakeStruct(slots.into_iter().map(Ex::Local).collect())),
             this_back: None,
@@ -3201,6 +3244,7 @@ impl Compiler {
             ret: sig.ret,
             body: stmts,
             frame_size: (scope.max as usize).max(sig.params.len()),
+            frame_values: scope.values,
             end: Span::new(body.span.file, end.saturating_sub(1), end),
             result: None,
             this_back: Some(Ex::MakeStruct(slots.into_iter().map(Ex::Local).collect())),
@@ -3452,6 +3496,7 @@ impl Compiler {
                 ret: s.ret,
                 body: Vec::new(),
                 frame_size: s.params.len(),
+                frame_values: 0,
                 end: s.span,
                 result: None,
                 this_back: None,
@@ -3519,6 +3564,7 @@ impl Compiler {
                 ret: sig.ret,
                 body: stmts,
                 frame_size: (scope.max as usize).max(sig.params.len()),
+                frame_values: scope.values,
                 end: Span::new(body.span.file, end.saturating_sub(1), end),
                 result: None,
                 this_back: None,
@@ -3937,6 +3983,10 @@ fn pt_index(t: Ty) -> usize {
 
 /// The most values an array may hold (counting those of its elements).
 const MAX_ARRAY_VALUES: usize = 1 << 22;
+
+/// The local variables of one body (a rule or a function) may hold this
+/// many values in all.
+const MAX_BODY_VALUES: usize = 1 << 22;
 
 /// `a op b` of two constants, computed once at compile time. Divisions of
 /// integers are left alone: `check` warns about those that truncate, and

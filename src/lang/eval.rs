@@ -163,6 +163,12 @@ const DEADLINE_EVERY: u32 = 1 << 16;
 /// deeper call is an error at the call.
 pub const MAX_CALL_DEPTH: u32 = 10_000;
 
+/// The frames of the user function calls in progress may hold this many
+/// values in all (their arguments, arrays passed included, and their
+/// local arrays): a recursion that copies a large array at every level
+/// stops with a message before it runs out of memory.
+pub const MAX_FRAME_VALUES: usize = 1 << 22;
+
 /// The interpreter recurses on the Rust stack. Once a chain of user
 /// function calls has used this much of the caller's stack (whose size is
 /// not known: a test thread has 2 MiB), the next call runs on a new thread
@@ -180,6 +186,8 @@ pub struct Interp<'p> {
     funcs: &'p [Function],
     /// User function calls in progress.
     calls: u32,
+    /// The values their frames hold (see [`MAX_FRAME_VALUES`]).
+    frame_values: usize,
     /// The value of the `return` that ended the running function.
     ret: Option<Value>,
     /// The stack address where the current stack segment started (0: not
@@ -201,6 +209,7 @@ impl<'p> Interp<'p> {
             structs,
             funcs: &[],
             calls: 0,
+            frame_values: 0,
             ret: None,
             stack_base: 0,
             stack_room: STACK_SEGMENT,
@@ -546,8 +555,23 @@ impl<'p> Interp<'p> {
                 return Err(rt(Some(span), m));
             }
         }
+        let values = frame[..args.len()]
+            .iter()
+            .fold(f.frame_values, |n, v| n.saturating_add(value_count(v)));
+        if self.frame_values.saturating_add(values) > MAX_FRAME_VALUES {
+            return Err(rt(
+                Some(span),
+                format!(
+                    "the calls of functions in progress would hold more than {MAX_FRAME_VALUES} \
+                     values (arguments and local arrays; an array passed is copied), calling `{}`",
+                    f.name
+                ),
+            ));
+        }
         self.calls += 1;
+        self.frame_values += values;
         let r = self.invoke(f, &mut frame, cx.env, span);
+        self.frame_values -= values;
         self.calls -= 1;
         let v = r?;
         for (k, place) in back {
@@ -1174,6 +1198,15 @@ impl std::fmt::Display for RuntimeError {
 }
 
 impl std::error::Error for RuntimeError {}
+
+/// How many numbers a value holds: an array or struct counts its
+/// elements, all the way down.
+fn value_count(v: &Value) -> usize {
+    match v {
+        Value::Struct(fs) => fs.iter().fold(1, |n, f| n.saturating_add(value_count(f))),
+        _ => 1,
+    }
+}
 
 /// The value at a place whose array indices `idx` are evaluated.
 fn load_at(place: &Place, idx: &[i64], cx: &Cx) -> R<Value> {
