@@ -2993,8 +2993,10 @@ impl Compiler {
                 }
             }
             // C passes arrays as pointers: the callee's writes are the
-            // caller's.
-            by_ref |= self.is_array(ty);
+            // caller's. So are a `char *s` or `char s[]` parameter's
+            // (`sprintf(s, ...)` fills the caller's buffer) when the
+            // argument is a variable; a `const` one is not written.
+            by_ref |= self.is_array(ty) || (ty == Ty::Str && !p.is_const);
             out.push((ty, by_ref));
         }
         ok.then_some(out)
@@ -3164,6 +3166,7 @@ impl Compiler {
             },
             name: None,
             dims: Vec::new(),
+            is_const: false,
         };
         let def = ast::FunctionDef {
             params: std::iter::once(this)
@@ -3633,11 +3636,13 @@ impl Compiler {
                     ),
                 );
             };
-            if by_ref {
-                let is_place = matches!(
-                    a.kind,
-                    ExprKind::Ident(_) | ExprKind::Field(..) | ExprKind::Index(..)
-                );
+            let is_place = matches!(
+                a.kind,
+                ExprKind::Ident(_) | ExprKind::Field(..) | ExprKind::Index(..)
+            );
+            // A string argument that is not a variable (a literal, a
+            // call) is passed as a value.
+            if by_ref && (pt != Ty::Str || is_place) {
                 if !is_place {
                     self.err(
                         a.span,

@@ -147,6 +147,8 @@ pub struct Param {
     pub name: Option<Name>,
     /// Array dimensions; `None` for `[]`.
     pub dims: Vec<Option<Expr>>,
+    /// Written with `const` (`const char *s`).
+    pub is_const: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

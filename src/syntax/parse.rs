@@ -574,7 +574,11 @@ impl<'t> Parser<'t> {
         }
         if !self.eat_punct(")") {
             loop {
+                let start = self.pos;
                 let ty = self.type_ref()?;
+                let is_const = self.toks[start..self.pos]
+                    .iter()
+                    .any(|t| t.tok.is_ident("const"));
                 let pname = match self.peek().map(|t| &t.tok) {
                     Some(Tok::Ident(_)) => Some(self.name("a parameter name")?),
                     _ => None,
@@ -584,6 +588,7 @@ impl<'t> Parser<'t> {
                     ty,
                     name: pname,
                     dims,
+                    is_const,
                 });
                 if self.eat_punct(")") {
                     break;

@@ -137,3 +137,28 @@ A(a0, a1, a2, a3, k1, k2, fl, j) : {
     // lpfg: A(11,1,10,4,2,1,3.75,21)
     assert_eq!(words(src), "A(11, 1, 10, 4, 2, 1, 3.75, 21)");
 }
+
+/// A `char *` or `char []` parameter points at the caller's buffer: what
+/// the function writes there with `sprintf`, `strcpy` or `strcat` is the
+/// caller's (it was lost). A `const char *` parameter is not written back,
+/// even when the function points it elsewhere, and a literal argument is
+/// passed as a value. lpfg prints `ab#42 abab x#7` for the `printf`.
+#[test]
+fn char_pointer_parameters_write_the_callers_buffer() {
+    let src = r#"void fill(char* out, const char* what, int n) { sprintf(out, "%s#%d", what, n); what = "changed"; }
+void twice(char s[]) { strcat(s, s); }
+int len(const char* s) { return strlen(s); }
+struct L { char name[16]; int k; };
+derivation length: 1;
+module A(int, int, int, int);
+Axiom: A(0, 0, 0, 0);
+production:
+A(a, b, c, d) : {
+  char buf[32]; char src[8]; strcpy(src, "ab"); L l;
+  fill(buf, src, 42); twice(src); fill(l.name, "x", 7);
+  produce A(len(buf), len(src), len("literal"), len(l.name));
+}
+"#;
+    // lpfg: A(5,4,7,3)
+    assert_eq!(words(src), "A(5, 4, 7, 3)");
+}
