@@ -227,6 +227,7 @@ pub static LIBRARY: &[Builtin] = &[
     math1!("log", f64::ln),
     math1!("log10", f64::log10),
     math1!("log2", f64::log2),
+    math1!("exp2", f64::exp2),
     math1!("fabs", f64::abs),
     math1!("floor", f64::floor),
     math1!("ceil", f64::ceil),

@@ -138,6 +138,8 @@ struct Compiler {
     struct_names: HashMap<String, u16>,
     struct_fields: Vec<HashMap<String, u16>>,
     struct_shapes: Vec<(usize, usize)>,
+    /// The values the globals and `static` locals hold in all.
+    global_values: usize,
     /// The limits on counts already reported: each is reported once.
     counts_reported: HashSet<&'static str>,
     /// Where a division of two integers was compiled.
@@ -227,6 +229,8 @@ struct Scope {
     statics: HashSet<usize>,
     /// In a function: its return type and name.
     ret: Option<(Ty, String)>,
+    /// The values its locals hold in all (an array counts its elements).
+    values: usize,
 }
 
 /// The most local variables one body may have (their slots are `u16`s).
@@ -372,6 +376,7 @@ impl Compiler {
             struct_names,
             struct_fields,
             struct_shapes,
+            global_values: 0,
             counts_reported: HashSet::new(),
             inlining: Vec::new(),
             inlined: 0,
@@ -945,6 +950,7 @@ impl Compiler {
                 self.too_many(MAX_DECLARED, "global variables", d.name.span);
                 continue;
             }
+            self.count_global_values(ty, d.name.span);
             self.global_names
                 .insert(d.name.text.clone(), self.globals.len() as u16);
             self.globals.push(GlobalVar {
@@ -1643,6 +1649,21 @@ impl Compiler {
         if scope.full {
             self.too_many_locals(scope, span);
         }
+        let width = match ty {
+            Ty::Struct(i) => self.struct_shapes[i as usize].0,
+            _ => 1,
+        };
+        let before = scope.values;
+        scope.values = scope.values.saturating_add(width);
+        if before <= MAX_BODY_VALUES && scope.values > MAX_BODY_VALUES {
+            self.err(
+                span,
+                format!(
+                    "the local variables of this body hold more than {MAX_BODY_VALUES} \
+                     values (an array counts its elements), the limit"
+                ),
+            );
+        }
         slot
     }
 
@@ -2304,21 +2325,17 @@ impl Compiler {
                         self.check_truncation(x);
                     }
                 }
-                // C's overloads: `sqrt` of a `float` is a `float`, of a
-                // `double` or an `int` a `double`; a vector's length or
-                // dot product has its components' precision. What the
-                // library declares `float` (lpfg's `ran`, `func`) is a
-                // single-precision result.
+                // lpfg's programs call C's maths functions of <math.h>,
+                // not C++'s overloads: `sqrt` of a `float` is a `double`
+                // (lpfg 9bf820d: `sqrt(x) * sqrt(x) - 2` with a float
+                // `x = 2` is 4.4e-16, not the float -1.2e-7). A vector's
+                // length or dot product has its components' precision.
+                // What the library declares `float` (lpfg's `ran`,
+                // `func`) is a single-precision result.
                 let ty = match f {
                     // `expf`, `sqrtf`, …: a float whatever the argument.
                     Func::Math1(_) | Func::Math2(_) if float_function => self.prec(Ty::Float),
-                    Func::Math1(_) | Func::Math2(_) => {
-                        if tys.iter().all(|t| *t == Ty::Float) {
-                            Ty::Float
-                        } else {
-                            Ty::Double
-                        }
-                    }
+                    Func::Math1(_) | Func::Math2(_) => Ty::Double,
                     Func::Length | Func::Dot => tys.first().map_or(ty, |t| t.scalar()),
                     Func::Normalized | Func::Cross => tys.first().map_or(ty, |t| *t),
                     _ => self.prec(ty),
@@ -2856,6 +2873,26 @@ impl Compiler {
         }
     }
 
+    /// Adds a global's (or a `static` local's) values to the program's
+    /// total, which is limited as one body's locals are.
+    fn count_global_values(&mut self, ty: Ty, span: Span) {
+        let width = match ty {
+            Ty::Struct(i) => self.struct_shapes[i as usize].0,
+            _ => 1,
+        };
+        let before = self.global_values;
+        self.global_values = before.saturating_add(width);
+        if before <= MAX_BODY_VALUES && self.global_values > MAX_BODY_VALUES {
+            self.err(
+                span,
+                format!(
+                    "the global (and static) variables hold more than {MAX_BODY_VALUES} \
+                     values (an array counts its elements), the limit"
+                ),
+            );
+        }
+    }
+
     /// `static int n = 0;` in a body: a global that only this body names,
     /// initialised once before the run.
     #[inline(never)]
@@ -2872,6 +2909,7 @@ impl Compiler {
             self.too_many(MAX_DECLARED, "global variables", v.name.span);
             return;
         }
+        self.count_global_values(ty, v.name.span);
         let owner = scope.ret.as_ref().map_or("a body", |(_, n)| n.as_str());
         let slot = self.globals.len() as u16;
         self.globals.push(GlobalVar {
@@ -2955,8 +2993,10 @@ impl Compiler {
                 }
             }
             // C passes arrays as pointers: the callee's writes are the
-            // caller's.
-            by_ref |= self.is_array(ty);
+            // caller's. So are a `char *s` or `char s[]` parameter's
+            // (`sprintf(s, ...)` fills the caller's buffer) when the
+            // argument is a variable; a `const` one is not written.
+            by_ref |= self.is_array(ty) || (ty == Ty::Str && !p.is_const);
             out.push((ty, by_ref));
         }
         ok.then_some(out)
@@ -3094,6 +3134,7 @@ impl Compiler {
             ret: sig.ret,
             body: stmts,
             frame_size: (scope.max as usize).max(sig.params.len()),
+            frame_values: scope.values,
             end: Span::new(c.body.span.file, end.saturating_sub(1), end),
             result: Some(Ex::MakeStruct(slots.into_iter().map(Ex::Local).collect())),
             this_back: None,
@@ -3125,6 +3166,7 @@ impl Compiler {
             },
             name: None,
             dims: Vec::new(),
+            is_const: false,
         };
         let def = ast::FunctionDef {
             params: std::iter::once(this)
@@ -3205,6 +3247,7 @@ impl Compiler {
             ret: sig.ret,
             body: stmts,
             frame_size: (scope.max as usize).max(sig.params.len()),
+            frame_values: scope.values,
             end: Span::new(body.span.file, end.saturating_sub(1), end),
             result: None,
             this_back: Some(Ex::MakeStruct(slots.into_iter().map(Ex::Local).collect())),
@@ -3456,6 +3499,7 @@ impl Compiler {
                 ret: s.ret,
                 body: Vec::new(),
                 frame_size: s.params.len(),
+                frame_values: 0,
                 end: s.span,
                 result: None,
                 this_back: None,
@@ -3523,6 +3567,7 @@ impl Compiler {
                 ret: sig.ret,
                 body: stmts,
                 frame_size: (scope.max as usize).max(sig.params.len()),
+                frame_values: scope.values,
                 end: Span::new(body.span.file, end.saturating_sub(1), end),
                 result: None,
                 this_back: None,
@@ -3591,11 +3636,13 @@ impl Compiler {
                     ),
                 );
             };
-            if by_ref {
-                let is_place = matches!(
-                    a.kind,
-                    ExprKind::Ident(_) | ExprKind::Field(..) | ExprKind::Index(..)
-                );
+            let is_place = matches!(
+                a.kind,
+                ExprKind::Ident(_) | ExprKind::Field(..) | ExprKind::Index(..)
+            );
+            // A string argument that is not a variable (a literal, a
+            // call) is passed as a value.
+            if by_ref && (pt != Ty::Str || is_place) {
                 if !is_place {
                     self.err(
                         a.span,
@@ -3942,6 +3989,10 @@ fn pt_index(t: Ty) -> usize {
 /// The most values an array may hold (counting those of its elements).
 const MAX_ARRAY_VALUES: usize = 1 << 22;
 
+/// The local variables of one body (a rule or a function) may hold this
+/// many values in all.
+const MAX_BODY_VALUES: usize = 1 << 22;
+
 /// `a op b` of two constants, computed once at compile time. Divisions of
 /// integers are left alone: `check` warns about those that truncate, and
 /// division by zero is an error where the program runs.
@@ -4039,7 +4090,9 @@ pub fn binary_type(op: BinOp, a: Ty, b: Ty) -> Option<Ty> {
         Lt | Le | Gt | Ge => num.then_some(Ty::Bool),
         Eq | Ne => (num || vectors).then_some(Ty::Bool),
         And | Or => num.then_some(Ty::Bool),
-        BitAnd | BitOr | BitXor => (num && !a.is_floating() && !b.is_floating()).then_some(Ty::Int),
+        BitAnd | BitOr | BitXor | Shl | Shr => {
+            (num && !a.is_floating() && !b.is_floating()).then_some(Ty::Int)
+        }
     }
 }
 

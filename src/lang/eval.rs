@@ -163,6 +163,12 @@ const DEADLINE_EVERY: u32 = 1 << 16;
 /// deeper call is an error at the call.
 pub const MAX_CALL_DEPTH: u32 = 10_000;
 
+/// The frames of the user function calls in progress may hold this many
+/// values in all (their arguments, arrays passed included, and their
+/// local arrays): a recursion that copies a large array at every level
+/// stops with a message before it runs out of memory.
+pub const MAX_FRAME_VALUES: usize = 1 << 22;
+
 /// The interpreter recurses on the Rust stack. Once a chain of user
 /// function calls has used this much of the caller's stack (whose size is
 /// not known: a test thread has 2 MiB), the next call runs on a new thread
@@ -180,6 +186,8 @@ pub struct Interp<'p> {
     funcs: &'p [Function],
     /// User function calls in progress.
     calls: u32,
+    /// The values their frames hold (see [`MAX_FRAME_VALUES`]).
+    frame_values: usize,
     /// The value of the `return` that ended the running function.
     ret: Option<Value>,
     /// The stack address where the current stack segment started (0: not
@@ -201,6 +209,7 @@ impl<'p> Interp<'p> {
             structs,
             funcs: &[],
             calls: 0,
+            frame_values: 0,
             ret: None,
             stack_base: 0,
             stack_room: STACK_SEGMENT,
@@ -473,35 +482,7 @@ impl<'p> Interp<'p> {
         } else {
             self.indices(place, cx)?
         };
-        let mut v = if place.global {
-            &cx.env.globals[place.slot as usize]
-        } else {
-            &cx.frame[place.slot as usize]
-        };
-        let mut k = 0;
-        for step in &place.path {
-            match step {
-                Step::Field(i) => match v {
-                    Value::Struct(fs) => v = &fs[*i as usize],
-                    other => return Ok(field(other, *i)),
-                },
-                Step::Index(_, span) => {
-                    let i = idx[k];
-                    k += 1;
-                    match v {
-                        Value::Struct(fs) => {
-                            match usize::try_from(i).ok().and_then(|i| fs.get(i)) {
-                                Some(e) => v = e,
-                                None => return Err(out_of_range(i, fs.len(), *span)),
-                            }
-                        }
-                        Value::Str(s) => return char_at(s, i, *span),
-                        _ => return Ok(Value::Void),
-                    }
-                }
-            }
-        }
-        Ok(v.clone())
+        load_at(place, &idx, cx)
     }
 
     #[inline(never)]
@@ -516,47 +497,28 @@ impl<'p> Interp<'p> {
             return Ok(());
         }
         let idx = self.indices(place, cx)?;
-        let root = if place.global {
-            &mut cx.env.globals[place.slot as usize]
+        store_at(place, &idx, value, cx)
+    }
+
+    /// Reads a place and writes `f` of its value back, the indices
+    /// evaluated once (C's `a[i++] += x` and `a[i++]++` step `i` once).
+    /// Returns the old and the new value.
+    #[inline(never)]
+    fn update(
+        &mut self,
+        place: &Place,
+        cx: &mut Cx,
+        f: impl FnOnce(Value) -> R<Value>,
+    ) -> R<(Value, Value)> {
+        let idx = if place.path.is_empty() {
+            Vec::new()
         } else {
-            &mut cx.frame[place.slot as usize]
+            self.indices(place, cx)?
         };
-        let mut v = root;
-        let mut k = 0;
-        for step in &place.path {
-            match step {
-                Step::Field(i) => match v {
-                    Value::Struct(fs) => v = &mut fs[*i as usize],
-                    other => {
-                        // The last step: a vector's component.
-                        set_path(other, std::slice::from_ref(step), value);
-                        return Ok(());
-                    }
-                },
-                Step::Index(_, span) => {
-                    let i = idx[k];
-                    k += 1;
-                    match v {
-                        Value::Struct(fs) => {
-                            let n = fs.len();
-                            match usize::try_from(i).ok().and_then(|i| fs.get_mut(i)) {
-                                Some(e) => v = e,
-                                None => return Err(out_of_range(i, n, *span)),
-                            }
-                        }
-                        Value::Str(_) => {
-                            return Err(rt(
-                                Some(*span),
-                                "a character of a string cannot be assigned; build the string with sprintf, strcpy or strcat",
-                            ))
-                        }
-                        _ => return Ok(()),
-                    }
-                }
-            }
-        }
-        *v = value;
-        Ok(())
+        let cur = load_at(place, &idx, cx)?;
+        let new = f(cur.clone())?;
+        store_at(place, &idx, new.clone(), cx)?;
+        Ok((cur, new))
     }
 
     /// A call of a user-defined function: the arguments go into a new
@@ -593,8 +555,23 @@ impl<'p> Interp<'p> {
                 return Err(rt(Some(span), m));
             }
         }
+        let values = frame[..args.len()]
+            .iter()
+            .fold(f.frame_values, |n, v| n.saturating_add(value_count(v)));
+        if self.frame_values.saturating_add(values) > MAX_FRAME_VALUES {
+            return Err(rt(
+                Some(span),
+                format!(
+                    "the calls of functions in progress would hold more than {MAX_FRAME_VALUES} \
+                     values (arguments and local arrays; an array passed is copied), calling `{}`",
+                    f.name
+                ),
+            ));
+        }
         self.calls += 1;
+        self.frame_values += values;
         let r = self.invoke(f, &mut frame, cx.env, span);
+        self.frame_values -= values;
         self.calls -= 1;
         let v = r?;
         for (k, place) in back {
@@ -735,24 +712,27 @@ impl<'p> Interp<'p> {
         Ok(match e {
             Ex::Assign(place, op, rhs, ty) => {
                 let r = self.expr(rhs, cx)?;
-                let v = match op {
-                    None => r,
+                match op {
+                    None => {
+                        let v = r.convert(*ty);
+                        self.store(place, v.clone(), cx)?;
+                        v
+                    }
                     Some(op) => {
-                        let cur = self.load(place, cx)?;
-                        binary(*op, cur, r).map_err(|m| rt(None, m))?
+                        let update =
+                            |cur| Ok(binary(*op, cur, r).map_err(|m| rt(None, m))?.convert(*ty));
+                        self.update(place, cx, update)?.1
                     }
                 }
-                .convert(*ty);
-                self.store(place, v.clone(), cx)?;
-                v
             }
             Ex::Load(..) | Ex::Index(..) | Ex::CallUser { .. } => self.expr_c(e, cx)?,
             Ex::IncDec(place, d, prefix) => {
-                let cur = self.load(place, cx)?;
-                let new = binary(BinOp::Add, cur.clone(), Value::Int(*d as i64))
-                    .map_err(|m| rt(None, m))?
-                    .convert(place.ty);
-                self.store(place, new.clone(), cx)?;
+                let step = |cur| {
+                    Ok(binary(BinOp::Add, cur, Value::Int(*d as i64))
+                        .map_err(|m| rt(None, m))?
+                        .convert(place.ty))
+                };
+                let (cur, new) = self.update(place, cx, step)?;
                 if *prefix {
                     new
                 } else {
@@ -1158,6 +1138,13 @@ pub fn binary(op: BinOp, x: Value, y: Value) -> Result<Value, String> {
         (BitAnd, Int(a), Int(b)) => Int(a & b),
         (BitOr, Int(a), Int(b)) => Int(a | b),
         (BitXor, Int(a), Int(b)) => Int(a ^ b),
+        // C leaves a shift by a negative count or by the width or more
+        // undefined; here it is an error rather than a guess.
+        (Shl | Shr, Int(_), Int(b)) if !(0..64).contains(&b) => {
+            return Err(format!("a shift by {b} bits (C allows 0 to 63 here)"))
+        }
+        (Shl, Int(a), Int(b)) => Int(a.wrapping_shl(b as u32)),
+        (Shr, Int(a), Int(b)) => Int(a >> b),
         (Lt, Int(a), Int(b)) => Bool(a < b),
         (Le, Int(a), Int(b)) => Bool(a <= b),
         (Gt, Int(a), Int(b)) => Bool(a > b),
@@ -1211,3 +1198,88 @@ impl std::fmt::Display for RuntimeError {
 }
 
 impl std::error::Error for RuntimeError {}
+
+/// How many numbers a value holds: an array or struct counts its
+/// elements, all the way down.
+fn value_count(v: &Value) -> usize {
+    match v {
+        Value::Struct(fs) => fs.iter().fold(1, |n, f| n.saturating_add(value_count(f))),
+        _ => 1,
+    }
+}
+
+/// The value at a place whose array indices `idx` are evaluated.
+fn load_at(place: &Place, idx: &[i64], cx: &Cx) -> R<Value> {
+    let mut v = if place.global {
+        &cx.env.globals[place.slot as usize]
+    } else {
+        &cx.frame[place.slot as usize]
+    };
+    let mut k = 0;
+    for step in &place.path {
+        match step {
+            Step::Field(i) => match v {
+                Value::Struct(fs) => v = &fs[*i as usize],
+                other => return Ok(field(other, *i)),
+            },
+            Step::Index(_, span) => {
+                let i = idx[k];
+                k += 1;
+                match v {
+                    Value::Struct(fs) => match usize::try_from(i).ok().and_then(|i| fs.get(i)) {
+                        Some(e) => v = e,
+                        None => return Err(out_of_range(i, fs.len(), *span)),
+                    },
+                    Value::Str(s) => return char_at(s, i, *span),
+                    _ => return Ok(Value::Void),
+                }
+            }
+        }
+    }
+    Ok(v.clone())
+}
+
+/// Writes `value` at a place whose array indices `idx` are evaluated.
+fn store_at(place: &Place, idx: &[i64], value: Value, cx: &mut Cx) -> R<()> {
+    let root = if place.global {
+        &mut cx.env.globals[place.slot as usize]
+    } else {
+        &mut cx.frame[place.slot as usize]
+    };
+    let mut v = root;
+    let mut k = 0;
+    for step in &place.path {
+        match step {
+            Step::Field(i) => match v {
+                Value::Struct(fs) => v = &mut fs[*i as usize],
+                other => {
+                    // The last step: a vector's component.
+                    set_path(other, std::slice::from_ref(step), value);
+                    return Ok(());
+                }
+            },
+            Step::Index(_, span) => {
+                let i = idx[k];
+                k += 1;
+                match v {
+                    Value::Struct(fs) => {
+                        let n = fs.len();
+                        match usize::try_from(i).ok().and_then(|i| fs.get_mut(i)) {
+                            Some(e) => v = e,
+                            None => return Err(out_of_range(i, n, *span)),
+                        }
+                    }
+                    Value::Str(_) => {
+                        return Err(rt(
+                            Some(*span),
+                            "a character of a string cannot be assigned; build the string with sprintf, strcpy or strcat",
+                        ))
+                    }
+                    _ => return Ok(()),
+                }
+            }
+        }
+    }
+    *v = value;
+    Ok(())
+}

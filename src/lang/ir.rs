@@ -272,6 +272,9 @@ pub struct Function {
     pub ret: Ty,
     pub body: Vec<St>,
     pub frame_size: usize,
+    /// The values its parameters and local variables hold at most (an
+    /// array counts its elements), for the limit on live frames.
+    pub frame_values: usize,
     /// The closing brace: where a function that must return a value and
     /// reaches its end without one is reported.
     pub end: Span,

@@ -176,6 +176,17 @@ impl ProgramOutput {
                  the path must be relative, without `..`"
             ));
         }
+        // The path must name a file that can be made: its last part a
+        // name (not `.` or a trailing `/`), no NUL byte, no part longer
+        // than a file system allows.
+        let names_a_file = !matches!(name.rsplit('/').next(), Some("" | "." | ".."));
+        if !names_a_file || name.contains('\0') || name.split('/').any(|c| c.len() > 255) {
+            return Err(format!(
+                "fopen(\"{}\"): the path does not name a file that can be written (it ends \
+                 in `/` or `.`, holds a NUL byte, or has a part longer than 255 bytes)",
+                name.escape_debug()
+            ));
+        }
         let file = match st.files.iter().position(|(p, _)| p == name) {
             Some(i) => {
                 if mode.starts_with('w') {

@@ -445,6 +445,10 @@ impl<'p> Derivation<'p> {
             return Err(self.step_error(StepError::Timeout(m), self.step + 1));
         }
         self.answer_queries()?;
+        // `StepNo()` is the step under way from `StartEach` on, counted
+        // from 1 (lpfg: 1 in the first `StartEach`, production and
+        // `EndEach`; 0 in `Start`).
+        self.env.step = self.step as i64 + 1;
         self.control(ControlKind::StartEach)?;
         self.env.current_group = self.env.next_group;
         let rules = self.candidates(Section::Productions);

@@ -147,6 +147,8 @@ pub struct Param {
     pub name: Option<Name>,
     /// Array dimensions; `None` for `[]`.
     pub dims: Vec<Option<Expr>>,
+    /// Written with `const` (`const char *s`).
+    pub is_const: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -314,6 +316,8 @@ pub enum BinOp {
     BitAnd,
     BitOr,
     BitXor,
+    Shl,
+    Shr,
 }
 
 impl BinOp {
@@ -335,6 +339,8 @@ impl BinOp {
             BinOp::BitAnd => "&",
             BinOp::BitOr => "|",
             BinOp::BitXor => "^",
+            BinOp::Shl => "<<",
+            BinOp::Shr => ">>",
         }
     }
 }

@@ -574,7 +574,11 @@ impl<'t> Parser<'t> {
         }
         if !self.eat_punct(")") {
             loop {
+                let start = self.pos;
                 let ty = self.type_ref()?;
+                let is_const = self.toks[start..self.pos]
+                    .iter()
+                    .any(|t| t.tok.is_ident("const"));
                 let pname = match self.peek().map(|t| &t.tok) {
                     Some(Tok::Ident(_)) => Some(self.name("a parameter name")?),
                     _ => None,
@@ -584,6 +588,7 @@ impl<'t> Parser<'t> {
                     ty,
                     name: pname,
                     dims,
+                    is_const,
                 });
                 if self.eat_punct(")") {
                     break;
@@ -1695,7 +1700,7 @@ impl<'t> Parser<'t> {
         self.assign_expr()
     }
 
-    /// assign := cond [ ('=' | '+=' | '-=' | '*=' | '/=' | '%=') assign ]
+    /// assign := cond [ ('=' | '+=' | '-=' | '*=' | '/=' | '%=' | '<<=' | '>>=') assign ]
     fn assign_expr(&mut self) -> PResult<Expr> {
         let outer = self.measure();
         let lhs = self.cond_expr()?;
@@ -1707,6 +1712,8 @@ impl<'t> Parser<'t> {
             Some(Tok::Punct("*=")) => Some(Some(BinOp::Mul)),
             Some(Tok::Punct("/=")) => Some(Some(BinOp::Div)),
             Some(Tok::Punct("%=")) => Some(Some(BinOp::Rem)),
+            Some(Tok::Punct("<<=")) => Some(Some(BinOp::Shl)),
+            Some(Tok::Punct(">>=")) => Some(Some(BinOp::Shr)),
             _ => None,
         };
         if let Some(op) = op {
@@ -2050,11 +2057,13 @@ fn binop_of(t: &Tok) -> Option<(BinOp, u8)> {
         ">" => (BinOp::Gt, 7),
         "<=" => (BinOp::Le, 7),
         ">=" => (BinOp::Ge, 7),
-        "+" => (BinOp::Add, 8),
-        "-" => (BinOp::Sub, 8),
-        "*" => (BinOp::Mul, 9),
-        "/" => (BinOp::Div, 9),
-        "%" => (BinOp::Rem, 9),
+        "<<" => (BinOp::Shl, 8),
+        ">>" => (BinOp::Shr, 8),
+        "+" => (BinOp::Add, 9),
+        "-" => (BinOp::Sub, 9),
+        "*" => (BinOp::Mul, 10),
+        "/" => (BinOp::Div, 10),
+        "%" => (BinOp::Rem, 10),
         _ => return None,
     })
 }

@@ -13,6 +13,7 @@ mod golden;
 mod golden_tests;
 mod lang_features;
 mod limits;
+mod lpfg_agreement;
 mod lpfg_semantics;
 mod lsystems;
 mod mesh;

@@ -61,7 +61,8 @@ fn a_float_time_crosses_its_threshold_as_in_lpfg() {
 }
 
 /// Vectors and scalars together: `V2f * 1.1` takes a float (lpfg's
-/// operator), `sqrt` of a float is a float, `double` stays double.
+/// operator), `sqrt` of a float is a double (C's `<math.h>`, as lpfg
+/// calls it), `double` stays double.
 #[test]
 fn mixed_float_double_and_vector_arithmetic_matches_lpfg_to_the_bit() {
     let src = "derivation length: 30;\nmodule P(V2f);\nmodule S(float);\nmodule D(double);\n\
