@@ -510,11 +510,18 @@ impl<'p> Interp<'p> {
         cx: &mut Cx,
         f: impl FnOnce(Value) -> R<Value>,
     ) -> R<(Value, Value)> {
-        let idx = if place.path.is_empty() {
-            Vec::new()
-        } else {
-            self.indices(place, cx)?
-        };
+        if place.path.is_empty() {
+            // A plain variable (`s += x`, `i++`): read and written in place.
+            let slot = if place.global {
+                &mut cx.env.globals[place.slot as usize]
+            } else {
+                &mut cx.frame[place.slot as usize]
+            };
+            let new = f(slot.clone())?;
+            let cur = std::mem::replace(slot, new.clone());
+            return Ok((cur, new));
+        }
+        let idx = self.indices(place, cx)?;
         let cur = load_at(place, &idx, cx)?;
         let new = f(cur.clone())?;
         store_at(place, &idx, new.clone(), cx)?;
