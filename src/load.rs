@@ -252,6 +252,18 @@ pub fn read_view_file(path: &Path) -> Result<ViewFile, Error> {
         })
         .collect();
     files.sort();
+    // A model's own view file (the one its `specifications` name) comes
+    // before the others.
+    if let Ok(Some(model)) = model::find(path) {
+        if let Some(i) = files.iter().position(|f| {
+            model
+                .files
+                .iter()
+                .any(|m| m.file_name().is_some() && m.file_name() == f.file_name())
+        }) {
+            files.swap(0, i);
+        }
+    }
     let Some(file) = files.first() else {
         return Ok(view);
     };

@@ -507,3 +507,25 @@ fn ea20_arrays_are_modules_with_a_warning() {
         "EA20({1, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 4}) A F(5)"
     );
 }
+
+/// A folder with two view files: the turtle reads the one the model's
+/// `specifications` name, as the model's other files are read, not the
+/// first by name.
+#[test]
+fn the_turtle_reads_the_view_file_the_specifications_name() {
+    let tmp = std::env::temp_dir().join(format!("subgram-two-views-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    std::fs::write(
+        tmp.join("lsystem.l"),
+        "derivation length: 1;\nmodule A;\nAxiom: A;\nA : { produce F(1) A; }\n",
+    )
+    .unwrap();
+    std::fs::write(tmp.join("specifications"), "model:\n\tlpfg lsystem.l b.v\n").unwrap();
+    // a.v comes first by name, and its tropism cannot be read.
+    std::fs::write(tmp.join("a.v"), "tropism: T: 0 0 0\n").unwrap();
+    std::fs::write(tmp.join("b.v"), "corrected rotation: on\n").unwrap();
+    let out = subgram::command::check(&tmp.display().to_string(), &[], false).unwrap();
+    std::fs::remove_dir_all(&tmp).unwrap();
+    assert!(!out.contains("a.v"), "{out}");
+    assert!(out.lines().last().unwrap().contains(": ok ("), "{out}");
+}
