@@ -733,6 +733,18 @@ impl<'p> Interp<'p> {
                 }
             }
             Ex::Load(..) | Ex::Index(..) | Ex::CallUser { .. } => self.expr_c(e, cx)?,
+            Ex::IncDec(place, d, prefix) if place.path.is_empty() && place.ty == Ty::Int => {
+                // `i++` on a plain int, the loop counter: in place.
+                let slot = if place.global {
+                    &mut cx.env.globals[place.slot as usize]
+                } else {
+                    &mut cx.frame[place.slot as usize]
+                };
+                let cur = slot.as_i64();
+                let new = cur.wrapping_add(*d as i64);
+                *slot = Value::Int(new);
+                Value::Int(if *prefix { new } else { cur })
+            }
             Ex::IncDec(place, d, prefix) => {
                 let step = |cur| {
                     Ok(binary(BinOp::Add, cur, Value::Int(*d as i64))

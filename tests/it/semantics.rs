@@ -328,3 +328,15 @@ fn the_derivation_length_is_read_after_start() {
                Axiom: A(0);\nA(x) : { produce A(x + 1); }\n";
     assert_eq!(run(src), "A(3)");
 }
+
+/// `++` and `--` on ints, locals and globals, prefix and postfix, as in C:
+/// the postfix form gives the value before, the prefix form the value after.
+#[test]
+fn increments_and_decrements_give_cs_values() {
+    let src = "int g;\nStart: { g = 10; }\nderivation length: 1;\nmodule A(int, int, int, int, int, int);\n\
+               Axiom: A(0, 0, 0, 0, 0, 0);\n\
+               A(a, b, c, d, e, f) : { int i = 5; a = i++; b = ++i; i--; c = i; \
+               d = g--; e = --g; f = g; produce A(a, b, c, d, e, f); }\n";
+    // i: 5 -> a 5 (i 6) -> b 7 (i 7) -> 6; g: 10 -> d 10 (g 9) -> e 8.
+    assert_eq!(run(src), "A(5, 7, 6, 10, 8, 8)");
+}
