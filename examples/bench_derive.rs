@@ -27,9 +27,15 @@ fn polygon(n: usize) -> Vec<DVec2> {
         .collect()
 }
 
-/// The reference: Chaikin with index arithmetic, two reused buffers, in
-/// double precision (the engine with `--double`).
-fn chaikin_loop(start: &[DVec2], steps: usize) -> Vec<DVec2> {
+/// The reference: Chaikin with index arithmetic, two reused buffers, on
+/// points of either precision: `Vec2` computes as lpfg computes `V2f` (and
+/// the engine by default), `DVec2` as the engine with `--double`.
+fn chaikin_loop<P, S>(start: &[P], steps: usize) -> Vec<P>
+where
+    P: Copy + std::ops::Add<Output = P> + std::ops::Mul<S, Output = P>,
+    S: Copy + From<f32>,
+{
+    let (quarter, three_quarters) = (S::from(0.25), S::from(0.75));
     let mut src = start.to_vec();
     let mut dst = Vec::with_capacity(start.len() << steps);
     for _ in 0..steps {
@@ -39,28 +45,8 @@ fn chaikin_loop(start: &[DVec2], steps: usize) -> Vec<DVec2> {
             let vl = src[(i + n - 1) % n];
             let v = src[i];
             let vr = src[(i + 1) % n];
-            dst.push(0.25 * vl + 0.75 * v);
-            dst.push(0.75 * v + 0.25 * vr);
-        }
-        std::mem::swap(&mut src, &mut dst);
-    }
-    src
-}
-
-/// The same loop in single precision, as lpfg computes `V2f` (and the
-/// engine by default).
-fn chaikin_loop_f32(start: &[Vec2], steps: usize) -> Vec<Vec2> {
-    let mut src = start.to_vec();
-    let mut dst = Vec::with_capacity(start.len() << steps);
-    for _ in 0..steps {
-        dst.clear();
-        let n = src.len();
-        for i in 0..n {
-            let vl = src[(i + n - 1) % n];
-            let v = src[i];
-            let vr = src[(i + 1) % n];
-            dst.push(0.25 * vl + 0.75 * v);
-            dst.push(0.75 * v + 0.25 * vr);
+            dst.push(vl * quarter + v * three_quarters);
+            dst.push(v * three_quarters + vr * quarter);
         }
         std::mem::swap(&mut src, &mut dst);
     }
@@ -89,14 +75,14 @@ fn main() {
         // Same arithmetic, same order: the results agree exactly.
         let (t_loop, out) = if precision == subgram::Precision::Single {
             let start: Vec<Vec2> = pts.iter().map(|p| p.as_vec2()).collect();
-            let (t, reference) = best_of(runs, || chaikin_loop_f32(&start, steps));
+            let (t, reference) = best_of(runs, || chaikin_loop::<Vec2, f32>(&start, steps));
             assert_eq!(derived.word.len(), reference.len());
             for (i, r) in reference.iter().enumerate() {
                 assert_eq!(derived.word.data(i), &[r.x as f64, r.y as f64]);
             }
             (t, reference.len())
         } else {
-            let (t, reference) = best_of(runs, || chaikin_loop(&pts, steps));
+            let (t, reference) = best_of(runs, || chaikin_loop::<DVec2, f64>(&pts, steps));
             assert_eq!(derived.word.len(), reference.len());
             for (i, r) in reference.iter().enumerate() {
                 assert_eq!(derived.word.data(i), &[r.x, r.y]);

@@ -1016,15 +1016,7 @@ impl Compiler {
         args: &[ast::Expr],
         span: Span,
     ) -> Option<Ex> {
-        let want: Vec<Ty> = match ty {
-            t if t.is_vector() => vec![t.scalar(); t.dim()],
-            Ty::Struct(i) => self.structs[i as usize]
-                .fields
-                .iter()
-                .map(|f| f.1)
-                .collect(),
-            t => vec![t],
-        };
+        let want = self.parts_of(ty);
         if exs.len() == 1 && (exs[0].1 == ty || ty.is_vector() && exs[0].1.dim() == ty.dim()) {
             let (ex, from) = exs.pop().expect("one");
             return self.coerce(ex, from, ty, span);
@@ -1045,22 +1037,21 @@ impl Compiler {
         for ((ex, et), (w, a)) in exs.into_iter().zip(want.iter().zip(args)) {
             parts.push(self.coerce(ex, et, *w, a.span)?);
         }
-        Some(match ty {
-            Ty::V2 | Ty::V2d => {
-                let mut it = parts.into_iter();
-                Ex::MakeV2(Box::new(it.next()?), Box::new(it.next()?))
-            }
-            Ty::V3 | Ty::V3d => {
-                let mut it = parts.into_iter();
-                Ex::MakeV3(
-                    Box::new(it.next()?),
-                    Box::new(it.next()?),
-                    Box::new(it.next()?),
-                )
-            }
-            Ty::Struct(_) => Ex::MakeStruct(parts),
-            _ => parts.pop()?,
-        })
+        assemble(ty, parts)
+    }
+
+    /// The types of the values that build a `ty`: a vector's components,
+    /// a struct's fields, or `ty` itself.
+    fn parts_of(&self, ty: Ty) -> Vec<Ty> {
+        match ty {
+            t if t.is_vector() => vec![t.scalar(); t.dim()],
+            Ty::Struct(i) => self.structs[i as usize]
+                .fields
+                .iter()
+                .map(|f| f.1)
+                .collect(),
+            t => vec![t],
+        }
     }
 
     /// Converts `ex` of type `from` to `to`, or reports a type error.
@@ -2710,15 +2701,7 @@ impl Compiler {
         span: Span,
         scope: &mut Scope,
     ) -> Option<Ex> {
-        let want: Vec<Ty> = match ty {
-            Ty::Struct(i) => self.structs[i as usize]
-                .fields
-                .iter()
-                .map(|f| f.1)
-                .collect(),
-            t if t.is_vector() => vec![t.scalar(); t.dim()],
-            t => vec![t],
-        };
+        let want = self.parts_of(ty);
         if items.len() > want.len() || (!matches!(ty, Ty::Struct(_)) && items.len() != want.len()) {
             self.err(
                 span,
@@ -2752,22 +2735,7 @@ impl Compiler {
         if !ok {
             return None;
         }
-        Some(match ty {
-            Ty::V2 | Ty::V2d => {
-                let mut it = parts.into_iter();
-                Ex::MakeV2(Box::new(it.next()?), Box::new(it.next()?))
-            }
-            Ty::V3 | Ty::V3d => {
-                let mut it = parts.into_iter();
-                Ex::MakeV3(
-                    Box::new(it.next()?),
-                    Box::new(it.next()?),
-                    Box::new(it.next()?),
-                )
-            }
-            Ty::Struct(_) => Ex::MakeStruct(parts),
-            _ => parts.pop()?,
-        })
+        assemble(ty, parts)
     }
 
     /// An integer constant: a literal, an enumerator, a `const` global
@@ -4034,6 +4002,22 @@ fn fold_unary(e: Ex) -> Ex {
         },
         e => e,
     }
+}
+
+/// A value of type `ty` built from its parts (see `Compiler::parts_of`),
+/// already converted to their types.
+fn assemble(ty: Ty, parts: Vec<Ex>) -> Option<Ex> {
+    let mut it = parts.into_iter();
+    Some(match ty {
+        Ty::V2 | Ty::V2d => Ex::MakeV2(Box::new(it.next()?), Box::new(it.next()?)),
+        Ty::V3 | Ty::V3d => Ex::MakeV3(
+            Box::new(it.next()?),
+            Box::new(it.next()?),
+            Box::new(it.next()?),
+        ),
+        Ty::Struct(_) => Ex::MakeStruct(it.collect()),
+        _ => it.last()?,
+    })
 }
 
 /// The result type of `a op b`, or `None` for a type error. Numbers
