@@ -51,6 +51,10 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
         }
+        Run::Vv(vv) => {
+            // A vertex-vertex program: its mesh's polygons.
+            println!("after {} steps:\n{}", vv.steps, vv.info);
+        }
         Run::Surface(surface) => {
             println!("after {} steps:\n{}", surface.steps, surface.mesh.info());
             let soup = surface.mesh.to_quad_soup();

@@ -11,7 +11,7 @@ use crate::deadline::{Deadline, DEFAULT_TIMEOUT};
 use crate::error::Error;
 use crate::lang::ProgramOutput;
 use crate::load::{load, LoadOptions, Precision};
-use crate::mesh::{self, Mesh};
+use crate::mesh::{self, Mesh, PolygonSoup};
 use crate::render::{self, Rgba, Scene, View};
 use crate::reverse::{self, Phase, ReverseOptions, Scheme};
 use crate::rewrite::derive::{DEFAULT_MAX_MODULES, MAX_STEPS};
@@ -31,6 +31,10 @@ pub fn check(file: &str, defines: &[String], double: bool) -> Result<String, Err
             "{file}: ok ({} rules, {} module kinds)",
             c.program.rules.len(),
             c.program.alphabet.kinds.len()
+        ),
+        System::Vv(v) => format!(
+            "{file}: ok (a vv program of {} functions)",
+            v.program.program.functions.len()
         ),
     };
     // Warnings first, each with its line and caret, then the verdict.
@@ -122,6 +126,18 @@ fn derive_text(
         output: a.output.clone(),
     };
     match system {
+        System::Vv(v) => {
+            let run = v.run(&opts, progress)?;
+            Ok(if a.json {
+                json(&run.info)?
+            } else {
+                format!(
+                    "after {} step(s):\n{}",
+                    run.steps,
+                    run.info.to_string().trim_end()
+                )
+            })
+        }
         System::Surface(s) => {
             let run = s.subdivide(&opts, progress)?;
             let info = run.mesh.info();
@@ -273,6 +289,17 @@ fn render_system(
             write_mesh_picture(&run.mesh, output, looks)?;
             Ok(Vec::new())
         }
+        System::Vv(v) => {
+            looks.check()?;
+            let opts = RunOptions {
+                steps: a.steps,
+                deadline,
+                ..RunOptions::default()
+            };
+            let run = v.run(&opts, progress)?;
+            write_soup_picture(&run.soup, output, looks)?;
+            Ok(Vec::new())
+        }
         System::Curve(c) => {
             let view = match a.view.as_deref().unwrap_or("xy") {
                 "xy" => View::Xy,
@@ -404,13 +431,32 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
     let mut inputs = vec![grammar.to_path_buf()];
     inputs.extend(a.mesh.as_deref().map(PathBuf::from));
     refuse_overwrite(&[output], &as_paths(&inputs), a.force)?;
-    let g = crate::surface::load_file(grammar, &a.defines)?;
     let opts = RunOptions {
         steps: a.steps,
         base_mesh: a.mesh.as_ref().map(PathBuf::from),
         deadline,
         ..RunOptions::default()
     };
+    let d = crate::render::mesh::MeshView::default();
+    let looks = MeshLooks {
+        size: (d.width, d.height),
+        background: d.background,
+        view: a.view.as_deref(),
+        wireframe: d.wireframe,
+    };
+    // A vv program subdivides too.
+    if let Some(v) = vv_program(grammar, &a.defines)? {
+        if a.mesh.is_none() {
+            inputs.extend(v.base_mesh());
+            refuse_overwrite(&[output], &as_paths(&inputs), a.force)?;
+        }
+        let run = v.run(&opts, progress)?;
+        if Picture::from_path(output).is_ok() {
+            return write_soup_picture(&run.soup, output, &looks);
+        }
+        return Ok(mesh::io::write(output, &run.soup)?);
+    }
+    let g = crate::surface::load_file(grammar, &a.defines)?;
     let surface = Surface::new(g, Some(grammar));
     if a.mesh.is_none() {
         // The grammar's own `mesh:` is an input too.
@@ -419,16 +465,20 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
     }
     let run = surface.subdivide(&opts, progress)?;
     if Picture::from_path(output).is_ok() {
-        let d = crate::render::mesh::MeshView::default();
-        let looks = MeshLooks {
-            size: (d.width, d.height),
-            background: d.background,
-            view: a.view.as_deref(),
-            wireframe: d.wireframe,
-        };
         return write_mesh_picture(&run.mesh, output, &looks);
     }
     Ok(mesh::io::write(output, &run.mesh.to_quad_soup())?)
+}
+
+/// The vv program in `file`, when it holds one.
+fn vv_program(file: &Path, defines: &[String]) -> Result<Option<crate::system::Vv>, Error> {
+    let text = crate::load::read(file)?;
+    let front = crate::load::front(&file.display().to_string(), text, defines)?;
+    if !crate::vv::is_vv(&front.tokens) {
+        return Ok(None);
+    }
+    let program = crate::load::with_stack(move || crate::vv::from_front(front))?;
+    Ok(Some(crate::system::Vv::new(program, Some(file))))
 }
 
 /// `subgram mesh info`: counts, boundary loops, Euler characteristic, genus,
@@ -756,13 +806,16 @@ impl MeshLooks<'_> {
 
 /// A mesh's picture, flat-shaded, to `.png` or `.svg`.
 fn write_mesh_picture(m: &Mesh, output: &Path, looks: &MeshLooks) -> Result<(), Error> {
+    write_soup_picture(&m.to_quad_soup(), output, looks)
+}
+
+fn write_soup_picture(soup: &PolygonSoup, output: &Path, looks: &MeshLooks) -> Result<(), Error> {
     let format = Picture::from_path(output)?;
     let mv = looks.check()?;
-    let soup = m.to_quad_soup();
-    crate::render::mesh::validate(&soup, &mv)?;
+    crate::render::mesh::validate(soup, &mv)?;
     let bytes = match format {
-        Picture::Svg => crate::render::mesh::render_svg(&soup, &mv).into_bytes(),
-        Picture::Png => crate::render::mesh::render_png(&soup, &mv)?,
+        Picture::Svg => crate::render::mesh::render_svg(soup, &mv).into_bytes(),
+        Picture::Png => crate::render::mesh::render_png(soup, &mv)?,
     };
     write_file(output, &bytes)
 }

@@ -38,6 +38,7 @@ mod production;
 mod rewrite;
 mod syntax;
 mod system;
+pub mod vv;
 
 pub mod command;
 pub mod draw;
@@ -59,5 +60,6 @@ pub use rewrite::derive::{DEFAULT_MAX_MODULES, MAX_STEPS};
 pub use rewrite::{derive, Derivation, DeriveError, DeriveOptions, Derived, Word};
 pub use syntax::{Diagnostic, FileId, SourceFile, SourceMap, Span};
 pub use system::{
-    load_mesh, Progress, Run, RunOptions, Surface, SurfaceRun, System, MAX_SURFACE_STEPS,
+    load_mesh, Progress, Run, RunOptions, Surface, SurfaceRun, System, Vv, VvInfo, VvResult,
+    MAX_SURFACE_STEPS,
 };

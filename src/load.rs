@@ -64,6 +64,9 @@ fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
     if surface::is_surface(&front.tokens) {
         let grammar = with_stack(move || surface::from_front(front))?;
         Ok(System::Surface(Surface::new(grammar, Some(path))))
+    } else if crate::vv::is_vv(&front.tokens) {
+        let program = with_stack(move || crate::vv::from_front(front))?;
+        Ok(System::Vv(crate::system::Vv::new(program, Some(path))))
     } else {
         let mut c = curve(front, opts.precision)?;
         view.give_to(&mut c);
@@ -336,6 +339,9 @@ fn load_text_as(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Er
     if surface::is_surface(&front.tokens) {
         let grammar = with_stack(move || surface::from_front(front))?;
         Ok(System::Surface(Surface::new(grammar, None)))
+    } else if crate::vv::is_vv(&front.tokens) {
+        let program = with_stack(move || crate::vv::from_front(front))?;
+        Ok(System::Vv(crate::system::Vv::new(program, None)))
     } else {
         Ok(System::Curve(curve(front, opts.precision)?))
     }

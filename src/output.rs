@@ -139,6 +139,6 @@ fn value_json(v: &Value, ty: Ty, structs: &[StructDef]) -> Json {
             )
         }
         Value::Str(s) => json!(s.as_ref()),
-        Value::Void | Value::Elem(_) => Json::Null,
+        Value::Void | Value::Elem(_) | Value::Set(_) => Json::Null,
     }
 }

@@ -7,11 +7,13 @@ use crate::deadline::Deadline;
 use crate::error::Error;
 use crate::lang::ProgramOutput;
 use crate::mesh::Mesh;
+use crate::mesh::PolygonSoup;
 use crate::rewrite::derive::DEFAULT_MAX_MODULES;
 use crate::rewrite::{DeriveOptions, Word};
 use crate::surface::{Grammar, StepCounts};
 use crate::syntax::Diagnostic;
 use crate::syntax::{FileId, SourceMap};
+use crate::vv::{VvError, VvProgram};
 
 /// A checked `.lsys` file: what [`crate::load`] returns.
 #[derive(Debug)]
@@ -21,6 +23,8 @@ pub enum System {
     Curve(Curve),
     /// A stellar subdivision grammar, run on a mesh.
     Surface(Surface),
+    /// A vertex-vertex program (paper 001), run on a rotation system.
+    Vv(Vv),
 }
 
 /// Settings of [`System::run`].
@@ -86,6 +90,7 @@ impl RunOptions {
 pub enum Run<'s> {
     Curve(CurveRun<'s>),
     Surface(SurfaceRun),
+    Vv(VvResult),
 }
 
 impl Run<'_> {
@@ -93,15 +98,23 @@ impl Run<'_> {
     pub fn word(&self) -> Option<&Word> {
         match self {
             Run::Curve(c) => Some(c.word()),
-            Run::Surface(_) => None,
+            Run::Surface(_) | Run::Vv(_) => None,
         }
     }
 
     /// A surface grammar's subdivided mesh.
     pub fn mesh(&self) -> Option<&Mesh> {
         match self {
-            Run::Curve(_) => None,
+            Run::Curve(_) | Run::Vv(_) => None,
             Run::Surface(s) => Some(&s.mesh),
+        }
+    }
+
+    /// A vv program's mesh, as polygons.
+    pub fn polygons(&self) -> Option<&PolygonSoup> {
+        match self {
+            Run::Vv(v) => Some(&v.soup),
+            _ => None,
         }
     }
 }
@@ -123,6 +136,7 @@ impl System {
         match self {
             System::Curve(c) => Ok(Run::Curve(c.run(opts.derive_options())?)),
             System::Surface(s) => Ok(Run::Surface(s.subdivide(opts, |_| {})?)),
+            System::Vv(v) => Ok(Run::Vv(v.run(opts, |_| {})?)),
         }
     }
 
@@ -134,6 +148,7 @@ impl System {
         let (sources, warnings) = match self {
             System::Curve(c) => (&c.sources, &c.program.warnings),
             System::Surface(s) => (&s.grammar.sources, &s.grammar.warnings),
+            System::Vv(v) => (&v.program.sources, &v.program.warnings),
         };
         warnings
             .iter()
@@ -146,6 +161,7 @@ impl System {
         match self {
             System::Curve(c) => &c.sources,
             System::Surface(s) => &s.grammar.sources,
+            System::Vv(v) => &v.program.sources,
         }
     }
 }
@@ -292,6 +308,180 @@ impl Surface {
         let steps = self.steps(opts.steps)?;
         self.run_on(&mut mesh, steps, opts.deadline, progress)?;
         Ok(SurfaceRun { mesh, steps })
+    }
+}
+
+/// A checked vv program and the folder its base mesh is relative to.
+#[derive(Debug)]
+pub struct Vv {
+    pub program: VvProgram,
+    dir: Option<PathBuf>,
+}
+
+/// What a vv run made: the mesh's polygons (Edmonds' faces) and
+/// positions, and the steps run.
+#[derive(Clone, Debug)]
+pub struct VvResult {
+    pub soup: PolygonSoup,
+    pub steps: u64,
+    pub info: VvInfo,
+}
+
+/// A vv mesh's counts: vertices, edges, faces, boundary loops, the Euler
+/// characteristic and the valences.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct VvInfo {
+    pub vertices: usize,
+    pub edges: usize,
+    pub faces: usize,
+    pub boundary_loops: usize,
+    pub euler_characteristic: i64,
+    /// `(valence, number of vertices)`, by valence.
+    pub valences: Vec<(usize, usize)>,
+    /// `(sides, number of faces)`, by sides.
+    pub face_sides: Vec<(usize, usize)>,
+}
+
+impl std::fmt::Display for VvInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "vertices: {}", self.vertices)?;
+        writeln!(f, "edges: {}", self.edges)?;
+        writeln!(f, "faces: {}", self.faces)?;
+        writeln!(f, "boundary loops: {}", self.boundary_loops)?;
+        writeln!(f, "Euler characteristic: {}", self.euler_characteristic)?;
+        let list = |v: &[(usize, usize)]| {
+            v.iter()
+                .map(|(k, n)| format!("{k}:{n}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        writeln!(f, "valences: {}", list(&self.valences))?;
+        writeln!(f, "face sides: {}", list(&self.face_sides))
+    }
+}
+
+impl Vv {
+    /// `program`, read from `file` (its base mesh is relative to the
+    /// file's folder) or from text (relative to the current folder).
+    pub fn new(program: VvProgram, file: Option<&Path>) -> Vv {
+        let dir = file.map(|f| f.parent().unwrap_or(Path::new("")).to_path_buf());
+        Vv { program, dir }
+    }
+
+    /// The base mesh file the program names (`mesh S = "cube.obj";`).
+    pub fn base_mesh(&self) -> Option<PathBuf> {
+        crate::vv::run::base_path(&self.program, self.dir.as_deref())
+    }
+
+    /// A run's error as an [`Error`], located in the program when a
+    /// statement is to blame.
+    pub fn error(&self, e: VvError) -> Error {
+        match e.span {
+            Some(span) => Error::at(
+                &self.program.sources,
+                crate::syntax::Diagnostic::new(span, e.message),
+            ),
+            None => Error::File {
+                path: self.program.sources.get(FileId(0)).name.clone(),
+                line: None,
+                message: e.message,
+            },
+        }
+    }
+
+    /// Reads the base mesh (`opts.base_mesh`, else the program's own), runs
+    /// `Start`, `opts.steps` steps (else the derivation length, else 1) and
+    /// `End`; `progress` hears after `Start` and after each step.
+    pub fn run(
+        &self,
+        opts: &RunOptions,
+        progress: impl FnMut(Progress),
+    ) -> Result<VvResult, Error> {
+        let path = opts.base_mesh.clone().or_else(|| self.base_mesh());
+        let soup = match &path {
+            Some(p) => Some(crate::mesh::io::read(p).map_err(|e| {
+                match (&self.program.base, opts.base_mesh.is_none(), e.line) {
+                    (Some((_, span)), true, None) => Error::at(
+                        &self.program.sources,
+                        Diagnostic::new(
+                            *span,
+                            format!("the base mesh `{}`: {}", e.path, e.message),
+                        ),
+                    ),
+                    _ => Error::from(e),
+                }
+            })?),
+            None => None,
+        };
+        self.run_from(soup.as_ref(), opts, progress)
+    }
+
+    /// Runs the program on the polygons `base` (instead of a file), as
+    /// [`Vv::run`] does.
+    pub fn run_soup(&self, base: &PolygonSoup, opts: &RunOptions) -> Result<VvResult, Error> {
+        self.run_from(Some(base), opts, |_| {})
+    }
+
+    fn run_from(
+        &self,
+        soup: Option<&PolygonSoup>,
+        opts: &RunOptions,
+        mut progress: impl FnMut(Progress),
+    ) -> Result<VvResult, Error> {
+        let mut run = self
+            .program
+            .start(soup, opts.steps, opts.deadline, opts.output.clone())
+            .map_err(|e| self.error(e))?;
+        let steps = run.length() as usize;
+        let at = |r: &crate::vv::VvRun| {
+            let n = r.members().len();
+            Progress {
+                step: crate::production::Topology::steps_done(r) as usize,
+                steps,
+                vertices: n,
+                edges: 0,
+                faces: 0,
+            }
+        };
+        progress(at(&run));
+        run.finish(|r| progress(at(r))).map_err(|e| self.error(e))?;
+        let soup = run.soup().map_err(|e| self.error(e))?;
+        let info = vv_info(&run);
+        Ok(VvResult {
+            soup,
+            steps: crate::production::Topology::steps_done(&run),
+            info,
+        })
+    }
+}
+
+/// The counts of a run's mesh.
+fn vv_info(run: &crate::vv::VvRun) -> VvInfo {
+    use std::collections::BTreeMap;
+    let members = run.members();
+    let mesh = &run.mesh;
+    let faces = mesh.faces(members).unwrap_or_default();
+    let holes = mesh.holes(members).unwrap_or_default();
+    let mut valences: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut degree_sum = 0;
+    for &v in members {
+        let k = mesh.valence(v, false).unwrap_or(0);
+        degree_sum += k;
+        *valences.entry(k).or_default() += 1;
+    }
+    let mut sides: BTreeMap<usize, usize> = BTreeMap::new();
+    for f in &faces {
+        *sides.entry(f.len()).or_default() += 1;
+    }
+    let edges = degree_sum / 2;
+    VvInfo {
+        vertices: members.len(),
+        edges,
+        faces: faces.len(),
+        boundary_loops: holes.len(),
+        euler_characteristic: members.len() as i64 - edges as i64 + faces.len() as i64,
+        valences: valences.into_iter().collect(),
+        face_sides: sides.into_iter().collect(),
     }
 }
 

@@ -111,14 +111,17 @@ fn successors(body: &[St], f: &mut impl FnMut(&Succ)) {
                     successors(std::slice::from_ref(b), f);
                 }
             }
-            St::Loop { body, .. } => successors(std::slice::from_ref(body), f),
+            St::Loop { body, .. } | St::ForAll { body, .. } => {
+                successors(std::slice::from_ref(body), f)
+            }
             St::Block(b) | St::Switch { body: b, .. } => successors(b, f),
             St::Expr(_)
             | St::Init(..)
             | St::Return
             | St::ReturnValue(_)
             | St::Break
-            | St::Continue => {}
+            | St::Continue
+            | St::SetEdit { .. } => {}
         }
     }
 }

@@ -6,7 +6,7 @@
 
 use super::ir::{Batch, Func};
 use super::random::Op;
-use super::value::{Ty, CAMERA_POSITION, MOUSE_STATUS};
+use super::value::{Ty, Value, CAMERA_POSITION, MOUSE_STATUS};
 
 /// Why a call does not fit a built-in's signature.
 #[derive(Clone, Debug, PartialEq)]
@@ -47,6 +47,33 @@ pub struct HostTable {
     pub arith: fn(u8) -> Option<(Func, Ty)>,
     /// The element kind a set of kind `k` holds, if `k` is a set.
     pub members: fn(u8) -> Option<u8>,
+    /// Element kinds that programs name as types (vv's `vertex`, `mesh`).
+    pub types: &'static [(&'static str, u8)],
+    /// The value of a variable of element kind `k` declared without an
+    /// initialiser: a global's, and a local's unless `fresh` makes one.
+    pub zero: fn(u8) -> Value,
+    /// The built-in a local of element kind `k` declared without an
+    /// initialiser calls (vv's `vertex v;` creates a vertex).
+    pub fresh: fn(u8) -> Option<Func>,
+    /// Properties of elements (`v$pos`), where the topology has them.
+    pub properties: Option<&'static HostProperties>,
+}
+
+/// Properties a topology's elements carry, read `e$name` and written
+/// `e$name = x`: built-in ones and those a program declares
+/// (`vertex float conc;`).
+pub struct HostProperties {
+    /// What declares a property for each owner: `vertex`, `edge`, `mesh`.
+    pub owners: &'static [&'static str],
+    /// The owner whose properties an element of kind `k` has.
+    pub owner_of: fn(u8) -> Option<u8>,
+    /// Built-in properties: owner, name, type. They take the first
+    /// numbers of their owner, in this order; declared ones follow.
+    pub builtin: &'static [(u8, &'static str, Ty)],
+    /// The host built-ins that read (`element, number`) and write
+    /// (`element, number, value`, giving the value) a property.
+    pub get: u16,
+    pub set: u16,
 }
 
 impl HostTable {
@@ -79,6 +106,10 @@ pub static WORD_HOST: HostTable = HostTable {
     values: &[],
     arith: |_| None,
     members: |_| None,
+    types: &[],
+    zero: |_| Value::Void,
+    fresh: |_| None,
+    properties: None,
 };
 
 /// C's single-precision maths functions of [`LIBRARY`]: each is its

@@ -29,7 +29,18 @@ pub enum Precision {
 
 /// Compiles a program whose `float` has the given precision.
 pub fn compile_with(file: &ast::File, precision: Precision) -> Result<Program, Vec<Diagnostic>> {
-    let mut c = Compiler::new(&WORD_HOST, Vec::new());
+    compile_on(file, precision, &WORD_HOST)
+}
+
+/// Compiles a whole program (functions, globals, control blocks) for a
+/// topology whose elements and built-ins `host` lists: words, or a vv
+/// program's rotation system.
+pub fn compile_on(
+    file: &ast::File,
+    precision: Precision,
+    host: &'static HostTable,
+) -> Result<Program, Vec<Diagnostic>> {
+    let mut c = Compiler::new(host, Vec::new());
     c.single = precision == Precision::Single;
     // The predefined structs' single-precision fields follow too.
     if !c.single {
@@ -151,6 +162,8 @@ struct Compiler {
     /// `float` is single precision (lpfg's); otherwise every `float`,
     /// `V2f` and `V3f` is read as `double`, `V2d`, `V3d`.
     single: bool,
+    /// The properties the program declares, by owner and name (vv).
+    props: Vec<DeclaredProp>,
     /// User-defined C functions' signatures, by number, and their numbers
     /// by name.
     user_fns: Vec<UserSig>,
@@ -336,6 +349,14 @@ impl Scope {
 
 type Typed = Option<(Ex, Ty)>;
 
+/// A property declared by the program, as the checker knows it.
+struct DeclaredProp {
+    owner: u8,
+    name: String,
+    ty: Ty,
+    index: u16,
+}
+
 impl Compiler {
     fn new(host: &'static HostTable, functions: Vec<ast::Define>) -> Compiler {
         let mut function_names = HashMap::new();
@@ -391,6 +412,7 @@ impl Compiler {
             methods: HashMap::new(),
             array_types: HashMap::new(),
             single: false,
+            props: Vec::new(),
         }
     }
 
@@ -561,7 +583,9 @@ impl Compiler {
             "V3d" => Ty::V3d,
             "void" => Ty::Void,
             other => {
-                if let Some(t) = self.typedefs.get(other) {
+                if let Some(&(_, k)) = self.host.types.iter().find(|(n, _)| *n == other) {
+                    Ty::Elem(k)
+                } else if let Some(t) = self.typedefs.get(other) {
                     *t
                 } else if let Some(&i) = self.struct_names.get(other) {
                     Ty::Struct(i)
@@ -699,6 +723,113 @@ impl Compiler {
         }
     }
 
+    /// The properties a vv program declares, numbered after their owner's
+    /// built-in ones.
+    fn property_decls(&mut self, file: &ast::File) {
+        for item in &file.items {
+            let Item::Property {
+                owner, ty, name, ..
+            } = item
+            else {
+                continue;
+            };
+            let Some(props) = self.host.properties else {
+                self.err(
+                    owner.span,
+                    format!("a {} has no properties", self.host.name),
+                );
+                continue;
+            };
+            let Some(o) = props.owners.iter().position(|n| *n == owner.text) else {
+                continue;
+            };
+            let o = o as u8;
+            let Some(t) = self.resolve_type(ty) else {
+                continue;
+            };
+            if !(t.is_numeric() || t.is_vector()) {
+                self.err(
+                    ty.span,
+                    format!(
+                        "a property holds a number or a vector; {} is neither",
+                        self.type_name(t)
+                    ),
+                );
+                continue;
+            }
+            let taken = props
+                .builtin
+                .iter()
+                .any(|(bo, n, _)| *bo == o && *n == name.text)
+                || self
+                    .props
+                    .iter()
+                    .any(|p| p.owner == o && p.name == name.text);
+            if taken {
+                self.err(
+                    name.span,
+                    format!(
+                        "{} property `{}` is already declared",
+                        owner.text, name.text
+                    ),
+                );
+                continue;
+            }
+            let index = props.builtin.iter().filter(|(bo, _, _)| *bo == o).count()
+                + self.props.iter().filter(|p| p.owner == o).count();
+            self.props.push(DeclaredProp {
+                owner: o,
+                name: name.text.clone(),
+                ty: t,
+                index: index as u16,
+            });
+        }
+    }
+
+    /// A property of an element of type `target_ty`: its owner, number and
+    /// type; an error at `name` if it has none of that name.
+    fn property(&mut self, target_ty: Ty, name: &ast::Name, at: Span) -> Option<(u8, u16, Ty)> {
+        let owner = match (self.host.properties, target_ty) {
+            (Some(p), Ty::Elem(k)) => (p.owner_of)(k).map(|o| (p, o)),
+            _ => None,
+        };
+        let Some((props, o)) = owner else {
+            self.err(
+                at,
+                format!(
+                    "`$` reads a property of a vertex, an edge or the mesh; this is {}",
+                    self.type_name(target_ty)
+                ),
+            );
+            return None;
+        };
+        let mut index = 0u16;
+        for (bo, n, t) in props.builtin {
+            if *bo == o {
+                if *n == name.text {
+                    return Some((o, index, *t));
+                }
+                index += 1;
+            }
+        }
+        if let Some(p) = self
+            .props
+            .iter()
+            .find(|p| p.owner == o && p.name == name.text)
+        {
+            return Some((o, p.index, p.ty));
+        }
+        let owner_name = props.owners[o as usize];
+        self.err(
+            name.span,
+            format!(
+                "{owner_name} property `{}` is not declared; declare it as `{owner_name} float {};`",
+                name.text, name.text
+            ),
+        );
+        None
+    }
+
     /// Turtle mode (The Algorithmic Beauty of Plants): a module used but not
     /// declared is declared with as many float parameters as its first use.
     fn declare_from_use(&mut self, file: &ast::File) {
@@ -781,7 +912,9 @@ impl Compiler {
             warnings: Vec::new(),
             model: Default::default(),
             single: self.single,
+            properties: Vec::new(),
         };
+        self.property_decls(file);
         // Group numbers seen with `group` (false) and `ggroup` (true), and
         // where first.
         let mut group_kinds: Vec<(i64, bool, Span)> = Vec::new();
@@ -893,6 +1026,34 @@ impl Compiler {
                         program.rules.push(rule);
                     }
                 }
+                Item::Property { ty, name, init, .. } => {
+                    let Some(p) = self.props.iter().find(|p| p.name == name.text) else {
+                        continue;
+                    };
+                    let (owner, pty, index) = (p.owner, p.ty, p.index);
+                    let _ = ty;
+                    let value = match init {
+                        Some(e) => {
+                            let mut scope = Scope::default();
+                            let Some((x, t)) = self.expr(e, &mut scope) else {
+                                continue;
+                            };
+                            let Some(x) = self.coerce(x, t, pty, e.span) else {
+                                continue;
+                            };
+                            x
+                        }
+                        None => Ex::Const(Value::zero(pty, &self.structs)),
+                    };
+                    program.properties.push(PropertyDef {
+                        owner,
+                        name: name.text.clone(),
+                        ty: pty,
+                        index,
+                        init: value,
+                        span: name.span,
+                    });
+                }
                 Item::Module { .. }
                 | Item::Struct { .. }
                 | Item::Typedef { .. }
@@ -906,7 +1067,8 @@ impl Compiler {
             .map(|(id, _, span)| (*id, *span))
             .collect();
         program.functions = self.function_bodies(file);
-        if !axiom_seen {
+        // A word needs an axiom; other topologies have their structure.
+        if !axiom_seen && std::ptr::eq(self.host, &WORD_HOST) {
             let end = file
                 .items
                 .last()
@@ -932,7 +1094,10 @@ impl Compiler {
                 continue;
             };
             let mut scope = Scope::default();
-            let init = self.initializer(ty, &d.init, d.name.span, &mut scope);
+            let init = match (ty, &d.init) {
+                (Ty::Elem(k), Init::None) => Some(Ex::Const((self.host.zero)(k))),
+                _ => self.initializer(ty, &d.init, d.name.span, &mut scope),
+            };
             if scope.max > 0 {
                 self.err(d.name.span, "a global initializer cannot declare variables");
             }
@@ -1393,8 +1558,34 @@ impl Compiler {
                     if d.is_const {
                         scope.consts.insert(slot);
                     }
-                    let value = init.unwrap_or(Ex::Const(Value::zero(ty, &self.structs)));
+                    let value = init.unwrap_or_else(|| match ty {
+                        Ty::Elem(k) => match (self.host.fresh)(k) {
+                            Some(f) => Ex::Call(f, Vec::new(), v.name.span),
+                            None => Ex::Const((self.host.zero)(k)),
+                        },
+                        _ => Ex::Const(Value::zero(ty, &self.structs)),
+                    });
                     out.push(St::Init(slot, value));
+                }
+            }
+            ast::Stmt::Forall {
+                var,
+                set,
+                body,
+                span,
+            } => {
+                if let Some(st) = self.forall(var, set, body, *span, scope) {
+                    out.push(st);
+                }
+            }
+            ast::Stmt::SetEdit {
+                op,
+                elem,
+                set,
+                span,
+            } => {
+                if let Some(st) = self.set_edit(*op, elem, set, *span, scope) {
+                    out.push(st);
                 }
             }
             ast::Stmt::If { cond, then, els } => {
@@ -1957,6 +2148,36 @@ impl Compiler {
                 let ex = if arithmetic { self.round(ex, ty) } else { ex };
                 Some((ex, ty))
             }
+            ExprKind::Assign(op, lhs, rhs) if matches!(lhs.kind, ExprKind::Prop(..)) => {
+                self.assign_property(*op, lhs, rhs, span, scope)
+            }
+            ExprKind::IncDec {
+                target,
+                delta,
+                prefix,
+            } if matches!(target.kind, ExprKind::Prop(..)) => {
+                let one = ast::Expr {
+                    kind: ExprKind::Int(1),
+                    span,
+                };
+                let op = if *delta > 0 { BinOp::Add } else { BinOp::Sub };
+                let (x, ty) = self.assign_property(Some(op), target, &one, span, scope)?;
+                if *prefix {
+                    return Some((x, ty));
+                }
+                if ty != Ty::Int {
+                    self.err(
+                        span,
+                        "a property's `++`/`--` after it gives its old value only for an int; write `v$x += 1`",
+                    );
+                    return None;
+                }
+                let back = if *delta > 0 { BinOp::Sub } else { BinOp::Add };
+                Some((
+                    Ex::Bin(back, Box::new(x), Box::new(Ex::Const(Value::Int(1))), span),
+                    ty,
+                ))
+            }
             ExprKind::Assign(op, lhs, rhs) => {
                 let place = self.place(lhs, scope);
                 let (rx, rhs_ty) = self.expr(rhs, scope)?;
@@ -2091,6 +2312,19 @@ impl Compiler {
                 self.gather(op, Some(var), set, cond.as_deref(), scope)
             }
             ExprKind::Call(name, args) => self.call(name, args, span, scope),
+            ExprKind::Prop(target, name) => {
+                let (tx, tt) = self.expr(target, scope)?;
+                let (_, index, ty) = self.property(tt, name, span)?;
+                let get = self.host.properties?.get;
+                Some((
+                    Ex::Call(
+                        Func::Host(get),
+                        vec![tx, Ex::Const(Value::Int(index as i64))],
+                        span,
+                    ),
+                    ty,
+                ))
+            }
             ExprKind::InContext(kind, pats) => {
                 if !scope.in_rule {
                     self.err(
@@ -2361,6 +2595,138 @@ impl Compiler {
 
     /// `sum(w in SET where COND)`: the variable is a local while the
     /// condition is checked.
+    /// `e$name = rhs` and `e$name op= rhs`: the topology's property
+    /// setter, which gives the value stored.
+    fn assign_property(
+        &mut self,
+        op: Option<BinOp>,
+        lhs: &ast::Expr,
+        rhs: &ast::Expr,
+        span: Span,
+        scope: &mut Scope,
+    ) -> Typed {
+        let ExprKind::Prop(target, name) = &lhs.kind else {
+            return None;
+        };
+        let (tx, tt) = self.expr(target, scope)?;
+        let (_, index, ty) = self.property(tt, name, lhs.span)?;
+        let props = self.host.properties?;
+        let value = match op {
+            None => rhs.clone(),
+            Some(o) => ast::Expr {
+                kind: ExprKind::Binary(o, Box::new(lhs.clone()), Box::new(rhs.clone())),
+                span,
+            },
+        };
+        let (vx, vt) = self.expr(&value, scope)?;
+        let vx = self.coerce(vx, vt, ty, rhs.span)?;
+        Some((
+            Ex::Call(
+                Func::Host(props.set),
+                vec![tx, Ex::Const(Value::Int(index as i64)), vx],
+                span,
+            ),
+            ty,
+        ))
+    }
+
+    /// `forall x in S body`: `x` takes each member of a set, or each
+    /// neighbour of a vertex (its members as the topology lists them).
+    fn forall(
+        &mut self,
+        var: &ast::Name,
+        set: &ast::Expr,
+        body: &ast::Stmt,
+        span: Span,
+        scope: &mut Scope,
+    ) -> Option<St> {
+        let (sx, st) = self.expr(set, scope)?;
+        let member = match st {
+            Ty::Elem(k) => (self.host.members)(k),
+            _ => None,
+        };
+        let Some(member) = member else {
+            self.err(
+                set.span,
+                format!(
+                    "`forall` goes over a set or a vertex's neighbours; this is {}",
+                    self.type_name(st)
+                ),
+            );
+            return None;
+        };
+        scope.push();
+        let slot = self.local(scope, &var.text, Ty::Elem(member), var.span);
+        scope.loops += 1;
+        let b = self.sub_stmt(body, scope);
+        scope.loops -= 1;
+        scope.pop();
+        Some(St::ForAll {
+            slot,
+            set: sx,
+            body: Box::new(b),
+            span,
+        })
+    }
+
+    /// `add v to S`, `remove v from S`, `merge S with T`: `S` must be a
+    /// variable (or a field or element of one) holding a set.
+    fn set_edit(
+        &mut self,
+        op: ast::SetEditOp,
+        elem: &ast::Expr,
+        set: &ast::Expr,
+        span: Span,
+        scope: &mut Scope,
+    ) -> Option<St> {
+        let place = self.place(set, scope);
+        let ex = self.expr(elem, scope);
+        let (place, (ex, et)) = (place?, ex?);
+        let member = match place.ty {
+            Ty::Elem(k) => (self.host.members)(k),
+            _ => None,
+        };
+        let word = match op {
+            ast::SetEditOp::Add => "add",
+            ast::SetEditOp::Remove => "remove",
+            ast::SetEditOp::Merge => "merge",
+        };
+        // A set's members are of another kind than the set; a vertex's
+        // members are its neighbours, and a vertex is not a set to edit.
+        let is_set = matches!(place.ty, Ty::Elem(k) if member != Some(k));
+        let Some(member) = member.filter(|_| is_set) else {
+            self.err(
+                set.span,
+                format!(
+                    "`{word}` changes a set (a `mesh` variable); this is {}",
+                    self.type_name(place.ty)
+                ),
+            );
+            return None;
+        };
+        let want = match op {
+            ast::SetEditOp::Merge => place.ty,
+            _ => Ty::Elem(member),
+        };
+        if et != want {
+            self.err(
+                elem.span,
+                format!(
+                    "`{word}` takes {} here; this is {}",
+                    self.type_name(want),
+                    self.type_name(et)
+                ),
+            );
+            return None;
+        }
+        let _ = span;
+        Some(St::SetEdit {
+            place,
+            op,
+            elem: ex,
+        })
+    }
+
     fn gather(
         &mut self,
         op: &ast::Name,
@@ -4024,6 +4390,12 @@ fn assemble(ty: Ty, parts: Vec<Ex>) -> Option<Ex> {
 /// follow C's usual arithmetic conversions (`double` over `float` over
 /// `int`); vectors of one size but two precisions give the double one.
 pub fn binary_type(op: BinOp, a: Ty, b: Ty) -> Option<Ty> {
+    if let (Ty::Elem(x), Ty::Elem(y)) = (a, b) {
+        // Elements compare by identity, and in the order of their ids
+        // (vv's universe order, `p < q`).
+        use BinOp::*;
+        return (x == y && matches!(op, Eq | Ne | Lt | Le | Gt | Ge)).then_some(Ty::Bool);
+    }
     let num = a.is_numeric() && b.is_numeric();
     let promote = || a.wider(b).wider(Ty::Int);
     let vectors = a.is_vector() && a.dim() == b.dim();

@@ -7,7 +7,7 @@
 use glam::{DVec2, DVec3};
 
 use crate::deadline::Deadline;
-use crate::syntax::ast::{BinOp, ContextKind};
+use crate::syntax::ast::{BinOp, ContextKind, SetEditOp};
 use crate::syntax::span::Span;
 
 use super::ir::*;
@@ -201,6 +201,8 @@ pub struct Interp<'p> {
     pub deadline: Option<Deadline>,
     /// Loop iterations since the interpreter was made, wrapping.
     ticks: u32,
+    /// Lists of members for `forall` loops, reused.
+    member_lists: Vec<Vec<Value>>,
 }
 
 impl<'p> Interp<'p> {
@@ -217,6 +219,7 @@ impl<'p> Interp<'p> {
             fuel: LOOP_LIMIT,
             deadline: None,
             ticks: 0,
+            member_lists: Vec::new(),
         }
     }
 
@@ -243,7 +246,7 @@ impl<'p> Interp<'p> {
         body: &[St],
         frame: &mut [Value],
         env: &mut Env,
-        host: &mut dyn Host,
+        host: &mut (dyn Host + Send),
         sink: &mut dyn Emit,
     ) -> Result<Flow, RuntimeError> {
         self.fuel = LOOP_LIMIT;
@@ -270,7 +273,7 @@ impl<'p> Interp<'p> {
         e: &Ex,
         frame: &mut [Value],
         env: &mut Env,
-        host: &mut dyn Host,
+        host: &mut (dyn Host + Send),
     ) -> Result<Value, RuntimeError> {
         let mut sink = NoSink;
         self.stack_base = 0;
@@ -403,7 +406,89 @@ impl<'p> Interp<'p> {
                 default,
                 body,
             } => self.switch(value, cases, *default, body, cx),
+            St::ForAll {
+                slot,
+                set,
+                body,
+                span,
+            } => self.for_all(*slot, set, body, *span, cx),
+            St::SetEdit { place, op, elem } => {
+                let e = self.expr(elem, cx)?;
+                self.set_edit(place, *op, e, cx)?;
+                Ok(Flow::Normal)
+            }
         }
+    }
+
+    /// `forall x in S`: the members the host lists when the loop starts,
+    /// one at a time in local `slot`. Out of `stmt`, so that its frame
+    /// stays small.
+    #[inline(never)]
+    fn for_all(&mut self, slot: u16, set: &Ex, body: &St, span: Span, cx: &mut Cx) -> R<Flow> {
+        let s = self.expr(set, cx)?;
+        let mut members = self.member_lists.pop().unwrap_or_default();
+        members.clear();
+        cx.host.members(&s, &mut members);
+        let mut flow = Flow::Normal;
+        for m in members.drain(..) {
+            if self.fuel == 0 {
+                return Err(rt(
+                    Some(span),
+                    format!("loops ran more than {LOOP_LIMIT} iterations in one body"),
+                ));
+            }
+            self.fuel -= 1;
+            self.ticks = self.ticks.wrapping_add(1);
+            if self.ticks.is_multiple_of(DEADLINE_EVERY) {
+                if let Err(m) = crate::deadline::check(self.deadline) {
+                    return Err(rt(Some(span), m));
+                }
+            }
+            cx.frame[slot as usize] = m;
+            match self.stmt(body, cx)? {
+                Flow::Break => break,
+                Flow::Normal | Flow::Continue => {}
+                f => {
+                    flow = f;
+                    break;
+                }
+            }
+        }
+        members.clear();
+        self.member_lists.push(members);
+        Ok(flow)
+    }
+
+    /// `add`, `remove`, `merge` on the set at `place`: in place when the
+    /// place is a variable, so that a set held once is never copied.
+    #[inline(never)]
+    fn set_edit(&mut self, place: &Place, op: SetEditOp, elem: Value, cx: &mut Cx) -> R<()> {
+        fn edit(set: &mut Value, op: SetEditOp, elem: &Value) {
+            let Value::Set(s) = set else { return };
+            let s = std::sync::Arc::make_mut(s);
+            match (op, elem) {
+                (SetEditOp::Add, Value::Elem(e)) => {
+                    s.insert(e.ids[0]);
+                }
+                (SetEditOp::Remove, Value::Elem(e)) => {
+                    s.remove(e.ids[0]);
+                }
+                (SetEditOp::Merge, Value::Set(t)) => s.merge(t),
+                _ => {}
+            }
+        }
+        if place.path.is_empty() {
+            let root = if place.global {
+                &mut cx.env.globals[place.slot as usize]
+            } else {
+                &mut cx.frame[place.slot as usize]
+            };
+            edit(root, op, &elem);
+            return Ok(());
+        }
+        let mut v = self.load(place, cx)?;
+        edit(&mut v, op, &elem);
+        self.store(place, v, cx)
     }
 
     /// Runs a `switch`'s body from the label of its value's; a `break`
@@ -577,7 +662,7 @@ impl<'p> Interp<'p> {
         }
         self.calls += 1;
         self.frame_values += values;
-        let r = self.invoke(f, &mut frame, cx.env, span);
+        let r = self.invoke(f, &mut frame, cx.env, &mut *cx.host, span);
         self.frame_values -= values;
         self.calls -= 1;
         let v = r?;
@@ -596,6 +681,7 @@ impl<'p> Interp<'p> {
         f: &'p Function,
         frame: &mut [Value],
         env: &mut Env,
+        host: &mut (dyn Host + Send),
         span: Span,
     ) -> R<Value> {
         let here = stack_address();
@@ -611,7 +697,7 @@ impl<'p> Interp<'p> {
                     .spawn_scoped(s, || {
                         self.stack_base = 0;
                         self.stack_room = SEGMENT_STACK - SEGMENT_MARGIN;
-                        self.run_function(f, frame, env)
+                        self.run_function(f, frame, env, host)
                     })
                     .map(|h| h.join())
             });
@@ -625,16 +711,22 @@ impl<'p> Interp<'p> {
                 )),
             };
         }
-        self.run_function(f, frame, env)
+        self.run_function(f, frame, env, host)
     }
 
     #[inline(never)]
-    fn run_function(&mut self, f: &'p Function, frame: &mut [Value], env: &mut Env) -> R<Value> {
+    fn run_function(
+        &mut self,
+        f: &'p Function,
+        frame: &mut [Value],
+        env: &mut Env,
+        host: &mut (dyn Host + Send),
+    ) -> R<Value> {
         let mut sink = NoSink;
         let mut cx = Cx {
             frame,
             env,
-            host: &mut NoHost,
+            host,
             sink: &mut sink,
         };
         self.ret = None;
@@ -1025,7 +1117,7 @@ fn batch(b: Batch) -> Value {
 struct Cx<'a> {
     frame: &'a mut [Value],
     env: &'a mut Env,
-    host: &'a mut dyn Host,
+    host: &'a mut (dyn Host + Send),
     sink: &'a mut dyn Emit,
 }
 
@@ -1146,6 +1238,14 @@ pub fn binary(op: BinOp, x: Value, y: Value) -> Result<Value, String> {
     let x = if let Bool(b) = x { Int(b as i64) } else { x };
     let y = if let Bool(b) = y { Int(b as i64) } else { y };
     Ok(match (op, x, y) {
+        // Elements: by identity (not by the flags of how they were read),
+        // ordered by id.
+        (Eq, Elem(a), Elem(b)) => Bool(a.kind == b.kind && a.ids == b.ids),
+        (Ne, Elem(a), Elem(b)) => Bool(!(a.kind == b.kind && a.ids == b.ids)),
+        (Lt, Elem(a), Elem(b)) => Bool(a.ids[0] < b.ids[0]),
+        (Le, Elem(a), Elem(b)) => Bool(a.ids[0] <= b.ids[0]),
+        (Gt, Elem(a), Elem(b)) => Bool(a.ids[0] > b.ids[0]),
+        (Ge, Elem(a), Elem(b)) => Bool(a.ids[0] >= b.ids[0]),
         (Add, Int(a), Int(b)) => Int(a.wrapping_add(b)),
         (Sub, Int(a), Int(b)) => Int(a.wrapping_sub(b)),
         (Mul, Int(a), Int(b)) => Int(a.wrapping_mul(b)),

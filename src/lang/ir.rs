@@ -4,7 +4,7 @@
 //! list of [`Pattern`]s per role; the topology that matches it (a word today,
 //! a mesh later) lives in `rewrite`.
 
-use crate::syntax::ast::{BinOp, ContextKind, ControlKind, Section};
+use crate::syntax::ast::{BinOp, ContextKind, ControlKind, Section, SetEditOp};
 use crate::syntax::span::Span;
 
 use super::modules::{Alphabet, Sym};
@@ -186,6 +186,21 @@ pub enum St {
         default: Option<u32>,
         body: Vec<St>,
     },
+    /// vv's `forall x in S`: local `slot` takes each member of the set (or
+    /// neighbour of the vertex) that `set` gives, as the topology lists
+    /// them when the loop starts; `break` and `continue` as in C.
+    ForAll {
+        slot: u16,
+        set: Ex,
+        body: Box<St>,
+        span: Span,
+    },
+    /// vv's `add`, `remove`, `merge`: the set at `place` changed in place.
+    SetEdit {
+        place: Place,
+        op: SetEditOp,
+        elem: Ex,
+    },
 }
 
 /// A successor module: a symbol and argument expressions of its types.
@@ -317,6 +332,24 @@ pub struct Program {
     /// `float` is single precision (lpfg's): what the turtle writes into
     /// `float` parameters (query modules' answers) is rounded to it.
     pub single: bool,
+    /// The properties a vv program declares (`vertex float conc = 1;`),
+    /// in the order of their numbers after each owner's built-in ones.
+    pub properties: Vec<PropertyDef>,
+}
+
+/// A declared property of every element of an owner (vertex, edge, mesh).
+#[derive(Clone, Debug)]
+pub struct PropertyDef {
+    /// The owner's number in the topology's `HostProperties::owners`.
+    pub owner: u8,
+    pub name: String,
+    pub ty: Ty,
+    /// Its number among its owner's properties (built-in ones first).
+    pub index: u16,
+    /// The value every new element starts with (the type's zero without
+    /// an initialiser), a constant expression.
+    pub init: Ex,
+    pub span: Span,
 }
 
 impl Program {

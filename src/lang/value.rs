@@ -116,6 +116,86 @@ pub enum Value {
     Void,
     /// An element of a topology, as its topology captured it.
     Elem(Elem),
+    /// A set of a topology's elements held by value (vv's `mesh S`),
+    /// shared until one holder changes it.
+    Set(std::sync::Arc<IdSet>),
+}
+
+/// A set of element ids (vertex ids of a vv program's `mesh`): the ids in
+/// the order they were added, each once, with a bitmap for membership.
+/// Adding and testing are O(1); removing is O(n).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct IdSet {
+    items: Vec<u32>,
+    bits: Vec<u64>,
+}
+
+impl IdSet {
+    pub fn new() -> IdSet {
+        IdSet::default()
+    }
+
+    /// The ids, in the order they were added.
+    pub fn ids(&self) -> &[u32] {
+        &self.items
+    }
+
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    pub fn contains(&self, id: u32) -> bool {
+        self.bits
+            .get(id as usize / 64)
+            .is_some_and(|w| w & (1 << (id % 64)) != 0)
+    }
+
+    /// Adds `id`; false when it was there.
+    pub fn insert(&mut self, id: u32) -> bool {
+        if self.contains(id) {
+            return false;
+        }
+        let w = id as usize / 64;
+        if w >= self.bits.len() {
+            self.bits.resize(w + 1, 0);
+        }
+        self.bits[w] |= 1 << (id % 64);
+        self.items.push(id);
+        true
+    }
+
+    /// Removes `id`; false when it was not there.
+    pub fn remove(&mut self, id: u32) -> bool {
+        if !self.contains(id) {
+            return false;
+        }
+        self.bits[id as usize / 64] &= !(1 << (id % 64));
+        if let Some(i) = self.items.iter().position(|&x| x == id) {
+            self.items.remove(i);
+        }
+        true
+    }
+
+    /// Adds the ids of `other` that are not here, in its order.
+    pub fn merge(&mut self, other: &IdSet) {
+        for &id in &other.items {
+            self.insert(id);
+        }
+    }
+}
+
+impl FromIterator<u32> for IdSet {
+    fn from_iter<I: IntoIterator<Item = u32>>(iter: I) -> IdSet {
+        let mut s = IdSet::new();
+        for id in iter {
+            s.insert(id);
+        }
+        s
+    }
 }
 
 /// An element of a topology (a mesh vertex, edge or face, a set of them):
@@ -236,6 +316,7 @@ impl fmt::Display for Value {
             Value::Str(s) => write!(f, "\"{s}\""),
             Value::Void => f.write_str("void"),
             Value::Elem(e) => write!(f, "element {}", e.ids[0]),
+            Value::Set(s) => write!(f, "a set of {} elements", s.len()),
         }
     }
 }
@@ -336,7 +417,7 @@ pub fn encode(v: &Value, out: &mut Vec<f64>) {
         Value::V3(p) => out.extend_from_slice(&[p.x, p.y, p.z]),
         Value::Struct(fs) => fs.iter().for_each(|f| encode(f, out)),
         Value::Str(s) => out.push(f64::from_bits(intern(s) as u64)),
-        Value::Void | Value::Elem(_) => {}
+        Value::Void | Value::Elem(_) | Value::Set(_) => {}
     }
 }
 

@@ -12,7 +12,7 @@
 //! linear however deeply branches nest and however long the runs; without
 //! tables (the new word, still being built) the modules are walked.
 
-use std::cell::OnceCell;
+use std::sync::OnceLock as OnceCell;
 
 use crate::lang::ir::{Filter, Pattern};
 use crate::lang::Sym;

@@ -323,6 +323,10 @@ pub static SURFACE_HOST: HostTable = HostTable {
     ],
     arith: |k| (k == VERTEX).then_some((Func::Host(id::POS), Ty::V3d)),
     members: |k| (k == SET).then_some(VERTEX),
+    types: &[],
+    zero: |_| Value::Void,
+    fresh: |_| None,
+    properties: None,
 };
 
 /// The mesh as a rule's expressions see it while the rule runs.

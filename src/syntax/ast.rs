@@ -100,6 +100,15 @@ pub enum Item {
         name: Option<Name>,
         variants: Vec<(Name, Option<Expr>)>,
     },
+    /// A vv program's property of every vertex, directed edge or of the
+    /// mesh: `vertex float conc = 1;`, `edge int kind;`, `mesh int cells;`.
+    Property {
+        /// `vertex`, `edge` or `mesh`.
+        owner: Name,
+        ty: TypeRef,
+        name: Name,
+        init: Option<Expr>,
+    },
 }
 
 /// An enum's enumerators, each with its value if one is written.
@@ -173,6 +182,8 @@ pub enum ControlKind {
     StartEach,
     EndEach,
     End,
+    /// A vv program's `Step: { ... }`, once per derivation step.
+    Step,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -295,7 +306,31 @@ pub enum Stmt {
     Case(Expr, Span),
     /// `default:`, a label directly in a `switch`'s body.
     Default(Span),
+    /// vv's `forall x in S body`: `var` takes each member of the set (or
+    /// each neighbour of the vertex) `set` holds when the loop starts.
+    Forall {
+        var: Name,
+        set: Expr,
+        body: Box<Stmt>,
+        span: Span,
+    },
+    /// vv's `add v to S;`, `remove v from S;`, `merge S with T;`: the set
+    /// `set` (a variable) changed in place by `elem`.
+    SetEdit {
+        op: SetEditOp,
+        elem: Expr,
+        set: Expr,
+        span: Span,
+    },
     Empty,
+}
+
+/// What a [`Stmt::SetEdit`] does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SetEditOp {
+    Add,
+    Remove,
+    Merge,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -403,6 +438,8 @@ pub enum ExprKind {
         set: Box<Expr>,
         cond: Option<Box<Expr>>,
     },
+    /// vv's `v$pos`, `(p, q)$w`, `mesh$cells`: a property of an element.
+    Prop(Box<Expr>, Name),
 }
 
 /// `define f(a, b) = expr;`: a function whose body is inlined at each

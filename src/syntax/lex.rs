@@ -296,6 +296,20 @@ fn char_lit(i: &str) -> Result<(&str, i64), (usize, String)> {
     }
 }
 
+/// True when the `'` that starts `i` is a prime before a name (vv's `'v`,
+/// the old state of vertex `v`): a name follows that is not closed by a
+/// `'` as a character constant (`'a'`) would be.
+fn is_prime(i: &str) -> bool {
+    let name = i[1..]
+        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .unwrap_or(i.len() - 1);
+    let starts = i[1..]
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
+    starts && !i[1 + name..].starts_with('\'')
+}
+
 fn punct(i: &str) -> IResult<&str, &'static str> {
     match PUNCTS.iter().find(|p| i.starts_with(**p)) {
         Some(p) => Ok((&i[p.len()..], p)),
@@ -398,6 +412,9 @@ pub fn lex_all(file: FileId, text: &str) -> Result<Lexed, Diagnostic> {
                     continue;
                 }
             }
+        } else if rest.starts_with('\'') && is_prime(rest) {
+            // vv's `'v$pos`: the prime before a name, not a character.
+            (&rest[1..], Tok::Punct("'"))
         } else if rest.starts_with('\'') {
             match char_lit(rest) {
                 Ok((r, code)) => (r, Tok::Int(code)),
@@ -474,9 +491,14 @@ mod tests {
         for (text, want) in cases {
             assert_eq!(one(text), Ok(Tok::Int(want)), "{text}");
         }
-        for bad in ["'ab'", "''", "'\\q'", "'\\x123'", "'é'", "'a"] {
+        for bad in ["'ab'", "''", "'\\q'", "'\\x123'", "'é'"] {
             assert!(one(bad).is_err(), "{bad}");
         }
+        // A `'` before a name that no `'` closes is vv's prime (`'v$pos`),
+        // for the parser to accept or refuse.
+        let toks = lex(FileId(0), "'a$pos").unwrap();
+        assert_eq!(toks[0].tok, Tok::Punct("'"));
+        assert_eq!(toks[1].tok, Tok::Ident("a".into()));
     }
 
     fn float(value: f64, single: bool) -> Tok {

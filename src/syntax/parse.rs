@@ -15,6 +15,9 @@ const TYPE_KEYWORDS: &[&str] = &[
     "short", "signed", "void", "FILE", "size_t",
 ];
 
+/// The types a vv program adds.
+const VV_TYPES: &[&str] = &["vertex", "mesh"];
+
 /// Words that may come before a declaration's type and mean nothing here.
 const QUALIFIERS: &[&str] = &[
     "static", "inline", "extern", "const", "register", "volatile",
@@ -42,6 +45,9 @@ pub struct Parser<'t> {
     /// Declared and predefined module names: a line that starts with one
     /// is a production, not a declaration (`B P(vl) < P(v) : ...`).
     module_names: HashSet<String>,
+    /// A vertex-vertex program (paper 001): `vertex` and `mesh` are types,
+    /// and vv's statements and expressions are read.
+    vv: bool,
     eof: Span,
 }
 
@@ -71,6 +77,7 @@ impl<'t> Parser<'t> {
             peak: 0,
             type_names: HashSet::new(),
             module_names: HashSet::new(),
+            vv: false,
             eof,
         }
     }
@@ -101,6 +108,11 @@ fn scoped_names(toks: &[Token]) -> Vec<Token> {
 }
 
 pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<File> {
+    parse_file_as(toks, eof, predefined, false)
+}
+
+/// Parses a file, as a vertex-vertex program when `vv` is set.
+pub fn parse_file_as(toks: &[Token], eof: Span, predefined: &[&str], vv: bool) -> PResult<File> {
     let scoped;
     let toks = if toks.iter().any(|t| t.tok.is_punct("::")) {
         scoped = scoped_names(toks);
@@ -130,7 +142,12 @@ pub fn parse_file(toks: &[Token], eof: Span, predefined: &[&str]) -> PResult<Fil
         split_last: None,
         depth: 0,
         peak: 0,
-        type_names: HashSet::new(),
+        type_names: if vv {
+            VV_TYPES.iter().map(|s| s.to_string()).collect()
+        } else {
+            HashSet::new()
+        },
+        vv,
         eof,
     };
     let mut items = Vec::new();
@@ -424,12 +441,15 @@ impl<'t> Parser<'t> {
                     });
                     return Ok(());
                 }
-                "Start" | "StartEach" | "EndEach" | "End" if next_colon => {
+                "Start" | "StartEach" | "EndEach" | "End" | "Step"
+                    if next_colon && (word != "Step" || self.vv) =>
+                {
                     self.pos += 2;
                     let kind = match word.as_str() {
                         "Start" => ControlKind::Start,
                         "StartEach" => ControlKind::StartEach,
                         "EndEach" => ControlKind::EndEach,
+                        "Step" => ControlKind::Step,
                         _ => ControlKind::End,
                     };
                     let body = self.block()?;
@@ -440,6 +460,15 @@ impl<'t> Parser<'t> {
                         span: start,
                     });
                     return Ok(());
+                }
+                "vertex" | "edge" | "mesh"
+                    if self.vv
+                        && self.peek_at(1).is_some_and(|t| match &t.tok {
+                            Tok::Ident(n) => self.is_type_name(n),
+                            _ => false,
+                        }) =>
+                {
+                    return self.property(items);
                 }
                 _ => {}
             }
@@ -461,6 +490,26 @@ impl<'t> Parser<'t> {
         }
         let prod = self.production()?;
         items.push(Item::Production(prod));
+        Ok(())
+    }
+
+    /// property := ('vertex' | 'edge' | 'mesh') TYPE NAME [ '=' expr ] ';'
+    fn property(&mut self, items: &mut Vec<Item>) -> PResult<()> {
+        let owner = self.name("vertex, edge or mesh")?;
+        let ty = self.type_ref()?;
+        let name = self.name("the property's name")?;
+        let init = if self.eat_punct("=") {
+            Some(self.expr()?)
+        } else {
+            None
+        };
+        self.expect_punct(";", "after the property")?;
+        items.push(Item::Property {
+            owner,
+            ty,
+            name,
+            init,
+        });
         Ok(())
     }
 
@@ -1624,6 +1673,11 @@ impl<'t> Parser<'t> {
                 }
                 _ => {}
             }
+            if self.vv {
+                if let Some(s) = self.vv_stmt(w)? {
+                    return Ok(s);
+                }
+            }
             if self.at_declaration() {
                 let d = self.var_decl()?;
                 self.expect_punct(";", "after the declaration")?;
@@ -1635,6 +1689,151 @@ impl<'t> Parser<'t> {
             self.expect_punct(";", "after the expression")?;
         }
         Ok(Stmt::Expr(e))
+    }
+
+    /// The statements of the vertex-vertex algebra (paper 001, Tables 1
+    /// and 2), when `word` at the cursor starts one:
+    ///
+    /// ```text
+    /// forall NAME in expr stmt        add expr to expr ;
+    /// remove expr from expr ;          merge expr with expr ;
+    /// synchronize expr ;               make '{' expr {',' expr} '}' nb_of expr ;
+    /// erase expr from expr ;           replace expr with expr in expr ;
+    /// splice expr (after | before) expr in expr ;
+    /// ```
+    ///
+    /// The editing statements are calls of the topology's built-ins
+    /// (`make(v, a, b, c)`, `erase(x, v)`, …). A word followed by `(` or an
+    /// assignment is not a keyword here. Out of `stmt_inner`, so that its
+    /// frame stays small.
+    #[inline(never)]
+    fn vv_stmt(&mut self, w: &str) -> PResult<Option<Stmt>> {
+        let next = self.peek_at(1).map(|t| &t.tok);
+        let operand = matches!(next, Some(Tok::Ident(_)) | Some(Tok::Punct("'")))
+            || (w == "make" && matches!(next, Some(Tok::Punct("{"))));
+        if !operand {
+            return Ok(None);
+        }
+        let span = self.span_here();
+        let call = |name: &str, args: Vec<Expr>, end: Span| {
+            Stmt::Expr(Expr {
+                kind: ExprKind::Call(
+                    Name {
+                        text: name.into(),
+                        span,
+                    },
+                    args,
+                ),
+                span: span.to(end),
+            })
+        };
+        let s = match w {
+            "forall" => {
+                self.pos += 1;
+                let var = self.name("the loop variable after `forall`")?;
+                if !self.eat_ident("in") {
+                    return self.error("`in` after `forall x`");
+                }
+                let set = self.expr()?;
+                let body = Box::new(self.stmt_or_end()?);
+                return Ok(Some(Stmt::Forall {
+                    var,
+                    set,
+                    body,
+                    span,
+                }));
+            }
+            "add" | "remove" | "merge" => {
+                self.pos += 1;
+                let elem = self.expr()?;
+                let (op, word) = match w {
+                    "add" => (SetEditOp::Add, "to"),
+                    "remove" => (SetEditOp::Remove, "from"),
+                    _ => (SetEditOp::Merge, "with"),
+                };
+                if !self.eat_ident(word) {
+                    return self.error(&format!("`{word}` in `{w} ... {word} ...`"));
+                }
+                // `merge S with T` changes S: the set edited comes first.
+                let other = self.expr()?;
+                let (elem, set) = if op == SetEditOp::Merge {
+                    (other, elem)
+                } else {
+                    (elem, other)
+                };
+                Stmt::SetEdit {
+                    op,
+                    elem,
+                    set,
+                    span,
+                }
+            }
+            "synchronize" => {
+                self.pos += 1;
+                let set = self.expr()?;
+                call("synchronize", vec![set], self.prev_span())
+            }
+            "make" => {
+                self.pos += 1;
+                self.expect_punct(
+                    "{",
+                    "after `make`: the neighbours, as in `make {a, b, c} nb_of v`",
+                )?;
+                let mut args = vec![];
+                let mut list = self.args("}")?;
+                if !self.eat_ident("nb_of") {
+                    return self
+                        .error("`nb_of` after the neighbour list, as in `make {a, b, c} nb_of v`");
+                }
+                args.push(self.expr()?);
+                args.append(&mut list);
+                call("make", args, self.prev_span())
+            }
+            "erase" => {
+                self.pos += 1;
+                let x = self.expr()?;
+                if !self.eat_ident("from") {
+                    return self.error("`from` in `erase x from v`");
+                }
+                let v = self.expr()?;
+                call("erase", vec![x, v], self.prev_span())
+            }
+            "replace" => {
+                self.pos += 1;
+                let a = self.expr()?;
+                if !self.eat_ident("with") {
+                    return self.error("`with` in `replace a with x in v`");
+                }
+                let x = self.expr()?;
+                if !self.eat_ident("in") {
+                    return self.error("`in` in `replace a with x in v`");
+                }
+                let v = self.expr()?;
+                call("replace", vec![a, x, v], self.prev_span())
+            }
+            "splice" => {
+                self.pos += 1;
+                let x = self.expr()?;
+                let name = if self.eat_ident("after") {
+                    "splice_after"
+                } else if self.eat_ident("before") {
+                    "splice_before"
+                } else {
+                    return self.error("`after` or `before` in `splice x after a in v`");
+                };
+                let a = self.expr()?;
+                if !self.eat_ident("in") {
+                    return self.error("`in` in `splice x after a in v`");
+                }
+                let v = self.expr()?;
+                call(name, vec![x, a, v], self.prev_span())
+            }
+            _ => return Ok(None),
+        };
+        if !self.peek_punct("}") {
+            self.expect_punct(";", &format!("after the `{w}` statement"))?;
+        }
+        Ok(Some(s))
     }
 
     /// switch := 'switch' expr ( '{' { stmt } '}' | { label } stmt ), whose
@@ -1812,6 +2011,11 @@ impl<'t> Parser<'t> {
                 span,
             });
         }
+        if self.vv {
+            if let Some(e) = self.vv_query()? {
+                return Ok(e);
+            }
+        }
         if t.tok.is_punct("++") || t.tok.is_punct("--") {
             self.pos += 1;
             let e = self.unary()?;
@@ -1850,6 +2054,52 @@ impl<'t> Parser<'t> {
         self.postfix()
     }
 
+    /// The query and selection operations of the vertex-vertex algebra,
+    /// when one starts at the cursor: `is x in v`, `valence v`, `any in
+    /// v`, `nextto x in v`, `prevto x in v`, each a call of the topology's
+    /// built-in (`is_in(x, v)`, `valence(v)`, …); their operands are unary
+    /// expressions. A word followed by `(` is a plain call.
+    #[inline(never)]
+    fn vv_query(&mut self) -> PResult<Option<Expr>> {
+        let Some(Tok::Ident(w)) = self.peek().map(|t| &t.tok) else {
+            return Ok(None);
+        };
+        let name = match w.as_str() {
+            "is" => "is_in",
+            "valence" => "valence",
+            "any" => "any",
+            "nextto" => "nextto",
+            "prevto" => "prevto",
+            _ => return Ok(None),
+        };
+        let next = self.peek_at(1).map(|t| &t.tok);
+        if !matches!(next, Some(Tok::Ident(_)) | Some(Tok::Punct("'"))) {
+            return Ok(None);
+        }
+        let span = self.bump().span;
+        let mut args = Vec::new();
+        if name != "any" {
+            args.push(self.unary()?);
+        }
+        if name != "valence" && !self.eat_ident("in") {
+            return self.error(&format!("`in` in `{w} ... in v`"));
+        }
+        if name != "valence" {
+            args.push(self.unary()?);
+        }
+        let end = self.prev_span();
+        Ok(Some(Expr {
+            kind: ExprKind::Call(
+                Name {
+                    text: name.into(),
+                    span,
+                },
+                args,
+            ),
+            span: span.to(end),
+        }))
+    }
+
     /// postfix := primary { '.' NAME [ '(' args ')' ] | '++' | '--' }, a
     /// left-deep chain like a binary operator's.
     fn postfix(&mut self) -> PResult<Expr> {
@@ -1864,7 +2114,16 @@ impl<'t> Parser<'t> {
             {
                 reached = self.wrap(reached, self.span_here())?;
             }
-            if self.peek_punct("[") {
+            if self.vv && self.peek_punct("$") {
+                reached = self.wrap(reached, self.span_here())?;
+                self.pos += 1;
+                let name = self.name("a property name after `$`, as in `v$pos`")?;
+                let span = e.span.to(name.span);
+                e = Expr {
+                    kind: ExprKind::Prop(Box::new(e), name),
+                    span,
+                };
+            } else if self.peek_punct("[") {
                 let (indexed, r) = self.index_of(e)?;
                 e = indexed;
                 reached = reached.max(r);
@@ -1944,6 +2203,40 @@ impl<'t> Parser<'t> {
             Tok::Str(s) => {
                 self.pos += 1;
                 ExprKind::Str(s.clone())
+            }
+            Tok::Punct("'") if self.vv => {
+                // `'v`: the vertex as the last `synchronize` left it.
+                self.pos += 1;
+                let v = self.primary()?;
+                ExprKind::Call(
+                    Name {
+                        text: "old".into(),
+                        span,
+                    },
+                    vec![v],
+                )
+            }
+            Tok::Punct("(") if self.vv => {
+                // `(p, q)`: the directed edge from p to q, as in `(p, q)$w`.
+                self.pos += 1;
+                let e = self.expr()?;
+                if self.eat_punct(",") {
+                    let f = self.expr()?;
+                    self.expect_punct(")", "to close the edge `(p, q)`")?;
+                    ExprKind::Call(
+                        Name {
+                            text: "edge".into(),
+                            span,
+                        },
+                        vec![e, f],
+                    )
+                } else {
+                    self.expect_punct(")", "to close the parenthesis")?;
+                    return Ok(Expr {
+                        kind: e.kind,
+                        span: span.to(self.prev_span()),
+                    });
+                }
             }
             Tok::Punct("(") => {
                 self.pos += 1;

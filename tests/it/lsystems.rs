@@ -14,6 +14,8 @@
 //!   ([`canonical_obj`]), and the counts, levels and valences that
 //!   `subgram derive FILE` prints as `NAME.txt`; the grammars with boundary
 //!   rules also run on `meshes/grid.obj`, as `NAME-on-grid.obj`;
+//! * a vv program (`vv/*.lsys`): as a surface grammar; those with boundary
+//!   rules also run on `meshes/pentagon-patch.obj`, as `NAME-on-patch.obj`;
 //! * a base mesh (`meshes/*.obj`): `subgram mesh info FILE` as `NAME.txt`.
 //!
 //! Regenerate with `UPDATE_GOLDEN=1 cargo test --test it lsystems::`.
@@ -26,11 +28,14 @@ use crate::support::root;
 
 /// The folders of `lsystems/`, each checked by its own test below.
 const FOLDERS: &[&str] = &[
-    "abop", "curves", "figures", "lplusc", "meshes", "paper", "reverse", "surfaces",
+    "abop", "curves", "figures", "lplusc", "meshes", "paper", "reverse", "surfaces", "vv",
 ];
 
 /// Surface grammars with boundary rules, run on the open grid as well.
 const ON_GRID: &[&str] = &["catmull-clark", "four-eight", "loop", "sqrt3"];
+
+/// vv programs with boundary rules, run on the open triangle patch as well.
+const ON_PATCH: &[&str] = &["butterfly", "loop", "sqrt3"];
 
 /// The golden files of `lsystems/REL`, with how each is compared; `None`
 /// for a file no rule covers.
@@ -41,10 +46,13 @@ fn goldens(rel: &Path) -> Option<Vec<(PathBuf, Kind)>> {
     let with = |suffix: &str| base.with_file_name(format!("{stem}{suffix}"));
     match (folder, rel.extension()?.to_str()?) {
         ("meshes", "obj") => Some(vec![(with(".txt"), Kind::Exact)]),
-        ("surfaces", "lsys") => {
+        ("surfaces" | "vv", "lsys") => {
             let mut v = vec![(with(".obj"), Kind::Numeric), (with(".txt"), Kind::Exact)];
-            if ON_GRID.contains(&stem) {
+            if folder == "surfaces" && ON_GRID.contains(&stem) {
                 v.push((with("-on-grid.obj"), Kind::Numeric));
+            }
+            if folder == "vv" && ON_PATCH.contains(&stem) {
+                v.push((with("-on-patch.obj"), Kind::Numeric));
             }
             Some(v)
         }
@@ -138,7 +146,7 @@ fn outputs(rel: &Path) -> Result<Vec<Vec<u8>>, String> {
     if folder == "meshes" {
         return Ok(vec![subgram(&["mesh", "info", f])?]);
     }
-    if folder != "surfaces" {
+    if folder != "surfaces" && folder != "vv" {
         let json: serde_json::Value =
             serde_json::from_slice(&subgram(&["derive", f, "--format", "json"])?)
                 .map_err(|e| format!("{f}: the JSON word does not parse: {e}"))?;
@@ -161,10 +169,16 @@ fn outputs(rel: &Path) -> Result<Vec<Vec<u8>>, String> {
         subdivide(None, &format!("{stem}.obj"))?,
         subgram(&["derive", f])?,
     ];
-    if ON_GRID.contains(&stem) {
+    if folder == "surfaces" && ON_GRID.contains(&stem) {
         v.push(subdivide(
             Some("lsystems/meshes/grid.obj"),
             &format!("{stem}-on-grid.obj"),
+        )?);
+    }
+    if folder == "vv" && ON_PATCH.contains(&stem) {
+        v.push(subdivide(
+            Some("lsystems/meshes/pentagon-patch.obj"),
+            &format!("{stem}-on-patch.obj"),
         )?);
     }
     Ok(v)
@@ -248,6 +262,11 @@ fn reverse() {
 #[test]
 fn surfaces() {
     check_folder("surfaces");
+}
+
+#[test]
+fn vv() {
+    check_folder("vv");
 }
 
 /// No file of `lsystems/` escapes the tests above, and no golden file is

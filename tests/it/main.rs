@@ -31,3 +31,4 @@ mod semantics;
 mod support;
 mod surface;
 mod surface_quad;
+mod vv;

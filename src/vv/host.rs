@@ -1,0 +1,547 @@
+//! The rotation-system topology as the language sees it: vertices, sets of
+//! vertices (`mesh S`), directed edges and the mesh itself as element
+//! values; the vertex-vertex algebra of paper 001 (Tables 1 and 2) as host
+//! built-ins in one table beside the library's maths; properties read
+//! `v$pos` and written `v$pos = x`. Bodies are checked by `lang::compile`
+//! and run by `lang::eval` against a [`VvHost`].
+//!
+//! The parser reads vv's statements as calls of these built-ins: `make {a,
+//! b} nb_of v` is `make(v, a, b)`, `nextto x in v` is `nextto(x, v)`, `'v`
+//! is `old(v)`, `(p, q)` is `edge(p, q)`.
+
+use glam::{DVec2, DVec3};
+
+use crate::lang::builtins::{Builtin, HostProperties, HostTable, SigError};
+use crate::lang::eval::Host;
+use crate::lang::ir::Func;
+use crate::lang::value::{Elem, IdSet, Ty, Value};
+
+use super::mesh::{Rotation, NULL};
+
+/// Element kinds.
+pub const VERTEX: u8 = 0;
+/// A set of vertices, vv's `mesh` type.
+pub const SET: u8 = 1;
+/// A directed edge `(p, q)`.
+pub const EDGE: u8 = 2;
+/// The mesh as a whole, `mesh$name`.
+pub const MESH: u8 = 3;
+
+/// A vertex read as `'v`: its state at the last `synchronize`.
+const OLD: u8 = 1;
+
+/// Host built-in numbers.
+pub mod id {
+    pub const NEW: u16 = 0;
+    pub const OLD: u16 = 1;
+    pub const VALENCE: u16 = 2;
+    pub const IS_IN: u16 = 3;
+    pub const ANY: u16 = 4;
+    pub const NEXTTO: u16 = 5;
+    pub const PREVTO: u16 = 6;
+    pub const MAKE: u16 = 7;
+    pub const ERASE: u16 = 8;
+    pub const REPLACE: u16 = 9;
+    pub const SPLICE_AFTER: u16 = 10;
+    pub const SPLICE_BEFORE: u16 = 11;
+    pub const SYNCHRONIZE: u16 = 12;
+    pub const EDGE: u16 = 13;
+    pub const CHECK: u16 = 14;
+    pub const GET: u16 = 15;
+    pub const SET: u16 = 16;
+    pub const NULL: u16 = 17;
+    pub const MESH: u16 = 18;
+    pub const BOUNDARY: u16 = 19;
+    pub const SIZE: u16 = 20;
+}
+
+const V: Ty = Ty::Elem(VERTEX);
+
+/// The vertex with id `v` (and the generation of its slot).
+pub fn vertex(v: u32, gen: u32) -> Value {
+    Value::Elem(Elem {
+        kind: VERTEX,
+        flags: 0,
+        ids: [v, gen, 0, 0],
+    })
+}
+
+/// The null vertex.
+pub fn null() -> Value {
+    vertex(NULL, 0)
+}
+
+/// Checks that every argument is a vertex.
+fn vertices(a: &[Ty], n: usize, usage: &str) -> Result<(), SigError> {
+    if a.len() != n {
+        return Err(SigError::Arity(n));
+    }
+    if a.iter().all(|t| *t == V) {
+        Ok(())
+    } else {
+        Err(SigError::Message(usage.into()))
+    }
+}
+
+macro_rules! vv {
+    ($name:literal, $n:expr, $id:expr, $ty:expr, $usage:literal) => {
+        Builtin {
+            name: $name,
+            resolve: |a| {
+                vertices(a, $n, $usage)?;
+                Ok((Func::Host($id), $ty))
+            },
+        }
+    };
+}
+
+static FUNCTIONS: &[Builtin] = &[
+    vv!("$new", 0, id::NEW, V, "`vertex v;` creates a vertex"),
+    vv!("old", 1, id::OLD, V, "`'v` (or `old(v)`) takes a vertex"),
+    vv!(
+        "valence",
+        1,
+        id::VALENCE,
+        Ty::Int,
+        "`valence v` takes a vertex"
+    ),
+    vv!(
+        "is_in",
+        2,
+        id::IS_IN,
+        Ty::Bool,
+        "`is x in v` takes two vertices"
+    ),
+    vv!("any", 1, id::ANY, V, "`any in v` takes a vertex"),
+    vv!(
+        "nextto",
+        2,
+        id::NEXTTO,
+        V,
+        "`nextto x in v` takes two vertices"
+    ),
+    vv!(
+        "prevto",
+        2,
+        id::PREVTO,
+        V,
+        "`prevto x in v` takes two vertices"
+    ),
+    Builtin {
+        name: "make",
+        resolve: |a| {
+            if a.is_empty() || a.iter().any(|t| *t != V) {
+                return Err(SigError::Message(
+                    "`make {a, b, c} nb_of v` takes vertices".into(),
+                ));
+            }
+            Ok((Func::Host(id::MAKE), Ty::Void))
+        },
+    },
+    vv!(
+        "erase",
+        2,
+        id::ERASE,
+        Ty::Void,
+        "`erase x from v` takes two vertices"
+    ),
+    vv!(
+        "replace",
+        3,
+        id::REPLACE,
+        Ty::Void,
+        "`replace a with x in v` takes three vertices"
+    ),
+    vv!(
+        "splice_after",
+        3,
+        id::SPLICE_AFTER,
+        Ty::Void,
+        "`splice x after a in v` takes three vertices"
+    ),
+    vv!(
+        "splice_before",
+        3,
+        id::SPLICE_BEFORE,
+        Ty::Void,
+        "`splice x before a in v` takes three vertices"
+    ),
+    Builtin {
+        name: "synchronize",
+        resolve: |a| match a {
+            [Ty::Elem(SET)] => Ok((Func::Host(id::SYNCHRONIZE), Ty::Void)),
+            [_] => Err(SigError::Message(
+                "`synchronize S` takes a set of vertices (a `mesh`)".into(),
+            )),
+            _ => Err(SigError::Arity(1)),
+        },
+    },
+    Builtin {
+        name: "check",
+        resolve: |a| match a {
+            [Ty::Elem(SET)] => Ok((Func::Host(id::CHECK), Ty::Void)),
+            [_] => Err(SigError::Message(
+                "`check(S)` takes a set of vertices (a `mesh`)".into(),
+            )),
+            _ => Err(SigError::Arity(1)),
+        },
+    },
+    Builtin {
+        name: "size",
+        resolve: |a| match a {
+            [Ty::Elem(SET)] => Ok((Func::Host(id::SIZE), Ty::Int)),
+            [_] => Err(SigError::Message(
+                "`size(S)` takes a set of vertices (a `mesh`)".into(),
+            )),
+            _ => Err(SigError::Arity(1)),
+        },
+    },
+    vv!(
+        "edge",
+        2,
+        id::EDGE,
+        Ty::Elem(EDGE),
+        "`(p, q)` takes two vertices"
+    ),
+    vv!(
+        "boundary",
+        1,
+        id::BOUNDARY,
+        Ty::Bool,
+        "`boundary(v)` takes a vertex"
+    ),
+];
+
+static PROPERTIES: HostProperties = HostProperties {
+    owners: &["vertex", "edge", "mesh"],
+    owner_of: |k| match k {
+        VERTEX => Some(0),
+        EDGE => Some(1),
+        MESH => Some(2),
+        _ => None,
+    },
+    builtin: &[(0, "pos", Ty::V3d)],
+    get: id::GET,
+    set: id::SET,
+};
+
+/// The vertex-vertex topology's table.
+pub static VV_HOST: HostTable = HostTable {
+    name: "vv program",
+    elements: &["a vertex", "a set of vertices", "an edge", "the mesh"],
+    functions: FUNCTIONS,
+    values: &[
+        ("null", Func::Host(id::NULL), V),
+        ("mesh", Func::Host(id::MESH), Ty::Elem(MESH)),
+    ],
+    arith: |_| None,
+    members: |k| match k {
+        SET | VERTEX => Some(VERTEX),
+        _ => None,
+    },
+    types: &[("vertex", VERTEX), ("mesh", SET)],
+    zero: |k| match k {
+        VERTEX => null(),
+        SET => Value::Set(Default::default()),
+        _ => Value::Void,
+    },
+    fresh: |k| (k == VERTEX).then_some(Func::Host(id::NEW)),
+    properties: Some(&PROPERTIES),
+};
+
+/// How a declared property's value is stored: its type, its first slot
+/// in its owner's row and its width.
+#[derive(Clone, Copy, Debug)]
+pub struct Layout {
+    pub ty: Ty,
+    pub index: usize,
+}
+
+/// The properties of a program, by owner (vertex, edge, mesh), in the
+/// order of their numbers after the built-in ones; `index` is the mesh's
+/// number of the property.
+#[derive(Clone, Debug, Default)]
+pub struct Layouts {
+    pub vertex: Vec<Layout>,
+    pub edge: Vec<Layout>,
+    pub mesh: Vec<Layout>,
+}
+
+/// The number of `f64`s a property of type `ty` takes.
+pub fn width(ty: Ty) -> usize {
+    match ty {
+        Ty::V2 | Ty::V2d => 2,
+        Ty::V3 | Ty::V3d => 3,
+        _ => 1,
+    }
+}
+
+/// A value of a property's type as slots.
+pub fn encode(v: &Value, out: &mut [f64]) {
+    match v {
+        Value::Int(i) => out[0] = *i as f64,
+        Value::Float(f) => out[0] = *f,
+        Value::Bool(b) => out[0] = *b as u8 as f64,
+        Value::V2(p) => out[..2].copy_from_slice(&[p.x, p.y]),
+        Value::V3(p) => out[..3].copy_from_slice(&[p.x, p.y, p.z]),
+        _ => {}
+    }
+}
+
+/// Slots as a value of type `ty`.
+pub fn decode(ty: Ty, s: &[f64]) -> Value {
+    match ty {
+        Ty::Int => Value::Int(s[0] as i64),
+        Ty::Bool => Value::Bool(s[0] != 0.0),
+        Ty::V2 | Ty::V2d => Value::V2(DVec2::new(s[0], s[1])),
+        Ty::V3 | Ty::V3d => Value::V3(DVec3::new(s[0], s[1], s[2])),
+        _ => Value::Float(s[0]),
+    }
+}
+
+/// The rotation system as a body sees it while it runs.
+pub struct VvHost<'a> {
+    pub mesh: &'a mut Rotation,
+    pub layouts: &'a Layouts,
+}
+
+/// The vertex an argument holds, and whether it was read as `'v`.
+fn vert(v: &Value) -> (u32, bool) {
+    match v {
+        Value::Elem(e) if e.kind == VERTEX => (e.ids[0], e.flags & OLD != 0),
+        _ => (NULL, false),
+    }
+}
+
+impl VvHost<'_> {
+    fn value(&self, v: u32) -> Value {
+        if v == NULL {
+            null()
+        } else {
+            vertex(v, self.mesh.generation(v).unwrap_or(0))
+        }
+    }
+
+    /// An edited vertex: its current state (`'v` cannot be edited).
+    fn current(&self, v: &Value, what: &str) -> Result<u32, String> {
+        let (v, old) = vert(v);
+        if old {
+            return Err(format!(
+                "{what}: `'v` is the state the last `synchronize` kept; edit `v` itself"
+            ));
+        }
+        Ok(v)
+    }
+
+    fn get(&self, target: &Value, index: usize) -> Result<Value, String> {
+        let Value::Elem(e) = target else {
+            return Ok(Value::Void);
+        };
+        let old = e.flags & OLD != 0;
+        match e.kind {
+            VERTEX if index == 0 => Ok(Value::V3(self.mesh.pos(e.ids[0], old)?)),
+            VERTEX => {
+                let l = self.layouts.vertex[index - 1];
+                let s = self.mesh.vertex_property(e.ids[0], l.index, old)?;
+                Ok(decode(l.ty, s))
+            }
+            EDGE => {
+                let l = self.layouts.edge[index];
+                match self.mesh.edge_property(e.ids[0], e.ids[2], l.index, old)? {
+                    Some(s) => Ok(decode(l.ty, s)),
+                    None => Err(format!(
+                        "the edge ({}, {}) is not in the mesh: {} is not a neighbour of {}",
+                        e.ids[0], e.ids[2], e.ids[2], e.ids[0]
+                    )),
+                }
+            }
+            _ => {
+                let l = self.layouts.mesh[index];
+                Ok(decode(l.ty, self.mesh.mesh_property(l.index)?))
+            }
+        }
+    }
+
+    fn set(&mut self, target: &Value, index: usize, value: &Value) -> Result<(), String> {
+        let Value::Elem(e) = target else {
+            return Ok(());
+        };
+        if e.flags & OLD != 0 {
+            return Err(
+                "`'v$...` is the state the last `synchronize` kept; assign to `v$...`".into(),
+            );
+        }
+        let mut buf = [0.0; 3];
+        match e.kind {
+            VERTEX if index == 0 => {
+                let p = match value {
+                    Value::V3(p) => *p,
+                    _ => DVec3::NAN,
+                };
+                if !p.is_finite() {
+                    return Err(format!(
+                        "a vertex position must be finite; this is ({}, {}, {})",
+                        p.x, p.y, p.z
+                    ));
+                }
+                self.mesh.set_pos(e.ids[0], p)
+            }
+            VERTEX => {
+                let l = self.layouts.vertex[index - 1];
+                encode(value, &mut buf);
+                self.mesh
+                    .set_vertex_property(e.ids[0], l.index, &buf[..width(l.ty)])
+            }
+            EDGE => {
+                let l = self.layouts.edge[index];
+                encode(value, &mut buf);
+                self.mesh
+                    .set_edge_property(e.ids[0], e.ids[2], l.index, &buf[..width(l.ty)])
+            }
+            _ => {
+                let l = self.layouts.mesh[index];
+                encode(value, &mut buf);
+                self.mesh.set_mesh_property(l.index, &buf[..width(l.ty)])
+            }
+        }
+    }
+}
+
+impl Host for VvHost<'_> {
+    fn call(&mut self, f: u16, args: &[Value]) -> Result<Value, String> {
+        let arg = |i: usize| args.get(i).map_or((NULL, false), vert);
+        Ok(match f {
+            id::NEW => {
+                let v = self.mesh.new_vertex();
+                self.value(v)
+            }
+            id::OLD => match args.first() {
+                Some(Value::Elem(e)) => Value::Elem(Elem {
+                    flags: e.flags | OLD,
+                    ..*e
+                }),
+                _ => null(),
+            },
+            id::VALENCE => {
+                let (v, old) = arg(0);
+                Value::Int(self.mesh.valence(v, old)? as i64)
+            }
+            id::IS_IN => {
+                let ((x, _), (v, old)) = (arg(0), arg(1));
+                Value::Bool(self.mesh.is_in(x, v, old)?)
+            }
+            id::ANY => {
+                let (v, old) = arg(0);
+                let a = self.mesh.any(v, old)?;
+                self.value(a)
+            }
+            id::NEXTTO | id::PREVTO => {
+                let ((x, _), (v, old)) = (arg(0), arg(1));
+                let n = if f == id::NEXTTO {
+                    self.mesh.nextto(x, v, old)?
+                } else {
+                    self.mesh.prevto(x, v, old)?
+                };
+                self.value(n)
+            }
+            id::MAKE => {
+                let v = self.current(&args[0], "`make`")?;
+                let list: Vec<u32> = args[1..].iter().map(|a| vert(a).0).collect();
+                self.mesh.make(v, &list)?;
+                Value::Void
+            }
+            id::ERASE => {
+                let v = self.current(&args[1], "`erase`")?;
+                self.mesh.erase(arg(0).0, v)?;
+                Value::Void
+            }
+            id::REPLACE => {
+                let v = self.current(&args[2], "`replace`")?;
+                self.mesh.replace(arg(0).0, arg(1).0, v)?;
+                Value::Void
+            }
+            id::SPLICE_AFTER | id::SPLICE_BEFORE => {
+                let v = self.current(&args[2], "`splice`")?;
+                if f == id::SPLICE_AFTER {
+                    self.mesh.splice_after(arg(0).0, arg(1).0, v)?;
+                } else {
+                    self.mesh.splice_before(arg(0).0, arg(1).0, v)?;
+                }
+                Value::Void
+            }
+            id::SYNCHRONIZE => {
+                if let Some(Value::Set(s)) = args.first() {
+                    self.mesh.synchronize(s.ids())?;
+                }
+                Value::Void
+            }
+            id::CHECK => {
+                if let Some(Value::Set(s)) = args.first() {
+                    self.mesh.check(s.ids())?;
+                }
+                Value::Void
+            }
+            id::SIZE => match args.first() {
+                Some(Value::Set(s)) => Value::Int(s.len() as i64),
+                _ => Value::Int(0),
+            },
+            id::EDGE => {
+                let ((p, _), (q, _)) = (arg(0), arg(1));
+                if p == NULL || q == NULL {
+                    return Err("an edge `(p, q)` of the null vertex".into());
+                }
+                Value::Elem(Elem {
+                    kind: EDGE,
+                    flags: 0,
+                    ids: [p, 0, q, 0],
+                })
+            }
+            id::BOUNDARY => {
+                let (v, old) = arg(0);
+                Value::Bool(self.mesh.is_open(v, old)?)
+            }
+            id::GET => self.get(&args[0], args[1].as_i64() as usize)?,
+            id::SET => {
+                self.set(&args[0], args[1].as_i64() as usize, &args[2])?;
+                args[2].clone()
+            }
+            id::NULL => null(),
+            id::MESH => Value::Elem(Elem {
+                kind: MESH,
+                flags: 0,
+                ids: [0; 4],
+            }),
+            _ => Value::Void,
+        })
+    }
+
+    fn members(&mut self, set: &Value, out: &mut Vec<Value>) {
+        match set {
+            Value::Set(s) => out.extend(s.ids().iter().map(|&v| self.value(v))),
+            Value::Elem(e) if e.kind == VERTEX => {
+                let old = e.flags & OLD != 0;
+                let mesh = &*self.mesh;
+                if let Ok(ns) = mesh.neighbours(e.ids[0], old) {
+                    out.extend(
+                        ns.iter()
+                            .map(|&v| vertex(v, mesh.generation(v).unwrap_or(0))),
+                    );
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// The set of vertex ids a value holds (empty for any other value).
+pub fn set_ids(v: &Value) -> &[u32] {
+    match v {
+        Value::Set(s) => s.ids(),
+        _ => &[],
+    }
+}
+
+/// A set of vertices as a value.
+pub fn set_value(ids: impl IntoIterator<Item = u32>) -> Value {
+    Value::Set(std::sync::Arc::new(ids.into_iter().collect::<IdSet>()))
+}

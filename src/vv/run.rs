@@ -1,0 +1,305 @@
+//! Running a vv program: the base mesh into the rotation system, `Start`,
+//! then each step `StartEach`, `Step`, `EndEach`, the consistency check of
+//! the mesh and the release of vertices nothing holds; `End` after the
+//! last step.
+
+use std::path::PathBuf;
+
+use crate::deadline::Deadline;
+use crate::lang::eval::{Env, Interp, RuntimeError};
+use crate::lang::ir::{Program, St};
+use crate::lang::value::Value;
+use crate::mesh::PolygonSoup;
+use crate::production::Topology;
+use crate::syntax::ast::ControlKind;
+use crate::syntax::{Diagnostic, SourceMap, Span};
+
+use super::host::{self, Layout, Layouts, VvHost, VV_HOST};
+use super::mesh::Rotation;
+
+/// The most steps a vv program may run.
+pub const MAX_VV_STEPS: u64 = 1000;
+
+/// The most vertices a vv mesh may hold.
+pub const MAX_VV_VERTICES: usize = 20_000_000;
+
+/// A checked vv program.
+#[derive(Debug)]
+pub struct VvProgram {
+    pub program: Program,
+    pub sources: SourceMap,
+    pub warnings: Vec<Diagnostic>,
+    /// The global `mesh` that is the structure: drawn, written, checked.
+    pub structure: u16,
+    /// Its name and where it is declared.
+    pub structure_name: (String, Span),
+    /// The base mesh file its declaration names (`mesh S = "cube.obj";`),
+    /// as written, with the span of the string.
+    pub base: Option<(String, Span)>,
+}
+
+/// Why a run stopped: a message, located in the program when a statement
+/// is to blame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VvError {
+    pub span: Option<Span>,
+    pub message: String,
+}
+
+impl From<RuntimeError> for VvError {
+    fn from(e: RuntimeError) -> VvError {
+        VvError {
+            span: e.span,
+            message: e.message,
+        }
+    }
+}
+
+/// A vv program running on its mesh.
+pub struct VvRun<'p> {
+    vv: &'p VvProgram,
+    pub mesh: Rotation,
+    pub env: Env,
+    layouts: Layouts,
+    interp: Interp<'p>,
+    steps: u64,
+    length: u64,
+}
+
+impl VvProgram {
+    /// Starts a run on `base` (the base mesh's polygons, if any): the
+    /// properties declared, the globals initialised, `Start` run; the
+    /// steps to make are `steps`, else the derivation length, else 1.
+    pub fn start(
+        &self,
+        base: Option<&PolygonSoup>,
+        steps: Option<u64>,
+        deadline: Option<Deadline>,
+        output: crate::lang::ProgramOutput,
+    ) -> Result<VvRun<'_>, VvError> {
+        let program = &self.program;
+        let mut interp = Interp::for_program(program, deadline);
+        let zeros = program
+            .globals
+            .iter()
+            .map(|g| Value::zero(g.ty, &program.structs))
+            .collect();
+        let mut env = Env::new(zeros);
+        env.output = output;
+        for (k, g) in program.globals.iter().enumerate() {
+            if let Some(e) = &g.init {
+                env.globals[k] = interp.eval_global(e, &mut env)?.convert(g.ty);
+            }
+        }
+        let (mut mesh, members) = match base {
+            Some(soup) => Rotation::from_soup(soup).map_err(|m| VvError {
+                span: self.base.as_ref().map(|b| b.1),
+                message: format!("the base mesh: {m}"),
+            })?,
+            None => (Rotation::new(), Vec::new()),
+        };
+        env.globals[self.structure as usize] = host::set_value(members);
+        let mut layouts = Layouts::default();
+        for p in &program.properties {
+            let value = interp.eval_global(&p.init, &mut env)?.convert(p.ty);
+            let mut slots = vec![0.0; host::width(p.ty)];
+            host::encode(&value, &mut slots);
+            let index = match p.owner {
+                0 => mesh.add_vertex_property(slots.len(), &slots),
+                1 => mesh.add_edge_property(slots.len(), &slots),
+                _ => mesh.add_mesh_property(slots.len(), &slots),
+            };
+            let l = Layout { ty: p.ty, index };
+            match p.owner {
+                0 => layouts.vertex.push(l),
+                1 => layouts.edge.push(l),
+                _ => layouts.mesh.push(l),
+            }
+        }
+        let mut run = VvRun {
+            vv: self,
+            mesh,
+            env,
+            layouts,
+            interp,
+            steps: 0,
+            length: 0,
+        };
+        run.control(ControlKind::Start)?;
+        let stated = match &program.derivation_length {
+            Some((e, span)) => {
+                let v = run.interp.eval_global(e, &mut run.env)?.as_f64();
+                if !(0.0..=MAX_VV_STEPS as f64).contains(&v) || v.fract() != 0.0 {
+                    return Err(VvError {
+                        span: Some(*span),
+                        message: format!(
+                            "the derivation length must be a whole number of steps from 0 to {MAX_VV_STEPS}"
+                        ),
+                    });
+                }
+                Some(v as u64)
+            }
+            None => None,
+        };
+        run.length = steps.or(stated).unwrap_or(1);
+        if run.length > MAX_VV_STEPS {
+            return Err(VvError {
+                span: None,
+                message: format!(
+                    "{} steps are more than a vv program may run ({MAX_VV_STEPS})",
+                    run.length
+                ),
+            });
+        }
+        run.end_of_step("`Start`")?;
+        Ok(run)
+    }
+}
+
+impl<'p> VvRun<'p> {
+    fn control(&mut self, kind: ControlKind) -> Result<(), VvError> {
+        for (k, body, frame) in &self.vv.program.control {
+            if *k == kind {
+                run_body(
+                    &mut self.interp,
+                    body,
+                    *frame,
+                    &mut self.env,
+                    &mut self.mesh,
+                    &self.layouts,
+                )?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The structure's vertices.
+    pub fn members(&self) -> &[u32] {
+        host::set_ids(&self.env.globals[self.vv.structure as usize])
+    }
+
+    /// The consistency check of the structure, then the release of every
+    /// vertex that no global holds.
+    fn end_of_step(&mut self, after: &str) -> Result<(), VvError> {
+        let members = host::set_ids(&self.env.globals[self.vv.structure as usize]);
+        if let Err(m) = self.mesh.check(members) {
+            return Err(VvError {
+                span: Some(self.vv.structure_name.1),
+                message: format!(
+                    "after {after}, `{}` is not a consistent mesh: {m}",
+                    self.vv.structure_name.0
+                ),
+            });
+        }
+        let mut roots: Vec<u32> = Vec::new();
+        for g in &self.env.globals {
+            collect_vertices(g, &mut roots);
+        }
+        self.mesh.retain(&roots);
+        if self.mesh.len() > MAX_VV_VERTICES {
+            return Err(VvError {
+                span: None,
+                message: format!(
+                    "the mesh holds {} vertices, more than the {MAX_VV_VERTICES} allowed",
+                    self.mesh.len()
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// The structure's polygons (Edmonds' faces) and positions.
+    pub fn soup(&self) -> Result<PolygonSoup, VvError> {
+        self.mesh
+            .to_soup(self.members())
+            .map_err(|message| VvError {
+                span: None,
+                message,
+            })
+    }
+
+    /// Runs the steps that remain, then `End`.
+    pub fn finish(&mut self, mut progress: impl FnMut(&Self)) -> Result<(), VvError> {
+        crate::production::run(self, &mut progress)?;
+        self.control(ControlKind::End)?;
+        self.end_of_step("`End`")
+    }
+
+    /// The number of steps the run makes.
+    pub fn length(&self) -> u64 {
+        self.length
+    }
+}
+
+/// Appends the vertices a global holds (a vertex, a set, inside structs).
+fn collect_vertices(v: &Value, out: &mut Vec<u32>) {
+    match v {
+        Value::Elem(e) if e.kind == host::VERTEX && e.ids[0] != super::mesh::NULL => {
+            out.push(e.ids[0])
+        }
+        Value::Set(s) => out.extend_from_slice(s.ids()),
+        Value::Struct(fs) => fs.iter().for_each(|f| collect_vertices(f, out)),
+        _ => {}
+    }
+}
+
+fn run_body(
+    interp: &mut Interp,
+    body: &[St],
+    frame: usize,
+    env: &mut Env,
+    mesh: &mut Rotation,
+    layouts: &Layouts,
+) -> Result<(), VvError> {
+    let mut frame = vec![Value::Void; frame];
+    let mut sink: Vec<(crate::lang::modules::Sym, Vec<Value>)> = Vec::new();
+    let mut host = VvHost { mesh, layouts };
+    interp.run(body, &mut frame, env, &mut host, &mut sink)?;
+    Ok(())
+}
+
+impl Topology for VvRun<'_> {
+    type Structure = Rotation;
+    type Error = VvError;
+
+    fn host_table() -> &'static crate::lang::builtins::HostTable {
+        &VV_HOST
+    }
+
+    fn structure(&self) -> &Rotation {
+        &self.mesh
+    }
+
+    fn steps_done(&self) -> u64 {
+        self.steps
+    }
+
+    fn has_next(&self) -> bool {
+        self.steps < self.length && !self.env.stop
+    }
+
+    fn step(&mut self) -> Result<(), VvError> {
+        if let Err(m) = crate::deadline::check(self.interp.deadline) {
+            return Err(VvError {
+                span: None,
+                message: m,
+            });
+        }
+        self.env.step = self.steps as i64;
+        self.control(ControlKind::StartEach)?;
+        self.control(ControlKind::Step)?;
+        self.control(ControlKind::EndEach)?;
+        self.steps += 1;
+        self.env.step = self.steps as i64;
+        let after = format!("step {}", self.steps);
+        self.end_of_step(&after)
+    }
+}
+
+/// The base mesh path of a program read from `file`: relative to its
+/// folder when that file exists, else as written.
+pub fn base_path(vv: &VvProgram, dir: Option<&std::path::Path>) -> Option<PathBuf> {
+    let (p, _) = vv.base.as_ref()?;
+    let rel = dir.unwrap_or(std::path::Path::new(".")).join(p);
+    Some(if rel.exists() { rel } else { PathBuf::from(p) })
+}

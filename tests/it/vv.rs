@@ -1,0 +1,407 @@
+//! Vertex-vertex programs (paper 001): the paper's schemes against the
+//! stellar grammars that implement the same schemes, the butterfly against
+//! its mask built here, `synchronize` against the order of iteration, and
+//! the error cases of Table 2.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use subgram::mesh::{io, shapes, PolygonSoup};
+use subgram::{LoadOptions, Run, RunOptions, System};
+
+/// A folder of its own for a test, removed at the end.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new() -> TempDir {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        static N: AtomicUsize = AtomicUsize::new(0);
+        let n = N.fetch_add(1, Ordering::Relaxed);
+        let p = std::env::temp_dir().join(format!("subgram-vv-{}-{n}", std::process::id()));
+        std::fs::create_dir_all(&p).unwrap();
+        TempDir(p)
+    }
+
+    fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Runs `file` (a vv program or a surface grammar) `steps` steps on `mesh`
+/// and gives its polygons.
+fn run(file: &Path, mesh: &Path, steps: u64, defines: &[&str]) -> PolygonSoup {
+    let opts = LoadOptions {
+        defines: defines.iter().map(|d| d.to_string()).collect(),
+        ..LoadOptions::default()
+    };
+    let system = subgram::load(file, &opts).unwrap_or_else(|e| panic!("{e}"));
+    let ro = RunOptions {
+        steps: Some(steps),
+        base_mesh: Some(mesh.to_path_buf()),
+        ..RunOptions::default()
+    };
+    match system.run(&ro).unwrap_or_else(|e| panic!("{e}")) {
+        Run::Vv(v) => v.soup,
+        Run::Surface(s) => s.mesh.to_soup(),
+        Run::Curve(_) => panic!("{} is a curve", file.display()),
+    }
+}
+
+/// The same mesh up to the numbering of vertices and the first vertex of
+/// each face: every vertex of `a` has one of `b` within `tol`, and the
+/// faces map onto each other.
+fn assert_same_mesh(a: &PolygonSoup, b: &PolygonSoup, tol: f64, what: &str) {
+    assert_eq!(
+        a.positions.len(),
+        b.positions.len(),
+        "{what}: vertex counts"
+    );
+    assert_eq!(a.faces.len(), b.faces.len(), "{what}: face counts");
+    // Sort b's vertices by x so that each search looks at a window.
+    let mut order: Vec<usize> = (0..b.positions.len()).collect();
+    order.sort_by(|&i, &j| b.positions[i].x.total_cmp(&b.positions[j].x));
+    let xs: Vec<f64> = order.iter().map(|&i| b.positions[i].x).collect();
+    let mut map = vec![usize::MAX; a.positions.len()];
+    let mut taken = vec![false; b.positions.len()];
+    for (i, p) in a.positions.iter().enumerate() {
+        let lo = xs.partition_point(|&x| x < p.x - tol);
+        let hits: Vec<usize> = order[lo..]
+            .iter()
+            .take_while(|&&j| b.positions[j].x <= p.x + tol)
+            .copied()
+            .filter(|&j| (b.positions[j] - *p).abs().max_element() <= tol)
+            .collect();
+        assert_eq!(
+            hits.len(),
+            1,
+            "{what}: vertex {i} at {p} has {} matches",
+            hits.len()
+        );
+        assert!(!taken[hits[0]], "{what}: two vertices at {p}");
+        taken[hits[0]] = true;
+        map[i] = hits[0];
+    }
+    let canon = |f: &[u32]| {
+        let k = (0..f.len()).min_by_key(|&k| f[k]).unwrap();
+        let mut c: Vec<u32> = f[k..].to_vec();
+        c.extend_from_slice(&f[..k]);
+        c
+    };
+    let mut fa: Vec<Vec<u32>> = a
+        .faces
+        .iter()
+        .map(|f| {
+            canon(
+                &f.iter()
+                    .map(|&v| map[v as usize] as u32)
+                    .collect::<Vec<_>>(),
+            )
+        })
+        .collect();
+    let mut fb: Vec<Vec<u32>> = b.faces.iter().map(|f| canon(f)).collect();
+    fa.sort();
+    fb.sort();
+    assert_eq!(fa, fb, "{what}: faces");
+}
+
+fn vv(name: &str) -> PathBuf {
+    root().join("lsystems/vv").join(name)
+}
+
+fn grammar(name: &str) -> PathBuf {
+    root().join("lsystems/surfaces").join(name)
+}
+
+fn mesh(name: &str) -> PathBuf {
+    root().join("lsystems/meshes").join(name)
+}
+
+#[test]
+fn vv_loop_is_the_grammar_loop_closed_and_open() {
+    for (m, steps) in [
+        ("octahedron.obj", 3),
+        ("tetrahedron.obj", 3),
+        ("pentagon-patch.obj", 3),
+    ] {
+        let a = run(&vv("loop.lsys"), &mesh(m), steps, &[]);
+        let b = run(&grammar("loop.lsys"), &mesh(m), steps, &[]);
+        assert_same_mesh(&a, &b, 1e-12, &format!("Loop on {m}"));
+    }
+}
+
+#[test]
+fn vv_sqrt3_is_the_grammar_sqrt3_closed_and_open() {
+    // Four steps on the open patch: two of each kind of boundary step.
+    for (m, steps) in [("octahedron.obj", 3), ("pentagon-patch.obj", 4)] {
+        let a = run(&vv("sqrt3.lsys"), &mesh(m), steps, &[]);
+        let b = run(&grammar("sqrt3.lsys"), &mesh(m), steps, &[]);
+        assert_same_mesh(&a, &b, 1e-12, &format!("sqrt3 on {m}"));
+    }
+}
+
+/// A triangle grid with bumps: valence 6 inside, not planar.
+fn bumpy_grid(dir: &Path) -> (PathBuf, PolygonSoup) {
+    let mut soup = shapes::triangle_grid(8, 8);
+    for (i, p) in soup.positions.iter_mut().enumerate() {
+        p.z = ((i * 7919) % 13) as f64 / 13.0 - 0.5;
+    }
+    let path = dir.join("grid.obj");
+    io::write(&path, &soup).unwrap();
+    (path, soup)
+}
+
+#[test]
+fn vv_butterfly_is_the_eight_point_mask_on_a_regular_region() {
+    let dir = TempDir::new();
+    let (path, base) = bumpy_grid(dir.path());
+    let out = run(&vv("butterfly.lsys"), &path, 1, &[]);
+    // The scheme interpolates: the old vertices come first, unmoved.
+    assert_eq!(&out.positions[..base.positions.len()], &base.positions[..]);
+    // Neighbours, counter-clockwise, from the base triangles.
+    let n = base.positions.len();
+    let mut next: Vec<Vec<(u32, u32)>> = vec![Vec::new(); n];
+    for f in &base.faces {
+        for k in 0..3 {
+            // In triangle (a, b, c), c follows b around a.
+            next[f[k] as usize].push((f[(k + 1) % 3], f[(k + 2) % 3]));
+        }
+    }
+    let after = |a: u32, b: u32| {
+        next[a as usize]
+            .iter()
+            .find(|(x, _)| *x == b)
+            .map(|(_, c)| *c)
+    };
+    let before = |a: u32, b: u32| {
+        next[a as usize]
+            .iter()
+            .find(|(_, c)| *c == b)
+            .map(|(x, _)| *x)
+    };
+    let interior = |v: u32| {
+        next[v as usize].len() == 6 && {
+            let first = next[v as usize][0].0;
+            let mut x = first;
+            let mut k = 0;
+            while let Some(y) = after(v, x) {
+                x = y;
+                k += 1;
+                if x == first || k > 6 {
+                    break;
+                }
+            }
+            x == first && k == 6
+        }
+    };
+    let w = 1.0 / 16.0;
+    let pos = |v: u32| base.positions[v as usize];
+    let mut checked = 0;
+    for p in 0..n as u32 {
+        for &(q, r) in &next[p as usize] {
+            if p > q || !interior(p) || !interior(q) {
+                continue;
+            }
+            let s = before(p, q).unwrap();
+            let wings = [after(p, r), before(q, r), before(p, s), after(q, s)];
+            let Some(t) = wings.iter().copied().collect::<Option<Vec<u32>>>() else {
+                continue;
+            };
+            if ![r, s].iter().chain(&t).all(|&v| interior(v)) {
+                continue;
+            }
+            let expected: DVec3 = 0.5 * (pos(p) + pos(q)) + 2.0 * w * (pos(r) + pos(s))
+                - w * (pos(t[0]) + pos(t[1]) + pos(t[2]) + pos(t[3]));
+            let hit = out.positions[n..]
+                .iter()
+                .any(|x| (*x - expected).abs().max_element() < 1e-12);
+            assert!(
+                hit,
+                "no new vertex at the mask's point {expected} for edge ({p}, {q})"
+            );
+            checked += 1;
+        }
+    }
+    // An 8 x 8 grid has 7 x 7 interior vertices; the edges whose whole
+    // stencil is interior number in the dozens.
+    assert!(checked > 40, "only {checked} edges checked");
+}
+
+/// Loop's step over the structure in its order, or (with `-D REVERSED`)
+/// over the same vertices in the opposite order.
+const LOOP_IN_ANY_ORDER: &str = r#"
+mesh S;
+double beta(int n) { return (5.0/8 - pow(3.0/8 + 0.25*cos(2*PI/n), 2)) / n; }
+void insert(vertex p, vertex q, vertex x) {
+  replace q with x in p;
+  replace p with x in q;
+  make {p, q} nb_of x;
+}
+Step: {
+  mesh R;
+#ifdef REVERSED
+  vertex all[1000];
+  int n = 0;
+  forall p in S { all[n] = p; n++; }
+  for (int i = n - 1; i >= 0; i--) add all[i] to R;
+#else
+  R = S;
+#endif
+  mesh NV;
+  synchronize S;
+  forall p in R
+    forall q in 'p
+      if (p < q) {
+        vertex x;
+        vertex r = nextto q in 'p;
+        vertex s = prevto q in 'p;
+        if (r == null || s == null) x$pos = 0.5 * ('p$pos + 'q$pos);
+        else x$pos = 3.0/8 * ('p$pos + 'q$pos) + 1.0/8 * ('r$pos + 's$pos);
+        insert(p, q, x);
+        add x to NV;
+      }
+  forall p in R {
+    int n = valence 'p;
+    V3d sum = V3d(0, 0, 0);
+    forall q in 'p sum += 'q$pos;
+    if (!boundary('p)) p$pos = (1 - n * beta(n)) * 'p$pos + beta(n) * sum;
+  }
+  forall x in NV {
+    vertex p = any in x;
+    vertex q = nextto p in x;
+    make {p, prevto x in p, nextto x in q, q, prevto x in q, nextto x in p} nb_of x;
+  }
+  merge S with NV;
+}
+"#;
+
+#[test]
+fn synchronize_makes_the_order_of_iteration_irrelevant_to_the_bit() {
+    let dir = TempDir::new();
+    let file = dir.path().join("order.lsys");
+    std::fs::write(&file, LOOP_IN_ANY_ORDER).unwrap();
+    for m in ["octahedron.obj", "pentagon-patch.obj", "torus.obj"] {
+        let m = mesh(m);
+        let forward = run(&file, &m, 1, &[]);
+        let reversed = run(&file, &m, 1, &["REVERSED=1"]);
+        // Different orders make the new vertices in different orders...
+        assert_ne!(forward.positions, reversed.positions);
+        // ...but the same mesh, to the last bit.
+        assert_same_mesh(&forward, &reversed, 0.0, "the two orders");
+    }
+}
+
+/// Runs a vv program from text; the first error, as the binary shows it.
+fn error_of(text: &str) -> String {
+    let dir = TempDir::new();
+    let file = dir.path().join("t.lsys");
+    std::fs::write(&file, text).unwrap();
+    let system = subgram::load(&file, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert!(matches!(system, System::Vv(_)));
+    match system.run(&RunOptions::default()) {
+        Ok(_) => panic!("no error from:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// A program on the tetrahedron whose `Step` is `body`.
+fn program(body: &str) -> String {
+    let tet = mesh("tetrahedron.obj");
+    format!(
+        "mesh S = \"{}\";\nStep: {{\n  vertex v = any in S_first();\n{body}\n}}\nvertex S_first() {{ forall v in S return v; return null; }}\n",
+        tet.display()
+    )
+}
+
+#[test]
+fn table_2_error_cases_are_located_errors() {
+    let cases: &[(&str, &str, &str)] = &[
+        // Note 3: v in its own list, a vertex listed twice.
+        (
+            "  vertex a = any in v;\n  make {a, v} nb_of v;",
+            "2:",
+            "its own neighbourhood",
+        ),
+        (
+            "  vertex a = any in v;\n  make {a, a} nb_of v;",
+            "2:",
+            "listed twice",
+        ),
+        // Note 5: x = v, or x already a neighbour.
+        ("  vertex a = any in v;\n  replace a with v in v;", "2:", ""),
+        (
+            "  vertex a = any in v;\n  vertex b = nextto a in v;\n  replace a with b in v;",
+            "3:",
+            "",
+        ),
+        ("  vertex a = any in v;\n  splice v after a in v;", "2:", ""),
+        (
+            "  vertex a = any in v;\n  vertex b = nextto a in v;\n  splice b before a in v;",
+            "3:",
+            "",
+        ),
+        // The null vertex has no neighbourhood.
+        ("  vertex a = any in null;", "1:", "null"),
+        // 'v is for reading.
+        (
+            "  vertex a = any in v;\n  synchronize S;\n  erase a from 'v;",
+            "3:",
+            "synchronize",
+        ),
+        // A vertex made after the last synchronize has no old state.
+        (
+            "  synchronize S;\n  vertex x;\n  int n = valence 'x;",
+            "3:",
+            "synchroniz",
+        ),
+    ];
+    for (body, line, needle) in cases {
+        // The body starts on the program's line 4.
+        let k: usize = line.trim_end_matches(':').parse().unwrap();
+        let e = error_of(&program(body));
+        assert!(e.contains(&format!("t.lsys:{}:", k + 3)), "{body}\n-> {e}");
+        assert!(e.contains(needle), "{body}\n-> {e}");
+        assert!(e.contains('^'), "{body}\n-> {e}");
+    }
+}
+
+#[test]
+fn table_2_null_and_no_effect_cases() {
+    let dir = TempDir::new();
+    // Notes 1, 2 and 4, and 5's "no effect": printed by the program.
+    let body = r#"
+  vertex a = any in v;
+  vertex b = nextto a in v;
+  vertex x;
+  printf("%d ", any in x == null);              // note 1
+  printf("%d ", nextto x in v == null);         // note 2
+  printf("%d ", prevto x in v == null);         // note 2
+  int n = valence v;
+  erase x from v;                               // note 4
+  printf("%d ", valence v == n);
+  replace x with b in v;                        // note 5: x not in v*
+  splice x after x in v;
+  printf("%d ", valence v == n && is a in v && !(is x in v));
+  printf("%d\n", valence x);
+"#;
+    let file = dir.path().join("t.lsys");
+    std::fs::write(&file, program(body)).unwrap();
+    let output = subgram::ProgramOutput::new();
+    let system = subgram::load(&file, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let ro = RunOptions {
+        output: output.clone(),
+        ..RunOptions::default()
+    };
+    system.run(&ro).unwrap_or_else(|e| panic!("{e}"));
+    let printed: String = output.take_text().into_iter().map(|(_, t)| t).collect();
+    assert_eq!(printed.trim(), "1 1 1 1 1 0");
+}
