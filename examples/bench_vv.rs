@@ -26,7 +26,8 @@ fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
 fn main() {
     let out = PathBuf::from(
         std::env::args()
-            .nth(1)
+            .skip(1)
+            .find(|a| !a.starts_with("--"))
             .unwrap_or_else(|| "/tmp/subgram-bench".into()),
     );
     std::fs::create_dir_all(&out).expect("output folder");
@@ -35,6 +36,20 @@ fn main() {
     let sphere = shapes::icosphere(6);
     io::write(&out.join("icosphere6.obj"), &sphere).expect("write");
 
+    // `--only-vv`: the vv program alone, for a profiler.
+    if std::env::args().any(|a| a == "--only-vv") {
+        let System::Vv(v) =
+            subgram::load(root.join("lsystems/vv/loop.lsys"), &LoadOptions::default())
+                .expect("loads")
+        else {
+            panic!("a vv program")
+        };
+        for _ in 0..runs {
+            v.run_soup(&sphere, &RunOptions::default().with_steps(1))
+                .expect("runs");
+        }
+        return;
+    }
     let g = subgram::surface::load_file(&root.join("lsystems/surfaces/loop.lsys"), &[])
         .expect("grammar");
     let (tg, grammar) = best_of(runs, || {

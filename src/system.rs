@@ -445,8 +445,8 @@ impl Vv {
         };
         progress(at(&run));
         run.finish(|r| progress(at(r))).map_err(|e| self.error(e))?;
-        let soup = run.soup().map_err(|e| self.error(e))?;
-        let info = vv_info(&run);
+        let (soup, holes) = run.soup().map_err(|e| self.error(e))?;
+        let info = vv_info(&run, &soup, holes);
         Ok(VvResult {
             soup,
             steps: crate::production::Topology::steps_done(&run),
@@ -456,12 +456,11 @@ impl Vv {
 }
 
 /// The counts of a run's mesh.
-fn vv_info(run: &crate::vv::VvRun) -> VvInfo {
+fn vv_info(run: &crate::vv::VvRun, soup: &PolygonSoup, holes: usize) -> VvInfo {
     use std::collections::BTreeMap;
     let members = run.members();
     let mesh = &run.mesh;
-    let faces = mesh.faces(members).unwrap_or_default();
-    let holes = mesh.holes(members).unwrap_or_default();
+    let faces = &soup.faces;
     let mut valences: BTreeMap<usize, usize> = BTreeMap::new();
     let mut degree_sum = 0;
     for &v in members {
@@ -470,7 +469,7 @@ fn vv_info(run: &crate::vv::VvRun) -> VvInfo {
         *valences.entry(k).or_default() += 1;
     }
     let mut sides: BTreeMap<usize, usize> = BTreeMap::new();
-    for f in &faces {
+    for f in faces {
         *sides.entry(f.len()).or_default() += 1;
     }
     let edges = degree_sum / 2;
@@ -478,7 +477,7 @@ fn vv_info(run: &crate::vv::VvRun) -> VvInfo {
         vertices: members.len(),
         edges,
         faces: faces.len(),
-        boundary_loops: holes.len(),
+        boundary_loops: holes,
         euler_characteristic: members.len() as i64 - edges as i64 + faces.len() as i64,
         valences: valences.into_iter().collect(),
         face_sides: sides.into_iter().collect(),

@@ -203,6 +203,8 @@ pub struct Interp<'p> {
     ticks: u32,
     /// Lists of members for `forall` loops, reused.
     member_lists: Vec<Vec<Value>>,
+    /// Frames of user function calls, reused.
+    frames: Vec<Vec<Value>>,
 }
 
 impl<'p> Interp<'p> {
@@ -220,6 +222,7 @@ impl<'p> Interp<'p> {
             deadline: None,
             ticks: 0,
             member_lists: Vec::new(),
+            frames: Vec::new(),
         }
     }
 
@@ -627,7 +630,27 @@ impl<'p> Interp<'p> {
     ) -> R<Value> {
         let funcs = self.funcs;
         let f = &funcs[id as usize];
-        let mut frame = vec![Value::Void; f.frame_size.max(args.len())];
+        // Frames are reused: a call allocates only when it goes deeper
+        // than any before it.
+        let mut frame = self.frames.pop().unwrap_or_default();
+        frame.clear();
+        frame.resize(f.frame_size.max(args.len()), Value::Void);
+        let r = self.call_in(f, args, back, span, cx, &mut frame);
+        frame.clear();
+        self.frames.push(frame);
+        r
+    }
+
+    /// [`Interp::call_user`] on the frame it got.
+    fn call_in(
+        &mut self,
+        f: &'p Function,
+        args: &[Ex],
+        back: &[(u16, Place)],
+        span: Span,
+        cx: &mut Cx,
+        frame: &mut [Value],
+    ) -> R<Value> {
         for (slot, a) in frame.iter_mut().zip(args) {
             *slot = self.expr(a, cx)?;
         }
@@ -662,7 +685,7 @@ impl<'p> Interp<'p> {
         }
         self.calls += 1;
         self.frame_values += values;
-        let r = self.invoke(f, &mut frame, cx.env, &mut *cx.host, span);
+        let r = self.invoke(f, frame, cx.env, &mut *cx.host, span);
         self.frame_values -= values;
         self.calls -= 1;
         let v = r?;
@@ -992,6 +1015,18 @@ impl<'p> Interp<'p> {
                 Func::Math1(g) => return Ok(Value::Float(g(self.expr(a, cx)?.as_f64()))),
                 _ => {}
             }
+        }
+        // A host built-in of two or three arguments (a topology's queries
+        // and edits) takes them on the stack too.
+        if let (Func::Host(id), 2..=3) = (f, args.len()) {
+            let mut vs = [Value::Void, Value::Void, Value::Void];
+            for (v, a) in vs.iter_mut().zip(args) {
+                *v = self.expr(a, cx)?;
+            }
+            return cx
+                .host
+                .call(id, &vs[..args.len()])
+                .map_err(|m| rt(Some(span), m));
         }
         // Other arguments go on the scratch stack: no allocation per call.
         let base = self.scratch.len();

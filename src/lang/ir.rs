@@ -360,3 +360,108 @@ impl Program {
             .filter(move |(_, r)| r.section == section)
     }
 }
+
+impl Ex {
+    /// Calls `f` on every expression inside `self`, children before their
+    /// parent, `self` last: for the specialisations of a topology, which
+    /// rewrite nodes in place.
+    pub fn walk_mut(&mut self, f: &mut impl FnMut(&mut Ex)) {
+        match self {
+            Ex::Const(_) | Ex::Local(_) | Ex::Global(_) => {}
+            Ex::Field(a, _) | Ex::Neg(a) | Ex::Not(a) | Ex::Convert(_, a) => a.walk_mut(f),
+            Ex::Bin(_, a, b, _)
+            | Ex::Logic(_, a, b)
+            | Ex::MakeV2(a, b)
+            | Ex::Let(_, a, b)
+            | Ex::Index(a, b, _) => {
+                a.walk_mut(f);
+                b.walk_mut(f);
+            }
+            Ex::Cond(a, b, c) | Ex::MakeV3(a, b, c) => {
+                a.walk_mut(f);
+                b.walk_mut(f);
+                c.walk_mut(f);
+            }
+            Ex::Load(p) | Ex::IncDec(p, _, _) => p.walk_mut(f),
+            Ex::Assign(p, _, a, _) => {
+                p.walk_mut(f);
+                a.walk_mut(f);
+            }
+            Ex::CallUser { args, back, .. } => {
+                args.iter_mut().for_each(|a| a.walk_mut(f));
+                back.iter_mut().for_each(|(_, p)| p.walk_mut(f));
+            }
+            Ex::Call(_, args, _) | Ex::MakeStruct(args) => {
+                args.iter_mut().for_each(|a| a.walk_mut(f))
+            }
+            Ex::InContext(_, _, places) => places.iter_mut().for_each(|p| p.walk_mut(f)),
+            Ex::Fold {
+                set, cond, value, ..
+            } => {
+                set.walk_mut(f);
+                if let Some(c) = cond {
+                    c.walk_mut(f);
+                }
+                if let Some((v, _)) = value {
+                    v.walk_mut(f);
+                }
+            }
+        }
+        f(self);
+    }
+}
+
+impl Place {
+    /// Calls `f` on the index expressions of the place's path.
+    pub fn walk_mut(&mut self, f: &mut impl FnMut(&mut Ex)) {
+        for s in &mut self.path {
+            if let Step::Index(e, _) = s {
+                e.walk_mut(f);
+            }
+        }
+    }
+}
+
+impl St {
+    /// Calls [`Ex::walk_mut`]'s `f` on every expression of the statement.
+    pub fn walk_mut(&mut self, f: &mut impl FnMut(&mut Ex)) {
+        match self {
+            St::Expr(e) | St::Init(_, e) | St::ReturnValue(e) => e.walk_mut(f),
+            St::If(c, a, b) => {
+                c.walk_mut(f);
+                a.walk_mut(f);
+                if let Some(b) = b {
+                    b.walk_mut(f);
+                }
+            }
+            St::Loop {
+                cond, body, step, ..
+            } => {
+                if let Some(c) = cond {
+                    c.walk_mut(f);
+                }
+                body.walk_mut(f);
+                if let Some(s) = step {
+                    s.walk_mut(f);
+                }
+            }
+            St::Block(b) => b.iter_mut().for_each(|s| s.walk_mut(f)),
+            St::Produce { modules, .. } => modules
+                .iter_mut()
+                .for_each(|m| m.args.iter_mut().for_each(|a| a.walk_mut(f))),
+            St::Return | St::Break | St::Continue => {}
+            St::Switch { value, body, .. } => {
+                value.walk_mut(f);
+                body.iter_mut().for_each(|s| s.walk_mut(f));
+            }
+            St::ForAll { set, body, .. } => {
+                set.walk_mut(f);
+                body.walk_mut(f);
+            }
+            St::SetEdit { place, elem, .. } => {
+                place.walk_mut(f);
+                elem.walk_mut(f);
+            }
+        }
+    }
+}

@@ -13,7 +13,7 @@ use glam::{DVec2, DVec3};
 
 use crate::lang::builtins::{Builtin, HostProperties, HostTable, SigError};
 use crate::lang::eval::Host;
-use crate::lang::ir::Func;
+use crate::lang::ir::{Ex, Func};
 use crate::lang::value::{Elem, IdSet, Ty, Value};
 
 use super::mesh::{Rotation, NULL};
@@ -53,6 +53,17 @@ pub mod id {
     pub const MESH: u16 = 18;
     pub const BOUNDARY: u16 = 19;
     pub const SIZE: u16 = 20;
+    // Specialisations (see `specialise`): a read of the old state fused
+    // into the read, a position read or written as such.
+    pub const POS: u16 = 100;
+    pub const POS_OLD: u16 = 101;
+    pub const GET_OLD: u16 = 102;
+    pub const SET_POS: u16 = 103;
+    pub const VALENCE_OLD: u16 = 104;
+    pub const NEXTTO_OLD: u16 = 105;
+    pub const PREVTO_OLD: u16 = 106;
+    pub const IS_IN_OLD: u16 = 107;
+    pub const ANY_OLD: u16 = 108;
 }
 
 const V: Ty = Ty::Elem(VERTEX);
@@ -500,6 +511,49 @@ impl Host for VvHost<'_> {
                 let (v, old) = arg(0);
                 Value::Bool(self.mesh.is_open(v, old)?)
             }
+            id::POS | id::POS_OLD => {
+                let (v, old) = arg(0);
+                Value::V3(self.mesh.pos(v, old || f == id::POS_OLD)?)
+            }
+            id::SET_POS => {
+                let v = self.current(&args[0], "`v$pos = ...`")?;
+                let p = match &args[1] {
+                    Value::V3(p) => *p,
+                    _ => DVec3::NAN,
+                };
+                if !p.is_finite() {
+                    return Err(format!(
+                        "a vertex position must be finite; this is ({}, {}, {})",
+                        p.x, p.y, p.z
+                    ));
+                }
+                self.mesh.set_pos(v, p)?;
+                args[1].clone()
+            }
+            id::GET_OLD => {
+                let t = match &args[0] {
+                    Value::Elem(e) => Value::Elem(Elem {
+                        flags: e.flags | OLD,
+                        ..*e
+                    }),
+                    other => other.clone(),
+                };
+                self.get(&t, args[1].as_i64() as usize)?
+            }
+            id::VALENCE_OLD => Value::Int(self.mesh.valence(arg(0).0, true)? as i64),
+            id::ANY_OLD => {
+                let a = self.mesh.any(arg(0).0, true)?;
+                self.value(a)
+            }
+            id::NEXTTO_OLD => {
+                let n = self.mesh.nextto(arg(0).0, arg(1).0, true)?;
+                self.value(n)
+            }
+            id::PREVTO_OLD => {
+                let n = self.mesh.prevto(arg(0).0, arg(1).0, true)?;
+                self.value(n)
+            }
+            id::IS_IN_OLD => Value::Bool(self.mesh.is_in(arg(0).0, arg(1).0, true)?),
             id::GET => self.get(&args[0], args[1].as_i64() as usize)?,
             id::SET => {
                 self.set(&args[0], args[1].as_i64() as usize, &args[2])?;
@@ -530,6 +584,57 @@ impl Host for VvHost<'_> {
             }
             _ => {}
         }
+    }
+}
+
+/// Rewrites the checked program's expressions for speed, meaning the
+/// same: `f('v)` of a query or selection becomes one call that reads the
+/// old state, and `v$pos` (read or written) a call of its own. A
+/// specialisation of the IR, as the surface grammars' are.
+/// `walk_mut` calls it on every node of a body, children first.
+pub fn specialise_node(e: &mut Ex) {
+    if let Some(f) = fused(e) {
+        *e = f;
+    }
+}
+
+fn host_args(e: &Ex, f: u16) -> Option<&[Ex]> {
+    match e {
+        Ex::Call(Func::Host(g), args, _) if *g == f => Some(args),
+        _ => None,
+    }
+}
+
+/// The vertex `'x` reads, when `e` is `old(x)`.
+fn old_of(e: &Ex) -> Option<&Ex> {
+    match host_args(e, id::OLD)? {
+        [x] => Some(x),
+        _ => None,
+    }
+}
+
+fn fused(e: &Ex) -> Option<Ex> {
+    let Ex::Call(Func::Host(f), args, span) = e else {
+        return None;
+    };
+    let call = |g: u16, args: Vec<Ex>| Some(Ex::Call(Func::Host(g), args, *span));
+    let pos = |k: &Ex| matches!(k, Ex::Const(Value::Int(0)));
+    match (*f, &args[..]) {
+        (id::GET, [t, k]) => match (old_of(t), pos(k)) {
+            (Some(x), true) => call(id::POS_OLD, vec![x.clone()]),
+            (Some(x), false) => call(id::GET_OLD, vec![x.clone(), k.clone()]),
+            (None, true) => call(id::POS, vec![t.clone()]),
+            (None, false) => None,
+        },
+        (id::SET, [t, k, v]) if pos(k) && old_of(t).is_none() => {
+            call(id::SET_POS, vec![t.clone(), v.clone()])
+        }
+        (id::VALENCE, [v]) => call(id::VALENCE_OLD, vec![old_of(v)?.clone()]),
+        (id::ANY, [v]) => call(id::ANY_OLD, vec![old_of(v)?.clone()]),
+        (id::NEXTTO, [x, v]) => call(id::NEXTTO_OLD, vec![x.clone(), old_of(v)?.clone()]),
+        (id::PREVTO, [x, v]) => call(id::PREVTO_OLD, vec![x.clone(), old_of(v)?.clone()]),
+        (id::IS_IN, [x, v]) => call(id::IS_IN_OLD, vec![x.clone(), old_of(v)?.clone()]),
+        _ => None,
     }
 }
 

@@ -1181,6 +1181,11 @@ impl Rotation {
     /// `set` as a polygon soup: the positions in `set`'s order and the
     /// faces of [`Rotation::faces`] by position in `set`.
     pub fn to_soup(&self, set: &[u32]) -> Result<PolygonSoup, String> {
+        self.to_soup_and_holes(set).map(|(soup, _)| soup)
+    }
+
+    /// [`Rotation::to_soup`], and the number of holes, from one walk.
+    pub fn to_soup_and_holes(&self, set: &[u32]) -> Result<(PolygonSoup, usize), String> {
         let mut index = vec![0u32; self.alive.len()];
         for (k, &v) in set.iter().enumerate() {
             if let Some(i) = index.get_mut(v as usize) {
@@ -1188,16 +1193,20 @@ impl Rotation {
             }
         }
         let mut faces = Vec::new();
+        let mut holes = 0;
         self.trace(set, |hole, vs| {
-            if !hole {
+            if hole {
+                holes += 1;
+            } else {
                 faces.push(vs.iter().map(|&v| index[v as usize]).collect());
             }
         })?;
-        Ok(PolygonSoup {
+        let soup = PolygonSoup {
             positions: set.iter().map(|&v| self.pos[v as usize]).collect(),
             faces,
             ..Default::default()
-        })
+        };
+        Ok((soup, holes))
     }
 }
 

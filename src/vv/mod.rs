@@ -3,7 +3,7 @@
 //! vertex-vertex algebra from programs in the `.lsys` language.
 //!
 //! A vv program is the third topology of the one production model: its
-//! statements are the host built-ins of [`host::VV_HOST`], checked by the
+//! statements are the host built-ins of `host::VV_HOST`, checked by the
 //! one checker and run by the one interpreter; [`run::VvRun`] is its
 //! schedule (`Start`, then `StartEach`, `Step`, `EndEach` per step, with
 //! the mesh's consistency checked after each).
@@ -19,7 +19,7 @@ use crate::syntax::ast::{ExprKind, Init, Item};
 use crate::syntax::lex::{Tok, Token};
 use crate::syntax::{parse, Diagnostic, Span};
 
-pub use mesh::Rotation;
+pub use mesh::{Rotation, NULL};
 pub use run::{VvError, VvProgram, VvRun};
 
 /// True when preprocessed tokens are a vv program: a line that starts
@@ -98,7 +98,7 @@ pub(crate) fn from_front(front: Front) -> Result<VvProgram, Error> {
     if !diags.is_empty() {
         return Err(fail(sources, diags));
     }
-    let program =
+    let mut program =
         match lang::compile::compile_on(&file, lang::compile::Precision::Double, &host::VV_HOST) {
             Ok(p) => p,
             Err(mut d) => {
@@ -110,6 +110,15 @@ pub(crate) fn from_front(front: Front) -> Result<VvProgram, Error> {
                 return Err(fail(sources, d));
             }
         };
+    for (_, body, _) in &mut program.control {
+        body.iter_mut()
+            .for_each(|s| s.walk_mut(&mut host::specialise_node));
+    }
+    for f in &mut program.functions {
+        f.body
+            .iter_mut()
+            .for_each(|s| s.walk_mut(&mut host::specialise_node));
+    }
     // Globals are numbered in declaration order by the checker too.
     let structure = program
         .globals

@@ -208,21 +208,30 @@ impl<'p> VvRun<'p> {
         Ok(())
     }
 
-    /// The structure's polygons (Edmonds' faces) and positions.
-    pub fn soup(&self) -> Result<PolygonSoup, VvError> {
+    /// The structure's polygons (Edmonds' faces) and positions, and its
+    /// number of holes (boundary loops).
+    pub fn soup(&self) -> Result<(PolygonSoup, usize), VvError> {
         self.mesh
-            .to_soup(self.members())
+            .to_soup_and_holes(self.members())
             .map_err(|message| VvError {
                 span: None,
                 message,
             })
     }
 
+    /// True when the program has a control block of `kind`.
+    fn has(&self, kind: ControlKind) -> bool {
+        self.vv.program.control.iter().any(|(k, _, _)| *k == kind)
+    }
+
     /// Runs the steps that remain, then `End`.
     pub fn finish(&mut self, mut progress: impl FnMut(&Self)) -> Result<(), VvError> {
         crate::production::run(self, &mut progress)?;
-        self.control(ControlKind::End)?;
-        self.end_of_step("`End`")
+        if self.has(ControlKind::End) {
+            self.control(ControlKind::End)?;
+            self.end_of_step("`End`")?;
+        }
+        Ok(())
     }
 
     /// The number of steps the run makes.
