@@ -405,3 +405,56 @@ fn table_2_null_and_no_effect_cases() {
     let printed: String = output.take_text().into_iter().map(|(_, t)| t).collect();
     assert_eq!(printed.trim(), "1 1 1 1 1 0");
 }
+
+/// The program the README shows is the polyhedral subdivision of
+/// `lsystems/vv/polyhedral.lsys`, and runs as printed.
+#[test]
+fn the_readme_program_runs_as_printed() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let section = &readme[readme.find("## Vertex-vertex programs").unwrap()..];
+    let start = section.find("```c\n").unwrap() + 5;
+    let text = &section[start..start + section[start..].find("```").unwrap()];
+    let dir = TempDir::new();
+    let file = dir.path().join("readme.lsys");
+    std::fs::write(&file, text).unwrap();
+    let a = run(&file, &mesh("octahedron.obj"), 2, &[]);
+    let b = run(&vv("polyhedral.lsys"), &mesh("octahedron.obj"), 2, &[]);
+    assert_same_mesh(&a, &b, 0.0, "the README's program");
+    assert_eq!(a.faces.len(), 8 * 16);
+}
+
+/// The tissue example stays a sheet of cells: a disk (V - E + F = 1, one
+/// boundary loop) whose cells keep a positive area in the plane, never
+/// fewer from one step to the next, and none more than twice the area at
+/// which a cell divides (0.1 in the file).
+#[test]
+fn the_tissue_grows_and_divides_into_proper_cells() {
+    let file = vv("tissue.lsys");
+    let system = subgram::load(&file, &LoadOptions::default()).unwrap();
+    let mut cells = 0;
+    for steps in 0..=10 {
+        let Run::Vv(r) = system
+            .run(&RunOptions::default().with_steps(steps))
+            .unwrap()
+        else {
+            panic!("a vv program")
+        };
+        let info = &r.info;
+        assert_eq!(info.euler_characteristic, 1, "step {steps}");
+        assert_eq!(info.boundary_loops, 1, "step {steps}");
+        assert!(info.faces >= cells, "step {steps}: fewer cells");
+        cells = info.faces;
+        for f in &r.soup.faces {
+            let p = |i: usize| r.soup.positions[f[i % f.len()] as usize];
+            let area: f64 = (0..f.len())
+                .map(|i| p(i).x * p(i + 1).y - p(i + 1).x * p(i).y)
+                .sum::<f64>()
+                / 2.0;
+            assert!(
+                area > 0.0 && area <= 0.2,
+                "step {steps}: a cell of area {area}"
+            );
+        }
+    }
+    assert!(cells > 16 * 4, "only {cells} cells after 10 steps");
+}
