@@ -135,3 +135,18 @@ pub(crate) fn from_front(front: Front) -> Result<VvProgram, Error> {
         base,
     })
 }
+
+impl Rotation {
+    /// The rotation system of a half-edge mesh: its polygons as the mesh
+    /// shows them (basic blocks as quads), ids in the mesh's vertex order;
+    /// the members in id order.
+    pub fn from_halfedge(m: &crate::mesh::Mesh) -> Result<(Rotation, Vec<u32>), String> {
+        Rotation::from_soup(&m.to_quad_soup())
+    }
+
+    /// The half-edge mesh of the faces of `set` (Edmonds' orbits), its
+    /// vertices in the order of `set`.
+    pub fn to_halfedge(&self, set: &[u32]) -> Result<crate::mesh::Mesh, String> {
+        crate::mesh::Mesh::from_soup(&self.to_soup(set)?).map_err(|e| e.to_string())
+    }
+}

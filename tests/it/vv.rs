@@ -458,3 +458,29 @@ fn the_tissue_grows_and_divides_into_proper_cells() {
     }
     assert!(cells > 16 * 4, "only {cells} cells after 10 steps");
 }
+
+/// A half-edge mesh becomes a rotation system and back, unchanged: closed
+/// and open, triangles and quads.
+#[test]
+fn the_rotation_system_converts_to_and_from_the_half_edge_mesh() {
+    use subgram::vv::Rotation;
+    for m in [
+        "cube.obj",
+        "octahedron.obj",
+        "torus.obj",
+        "grid.obj",
+        "pentagon-patch.obj",
+    ] {
+        let mesh = subgram::load_mesh(&self::mesh(m)).unwrap();
+        let (rot, members) = Rotation::from_halfedge(&mesh).unwrap();
+        assert_eq!(members.len(), mesh.vertex_count(), "{m}");
+        rot.check(&members).unwrap_or_else(|e| panic!("{m}: {e}"));
+        let back = rot.to_halfedge(&members).unwrap();
+        // The same polygons on the same vertices (a quad's diagonal inside
+        // the half-edge mesh is its own business).
+        let (a, b) = (mesh.to_quad_soup(), back.to_quad_soup());
+        assert_eq!(a.positions, b.positions, "{m}");
+        assert_same_mesh(&a, &b, 0.0, m);
+        assert_eq!(back.info().faces, mesh.info().faces, "{m}");
+    }
+}
