@@ -52,6 +52,14 @@ details = ['"format"', '"subgram-details"', '"version"', '"scheme"', '"builtin:c
            "1e308", "-1e308", "18446744073709551615", "4294967295", "0", "6", "[0.5,0.5]"]
 
 
+vv = """mesh vertex edge Step: Start: End: forall in add to remove from merge with synchronize make nb_of erase replace splice after before
+is valence any nextto prevto null boundary( size( check( $pos $ ' StepNo() V3d( .x .y .z""".split()
+vv_snippets = ["mesh S;", "mesh NV;", "vertex x;", "vertex float g = 1;", "edge int w;", "mesh int n;", "(p, q)$w", "mesh$n",
+               "forall p in S { }", "forall q in 'p { }", "add x to NV;", "merge S with NV;", "synchronize S;",
+               "make {p, null, q} nb_of x;", "replace q with x in p;", "splice x after q in p;", "erase q from p;",
+               "x$pos = 0.5 * ('p$pos + 'q$pos);", "if (p < q)", "nextto q in 'p", "prevto x in p", "any in x", "valence 'p",
+               "void f(vertex p, vertex q) { }", "Step: { }"]
+
 def esc(s):
     return ''.join('\\x%02x' % ord(c) if c in '"\\' or ord(c) < 32 or ord(c) >= 127 else c for c in s)
 
@@ -66,12 +74,14 @@ def write(name, header, toks):
         f.write(''.join('"%s"\n' % esc(t) for t in seen))
 
 
-write('lsys_check', '.lsys curve L-systems and surface grammars: keywords, directives, punctuation, lpfg modules',
-      lang + punct + curve_snippets + surface + surface_snippets)
+write('lsys_check', '.lsys curve L-systems, surface grammars and vv programs: keywords, directives, punctuation, lpfg modules',
+      lang + punct + curve_snippets + surface + surface_snippets + vv + vv_snippets)
 write('lsys_derive', 'curve L-systems: keywords, directives, punctuation, lpfg modules and turtle commands',
       lang + punct + curve_snippets)
 write('surface_run', 'surface grammars: directives, rule forms, host built-ins, the shared expression language',
       surface + surface_snippets + punct + "int float bool if else sqrt cos sin pow fabs PI #define".split())
+write('vv_run', 'vv programs: the algebra statements and built-ins, properties, the shared expression language',
+      vv + vv_snippets + punct + "int float double bool if else while for return sqrt cos sin pow PI".split())
 write('mesh_read', 'OBJ, OFF and PLY keywords, types and numbers', mesh)
 write('contour_reverse', 'contours: point lists, SVG elements and path commands, PNG signature and chunk names', contour)
 write('details_reconstruct', 'details files (JSON): keys, values, extreme numbers', details)

@@ -38,6 +38,7 @@ pub const TARGETS: &[(&str, Body)] = &[
     ("contour_reverse", contour_reverse),
     ("details_reconstruct", details_reconstruct),
     ("model_files", model_files),
+    ("vv_run", vv_run),
 ];
 
 /// Steps of a curve derivation.
@@ -205,6 +206,40 @@ pub fn surface_run(data: &[u8]) {
     };
     if let Ok(scene) = render::mesh::scene(&soup, &view) {
         std::hint::black_box(scene);
+    }
+}
+
+/// The most vertices a vv program may make in a fuzz run.
+pub const MAX_VV_VERTICES: usize = 20_000;
+
+/// (h) A vv program loaded and run on the fixed base mesh of
+/// [`base_mesh`] (or the one it builds in `Start`) for its derivation
+/// length clamped to 1..=2 steps, with at most [`MAX_VV_VERTICES`]
+/// vertices; whether it succeeds or stops with an error, what it made is
+/// described, and its polygons drawn into a scene.
+pub fn vv_run(data: &[u8]) {
+    let text = text(data);
+    let Ok(System::Vv(mut vv)) = subgram::load_text("fuzz.lsys", &text, &LoadOptions::default())
+    else {
+        return;
+    };
+    vv.program.max_vertices = MAX_VV_VERTICES;
+    let opts = subgram::RunOptions::default().with_steps(1 + data.len() as u64 % 2);
+    match vv.run_soup(&base_mesh(data), &opts) {
+        Ok(run) => {
+            std::hint::black_box(run.info.to_string());
+            let view = render::mesh::MeshView {
+                width: 64,
+                height: 64,
+                ..Default::default()
+            };
+            if let Ok(scene) = render::mesh::scene(&run.soup, &view) {
+                std::hint::black_box(scene);
+            }
+        }
+        Err(e) => {
+            std::hint::black_box(e.to_string());
+        }
     }
 }
 

@@ -314,6 +314,8 @@ pub fn decode(ty: Ty, s: &[f64]) -> Value {
 pub struct VvHost<'a> {
     pub mesh: &'a mut Rotation,
     pub layouts: &'a Layouts,
+    /// `vertex v;` beyond this many live vertices is an error.
+    pub max_vertices: usize,
 }
 
 /// The vertex an argument holds, and whether it was read as `'v`.
@@ -423,6 +425,12 @@ impl Host for VvHost<'_> {
         let arg = |i: usize| args.get(i).map_or((NULL, false), vert);
         Ok(match f {
             id::NEW => {
+                if self.mesh.len() >= self.max_vertices {
+                    return Err(format!(
+                        "a vertex beyond the {} the mesh may hold (a loop that makes vertices without end?)",
+                        self.max_vertices
+                    ));
+                }
                 let v = self.mesh.new_vertex();
                 self.value(v)
             }

@@ -133,6 +133,7 @@ pub(crate) fn from_front(front: Front) -> Result<VvProgram, Error> {
         structure,
         structure_name: (name, span),
         base,
+        max_vertices: run::MAX_VV_VERTICES,
     })
 }
 

@@ -20,8 +20,10 @@ use super::mesh::Rotation;
 /// The most steps a vv program may run.
 pub const MAX_VV_STEPS: u64 = 1000;
 
-/// The most vertices a vv mesh may hold.
-pub const MAX_VV_VERTICES: usize = 20_000_000;
+/// The most vertices a vv mesh may hold, by default: about 2 GB of
+/// neighbour lists and positions (Loop makes 2.6 million from an
+/// 81,920-triangle sphere in three steps).
+pub const MAX_VV_VERTICES: usize = 5_000_000;
 
 /// A checked vv program.
 #[derive(Debug)]
@@ -36,6 +38,9 @@ pub struct VvProgram {
     /// The base mesh file its declaration names (`mesh S = "cube.obj";`),
     /// as written, with the span of the string.
     pub base: Option<(String, Span)>,
+    /// Creating a vertex beyond this many is an error
+    /// ([`MAX_VV_VERTICES`] unless changed).
+    pub max_vertices: usize,
 }
 
 /// Why a run stopped: a message, located in the program when a statement
@@ -160,14 +165,12 @@ impl<'p> VvRun<'p> {
     fn control(&mut self, kind: ControlKind) -> Result<(), VvError> {
         for (k, body, frame) in &self.vv.program.control {
             if *k == kind {
-                run_body(
-                    &mut self.interp,
-                    body,
-                    *frame,
-                    &mut self.env,
-                    &mut self.mesh,
-                    &self.layouts,
-                )?;
+                let mut host = VvHost {
+                    mesh: &mut self.mesh,
+                    layouts: &self.layouts,
+                    max_vertices: self.vv.max_vertices,
+                };
+                run_body(&mut self.interp, body, *frame, &mut self.env, &mut host)?;
             }
         }
         Ok(())
@@ -196,15 +199,6 @@ impl<'p> VvRun<'p> {
             collect_vertices(g, &mut roots);
         }
         self.mesh.retain(&roots);
-        if self.mesh.len() > MAX_VV_VERTICES {
-            return Err(VvError {
-                span: None,
-                message: format!(
-                    "the mesh holds {} vertices, more than the {MAX_VV_VERTICES} allowed",
-                    self.mesh.len()
-                ),
-            });
-        }
         Ok(())
     }
 
@@ -257,13 +251,11 @@ fn run_body(
     body: &[St],
     frame: usize,
     env: &mut Env,
-    mesh: &mut Rotation,
-    layouts: &Layouts,
+    host: &mut VvHost,
 ) -> Result<(), VvError> {
     let mut frame = vec![Value::Void; frame];
     let mut sink: Vec<(crate::lang::modules::Sym, Vec<Value>)> = Vec::new();
-    let mut host = VvHost { mesh, layouts };
-    interp.run(body, &mut frame, env, &mut host, &mut sink)?;
+    interp.run(body, &mut frame, env, host, &mut sink)?;
     Ok(())
 }
 

@@ -126,6 +126,11 @@ fn details_reconstruct() {
 }
 
 #[test]
+fn vv_run() {
+    replay("vv_run");
+}
+
+#[test]
 fn model_files() {
     replay("model_files");
 }
