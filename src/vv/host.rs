@@ -628,6 +628,7 @@ fn fused(e: &Ex) -> Option<Ex> {
     let call = |g: u16, args: Vec<Ex>| Some(Ex::Call(Func::Host(g), args, *span));
     let pos = |k: &Ex| matches!(k, Ex::Const(Value::Int(0)));
     match (*f, &args[..]) {
+        (id::NULL, []) => Some(Ex::Const(null())),
         (id::GET, [t, k]) => match (old_of(t), pos(k)) {
             (Some(x), true) => call(id::POS_OLD, vec![x.clone()]),
             (Some(x), false) => call(id::GET_OLD, vec![x.clone(), k.clone()]),
