@@ -484,3 +484,21 @@ fn the_rotation_system_converts_to_and_from_the_half_edge_mesh() {
         assert_eq!(back.info().faces, mesh.info().faces, "{m}");
     }
 }
+
+/// A tetrahedron written as neighbour lists, divided k times: 4 * 4^k
+/// triangles, 2 + 2 * 4^k vertices (Euler: V - E + F = 2 with E = 3F/2),
+/// every vertex on the unit sphere.
+#[test]
+fn a_base_mesh_written_as_neighbour_lists() {
+    let system = subgram::load(vv("geodesic.lsys"), &LoadOptions::default()).unwrap();
+    for k in 0..=3u32 {
+        let Run::Vv(r) = system.run(&RunOptions::default().with_steps(k as u64)).unwrap() else {
+            panic!("a vv program")
+        };
+        let f = 4 * 4usize.pow(k);
+        assert_eq!((r.info.faces, r.info.vertices), (f, 2 + f / 2), "k = {k}");
+        for p in &r.soup.positions {
+            assert!((p.length() - 1.0).abs() < 1e-12 || k == 0, "{p}");
+        }
+    }
+}
