@@ -826,7 +826,8 @@ impl Rotation {
     /// corner in a gap, at least 3 vertices, none twice) or a hole (every
     /// corner in a gap, at least 3 vertices).
     pub fn check(&self, set: &[u32]) -> Result<(), String> {
-        self.trace(set, |_, _| {})
+        // The order of the orbits does not matter to a check.
+        self.trace(set, false, |_, _| {})
     }
 
     /// The faces of the polygonal interpretation of `set` (Edmonds'
@@ -847,7 +848,7 @@ impl Rotation {
 
     fn orbits(&self, set: &[u32], holes: bool) -> Result<Vec<Vec<u32>>, String> {
         let mut out = Vec::new();
-        self.trace(set, |hole, vs| {
+        self.trace(set, true, |hole, vs| {
             if hole == holes {
                 out.push(vs.to_vec());
             }
@@ -869,7 +870,16 @@ impl Rotation {
     /// their other ends. Each step checks the vertex it comes to (alive, in
     /// the set, listing the vertex it came from); every directed edge is
     /// walked once.
-    fn trace(&self, set: &[u32], mut each: impl FnMut(bool, &[u32])) -> Result<(), String> {
+    ///
+    /// With `ordered` false the orbits come in no particular order (the
+    /// edges of a member in the order of its list), which is all a check
+    /// needs.
+    fn trace(
+        &self,
+        set: &[u32],
+        ordered: bool,
+        mut each: impl FnMut(bool, &[u32]),
+    ) -> Result<(), String> {
         const NONE: u32 = u32::MAX;
         let slots = self.alive.len();
         // Each member's first directed edge in `seen_edge`; NONE for the
@@ -892,7 +902,7 @@ impl Rotation {
             offset[v as usize] = 0;
         }
         let sorted;
-        let members = if set.is_sorted() {
+        let members = if !ordered || set.is_sorted() {
             set
         } else {
             sorted = {
@@ -927,7 +937,9 @@ impl Rotation {
             let start = &self.nbs[u as usize];
             order.clear();
             order.extend(start.iter().enumerate().map(|(p, &v)| (v, p)));
-            order.sort_unstable();
+            if ordered {
+                order.sort_unstable();
+            }
             for &(v, p) in &order {
                 if seen_edge[offset[u as usize] as usize + p] {
                     continue;
@@ -1194,7 +1206,7 @@ impl Rotation {
         }
         let mut faces = Vec::new();
         let mut holes = 0;
-        self.trace(set, |hole, vs| {
+        self.trace(set, true, |hole, vs| {
             if hole {
                 holes += 1;
             } else {

@@ -492,7 +492,10 @@ fn the_rotation_system_converts_to_and_from_the_half_edge_mesh() {
 fn a_base_mesh_written_as_neighbour_lists() {
     let system = subgram::load(vv("geodesic.lsys"), &LoadOptions::default()).unwrap();
     for k in 0..=3u32 {
-        let Run::Vv(r) = system.run(&RunOptions::default().with_steps(k as u64)).unwrap() else {
+        let Run::Vv(r) = system
+            .run(&RunOptions::default().with_steps(k as u64))
+            .unwrap()
+        else {
             panic!("a vv program")
         };
         let f = 4 * 4usize.pow(k);
