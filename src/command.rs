@@ -128,6 +128,10 @@ fn derive_text(
     match system {
         System::Vv(v) => {
             let run = v.run(&opts, progress)?;
+            // The files the program wrote (`fopen`), never over its inputs.
+            let mut inputs = vec![PathBuf::from(&a.file)];
+            inputs.extend(v.base_mesh());
+            write_program_files(&a.output, dir, &as_paths(&inputs))?;
             Ok(if a.json {
                 json(&run.info)?
             } else {
@@ -291,12 +295,18 @@ fn render_system(
         }
         System::Vv(v) => {
             looks.check()?;
+            let dir = writes_folder(&a.allow_writes, &a.program_output)?;
             let opts = RunOptions {
                 steps: a.steps,
+                max_modules: a.max_modules,
                 deadline,
+                output: a.program_output.clone(),
                 ..RunOptions::default()
             };
             let run = v.run(&opts, progress)?;
+            let mut inputs = vec![file.to_path_buf(), output.to_path_buf()];
+            inputs.extend(v.base_mesh());
+            write_program_files(&a.program_output, dir.as_deref(), &as_paths(&inputs))?;
             write_soup_picture(&run.soup, output, looks)?;
             Ok(Vec::new())
         }

@@ -428,6 +428,12 @@ impl Vv {
         opts: &RunOptions,
         mut progress: impl FnMut(Progress),
     ) -> Result<VvResult, Error> {
+        if let Some(n) = opts.steps.filter(|&n| n > crate::vv::run::MAX_VV_STEPS) {
+            return Err(Error::Usage(format!(
+                "{n} steps are more than a vv program may run ({})",
+                crate::vv::run::MAX_VV_STEPS
+            )));
+        }
         let mut run = self
             .program
             .start(soup, opts.steps, opts.deadline, opts.output.clone())

@@ -1026,8 +1026,22 @@ impl Compiler {
                         program.rules.push(rule);
                     }
                 }
-                Item::Property { ty, name, init, .. } => {
-                    let Some(p) = self.props.iter().find(|p| p.name == name.text) else {
+                Item::Property {
+                    owner,
+                    ty,
+                    name,
+                    init,
+                } => {
+                    // The same name may be a property of each owner.
+                    let o = self
+                        .host
+                        .properties
+                        .and_then(|ps| ps.owners.iter().position(|n| *n == owner.text));
+                    let Some(p) = self
+                        .props
+                        .iter()
+                        .find(|p| Some(p.owner as usize) == o && p.name == name.text)
+                    else {
                         continue;
                     };
                     let (owner, pty, index) = (p.owner, p.ty, p.index);
@@ -4174,6 +4188,11 @@ impl Compiler {
                             self.type_name(w)
                         }
                     ),
+                    // Vectors and structs have fields to print; a
+                    // topology's element (a vv vertex, a set) has none.
+                    None if matches!(t, Ty::Elem(_)) => {
+                        format!("`{n}` prints numbers and strings, not {found}")
+                    }
                     None => format!(
                         "`{n}` prints numbers and strings, not {found}; print its fields (`v.x`)"
                     ),

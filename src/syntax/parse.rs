@@ -1709,7 +1709,12 @@ impl<'t> Parser<'t> {
     #[inline(never)]
     fn vv_stmt(&mut self, w: &str) -> PResult<Option<Stmt>> {
         let next = self.peek_at(1).map(|t| &t.tok);
-        let operand = matches!(next, Some(Tok::Ident(_)) | Some(Tok::Punct("'")))
+        // A constant after the word is a wrong operand of the statement
+        // (`add 3 to S`), for the checker to name, not an expression.
+        let operand = matches!(
+            next,
+            Some(Tok::Ident(_) | Tok::Punct("'") | Tok::Int(_) | Tok::Float { .. } | Tok::Str(_))
+        )
             || (w == "make" && matches!(next, Some(Tok::Punct("{"))));
         if !operand {
             return Ok(None);

@@ -316,6 +316,10 @@ pub struct VvHost<'a> {
     pub layouts: &'a Layouts,
     /// `vertex v;` beyond this many live vertices is an error.
     pub max_vertices: usize,
+    /// A neighbourhood of more vertices than this is an error: queries
+    /// and edits scan a neighbourhood, so a valence that grows without
+    /// end makes a run quadratic.
+    pub max_valence: usize,
 }
 
 /// The vertex an argument holds, and whether it was read as `'v`.
@@ -333,6 +337,19 @@ impl VvHost<'_> {
         } else {
             vertex(v, self.mesh.generation(v).unwrap_or(0))
         }
+    }
+
+    /// Refuses a neighbourhood of `v` past the valence limit.
+    fn bounded(&self, v: u32) -> Result<(), String> {
+        let n = self.mesh.valence(v, false)?;
+        if n > self.max_valence {
+            return Err(format!(
+                "vertex {v} would have {n} neighbours, more than the {} allowed \
+                 (`SUBGRAM_MAX_VALENCE=N` in the environment sets the bound)",
+                self.max_valence
+            ));
+        }
+        Ok(())
     }
 
     /// An edited vertex: its current state (`'v` cannot be edited).
@@ -362,6 +379,11 @@ impl VvHost<'_> {
                 let l = self.layouts.edge[index];
                 match self.mesh.edge_property(e.ids[0], e.ids[2], l.index, old)? {
                     Some(s) => Ok(decode(l.ty, s)),
+                    None if old => Err(format!(
+                        "the edge ({}, {}) was not in the mesh at the last `synchronize`: \
+                         {} was not a neighbour of {}",
+                        e.ids[0], e.ids[2], e.ids[2], e.ids[0]
+                    )),
                     None => Err(format!(
                         "the edge ({}, {}) is not in the mesh: {} is not a neighbour of {}",
                         e.ids[0], e.ids[2], e.ids[2], e.ids[0]
@@ -380,9 +402,12 @@ impl VvHost<'_> {
             return Ok(());
         };
         if e.flags & OLD != 0 {
-            return Err(
-                "`'v$...` is the state the last `synchronize` kept; assign to `v$...`".into(),
-            );
+            return Err(if e.kind == EDGE {
+                "`('p, q)$...` is the state the last `synchronize` kept; assign to `(p, q)$...`"
+            } else {
+                "`'v$...` is the state the last `synchronize` kept; assign to `v$...`"
+            }
+            .into());
         }
         let mut buf = [0.0; 3];
         match e.kind {
@@ -466,6 +491,14 @@ impl Host for VvHost<'_> {
             id::MAKE => {
                 let v = self.current(&args[0], "`make`")?;
                 let list: Vec<u32> = args[1..].iter().map(|a| vert(a).0).collect();
+                let n = list.iter().filter(|&&x| x != NULL).count();
+                if n > self.max_valence && self.mesh.is_alive(v) {
+                    return Err(format!(
+                        "vertex {v} would have {n} neighbours, more than the {} allowed \
+                         (`SUBGRAM_MAX_VALENCE=N` in the environment sets the bound)",
+                        self.max_valence
+                    ));
+                }
                 self.mesh.make(v, &list)?;
                 Value::Void
             }
@@ -486,6 +519,7 @@ impl Host for VvHost<'_> {
                 } else {
                     self.mesh.splice_before(arg(0).0, arg(1).0, v)?;
                 }
+                self.bounded(v)?;
                 Value::Void
             }
             id::SYNCHRONIZE => {
@@ -505,13 +539,15 @@ impl Host for VvHost<'_> {
                 _ => Value::Int(0),
             },
             id::EDGE => {
-                let ((p, _), (q, _)) = (arg(0), arg(1));
+                // `('p, q)` is the edge as the last `synchronize` kept it:
+                // its properties live with `p`'s neighbourhood.
+                let ((p, old), (q, _)) = (arg(0), arg(1));
                 if p == NULL || q == NULL {
                     return Err("an edge `(p, q)` of the null vertex".into());
                 }
                 Value::Elem(Elem {
                     kind: EDGE,
-                    flags: 0,
+                    flags: if old { OLD } else { 0 },
                     ids: [p, 0, q, 0],
                 })
             }

@@ -64,6 +64,17 @@ pub(crate) fn from_front(front: Front) -> Result<VvProgram, Error> {
         match item {
             Item::Global(d) => {
                 for v in &mut d.vars {
+                    if structure.is_some() && d.ty.name == "mesh" {
+                        if let Init::Expr(e) = &v.init {
+                            if let ExprKind::Str(_) = &e.kind {
+                                diags.push(Diagnostic::new(
+                                    e.span,
+                                    "only the structure, the first global `mesh`, reads a base \
+                                     mesh file; build this set in `Start` or a step",
+                                ));
+                            }
+                        }
+                    }
                     if structure.is_none() && d.ty.name == "mesh" && v.dims.is_empty() {
                         let mut base = None;
                         if let Init::Expr(e) = &v.init {

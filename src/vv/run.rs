@@ -25,6 +25,35 @@ pub const MAX_VV_STEPS: u64 = 1000;
 /// 81,920-triangle sphere in three steps).
 pub const MAX_VV_VERTICES: usize = 5_000_000;
 
+/// The environment variable that sets the valence limit, as for surface
+/// grammars: `SUBGRAM_MAX_VALENCE=5000`.
+use crate::surface::run::MAX_VALENCE_VAR;
+
+/// The valence limit: [`MAX_VALENCE_VAR`] where it is set, else the
+/// surface grammars' default (1000); raised to twice the base mesh's
+/// highest valence.
+fn valence_limit(mesh: &Rotation, members: &[u32]) -> Result<usize, String> {
+    let configured = match std::env::var(MAX_VALENCE_VAR) {
+        Err(std::env::VarError::NotPresent) => crate::surface::run::MAX_VALENCE,
+        Ok(v) => v
+            .trim()
+            .parse()
+            .map_err(|_| format!("{MAX_VALENCE_VAR} must be a whole number, found `{v}`"))?,
+        Err(std::env::VarError::NotUnicode(v)) => {
+            return Err(format!(
+                "{MAX_VALENCE_VAR} must be a whole number, found `{}`",
+                v.to_string_lossy()
+            ))
+        }
+    };
+    let highest = members
+        .iter()
+        .map(|&v| mesh.valence(v, false).unwrap_or(0))
+        .max()
+        .unwrap_or(0);
+    Ok(configured.max(2 * highest))
+}
+
 /// A checked vv program.
 #[derive(Debug)]
 pub struct VvProgram {
@@ -67,6 +96,8 @@ pub struct VvRun<'p> {
     pub env: Env,
     layouts: Layouts,
     interp: Interp<'p>,
+    /// The valence limit of this run (see `valence_limit`).
+    max_valence: usize,
     steps: u64,
     length: u64,
 }
@@ -103,6 +134,10 @@ impl VvProgram {
             })?,
             None => (Rotation::new(), Vec::new()),
         };
+        let max_valence = valence_limit(&mesh, &members).map_err(|message| VvError {
+            span: None,
+            message,
+        })?;
         env.globals[self.structure as usize] = host::set_value(members);
         let mut layouts = Layouts::default();
         for p in &program.properties {
@@ -127,6 +162,7 @@ impl VvProgram {
             env,
             layouts,
             interp,
+            max_valence,
             steps: 0,
             length: 0,
         };
@@ -169,6 +205,7 @@ impl<'p> VvRun<'p> {
                     mesh: &mut self.mesh,
                     layouts: &self.layouts,
                     max_vertices: self.vv.max_vertices,
+                    max_valence: self.max_valence,
                 };
                 run_body(&mut self.interp, body, *frame, &mut self.env, &mut host)?;
             }
@@ -182,7 +219,7 @@ impl<'p> VvRun<'p> {
     }
 
     /// The consistency check of the structure, then the release of every
-    /// vertex that no global holds.
+    /// vertex that the program can no longer reach.
     fn end_of_step(&mut self, after: &str) -> Result<(), VvError> {
         let members = host::set_ids(&self.env.globals[self.vv.structure as usize]);
         if let Err(m) = self.mesh.check(members) {
@@ -198,6 +235,7 @@ impl<'p> VvRun<'p> {
         for g in &self.env.globals {
             collect_vertices(g, &mut roots);
         }
+        reachable(&self.mesh, &mut roots);
         self.mesh.retain(&roots);
         Ok(())
     }
@@ -243,6 +281,34 @@ fn collect_vertices(v: &Value, out: &mut Vec<u32>) {
         Value::Set(s) => out.extend_from_slice(s.ids()),
         Value::Struct(fs) => fs.iter().for_each(|f| collect_vertices(f, out)),
         _ => {}
+    }
+}
+
+/// Extends `roots` (vertices the globals hold) with every vertex reachable
+/// from them through current and old (`'v`) neighbourhoods: a program
+/// reaches those with `forall x in v` and `forall x in 'v`, so freeing one
+/// and reusing its slot would make a stale id name a new vertex.
+fn reachable(mesh: &Rotation, roots: &mut Vec<u32>) {
+    let mut seen = vec![false; mesh.slots()];
+    roots.retain(|&v| {
+        let fresh = mesh.is_alive(v) && !seen[v as usize];
+        if fresh {
+            seen[v as usize] = true;
+        }
+        fresh
+    });
+    let mut k = 0;
+    while k < roots.len() {
+        let v = roots[k];
+        k += 1;
+        let old = mesh.neighbours(v, true).unwrap_or(&[]);
+        let cur = mesh.neighbours(v, false).unwrap_or(&[]);
+        for &x in cur.iter().chain(old) {
+            if mesh.is_alive(x) && !seen[x as usize] {
+                seen[x as usize] = true;
+                roots.push(x);
+            }
+        }
     }
 }
 
