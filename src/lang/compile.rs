@@ -2669,6 +2669,13 @@ impl Compiler {
             );
             return None;
         };
+        // A topology may check what a loop goes over (vv: a vertex that
+        // has a neighbourhood to list) through its built-in `$forall`,
+        // which gives it back; a host's `members` lists nothing otherwise.
+        let sx = match self.host.function("$forall").map(|b| (b.resolve)(&[st])) {
+            Some(Ok((f, _))) => Ex::Call(f, vec![sx], set.span),
+            _ => sx,
+        };
         scope.push();
         let slot = self.local(scope, &var.text, Ty::Elem(member), var.span);
         scope.loops += 1;
@@ -2734,6 +2741,15 @@ impl Compiler {
             return None;
         }
         let _ = span;
+        // A topology may refuse what joins a set (vv: the null vertex)
+        // through its built-in `$member`, which gives the element back.
+        let ex = match (op, self.host.function("$member")) {
+            (ast::SetEditOp::Add, Some(b)) => match (b.resolve)(&[et]) {
+                Ok((f, _)) => Ex::Call(f, vec![ex], elem.span),
+                Err(_) => ex,
+            },
+            _ => ex,
+        };
         Some(St::SetEdit {
             place,
             op,
@@ -2797,6 +2813,11 @@ impl Compiler {
             self.err(set_span, "this expression needs too many variables");
             return None;
         }
+        // As for `forall`: the topology may check what is folded over.
+        let set = match self.host.function("$forall").map(|b| (b.resolve)(&[set_ty])) {
+            Some(Ok((f, _))) => Ex::Call(f, vec![set], set_span),
+            _ => set,
+        };
         let mark = (scope.vars.len(), scope.next);
         let name = var.map_or("", |v| v.text.as_str());
         let slot = self.local(scope, name, Ty::Elem(member), op.span);

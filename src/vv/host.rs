@@ -53,6 +53,8 @@ pub mod id {
     pub const MESH: u16 = 18;
     pub const BOUNDARY: u16 = 19;
     pub const SIZE: u16 = 20;
+    pub const MEMBER: u16 = 21;
+    pub const FORALL: u16 = 22;
     // Specialisations (see `specialise`): a read of the old state fused
     // into the read, a position read or written as such.
     pub const POS: u16 = 100;
@@ -108,6 +110,14 @@ macro_rules! vv {
 
 static FUNCTIONS: &[Builtin] = &[
     vv!("$new", 0, id::NEW, V, "`vertex v;` creates a vertex"),
+    // What `add v to S` adds: the checker passes it through this, which
+    // refuses the null vertex (a set of ids holds no null).
+    vv!("$member", 1, id::MEMBER, V, "`add v to S` takes a vertex"),
+    // What `forall x in v` goes over, when it is a vertex: the checker
+    // passes it through this, which refuses a vertex with no
+    // neighbourhood to list (the null vertex, `'v` before a
+    // `synchronize`) instead of looping over nothing.
+    vv!("$forall", 1, id::FORALL, V, "`forall x in v` takes a vertex"),
     vv!("old", 1, id::OLD, V, "`'v` (or `old(v)`) takes a vertex"),
     vv!(
         "valence",
@@ -287,6 +297,22 @@ pub fn width(ty: Ty) -> usize {
     }
 }
 
+/// The largest magnitude of an `int` property: properties are stored as
+/// `f64`s, which hold every integer up to 2^53 exactly.
+pub const MAX_INT_PROPERTY: i64 = 1 << 53;
+
+/// Refuses a value that a property's slots would not hold exactly: an
+/// `int` beyond ±2^53.
+pub fn storable(v: &Value) -> Result<(), String> {
+    match v {
+        Value::Int(i) if i.unsigned_abs() > MAX_INT_PROPERTY as u64 => Err(format!(
+            "an `int` property holds whole numbers up to 2^53 = {MAX_INT_PROPERTY} in \
+             magnitude; this is {i}"
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// A value of a property's type as slots.
 pub fn encode(v: &Value, out: &mut [f64]) {
     match v {
@@ -410,6 +436,7 @@ impl VvHost<'_> {
             .into());
         }
         let mut buf = [0.0; 3];
+        storable(value)?;
         match e.kind {
             VERTEX if index == 0 => {
                 let p = match value {
@@ -458,6 +485,25 @@ impl Host for VvHost<'_> {
                 }
                 let v = self.mesh.new_vertex();
                 self.value(v)
+            }
+            id::MEMBER => {
+                let (v, old) = arg(0);
+                if v == NULL {
+                    return Err("`add v to S`: the null vertex cannot be a member of a set".into());
+                }
+                if !self.mesh.is_alive(v) {
+                    return Err(format!(
+                        "`add v to S`: vertex {v} no longer exists"
+                    ));
+                }
+                // `add 'v to S` adds the vertex itself.
+                let _ = old;
+                self.value(v)
+            }
+            id::FORALL => {
+                let (v, old) = arg(0);
+                self.mesh.neighbours(v, old)?;
+                args[0].clone()
             }
             id::OLD => match args.first() {
                 Some(Value::Elem(e)) => Value::Elem(Elem {

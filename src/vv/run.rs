@@ -142,6 +142,10 @@ impl VvProgram {
         let mut layouts = Layouts::default();
         for p in &program.properties {
             let value = interp.eval_global(&p.init, &mut env)?.convert(p.ty);
+            host::storable(&value).map_err(|message| VvError {
+                span: Some(p.span),
+                message,
+            })?;
             let mut slots = vec![0.0; host::width(p.ty)];
             host::encode(&value, &mut slots);
             let index = match p.owner {
