@@ -413,7 +413,28 @@ impl Vv {
             })?),
             None => None,
         };
-        self.run_from(soup.as_ref(), opts, progress)
+        let r = self.run_from(soup.as_ref(), opts, progress);
+        match (r, &path, &self.program.base) {
+            // A base mesh given on the command line is refused at its
+            // file, not at the program's own `mesh S = "...";`.
+            (
+                Err(Error::Program {
+                    ref diagnostics, ..
+                }),
+                Some(p),
+                Some((_, span)),
+            ) if opts.base_mesh.is_some()
+                && diagnostics.len() == 1
+                && diagnostics[0].span == *span =>
+            {
+                Err(Error::File {
+                    path: p.display().to_string(),
+                    line: None,
+                    message: diagnostics[0].message.clone(),
+                })
+            }
+            (r, _, _) => r,
+        }
     }
 
     /// Runs the program on the polygons `base` (instead of a file), as

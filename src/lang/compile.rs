@@ -1390,10 +1390,15 @@ impl Compiler {
         count: usize,
     ) -> Option<(Sym, Vec<Ty>, Option<usize>)> {
         let Some(sym) = self.alphabet.lookup(&name.text) else {
-            self.err(
-                name.span,
-                super::modules::undeclared(&name.text, &vec!["float"; count].join(", ")),
-            );
+            let mut m = super::modules::undeclared(&name.text, &vec!["float"; count].join(", "));
+            if name.text == "Step" && count == 0 {
+                // `Step:` is a block only in a vv program.
+                m.push_str(
+                    "; a `Step:` block belongs to a vertex-vertex program, which declares \
+                     its mesh first: `mesh S = \"base.obj\";`",
+                );
+            }
+            self.err(name.span, m);
             return None;
         };
         match &self.alphabet.get(sym).sig {

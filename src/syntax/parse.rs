@@ -1739,7 +1739,10 @@ impl<'t> Parser<'t> {
                 if !self.eat_ident("in") {
                     return self.error("`in` after `forall x`");
                 }
-                let set = self.expr()?;
+                let set = match self.set_before_edge() {
+                    Some(set) => set,
+                    None => self.expr()?,
+                };
                 let body = Box::new(self.stmt_or_end()?);
                 return Ok(Some(Stmt::Forall {
                     var,
@@ -1839,6 +1842,59 @@ impl<'t> Parser<'t> {
             self.expect_punct(";", &format!("after the `{w}` statement"))?;
         }
         Ok(Some(s))
+    }
+
+    /// The set of `forall x in S (x, y)$w = 1;` or `forall y in 'x (x,
+    /// y)$w = 1;`: a name (or `'name`) followed by a parenthesis whose
+    /// close is followed by `$` is the set, and the parenthesis is the
+    /// body's edge, not a call (a property is never a set to go over).
+    fn set_before_edge(&mut self) -> Option<Expr> {
+        let old = self.peek().is_some_and(|t| t.tok.is_punct("'"));
+        let k = old as usize;
+        let (name, span) = match self.peek_at(k).map(|t| (&t.tok, t.span)) {
+            Some((Tok::Ident(n), span)) => (n.clone(), span),
+            _ => return None,
+        };
+        if !self.peek_at(k + 1).is_some_and(|t| t.tok.is_punct("(")) {
+            return None;
+        }
+        let mut depth = 0usize;
+        let mut j = k + 1;
+        loop {
+            let t = self.peek_at(j)?;
+            if t.tok.is_punct("(") {
+                depth += 1;
+            } else if t.tok.is_punct(")") {
+                depth -= 1;
+                if depth == 0 {
+                    break;
+                }
+            }
+            j += 1;
+        }
+        if !self.peek_at(j + 1).is_some_and(|t| t.tok.is_punct("$")) {
+            return None;
+        }
+        let start = self.span_here();
+        self.pos += k + 1;
+        let ident = Expr {
+            kind: ExprKind::Ident(name),
+            span,
+        };
+        Some(if old {
+            Expr {
+                kind: ExprKind::Call(
+                    Name {
+                        text: "old".into(),
+                        span: start,
+                    },
+                    vec![ident],
+                ),
+                span: start.to(span),
+            }
+        } else {
+            ident
+        })
     }
 
     /// switch := 'switch' expr ( '{' { stmt } '}' | { label } stmt ), whose
