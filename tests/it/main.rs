@@ -32,3 +32,4 @@ mod support;
 mod surface;
 mod surface_quad;
 mod vv;
+mod vv_adversarial;
