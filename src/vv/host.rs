@@ -348,6 +348,11 @@ pub struct VvHost<'a> {
     pub max_valence: usize,
 }
 
+/// Whether a value is a vertex (not an edge or the mesh).
+fn is_vertex(v: &Value) -> bool {
+    matches!(v, Value::Elem(e) if e.kind == VERTEX)
+}
+
 /// The vertex an argument holds, and whether it was read as `'v`.
 fn vert(v: &Value) -> (u32, bool) {
     match v {
@@ -600,6 +605,22 @@ impl Host for VvHost<'_> {
             id::BOUNDARY => {
                 let (v, old) = arg(0);
                 Value::Bool(self.mesh.is_open(v, old)?)
+            }
+            // `specialise` cannot tell an edge's or the mesh's property 0
+            // (their first declared one) from a vertex's `pos`.
+            id::POS | id::POS_OLD if !is_vertex(&args[0]) => {
+                let t = match &args[0] {
+                    Value::Elem(e) if f == id::POS_OLD => Value::Elem(Elem {
+                        flags: e.flags | OLD,
+                        ..*e
+                    }),
+                    other => other.clone(),
+                };
+                self.get(&t, 0)?
+            }
+            id::SET_POS if !is_vertex(&args[0]) => {
+                self.set(&args[0], 0, &args[1])?;
+                args[1].clone()
             }
             id::POS | id::POS_OLD => {
                 let (v, old) = arg(0);
