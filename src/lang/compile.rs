@@ -1152,7 +1152,10 @@ impl Compiler {
             // `S s;` and `S s(1, 2);` call `S`'s constructors; the structs
             // of a plain struct or an array are built by theirs.
             Init::None => match self.default_value(ty, at) {
-                Ex::Const(_) => None,
+                // A struct or an array holding elements starts with the
+                // topology's zeros; a lone element is made by the caller
+                // (`vertex v;` in a body creates one).
+                Ex::Const(_) if !matches!(ty, Ty::Struct(_)) || !self.holds_elements(ty) => None,
                 built => Some(built),
             },
             Init::Ctor(args, span) if has_ctor => {
@@ -1582,7 +1585,7 @@ impl Compiler {
                             Some(f) => Ex::Call(f, Vec::new(), v.name.span),
                             None => Ex::Const((self.host.zero)(k)),
                         },
-                        _ => Ex::Const(Value::zero(ty, &self.structs)),
+                        _ => Ex::Const(self.zero(ty)),
                     });
                     out.push(St::Init(slot, value));
                 }
@@ -3676,6 +3679,39 @@ impl Compiler {
         self.user_call(id, name, &all, span, scope)
     }
 
+    /// Zero of type `ty`, with the topology's own zero for its elements
+    /// (vv: the null vertex, an empty set) inside structs and arrays too;
+    /// [`Value::zero`] knows no topology and leaves them void, which a
+    /// set edit ignored (`add v to sets[1]` did nothing).
+    fn zero(&self, ty: Ty) -> Value {
+        match ty {
+            Ty::Elem(k) => (self.host.zero)(k),
+            Ty::Struct(id) if self.holds_elements(ty) => Value::Struct(
+                self.structs[id as usize]
+                    .fields
+                    .iter()
+                    .map(|(_, t)| self.zero(*t))
+                    .collect(),
+            ),
+            _ => Value::zero(ty, &self.structs),
+        }
+    }
+
+    /// Whether a value of type `ty` holds elements of the topology.
+    fn holds_elements(&self, ty: Ty) -> bool {
+        match ty {
+            Ty::Elem(_) => true,
+            Ty::Struct(id) => {
+                let def = &self.structs[id as usize];
+                match def.elem {
+                    Some(t) => self.holds_elements(t),
+                    None => def.fields.iter().any(|(_, t)| self.holds_elements(*t)),
+                }
+            }
+            _ => false,
+        }
+    }
+
     /// The value a variable of type `ty` starts with when nothing
     /// initialises it, as C++ makes it: for a struct with a constructor
     /// without parameters, what that constructor makes; for another struct
@@ -3683,9 +3719,9 @@ impl Compiler {
     /// constant).
     fn default_value(&mut self, ty: Ty, span: Span) -> Ex {
         let Ty::Struct(si) = ty else {
-            return Ex::Const(Value::zero(ty, &self.structs));
+            return Ex::Const(self.zero(ty));
         };
-        let zero = |c: &Compiler| Ex::Const(Value::zero(ty, &c.structs));
+        let zero = |c: &Compiler| Ex::Const(c.zero(ty));
         if self.ctors.is_empty() {
             return zero(self);
         }

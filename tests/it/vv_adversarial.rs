@@ -251,3 +251,32 @@ fn vv_programs_write_their_files_under_allow_writes() {
     assert_eq!(derived.ok().as_deref(), Some("4\n"));
     assert_eq!(rendered.ok().as_deref(), Some("4\n"));
 }
+
+/// Sets and vertices inside arrays and structs start as an empty set and
+/// the null vertex, as plain variables do: they started void, so `add p
+/// to sets[1]` did nothing and `corners[0] == null` was false.
+#[test]
+fn sets_and_vertices_in_arrays_and_structs_start_empty_and_null() {
+    let text = r#"
+mesh S;
+struct Group { mesh m; vertex v; };
+mesh global_sets[2];
+Group global_group;
+Step: {
+  mesh sets[2];
+  Group group;
+  vertex corners[2];
+  forall p in S {
+    add p to sets[1];
+    add p to group.m;
+    add p to global_sets[0];
+    add p to global_group.m;
+  }
+  printf("%d %d %d %d %d\n", size(sets[0]), size(sets[1]), size(group.m),
+         size(global_sets[0]), size(global_group.m));
+  printf("%d %d %d\n", corners[1] == null, group.v == null, global_group.v == null);
+}
+"#;
+    // The cube has 8 vertices; sets[0] got none.
+    assert_eq!(printed(text, "cube.obj"), "0 8 8 8 8\n1 1 1\n");
+}
