@@ -298,7 +298,7 @@ fn render_system(
             let dir = writes_folder(&a.allow_writes, &a.program_output)?;
             let opts = RunOptions {
                 steps: a.steps,
-                max_modules: a.max_modules,
+                seed: a.seed,
                 deadline,
                 output: a.program_output.clone(),
                 ..RunOptions::default()

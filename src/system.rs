@@ -457,7 +457,13 @@ impl Vv {
         }
         let mut run = self
             .program
-            .start(soup, opts.steps, opts.deadline, opts.output.clone())
+            .start(
+                soup,
+                opts.steps,
+                opts.deadline,
+                opts.output.clone(),
+                opts.seed,
+            )
             .map_err(|e| self.error(e))?;
         let steps = run.length() as usize;
         let at = |r: &crate::vv::VvRun| {

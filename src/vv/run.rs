@@ -106,12 +106,15 @@ impl VvProgram {
     /// Starts a run on `base` (the base mesh's polygons, if any): the
     /// properties declared, the globals initialised, `Start` run; the
     /// steps to make are `steps`, else the derivation length, else 1.
+    /// `seed` seeds every random number generator (`--seed`), as for
+    /// curves; without it they start as lpfg's do.
     pub fn start(
         &self,
         base: Option<&PolygonSoup>,
         steps: Option<u64>,
         deadline: Option<Deadline>,
         output: crate::lang::ProgramOutput,
+        seed: Option<u32>,
     ) -> Result<VvRun<'_>, VvError> {
         let program = &self.program;
         let mut interp = Interp::for_program(program, deadline);
@@ -122,6 +125,7 @@ impl VvProgram {
             .collect();
         let mut env = Env::new(zeros);
         env.output = output;
+        env.random = crate::lang::random::Random::new(seed);
         for (k, g) in program.globals.iter().enumerate() {
             if let Some(e) = &g.init {
                 env.globals[k] = interp.eval_global(e, &mut env)?.convert(g.ty);

@@ -280,3 +280,45 @@ Step: {
     // The cube has 8 vertices; sets[0] got none.
     assert_eq!(printed(text, "cube.obj"), "0 8 8 8 8\n1 1 1\n");
 }
+
+/// `--seed` seeds a vv program's random number generators as it seeds a
+/// curve's (it was ignored: every seed gave lpfg's starting state).
+#[test]
+fn seed_seeds_a_vv_program_as_it_seeds_a_curve() {
+    let dir = std::env::temp_dir().join(format!("subgram-vv-adv-s-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(mesh("tetrahedron.obj"), dir.join("tetrahedron.obj")).unwrap();
+    let draw = r#"printf("%g %d %g\n", ran(1.0), rand(), drand48());"#;
+    let vv = dir.join("vv.lsys");
+    let curve = dir.join("curve.lsys");
+    std::fs::write(
+        &vv,
+        format!("mesh S = \"tetrahedron.obj\";\nStep: {{ {draw} }}\n"),
+    )
+    .unwrap();
+    std::fs::write(&curve, format!("Start: {{ {draw} }}\nAxiom: F;\n")).unwrap();
+    let first_line = |file: &PathBuf, seed: &str| {
+        let mut args = vec!["derive", file.to_str().unwrap()];
+        if !seed.is_empty() {
+            args.extend(["--seed", seed]);
+        }
+        let o = Command::new(env!("CARGO_BIN_EXE_subgram"))
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .next()
+            .unwrap_or_default()
+            .to_string()
+    };
+    let (v7, c7) = (first_line(&vv, "7"), first_line(&curve, "7"));
+    let (v8, v_none) = (first_line(&vv, "8"), first_line(&vv, ""));
+    let c_none = first_line(&curve, "");
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(v7, c7);
+    assert_eq!(v_none, c_none);
+    assert_ne!(v7, v8);
+    assert_ne!(v7, v_none);
+}
