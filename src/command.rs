@@ -127,6 +127,13 @@ fn derive_text(
     };
     match system {
         System::Vv(v) => {
+            if a.interpreted {
+                return Err(Error::Usage(
+                    "--interpreted prints the word after interpretation rules; a vv program has \
+                     no word, only its mesh"
+                        .into(),
+                ));
+            }
             let run = v.run(&opts, progress)?;
             // The files the program wrote (`fopen`), never over its inputs.
             let mut inputs = vec![PathBuf::from(&a.file)];
@@ -295,6 +302,13 @@ fn render_system(
         }
         System::Vv(v) => {
             looks.check()?;
+            if a.each {
+                return Err(Error::Usage(
+                    "--each draws the steps of an L-system side by side; a vv program draws its \
+                     mesh after the last step (`-n` chooses it)"
+                        .into(),
+                ));
+            }
             let dir = writes_folder(&a.allow_writes, &a.program_output)?;
             let opts = RunOptions {
                 steps: a.steps,
