@@ -22,12 +22,15 @@ use crate::syntax::{parse, Diagnostic, Span};
 pub use mesh::{Rotation, NULL};
 pub use run::{VvError, VvProgram, VvRun};
 
-/// True when preprocessed tokens are a vv program: a line that starts
-/// with `mesh NAME` (a declaration of a set of vertices; a surface
-/// grammar's `mesh:` has a colon).
+/// True when preprocessed tokens are a vv program: `mesh NAME` that
+/// starts a line or follows a `;` or `}` (a declaration of a set of
+/// vertices, as in `int n; mesh S;`; a surface grammar's `mesh:` has a
+/// colon).
 pub(crate) fn is_vv(toks: &[Token]) -> bool {
-    toks.windows(2).any(|w| {
-        w[0].line_start
+    toks.windows(2).enumerate().any(|(k, w)| {
+        let starts = w[0].line_start
+            || (k > 0 && (toks[k - 1].tok.is_punct(";") || toks[k - 1].tok.is_punct("}")));
+        starts
             && w[0].tok.is_ident("mesh")
             && matches!(&w[1].tok, Tok::Ident(n) if !is_type(n))
     })

@@ -322,3 +322,17 @@ fn seed_seeds_a_vv_program_as_it_seeds_a_curve() {
     assert_ne!(v7, v8);
     assert_ne!(v7, v_none);
 }
+
+/// A vv program is recognised by `mesh NAME` after a `;` too, not only at
+/// the start of a line (`int n; mesh S;` was read as a curve, with three
+/// errors about an unknown type, the axiom and a module `Step`); a curve
+/// that names a variable `mesh` stays a curve.
+#[test]
+fn a_vv_program_may_declare_its_mesh_after_a_semicolon() {
+    let opts = LoadOptions::default();
+    let vv = subgram::load_text("a.lsys", "int n; mesh S;\nStep: { n++; }\n", &opts);
+    assert!(matches!(vv, Ok(System::Vv(_))), "{:?}", vv.err());
+    let curve = "int mesh;\nStart: { mesh = 1; mesh++; }\nAxiom: F(mesh);\n";
+    let c = subgram::load_text("b.lsys", curve, &opts);
+    assert!(matches!(c, Ok(System::Curve(_))), "{:?}", c.err());
+}
