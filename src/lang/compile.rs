@@ -2822,7 +2822,11 @@ impl Compiler {
             return None;
         }
         // As for `forall`: the topology may check what is folded over.
-        let set = match self.host.function("$forall").map(|b| (b.resolve)(&[set_ty])) {
+        let set = match self
+            .host
+            .function("$forall")
+            .map(|b| (b.resolve)(&[set_ty]))
+        {
             Some(Ok((f, _))) => Ex::Call(f, vec![set], set_span),
             _ => set,
         };

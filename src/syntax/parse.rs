@@ -1714,8 +1714,7 @@ impl<'t> Parser<'t> {
         let operand = matches!(
             next,
             Some(Tok::Ident(_) | Tok::Punct("'") | Tok::Int(_) | Tok::Float { .. } | Tok::Str(_))
-        )
-            || (w == "make" && matches!(next, Some(Tok::Punct("{"))));
+        ) || (w == "make" && matches!(next, Some(Tok::Punct("{"))));
         if !operand {
             return Ok(None);
         }

@@ -117,7 +117,13 @@ static FUNCTIONS: &[Builtin] = &[
     // passes it through this, which refuses a vertex with no
     // neighbourhood to list (the null vertex, `'v` before a
     // `synchronize`) instead of looping over nothing.
-    vv!("$forall", 1, id::FORALL, V, "`forall x in v` takes a vertex"),
+    vv!(
+        "$forall",
+        1,
+        id::FORALL,
+        V,
+        "`forall x in v` takes a vertex"
+    ),
     vv!("old", 1, id::OLD, V, "`'v` (or `old(v)`) takes a vertex"),
     vv!(
         "valence",
@@ -497,9 +503,7 @@ impl Host for VvHost<'_> {
                     return Err("`add v to S`: the null vertex cannot be a member of a set".into());
                 }
                 if !self.mesh.is_alive(v) {
-                    return Err(format!(
-                        "`add v to S`: vertex {v} no longer exists"
-                    ));
+                    return Err(format!("`add v to S`: vertex {v} no longer exists"));
                 }
                 // `add 'v to S` adds the vertex itself.
                 let _ = old;

@@ -30,9 +30,7 @@ pub(crate) fn is_vv(toks: &[Token]) -> bool {
     toks.windows(2).enumerate().any(|(k, w)| {
         let starts = w[0].line_start
             || (k > 0 && (toks[k - 1].tok.is_punct(";") || toks[k - 1].tok.is_punct("}")));
-        starts
-            && w[0].tok.is_ident("mesh")
-            && matches!(&w[1].tok, Tok::Ident(n) if !is_type(n))
+        starts && w[0].tok.is_ident("mesh") && matches!(&w[1].tok, Tok::Ident(n) if !is_type(n))
     })
 }
 

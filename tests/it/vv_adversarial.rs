@@ -233,18 +233,21 @@ fn vv_programs_write_their_files_under_allow_writes() {
     let bin = env!("CARGO_BIN_EXE_subgram");
     let run = |args: &[&str]| {
         let o = Command::new(bin).args(args).output().unwrap();
-        assert!(
-            o.status.success(),
-            "{}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     };
     let (p, w) = (program.to_str().unwrap(), out.to_str().unwrap());
     run(&["derive", "--allow-writes", w, p]);
     let derived = std::fs::read_to_string(out.join("count.txt"));
     std::fs::remove_file(out.join("count.txt")).ok();
     let png = dir.join("t.png");
-    run(&["render", "--allow-writes", w, "-o", png.to_str().unwrap(), p]);
+    run(&[
+        "render",
+        "--allow-writes",
+        w,
+        "-o",
+        png.to_str().unwrap(),
+        p,
+    ]);
     let rendered = std::fs::read_to_string(out.join("count.txt"));
     let _ = std::fs::remove_dir_all(&dir);
     // The tetrahedron has 4 vertices.
