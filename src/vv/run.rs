@@ -68,7 +68,7 @@ pub struct VvProgram {
     /// as written, with the span of the string.
     pub base: Option<(String, Span)>,
     /// Creating a vertex beyond this many is an error
-    /// ([`MAX_VV_VERTICES`] unless changed).
+    /// (`MAX_VV_VERTICES` unless changed).
     pub max_vertices: usize,
 }
 
