@@ -2265,9 +2265,35 @@ impl<'t> Parser<'t> {
                 ExprKind::Str(s.clone())
             }
             Tok::Punct("'") if self.vv => {
-                // `'v`: the vertex as the last `synchronize` left it.
+                // `'v`: the vertex as the last `synchronize` left it; `'a[i]`
+                // and `'g.v` of a vertex in an array or a struct (`$` and
+                // calls bind outside: `'v$pos` is the old position).
                 self.pos += 1;
-                let v = self.primary()?;
+                let outer = self.measure();
+                let mut v = self.primary()?;
+                let mut reached = self.reached(outer);
+                loop {
+                    let field = self.peek_punct(".")
+                        && matches!(self.peek_at(1).map(|t| &t.tok), Some(Tok::Ident(_)))
+                        && !self.peek_at(2).is_some_and(|t| t.tok.is_punct("("));
+                    if self.peek_punct("[") {
+                        reached = self.wrap(reached, self.span_here())?;
+                        let (indexed, r) = self.index_of(v)?;
+                        v = indexed;
+                        reached = reached.max(r);
+                    } else if field {
+                        reached = self.wrap(reached, self.span_here())?;
+                        self.pos += 1;
+                        let name = self.name("a field name after `.`")?;
+                        let span = v.span.to(name.span);
+                        v = Expr {
+                            kind: ExprKind::Field(Box::new(v), name),
+                            span,
+                        };
+                    } else {
+                        break;
+                    }
+                }
                 ExprKind::Call(
                     Name {
                         text: "old".into(),

@@ -339,3 +339,26 @@ fn a_vv_program_may_declare_its_mesh_after_a_semicolon() {
     let c = subgram::load_text("b.lsys", curve, &opts);
     assert!(matches!(c, Ok(System::Curve(_))), "{:?}", c.err());
 }
+
+/// `'a[i]` and `'g.v` read the old state of a vertex held in an array or
+/// a struct (they read as `old(a)[i]`, "`'v` takes a vertex"); `$` still
+/// binds outside, so `'a[1]$pos` is the old position.
+#[test]
+fn old_state_of_a_vertex_in_an_array_or_a_struct() {
+    let text = r#"
+mesh S;
+struct G { vertex v; };
+G g;
+vertex a[2];
+Step: {
+  forall p in S { g.v = p; a[1] = p; }
+  synchronize S;
+  forall p in S
+    p$pos = 2 * p$pos;
+  printf("%d %d %g %g %g\n", valence 'g.v, valence 'a[1], 'a[1]$pos.x, a[1]$pos.x, 'g.v$pos.y);
+}
+"#;
+    // Both hold the last vertex of S, the cube's eighth, at (1, 1, 1), of
+    // valence 3; its position doubles after the synchronize.
+    assert_eq!(printed(text, "cube.obj"), "3 3 1 2 1\n");
+}
