@@ -20,10 +20,29 @@ use super::mesh::Rotation;
 /// The most steps a vv program may run.
 pub const MAX_VV_STEPS: u64 = 1000;
 
-/// The most vertices a vv mesh may hold, by default: about 2 GB of
-/// neighbour lists and positions (Loop makes 2.6 million from an
-/// 81,920-triangle sphere in three steps).
-pub const MAX_VV_VERTICES: usize = 5_000_000;
+/// The most vertices a vv mesh may hold, by default: about 500 MB of
+/// neighbour lists, positions and their synchronized copies (Loop makes
+/// 655,362 from an 81,920-triangle sphere in two steps, 2.6 million in
+/// three). `SUBGRAM_MAX_VERTICES=N` in the environment sets another bound.
+pub const MAX_VV_VERTICES: usize = 2_000_000;
+
+/// The environment variable that sets the vertex limit.
+const MAX_VERTICES_VAR: &str = "SUBGRAM_MAX_VERTICES";
+
+/// The vertex limit of a run: the environment's, else `default`.
+fn vertex_limit(default: usize) -> Result<usize, String> {
+    match std::env::var(MAX_VERTICES_VAR) {
+        Err(std::env::VarError::NotPresent) => Ok(default),
+        Ok(v) => v
+            .trim()
+            .parse()
+            .map_err(|_| format!("{MAX_VERTICES_VAR} must be a whole number, found `{v}`")),
+        Err(std::env::VarError::NotUnicode(v)) => Err(format!(
+            "{MAX_VERTICES_VAR} must be a whole number, found `{}`",
+            v.to_string_lossy()
+        )),
+    }
+}
 
 /// The environment variable that sets the valence limit, as for surface
 /// grammars: `SUBGRAM_MAX_VALENCE=5000`.
@@ -98,6 +117,8 @@ pub struct VvRun<'p> {
     interp: Interp<'p>,
     /// The valence limit of this run (see `valence_limit`).
     max_valence: usize,
+    /// The most vertices the run may make (see [`MAX_VV_VERTICES`]).
+    max_vertices: usize,
     steps: u64,
     length: u64,
 }
@@ -142,6 +163,10 @@ impl VvProgram {
             span: None,
             message,
         })?;
+        let max_vertices = vertex_limit(self.max_vertices).map_err(|message| VvError {
+            span: None,
+            message,
+        })?;
         env.globals[self.structure as usize] = host::set_value(members);
         let mut layouts = Layouts::default();
         for p in &program.properties {
@@ -171,6 +196,7 @@ impl VvProgram {
             layouts,
             interp,
             max_valence,
+            max_vertices,
             steps: 0,
             length: 0,
         };
@@ -200,7 +226,11 @@ impl VvProgram {
                 ),
             });
         }
-        run.end_of_step("`Start`")?;
+        // A mesh read from a file is consistent, and holds nothing to
+        // release; one that `Start` built or changed is checked.
+        if base.is_none() || run.has(ControlKind::Start) {
+            run.end_of_step("`Start`")?;
+        }
         Ok(run)
     }
 }
@@ -212,7 +242,7 @@ impl<'p> VvRun<'p> {
                 let mut host = VvHost {
                     mesh: &mut self.mesh,
                     layouts: &self.layouts,
-                    max_vertices: self.vv.max_vertices,
+                    max_vertices: self.max_vertices,
                     max_valence: self.max_valence,
                 };
                 run_body(&mut self.interp, body, *frame, &mut self.env, &mut host)?;
