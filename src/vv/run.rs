@@ -229,7 +229,7 @@ impl VvProgram {
         // A mesh read from a file is consistent, and holds nothing to
         // release; one that `Start` built or changed is checked.
         if base.is_none() || run.has(ControlKind::Start) {
-            run.end_of_step("`Start`")?;
+            run.end_of_step("`Start`", true)?;
         }
         Ok(run)
     }
@@ -256,9 +256,10 @@ impl<'p> VvRun<'p> {
         host::set_ids(&self.env.globals[self.vv.structure as usize])
     }
 
-    /// The consistency check of the structure, then the release of every
-    /// vertex that the program can no longer reach.
-    fn end_of_step(&mut self, after: &str) -> Result<(), VvError> {
+    /// The consistency check of the structure, then, with `release`, the
+    /// release of every vertex that the program can no longer reach (not
+    /// needed when nothing runs after).
+    fn end_of_step(&mut self, after: &str, release: bool) -> Result<(), VvError> {
         let members = host::set_ids(&self.env.globals[self.vv.structure as usize]);
         if let Err(m) = self.mesh.check(members) {
             return Err(VvError {
@@ -268,6 +269,9 @@ impl<'p> VvRun<'p> {
                     self.vv.structure_name.0
                 ),
             });
+        }
+        if !release {
+            return Ok(());
         }
         let mut roots: Vec<u32> = Vec::new();
         for g in &self.env.globals {
@@ -299,7 +303,7 @@ impl<'p> VvRun<'p> {
         crate::production::run(self, &mut progress)?;
         if self.has(ControlKind::End) {
             self.control(ControlKind::End)?;
-            self.end_of_step("`End`")?;
+            self.end_of_step("`End`", false)?;
         }
         Ok(())
     }
@@ -397,7 +401,10 @@ impl Topology for VvRun<'_> {
         self.steps += 1;
         self.env.step = self.steps as i64;
         let after = format!("step {}", self.steps);
-        self.end_of_step(&after)
+        // Nothing runs after the last step but `End`: what it would
+        // release goes with the run.
+        let release = self.steps < self.length || self.has(ControlKind::End);
+        self.end_of_step(&after, release)
     }
 }
 
