@@ -444,6 +444,8 @@ pub struct SubdivideArgs {
     pub timeout: Option<Duration>,
     /// Write the output even over one of the inputs.
     pub force: bool,
+    /// What a vv program prints: the caller keeps a clone and prints it.
+    pub program_output: ProgramOutput,
 }
 
 /// `subgram subdivide`: runs a surface grammar on a mesh and writes the
@@ -459,6 +461,7 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         steps: a.steps,
         base_mesh: a.mesh.as_ref().map(PathBuf::from),
         deadline,
+        output: a.program_output.clone(),
         ..RunOptions::default()
     };
     let d = crate::render::mesh::MeshView::default();

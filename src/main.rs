@@ -453,8 +453,11 @@ fn run(cli: Cli) -> Result<(), Error> {
                 view,
                 timeout: timeout.0,
                 force,
+                program_output: subgram::ProgramOutput::new(),
             };
-            with_progress(|p| command::subdivide(&args, p))
+            let result = with_progress(|p| command::subdivide(&args, p));
+            print_program_output(&args.program_output, false)?;
+            result
         }
         Command::Mesh { command } => match command {
             MeshCommand::Info { file, format } => {

@@ -505,3 +505,33 @@ fn a_base_mesh_written_as_neighbour_lists() {
         }
     }
 }
+
+/// `subdivide` prints what a vv program prints, as `derive` and `render` do.
+#[test]
+fn subdivide_prints_what_a_vv_program_prints() {
+    let dir = TempDir::new();
+    let file = dir.path().join("p.lsys");
+    std::fs::write(
+        &file,
+        "mesh S;\nStart: { printf(\"hello\\n\"); }\nStep: { printf(\"step %d\\n\", StepNo()); }\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .arg("subdivide")
+        .arg(mesh("cube.obj"))
+        .arg("--grammar")
+        .arg(&file)
+        .args(["-n", "2", "-o"])
+        .arg(dir.path().join("out.obj"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "hello\nstep 0\nstep 1\n"
+    );
+}
