@@ -196,6 +196,9 @@ pub struct Interp<'p> {
     stack_room: usize,
     scratch: Vec<Value>,
     fuel: u64,
+    /// The loop iterations one body may run ([`LOOP_LIMIT`] unless the
+    /// topology sets more: a vv step walks the whole mesh).
+    pub loop_limit: u64,
     /// The run stops once this passes; looked at every
     /// [`DEADLINE_EVERY`] loop iterations.
     pub deadline: Option<Deadline>,
@@ -219,6 +222,7 @@ impl<'p> Interp<'p> {
             stack_room: STACK_SEGMENT,
             scratch: Vec::new(),
             fuel: LOOP_LIMIT,
+            loop_limit: LOOP_LIMIT,
             deadline: None,
             ticks: 0,
             member_lists: Vec::new(),
@@ -252,7 +256,7 @@ impl<'p> Interp<'p> {
         host: &mut (dyn Host + Send),
         sink: &mut dyn Emit,
     ) -> Result<Flow, RuntimeError> {
-        self.fuel = LOOP_LIMIT;
+        self.fuel = self.loop_limit;
         self.stack_base = 0;
         let mut cx = Cx {
             frame,
@@ -361,7 +365,7 @@ impl<'p> Interp<'p> {
                     if self.fuel == 0 {
                         return Err(rt(
                             Some(*span),
-                            format!("a loop ran more than {LOOP_LIMIT} iterations in one body; is its condition ever false?"),
+                            format!("a loop ran more than {} iterations in one body; is its condition ever false?", self.loop_limit),
                         ));
                     }
                     self.fuel -= 1;
@@ -437,7 +441,10 @@ impl<'p> Interp<'p> {
             if self.fuel == 0 {
                 return Err(rt(
                     Some(span),
-                    format!("loops ran more than {LOOP_LIMIT} iterations in one body"),
+                    format!(
+                        "loops ran more than {} iterations in one body",
+                        self.loop_limit
+                    ),
                 ));
             }
             self.fuel -= 1;

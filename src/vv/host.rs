@@ -53,6 +53,7 @@ pub mod id {
     pub const MESH: u16 = 18;
     pub const BOUNDARY: u16 = 19;
     pub const SIZE: u16 = 20;
+    pub const ERROR: u16 = 23;
     pub const MEMBER: u16 = 21;
     pub const FORALL: u16 = 22;
     // Specialisations (see `specialise`): a read of the old state fused
@@ -230,6 +231,16 @@ static FUNCTIONS: &[Builtin] = &[
         Ty::Elem(EDGE),
         "`(p, q)` takes two vertices"
     ),
+    Builtin {
+        name: "error",
+        resolve: |a| match a {
+            [Ty::Str] => Ok((Func::Host(id::ERROR), Ty::Void)),
+            [_] => Err(SigError::Message(
+                "`error(\"message\")` takes a string".into(),
+            )),
+            _ => Err(SigError::Arity(1)),
+        },
+    },
     vv!(
         "boundary",
         1,
@@ -348,6 +359,8 @@ pub struct VvHost<'a> {
     pub layouts: &'a Layouts,
     /// `vertex v;` beyond this many live vertices is an error.
     pub max_vertices: usize,
+    /// `make`'s list, reused from call to call.
+    pub list: Vec<u32>,
     /// A neighbourhood of more vertices than this is an error: queries
     /// and edits scan a neighbourhood, so a valence that grows without
     /// end makes a run quadratic.
@@ -490,7 +503,7 @@ impl Host for VvHost<'_> {
             id::NEW => {
                 if self.mesh.len() >= self.max_vertices {
                     return Err(format!(
-                        "a vertex beyond the {} the mesh may hold (a loop that makes vertices without end?)",
+                        "a vertex beyond the {} the mesh may hold (`SUBGRAM_MAX_VERTICES=N` in the environment sets the bound)",
                         self.max_vertices
                     ));
                 }
@@ -545,7 +558,9 @@ impl Host for VvHost<'_> {
             }
             id::MAKE => {
                 let v = self.current(&args[0], "`make`")?;
-                let list: Vec<u32> = args[1..].iter().map(|a| vert(a).0).collect();
+                let mut list = std::mem::take(&mut self.list);
+                list.clear();
+                list.extend(args[1..].iter().map(|a| vert(a).0));
                 let n = list.iter().filter(|&&x| x != NULL).count();
                 if n > self.max_valence && self.mesh.is_alive(v) {
                     return Err(format!(
@@ -554,7 +569,9 @@ impl Host for VvHost<'_> {
                         self.max_valence
                     ));
                 }
-                self.mesh.make(v, &list)?;
+                let made = self.mesh.make(v, &list);
+                self.list = list;
+                made?;
                 Value::Void
             }
             id::ERASE => {
@@ -673,6 +690,12 @@ impl Host for VvHost<'_> {
             id::SET => {
                 self.set(&args[0], args[1].as_i64() as usize, &args[2])?;
                 args[2].clone()
+            }
+            id::ERROR => {
+                return Err(match args.first() {
+                    Some(Value::Str(m)) => m.to_string(),
+                    _ => "error".into(),
+                })
             }
             id::NULL => null(),
             id::MESH => Value::Elem(Elem {

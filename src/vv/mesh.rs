@@ -112,6 +112,7 @@ const PROPS: &str = "has no properties";
 const IS_IN: Op = op("is x in v", NB);
 const VALENCE: Op = op("valence v", NB);
 const NEIGHBOURS: Op = op("forall x in v", NB);
+const BOUNDARY: Op = op("boundary(v)", NB);
 const ANY: Op = op("any in v", NB);
 const NEXTTO: Op = op("nextto x in v", NB);
 const PREVTO: Op = op("prevto x in v", NB);
@@ -166,6 +167,12 @@ impl Rotation {
             .enumerate()
             .filter(|(_, &a)| a)
             .map(|(i, _)| i as u32)
+    }
+
+    /// Whether `v` is alive and has an old state (`synchronize` took it
+    /// since it was made).
+    pub fn has_old(&self, v: u32) -> bool {
+        self.is_alive(v) && self.synced[v as usize]
     }
 
     /// Whether `v` is a vertex alive now (false for [`NULL`]).
@@ -346,7 +353,7 @@ impl Rotation {
     /// Whether `v`'s neighbourhood is open (`v` lies on the boundary).
     #[inline]
     pub fn is_open(&self, v: u32, old: bool) -> Result<bool, String> {
-        let i = self.slot(v, old, NEIGHBOURS)?;
+        let i = self.slot(v, old, BOUNDARY)?;
         Ok(self.state(i, old).1)
     }
 

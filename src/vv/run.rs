@@ -189,6 +189,8 @@ impl VvProgram {
                 _ => layouts.mesh.push(l),
             }
         }
+        // A step walks the whole mesh, some dozen iterations a vertex.
+        interp.loop_limit = crate::lang::eval::LOOP_LIMIT.max(64 * max_vertices as u64);
         let mut run = VvRun {
             vv: self,
             mesh,
@@ -243,6 +245,7 @@ impl<'p> VvRun<'p> {
                     mesh: &mut self.mesh,
                     layouts: &self.layouts,
                     max_vertices: self.max_vertices,
+                    list: Vec::new(),
                     max_valence: self.max_valence,
                 };
                 run_body(&mut self.interp, body, *frame, &mut self.env, &mut host)?;
@@ -261,7 +264,18 @@ impl<'p> VvRun<'p> {
     /// needed when nothing runs after).
     fn end_of_step(&mut self, after: &str, release: bool) -> Result<(), VvError> {
         let members = host::set_ids(&self.env.globals[self.vv.structure as usize]);
-        if let Err(m) = self.mesh.check(members) {
+        // A vertex of the mesh lies on a face: one with no neighbours is
+        // not part of a 2-manifold.
+        let lone = members
+            .iter()
+            .find(|&&v| self.mesh.valence(v, false).is_ok_and(|n| n == 0));
+        let checked = match lone {
+            Some(v) => Err(format!(
+                "vertex {v} has no neighbours: every vertex of a mesh lies on a face"
+            )),
+            None => self.mesh.check(members),
+        };
+        if let Err(m) = checked {
             return Err(VvError {
                 span: Some(self.vv.structure_name.1),
                 message: format!(
@@ -343,7 +357,12 @@ fn reachable(mesh: &Rotation, roots: &mut Vec<u32>) {
     while k < roots.len() {
         let v = roots[k];
         k += 1;
-        let old = mesh.neighbours(v, true).unwrap_or(&[]);
+        // No error strings made for vertices without an old state.
+        let old = if mesh.has_old(v) {
+            mesh.neighbours(v, true).unwrap_or(&[])
+        } else {
+            &[]
+        };
         let cur = mesh.neighbours(v, false).unwrap_or(&[]);
         for &x in cur.iter().chain(old) {
             if mesh.is_alive(x) && !seen[x as usize] {

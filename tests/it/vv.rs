@@ -337,17 +337,30 @@ fn table_2_error_cases_are_located_errors() {
             "listed twice",
         ),
         // Note 5: x = v, or x already a neighbour.
-        ("  vertex a = any in v;\n  replace a with v in v;", "2:", ""),
+        (
+            "  vertex a = any in v;\n  replace a with v in v;",
+            "2:",
+            "x is v itself",
+        ),
         (
             "  vertex a = any in v;\n  vertex b = nextto a in v;\n  replace a with b in v;",
             "3:",
-            "",
+            "is already a neighbour of",
         ),
-        ("  vertex a = any in v;\n  splice v after a in v;", "2:", ""),
+        (
+            "  vertex a = any in v;\n  splice v after a in v;",
+            "2:",
+            "x is v itself",
+        ),
+        (
+            "  vertex a = any in v;\n  splice a before a in v;",
+            "2:",
+            "is already a neighbour of",
+        ),
         (
             "  vertex a = any in v;\n  vertex b = nextto a in v;\n  splice b before a in v;",
             "3:",
-            "",
+            "is already a neighbour of",
         ),
         // The null vertex has no neighbourhood.
         ("  vertex a = any in null;", "1:", "null"),
@@ -533,5 +546,102 @@ fn subdivide_prints_what_a_vv_program_prints() {
     assert_eq!(
         String::from_utf8_lossy(&out.stdout),
         "hello\nstep 0\nstep 1\n"
+    );
+}
+
+/// The butterfly program's boundary rules, checked by what they must
+/// reproduce: on an open grid lifted onto a plane every new vertex lies on
+/// the plane (the interior mask, the reflected wings and the four-point
+/// rule all keep affine functions); along a straight boundary the
+/// four-point rule reproduces a cubic at the midpoints whose stencil lies
+/// on that side.
+#[test]
+fn vv_butterfly_boundary_rules_keep_planes_and_boundary_cubics() {
+    let dir = TempDir::new();
+    let plane = |p: DVec3| 0.2 * p.x + 0.3 * p.y + 0.1;
+    let mut soup = shapes::triangle_grid(8, 4);
+    for p in &mut soup.positions {
+        p.z = plane(*p);
+    }
+    let path = dir.path().join("plane.obj");
+    io::write(&path, &soup).unwrap();
+    let out = run(&vv("butterfly.lsys"), &path, 2, &[]);
+    assert!(out.positions.len() > soup.positions.len() * 4);
+    for p in &out.positions {
+        assert!((p.z - plane(*p)).abs() < 1e-12, "{p} is off the plane");
+    }
+    // One step: the lattice is reproduced too. Every new vertex off the
+    // grid's sides sits at the midpoint of its edge (x a multiple of 1/16,
+    // y of 1/8), which the interior mask keeps and a wrong ghost for a
+    // missing wing (near the sides) would not.
+    let out = run(&vv("butterfly.lsys"), &path, 1, &[]);
+    let mut inner = 0;
+    for p in &out.positions[soup.positions.len()..] {
+        if p.x > 0.0 && p.x < 1.0 && p.y > 0.0 && p.y < 1.0 {
+            let on = |t: f64| (t - t.round()).abs() < 1e-12;
+            assert!(
+                on(p.x * 16.0) && on(p.y * 8.0),
+                "{p}: not an edge's midpoint"
+            );
+            inner += 1;
+        }
+    }
+    assert!(inner > 60, "{inner}");
+
+    let mut soup = shapes::triangle_grid(8, 4);
+    for p in &mut soup.positions {
+        p.z = p.x.powi(3);
+    }
+    let path = dir.path().join("cubic.obj");
+    io::write(&path, &soup).unwrap();
+    let out = run(&vv("butterfly.lsys"), &path, 1, &[]);
+    let h = 1.0 / 8.0;
+    let mut checked = 0;
+    for p in &out.positions[soup.positions.len()..] {
+        // A new vertex on the side y = 0 whose four-point stencil stays on
+        // that side: the midpoints of the edges from x = h to x = 7h.
+        if p.y == 0.0 && p.x > h && p.x < 1.0 - h {
+            assert!((p.z - p.x.powi(3)).abs() < 1e-12, "{p}: not on the cubic");
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 6);
+}
+
+/// The triangle schemes refuse a mesh with larger faces at their check in
+/// `Start`, instead of applying their masks to it.
+#[test]
+fn triangle_schemes_refuse_quads() {
+    for f in [
+        "loop.lsys",
+        "butterfly.lsys",
+        "sqrt3.lsys",
+        "polyhedral.lsys",
+    ] {
+        let system = subgram::load(vv(f), &LoadOptions::default()).unwrap();
+        let ro = RunOptions {
+            base_mesh: Some(mesh("cube.obj")),
+            ..RunOptions::default()
+        };
+        let e = system
+            .run(&ro)
+            .err()
+            .unwrap_or_else(|| panic!("{f} ran on quads"));
+        assert!(e.to_string().contains("takes a triangle mesh"), "{f}: {e}");
+    }
+}
+
+/// A step that leaves a vertex of the mesh without neighbours fails the
+/// check after the step: a mesh's vertices lie on faces.
+#[test]
+fn a_vertex_without_neighbours_fails_the_check_after_a_step() {
+    let text = format!(
+        "mesh S = \"{}\";\nStep: {{ forall p in S forall q in p erase q from p; }}\n",
+        mesh("tetrahedron.obj").display()
+    );
+    let e = error_of(&text);
+    assert!(
+        e.contains("after step 1") && e.contains("has no neighbours"),
+        "{e}"
     );
 }
