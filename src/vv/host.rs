@@ -54,6 +54,7 @@ pub mod id {
     pub const BOUNDARY: u16 = 19;
     pub const SIZE: u16 = 20;
     pub const ERROR: u16 = 23;
+    pub const TRIANGLES: u16 = 24;
     pub const MEMBER: u16 = 21;
     pub const FORALL: u16 = 22;
     // Specialisations (see `specialise`): a read of the old state fused
@@ -231,6 +232,16 @@ static FUNCTIONS: &[Builtin] = &[
         Ty::Elem(EDGE),
         "`(p, q)` takes two vertices"
     ),
+    Builtin {
+        name: "triangles",
+        resolve: |a| match a {
+            [Ty::Elem(SET)] => Ok((Func::Host(id::TRIANGLES), Ty::Bool)),
+            [_] => Err(SigError::Message(
+                "`triangles(S)` takes a set of vertices (a `mesh`)".into(),
+            )),
+            _ => Err(SigError::Arity(1)),
+        },
+    },
     Builtin {
         name: "error",
         resolve: |a| match a {
@@ -691,6 +702,10 @@ impl Host for VvHost<'_> {
                 self.set(&args[0], args[1].as_i64() as usize, &args[2])?;
                 args[2].clone()
             }
+            id::TRIANGLES => match args.first() {
+                Some(Value::Set(s)) => Value::Bool(self.mesh.all_triangles(s.ids())),
+                _ => Value::Bool(false),
+            },
             id::ERROR => {
                 return Err(match args.first() {
                     Some(Value::Str(m)) => m.to_string(),

@@ -51,6 +51,9 @@ pub const NULL: u32 = u32::MAX;
 /// ([`Rotation::add_mesh_property`]).
 #[derive(Clone, Debug, Default)]
 pub struct Rotation {
+    /// Edits of the topology so far (vertices made or freed, lists
+    /// changed), so that a run can tell whether a block changed anything.
+    edits: u64,
     alive: Vec<bool>,
     gen: Vec<u32>,
     nbs: Vec<Vec<u32>>,
@@ -167,6 +170,26 @@ impl Rotation {
             .enumerate()
             .filter(|(_, &a)| a)
             .map(|(i, _)| i as u32)
+    }
+
+    /// How many edits of the topology were made so far.
+    pub fn topology_edits(&self) -> u64 {
+        self.edits
+    }
+
+    /// Whether every face of `set` (every orbit that is not a hole) is a
+    /// triangle; assumes a consistent set.
+    pub fn all_triangles(&self, set: &[u32]) -> bool {
+        set.iter().all(|&u| {
+            self.nbs[u as usize].iter().all(|&v| {
+                // The face through (u, v) is (u, v, w), w before u around
+                // v, when v's corner there is not its gap.
+                match self.prevto(u, v, false) {
+                    Ok(w) if w != NULL => self.prevto(v, w, false) == Ok(u),
+                    _ => true,
+                }
+            })
+        })
     }
 
     /// Whether `v` is alive and has an old state (`synchronize` took it
@@ -424,6 +447,7 @@ impl Rotation {
     /// properties at their defaults and no old state. Reuses a freed slot
     /// (and its lists' capacity) when there is one.
     pub fn new_vertex(&mut self) -> u32 {
+        self.edits += 1;
         self.live += 1;
         if let Some(v) = self.free.pop() {
             let i = v as usize;
@@ -465,6 +489,7 @@ impl Rotation {
     /// neighbours. Refused (note 3) if `v` is in the list or a vertex is
     /// listed twice.
     pub fn make(&mut self, v: u32, list: &[u32]) -> Result<(), String> {
+        self.edits += 1;
         let i = self.slot(v, false, MAKE)?;
         let n = list.len();
         let (mut runs, mut start, mut count) = (0, 0, 0);
@@ -560,6 +585,7 @@ impl Rotation {
     /// neighbourhood left empty is closed.
     #[inline]
     pub fn erase(&mut self, x: u32, v: u32) -> Result<(), String> {
+        self.edits += 1;
         let i = self.slot(v, false, ERASE)?;
         if let Some(k) = find(&self.nbs[i], x) {
             self.nbs[i].remove(k);
@@ -580,6 +606,7 @@ impl Rotation {
     /// dead vertex.
     #[inline]
     pub fn replace(&mut self, a: u32, x: u32, v: u32) -> Result<(), String> {
+        self.edits += 1;
         let i = self.slot(v, false, REPLACE)?;
         self.storable(x, v, REPLACE)?;
         let Some(k) = find(&self.nbs[i], a) else {
@@ -617,6 +644,7 @@ impl Rotation {
 
     #[inline]
     fn splice(&mut self, x: u32, a: u32, v: u32, shift: usize, op: Op) -> Result<(), String> {
+        self.edits += 1;
         let i = self.slot(v, false, op)?;
         self.storable(x, v, op)?;
         let Some(k) = find(&self.nbs[i], a) else {
@@ -790,6 +818,7 @@ impl Rotation {
     /// Frees `v`: its slot goes to the free list, its generation moves on,
     /// so handles to it are stale. Its neighbours' lists are not touched.
     pub fn free(&mut self, v: u32) -> Result<(), String> {
+        self.edits += 1;
         let i = self.slot(v, false, FREE)?;
         self.alive[i] = false;
         self.gen[i] = self.gen[i].wrapping_add(1);

@@ -202,6 +202,7 @@ impl VvProgram {
             steps: 0,
             length: 0,
         };
+        let edits = run.mesh.topology_edits();
         run.control(ControlKind::Start)?;
         let stated = match &program.derivation_length {
             Some((e, span)) => {
@@ -230,7 +231,7 @@ impl VvProgram {
         }
         // A mesh read from a file is consistent, and holds nothing to
         // release; one that `Start` built or changed is checked.
-        if base.is_none() || run.has(ControlKind::Start) {
+        if base.is_none() || run.mesh.topology_edits() != edits {
             run.end_of_step("`Start`", true)?;
         }
         Ok(run)
