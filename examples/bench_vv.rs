@@ -5,22 +5,17 @@
 //! traced back into a soup. `igl.loop` is timed on the same file by
 //! `benches/peers.py`. `cargo run --release --example bench_vv [OUT_DIR]`
 
+mod common;
+
 use std::path::PathBuf;
-use std::time::Instant;
 
 use subgram::mesh::{io, shapes, Mesh, PolygonSoup};
 use subgram::{LoadOptions, RunOptions, System};
 
-fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
-    let mut best = f64::MAX;
-    let mut last = None;
-    for _ in 0..runs {
-        let t = Instant::now();
-        let r = f();
-        best = best.min(t.elapsed().as_secs_f64());
-        last = Some(r);
-    }
-    (best, last.expect("one run"))
+/// The best time of `runs` runs of `f`, in seconds, and its last result.
+fn best_of<T>(runs: usize, f: impl FnMut() -> T) -> (f64, T) {
+    let (t, r) = common::best_of(runs, f);
+    (t.as_secs_f64(), r)
 }
 
 fn main() {

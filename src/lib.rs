@@ -33,6 +33,7 @@ mod curve;
 mod deadline;
 mod error;
 mod lang;
+mod limits;
 mod load;
 mod production;
 mod rewrite;

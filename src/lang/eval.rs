@@ -40,6 +40,34 @@ pub struct Env {
     pub environment: bool,
 }
 
+impl Env {
+    /// The environment of a run of `program`: every global exists, zero,
+    /// before the initialisers run (one may call a function that reads a
+    /// global declared after it); then each initialiser, in order.
+    pub fn for_program(
+        program: &Program,
+        interp: &mut Interp,
+        output: ProgramOutput,
+        seed: Option<u32>,
+    ) -> Result<Env, RuntimeError> {
+        let zeros = program
+            .globals
+            .iter()
+            .map(|g| Value::zero(g.ty, &program.structs))
+            .collect();
+        let mut env = Env::new(zeros);
+        env.output = output;
+        env.random = Random::new(seed);
+        env.model = program.model.clone();
+        for (k, g) in program.globals.iter().enumerate() {
+            if let Some(e) = &g.init {
+                env.globals[k] = interp.eval_global(e, &mut env)?.convert(g.ty);
+            }
+        }
+        Ok(env)
+    }
+}
+
 /// More views than this are not recorded.
 pub const MAX_VIEWS: usize = 64;
 

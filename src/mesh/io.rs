@@ -74,16 +74,11 @@ impl Format {
 /// when it is set, else [`MAX_FILE_BYTES`]; a message when the variable is
 /// not a whole number.
 pub fn max_file_bytes() -> Result<u64, String> {
-    match std::env::var(MAX_FILE_BYTES_VAR) {
-        Err(std::env::VarError::NotPresent) => Ok(MAX_FILE_BYTES),
-        Ok(v) => v.trim().parse::<u64>().map_err(|_| {
-            format!("{MAX_FILE_BYTES_VAR} must be a whole number of bytes, found `{v}`")
-        }),
-        Err(std::env::VarError::NotUnicode(v)) => Err(format!(
-            "{MAX_FILE_BYTES_VAR} must be a whole number of bytes, found `{}`",
-            v.to_string_lossy()
-        )),
-    }
+    crate::limits::from_env(
+        MAX_FILE_BYTES_VAR,
+        MAX_FILE_BYTES,
+        "a whole number of bytes",
+    )
 }
 
 /// Reads the mesh file at `path`, its format chosen by extension. A file

@@ -5,7 +5,6 @@
 use crate::deadline::Deadline;
 use crate::lang::eval::{Env, Interp, NoHost, RuntimeError};
 use crate::lang::ir::{Program, St};
-use crate::lang::random::Random;
 use crate::lang::{ProgramOutput, Sym, Value};
 use crate::syntax::ast::{ControlKind, Section};
 use crate::syntax::span::Span;
@@ -196,25 +195,8 @@ impl<'p> Derivation<'p> {
         traced: bool,
     ) -> Result<Derivation<'p>, DeriveError> {
         let mut interp = Interp::for_program(program, opts.deadline);
-        // Every global exists, zero, before the initialisers run: one may
-        // call a function that reads a global declared after it.
-        let zeros = program
-            .globals
-            .iter()
-            .map(|g| Value::zero(g.ty, &program.structs))
-            .collect();
-        let mut env = Env::new(zeros);
-        env.output = opts.output.clone();
-        env.random = Random::new(opts.seed);
-        env.model = program.model.clone();
-        for (k, g) in program.globals.iter().enumerate() {
-            if let Some(e) = &g.init {
-                env.globals[k] = interp
-                    .eval_global(e, &mut env)
-                    .map_err(|e| runtime(e, None, 0))?
-                    .convert(g.ty);
-            }
-        }
+        let env = Env::for_program(program, &mut interp, opts.output.clone(), opts.seed)
+            .map_err(|e| runtime(e, None, 0))?;
         let mut d = Derivation {
             program,
             rewriter: Rewriter::new(program),

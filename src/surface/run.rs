@@ -96,19 +96,8 @@ pub const MAX_VALENCE_VAR: &str = "SUBGRAM_MAX_VALENCE";
 /// valence.
 /// Also gives the mesh's highest valence.
 fn valence_limit(configured: usize, mesh: &Mesh) -> Result<(usize, usize), String> {
-    let limit = match std::env::var(MAX_VALENCE_VAR) {
-        Err(std::env::VarError::NotPresent) => configured,
-        Ok(v) => v
-            .trim()
-            .parse()
-            .map_err(|_| format!("{MAX_VALENCE_VAR} must be a whole number, found `{v}`"))?,
-        Err(std::env::VarError::NotUnicode(v)) => {
-            return Err(format!(
-                "{MAX_VALENCE_VAR} must be a whole number, found `{}`",
-                v.to_string_lossy()
-            ))
-        }
-    };
+    let limit =
+        crate::limits::from_env(MAX_VALENCE_VAR, configured as u64, "a whole number")? as usize;
     let highest = mesh.max_valence().map_or(0, |(_, n)| n);
     Ok((limit.max(2 * highest), highest))
 }

@@ -1719,18 +1719,8 @@ impl<'t> Parser<'t> {
             return Ok(None);
         }
         let span = self.span_here();
-        let call = |name: &str, args: Vec<Expr>, end: Span| {
-            Stmt::Expr(Expr {
-                kind: ExprKind::Call(
-                    Name {
-                        text: name.into(),
-                        span,
-                    },
-                    args,
-                ),
-                span: span.to(end),
-            })
-        };
+        let call =
+            |name: &str, args: Vec<Expr>, end: Span| Stmt::Expr(call_of(name, span, args, end));
         let s = match w {
             "forall" => {
                 self.pos += 1;
@@ -2147,17 +2137,7 @@ impl<'t> Parser<'t> {
         if name != "valence" {
             args.push(self.unary()?);
         }
-        let end = self.prev_span();
-        Ok(Some(Expr {
-            kind: ExprKind::Call(
-                Name {
-                    text: name.into(),
-                    span,
-                },
-                args,
-            ),
-            span: span.to(end),
-        }))
+        Ok(Some(call_of(name, span, args, self.prev_span())))
     }
 
     /// postfix := primary { '.' NAME [ '(' args ')' ] | '++' | '--' }, a
@@ -2398,6 +2378,21 @@ impl<'t> Parser<'t> {
             kind,
             span: span.to(self.prev_span()),
         })
+    }
+}
+
+/// A call of the built-in `name` written from `span` to `end` (vv's
+/// statements and queries are calls of the topology's built-ins).
+fn call_of(name: &str, span: Span, args: Vec<Expr>, end: Span) -> Expr {
+    Expr {
+        kind: ExprKind::Call(
+            Name {
+                text: name.into(),
+                span,
+            },
+            args,
+        ),
+        span: span.to(end),
     }
 }
 

@@ -110,6 +110,20 @@ macro_rules! vv {
     };
 }
 
+/// A built-in of one set of vertices.
+macro_rules! on_set {
+    ($name:literal, $id:expr, $ty:expr, $usage:literal) => {
+        Builtin {
+            name: $name,
+            resolve: |a| match a {
+                [Ty::Elem(SET)] => Ok((Func::Host($id), $ty)),
+                [_] => Err(SigError::Message($usage.into())),
+                _ => Err(SigError::Arity(1)),
+            },
+        }
+    };
+}
+
 static FUNCTIONS: &[Builtin] = &[
     vv!("$new", 0, id::NEW, V, "`vertex v;` creates a vertex"),
     // What `add v to S` adds: the checker passes it through this, which
@@ -195,36 +209,24 @@ static FUNCTIONS: &[Builtin] = &[
         Ty::Void,
         "`splice x before a in v` takes three vertices"
     ),
-    Builtin {
-        name: "synchronize",
-        resolve: |a| match a {
-            [Ty::Elem(SET)] => Ok((Func::Host(id::SYNCHRONIZE), Ty::Void)),
-            [_] => Err(SigError::Message(
-                "`synchronize S` takes a set of vertices (a `mesh`)".into(),
-            )),
-            _ => Err(SigError::Arity(1)),
-        },
-    },
-    Builtin {
-        name: "check",
-        resolve: |a| match a {
-            [Ty::Elem(SET)] => Ok((Func::Host(id::CHECK), Ty::Void)),
-            [_] => Err(SigError::Message(
-                "`check(S)` takes a set of vertices (a `mesh`)".into(),
-            )),
-            _ => Err(SigError::Arity(1)),
-        },
-    },
-    Builtin {
-        name: "size",
-        resolve: |a| match a {
-            [Ty::Elem(SET)] => Ok((Func::Host(id::SIZE), Ty::Int)),
-            [_] => Err(SigError::Message(
-                "`size(S)` takes a set of vertices (a `mesh`)".into(),
-            )),
-            _ => Err(SigError::Arity(1)),
-        },
-    },
+    on_set!(
+        "synchronize",
+        id::SYNCHRONIZE,
+        Ty::Void,
+        "`synchronize S` takes a set of vertices (a `mesh`)"
+    ),
+    on_set!(
+        "check",
+        id::CHECK,
+        Ty::Void,
+        "`check(S)` takes a set of vertices (a `mesh`)"
+    ),
+    on_set!(
+        "size",
+        id::SIZE,
+        Ty::Int,
+        "`size(S)` takes a set of vertices (a `mesh`)"
+    ),
     vv!(
         "edge",
         2,
@@ -232,16 +234,12 @@ static FUNCTIONS: &[Builtin] = &[
         Ty::Elem(EDGE),
         "`(p, q)` takes two vertices"
     ),
-    Builtin {
-        name: "triangles",
-        resolve: |a| match a {
-            [Ty::Elem(SET)] => Ok((Func::Host(id::TRIANGLES), Ty::Bool)),
-            [_] => Err(SigError::Message(
-                "`triangles(S)` takes a set of vertices (a `mesh`)".into(),
-            )),
-            _ => Err(SigError::Arity(1)),
-        },
-    },
+    on_set!(
+        "triangles",
+        id::TRIANGLES,
+        Ty::Bool,
+        "`triangles(S)` takes a set of vertices (a `mesh`)"
+    ),
     Builtin {
         name: "error",
         resolve: |a| match a {
@@ -364,6 +362,22 @@ pub fn decode(ty: Ty, s: &[f64]) -> Value {
     }
 }
 
+/// A position to store: a finite vector.
+fn finite_position(value: &Value) -> Result<DVec3, String> {
+    let p = match value {
+        Value::V3(p) => *p,
+        _ => DVec3::NAN,
+    };
+    if p.is_finite() {
+        Ok(p)
+    } else {
+        Err(format!(
+            "a vertex position must be finite; this is ({}, {}, {})",
+            p.x, p.y, p.z
+        ))
+    }
+}
+
 /// The rotation system as a body sees it while it runs.
 pub struct VvHost<'a> {
     pub mesh: &'a mut Rotation,
@@ -474,16 +488,7 @@ impl VvHost<'_> {
         storable(value)?;
         match e.kind {
             VERTEX if index == 0 => {
-                let p = match value {
-                    Value::V3(p) => *p,
-                    _ => DVec3::NAN,
-                };
-                if !p.is_finite() {
-                    return Err(format!(
-                        "a vertex position must be finite; this is ({}, {}, {})",
-                        p.x, p.y, p.z
-                    ));
-                }
+                let p = finite_position(value)?;
                 self.mesh.set_pos(e.ids[0], p)
             }
             VERTEX => {
@@ -660,16 +665,7 @@ impl Host for VvHost<'_> {
             }
             id::SET_POS => {
                 let v = self.current(&args[0], "`v$pos = ...`")?;
-                let p = match &args[1] {
-                    Value::V3(p) => *p,
-                    _ => DVec3::NAN,
-                };
-                if !p.is_finite() {
-                    return Err(format!(
-                        "a vertex position must be finite; this is ({}, {}, {})",
-                        p.x, p.y, p.z
-                    ));
-                }
+                let p = finite_position(&args[1])?;
                 self.mesh.set_pos(v, p)?;
                 args[1].clone()
             }

@@ -31,17 +31,7 @@ const MAX_VERTICES_VAR: &str = "SUBGRAM_MAX_VERTICES";
 
 /// The vertex limit of a run: the environment's, else `default`.
 fn vertex_limit(default: usize) -> Result<usize, String> {
-    match std::env::var(MAX_VERTICES_VAR) {
-        Err(std::env::VarError::NotPresent) => Ok(default),
-        Ok(v) => v
-            .trim()
-            .parse()
-            .map_err(|_| format!("{MAX_VERTICES_VAR} must be a whole number, found `{v}`")),
-        Err(std::env::VarError::NotUnicode(v)) => Err(format!(
-            "{MAX_VERTICES_VAR} must be a whole number, found `{}`",
-            v.to_string_lossy()
-        )),
-    }
+    crate::limits::from_env(MAX_VERTICES_VAR, default as u64, "a whole number").map(|n| n as usize)
 }
 
 /// The environment variable that sets the valence limit, as for surface
@@ -52,19 +42,11 @@ use crate::surface::run::MAX_VALENCE_VAR;
 /// surface grammars' default (1000); raised to twice the base mesh's
 /// highest valence.
 fn valence_limit(mesh: &Rotation, members: &[u32]) -> Result<usize, String> {
-    let configured = match std::env::var(MAX_VALENCE_VAR) {
-        Err(std::env::VarError::NotPresent) => crate::surface::run::MAX_VALENCE,
-        Ok(v) => v
-            .trim()
-            .parse()
-            .map_err(|_| format!("{MAX_VALENCE_VAR} must be a whole number, found `{v}`"))?,
-        Err(std::env::VarError::NotUnicode(v)) => {
-            return Err(format!(
-                "{MAX_VALENCE_VAR} must be a whole number, found `{}`",
-                v.to_string_lossy()
-            ))
-        }
-    };
+    let configured = crate::limits::from_env(
+        MAX_VALENCE_VAR,
+        crate::surface::run::MAX_VALENCE as u64,
+        "a whole number",
+    )? as usize;
     let highest = members
         .iter()
         .map(|&v| mesh.valence(v, false).unwrap_or(0))
@@ -139,19 +121,7 @@ impl VvProgram {
     ) -> Result<VvRun<'_>, VvError> {
         let program = &self.program;
         let mut interp = Interp::for_program(program, deadline);
-        let zeros = program
-            .globals
-            .iter()
-            .map(|g| Value::zero(g.ty, &program.structs))
-            .collect();
-        let mut env = Env::new(zeros);
-        env.output = output;
-        env.random = crate::lang::random::Random::new(seed);
-        for (k, g) in program.globals.iter().enumerate() {
-            if let Some(e) = &g.init {
-                env.globals[k] = interp.eval_global(e, &mut env)?.convert(g.ty);
-            }
-        }
+        let mut env = Env::for_program(program, &mut interp, output, seed)?;
         let (mut mesh, members) = match base {
             Some(soup) => Rotation::from_soup(soup).map_err(|m| VvError {
                 span: self.base.as_ref().map(|b| b.1),
