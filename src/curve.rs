@@ -141,7 +141,6 @@ impl Curve {
             &self.program.alphabet,
             &self.program.structs,
         )
-        .to_string()
     }
 
     /// Derives, interprets and lays out the program's picture: its main

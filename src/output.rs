@@ -5,7 +5,7 @@
 //! users see it: `1.9999987`, not the `double` `1.999998688697815` that
 //! holds it.
 
-use serde_json::{json, Value as Json};
+use std::io::Write;
 
 use crate::lang::value::StructDef;
 use crate::lang::{Alphabet, Ty, Value};
@@ -82,63 +82,214 @@ fn field_types(ty: Ty, structs: &[StructDef]) -> Vec<Ty> {
 }
 
 /// A struct parameter is an array of its fields.
-/// `{"ring": bool, "step": N, "modules": [{"symbol": "P", "params": [[0.0, 1.0]]}]}`
+/// `{"modules": [{"params": [[0.0, 1.0]], "symbol": "P"}, …], "ring": bool, "step": N}`,
+/// keys in that order, compact, as a `serde_json` value of the same word
+/// prints; written as it goes, with no tree of values.
+pub fn write_word_json(
+    out: &mut impl Write,
+    word: &Word,
+    ring: bool,
+    step: u64,
+    alphabet: &Alphabet,
+    structs: &[StructDef],
+) -> std::io::Result<()> {
+    out.write_all(b"{\"modules\":[")?;
+    // Each symbol's name as a JSON string, and whether it has parameters
+    // when it takes no slots (a struct of no fields is one), made once.
+    let mut names: Vec<Option<(Vec<u8>, bool)>> = Vec::new();
+    for i in 0..word.len() {
+        if i > 0 {
+            out.write_all(b",")?;
+        }
+        let sym = word.syms()[i];
+        let k = sym.0 as usize;
+        if names.len() <= k {
+            names.resize(k + 1, None);
+        }
+        let (name, bare) = names[k].get_or_insert_with(|| {
+            (
+                serde_json::to_vec(alphabet.name(sym)).expect("a string is JSON"),
+                alphabet.layout(sym, 0, structs).is_empty(),
+            )
+        });
+        out.write_all(b"{\"params\":[")?;
+        if !(word.data(i).is_empty() && *bare) {
+            let tys = alphabet.layout(sym, word.data(i).len(), structs);
+            for (j, p) in word.values(i, alphabet, structs).iter().enumerate() {
+                if j > 0 {
+                    out.write_all(b",")?;
+                }
+                value_json(out, p, tys.get(j).copied().unwrap_or(Ty::Double), structs)?;
+            }
+        }
+        out.write_all(b"],\"symbol\":")?;
+        out.write_all(name)?;
+        out.write_all(b"}")?;
+    }
+    write!(out, "],\"ring\":{ring},\"step\":{step}}}")
+}
+
+/// [`write_word_json`] into a string.
 pub fn word_json(
     word: &Word,
     ring: bool,
     step: u64,
     alphabet: &Alphabet,
     structs: &[StructDef],
-) -> Json {
-    let modules: Vec<Json> = (0..word.len())
-        .map(|i| {
-            let sym = word.syms()[i];
-            let tys = alphabet.layout(sym, word.data(i).len(), structs);
-            let params: Vec<Json> = word
-                .values(i, alphabet, structs)
-                .iter()
-                .enumerate()
-                .map(|(j, p)| value_json(p, tys.get(j).copied().unwrap_or(Ty::Double), structs))
-                .collect();
-            json!({ "symbol": alphabet.name(sym), "params": params })
-        })
-        .collect();
-    json!({ "ring": ring, "step": step, "modules": modules })
+) -> String {
+    let mut out = Vec::new();
+    write_word_json(&mut out, word, ring, step, alphabet, structs)
+        .expect("writing into memory does not fail");
+    String::from_utf8(out).expect("JSON is UTF-8")
 }
 
-/// A number: a single-precision value is the `double` nearest the shortest
-/// decimal of its `float`, so that JSON shows `0.1`, not `0.10000000149011612`.
-fn float_json(x: f64, single: bool) -> Json {
-    if single && (x as f32) as f64 == x {
-        let shortest: f64 = (x as f32).to_string().parse().unwrap_or(x);
-        json!(shortest)
+/// A number as JSON shows it (`null` for a non-finite one): a
+/// single-precision value is the `double` nearest the shortest decimal of
+/// its `float`, so that JSON shows `0.1`, not `0.10000000149011612`.
+fn float_json(out: &mut impl Write, x: f64, single: bool) -> std::io::Result<()> {
+    let x = if single && (x as f32) as f64 == x {
+        (x as f32).to_string().parse().unwrap_or(x)
     } else {
-        json!(x)
+        x
+    };
+    if x.is_finite() {
+        serde_json::to_writer(&mut *out, &x)?;
+        Ok(())
+    } else {
+        out.write_all(b"null")
     }
 }
 
-fn value_json(v: &Value, ty: Ty, structs: &[StructDef]) -> Json {
+fn value_json(
+    out: &mut impl Write,
+    v: &Value,
+    ty: Ty,
+    structs: &[StructDef],
+) -> std::io::Result<()> {
     let single = ty.is_single();
     match v {
-        Value::Int(i) => json!(i),
-        Value::Float(f) => float_json(*f, single),
-        Value::Bool(b) => json!(b),
-        Value::V2(p) => json!([float_json(p.x, single), float_json(p.y, single)]),
-        Value::V3(p) => json!([
-            float_json(p.x, single),
-            float_json(p.y, single),
-            float_json(p.z, single)
-        ]),
+        Value::Int(i) => write!(out, "{i}"),
+        Value::Float(f) => float_json(out, *f, single),
+        Value::Bool(b) => write!(out, "{b}"),
+        Value::V2(p) => {
+            out.write_all(b"[")?;
+            float_json(out, p.x, single)?;
+            out.write_all(b",")?;
+            float_json(out, p.y, single)?;
+            out.write_all(b"]")
+        }
+        Value::V3(p) => {
+            out.write_all(b"[")?;
+            float_json(out, p.x, single)?;
+            out.write_all(b",")?;
+            float_json(out, p.y, single)?;
+            out.write_all(b",")?;
+            float_json(out, p.z, single)?;
+            out.write_all(b"]")
+        }
         Value::Struct(fs) => {
             let tys = field_types(ty, structs);
-            Json::Array(
-                fs.iter()
-                    .enumerate()
-                    .map(|(i, f)| value_json(f, tys.get(i).copied().unwrap_or(Ty::Double), structs))
-                    .collect(),
-            )
+            out.write_all(b"[")?;
+            for (i, f) in fs.iter().enumerate() {
+                if i > 0 {
+                    out.write_all(b",")?;
+                }
+                value_json(out, f, tys.get(i).copied().unwrap_or(Ty::Double), structs)?;
+            }
+            out.write_all(b"]")
         }
-        Value::Str(s) => json!(s.as_ref()),
-        Value::Void | Value::Elem(_) | Value::Set(_) => Json::Null,
+        Value::Str(s) => {
+            serde_json::to_writer(&mut *out, s.as_ref())?;
+            Ok(())
+        }
+        Value::Void | Value::Elem(_) | Value::Set(_) => out.write_all(b"null"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::{json, Value as Json};
+
+    use super::*;
+
+    /// The word as a `serde_json` tree, as this module built it before it
+    /// wrote as it went: the reference for the streamed text.
+    fn tree(
+        word: &Word,
+        ring: bool,
+        step: u64,
+        alphabet: &Alphabet,
+        structs: &[StructDef],
+    ) -> Json {
+        fn float(x: f64, single: bool) -> Json {
+            if single && (x as f32) as f64 == x {
+                let shortest: f64 = (x as f32).to_string().parse().unwrap_or(x);
+                json!(shortest)
+            } else {
+                json!(x)
+            }
+        }
+        fn value(v: &Value, ty: Ty, structs: &[StructDef]) -> Json {
+            let single = ty.is_single();
+            match v {
+                Value::Int(i) => json!(i),
+                Value::Float(f) => float(*f, single),
+                Value::Bool(b) => json!(b),
+                Value::V2(p) => json!([float(p.x, single), float(p.y, single)]),
+                Value::V3(p) => json!([float(p.x, single), float(p.y, single), float(p.z, single)]),
+                Value::Struct(fs) => {
+                    let tys = field_types(ty, structs);
+                    Json::Array(
+                        fs.iter()
+                            .enumerate()
+                            .map(|(i, f)| {
+                                value(f, tys.get(i).copied().unwrap_or(Ty::Double), structs)
+                            })
+                            .collect(),
+                    )
+                }
+                Value::Str(s) => json!(s.as_ref()),
+                Value::Void | Value::Elem(_) | Value::Set(_) => Json::Null,
+            }
+        }
+        let modules: Vec<Json> = (0..word.len())
+            .map(|i| {
+                let sym = word.syms()[i];
+                let tys = alphabet.layout(sym, word.data(i).len(), structs);
+                let params: Vec<Json> = word
+                    .values(i, alphabet, structs)
+                    .iter()
+                    .enumerate()
+                    .map(|(j, p)| value(p, tys.get(j).copied().unwrap_or(Ty::Double), structs))
+                    .collect();
+                json!({ "symbol": alphabet.name(sym), "params": params })
+            })
+            .collect();
+        json!({ "ring": ring, "step": step, "modules": modules })
+    }
+
+    /// Every kind of parameter, streamed, prints as the tree prints.
+    #[test]
+    fn the_streamed_json_is_the_trees() {
+        let text = r#"
+            struct S { int k; float w; V2f v; };
+            struct E { };
+            module A(float, double, int, bool);
+            module D(E);
+            module B(V2f, V3d);
+            module C(S);
+            Axiom: A(0.1, 1e-7, -3, true) B(V2f(1.5, -2.25), V3d(1e300, 0, -0.5)) C(S(7, 0.3f, V2f(0, 1e-30))) D(E()) F;
+            derivation length: 0;
+        "#;
+        let curve = crate::load_str("t.lsys", text, &[]).unwrap_or_else(|e| panic!("{e}"));
+        let run = curve.run(Default::default()).unwrap();
+        let (alphabet, structs) = (&curve.program.alphabet, &curve.program.structs);
+        let word = run.word();
+        for ring in [false, true] {
+            let streamed = word_json(word, ring, 3, alphabet, structs);
+            let reference = tree(word, ring, 3, alphabet, structs).to_string();
+            assert_eq!(streamed, reference);
+            assert!(serde_json::from_str::<Json>(&streamed).is_ok());
+        }
     }
 }
