@@ -101,20 +101,82 @@ pub struct Printed {
 /// or JSON; for a surface grammar, the subdivided mesh's description. The
 /// program's warnings come with it.
 pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<Printed, Error> {
+    let mut out = Vec::new();
+    let mut warnings = Vec::new();
+    derive_to(
+        a,
+        progress,
+        |w| {
+            warnings = w.to_vec();
+            Ok(())
+        },
+        &mut out,
+    )?;
+    let mut text = String::from_utf8(out).map_err(|e| Error::Failed(e.to_string()))?;
+    if text.ends_with('\n') {
+        text.pop();
+    }
+    Ok(Printed { text, warnings })
+}
+
+/// [`derive`], the result written to `out` as it is made (a large word is
+/// never held as text), followed by a newline. `before` hears the
+/// program's warnings once the result is ready and before the first byte
+/// of it is written (the binary prints what the program printed, then the
+/// warnings, there). A broken pipe ends the writing quietly.
+pub fn derive_to(
+    a: &DeriveArgs,
+    progress: impl FnMut(Progress),
+    before: impl FnOnce(&[String]) -> Result<(), Error>,
+    out: &mut dyn std::io::Write,
+) -> Result<(), Error> {
     let deadline = a.timeout.map(Deadline::after);
     let dir = writes_folder(&a.allow_writes, &a.output)?;
     let system = load(&a.file, &load_options(&a.defines, a.double))?;
     let warnings = system.warnings();
-    let text = derive_text(a, system, deadline, dir.as_deref(), progress)?;
-    Ok(Printed { text, warnings })
+    let before = || before(&warnings);
+    derive_out(a, &system, deadline, dir.as_deref(), progress, before, out)
 }
 
-fn derive_text(
+/// What a write to the output came to: a broken pipe is no error (the
+/// reader has what it wanted), anything else is.
+fn wrote(r: std::io::Result<()>) -> Result<(), Error> {
+    match r {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(Error::Failed(format!("cannot write the output: {e}"))),
+    }
+}
+
+fn derive_out(
     a: &DeriveArgs,
-    system: System,
+    system: &System,
     deadline: Option<Deadline>,
     dir: Option<&Path>,
     progress: impl FnMut(Progress),
+    before: impl FnOnce() -> Result<(), Error>,
+    out: &mut dyn std::io::Write,
+) -> Result<(), Error> {
+    use std::io::Write;
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
+    let text = derive_text(a, system, deadline, dir, progress, before, &mut out)?;
+    wrote(
+        out.write_all(text.as_bytes())
+            .and_then(|_| out.write_all(b"\n"))
+            .and_then(|_| out.flush()),
+    )
+}
+
+/// The result as text for meshes; for a curve, the word is written to
+/// `out` here (after `before`), and the text returned is empty.
+fn derive_text(
+    a: &DeriveArgs,
+    system: &System,
+    deadline: Option<Deadline>,
+    dir: Option<&Path>,
+    progress: impl FnMut(Progress),
+    before: impl FnOnce() -> Result<(), Error>,
+    out: &mut impl std::io::Write,
 ) -> Result<String, Error> {
     let opts = RunOptions {
         steps: a.steps,
@@ -139,6 +201,7 @@ fn derive_text(
             let mut inputs = vec![PathBuf::from(&a.file)];
             inputs.extend(v.base_mesh());
             write_program_files(&a.output, dir, &as_paths(&inputs))?;
+            before()?;
             Ok(if a.json {
                 json(&run.info)?
             } else {
@@ -152,6 +215,7 @@ fn derive_text(
         System::Surface(s) => {
             let run = s.subdivide(&opts, progress)?;
             let info = run.mesh.info();
+            before()?;
             Ok(if a.json {
                 json(&info)?
             } else {
@@ -165,22 +229,20 @@ fn derive_text(
         System::Curve(c) => {
             check_steps(a.steps)?;
             let mut run = c.run(opts.derive_options())?;
-            let word = if !a.interpreted {
-                if a.json {
-                    run.json()
-                } else {
-                    run.text()
-                }
+            let interpreted = if a.interpreted {
+                Some(run.interpreted()?)
             } else {
-                let word = run.interpreted()?;
-                if a.json {
-                    c.word_json(&word, run.ring(), run.step())
-                } else {
-                    c.word_text(&word)
-                }
+                None
             };
             write_program_files(&a.output, dir, &[Path::new(&a.file)])?;
-            Ok(word)
+            before()?;
+            let word = interpreted.as_ref().unwrap_or(run.word());
+            wrote(if a.json {
+                c.write_word_json(out, word, run.ring(), run.step())
+            } else {
+                c.write_word_text(out, word)
+            })?;
+            Ok(String::new())
         }
     }
 }

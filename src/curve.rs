@@ -131,6 +131,33 @@ impl Curve {
         crate::output::word_text(word, &self.program.alphabet, &self.program.structs)
     }
 
+    /// [`Curve::word_text`], written to `out` as it goes.
+    pub fn write_word_text(
+        &self,
+        out: &mut impl std::io::Write,
+        word: &Word,
+    ) -> std::io::Result<()> {
+        crate::output::write_word_text(out, word, &self.program.alphabet, &self.program.structs)
+    }
+
+    /// [`Curve::word_json`], written to `out` as it goes.
+    pub fn write_word_json(
+        &self,
+        out: &mut impl std::io::Write,
+        word: &Word,
+        ring: bool,
+        step: u64,
+    ) -> std::io::Result<()> {
+        crate::output::write_word_json(
+            out,
+            word,
+            ring,
+            step,
+            &self.program.alphabet,
+            &self.program.structs,
+        )
+    }
+
     /// `word` as JSON: `{"ring": bool, "step": N, "modules": [{"symbol": "P",
     /// "params": [[0.0, 1.0]]}, …]}`.
     pub fn word_json(&self, word: &Word, ring: bool, step: u64) -> String {

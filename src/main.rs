@@ -384,13 +384,34 @@ fn run(cli: Cli) -> Result<(), Error> {
                 allow_writes,
                 output: subgram::ProgramOutput::new(),
             };
-            let result = with_progress(|p| command::derive(&args, p));
-            // The program's standard output goes before the word, or to
-            // standard error when the word is JSON, which must stay whole.
-            print_program_output(&args.output, json)?;
-            let printed = result?;
-            print_warnings(&printed.warnings);
-            print_out(&printed.text)
+            // The word is written as it is made. Before it: what the
+            // program printed (to standard error when the word is JSON,
+            // which must stay whole), then the warnings, the progress bar
+            // cleared first.
+            let bar = std::cell::RefCell::new(None);
+            let done = std::cell::Cell::new(false);
+            let mut stdout = std::io::stdout().lock();
+            let result = command::derive_to(
+                &args,
+                |p| progress_to(&bar, p),
+                |warnings| {
+                    if let Some(b) = bar.borrow_mut().take() {
+                        b.finish_and_clear();
+                    }
+                    done.set(true);
+                    print_program_output(&args.output, json)?;
+                    print_warnings(warnings);
+                    Ok(())
+                },
+                &mut stdout,
+            );
+            if let Some(b) = bar.borrow_mut().take() {
+                b.finish_and_clear();
+            }
+            if !done.get() {
+                print_program_output(&args.output, json)?;
+            }
+            result
         }
         Command::Render {
             file,
@@ -530,28 +551,30 @@ fn run(cli: Cli) -> Result<(), Error> {
 /// Runs `f` with a progress bar on standard error for surface grammars'
 /// steps (shown only on a terminal).
 fn with_progress<T>(f: impl FnOnce(&mut dyn FnMut(Progress)) -> T) -> T {
-    let mut bar: Option<indicatif::ProgressBar> = None;
-    let result = f(&mut |p: Progress| {
-        let b = bar.get_or_insert_with(|| {
-            let b = indicatif::ProgressBar::new(p.steps as u64);
-            b.set_style(
-                indicatif::ProgressStyle::with_template(
-                    "{spinner} step {pos}/{len} {msg} [{elapsed}]",
-                )
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-            );
-            b
-        });
-        b.set_position(p.step as u64);
-        b.set_message(format!(
-            "{} vertices, {} edges, {} faces",
-            p.vertices, p.edges, p.faces
-        ));
-    });
-    if let Some(b) = bar {
+    let bar = std::cell::RefCell::new(None);
+    let result = f(&mut |p: Progress| progress_to(&bar, p));
+    if let Some(b) = bar.into_inner() {
         b.finish_and_clear();
     }
     result
+}
+
+/// Shows `p` on the progress bar in `bar`, made on the first report.
+fn progress_to(bar: &std::cell::RefCell<Option<indicatif::ProgressBar>>, p: Progress) {
+    let mut bar = bar.borrow_mut();
+    let b = bar.get_or_insert_with(|| {
+        let b = indicatif::ProgressBar::new(p.steps as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} step {pos}/{len} {msg} [{elapsed}]")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    });
+    b.set_position(p.step as u64);
+    b.set_message(format!(
+        "{} vertices, {} edges, {} faces",
+        p.vertices, p.edges, p.faces
+    ));
 }
 
 /// Writes what an L+C program printed (`printf`, `fprintf(stderr, …)`):

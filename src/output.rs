@@ -13,28 +13,42 @@ use crate::rewrite::Word;
 
 /// `P([0, 0.25]) E A(1, 2)`: one module after another, vectors in brackets.
 pub fn word_text(word: &Word, alphabet: &Alphabet, structs: &[StructDef]) -> String {
-    let mut out = String::new();
+    let mut out = Vec::new();
+    write_word_text(&mut out, word, alphabet, structs).expect("writing into memory does not fail");
+    String::from_utf8(out).expect("the text is UTF-8")
+}
+
+/// [`word_text`], written as it goes.
+pub fn write_word_text(
+    out: &mut impl Write,
+    word: &Word,
+    alphabet: &Alphabet,
+    structs: &[StructDef],
+) -> std::io::Result<()> {
     for i in 0..word.len() {
         let sym = word.syms()[i];
         if i > 0 {
-            out.push(' ');
+            out.write_all(b" ")?;
         }
-        out.push_str(alphabet.name(sym));
+        out.write_all(alphabet.name(sym).as_bytes())?;
+        if word.data(i).is_empty() && alphabet.layout(sym, 0, structs).is_empty() {
+            continue;
+        }
         let params = word.values(i, alphabet, structs);
         if !params.is_empty() {
             let tys = alphabet.layout(sym, word.data(i).len(), structs);
-            out.push('(');
+            out.write_all(b"(")?;
             for (j, p) in params.iter().enumerate() {
                 if j > 0 {
-                    out.push_str(", ");
+                    out.write_all(b", ")?;
                 }
                 let ty = tys.get(j).copied().unwrap_or(Ty::Double);
-                out.push_str(&value_text(p, ty, structs));
+                out.write_all(value_text(p, ty, structs).as_bytes())?;
             }
-            out.push(')');
+            out.write_all(b")")?;
         }
     }
-    out
+    Ok(())
 }
 
 /// `x` as text: a single-precision value as the shortest decimal of its

@@ -40,6 +40,30 @@ fn derive_json_has_the_documented_shape() {
     assert_eq!(v["modules"][1]["params"], serde_json::json!([[0.0, 1.0]]));
 }
 
+/// A large word, written as it is made, is whole JSON: the quadratic Koch
+/// island after 5 steps holds 4 * 8^5 = 131,072 `F` (each `F` becomes 8),
+/// and the text form says the same.
+#[test]
+fn a_large_word_streams_as_valid_json_and_text() {
+    let f = lsys("abop/quadratic-koch-island.lsys");
+    let o = subgram(&["derive", f.to_str().unwrap(), "-n", "5", "--format", "json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let modules = v["modules"].as_array().unwrap();
+    let f_count = modules.iter().filter(|m| m["symbol"] == "F").count();
+    assert_eq!(f_count, 4 * 8usize.pow(5));
+    assert_eq!(v["step"], 5);
+    let o = subgram(&["derive", f.to_str().unwrap(), "-n", "5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.ends_with('\n') && !text.ends_with("\n\n"));
+    assert_eq!(
+        text.split_whitespace().filter(|m| *m == "F").count(),
+        4 * 8usize.pow(5)
+    );
+    assert_eq!(text.split_whitespace().count(), modules.len());
+}
+
 #[test]
 fn steps_and_defines_override_the_file() {
     let f = lsys("curves/chaikin-13.lsys");
