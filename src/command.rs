@@ -119,7 +119,7 @@ pub fn derive(a: &DeriveArgs, progress: impl FnMut(Progress)) -> Result<Printed,
     Ok(Printed { text, warnings })
 }
 
-/// [`derive`], the result written to `out` as it is made (a large word is
+/// [`derive()`], the result written to `out` as it is made (a large word is
 /// never held as text), followed by a newline. `before` hears the
 /// program's warnings once the result is ready and before the first byte
 /// of it is written (the binary prints what the program printed, then the
