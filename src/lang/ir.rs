@@ -362,6 +362,51 @@ impl Program {
 }
 
 impl Ex {
+    /// Calls `f` on `self` and on every expression inside it, each parent
+    /// before its children, in the order they are written.
+    pub fn walk(&self, f: &mut impl FnMut(&Ex)) {
+        f(self);
+        match self {
+            Ex::Const(_) | Ex::Local(_) | Ex::Global(_) => {}
+            Ex::Field(a, _) | Ex::Neg(a) | Ex::Not(a) | Ex::Convert(_, a) => a.walk(f),
+            Ex::Bin(_, a, b, _)
+            | Ex::Logic(_, a, b)
+            | Ex::MakeV2(a, b)
+            | Ex::Let(_, a, b)
+            | Ex::Index(a, b, _) => {
+                a.walk(f);
+                b.walk(f);
+            }
+            Ex::Cond(a, b, c) | Ex::MakeV3(a, b, c) => {
+                a.walk(f);
+                b.walk(f);
+                c.walk(f);
+            }
+            Ex::Load(p) | Ex::IncDec(p, _, _) => p.walk(f),
+            Ex::Assign(p, _, a, _) => {
+                p.walk(f);
+                a.walk(f);
+            }
+            Ex::CallUser { args, back, .. } => {
+                args.iter().for_each(|a| a.walk(f));
+                back.iter().for_each(|(_, p)| p.walk(f));
+            }
+            Ex::Call(_, args, _) | Ex::MakeStruct(args) => args.iter().for_each(|a| a.walk(f)),
+            Ex::InContext(_, _, places) => places.iter().for_each(|p| p.walk(f)),
+            Ex::Fold {
+                set, cond, value, ..
+            } => {
+                set.walk(f);
+                if let Some(c) = cond {
+                    c.walk(f);
+                }
+                if let Some((v, _)) = value {
+                    v.walk(f);
+                }
+            }
+        }
+    }
+
     /// Calls `f` on every expression inside `self`, children before their
     /// parent, `self` last: for the specialisations of a topology, which
     /// rewrite nodes in place.
@@ -412,6 +457,15 @@ impl Ex {
 }
 
 impl Place {
+    /// Calls [`Ex::walk`]'s `f` on the index expressions of the path.
+    pub fn walk(&self, f: &mut impl FnMut(&Ex)) {
+        for s in &self.path {
+            if let Step::Index(e, _) = s {
+                e.walk(f);
+            }
+        }
+    }
+
     /// Calls `f` on the index expressions of the place's path.
     pub fn walk_mut(&mut self, f: &mut impl FnMut(&mut Ex)) {
         for s in &mut self.path {

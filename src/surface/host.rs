@@ -579,43 +579,11 @@ impl Host for MeshHost<'_> {
 /// `new(w)` or `!new(w)`. Everything else is left to the interpreter.
 pub fn specialise(e: &mut Ex) {
     // Children first, so that a fused condition inside a fold is seen.
-    match e {
-        Ex::Field(a, _) | Ex::Neg(a) | Ex::Not(a) | Ex::Convert(_, a) => specialise(a),
-        Ex::Bin(_, a, b, _) | Ex::Logic(_, a, b) | Ex::MakeV2(a, b) | Ex::Let(_, a, b) => {
-            specialise(a);
-            specialise(b);
+    e.walk_mut(&mut |x| {
+        if let Some(fused) = fused(x) {
+            *x = fused;
         }
-        Ex::Cond(a, b, c) | Ex::MakeV3(a, b, c) => {
-            specialise(a);
-            specialise(b);
-            specialise(c);
-        }
-        Ex::Assign(_, _, a, _) => specialise(a),
-        Ex::Call(_, args, _) | Ex::MakeStruct(args) => args.iter_mut().for_each(specialise),
-        Ex::Fold {
-            set, cond, value, ..
-        } => {
-            specialise(set);
-            if let Some(c) = cond {
-                specialise(c);
-            }
-            if let Some((v, _)) = value {
-                specialise(v);
-            }
-        }
-        // Arrays and user functions are not part of surface grammars.
-        Ex::Const(_)
-        | Ex::Local(_)
-        | Ex::Global(_)
-        | Ex::IncDec(..)
-        | Ex::InContext(..)
-        | Ex::Load(_)
-        | Ex::Index(..)
-        | Ex::CallUser { .. } => {}
-    }
-    if let Some(fused) = fused(e) {
-        *e = fused;
-    }
+    });
 }
 
 fn host_call(e: &Ex, f: u16) -> Option<&[Ex]> {
@@ -778,7 +746,7 @@ fn path(e: &Ex, slot: u16) -> Option<Path> {
 /// every element a rule tests.
 fn invariant(e: &Ex) -> bool {
     let mut ok = true;
-    walk(e, &mut |x| match x {
+    e.walk(&mut |x| match x {
         Ex::Local(_) | Ex::Global(_) | Ex::Assign(..) | Ex::IncDec(..) | Ex::InContext(..) => {
             ok = false
         }
@@ -787,45 +755,6 @@ fn invariant(e: &Ex) -> bool {
         _ => {}
     });
     ok
-}
-
-/// Calls `f` on `e` and every expression inside it.
-fn walk(e: &Ex, f: &mut dyn FnMut(&Ex)) {
-    f(e);
-    match e {
-        Ex::Field(a, _) | Ex::Neg(a) | Ex::Not(a) | Ex::Convert(_, a) => walk(a, f),
-        Ex::Assign(_, _, a, _) => walk(a, f),
-        Ex::Bin(_, a, b, _) | Ex::Logic(_, a, b) | Ex::MakeV2(a, b) | Ex::Let(_, a, b) => {
-            walk(a, f);
-            walk(b, f);
-        }
-        Ex::Cond(a, b, c) | Ex::MakeV3(a, b, c) => {
-            walk(a, f);
-            walk(b, f);
-            walk(c, f);
-        }
-        Ex::Call(_, args, _) | Ex::MakeStruct(args) => args.iter().for_each(|a| walk(a, f)),
-        Ex::Fold {
-            set, cond, value, ..
-        } => {
-            walk(set, f);
-            if let Some(c) = cond {
-                walk(c, f);
-            }
-            if let Some((v, _)) = value {
-                walk(v, f);
-            }
-        }
-        // Arrays and user functions are not part of surface grammars.
-        Ex::Const(_)
-        | Ex::Local(_)
-        | Ex::Global(_)
-        | Ex::IncDec(..)
-        | Ex::InContext(..)
-        | Ex::Load(_)
-        | Ex::Index(..)
-        | Ex::CallUser { .. } => {}
-    }
 }
 
 impl Guard {
@@ -973,7 +902,7 @@ fn point_call(e: &Ex) -> Option<(u16, u16, [i64; 2])> {
 /// (the integers bound by the lets) and arithmetic on them.
 fn scalar(e: &Ex) -> bool {
     let mut ok = true;
-    walk(e, &mut |x| match x {
+    e.walk(&mut |x| match x {
         Ex::Call(Func::Host(f), ..) if !matches!(*f, id::CURRENT | id::STEP) => ok = false,
         Ex::Global(_)
         | Ex::Assign(..)
@@ -1013,7 +942,7 @@ impl Affine {
         let later: Vec<u16> = self.lets.iter().filter(|l| !l.2).map(|l| l.0).collect();
         let mut ok = true;
         for (_, a, reads) in &self.lets {
-            walk(a, &mut |x| match x {
+            a.walk(&mut |x| match x {
                 Ex::Local(s) if *reads && later.contains(s) => ok = false,
                 Ex::Let(s, ..) | Ex::Fold { slot: s, .. } if held.contains(s) => ok = false,
                 _ => {}
@@ -1021,7 +950,7 @@ impl Affine {
         }
         for t in &self.terms {
             for (x, _) in &t.factors {
-                walk(x, &mut |x| match x {
+                x.walk(&mut |x| match x {
                     Ex::Let(s, ..) | Ex::Fold { slot: s, .. } if held.contains(s) => ok = false,
                     _ => {}
                 });
@@ -1252,7 +1181,7 @@ fn rewrite(e: &mut Ex, alias: &mut Vec<(u16, u16)>) {
 /// its ring, arithmetic on those.
 fn integer_host(e: &Ex) -> bool {
     let mut ok = true;
-    walk(e, &mut |x| match x {
+    e.walk(&mut |x| match x {
         Ex::Call(Func::Host(id::RING_FOLD), args, _) => {
             if !matches!(args.get(1), Some(Ex::Const(Value::Int(2)))) {
                 ok = false

@@ -105,7 +105,7 @@ fn valence_limit(configured: usize, mesh: &Mesh) -> Result<(usize, usize), Strin
 /// Where the first call of host built-in `f` in `e` is, if there is one.
 fn first_call(e: &Ex, f: u16) -> Option<Span> {
     let mut found: Option<Span> = None;
-    visit(e, &mut |x| {
+    e.walk(&mut |x| {
         if let Ex::Call(Func::Host(g), _, span) = x {
             if *g == f && found.is_none() {
                 found = Some(*span);
@@ -113,45 +113,6 @@ fn first_call(e: &Ex, f: u16) -> Option<Span> {
         }
     });
     found
-}
-
-/// Calls `f` on `e` and every expression inside it, parents first.
-fn visit(e: &Ex, f: &mut dyn FnMut(&Ex)) {
-    f(e);
-    match e {
-        Ex::Field(a, _) | Ex::Neg(a) | Ex::Not(a) | Ex::Convert(_, a) => visit(a, f),
-        Ex::Assign(_, _, a, _) => visit(a, f),
-        Ex::Bin(_, a, b, _) | Ex::Logic(_, a, b) | Ex::MakeV2(a, b) | Ex::Let(_, a, b) => {
-            visit(a, f);
-            visit(b, f);
-        }
-        Ex::Cond(a, b, c) | Ex::MakeV3(a, b, c) => {
-            visit(a, f);
-            visit(b, f);
-            visit(c, f);
-        }
-        Ex::Call(_, args, _) | Ex::MakeStruct(args) => args.iter().for_each(|a| visit(a, f)),
-        Ex::Fold {
-            set, cond, value, ..
-        } => {
-            visit(set, f);
-            if let Some(c) = cond {
-                visit(c, f);
-            }
-            if let Some((v, _)) = value {
-                visit(v, f);
-            }
-        }
-        // Arrays and user functions are not part of surface grammars.
-        Ex::Const(_)
-        | Ex::Local(_)
-        | Ex::Global(_)
-        | Ex::IncDec(..)
-        | Ex::InContext(..)
-        | Ex::Load(_)
-        | Ex::Index(..)
-        | Ex::CallUser { .. } => {}
-    }
 }
 
 /// Compiles a parsed grammar file: its conditions and assignments are
