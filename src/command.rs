@@ -138,6 +138,22 @@ pub fn derive_to(
     derive_out(a, &system, deadline, dir.as_deref(), progress, before, out)
 }
 
+/// A mesh's counts after `steps` steps, as text or JSON.
+fn mesh_counts(
+    as_json: bool,
+    steps: usize,
+    info: &(impl std::fmt::Display + serde::Serialize),
+) -> Result<String, Error> {
+    if as_json {
+        json(info)
+    } else {
+        Ok(format!(
+            "after {steps} step(s):\n{}",
+            info.to_string().trim_end()
+        ))
+    }
+}
+
 /// What a write to the output came to: a broken pipe is no error (the
 /// reader has what it wanted), anything else is.
 fn wrote(r: std::io::Result<()>) -> Result<(), Error> {
@@ -202,29 +218,13 @@ fn derive_text(
             inputs.extend(v.base_mesh());
             write_program_files(&a.output, dir, &as_paths(&inputs))?;
             before()?;
-            Ok(if a.json {
-                json(&run.info)?
-            } else {
-                format!(
-                    "after {} step(s):\n{}",
-                    run.steps,
-                    run.info.to_string().trim_end()
-                )
-            })
+            mesh_counts(a.json, run.steps as usize, &run.info)
         }
         System::Surface(s) => {
             let run = s.subdivide(&opts, progress)?;
             let info = run.mesh.info();
             before()?;
-            Ok(if a.json {
-                json(&info)?
-            } else {
-                format!(
-                    "after {} step(s):\n{}",
-                    run.steps,
-                    info.to_string().trim_end()
-                )
-            })
+            mesh_counts(a.json, run.steps, &info)
         }
         System::Curve(c) => {
             check_steps(a.steps)?;
