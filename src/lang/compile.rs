@@ -3462,17 +3462,7 @@ impl Compiler {
             slots.push(slot);
         }
         scope.push();
-        for (k, p) in c.params.iter().enumerate() {
-            if let Some(n) = &p.name {
-                if scope.vars[fields.len()..].iter().any(|v| v.0 == n.text) {
-                    self.err(
-                        n.span,
-                        format!("the parameter name `{}` is used twice", n.text),
-                    );
-                }
-                scope.bind(&n.text, sig.params[k].0, k as u16);
-            }
-        }
+        self.bind_params(&mut scope, &c.params, &sig.params, 0, fields.len());
         let mut inits: Vec<(usize, &ast::Name, &Vec<ast::Expr>, Span)> = Vec::new();
         for (f, args, span) in &c.inits {
             let Some(k) = fields.iter().position(|(n, _)| *n == f.text) else {
@@ -3609,17 +3599,7 @@ impl Compiler {
             slots.push(slot);
         }
         scope.push();
-        for (k, p) in m.params.iter().enumerate() {
-            if let Some(n) = &p.name {
-                if scope.vars[fields.len()..].iter().any(|v| v.0 == n.text) {
-                    self.err(
-                        n.span,
-                        format!("the parameter name `{}` is used twice", n.text),
-                    );
-                }
-                scope.bind(&n.text, sig.params[k + 1].0, k as u16 + 1);
-            }
-        }
+        self.bind_params(&mut scope, &m.params, &sig.params, 1, fields.len());
         stmts.extend(self.block_stmts(&body.stmts, &mut scope));
         let end = body.span.end as usize;
         Some(Function {
@@ -3988,6 +3968,31 @@ impl Compiler {
             };
         }
         out
+    }
+
+    /// Binds the named parameters of a constructor or a method, which
+    /// follow its struct's `fields` field locals in `scope`: parameter `k`
+    /// lives in slot `first + k` with the type `types[first + k]`; a name
+    /// given twice is an error.
+    fn bind_params(
+        &mut self,
+        scope: &mut Scope,
+        params: &[ast::Param],
+        types: &[(Ty, bool)],
+        first: usize,
+        fields: usize,
+    ) {
+        for (k, p) in params.iter().enumerate() {
+            if let Some(n) = &p.name {
+                if scope.vars[fields..].iter().any(|v| v.0 == n.text) {
+                    self.err(
+                        n.span,
+                        format!("the parameter name `{}` is used twice", n.text),
+                    );
+                }
+                scope.bind(&n.text, types[first + k].0, (first + k) as u16);
+            }
+        }
     }
 
     /// Whether assigning to `p` is refused (a `const` variable).
