@@ -37,6 +37,7 @@ mod limits;
 mod load;
 mod production;
 mod rewrite;
+mod shape;
 mod syntax;
 mod system;
 pub mod vv;

@@ -1,0 +1,2117 @@
+//! The geometry kernel of shape grammars (paper 003): points shared by every
+//! shape of a derivation, a shape's geometry (faces, edges or points), its
+//! scope, plane cuts and splits with caps, primitives, extrusion, component
+//! selection and the welding of a smoothing group into one polygon soup.
+//!
+//! Shapes hold [`PointId`]s into one [`Points`]; two shapes that hold the
+//! same id share that vertex. Cuts are made once per edge and plane, so the
+//! shapes on both sides of a cut, and siblings cut by the same plane, share
+//! the cut points; [`Points::resolve`] inserts the cut points that lie on a
+//! polygon's edges so that neighbours meet without T-junctions.
+//!
+//! Nothing here panics on bad input: degenerate geometry gives an empty
+//! result or an `Err` with a message.
+#![allow(dead_code)]
+
+use std::collections::{HashMap, HashSet};
+
+use glam::{DAffine3, DMat3, DVec3};
+
+use crate::mesh::PolygonSoup;
+
+/// The index of a point in [`Points`].
+pub(crate) type PointId = u32;
+
+/// The most points one derivation may hold.
+pub(crate) const MAX_POINTS: usize = 50_000_000;
+
+/// The most segments (or slices, stacks) a round primitive may have.
+pub(crate) const MAX_SEGMENTS: usize = 1 << 16;
+
+/// All points of one derivation.
+///
+/// A shape's vertices shared with its parent, children and siblings are the
+/// ids they have in common: that is the paper's connectivity map.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Points {
+    pub pos: Vec<DVec3>,
+    /// A line's root edge (min id, max id) -> the cut points on it, sorted
+    /// by their parameter along min -> max. A cut of a piece of that edge
+    /// (a cut on a cut) joins the same list, so the list holds every point
+    /// that cuts put on the segment.
+    cuts: HashMap<(PointId, PointId), Vec<(f64, PointId)>>,
+    /// A cut point -> its root edge and its parameter along it.
+    root: HashMap<PointId, ((PointId, PointId), f64)>,
+}
+
+impl Points {
+    pub fn new() -> Points {
+        Points::default()
+    }
+
+    /// How many points there are.
+    pub fn len(&self) -> usize {
+        self.pos.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.pos.is_empty()
+    }
+
+    /// The position of `id` (NaN for an id that is not a point).
+    pub fn get(&self, id: PointId) -> DVec3 {
+        self.pos.get(id as usize).copied().unwrap_or(DVec3::NAN)
+    }
+
+    /// A new point. Refused past [`MAX_POINTS`] and for a position that is
+    /// not finite.
+    pub fn add(&mut self, p: DVec3) -> Result<PointId, String> {
+        if !p.is_finite() {
+            return Err(format!(
+                "a point at ({}, {}, {}) is not finite",
+                p.x, p.y, p.z
+            ));
+        }
+        if self.pos.len() >= MAX_POINTS {
+            return Err(format!(
+                "the shapes have more than {MAX_POINTS} points; the grammar makes too much geometry"
+            ));
+        }
+        self.pos.push(p);
+        Ok((self.pos.len() - 1) as PointId)
+    }
+
+    fn check(&self, id: PointId) -> Result<(), String> {
+        if (id as usize) < self.pos.len() {
+            Ok(())
+        } else {
+            Err(format!("point {id} does not exist"))
+        }
+    }
+
+    /// The root edge of the line that edge (a, b) lies on: the edge that
+    /// was cut first when a or b is a cut point on it, else (a, b) itself.
+    fn line_of(&self, a: PointId, b: PointId) -> (PointId, PointId) {
+        for (x, y) in [(a, b), (b, a)] {
+            if let Some(&(r, _)) = self.root.get(&y) {
+                if x == r.0 || x == r.1 || self.root.get(&x).map(|e| e.0) == Some(r) {
+                    return r;
+                }
+            }
+        }
+        (a.min(b), a.max(b))
+    }
+
+    /// The parameter of `p` along root edge `r` (0 at r.0, 1 at r.1).
+    fn param(&self, r: (PointId, PointId), p: PointId) -> f64 {
+        if p == r.0 {
+            return 0.0;
+        }
+        if p == r.1 {
+            return 1.0;
+        }
+        match self.root.get(&p) {
+            Some(&(rr, t)) if rr == r => t,
+            _ => {
+                let (a, b) = (self.get(r.0), self.get(r.1));
+                let l2 = (b - a).length_squared();
+                if l2 > 0.0 {
+                    (self.get(p) - a).dot(b - a) / l2
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+
+    /// The point where the plane {x : n·x = d} crosses edge (a, b), made
+    /// once: the same id whichever face or shape asks (a sibling that cut
+    /// the same segment with the same plane included), at a position
+    /// computed from the (min id, max id) order so that it is
+    /// bit-identical whatever the direction asked.
+    pub fn cut(&mut self, a: PointId, b: PointId, n: DVec3, d: f64) -> Result<PointId, String> {
+        self.check(a)?;
+        self.check(b)?;
+        if a == b {
+            return Ok(a);
+        }
+        let (lo, hi) = (a.min(b), a.max(b));
+        let (plo, phi) = (self.get(lo), self.get(hi));
+        let (da, db) = (n.dot(plo) - d, n.dot(phi) - d);
+        let mut t = da / (da - db);
+        if !t.is_finite() {
+            t = 0.5;
+        }
+        let t = t.clamp(0.0, 1.0);
+        let p = plo + t * (phi - plo);
+        let r = self.line_of(a, b);
+        let (ra, rb) = (self.get(r.0), self.get(r.1));
+        let len = (rb - ra).length();
+        let tp = self.param_of_pos(r, p);
+        let tol = 1e-9 * (1.0 + d.abs() + p.length());
+        let (ta, tb) = (self.param(r, a), self.param(r, b));
+        let (tmin, tmax) = (ta.min(tb), ta.max(tb));
+        if let Some(list) = self.cuts.get(&r) {
+            let slack = if len > 0.0 { tol / len } else { 0.0 };
+            let start = list.partition_point(|&(t, _)| t < tp - slack);
+            for &(t, q) in &list[start..] {
+                if t > tp + slack {
+                    break;
+                }
+                if t > tmin && t < tmax && (n.dot(self.get(q)) - d).abs() <= tol {
+                    return Ok(q);
+                }
+            }
+        }
+        let id = self.add(p)?;
+        let list = self.cuts.entry(r).or_default();
+        let at = list.partition_point(|&(t, _)| t < tp);
+        list.insert(at, (tp, id));
+        self.root.insert(id, (r, tp));
+        Ok(id)
+    }
+
+    fn param_of_pos(&self, r: (PointId, PointId), p: DVec3) -> f64 {
+        let (a, b) = (self.get(r.0), self.get(r.1));
+        let l2 = (b - a).length_squared();
+        if l2 > 0.0 {
+            (p - a).dot(b - a) / l2
+        } else {
+            0.0
+        }
+    }
+
+    /// `poly` with every point that cuts put on its edges inserted in
+    /// order, cuts on cuts included: faces of neighbouring shapes then meet
+    /// without T-junctions. `out` is cleared first.
+    pub fn resolve(&self, poly: &[PointId], out: &mut Vec<PointId>) {
+        out.clear();
+        let m = poly.len();
+        for i in 0..m {
+            let (a, b) = (poly[i], poly[(i + 1) % m]);
+            out.push(a);
+            if a == b {
+                continue;
+            }
+            let r = self.line_of(a, b);
+            let Some(list) = self.cuts.get(&r) else {
+                continue;
+            };
+            let (ta, tb) = (self.param(r, a), self.param(r, b));
+            let (tmin, tmax) = (ta.min(tb), ta.max(tb));
+            let lo = list.partition_point(|&(t, _)| t <= tmin);
+            let hi = list.partition_point(|&(t, _)| t < tmax);
+            if lo >= hi {
+                continue;
+            }
+            let inner = list[lo..hi]
+                .iter()
+                .map(|&(_, q)| q)
+                .filter(|&q| q != a && q != b);
+            if ta <= tb {
+                out.extend(inner);
+            } else {
+                let v: Vec<PointId> = inner.collect();
+                out.extend(v.into_iter().rev());
+            }
+        }
+    }
+}
+
+/// A polygon of a shape.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Face {
+    /// Counter-clockwise seen from outside (3D) or from the side the
+    /// normal points to (2D).
+    pub pts: Vec<PointId>,
+    /// 0: the shape's own surface. 2k: the cap cut k made on its lower
+    /// side, 2k + 1: the same cap on its upper side (the same ids,
+    /// reversed).
+    pub seam: u32,
+}
+
+/// A shape's geometry: a polyhedron (dim 3) or faces (dim 2), edges (dim 1)
+/// or points (dim 0).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Geometry {
+    pub dim: u8,
+    pub faces: Vec<Face>,
+    pub edges: Vec<[PointId; 2]>,
+    pub verts: Vec<PointId>,
+}
+
+impl Geometry {
+    pub fn empty(dim: u8) -> Geometry {
+        Geometry {
+            dim,
+            faces: Vec::new(),
+            edges: Vec::new(),
+            verts: Vec::new(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.faces.is_empty() && self.edges.is_empty() && self.verts.is_empty()
+    }
+
+    /// Every point id the geometry uses, once per use (faces, then edges,
+    /// then points).
+    pub fn point_ids(&self) -> impl Iterator<Item = PointId> + '_ {
+        self.faces
+            .iter()
+            .flat_map(|f| f.pts.iter().copied())
+            .chain(self.edges.iter().flat_map(|e| e.iter().copied()))
+            .chain(self.verts.iter().copied())
+    }
+
+    /// Every point id the geometry uses, once, in first-use order.
+    pub fn unique_points(&self) -> Vec<PointId> {
+        let mut seen = HashSet::new();
+        self.point_ids().filter(|&p| seen.insert(p)).collect()
+    }
+
+    pub fn face_count(&self) -> usize {
+        self.faces.len()
+    }
+}
+
+/// A shape's frame: origin, orthonormal right-handed axes x, y, z and the
+/// size along them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Scope {
+    pub origin: DVec3,
+    pub axes: [DVec3; 3],
+    pub size: DVec3,
+}
+
+impl Scope {
+    /// The world frame at the origin, of size 0.
+    pub fn world() -> Scope {
+        Scope {
+            origin: DVec3::ZERO,
+            axes: [DVec3::X, DVec3::Y, DVec3::Z],
+            size: DVec3::ZERO,
+        }
+    }
+
+    /// The coordinates of world point `p` in the scope's frame.
+    pub fn local(&self, p: DVec3) -> DVec3 {
+        let v = p - self.origin;
+        DVec3::new(
+            v.dot(self.axes[0]),
+            v.dot(self.axes[1]),
+            v.dot(self.axes[2]),
+        )
+    }
+
+    /// The world point at coordinates `l` in the scope's frame (named
+    /// `to_world` because `world()` makes the world scope).
+    pub fn to_world(&self, l: DVec3) -> DVec3 {
+        self.origin + l.x * self.axes[0] + l.y * self.axes[1] + l.z * self.axes[2]
+    }
+
+    fn is_right_handed(&self) -> bool {
+        self.axes[0].cross(self.axes[1]).dot(self.axes[2]) >= 0.0
+    }
+}
+
+/// The polygon's normal by Newell's method (its length is twice the area).
+pub(crate) fn newell(points: &Points, poly: &[PointId]) -> DVec3 {
+    let m = poly.len();
+    let mut n = DVec3::ZERO;
+    for i in 0..m {
+        let a = points.get(poly[i]);
+        let b = points.get(poly[(i + 1) % m]);
+        n += DVec3::new(
+            (a.y - b.y) * (a.z + b.z),
+            (a.z - b.z) * (a.x + b.x),
+            (a.x - b.x) * (a.y + b.y),
+        );
+    }
+    n
+}
+
+fn check_plane(n: DVec3, d: f64, eps: f64) -> Result<(), String> {
+    if !n.is_finite() || n.length_squared() == 0.0 || !d.is_finite() || !eps.is_finite() {
+        return Err(format!(
+            "a cut plane needs a finite non-zero normal and offset (got normal ({}, {}, {}), offset {d})",
+            n.x, n.y, n.z
+        ));
+    }
+    Ok(())
+}
+
+fn seams_of(cut: u32) -> Result<(u32, u32), String> {
+    if cut == 0 || cut > (u32::MAX - 1) / 2 {
+        return Err(format!("cut number {cut} is out of range"));
+    }
+    Ok((2 * cut, 2 * cut + 1))
+}
+
+/// One node of a face's ring while it is split: a vertex, or the point
+/// where an edge crosses the plane.
+#[derive(Clone, Copy)]
+struct Node {
+    id: PointId,
+    /// For a vertex: -1 below, 0 on, 1 above. Unused for a crossing.
+    side: i8,
+    /// For a crossing: Some(true) from above to below, Some(false) from
+    /// below to above.
+    down: Option<bool>,
+    /// Where a crossing lies along the cut line, and the tie-break for two
+    /// crossings at one on-plane vertex.
+    key: (f64, f64),
+}
+
+/// Splits one polygon (any shape) by the plane: every piece on each side.
+/// On-plane vertices count as infinitesimally below for the topology (so
+/// every crossing is proper) and stand for their own crossing points.
+fn split_polygon(
+    points: &mut Points,
+    face: &Face,
+    n: DVec3,
+    d: f64,
+    s: &[f64],
+    side: &[i8],
+    below: &mut Vec<Face>,
+    above: &mut Vec<Face>,
+) -> Result<(), String> {
+    let pts = &face.pts;
+    let m = pts.len();
+    let dir = n.cross(newell(points, pts));
+    let mut ring: Vec<Node> = Vec::with_capacity(m * 2);
+    for i in 0..m {
+        let j = (i + 1) % m;
+        ring.push(Node {
+            id: pts[i],
+            side: side[i],
+            down: None,
+            key: (0.0, 0.0),
+        });
+        let (bi, bj) = (side[i] <= 0, side[j] <= 0);
+        if bi == bj {
+            continue;
+        }
+        let (lo, hi) = if bi { (i, j) } else { (j, i) };
+        let (id, tie) = if side[lo] == 0 {
+            let v = points.get(pts[lo]);
+            (pts[lo], dir.dot(points.get(pts[hi]) - v) / s[hi])
+        } else {
+            (points.cut(pts[i], pts[j], n, d)?, 0.0)
+        };
+        ring.push(Node {
+            id,
+            side: 0,
+            down: Some(!bi),
+            key: (dir.dot(points.get(id)), tie),
+        });
+    }
+    let mut crossings: Vec<usize> = (0..ring.len())
+        .filter(|&i| ring[i].down.is_some())
+        .collect();
+    if crossings.len() % 2 != 0 {
+        return Err("a face crosses a cut plane an odd number of times".into());
+    }
+    crossings.sort_by(|&a, &b| {
+        let (ka, kb) = (ring[a].key, ring[b].key);
+        ka.0.total_cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+    });
+    let mut partner = vec![usize::MAX; ring.len()];
+    for pair in crossings.chunks(2) {
+        partner[pair[0]] = pair[1];
+        partner[pair[1]] = pair[0];
+    }
+    let len = ring.len();
+    for (entering_down, side_sign, out) in [(true, -1i8, &mut *below), (false, 1i8, &mut *above)] {
+        let mut visited = vec![false; len];
+        for start in 0..len {
+            if ring[start].down != Some(entering_down) || visited[start] {
+                continue;
+            }
+            let mut piece: Vec<PointId> = Vec::new();
+            let mut strict = false;
+            let mut i = start;
+            let mut steps = 0usize;
+            loop {
+                visited[i] = true;
+                piece.push(ring[i].id);
+                i = (i + 1) % len;
+                while ring[i].down != Some(!entering_down) {
+                    if ring[i].down.is_none() {
+                        piece.push(ring[i].id);
+                        strict |= ring[i].side == side_sign;
+                    }
+                    i = (i + 1) % len;
+                    steps += 1;
+                    if steps > 4 * len {
+                        return Err("a face could not be split by a cut plane".into());
+                    }
+                }
+                visited[i] = true;
+                piece.push(ring[i].id);
+                let j = partner[i];
+                if j >= len || ring[j].down != Some(entering_down) {
+                    return Err(
+                        "a face could not be split by a cut plane (is it self-intersecting?)"
+                            .into(),
+                    );
+                }
+                if j == start {
+                    break;
+                }
+                if visited[j] {
+                    return Err(
+                        "a face could not be split by a cut plane (is it self-intersecting?)"
+                            .into(),
+                    );
+                }
+                i = j;
+                steps += 1;
+                if steps > 4 * len {
+                    return Err("a face could not be split by a cut plane".into());
+                }
+            }
+            dedup_ring(&mut piece);
+            if strict && piece.len() >= 3 {
+                out.push(Face {
+                    pts: piece,
+                    seam: face.seam,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Removes consecutive repeats, around the end too.
+fn dedup_ring(poly: &mut Vec<PointId>) {
+    poly.dedup();
+    while poly.len() > 1 && poly.first() == poly.last() {
+        poly.pop();
+    }
+}
+
+/// Cuts `geom` by the plane {x : n·x = d}: (below = {n·x <= d}, above).
+///
+/// Vertices within `eps` of the plane are on it and belong to both sides
+/// without a cut. Faces of any shape are split into all their pieces. A
+/// polyhedron (dim 3) is closed again with caps: the loops of its cut
+/// outline, seam `2 cut` with normal +n below and the same ids reversed,
+/// seam `2 cut + 1`, above. A cap with a hole is refused; an outline that
+/// does not close (an open input mesh) gets no cap. Faces (dim 2) share
+/// the cut points and get no caps; edges (dim 1) are split; points (dim 0)
+/// go by side, on-plane ones below.
+pub(crate) fn plane_cut(
+    points: &mut Points,
+    geom: &Geometry,
+    n: DVec3,
+    d: f64,
+    cut: u32,
+    eps: f64,
+) -> Result<(Geometry, Geometry), String> {
+    check_plane(n, d, eps)?;
+    let (seam_below, seam_above) = seams_of(cut)?;
+    let eps = eps.abs();
+    let mut below = Geometry::empty(geom.dim);
+    let mut above = Geometry::empty(geom.dim);
+    let sd = |points: &Points, p: PointId| n.dot(points.get(p)) - d;
+    let side_of = |s: f64| -> i8 {
+        if s > eps {
+            1
+        } else if s < -eps {
+            -1
+        } else {
+            0
+        }
+    };
+    for &v in &geom.verts {
+        points.check(v)?;
+        if side_of(sd(points, v)) <= 0 {
+            below.verts.push(v);
+        } else {
+            above.verts.push(v);
+        }
+    }
+    for &[a, b] in &geom.edges {
+        points.check(a)?;
+        points.check(b)?;
+        let (sa, sb) = (side_of(sd(points, a)), side_of(sd(points, b)));
+        if sa * sb < 0 {
+            let c = points.cut(a, b, n, d)?;
+            if sa < 0 {
+                below.edges.push([a, c]);
+                above.edges.push([c, b]);
+            } else {
+                above.edges.push([a, c]);
+                below.edges.push([c, b]);
+            }
+        } else if sa > 0 || sb > 0 {
+            above.edges.push([a, b]);
+        } else {
+            below.edges.push([a, b]);
+        }
+    }
+    for face in &geom.faces {
+        for &p in &face.pts {
+            points.check(p)?;
+        }
+        if face.pts.len() < 3 {
+            continue;
+        }
+        let s: Vec<f64> = face.pts.iter().map(|&p| sd(points, p)).collect();
+        let side: Vec<i8> = s.iter().map(|&x| side_of(x)).collect();
+        let has_below = side.contains(&-1);
+        let has_above = side.contains(&1);
+        if !has_below && !has_above {
+            // In the plane: a solid's face goes to the side it bounds.
+            if geom.dim >= 3 && newell(points, &face.pts).dot(n) < 0.0 {
+                above.faces.push(face.clone());
+            } else {
+                below.faces.push(face.clone());
+            }
+        } else if !has_above {
+            below.faces.push(face.clone());
+        } else if !has_below {
+            above.faces.push(face.clone());
+        } else {
+            split_polygon(
+                points,
+                face,
+                n,
+                d,
+                &s,
+                &side,
+                &mut below.faces,
+                &mut above.faces,
+            )?;
+        }
+    }
+    if geom.dim >= 3 && !below.faces.is_empty() && !above.faces.is_empty() {
+        let slack = eps.max(1e-12 * (1.0 + d.abs()));
+        let caps = cap_loops(points, &below.faces, |p| (sd(points, p)).abs() <= slack)?;
+        for lp in caps {
+            let o = newell(points, &lp).dot(n);
+            if o < 0.0 {
+                return Err(format!(
+                    "cut {cut} would leave a cap with a hole (the plane crosses the shape around \
+                     an opening); caps with holes are not supported"
+                ));
+            }
+            if o == 0.0 {
+                continue;
+            }
+            let mut rev = lp.clone();
+            rev.reverse();
+            below.faces.push(Face {
+                pts: lp,
+                seam: seam_below,
+            });
+            above.faces.push(Face {
+                pts: rev,
+                seam: seam_above,
+            });
+        }
+    }
+    Ok((below, above))
+}
+
+/// The loops that close `faces` (a solid's part on one side) in the cut
+/// plane: the in-plane edges no other face uses the other way, reversed and
+/// chained. Chains that do not close are left out.
+fn cap_loops(
+    _points: &Points,
+    faces: &[Face],
+    on: impl Fn(PointId) -> bool,
+) -> Result<Vec<Vec<PointId>>, String> {
+    let mut directed = HashSet::new();
+    for f in faces {
+        let m = f.pts.len();
+        for i in 0..m {
+            directed.insert((f.pts[i], f.pts[(i + 1) % m]));
+        }
+    }
+    let mut edges: Vec<(PointId, PointId)> = Vec::new();
+    let mut next: HashMap<PointId, usize> = HashMap::new();
+    for f in faces {
+        let m = f.pts.len();
+        for i in 0..m {
+            let (u, v) = (f.pts[i], f.pts[(i + 1) % m]);
+            if u != v && on(u) && on(v) && !directed.contains(&(v, u)) {
+                if next.insert(v, edges.len()).is_some() {
+                    return Err(
+                        "a cut plane touches the shape where two outlines of the cut meet at \
+                         one point; move the cut slightly"
+                            .into(),
+                    );
+                }
+                edges.push((v, u));
+            }
+        }
+    }
+    let mut used = vec![false; edges.len()];
+    let mut loops = Vec::new();
+    for e in 0..edges.len() {
+        if used[e] {
+            continue;
+        }
+        let start = edges[e].0;
+        let mut lp = vec![start];
+        let mut cur = e;
+        let mut closed = false;
+        for _ in 0..=edges.len() {
+            used[cur] = true;
+            let to = edges[cur].1;
+            if to == start {
+                closed = true;
+                break;
+            }
+            lp.push(to);
+            match next.get(&to) {
+                Some(&k) if !used[k] => cur = k,
+                _ => break,
+            }
+        }
+        if closed && lp.len() >= 3 {
+            loops.push(lp);
+        }
+    }
+    Ok(loops)
+}
+
+/// Splits `geom` across planes normal to `axis` (unit) at distances `cuts`
+/// (increasing) from `origin`: `cuts.len() + 1` pieces, lowest first, made
+/// sequentially (the whole at the first plane, the part above it at the
+/// next, ...). Piece i and piece i + 1 share cut `first_cut + i`. Pieces may
+/// be empty.
+pub(crate) fn split(
+    points: &mut Points,
+    geom: &Geometry,
+    origin: DVec3,
+    axis: DVec3,
+    cuts: &[f64],
+    first_cut: u32,
+) -> Result<Vec<Geometry>, String> {
+    if !origin.is_finite() || !axis.is_finite() || axis.length_squared() == 0.0 {
+        return Err("a split needs a finite origin and a non-zero axis".into());
+    }
+    let axis = axis.normalize();
+    for w in cuts.windows(2) {
+        if w[0] > w[1] {
+            return Err(format!(
+                "split positions must increase ({} comes before {})",
+                w[0], w[1]
+            ));
+        }
+    }
+    if let Some(c) = cuts.iter().find(|c| !c.is_finite()) {
+        return Err(format!("split position {c} is not finite"));
+    }
+    let base = axis.dot(origin);
+    let mut pieces = Vec::with_capacity(cuts.len() + 1);
+    let mut rest = geom.clone();
+    for (i, &c) in cuts.iter().enumerate() {
+        let cut = u32::try_from(i)
+            .ok()
+            .and_then(|i| first_cut.checked_add(i))
+            .ok_or_else(|| "too many cuts".to_string())?;
+        let d = base + c;
+        let eps = 1e-9 * (1.0 + d.abs());
+        let (lo, hi) = plane_cut(points, &rest, axis, d, cut, eps)?;
+        pieces.push(lo);
+        rest = hi;
+    }
+    pieces.push(rest);
+    Ok(pieces)
+}
+
+fn check_scope(scope: &Scope) -> bool {
+    scope.origin.is_finite()
+        && scope.axes.iter().all(|a| a.is_finite())
+        && scope.size.is_finite()
+        && scope.size.min_element() > 0.0
+}
+
+fn quad(a: PointId, b: PointId, c: PointId, e: PointId) -> Face {
+    Face {
+        pts: vec![a, b, c, e],
+        seam: 0,
+    }
+}
+
+fn solid(faces: Vec<Face>, scope: &Scope) -> Geometry {
+    let mut g = Geometry::empty(3);
+    g.faces = faces;
+    if !scope.is_right_handed() {
+        for f in &mut g.faces {
+            f.pts.reverse();
+        }
+    }
+    g
+}
+
+/// A box filling the scope: 6 quads, counter-clockwise from outside, each
+/// side face starting at its bottom edge (so that its `comp` scope has y up).
+/// A scope with a zero (or non-finite) size gives an empty geometry.
+pub(crate) fn box_in(points: &mut Points, scope: &Scope) -> Result<Geometry, String> {
+    if !check_scope(scope) {
+        return Ok(Geometry::empty(3));
+    }
+    let mut c = [0; 8];
+    for (k, slot) in c.iter_mut().enumerate() {
+        let l = DVec3::new(
+            (k & 1) as f64 * scope.size.x,
+            ((k >> 1) & 1) as f64 * scope.size.y,
+            ((k >> 2) & 1) as f64 * scope.size.z,
+        );
+        *slot = points.add(scope.to_world(l))?;
+    }
+    let faces = vec![
+        quad(c[4], c[5], c[7], c[6]), // front +z
+        quad(c[1], c[0], c[2], c[3]), // back -z
+        quad(c[5], c[1], c[3], c[7]), // right +x
+        quad(c[0], c[4], c[6], c[2]), // left -x
+        quad(c[6], c[7], c[3], c[2]), // top +y
+        quad(c[0], c[1], c[5], c[4]), // bottom -y
+    ];
+    Ok(solid(faces, scope))
+}
+
+fn check_segments(what: &str, k: usize, min: usize) -> Result<(), String> {
+    if k < min || k > MAX_SEGMENTS {
+        return Err(format!(
+            "{what} must be between {min} and {MAX_SEGMENTS} (got {k})"
+        ));
+    }
+    Ok(())
+}
+
+/// A cylinder in the scope: its axis along the scope's y, its base the
+/// ellipse inscribed in the scope's x-z rectangle, `segments` sides; n-gon
+/// caps and quads around.
+pub(crate) fn cylinder_in(
+    points: &mut Points,
+    scope: &Scope,
+    segments: usize,
+) -> Result<Geometry, String> {
+    check_segments("a cylinder's segments", segments, 3)?;
+    if !check_scope(scope) {
+        return Ok(Geometry::empty(3));
+    }
+    let (rx, rz, h) = (scope.size.x / 2.0, scope.size.z / 2.0, scope.size.y);
+    let mut bottom = Vec::with_capacity(segments);
+    let mut top = Vec::with_capacity(segments);
+    for i in 0..segments {
+        let a = std::f64::consts::TAU * i as f64 / segments as f64;
+        // Counter-clockwise seen from +y: x = cos, z = -sin.
+        let (x, z) = (rx + rx * a.cos(), rz - rz * a.sin());
+        bottom.push(points.add(scope.to_world(DVec3::new(x, 0.0, z)))?);
+        top.push(points.add(scope.to_world(DVec3::new(x, h, z)))?);
+    }
+    let mut faces = Vec::with_capacity(segments + 2);
+    for i in 0..segments {
+        let j = (i + 1) % segments;
+        faces.push(quad(bottom[i], bottom[j], top[j], top[i]));
+    }
+    let mut b = bottom.clone();
+    b.reverse();
+    faces.push(Face { pts: top, seam: 0 });
+    faces.push(Face { pts: b, seam: 0 });
+    Ok(solid(faces, scope))
+}
+
+/// A UV sphere (an ellipsoid) inscribed in the scope: `slices` around the
+/// scope's y, `stacks` from pole to pole; triangles at the poles, quads
+/// elsewhere.
+pub(crate) fn sphere_in(
+    points: &mut Points,
+    scope: &Scope,
+    slices: usize,
+    stacks: usize,
+) -> Result<Geometry, String> {
+    check_segments("a sphere's slices", slices, 3)?;
+    check_segments("a sphere's stacks", stacks, 2)?;
+    if !check_scope(scope) {
+        return Ok(Geometry::empty(3));
+    }
+    let r = scope.size / 2.0;
+    let at = |polar: f64, az: f64| {
+        let (sp, cp) = polar.sin_cos();
+        r + DVec3::new(r.x * sp * az.cos(), r.y * cp, -r.z * sp * az.sin())
+    };
+    let north = points.add(scope.to_world(r + DVec3::new(0.0, r.y, 0.0)))?;
+    let south = points.add(scope.to_world(r - DVec3::new(0.0, r.y, 0.0)))?;
+    let mut rings = Vec::with_capacity(stacks - 1);
+    for k in 1..stacks {
+        let polar = std::f64::consts::PI * k as f64 / stacks as f64;
+        let mut ring = Vec::with_capacity(slices);
+        for i in 0..slices {
+            let az = std::f64::consts::TAU * i as f64 / slices as f64;
+            ring.push(points.add(scope.to_world(at(polar, az)))?);
+        }
+        rings.push(ring);
+    }
+    let mut faces = Vec::new();
+    // Azimuth grows counter-clockwise seen from +y; polar grows downwards.
+    for i in 0..slices {
+        let j = (i + 1) % slices;
+        faces.push(Face {
+            pts: vec![north, rings[0][i], rings[0][j]],
+            seam: 0,
+        });
+        for k in 0..rings.len() - 1 {
+            let (u, l) = (&rings[k], &rings[k + 1]);
+            faces.push(quad(u[i], l[i], l[j], u[j]));
+        }
+        let last = &rings[rings.len() - 1];
+        faces.push(Face {
+            pts: vec![south, last[j], last[i]],
+            seam: 0,
+        });
+    }
+    Ok(solid(faces, scope))
+}
+
+/// A polygon soup fitted into the scope: its bounding box mapped onto the
+/// scope's box (a zero extent maps to the scope's origin plane), on new
+/// points.
+pub(crate) fn mesh_in(
+    points: &mut Points,
+    scope: &Scope,
+    soup: &PolygonSoup,
+) -> Result<Geometry, String> {
+    if soup.positions.is_empty() || !check_scope_finite(scope) {
+        return Ok(Geometry::empty(3));
+    }
+    if soup.positions.iter().any(|p| !p.is_finite()) {
+        return Err("the mesh has a vertex that is not finite".into());
+    }
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for &p in &soup.positions {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    let ext = hi - lo;
+    let scale = |e: f64, s: f64| if e > 0.0 { s / e } else { 0.0 };
+    let k = DVec3::new(
+        scale(ext.x, scope.size.x),
+        scale(ext.y, scope.size.y),
+        scale(ext.z, scope.size.z),
+    );
+    let mut ids = Vec::with_capacity(soup.positions.len());
+    for &p in &soup.positions {
+        ids.push(points.add(scope.to_world((p - lo) * k))?);
+    }
+    let mut g = Geometry::empty(3);
+    for (f, face) in soup.faces.iter().enumerate() {
+        let mut pts = Vec::with_capacity(face.len());
+        for &i in face {
+            let id = ids.get(i as usize).ok_or_else(|| {
+                format!(
+                    "face {} of the mesh uses vertex {i}, which does not exist",
+                    f + 1
+                )
+            })?;
+            pts.push(*id);
+        }
+        if pts.len() >= 3 {
+            g.faces.push(Face { pts, seam: 0 });
+        }
+    }
+    if !scope.is_right_handed() {
+        for f in &mut g.faces {
+            f.pts.reverse();
+        }
+    }
+    Ok(g)
+}
+
+fn check_scope_finite(scope: &Scope) -> bool {
+    scope.origin.is_finite()
+        && scope.axes.iter().all(|a| a.is_finite())
+        && scope.size.is_finite()
+        && scope.size.min_element() >= 0.0
+}
+
+/// One planar polygon (dim 2) on new points at world positions `corners`.
+pub(crate) fn polygon(points: &mut Points, corners: &[DVec3]) -> Result<Geometry, String> {
+    if corners.len() < 3 {
+        return Err(format!(
+            "a polygon needs at least 3 corners (got {})",
+            corners.len()
+        ));
+    }
+    let mut pts = Vec::with_capacity(corners.len());
+    for &c in corners {
+        pts.push(points.add(c)?);
+    }
+    let mut g = Geometry::empty(2);
+    g.faces.push(Face { pts, seam: 0 });
+    Ok(g)
+}
+
+/// One planar polygon (dim 2) with corners given in the scope's frame.
+pub(crate) fn polygon_in(
+    points: &mut Points,
+    scope: &Scope,
+    corners: &[DVec3],
+) -> Result<Geometry, String> {
+    let world: Vec<DVec3> = corners.iter().map(|&c| scope.to_world(c)).collect();
+    polygon(points, &world)
+}
+
+/// Extrudes faces (dim 2) by `h` along unit `dir` into a polyhedron: the
+/// base faces reversed on the original ids, the top faces on new points
+/// moved by h·dir, a quad on every boundary edge (an edge of one face).
+/// The faces point outwards for either sign of `h`.
+pub(crate) fn extrude(
+    points: &mut Points,
+    geom: &Geometry,
+    dir: DVec3,
+    h: f64,
+) -> Result<Geometry, String> {
+    if geom.dim != 2 {
+        return Err(format!(
+            "only faces can be extruded (this shape has dimension {})",
+            geom.dim
+        ));
+    }
+    if !h.is_finite() || !dir.is_finite() || h == 0.0 || dir.length_squared() == 0.0 {
+        return Err(format!(
+            "an extrusion needs a finite non-zero height and direction (got {h})"
+        ));
+    }
+    let offset = dir * h;
+    let mut total = DVec3::ZERO;
+    for f in &geom.faces {
+        for &p in &f.pts {
+            points.check(p)?;
+        }
+        total += newell(points, &f.pts);
+    }
+    let orient = total.dot(offset);
+    if geom.faces.is_empty() {
+        return Ok(Geometry::empty(3));
+    }
+    if orient == 0.0 || !orient.is_finite() {
+        return Err("the extrusion direction lies in the plane of the faces".into());
+    }
+    let up = orient > 0.0;
+    let mut top_of: HashMap<PointId, PointId> = HashMap::new();
+    let mut count: HashMap<(PointId, PointId), u32> = HashMap::new();
+    for f in &geom.faces {
+        let m = f.pts.len();
+        for i in 0..m {
+            let (a, b) = (f.pts[i], f.pts[(i + 1) % m]);
+            *count.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut out = Geometry::empty(3);
+    let mut sides = Vec::new();
+    let mut tops = Vec::new();
+    for f in &geom.faces {
+        let mut top = Vec::with_capacity(f.pts.len());
+        for &p in &f.pts {
+            let t = match top_of.get(&p) {
+                Some(&t) => t,
+                None => {
+                    let t = points.add(points.get(p) + offset)?;
+                    top_of.insert(p, t);
+                    t
+                }
+            };
+            top.push(t);
+        }
+        let m = f.pts.len();
+        for i in 0..m {
+            let (a, b) = (f.pts[i], f.pts[(i + 1) % m]);
+            if count.get(&(a.min(b), a.max(b))) != Some(&1) {
+                continue;
+            }
+            let (ta, tb) = (top[i], top[(i + 1) % m]);
+            sides.push(if up {
+                quad(a, b, tb, ta)
+            } else {
+                quad(b, a, ta, tb)
+            });
+        }
+        let mut base = f.pts.clone();
+        if up {
+            base.reverse();
+        } else {
+            top.reverse();
+        }
+        out.faces.push(Face {
+            pts: base,
+            seam: f.seam,
+        });
+        tops.push(Face {
+            pts: top,
+            seam: f.seam,
+        });
+    }
+    out.faces.extend(tops);
+    out.faces.extend(sides);
+    Ok(out)
+}
+
+/// Which faces a component split takes, by the direction of their normal in
+/// the shape's scope.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Selector {
+    Front,
+    Back,
+    Left,
+    Right,
+    Top,
+    Bottom,
+    /// Front, back, left and right.
+    Side,
+    /// Top and bottom.
+    Horizontal,
+    /// The same as `Side`.
+    Vertical,
+    All,
+}
+
+impl Selector {
+    pub fn parse(s: &str) -> Option<Selector> {
+        Some(match s {
+            "front" => Selector::Front,
+            "back" => Selector::Back,
+            "left" => Selector::Left,
+            "right" => Selector::Right,
+            "top" => Selector::Top,
+            "bottom" => Selector::Bottom,
+            "side" => Selector::Side,
+            "horizontal" => Selector::Horizontal,
+            "vertical" => Selector::Vertical,
+            "all" => Selector::All,
+            _ => return None,
+        })
+    }
+
+    /// The direction a normal (in the scope's frame) faces, by its dominant
+    /// component: +z front, -z back, -x left, +x right, +y top, -y bottom;
+    /// on ties y wins, then z, then x.
+    pub fn classify(n: DVec3) -> Selector {
+        let a = n.abs();
+        if a.y >= a.z && a.y >= a.x {
+            if n.y >= 0.0 {
+                Selector::Top
+            } else {
+                Selector::Bottom
+            }
+        } else if a.z >= a.x {
+            if n.z >= 0.0 {
+                Selector::Front
+            } else {
+                Selector::Back
+            }
+        } else if n.x >= 0.0 {
+            Selector::Right
+        } else {
+            Selector::Left
+        }
+    }
+
+    /// Whether a face classified as `c` is selected.
+    pub fn takes(self, c: Selector) -> bool {
+        match self {
+            Selector::All => true,
+            Selector::Side | Selector::Vertical => matches!(
+                c,
+                Selector::Front | Selector::Back | Selector::Left | Selector::Right
+            ),
+            Selector::Horizontal => matches!(c, Selector::Top | Selector::Bottom),
+            s => s == c,
+        }
+    }
+}
+
+/// A frame with x along `x` and z along `z` (made orthogonal), y = z × x,
+/// fitted around `pts`: origin at the minimum corner, size the extent.
+fn frame_around(points: &Points, pts: &[PointId], x: DVec3, z: DVec3) -> Option<Scope> {
+    let z = z.try_normalize()?;
+    let x = (x - x.dot(z) * z).try_normalize()?;
+    let y = z.cross(x);
+    Some(fit(points, pts.iter().copied(), [x, y, z]))
+}
+
+fn fit(points: &Points, pts: impl Iterator<Item = PointId>, axes: [DVec3; 3]) -> Scope {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for p in pts {
+        let q = points.get(p);
+        let l = DVec3::new(q.dot(axes[0]), q.dot(axes[1]), q.dot(axes[2]));
+        lo = lo.min(l);
+        hi = hi.max(l);
+    }
+    if !lo.is_finite() || !hi.is_finite() {
+        return Scope {
+            origin: DVec3::ZERO,
+            axes,
+            size: DVec3::ZERO,
+        };
+    }
+    Scope {
+        origin: lo.x * axes[0] + lo.y * axes[1] + lo.z * axes[2],
+        axes,
+        size: hi - lo,
+    }
+}
+
+/// The faces of `geom` that `sel` takes, each as a one-face geometry (dim
+/// 2, the same point ids) with its scope: x along the face's first edge,
+/// z its normal (Newell), y = z × x, fitted around the face (size.z = 0).
+/// Degenerate faces (no area) are left out.
+pub(crate) fn comp_faces(
+    points: &Points,
+    geom: &Geometry,
+    scope: &Scope,
+    sel: Selector,
+) -> Vec<(Geometry, Scope)> {
+    let mut out = Vec::new();
+    for f in &geom.faces {
+        let n = newell(points, &f.pts);
+        if !n.is_finite() || n.length_squared() == 0.0 {
+            continue;
+        }
+        let local = DVec3::new(
+            n.dot(scope.axes[0]),
+            n.dot(scope.axes[1]),
+            n.dot(scope.axes[2]),
+        );
+        if !sel.takes(Selector::classify(local)) {
+            continue;
+        }
+        let m = f.pts.len();
+        let edge = (0..m)
+            .map(|i| points.get(f.pts[(i + 1) % m]) - points.get(f.pts[i]))
+            .find(|e| e.length_squared() > 0.0);
+        let Some(edge) = edge else { continue };
+        let Some(mut s) = frame_around(points, &f.pts, edge, n) else {
+            continue;
+        };
+        s.size.z = 0.0;
+        let mut g = Geometry::empty(2);
+        g.faces.push(f.clone());
+        out.push((g, s));
+    }
+    out
+}
+
+/// The unique undirected edges of `geom` (of its faces, or its edges), in
+/// first-seen order, each a one-edge geometry (dim 1) with a scope whose x
+/// runs along the edge (y the parent's y made orthogonal where it can be).
+pub(crate) fn comp_edges(
+    points: &Points,
+    geom: &Geometry,
+    scope: &Scope,
+) -> Vec<(Geometry, Scope)> {
+    let mut seen = HashSet::new();
+    let mut list = Vec::new();
+    for f in &geom.faces {
+        let m = f.pts.len();
+        for i in 0..m {
+            list.push([f.pts[i], f.pts[(i + 1) % m]]);
+        }
+    }
+    list.extend(geom.edges.iter().copied());
+    let mut out = Vec::new();
+    for [a, b] in list {
+        if a == b || !seen.insert((a.min(b), a.max(b))) {
+            continue;
+        }
+        let (pa, pb) = (points.get(a), points.get(b));
+        let Some(x) = (pb - pa).try_normalize() else {
+            continue;
+        };
+        let y = [
+            scope.axes[1],
+            scope.axes[2],
+            scope.axes[0],
+            DVec3::Y,
+            DVec3::Z,
+        ]
+        .into_iter()
+        .find_map(|c| (c - c.dot(x) * x).try_normalize())
+        .unwrap_or(DVec3::Y);
+        let z = x.cross(y);
+        let mut g = Geometry::empty(1);
+        g.edges.push([a, b]);
+        out.push((
+            g,
+            Scope {
+                origin: pa,
+                axes: [x, y, z],
+                size: DVec3::new((pb - pa).length(), 0.0, 0.0),
+            },
+        ));
+    }
+    out
+}
+
+/// Every point of `geom` once (first-use order), each a one-point geometry
+/// (dim 0) with the parent's axes, at the point, of size 0.
+pub(crate) fn comp_vertices(
+    points: &Points,
+    geom: &Geometry,
+    scope: &Scope,
+) -> Vec<(Geometry, Scope)> {
+    geom.unique_points()
+        .into_iter()
+        .map(|p| {
+            let mut g = Geometry::empty(0);
+            g.verts.push(p);
+            (
+                g,
+                Scope {
+                    origin: points.get(p),
+                    axes: scope.axes,
+                    size: DVec3::ZERO,
+                },
+            )
+        })
+        .collect()
+}
+
+/// The box on `axes` around `geom` (origin at its minimum corner); an empty
+/// geometry gives a scope at the world origin of size 0.
+pub(crate) fn bounding_scope(points: &Points, geom: &Geometry, axes: [DVec3; 3]) -> Scope {
+    fit(points, geom.point_ids(), axes)
+}
+
+/// A copy of `geom` moved by `m`, on new points (a moved shape no longer
+/// shares vertices). A mirroring transform reverses the faces so that they
+/// still face outwards.
+pub(crate) fn transform(
+    points: &mut Points,
+    geom: &Geometry,
+    m: &DAffine3,
+) -> Result<Geometry, String> {
+    let mat: DMat3 = m.matrix3;
+    if !mat.is_finite() || !m.translation.is_finite() {
+        return Err("a transformation with a non-finite entry".into());
+    }
+    let mut map: HashMap<PointId, PointId> = HashMap::new();
+    let mut moved = |points: &mut Points, p: PointId| -> Result<PointId, String> {
+        if let Some(&q) = map.get(&p) {
+            return Ok(q);
+        }
+        points.check(p)?;
+        let q = points.add(m.transform_point3(points.get(p)))?;
+        map.insert(p, q);
+        Ok(q)
+    };
+    let flip = mat.determinant() < 0.0;
+    let mut out = Geometry::empty(geom.dim);
+    for f in &geom.faces {
+        let mut pts = Vec::with_capacity(f.pts.len());
+        for &p in &f.pts {
+            pts.push(moved(points, p)?);
+        }
+        if flip {
+            pts.reverse();
+        }
+        out.faces.push(Face { pts, seam: f.seam });
+    }
+    for &[a, b] in &geom.edges {
+        out.edges.push([moved(points, a)?, moved(points, b)?]);
+    }
+    for &v in &geom.verts {
+        out.verts.push(moved(points, v)?);
+    }
+    Ok(out)
+}
+
+/// A smoothing group's faces gathered into one polygon soup.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Welded {
+    /// Positions of the used points, faces (polygons, counter-clockwise).
+    pub soup: PolygonSoup,
+    /// Soup vertex -> its point.
+    pub point_of: Vec<PointId>,
+    /// Soup face -> the index of its member shape in the group.
+    pub tags: Vec<u32>,
+    /// Soup vertex: shared with a shape outside the group.
+    pub protected_vertex: Vec<bool>,
+    /// Soup face: all its vertices protected.
+    pub protected_face: Vec<bool>,
+}
+
+/// The members' faces as one soup. For each cut k with caps on both sides
+/// among the members: the internal wall is dropped, unless another shape
+/// (in `others`) also has a cap of cut k, which is refused, or k is loose,
+/// where both caps stay and the upper side's members get their own copies
+/// of the wall's points that no member without cut-k caps holds (a
+/// zero-width slit, attached where another member holds the points). Every
+/// kept face is resolved (no T-junctions); points used by `others` are
+/// protected.
+pub(crate) fn weld(
+    points: &mut Points,
+    members: &[&Geometry],
+    others: &[&Geometry],
+    loose: &HashSet<u32>,
+) -> Result<Welded, String> {
+    if members.len() > u32::MAX as usize {
+        return Err("too many shapes in a smoothing group".into());
+    }
+    // Which members have each side of each cut.
+    let mut sides: HashMap<u32, [Vec<usize>; 2]> = HashMap::new();
+    for (i, g) in members.iter().enumerate() {
+        for f in &g.faces {
+            if f.seam >= 2 {
+                let e = sides.entry(f.seam / 2).or_default();
+                let s = &mut e[(f.seam % 2) as usize];
+                if s.last() != Some(&i) {
+                    s.push(i);
+                }
+            }
+        }
+    }
+    let mut other_cuts = HashSet::new();
+    let mut other_points = HashSet::new();
+    for g in others {
+        for f in &g.faces {
+            if f.seam >= 2 {
+                other_cuts.insert(f.seam / 2);
+            }
+        }
+        other_points.extend(g.point_ids());
+    }
+    let mut internal = HashSet::new();
+    let mut loose_cuts = Vec::new();
+    let mut keys: Vec<u32> = sides.keys().copied().collect();
+    keys.sort_unstable();
+    for k in keys {
+        let [s0, s1] = &sides[&k];
+        if s0.is_empty() || s1.is_empty() {
+            continue;
+        }
+        if other_cuts.contains(&k) {
+            return Err(format!(
+                "the smoothing group takes part of cut {k}'s wall: shapes on both sides of the cut \
+                 are in the group and another shape outside it also has a part of that wall; put \
+                 all shapes of the cut in the group, or none on one side"
+            ));
+        }
+        if loose.contains(&k) {
+            loose_cuts.push(k);
+        } else {
+            internal.insert(k);
+        }
+    }
+    // The kept faces, resolved, per member.
+    let mut kept: Vec<Vec<Face>> = Vec::with_capacity(members.len());
+    let mut buf = Vec::new();
+    for g in members {
+        let mut fs = Vec::new();
+        for f in &g.faces {
+            for &p in &f.pts {
+                points.check(p)?;
+            }
+            if f.seam >= 2 && internal.contains(&(f.seam / 2)) {
+                continue;
+            }
+            points.resolve(&f.pts, &mut buf);
+            dedup_ring(&mut buf);
+            if buf.len() >= 3 {
+                fs.push(Face {
+                    pts: buf.clone(),
+                    seam: f.seam,
+                });
+            }
+        }
+        kept.push(fs);
+    }
+    // Loose walls: the upper side gets its own copies of the wall's points.
+    for k in loose_cuts {
+        let [s0, s1] = &sides[&k];
+        let with_cut: HashSet<usize> = s0.iter().chain(s1.iter()).copied().collect();
+        let mut held = HashSet::new();
+        for (i, fs) in kept.iter().enumerate() {
+            if !with_cut.contains(&i) {
+                for f in fs {
+                    held.extend(f.pts.iter().copied());
+                }
+            }
+        }
+        let mut dup: HashMap<PointId, PointId> = HashMap::new();
+        for &i in s1 {
+            for f in &kept[i] {
+                if f.seam != 2 * k + 1 {
+                    continue;
+                }
+                for &p in &f.pts {
+                    if !held.contains(&p) && !dup.contains_key(&p) {
+                        let q = points.add(points.get(p))?;
+                        dup.insert(p, q);
+                    }
+                }
+            }
+        }
+        for &i in s1 {
+            for f in &mut kept[i] {
+                for p in &mut f.pts {
+                    if let Some(&q) = dup.get(p) {
+                        *p = q;
+                    }
+                }
+            }
+        }
+    }
+    let mut w = Welded::default();
+    let mut index: HashMap<PointId, u32> = HashMap::new();
+    for (i, fs) in kept.into_iter().enumerate() {
+        for f in fs {
+            let mut face = Vec::with_capacity(f.pts.len());
+            for p in f.pts {
+                let v = match index.get(&p) {
+                    Some(&v) => v,
+                    None => {
+                        let v = w.point_of.len() as u32;
+                        index.insert(p, v);
+                        w.point_of.push(p);
+                        w.soup.positions.push(points.get(p));
+                        w.protected_vertex.push(other_points.contains(&p));
+                        v
+                    }
+                };
+                face.push(v);
+            }
+            w.protected_face
+                .push(face.iter().all(|&v| w.protected_vertex[v as usize]));
+            w.soup.faces.push(face);
+            w.tags.push(i as u32);
+        }
+    }
+    w.soup.face_lines = vec![0; w.soup.faces.len()];
+    w.soup.vertex_lines = vec![0; w.soup.positions.len()];
+    Ok(w)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The signed volume by the divergence theorem: the sum over faces
+    /// (fanned) of p0 · (pi × pi+1) / 6.
+    fn volume(points: &Points, g: &Geometry) -> f64 {
+        let mut v = 0.0;
+        for f in &g.faces {
+            let p0 = points.get(f.pts[0]);
+            for i in 1..f.pts.len() - 1 {
+                v += p0.dot(points.get(f.pts[i]).cross(points.get(f.pts[i + 1])));
+            }
+        }
+        v / 6.0
+    }
+
+    /// Every undirected edge in exactly two faces, once each way (a closed,
+    /// consistently oriented 2-manifold surface).
+    fn assert_closed(faces: &[Vec<u32>]) {
+        let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
+        for f in faces {
+            for i in 0..f.len() {
+                *directed.entry((f[i], f[(i + 1) % f.len()])).or_default() += 1;
+            }
+        }
+        for (&(a, b), &k) in &directed {
+            assert_eq!(k, 1, "edge {a}->{b} used {k} times");
+            assert_eq!(directed.get(&(b, a)), Some(&1), "edge {a}-{b} has one face");
+        }
+    }
+
+    fn face_lists(g: &Geometry) -> Vec<Vec<u32>> {
+        g.faces.iter().map(|f| f.pts.clone()).collect()
+    }
+
+    fn sized(origin: DVec3, size: DVec3) -> Scope {
+        Scope {
+            origin,
+            size,
+            ..Scope::world()
+        }
+    }
+
+    fn unit_box(points: &mut Points) -> Geometry {
+        box_in(points, &sized(DVec3::ZERO, DVec3::ONE)).unwrap()
+    }
+
+    /// Splits the unit box at x = 0.3 and x = 0.7 (cuts 1 and 2).
+    fn three_pieces(points: &mut Points) -> Vec<Geometry> {
+        let b = unit_box(points);
+        split(points, &b, DVec3::ZERO, DVec3::X, &[0.3, 0.7], 1).unwrap()
+    }
+
+    fn cap(g: &Geometry, seam: u32) -> Vec<PointId> {
+        let caps: Vec<&Face> = g.faces.iter().filter(|f| f.seam == seam).collect();
+        assert_eq!(caps.len(), 1, "one cap with seam {seam}");
+        caps[0].pts.clone()
+    }
+
+    #[test]
+    fn split_box_gives_pieces_of_the_right_volumes_with_mirrored_caps() {
+        let mut points = Points::new();
+        let pieces = three_pieces(&mut points);
+        assert_eq!(pieces.len(), 3);
+        // Slabs of the unit box: 1 x 1 x width.
+        for (g, w) in pieces.iter().zip([0.3, 0.4, 0.3]) {
+            assert!((volume(&points, g) - w).abs() < 1e-12);
+            assert_closed(&face_lists(g));
+        }
+        for k in 1..=2u32 {
+            let lower = cap(&pieces[k as usize - 1], 2 * k);
+            let mut upper = cap(&pieces[k as usize], 2 * k + 1);
+            upper.reverse();
+            assert_eq!(lower, upper, "cut {k}'s caps are mirrored id for id");
+            assert_eq!(lower.len(), 4);
+            let x = [0.3, 0.7][k as usize - 1];
+            for &p in &lower {
+                assert!((points.get(p).x - x).abs() < 1e-15);
+            }
+            // The lower side's cap faces +x.
+            assert!(newell(&points, &lower).x > 0.0);
+        }
+        // 8 corners and 4 points per cut.
+        assert_eq!(points.len(), 16);
+    }
+
+    #[test]
+    fn welding_every_piece_closes_the_box_again() {
+        let mut points = Points::new();
+        let pieces = three_pieces(&mut points);
+        let members: Vec<&Geometry> = pieces.iter().collect();
+        let w = weld(&mut points, &members, &[], &HashSet::new()).unwrap();
+        assert_closed(&w.soup.faces);
+        // 8 corners + 2 cuts x 4 points; the 4 faces across x in 3 pieces
+        // each and the 2 ends: 14 faces, none of them a cap.
+        assert_eq!(w.soup.positions.len(), 16);
+        assert_eq!(w.soup.faces.len(), 14);
+        assert!(w.protected_vertex.iter().all(|&p| !p));
+        assert_eq!(w.tags.iter().filter(|&&t| t == 1).count(), 4);
+        let mut g = Geometry::empty(3);
+        for f in &w.soup.faces {
+            g.faces.push(Face {
+                pts: f.iter().map(|&v| w.point_of[v as usize]).collect(),
+                seam: 0,
+            });
+        }
+        assert!((volume(&points, &g) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_loose_cut_leaves_a_slit() {
+        let mut points = Points::new();
+        let pieces = three_pieces(&mut points);
+        let members: Vec<&Geometry> = pieces.iter().collect();
+        let loose: HashSet<u32> = [2].into_iter().collect();
+        let w = weld(&mut points, &members, &[], &loose).unwrap();
+        assert_closed(&w.soup.faces);
+        // 16 points and the 4 points of cut 2 copied for the upper side;
+        // 14 faces and both caps of cut 2.
+        assert_eq!(w.soup.positions.len(), 20);
+        assert_eq!(w.soup.faces.len(), 16);
+        // The copies sit where the originals are.
+        let mut at: HashMap<[u64; 3], usize> = HashMap::new();
+        for p in &w.soup.positions {
+            *at.entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+                .or_default() += 1;
+        }
+        assert_eq!(at.values().filter(|&&k| k == 2).count(), 4);
+        assert!(w
+            .soup
+            .positions
+            .iter()
+            .all(|p| p.x == 0.7 || at[&[p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]] == 1));
+    }
+
+    #[test]
+    fn a_wall_shared_with_a_shape_outside_the_group_is_refused() {
+        let mut points = Points::new();
+        let pieces = three_pieces(&mut points);
+        // Piece 1 split along z: its halves both hold a part of cut 2's wall.
+        let halves = split(&mut points, &pieces[1], DVec3::ZERO, DVec3::Z, &[0.5], 3).unwrap();
+        let e = weld(
+            &mut points,
+            &[&halves[0], &pieces[2]],
+            &[&halves[1]],
+            &HashSet::new(),
+        );
+        assert!(e.unwrap_err().contains("cut 2's wall"));
+    }
+
+    #[test]
+    fn welding_resolves_t_junctions() {
+        let mut points = Points::new();
+        let pieces = three_pieces(&mut points);
+        let halves = split(&mut points, &pieces[1], DVec3::ZERO, DVec3::Y, &[0.5], 3).unwrap();
+        assert_eq!(halves.len(), 2);
+        let members = [&pieces[0], &halves[0], &halves[1], &pieces[2]];
+        let w = weld(&mut points, &members, &[], &HashSet::new()).unwrap();
+        assert_closed(&w.soup.faces);
+        // The y cut put 4 points on the middle slab's edges at x = 0.3 and
+        // 0.7 (front and back), all used.
+        assert_eq!(w.soup.positions.len(), 20);
+    }
+
+    #[test]
+    fn a_shape_outside_the_group_protects_the_shared_wall() {
+        let mut points = Points::new();
+        let pieces = three_pieces(&mut points);
+        let w = weld(&mut points, &[&pieces[0]], &[&pieces[1]], &HashSet::new()).unwrap();
+        assert_closed(&w.soup.faces);
+        let protected: Vec<DVec3> = (0..w.soup.positions.len())
+            .filter(|&v| w.protected_vertex[v])
+            .map(|v| w.soup.positions[v])
+            .collect();
+        assert_eq!(protected.len(), 4);
+        assert!(protected.iter().all(|p| (p.x - 0.3).abs() < 1e-15));
+        let faces: Vec<usize> = (0..w.soup.faces.len())
+            .filter(|&f| w.protected_face[f])
+            .collect();
+        assert_eq!(faces.len(), 1);
+        let n = {
+            let f = &w.soup.faces[faces[0]];
+            let ids: Vec<PointId> = f.iter().map(|&v| w.point_of[v as usize]).collect();
+            newell(&points, &ids)
+        };
+        assert!(n.x > 0.0 && n.y.abs() < 1e-12 && n.z.abs() < 1e-12);
+    }
+
+    /// An L: [0,2]x[0,1] and [0,1]x[0,2] in the ground plane (x, z), facing up.
+    fn l_shape(points: &mut Points) -> Geometry {
+        let mut c = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(2.0, 0.0, 0.0),
+            DVec3::new(2.0, 0.0, 1.0),
+            DVec3::new(1.0, 0.0, 1.0),
+            DVec3::new(1.0, 0.0, 2.0),
+            DVec3::new(0.0, 0.0, 2.0),
+        ];
+        // Face +y: counter-clockwise seen from above.
+        let mut n = DVec3::ZERO;
+        for i in 0..c.len() {
+            n += c[i].cross(c[(i + 1) % c.len()]);
+        }
+        if n.y < 0.0 {
+            c.reverse();
+        }
+        polygon(points, &c).unwrap()
+    }
+
+    fn components(g: &Geometry) -> usize {
+        let faces = &g.faces;
+        let mut parent: Vec<usize> = (0..faces.len()).collect();
+        fn find(p: &mut Vec<usize>, i: usize) -> usize {
+            let mut i = i;
+            while p[i] != i {
+                p[i] = p[p[i]];
+                i = p[i];
+            }
+            i
+        }
+        let mut owner: HashMap<PointId, usize> = HashMap::new();
+        for (f, face) in faces.iter().enumerate() {
+            for &p in &face.pts {
+                if let Some(&o) = owner.get(&p) {
+                    let (a, b) = (find(&mut parent, o), find(&mut parent, f));
+                    parent[a] = b;
+                } else {
+                    owner.insert(p, f);
+                }
+            }
+        }
+        (0..faces.len())
+            .filter(|&f| find(&mut parent, f) == f)
+            .count()
+    }
+
+    #[test]
+    fn a_non_convex_solid_cut_through_its_notch_gives_two_parts_on_one_side() {
+        let mut points = Points::new();
+        let lot = l_shape(&mut points);
+        let solid = extrude(&mut points, &lot, DVec3::Y, 1.0).unwrap();
+        assert!((volume(&points, &solid) - 3.0).abs() < 1e-12);
+        // The plane x + z = 2.5 crosses both arms: the tip of each arm is
+        // the triangle (1.5, 1), (2, 1), (2, 0.5) (or its mirror), area
+        // 0.125, so 0.25 above and 3 - 0.25 below (height 1).
+        let n = DVec3::new(1.0, 0.0, 1.0).normalize();
+        let d = 2.5 / 2f64.sqrt();
+        let (below, above) = plane_cut(&mut points, &solid, n, d, 1, 1e-9).unwrap();
+        assert!((volume(&points, &above) - 0.25).abs() < 1e-12);
+        assert!((volume(&points, &below) - 2.75).abs() < 1e-12);
+        assert_closed(&face_lists(&above));
+        assert_closed(&face_lists(&below));
+        assert_eq!(components(&above), 2);
+        assert_eq!(components(&below), 1);
+        assert_eq!(above.faces.iter().filter(|f| f.seam == 3).count(), 2);
+        // The lot itself: two pieces above, one below sharing cut points.
+        let (b2, a2) = plane_cut(&mut points, &lot, n, d, 2, 1e-9).unwrap();
+        assert_eq!(a2.faces.len(), 2);
+        assert_eq!(b2.faces.len(), 1);
+        let below_pts: HashSet<PointId> = b2.point_ids().collect();
+        assert_eq!(a2.point_ids().filter(|p| below_pts.contains(p)).count(), 4);
+    }
+
+    #[test]
+    fn on_plane_vertices_belong_to_both_sides_without_cuts() {
+        let mut points = Points::new();
+        let b = unit_box(&mut points);
+        // A plane through the diagonal edge pair x = z: no edge is crossed
+        // between its ends except across the faces; the two halves are
+        // prisms of volume 1/2.
+        let n = DVec3::new(1.0, 0.0, -1.0).normalize();
+        let (lo, hi) = plane_cut(&mut points, &b, n, 0.0, 1, 1e-9).unwrap();
+        assert_eq!(
+            points.len(),
+            8,
+            "no new point: the plane passes through vertices"
+        );
+        assert!((volume(&points, &lo) - 0.5).abs() < 1e-12);
+        assert!((volume(&points, &hi) - 0.5).abs() < 1e-12);
+        assert_closed(&face_lists(&lo));
+        assert_closed(&face_lists(&hi));
+        // A plane along a face keeps the whole on one side, without caps.
+        let (lo, hi) = plane_cut(&mut points, &b, DVec3::X, 1.0, 2, 1e-9).unwrap();
+        assert_eq!((lo.faces.len(), hi.faces.len()), (6, 0));
+        let (lo, hi) = plane_cut(&mut points, &b, DVec3::X, 0.0, 3, 1e-9).unwrap();
+        assert_eq!((lo.faces.len(), hi.faces.len()), (0, 6));
+    }
+
+    #[test]
+    fn siblings_cut_by_one_plane_share_the_points_on_their_wall() {
+        let mut points = Points::new();
+        let b = unit_box(&mut points);
+        let halves = split(&mut points, &b, DVec3::ZERO, DVec3::X, &[0.5], 1).unwrap();
+        let lo = split(&mut points, &halves[0], DVec3::ZERO, DVec3::Y, &[0.5], 2).unwrap();
+        let hi = split(&mut points, &halves[1], DVec3::ZERO, DVec3::Y, &[0.5], 3).unwrap();
+        // 8 corners, 4 points of cut 1, and the y cuts cross the 4 vertical
+        // edges of each half, 2 of them (at x = 0.5) shared: 6.
+        assert_eq!(points.len(), 18);
+        let members = [&lo[0], &lo[1], &hi[0], &hi[1]];
+        for g in members {
+            assert!((volume(&points, g) - 0.25).abs() < 1e-12);
+        }
+        let w = weld(&mut points, &members, &[], &HashSet::new()).unwrap();
+        assert_closed(&w.soup.faces);
+        assert_eq!(w.soup.positions.len(), 18);
+    }
+
+    #[test]
+    fn cuts_through_a_reflex_vertex() {
+        let mut points = Points::new();
+        let lot = l_shape(&mut points);
+        let area = |points: &Points, g: &Geometry| -> f64 {
+            g.faces.iter().map(|f| newell(points, &f.pts).y / 2.0).sum()
+        };
+        // x = 1 runs along the inner wall from the reflex corner (1, 1):
+        // [0,1]x[0,2] (area 2) below, [1,2]x[0,1] (area 1) above.
+        let (lo, hi) = plane_cut(&mut points, &lot, DVec3::X, 1.0, 1, 1e-9).unwrap();
+        assert_eq!((lo.faces.len(), hi.faces.len()), (1, 1));
+        assert!((area(&points, &lo) - 2.0).abs() < 1e-12);
+        assert!((area(&points, &hi) - 1.0).abs() < 1e-12);
+        let solid = extrude(&mut points, &lot, DVec3::Y, 1.0).unwrap();
+        for (n, d, vlo, vhi) in [(DVec3::Z, 1.0, 2.0, 1.0), (DVec3::X, 1.0, 2.0, 1.0)] {
+            let (lo, hi) = plane_cut(&mut points, &solid, n, d, 2, 1e-9).unwrap();
+            assert!((volume(&points, &lo) - vlo).abs() < 1e-12);
+            assert!((volume(&points, &hi) - vhi).abs() < 1e-12);
+            assert_closed(&face_lists(&lo));
+            assert_closed(&face_lists(&hi));
+        }
+    }
+
+    #[test]
+    fn a_cap_with_a_hole_is_refused() {
+        let mut points = Points::new();
+        // A square frame: outer [0,3]^2, inner [1,2]^2 in (x, z), as 4
+        // quads facing +y, extruded up: a solid with a hole through it.
+        let corner = |x: f64, z: f64| DVec3::new(x, 0.0, z);
+        let o = [
+            corner(0.0, 0.0),
+            corner(0.0, 3.0),
+            corner(3.0, 3.0),
+            corner(3.0, 0.0),
+        ];
+        let i = [
+            corner(1.0, 1.0),
+            corner(1.0, 2.0),
+            corner(2.0, 2.0),
+            corner(2.0, 1.0),
+        ];
+        let oid: Vec<PointId> = o.iter().map(|&p| points.add(p).unwrap()).collect();
+        let iid: Vec<PointId> = i.iter().map(|&p| points.add(p).unwrap()).collect();
+        let mut frame = Geometry::empty(2);
+        for k in 0..4 {
+            let j = (k + 1) % 4;
+            frame.faces.push(quad(oid[k], oid[j], iid[j], iid[k]));
+        }
+        assert!(newell(&points, &frame.faces[0].pts).y > 0.0);
+        let solid = extrude(&mut points, &frame, DVec3::Y, 1.0).unwrap();
+        assert_closed(&face_lists(&solid));
+        // Outer 9 - inner 1, height 1.
+        assert!((volume(&points, &solid) - 8.0).abs() < 1e-12);
+        let e = plane_cut(&mut points, &solid, DVec3::Y, 0.5, 1, 1e-9);
+        assert!(e.unwrap_err().contains("hole"));
+        // Across the hole's axis there is no hole in the caps.
+        let (lo, hi) = plane_cut(&mut points, &solid, DVec3::X, 1.5, 2, 1e-9).unwrap();
+        assert!((volume(&points, &lo) - 4.0).abs() < 1e-12);
+        assert!((volume(&points, &hi) - 4.0).abs() < 1e-12);
+        assert_eq!(lo.faces.iter().filter(|f| f.seam == 4).count(), 2);
+    }
+
+    #[test]
+    fn primitives_are_closed_with_outward_faces() {
+        let mut points = Points::new();
+        let s = sized(DVec3::new(1.0, 2.0, 3.0), DVec3::new(2.0, 3.0, 4.0));
+        let b = box_in(&mut points, &s).unwrap();
+        assert_closed(&face_lists(&b));
+        assert!((volume(&points, &b) - 24.0).abs() < 1e-12);
+
+        // A regular n-gon of circumradius r has area (n / 2) r^2 sin(2 pi / n).
+        let n = 64;
+        let c = cylinder_in(
+            &mut points,
+            &sized(DVec3::ZERO, DVec3::new(2.0, 5.0, 2.0)),
+            n,
+        )
+        .unwrap();
+        assert_closed(&face_lists(&c));
+        let ngon = n as f64 / 2.0 * (std::f64::consts::TAU / n as f64).sin();
+        assert!((volume(&points, &c) - 5.0 * ngon).abs() < 1e-9);
+        assert!((volume(&points, &c) / (5.0 * std::f64::consts::PI) - 1.0).abs() < 0.01);
+
+        let sp = sphere_in(&mut points, &sized(DVec3::ZERO, DVec3::splat(2.0)), 32, 16).unwrap();
+        assert_closed(&face_lists(&sp));
+        for f in &sp.faces {
+            assert!(
+                newell(&points, &f.pts).length() > 1e-6,
+                "no degenerate face"
+            );
+        }
+        let v = volume(&points, &sp);
+        let ball = 4.0 / 3.0 * std::f64::consts::PI;
+        assert!(v < ball && v > 0.95 * ball, "{v} vs {ball}");
+        // 32 triangles at each pole, 32 x 14 quads.
+        assert_eq!(sp.faces.len(), 64 + 32 * 14);
+
+        // A zero-size scope gives nothing.
+        let flat = sized(DVec3::ZERO, DVec3::new(1.0, 0.0, 1.0));
+        assert!(box_in(&mut points, &flat).unwrap().is_empty());
+        assert!(sphere_in(&mut points, &flat, 8, 4).unwrap().is_empty());
+        assert!(cylinder_in(&mut points, &flat, 2).is_err());
+    }
+
+    #[test]
+    fn a_mesh_fills_its_scope() {
+        let mut points = Points::new();
+        // A tetrahedron with outward faces, volume 1/6, in [0,1]^3.
+        let soup = PolygonSoup {
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+            faces: vec![vec![0, 2, 1], vec![0, 1, 3], vec![0, 3, 2], vec![1, 2, 3]],
+            ..PolygonSoup::default()
+        };
+        let s = sized(DVec3::new(5.0, 0.0, 0.0), DVec3::new(2.0, 3.0, 4.0));
+        let g = mesh_in(&mut points, &s, &soup).unwrap();
+        assert_closed(&face_lists(&g));
+        // Scaled by 2, 3, 4.
+        assert!((volume(&points, &g) - 24.0 / 6.0).abs() < 1e-12);
+        let bs = bounding_scope(&points, &g, s.axes);
+        assert_eq!(bs.origin, s.origin);
+        assert_eq!(bs.size, s.size);
+        // A flat soup lands on the scope's origin plane.
+        let flat = PolygonSoup {
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            faces: vec![vec![0, 1, 2]],
+            ..PolygonSoup::default()
+        };
+        let g = mesh_in(&mut points, &s, &flat).unwrap();
+        assert!(g.point_ids().all(|p| points.get(p).z == 0.0));
+        let bad = PolygonSoup {
+            faces: vec![vec![0, 1, 7]],
+            ..flat
+        };
+        assert!(mesh_in(&mut points, &s, &bad).is_err());
+    }
+
+    #[test]
+    fn extruding_a_lot_gives_height_times_area() {
+        let mut points = Points::new();
+        let lot = polygon_in(
+            &mut points,
+            &Scope::world(),
+            &[
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(0.0, 0.0, 2.0),
+                DVec3::new(2.0, 0.0, 2.0),
+                DVec3::new(2.0, 0.0, 0.0),
+            ],
+        )
+        .unwrap();
+        assert!(newell(&points, &lot.faces[0].pts).y > 0.0);
+        let area = 4.0;
+        for (dir, h) in [(DVec3::Y, 3.0), (DVec3::Y, -3.0), (DVec3::NEG_Y, 3.0)] {
+            let g = extrude(&mut points, &lot, dir, h).unwrap();
+            assert_closed(&face_lists(&g));
+            assert!((volume(&points, &g) - 3.0 * area).abs() < 1e-12);
+            // The base keeps the lot's ids.
+            assert!(g.faces[0].pts.iter().all(|p| lot.faces[0].pts.contains(p)));
+        }
+        assert!(extrude(&mut points, &lot, DVec3::X, 3.0).is_err());
+        assert!(extrude(&mut points, &lot, DVec3::Y, f64::NAN).is_err());
+    }
+
+    #[test]
+    fn comp_of_a_box_gives_each_side_once_with_up_facades() {
+        let mut points = Points::new();
+        let s = sized(DVec3::ZERO, DVec3::new(2.0, 3.0, 4.0));
+        let b = box_in(&mut points, &s).unwrap();
+        for name in ["front", "back", "left", "right", "top", "bottom"] {
+            let sel = Selector::parse(name).unwrap();
+            let faces = comp_faces(&points, &b, &s, sel);
+            assert_eq!(faces.len(), 1, "{name}");
+            let (g, fs) = &faces[0];
+            assert_eq!(g.dim, 2);
+            assert_eq!(
+                g.faces[0],
+                *b.faces.iter().find(|f| f.pts == g.faces[0].pts).unwrap()
+            );
+            assert_eq!(fs.size.z, 0.0);
+        }
+        let sides = comp_faces(&points, &b, &s, Selector::Side);
+        assert_eq!(sides.len(), 4);
+        for (_, fs) in &sides {
+            assert!((fs.axes[1] - DVec3::Y).length() < 1e-12);
+            assert!(fs.axes[2].y.abs() < 1e-12);
+            assert!((fs.size.y - 3.0).abs() < 1e-12);
+        }
+        let (_, front) = &comp_faces(&points, &b, &s, Selector::Front)[0];
+        assert!((front.size - DVec3::new(2.0, 3.0, 0.0)).length() < 1e-12);
+        assert!((front.origin - DVec3::new(0.0, 0.0, 4.0)).length() < 1e-12);
+        assert_eq!(comp_faces(&points, &b, &s, Selector::Horizontal).len(), 2);
+        assert_eq!(comp_faces(&points, &b, &s, Selector::All).len(), 6);
+        // 12 edges and 8 vertices.
+        let edges = comp_edges(&points, &b, &s);
+        assert_eq!(edges.len(), 12);
+        for (g, es) in &edges {
+            let [a, c] = g.edges[0];
+            let e = points.get(c) - points.get(a);
+            assert!((es.axes[0] * es.size.x - e).length() < 1e-12);
+        }
+        assert_eq!(comp_vertices(&points, &b, &s).len(), 8);
+        assert_eq!(Selector::parse("sideways"), None);
+    }
+
+    #[test]
+    fn classify_by_the_dominant_component_with_y_then_z_winning_ties() {
+        assert_eq!(Selector::classify(DVec3::ONE), Selector::Top);
+        assert_eq!(
+            Selector::classify(DVec3::new(1.0, -1.0, 0.0)),
+            Selector::Bottom
+        );
+        assert_eq!(
+            Selector::classify(DVec3::new(1.0, 0.0, -1.0)),
+            Selector::Back
+        );
+        assert_eq!(
+            Selector::classify(DVec3::new(-2.0, 1.0, 1.0)),
+            Selector::Left
+        );
+        assert_eq!(
+            Selector::classify(DVec3::new(0.0, 0.2, 0.3)),
+            Selector::Front
+        );
+        assert_eq!(
+            Selector::classify(DVec3::new(0.5, 0.2, 0.3)),
+            Selector::Right
+        );
+    }
+
+    #[test]
+    fn cuts_are_shared_and_resolved_in_chains() {
+        let mut points = Points::new();
+        let a = points.add(DVec3::ZERO).unwrap();
+        let b = points.add(DVec3::new(1.0, 0.0, 0.0)).unwrap();
+        let c = points.add(DVec3::new(0.0, 1.0, 0.0)).unwrap();
+        let m = points.cut(a, b, DVec3::X, 0.5).unwrap();
+        assert_eq!(points.cut(b, a, DVec3::X, 0.5).unwrap(), m);
+        assert_eq!(points.get(m), DVec3::new(0.5, 0.0, 0.0));
+        // A cut on a cut, and a sibling's cut of the whole edge by the
+        // same plane: one point each.
+        let q = points.cut(a, m, DVec3::X, 0.25).unwrap();
+        assert_eq!(points.cut(a, b, DVec3::X, 0.25).unwrap(), q);
+        let r = points.cut(m, b, DVec3::X, 0.75).unwrap();
+        let mut out = Vec::new();
+        points.resolve(&[a, b, c], &mut out);
+        assert_eq!(out, vec![a, q, m, r, b, c]);
+        points.resolve(&[c, b, a], &mut out);
+        assert_eq!(out, vec![c, b, r, m, q, a]);
+        points.resolve(&[q, r, c], &mut out);
+        assert_eq!(out, vec![q, m, r, c]);
+        assert_eq!(points.len(), 6);
+    }
+
+    #[test]
+    fn bad_input_gives_errors_not_panics() {
+        let mut points = Points::new();
+        assert!(points.add(DVec3::new(f64::NAN, 0.0, 0.0)).is_err());
+        let b = unit_box(&mut points);
+        assert!(plane_cut(&mut points, &b, DVec3::ZERO, 0.5, 1, 1e-9).is_err());
+        assert!(plane_cut(&mut points, &b, DVec3::X, f64::NAN, 1, 1e-9).is_err());
+        assert!(plane_cut(&mut points, &b, DVec3::X, 0.5, 0, 1e-9).is_err());
+        assert!(split(&mut points, &b, DVec3::ZERO, DVec3::X, &[0.7, 0.3], 1).is_err());
+        let e = Geometry::empty(3);
+        let pieces = split(&mut points, &e, DVec3::ZERO, DVec3::X, &[0.5], 1).unwrap();
+        assert!(pieces.iter().all(Geometry::is_empty));
+        // Cuts outside the shape give empty pieces.
+        let pieces = split(&mut points, &b, DVec3::ZERO, DVec3::X, &[-1.0, 2.0], 1).unwrap();
+        assert!(pieces[0].is_empty() && pieces[2].is_empty());
+        assert_eq!(pieces[1].faces.len(), 6);
+        let ghost = Geometry {
+            verts: vec![999],
+            ..Geometry::empty(0)
+        };
+        assert!(plane_cut(&mut points, &ghost, DVec3::X, 0.5, 1, 1e-9).is_err());
+        let bs = bounding_scope(&points, &e, Scope::world().axes);
+        assert_eq!(bs.size, DVec3::ZERO);
+        let nan = DAffine3::from_translation(DVec3::NAN);
+        assert!(transform(&mut points, &b, &nan).is_err());
+    }
+
+    #[test]
+    fn transform_copies_onto_new_points_and_keeps_faces_outward() {
+        let mut points = Points::new();
+        let b = unit_box(&mut points);
+        let mirror = DAffine3::from_scale(DVec3::new(-2.0, 1.0, 1.0));
+        let t = transform(&mut points, &b, &mirror).unwrap();
+        let old: HashSet<PointId> = b.point_ids().collect();
+        assert!(t.point_ids().all(|p| !old.contains(&p)));
+        assert_eq!(t.unique_points().len(), 8);
+        assert_closed(&face_lists(&t));
+        assert!((volume(&points, &t) - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn lower_dimensions_split_too() {
+        let mut points = Points::new();
+        let a = points.add(DVec3::ZERO).unwrap();
+        let b = points.add(DVec3::new(2.0, 0.0, 0.0)).unwrap();
+        let edge = Geometry {
+            edges: vec![[a, b]],
+            ..Geometry::empty(1)
+        };
+        let (lo, hi) = plane_cut(&mut points, &edge, DVec3::X, 0.5, 1, 1e-9).unwrap();
+        let m = lo.edges[0][1];
+        assert_eq!(lo.edges, vec![[a, m]]);
+        assert_eq!(hi.edges, vec![[m, b]]);
+        assert_eq!(points.get(m).x, 0.5);
+        let pts = Geometry {
+            verts: vec![a, b, m],
+            ..Geometry::empty(0)
+        };
+        let (lo, hi) = plane_cut(&mut points, &pts, DVec3::X, 0.5, 2, 1e-9).unwrap();
+        assert_eq!(lo.verts, vec![a, m]);
+        assert_eq!(hi.verts, vec![b]);
+    }
+}

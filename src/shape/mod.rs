@@ -1,0 +1,2 @@
+//! Shape grammars (paper 003): the shape tree over the geometry kernel.
+pub(crate) mod geom;
