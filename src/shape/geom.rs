@@ -306,7 +306,7 @@ impl Scope {
 
     /// The world point at coordinates `l` in the scope's frame (named
     /// `to_world` because `world()` makes the world scope).
-    pub fn to_world(&self, l: DVec3) -> DVec3 {
+    pub fn to_world(self, l: DVec3) -> DVec3 {
         self.origin + l.x * self.axes[0] + l.y * self.axes[1] + l.z * self.axes[2]
     }
 
@@ -369,8 +369,7 @@ struct Node {
 fn split_polygon(
     points: &mut Points,
     face: &Face,
-    n: DVec3,
-    d: f64,
+    (n, d): (DVec3, f64),
     s: &[f64],
     side: &[i8],
     below: &mut Vec<Face>,
@@ -409,7 +408,7 @@ fn split_polygon(
     let mut crossings: Vec<usize> = (0..ring.len())
         .filter(|&i| ring[i].down.is_some())
         .collect();
-    if crossings.len() % 2 != 0 {
+    if !crossings.len().is_multiple_of(2) {
         return Err("a face crosses a cut plane an odd number of times".into());
     }
     crossings.sort_by(|&a, &b| {
@@ -577,8 +576,7 @@ pub(crate) fn plane_cut(
             split_polygon(
                 points,
                 face,
-                n,
-                d,
+                (n, d),
                 &s,
                 &side,
                 &mut below.faces,
@@ -587,8 +585,12 @@ pub(crate) fn plane_cut(
         }
     }
     if geom.dim >= 3 && !below.faces.is_empty() && !above.faces.is_empty() {
-        let slack = eps.max(1e-12 * (1.0 + d.abs()));
-        let caps = cap_loops(points, &below.faces, |p| (sd(points, p)).abs() <= slack)?;
+        // On the plane: within eps, or a cut point (off by rounding only).
+        let on = |p: PointId| {
+            let slack = eps.max(1e-12 * (1.0 + d.abs() + points.get(p).abs().max_element()));
+            sd(points, p).abs() <= slack
+        };
+        let caps = cap_loops(&below.faces, on)?;
         for lp in caps {
             let o = newell(points, &lp).dot(n);
             if o < 0.0 {
@@ -618,11 +620,7 @@ pub(crate) fn plane_cut(
 /// The loops that close `faces` (a solid's part on one side) in the cut
 /// plane: the in-plane edges no other face uses the other way, reversed and
 /// chained. Chains that do not close are left out.
-fn cap_loops(
-    _points: &Points,
-    faces: &[Face],
-    on: impl Fn(PointId) -> bool,
-) -> Result<Vec<Vec<PointId>>, String> {
+fn cap_loops(faces: &[Face], on: impl Fn(PointId) -> bool) -> Result<Vec<Vec<PointId>>, String> {
     let mut directed = HashSet::new();
     for f in faces {
         let m = f.pts.len();
@@ -1496,13 +1494,18 @@ mod tests {
     use super::*;
 
     /// The signed volume by the divergence theorem: the sum over faces
-    /// (fanned) of p0 · (pi × pi+1) / 6.
+    /// (fanned) of p0 · (pi × pi+1) / 6, positions taken relative to the
+    /// first point (a closed surface's volume does not depend on it).
     fn volume(points: &Points, g: &Geometry) -> f64 {
+        let Some(o) = g.point_ids().next().map(|p| points.get(p)) else {
+            return 0.0;
+        };
+        let at = |p: PointId| points.get(p) - o;
         let mut v = 0.0;
         for f in &g.faces {
-            let p0 = points.get(f.pts[0]);
+            let p0 = at(f.pts[0]);
             for i in 1..f.pts.len() - 1 {
-                v += p0.dot(points.get(f.pts[i]).cross(points.get(f.pts[i + 1])));
+                v += p0.dot(at(f.pts[i]).cross(at(f.pts[i + 1])));
             }
         }
         v / 6.0
@@ -1704,7 +1707,7 @@ mod tests {
     fn components(g: &Geometry) -> usize {
         let faces = &g.faces;
         let mut parent: Vec<usize> = (0..faces.len()).collect();
-        fn find(p: &mut Vec<usize>, i: usize) -> usize {
+        fn find(p: &mut [usize], i: usize) -> usize {
             let mut i = i;
             while p[i] != i {
                 p[i] = p[p[i]];
@@ -1819,6 +1822,37 @@ mod tests {
             assert!((volume(&points, &hi) - vhi).abs() < 1e-12);
             assert_closed(&face_lists(&lo));
             assert_closed(&face_lists(&hi));
+        }
+    }
+
+    #[test]
+    fn tilted_cuts_of_round_solids_conserve_volume() {
+        let mut points = Points::new();
+        let far = DVec3::new(1e6, -2e5, 3e5);
+        let c = cylinder_in(&mut points, &sized(far, DVec3::new(2.0, 3.0, 1.0)), 24).unwrap();
+        let sp = sphere_in(&mut points, &sized(far, DVec3::splat(2.0)), 16, 9).unwrap();
+        let mut cut = 1;
+        for g in [&c, &sp] {
+            let whole = volume(&points, g);
+            for n in [
+                DVec3::new(1.0, 2.0, 0.5),
+                DVec3::new(-0.3, 0.1, 1.0),
+                DVec3::X,
+            ] {
+                let n = n.normalize();
+                let d = n.dot(far + DVec3::new(0.9, 1.1, 0.5));
+                let (lo, hi) = plane_cut(&mut points, g, n, d, cut, 0.0).unwrap();
+                cut += 1;
+                assert_closed(&face_lists(&lo));
+                assert_closed(&face_lists(&hi));
+                let (vl, vh) = (volume(&points, &lo), volume(&points, &hi));
+                assert!(vl > 0.0 && vh > 0.0);
+                // Both parts make up the whole (additivity of volume).
+                assert!(
+                    (vl + vh - whole).abs() < 1e-6 * whole.abs().max(1.0),
+                    "{vl} + {vh} vs {whole}"
+                );
+            }
         }
     }
 
