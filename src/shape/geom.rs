@@ -1856,6 +1856,90 @@ mod tests {
         }
     }
 
+    /// A small deterministic generator (an LCG) for the randomised tests.
+    struct Lcg(u64);
+
+    impl Lcg {
+        /// Uniform in [0, 1).
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// A star-shaped simple polygon in the ground plane, facing up: corner
+    /// k at angle 2 pi k / m and a random radius.
+    fn star(points: &mut Points, rng: &mut Lcg, m: usize) -> Geometry {
+        let corners: Vec<DVec3> = (0..m)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / m as f64;
+                let r = 0.3 + rng.next();
+                // Counter-clockwise seen from +y: x = cos, z = -sin.
+                DVec3::new(r * a.cos(), 0.0, -r * a.sin())
+            })
+            .collect();
+        polygon(points, &corners).unwrap()
+    }
+
+    fn area_up(points: &Points, g: &Geometry) -> f64 {
+        g.faces.iter().map(|f| newell(points, &f.pts).y / 2.0).sum()
+    }
+
+    #[test]
+    fn random_cuts_of_non_convex_polygons_and_prisms_conserve_area_and_volume() {
+        let mut rng = Lcg(14);
+        let mut cut = 1;
+        for round in 0..200 {
+            let mut points = Points::new();
+            let m = 3 + (rng.next() * 12.0) as usize;
+            let lot = star(&mut points, &mut rng, m);
+            let whole = area_up(&points, &lot);
+            let a = rng.next() * std::f64::consts::TAU;
+            let n = DVec3::new(a.cos(), 0.0, a.sin());
+            // Every other plane passes exactly through a corner.
+            let d = if round % 2 == 0 {
+                n.dot(points.get(lot.faces[0].pts[(rng.next() * m as f64) as usize]))
+            } else {
+                (rng.next() - 0.5) * 1.5
+            };
+            let (lo, hi) = plane_cut(&mut points, &lot, n, d, cut, 1e-9).unwrap();
+            cut += 1;
+            // Additivity of area; every piece faces up and lies on its side.
+            let (al, ah) = (area_up(&points, &lo), area_up(&points, &hi));
+            assert!(
+                (al + ah - whole).abs() < 1e-9,
+                "round {round}: {al} + {ah} vs {whole}"
+            );
+            for f in &lo.faces {
+                assert!(newell(&points, &f.pts).y > 0.0);
+                assert!(f.pts.iter().all(|&p| n.dot(points.get(p)) - d <= 1e-9));
+            }
+            for f in &hi.faces {
+                assert!(newell(&points, &f.pts).y > 0.0);
+                assert!(f.pts.iter().all(|&p| n.dot(points.get(p)) - d >= -1e-9));
+            }
+            // The prism over the lot, cut by a plane off the corners: the
+            // two closed parts make up its volume.
+            if round % 2 == 1 {
+                let solid = extrude(&mut points, &lot, DVec3::Y, 1.0).unwrap();
+                let tilt = DVec3::new(n.x, 0.4 * (rng.next() - 0.5), n.z).normalize();
+                let d = tilt.dot(DVec3::new(0.0, 0.5, 0.0)) + (rng.next() - 0.5);
+                let (lo, hi) = plane_cut(&mut points, &solid, tilt, d, cut, 1e-9).unwrap();
+                cut += 1;
+                assert_closed(&face_lists(&lo));
+                assert_closed(&face_lists(&hi));
+                let (vl, vh) = (volume(&points, &lo), volume(&points, &hi));
+                assert!(
+                    (vl + vh - whole).abs() < 1e-9,
+                    "round {round}: {vl} + {vh} vs {whole}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn a_cap_with_a_hole_is_refused() {
         let mut points = Points::new();
