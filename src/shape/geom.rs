@@ -590,7 +590,7 @@ pub(crate) fn plane_cut(
             let slack = eps.max(1e-12 * (1.0 + d.abs() + points.get(p).abs().max_element()));
             sd(points, p).abs() <= slack
         };
-        let caps = cap_loops(&below.faces, on)?;
+        let caps = cap_loops(points, &below.faces, n, on);
         for lp in caps {
             let o = newell(points, &lp).dot(n);
             if o < 0.0 {
@@ -618,9 +618,16 @@ pub(crate) fn plane_cut(
 }
 
 /// The loops that close `faces` (a solid's part on one side) in the cut
-/// plane: the in-plane edges no other face uses the other way, reversed and
-/// chained. Chains that do not close are left out.
-fn cap_loops(faces: &[Face], on: impl Fn(PointId) -> bool) -> Result<Vec<Vec<PointId>>, String> {
+/// plane of normal `n`: the in-plane edges no other face uses the other
+/// way, reversed and chained. Where outlines meet at a point, each loop
+/// turns as far left as it can, so that the loops stay apart. Chains that
+/// do not close are left out.
+fn cap_loops(
+    points: &Points,
+    faces: &[Face],
+    n: DVec3,
+    on: impl Fn(PointId) -> bool,
+) -> Vec<Vec<PointId>> {
     let mut directed = HashSet::new();
     for f in faces {
         let m = f.pts.len();
@@ -629,19 +636,13 @@ fn cap_loops(faces: &[Face], on: impl Fn(PointId) -> bool) -> Result<Vec<Vec<Poi
         }
     }
     let mut edges: Vec<(PointId, PointId)> = Vec::new();
-    let mut next: HashMap<PointId, usize> = HashMap::new();
+    let mut out: HashMap<PointId, Vec<usize>> = HashMap::new();
     for f in faces {
         let m = f.pts.len();
         for i in 0..m {
             let (u, v) = (f.pts[i], f.pts[(i + 1) % m]);
             if u != v && on(u) && on(v) && !directed.contains(&(v, u)) {
-                if next.insert(v, edges.len()).is_some() {
-                    return Err(
-                        "a cut plane touches the shape where two outlines of the cut meet at \
-                         one point; move the cut slightly"
-                            .into(),
-                    );
-                }
+                out.entry(v).or_default().push(edges.len());
                 edges.push((v, u));
             }
         }
@@ -658,22 +659,33 @@ fn cap_loops(faces: &[Face], on: impl Fn(PointId) -> bool) -> Result<Vec<Vec<Poi
         let mut closed = false;
         for _ in 0..=edges.len() {
             used[cur] = true;
-            let to = edges[cur].1;
+            let (from, to) = edges[cur];
             if to == start {
                 closed = true;
                 break;
             }
             lp.push(to);
-            match next.get(&to) {
-                Some(&k) if !used[k] => cur = k,
-                _ => break,
+            let din = points.get(to) - points.get(from);
+            let turn = |k: usize| {
+                let dout = points.get(edges[k].1) - points.get(to);
+                n.dot(din.cross(dout)).atan2(din.dot(dout))
+            };
+            let candidates = out.get(&to).map(Vec::as_slice).unwrap_or(&[]);
+            let best = candidates
+                .iter()
+                .copied()
+                .filter(|&k| !used[k])
+                .max_by(|&a, &b| turn(a).total_cmp(&turn(b)));
+            match best {
+                Some(k) => cur = k,
+                None => break,
             }
         }
         if closed && lp.len() >= 3 {
             loops.push(lp);
         }
     }
-    Ok(loops)
+    loops
 }
 
 /// Splits `geom` across planes normal to `axis` (unit) at distances `cuts`
@@ -1938,6 +1950,36 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn outlines_meeting_at_a_point_give_separate_caps() {
+        let mut points = Points::new();
+        // Two unit squares facing up that share one corner (1, 0, 1).
+        let mut id = |x: f64, z: f64| points.add(DVec3::new(x, 0.0, z)).unwrap();
+        let (a0, a1, p, a3) = (id(0.0, 0.0), id(0.0, 1.0), id(1.0, 1.0), id(1.0, 0.0));
+        let (b1, b2, b3) = (id(1.0, 2.0), id(2.0, 2.0), id(2.0, 1.0));
+        let mut bowtie = Geometry::empty(2);
+        bowtie.faces.push(quad(a0, a1, p, a3));
+        bowtie.faces.push(quad(p, b1, b2, b3));
+        let solid = extrude(&mut points, &bowtie, DVec3::Y, 1.0).unwrap();
+        let (lo, hi) = plane_cut(&mut points, &solid, DVec3::Y, 0.5, 1, 1e-9).unwrap();
+        // Each square's section is a square cap; both pass through the
+        // point cut on the shared vertical edge.
+        let caps: Vec<&Face> = lo.faces.iter().filter(|f| f.seam == 2).collect();
+        assert_eq!(caps.len(), 2);
+        assert!(caps.iter().all(|f| f.pts.len() == 4));
+        let shared: Vec<PointId> = caps[0]
+            .pts
+            .iter()
+            .copied()
+            .filter(|q| caps[1].pts.contains(q))
+            .collect();
+        assert_eq!(shared.len(), 1);
+        assert_eq!(points.get(shared[0]), DVec3::new(1.0, 0.5, 1.0));
+        // Two unit squares by half the height on each side.
+        assert!((volume(&points, &lo) - 1.0).abs() < 1e-12);
+        assert!((volume(&points, &hi) - 1.0).abs() < 1e-12);
     }
 
     #[test]
