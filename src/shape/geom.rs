@@ -1171,6 +1171,27 @@ fn fit(points: &Points, pts: impl Iterator<Item = PointId>, axes: [DVec3; 3]) ->
     }
 }
 
+/// The scope of a lot (faces, dim 2, made by the axiom): x along the first
+/// face's first edge, y the faces' normal (Newell, summed), z = x × y,
+/// fitted around the faces (size.y = 0). None for faces without area.
+pub(crate) fn lot_scope(points: &Points, geom: &Geometry) -> Option<Scope> {
+    let f = geom.faces.first()?;
+    let y = geom
+        .faces
+        .iter()
+        .map(|f| newell(points, &f.pts))
+        .sum::<DVec3>()
+        .try_normalize()?;
+    let m = f.pts.len();
+    let edge = (0..m)
+        .map(|i| points.get(f.pts[(i + 1) % m]) - points.get(f.pts[i]))
+        .find(|e| e.length_squared() > 0.0)?;
+    let x = (edge - edge.dot(y) * y).try_normalize()?;
+    let mut s = fit(points, geom.point_ids(), [x, y, x.cross(y)]);
+    s.size.y = 0.0;
+    Some(s)
+}
+
 /// The faces of `geom` that `sel` takes, each as a one-face geometry (dim
 /// 2, the same point ids) with its scope: x along the face's first edge,
 /// z its normal (Newell), y = z × x, fitted around the face (size.z = 0).
@@ -2118,6 +2139,13 @@ mod tests {
             // The base keeps the lot's ids.
             assert!(g.faces[0].pts.iter().all(|p| lot.faces[0].pts.contains(p)));
         }
+        // The lot's own scope: x along its first edge (+z here), y up.
+        let s = lot_scope(&points, &lot).unwrap();
+        assert!((s.axes[0] - DVec3::Z).length() < 1e-12);
+        assert!((s.axes[1] - DVec3::Y).length() < 1e-12);
+        assert!((s.axes[2] + DVec3::X).length() < 1e-12);
+        assert!((s.size - DVec3::new(2.0, 0.0, 2.0)).length() < 1e-12);
+        assert!((s.origin - DVec3::new(2.0, 0.0, 0.0)).length() < 1e-12);
         assert!(extrude(&mut points, &lot, DVec3::X, 3.0).is_err());
         assert!(extrude(&mut points, &lot, DVec3::Y, f64::NAN).is_err());
     }
