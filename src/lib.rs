@@ -37,6 +37,7 @@ mod limits;
 mod load;
 mod production;
 mod rewrite;
+pub(crate) mod shape;
 mod syntax;
 mod system;
 pub mod vv;

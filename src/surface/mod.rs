@@ -15,7 +15,7 @@ use crate::load::{self, Front};
 use crate::syntax::lex::Token;
 use crate::syntax::Span;
 
-pub use run::{Grammar, GrammarRun, RunError, StepCounts};
+pub use run::{Grammar, GrammarRun, Protection, RunError, StepCounts};
 
 /// True when preprocessed tokens are a surface grammar: a `mesh:` directive
 /// at the start of a line, or a rule in paper 000's form on one line: `F(`,
