@@ -264,7 +264,9 @@ pub(crate) fn compile_with(
 
 /// The parts of a mesh a run leaves as they are (paper 003, §4.2.2: the
 /// faces and vertices a smoothing group shares with shapes outside it).
-/// No rule matches a protected face; a vertex that is protected or lies
+/// No rule matches a protected face, or a face whose three corners are
+/// protected vertices (Algorithm 3 for the mesh's triangles); a vertex
+/// that is protected or lies
 /// on a protected face; an edge with a protected face on either side, or
 /// whose two ends are protected. So no face point is put in a protected
 /// face, none of its vertices moves, no edge is drawn in it or split on
@@ -348,10 +350,18 @@ impl Protected {
         self.face.get(f.index()).copied().unwrap_or(false)
     }
 
-    /// A face rule may match `f`.
+    /// A face rule may match `f`: it is not protected, and not all its
+    /// corners are protected vertices. The second is Algorithm 3's rule
+    /// (a face whose vertices are all protected is protected) for the
+    /// triangles being subdivided, whatever polygons the protection was
+    /// given for: a face point in such a triangle would join three
+    /// spokes whose ends never move and whose edges never flip, and a
+    /// later step that flips all three (√3 next to a protected boundary
+    /// edge) would join two new vertices twice.
     #[inline]
-    fn face_free(&self, f: FaceId) -> bool {
-        !self.face(f)
+    fn face_free(&self, mesh: &Mesh, f: FaceId) -> bool {
+        let protected = |v: VertexId| self.vertex.get(v.index()).copied().unwrap_or(false);
+        !self.face(f) && !mesh.face_vertices(f).into_iter().all(protected)
     }
 
     /// A vertex rule may match `v`.
@@ -377,7 +387,8 @@ impl Protected {
                 (0..3).any(|k| (0..3).all(|i| now[(k + i) % 3] == vs[i]))
             }
         }) && self.positions.iter().all(|&(v, p)| {
-            mesh.is_vertex(v) && mesh.position(v).to_array().map(f64::to_bits) == p.to_array().map(f64::to_bits)
+            mesh.is_vertex(v)
+                && mesh.position(v).to_array().map(f64::to_bits) == p.to_array().map(f64::to_bits)
         })
     }
 }
@@ -685,7 +696,7 @@ impl Grammar {
                 match rule.op {
                     Op::FaceSplit => {
                         for f in (lo..hi).map(crate::mesh::FaceId) {
-                            if mesh.is_face(f) && protect.is_none_or(|p| p.face_free(f)) {
+                            if mesh.is_face(f) && protect.is_none_or(|p| p.face_free(mesh, f)) {
                                 let hs = mesh.face_halfedges(f);
                                 let val = host::face(
                                     hs.map(|h| mesh.from(h)),
@@ -1070,7 +1081,10 @@ impl GrammarRun<'_> {
         self.grammar.apply_all(&each, self.mesh, &mut self.state)?;
         self.state.swap_positions(self.mesh);
         debug_assert!(
-            self.state.protect.as_ref().is_none_or(|p| p.intact(self.mesh)),
+            self.state
+                .protect
+                .as_ref()
+                .is_none_or(|p| p.intact(self.mesh)),
             "a rule rewrote a protected element"
         );
         Ok(())
