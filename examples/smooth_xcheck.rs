@@ -97,7 +97,7 @@ fn bench() {
     });
     println!("sqrt(3), one step, {n} -> {faces} triangles, best of {runs}:");
     println!(
-        "  subdivide (soup -> mesh, protected run, tagged soup): {:.1} ms",
+        "  subdivide (soup -> tagged mesh, run, tagged soup):   {:.1} ms",
         t_sub * 1e3
     );
     println!(

@@ -609,6 +609,8 @@ impl Grammar {
                 });
             }
         }
+        // Nothing protected is no protection: the run is `start`'s.
+        let protection = protection.filter(|p| p.faces.iter().chain(&p.vertices).any(|&on| on));
         let protect = match protection {
             None => None,
             Some(p) => Some(Protected::new(p, mesh).map_err(|message| RunError {
