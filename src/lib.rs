@@ -65,3 +65,37 @@ pub use system::{
     load_mesh, Progress, Run, RunOptions, Surface, SurfaceRun, System, Vv, VvInfo, VvResult,
     MAX_SURFACE_STEPS,
 };
+
+/// Subdivide of a welded smoothing group (`shape::smooth`), for
+/// `examples/smooth_xcheck.rs` and its cross-check against CGAL: the
+/// grammar of scheme `name` ("sqrt3", "loop", "catmull-clark").
+#[doc(hidden)]
+pub fn smooth_scheme(name: &str) -> Result<surface::Grammar, String> {
+    shape::smooth::scheme(name)
+}
+
+/// `steps` steps of `grammar` on `soup` with the given face tags and
+/// protected vertices and faces, under the default time limit: the output
+/// soup, each output face's tag and each output vertex's input vertex
+/// (when it is one, unmoved).
+#[doc(hidden)]
+#[allow(clippy::type_complexity)] // the three parts of `Smoothed`, for one example
+pub fn smooth_subdivide(
+    grammar: &surface::Grammar,
+    soup: &mesh::PolygonSoup,
+    tags: &[u32],
+    protected_vertex: &[bool],
+    protected_face: &[bool],
+    steps: usize,
+) -> Result<(mesh::PolygonSoup, Vec<u32>, Vec<Option<u32>>), String> {
+    let s = shape::smooth::subdivide(
+        grammar,
+        soup,
+        tags,
+        protected_vertex,
+        protected_face,
+        steps,
+        &Deadline::after(DEFAULT_TIMEOUT),
+    )?;
+    Ok((s.soup, s.tags, s.origin))
+}

@@ -37,6 +37,41 @@ impl Mesh {
     /// Polygons of more than four sides are fanned into triangles, and the
     /// first of them is recorded as [`Mesh::fanned_polygon`].
     pub fn from_soup(soup: &PolygonSoup) -> Result<Mesh, MeshError> {
+        Mesh::build(soup, None)
+    }
+
+    /// [`Mesh::from_soup`], with a tag for each face of the soup: every
+    /// triangle made from face `i` (both halves of a quad, a polygon's
+    /// fan) gets `tags[i]`, and the stellar operators hand it down to the
+    /// faces cut from them ([`Mesh::tag`]).
+    pub fn from_soup_tagged(soup: &PolygonSoup, tags: &[u32]) -> Result<Mesh, MeshError> {
+        if tags.len() != soup.faces.len() {
+            return Err(MeshError::new(format!(
+                "{} tags were given for {} faces",
+                tags.len(),
+                soup.faces.len()
+            )));
+        }
+        Mesh::build(soup, Some(tags))
+    }
+
+    /// The faces [`Mesh::from_soup`] makes from each face of `soup`: face
+    /// `i` of `n` sides becomes the `n - 2` faces with ids in the `i`-th
+    /// range (a triangle itself, a quad's two block triangles, a polygon's
+    /// fan), since the mesh's faces are made in the soup's order.
+    pub(crate) fn soup_face_ranges(soup: &PolygonSoup) -> Vec<std::ops::Range<u32>> {
+        let mut next = 0u32;
+        soup.faces
+            .iter()
+            .map(|f| {
+                let start = next;
+                next += f.len().saturating_sub(2) as u32;
+                start..next
+            })
+            .collect()
+    }
+
+    fn build(soup: &PolygonSoup, tags: Option<&[u32]>) -> Result<Mesh, MeshError> {
         let nv = soup.positions.len();
         for (i, p) in soup.positions.iter().enumerate() {
             if !p.is_finite() {
@@ -190,7 +225,7 @@ impl Mesh {
                 hs[k] = h;
             }
             let level = 1;
-            let f = m.new_face(hs[0], level);
+            let f = m.new_face(hs[0], level, tags.map_or(0, |t| t[*fi]));
             face_of_source.push(*fi);
             m.set_triangle(f, hs[0], hs[1], hs[2]);
             for (k, h) in hs.iter().enumerate() {
@@ -252,7 +287,13 @@ impl Mesh {
 
     /// The mesh as triangles, with dead slots removed.
     pub fn to_soup(&self) -> PolygonSoup {
-        self.soup_with(|_| false)
+        self.soup_with(|_| false).0
+    }
+
+    /// [`Mesh::to_soup`] and the tag of each of its faces.
+    pub fn to_soup_tagged(&self) -> (PolygonSoup, Vec<u32>) {
+        let (soup, tags, _) = self.soup_with(|_| false);
+        (soup, tags)
     }
 
     /// Reads the mesh as plain triangles: no basic blocks, and, on a base
@@ -280,7 +321,28 @@ impl Mesh {
     /// The mesh with basic blocks merged back into polygons: quads for
     /// primal blocks, and for dual blocks the polygon around each centre.
     pub fn to_quad_soup(&self) -> PolygonSoup {
-        self.soup_with(|e| self.is_block_edge(e))
+        self.soup_with(|e| self.is_block_edge(e)).0
+    }
+
+    /// [`Mesh::to_quad_soup`] and the tag of each of its faces. A basic
+    /// block whose triangles have different tags (a √2 bisection's block
+    /// across two tagged quads) stays two triangles, so that every
+    /// polygon has the one tag of all its triangles.
+    pub fn to_quad_soup_tagged(&self) -> (PolygonSoup, Vec<u32>) {
+        let (soup, tags, _) = self.quad_soup_tagged_with_vertices();
+        (soup, tags)
+    }
+
+    /// [`Mesh::to_quad_soup_tagged`], and the mesh vertex of each soup
+    /// vertex.
+    pub(crate) fn quad_soup_tagged_with_vertices(&self) -> (PolygonSoup, Vec<u32>, Vec<VertexId>) {
+        self.soup_with(|e| {
+            self.is_block_edge(e)
+                && match self.edge_faces(e) {
+                    [Some(f), Some(g)] => self.tag(f) == self.tag(g),
+                    _ => true,
+                }
+        })
     }
 
     /// The mesh with the faces on either side of each `merge` edge joined
@@ -288,8 +350,10 @@ impl Mesh {
     /// when its border is a single loop through distinct vertices (a
     /// basic block's two triangles, or a dual block's fan around its
     /// centre); otherwise its triangles are kept. Vertices inside a
-    /// polygon (a dual block's centre) are left out.
-    fn soup_with(&self, merge: impl Fn(EdgeId) -> bool) -> PolygonSoup {
+    /// polygon (a dual block's centre) are left out. Also gives each
+    /// polygon's tag (that of its first triangle) and each soup vertex's
+    /// mesh vertex.
+    fn soup_with(&self, merge: impl Fn(EdgeId) -> bool) -> (PolygonSoup, Vec<u32>, Vec<VertexId>) {
         // Regions by union-find over the faces.
         let mut parent: Vec<u32> = (0..self.f_alive.len() as u32).collect();
         fn root(parent: &mut [u32], mut f: u32) -> u32 {
@@ -316,9 +380,11 @@ impl Mesh {
         if !merged_any {
             let mut index = vec![u32::MAX; self.v_alive.len()];
             let mut soup = PolygonSoup::default();
+            let mut verts = Vec::with_capacity(self.vertex_count());
             for v in self.vertices() {
                 index[v.index()] = soup.positions.len() as u32;
                 soup.positions.push(self.position(v));
+                verts.push(v);
             }
             soup.faces = self
                 .faces()
@@ -329,10 +395,12 @@ impl Mesh {
                         .collect()
                 })
                 .collect();
-            return soup;
+            let tags = self.faces().map(|f| self.tag(f)).collect();
+            return (soup, tags, verts);
         }
         let region = |parent: &mut [u32], h: HalfEdgeId| self.face(h).map(|f| root(parent, f.0));
         let mut polygons: Vec<Vec<VertexId>> = Vec::new();
+        let mut tags: Vec<u32> = Vec::new();
         let mut done = vec![false; self.f_alive.len()];
         let mut members: Vec<Vec<FaceId>> = vec![Vec::new(); self.f_alive.len()];
         for f in self.faces() {
@@ -347,6 +415,7 @@ impl Mesh {
             let faces = &members[r as usize];
             if faces.len() == 1 {
                 polygons.push(self.face_vertices(f).to_vec());
+                tags.push(self.tag(f));
                 continue;
             }
             // The region's border: half-edges whose twin lies outside it.
@@ -368,6 +437,7 @@ impl Mesh {
                 });
             if !block_shape {
                 polygons.extend(faces.iter().map(|&g| self.face_vertices(g).to_vec()));
+                tags.extend(faces.iter().map(|&g| self.tag(g)));
                 continue;
             }
             let mut loop_vs = Vec::with_capacity(border.len());
@@ -397,8 +467,10 @@ impl Mesh {
             sorted.dedup();
             if ok && h == border[0] && sorted.len() == border.len() {
                 polygons.push(loop_vs);
+                tags.push(self.tag(faces[0]));
             } else {
                 polygons.extend(faces.iter().map(|&g| self.face_vertices(g).to_vec()));
+                tags.extend(faces.iter().map(|&g| self.tag(g)));
             }
         }
         // Vertices inside a merged polygon are left out; all others stay.
@@ -414,16 +486,18 @@ impl Mesh {
             }
         }
         let mut soup = PolygonSoup::default();
+        let mut verts = Vec::new();
         for v in self.vertices() {
             if index[v.index()] == 0 {
                 index[v.index()] = soup.positions.len() as u32;
                 soup.positions.push(self.position(v));
+                verts.push(v);
             }
         }
         soup.faces = polygons
             .into_iter()
             .map(|p| p.iter().map(|v| index[v.index()]).collect())
             .collect();
-        soup
+        (soup, tags, verts)
     }
 }

@@ -142,6 +142,11 @@ pub struct Mesh {
     pub(crate) f_he: Vec<HalfEdgeId>,
     pub(crate) f_level: Vec<u32>,
     pub(crate) f_alive: Vec<bool>,
+    /// A number the caller gives each face of the soup
+    /// ([`Mesh::from_soup_tagged`]; 0 otherwise), handed down by the
+    /// stellar operators to the faces cut from it: which part of a welded
+    /// group of shapes a face belongs to.
+    pub(crate) f_tag: Vec<u32>,
     // Free slots.
     pub(crate) free_v: Vec<u32>,
     pub(crate) free_e: Vec<u32>,
@@ -214,7 +219,7 @@ impl Mesh {
         let v = self.v_alive.len() * (8 + 24 + 4 + 4 + 1);
         let h = self.he_to.len() * (4 + 4 + 4 + 4);
         let e = self.e_alive.len() * (4 + 1 + 1);
-        let f = self.f_alive.len() * (4 + 4 + 1);
+        let f = self.f_alive.len() * (4 + 4 + 1 + 4);
         (v + h + e + f) as f64 / self.face_count().max(1) as f64
     }
 
@@ -239,6 +244,12 @@ impl Mesh {
 
     pub fn face_level(&self, f: FaceId) -> u32 {
         self.f_level[f.index()]
+    }
+
+    /// The face's tag: that of the soup face it was cut from
+    /// ([`Mesh::from_soup_tagged`]), 0 for an untagged mesh.
+    pub fn tag(&self, f: FaceId) -> u32 {
+        self.f_tag[f.index()]
     }
 
     pub fn set_vertex_level(&mut self, v: VertexId, l: u32) {
@@ -482,6 +493,7 @@ impl Mesh {
         grow(&mut self.f_he, faces);
         grow(&mut self.f_level, faces);
         grow(&mut self.f_alive, faces);
+        grow(&mut self.f_tag, faces);
     }
 
     /// A new vertex at `p`, made in grammar step `step`.
@@ -536,16 +548,19 @@ impl Mesh {
         h
     }
 
-    pub(crate) fn new_face(&mut self, h: HalfEdgeId, level: u32) -> FaceId {
+    /// A new face with tag `tag`: that of the face it is cut from.
+    pub(crate) fn new_face(&mut self, h: HalfEdgeId, level: u32, tag: u32) -> FaceId {
         if let Some(i) = self.free_f.pop() {
             self.f_he[i as usize] = h;
             self.f_level[i as usize] = level;
             self.f_alive[i as usize] = true;
+            self.f_tag[i as usize] = tag;
             return FaceId(i);
         }
         self.f_he.push(h);
         self.f_level.push(level);
         self.f_alive.push(true);
+        self.f_tag.push(tag);
         FaceId(self.f_alive.len() as u32 - 1)
     }
 

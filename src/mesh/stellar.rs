@@ -57,6 +57,7 @@ impl Mesh {
     ///
     /// Levels: `l(v) = max(l(a), l(b), l(c)) + 1`; the three new edges get
     /// `l(v)`, the level of their common vertex; the faces `l(v) + 1`.
+    /// The three faces keep `f`'s tag (`f` itself is the one on `ab`).
     /// The default [`Split`]: see [`Mesh::face_split_with`].
     pub fn face_split(&mut self, f: FaceId, p: DVec3) -> Result<VertexId, MeshError> {
         self.face_split_with(f, p, &Split::default())
@@ -84,8 +85,9 @@ impl Mesh {
         let va = self.new_edge(v, a, lv);
         let vb = self.new_edge(v, b, lv);
         let vc = self.new_edge(v, c, lv);
-        let f1 = self.new_face(h1, 0);
-        let f2 = self.new_face(h2, 0);
+        let tag = self.f_tag[f.index()];
+        let f1 = self.new_face(h1, 0, tag);
+        let f2 = self.new_face(h2, 0, tag);
         self.set_triangle(f, h0, vb.twin(), va);
         self.set_triangle(f1, h1, vc.twin(), vb);
         self.set_triangle(f2, h2, va.twin(), vc);
@@ -103,7 +105,8 @@ impl Mesh {
     }
 
     /// Face weld, the inverse of face split: removes an interior vertex of
-    /// valence 3 and merges its three triangles.
+    /// valence 3 and merges its three triangles. The merged face reuses
+    /// the slot, and keeps the tag, of the first face around the vertex.
     ///
     /// ```text
     ///        c                 c
@@ -181,6 +184,9 @@ impl Mesh {
     /// of a basic block makes the four edges at `v` internal edges of
     /// blocks (primal quadrisection, the default [`Split`]: see
     /// [`Mesh::edge_split_with`]).
+    ///
+    /// Tags: each of the two faces on a side of the edge is cut in two;
+    /// both halves have its tag (the half at `a` keeps its slot).
     pub fn edge_split(&mut self, e: EdgeId, p: DVec3) -> Result<VertexId, MeshError> {
         self.edge_split_with(e, p, &Split::default())
     }
@@ -231,7 +237,7 @@ impl Mesh {
         let g = self.new_edge(v, b, le + 2); // v -> b
         let k = self.new_edge(v, c, self.v_level[c.index()] + 1); // v -> c
         self.e_transversal[k.edge().index()] = true;
-        let f2 = self.new_face(g, 0);
+        let f2 = self.new_face(g, 0, self.f_tag[f1.index()]);
         self.set_triangle(f1, h, k, h_ca);
         self.set_triangle(f2, g, h_bc, k.twin());
         if boundary {
@@ -254,7 +260,7 @@ impl Mesh {
             let d = self.to(t_ad);
             let m = self.new_edge(v, d, self.v_level[d.index()] + 1); // v -> d
             self.e_transversal[m.edge().index()] = true;
-            let f4 = self.new_face(g.twin(), 0);
+            let f4 = self.new_face(g.twin(), 0, self.f_tag[f3.index()]);
             self.set_triangle(f3, t, t_ad, m.twin());
             self.set_triangle(f4, g.twin(), m, t_db);
             self.v_out[v.index()] = Some(g);
@@ -310,7 +316,11 @@ impl Mesh {
     /// Edge weld, the inverse of edge split: removes `v` (interior of
     /// valence 4, or boundary of valence 3) and joins `keep` to the
     /// neighbour opposite it, restoring the split edge with level
-    /// `l(v, keep) - 2`.
+    /// `l(v, keep) - 2`. Tags: each merged face takes the tag of its half
+    /// on `keep`'s side (`keep-c-b` that of `v-keep-c`, `b-d-keep` that
+    /// of `v-d-keep` below). On the boundary the one merged face reuses
+    /// the slot, and keeps the tag, of the first face counter-clockwise
+    /// around `v` from its boundary gap.
     ///
     /// ```text
     ///        c                 c
@@ -430,6 +440,9 @@ impl Mesh {
         self.e_transversal[x.edge().index()] = false;
         self.set_triangle(faces[0], o_ac, o_cb, x.twin());
         self.set_triangle(faces[1], o_bd, o_da, x);
+        // faces[1] was v-c-b; it is now b-d-a, whose half on a's side was
+        // v-d-a, faces[3].
+        self.f_tag[faces[1].index()] = self.f_tag[faces[3].index()];
         for (w, h) in [(a, x), (b, x.twin()), (c, o_cb), (d, o_da)] {
             self.v_out[w.index()] = Some(h);
             self.fix_outgoing(w);
@@ -455,6 +468,15 @@ impl Mesh {
     ///
     /// Level: the flipped edge gets its parent's level plus one. Refused for
     /// a boundary edge and when `c` and `d` are already joined.
+    ///
+    /// Tags: the faces keep their slots and their tags. The face that was
+    /// `a-b-c` (the side of the edge's first half-edge running `a -> b`)
+    /// becomes `d-c-a` and keeps its tag; the face that was `b-a-d`
+    /// becomes `c-d-b` and keeps its own. Each new face is half of each
+    /// old one, so when the two old faces carry different tags (two
+    /// shapes of a welded group) which new face gets which tag is a
+    /// choice: the one that keeps corner `a` (resp. `b`) and the old
+    /// face's edge `c-a` (resp. `d-b`).
     pub fn edge_flip(&mut self, e: EdgeId) -> Result<(), MeshError> {
         if !self.is_edge(e) {
             return Err(MeshError::new(format!(

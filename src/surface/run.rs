@@ -22,7 +22,7 @@ use crate::lang::compile::RuleCompiler;
 use crate::lang::eval::{Env, Interp, RuntimeError};
 use crate::lang::ir::{Ex, Func};
 use crate::lang::value::{Elem, Ty, Value};
-use crate::mesh::{BlockSplit, Mesh, Split, VertexId};
+use crate::mesh::{BlockSplit, EdgeId, FaceId, Mesh, Split, VertexId};
 use crate::syntax::span::{Diagnostic, SourceMap, Span};
 
 use super::grammar::{GrammarFile, Op, VertexContext};
@@ -262,6 +262,137 @@ pub(crate) fn compile_with(
     })
 }
 
+/// The parts of a mesh a run leaves as they are (paper 003, §4.2.2: the
+/// faces and vertices a smoothing group shares with shapes outside it).
+/// No rule matches a protected face, or a face whose three corners are
+/// protected vertices (Algorithm 3 for the mesh's triangles); a vertex
+/// that is protected or lies
+/// on a protected face; an edge with a protected face on either side, or
+/// whose two ends are protected. So no face point is put in a protected
+/// face, none of its vertices moves, no edge is drawn in it or split on
+/// its border, and no edge next to it flips (Algorithm 2 with the sets of
+/// Algorithm 3). Protected elements are never rewritten, so their ids and
+/// positions stay as they were through the run.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Protection {
+    /// By [`FaceId`] index; faces past its end are not protected.
+    pub faces: Vec<bool>,
+    /// By [`VertexId`] index; vertices past its end are not protected.
+    pub vertices: Vec<bool>,
+}
+
+/// A [`Protection`] as a run reads it.
+#[derive(Debug, Default)]
+struct Protected {
+    face: Vec<bool>,
+    vertex: Vec<bool>,
+    /// Protected, or a corner of a protected face: never moved.
+    fixed: Vec<bool>,
+    /// The protected faces with their corners and the fixed vertices with
+    /// their positions, as the run found them (for a debug check).
+    faces: Vec<(FaceId, [VertexId; 3])>,
+    positions: Vec<(VertexId, DVec3)>,
+}
+
+impl Protected {
+    /// Checks `p` against `mesh`: every protected element must exist.
+    fn new(p: Protection, mesh: &Mesh) -> Result<Protected, String> {
+        if let Some(f) = p
+            .faces
+            .iter()
+            .enumerate()
+            .position(|(i, &on)| on && !mesh.is_face(FaceId(i as u32)))
+        {
+            return Err(format!(
+                "face {} is protected but is not a face of the mesh",
+                f + 1
+            ));
+        }
+        if let Some(v) = p
+            .vertices
+            .iter()
+            .enumerate()
+            .position(|(i, &on)| on && !mesh.is_vertex(VertexId(i as u32)))
+        {
+            return Err(format!(
+                "vertex {} is protected but is not a vertex of the mesh",
+                v + 1
+            ));
+        }
+        let mut fixed = p.vertices.clone();
+        fixed.resize(mesh.v_alive.len(), false);
+        let mut faces = Vec::new();
+        for (i, &on) in p.faces.iter().enumerate() {
+            if on {
+                let f = FaceId(i as u32);
+                let vs = mesh.face_vertices(f);
+                for v in vs {
+                    fixed[v.index()] = true;
+                }
+                faces.push((f, vs));
+            }
+        }
+        let positions = (0..fixed.len())
+            .filter(|&i| fixed[i])
+            .map(|i| (VertexId(i as u32), mesh.position(VertexId(i as u32))))
+            .collect();
+        Ok(Protected {
+            face: p.faces,
+            vertex: p.vertices,
+            fixed,
+            faces,
+            positions,
+        })
+    }
+
+    #[inline]
+    fn face(&self, f: FaceId) -> bool {
+        self.face.get(f.index()).copied().unwrap_or(false)
+    }
+
+    /// A face rule may match `f`: it is not protected, and not all its
+    /// corners are protected vertices. The second is Algorithm 3's rule
+    /// (a face whose vertices are all protected is protected) for the
+    /// triangles being subdivided, whatever polygons the protection was
+    /// given for: a face point in such a triangle would join three
+    /// spokes whose ends never move and whose edges never flip, and a
+    /// later step that flips all three (√3 next to a protected boundary
+    /// edge) would join two new vertices twice.
+    #[inline]
+    fn face_free(&self, mesh: &Mesh, f: FaceId) -> bool {
+        let protected = |v: VertexId| self.vertex.get(v.index()).copied().unwrap_or(false);
+        !self.face(f) && !mesh.face_vertices(f).into_iter().all(protected)
+    }
+
+    /// A vertex rule may match `v`.
+    #[inline]
+    fn vertex_free(&self, v: VertexId) -> bool {
+        !self.fixed.get(v.index()).copied().unwrap_or(false)
+    }
+
+    /// An edge rule may match `e`.
+    fn edge_free(&self, mesh: &Mesh, e: EdgeId) -> bool {
+        let protected = |v: VertexId| self.vertex.get(v.index()).copied().unwrap_or(false);
+        let (a, b) = mesh.edge_vertices(e);
+        !(protected(a) && protected(b)
+            || mesh.edge_faces(e).iter().flatten().any(|&f| self.face(f)))
+    }
+
+    /// True while every protected face has its corners and every fixed
+    /// vertex its position, bit for bit.
+    fn intact(&self, mesh: &Mesh) -> bool {
+        self.faces.iter().all(|&(f, vs)| {
+            mesh.is_face(f) && {
+                let now = mesh.face_vertices(f);
+                (0..3).any(|k| (0..3).all(|i| now[(k + i) % 3] == vs[i]))
+            }
+        }) && self.positions.iter().all(|&(v, p)| {
+            mesh.is_vertex(v)
+                && mesh.position(v).to_array().map(f64::to_bits) == p.to_array().map(f64::to_bits)
+        })
+    }
+}
+
 /// The elements a rule matched when it started.
 struct Matches {
     current: u32,
@@ -416,6 +547,26 @@ impl Grammar {
     /// vertices are made at step 0), and runs the `init:` rules. The run's
     /// [`GrammarRun::steps`] continue from one call to the next.
     pub fn start<'a>(&'a self, mesh: &'a mut Mesh) -> Result<GrammarRun<'a>, RunError> {
+        self.start_with(mesh, None)
+    }
+
+    /// [`Grammar::start`] with the parts of `mesh` that the run must
+    /// leave as they are: see [`Protection`]. An empty protection runs
+    /// exactly as [`Grammar::start`]. A protected element that is not in
+    /// the mesh is an error.
+    pub fn start_protected<'a>(
+        &'a self,
+        mesh: &'a mut Mesh,
+        protection: Protection,
+    ) -> Result<GrammarRun<'a>, RunError> {
+        self.start_with(mesh, Some(protection))
+    }
+
+    fn start_with<'a>(
+        &'a self,
+        mesh: &'a mut Mesh,
+        protection: Option<Protection>,
+    ) -> Result<GrammarRun<'a>, RunError> {
         if let (Some(span), Some(fan)) = (self.block_used_at, mesh.fanned_polygon()) {
             let line = fan.line.map_or(String::new(), |l| format!(" (line {l})"));
             return Err(RunError {
@@ -458,6 +609,15 @@ impl Grammar {
                 });
             }
         }
+        // Nothing protected is no protection: the run is `start`'s.
+        let protection = protection.filter(|p| p.faces.iter().chain(&p.vertices).any(|&on| on));
+        let protect = match protection {
+            None => None,
+            Some(p) => Some(Protected::new(p, mesh).map_err(|message| RunError {
+                span: None,
+                message,
+            })?),
+        };
         // `new(v)` counts this run's steps only.
         mesh.reset_vertex_steps();
         let (valence_limit, highest) =
@@ -470,12 +630,14 @@ impl Grammar {
             valence_bound: highest,
             blocks: self.block_split,
             face_split_makes_blocks: self.block_used_at.is_some(),
+            protect,
             ..RunState::default()
         };
         let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
         self.apply_all(&init, mesh, &mut state)?;
         // What init's vertex rules wrote is current before the first step.
         state.swap_positions(mesh);
+        debug_assert!(state.protect.as_ref().is_none_or(|p| p.intact(mesh)));
         Ok(GrammarRun {
             grammar: self,
             mesh,
@@ -519,6 +681,9 @@ impl Grammar {
             Op::Vertex => mesh.v_alive.len(),
         };
         let frame_len = rule.frame.max(other.map_or(0, |o| o.frame));
+        // What a protection leaves out is never tested, so the guards and
+        // every specialised path see the same elements.
+        let protect = state.protect.as_ref();
         type Part = (Vec<Elem>, Vec<crate::mesh::EdgeId>);
         // Conditions are pure, so ranges of ids are tested in parallel,
         // each by a plain loop, and the matches joined in id order.
@@ -533,7 +698,7 @@ impl Grammar {
                 match rule.op {
                     Op::FaceSplit => {
                         for f in (lo..hi).map(crate::mesh::FaceId) {
-                            if mesh.is_face(f) {
+                            if mesh.is_face(f) && protect.is_none_or(|p| p.face_free(mesh, f)) {
                                 let hs = mesh.face_halfedges(f);
                                 let val = host::face(
                                     hs.map(|h| mesh.from(h)),
@@ -550,7 +715,7 @@ impl Grammar {
                     Op::EdgeSplit | Op::BoundarySplit | Op::Flip => {
                         let want_boundary = rule.op == Op::BoundarySplit;
                         for e in (lo..hi).map(crate::mesh::EdgeId) {
-                            if !mesh.is_edge(e) {
+                            if !mesh.is_edge(e) || protect.is_some_and(|p| !p.edge_free(mesh, e)) {
                                 continue;
                             }
                             let on_boundary = mesh.is_boundary_edge(e);
@@ -580,7 +745,10 @@ impl Grammar {
                     }
                     Op::Vertex => {
                         for v in (lo..hi).map(VertexId) {
-                            if !mesh.is_vertex(v) || mesh.outgoing(v).is_none() {
+                            if !mesh.is_vertex(v)
+                                || mesh.outgoing(v).is_none()
+                                || protect.is_some_and(|p| !p.vertex_free(v))
+                            {
                                 continue;
                             }
                             let ok = match rule.context {
@@ -914,12 +1082,25 @@ impl GrammarRun<'_> {
         self.state.step += 1;
         self.grammar.apply_all(&each, self.mesh, &mut self.state)?;
         self.state.swap_positions(self.mesh);
+        debug_assert!(
+            self.state
+                .protect
+                .as_ref()
+                .is_none_or(|p| p.intact(self.mesh)),
+            "a rule rewrote a protected element"
+        );
         Ok(())
     }
 
     /// The mesh as the run has made it.
     pub fn mesh(&self) -> &Mesh {
         self.mesh
+    }
+
+    /// Stops the run with an error once `deadline` passes: it is looked
+    /// at before every rule.
+    pub fn set_deadline(&mut self, deadline: Option<crate::Deadline>) {
+        self.state.deadline = deadline;
     }
 }
 
@@ -945,6 +1126,8 @@ struct RunState {
     valence_bound: usize,
     /// The run stops once this passes.
     deadline: Option<crate::Deadline>,
+    /// What no rule may match.
+    protect: Option<Protected>,
 }
 
 impl RunState {

@@ -600,3 +600,159 @@ fn mesh_commands_info_convert_and_render() {
     );
     assert!(err.contains("inconsistent orientation"), "{err}");
 }
+
+/// The tag of the face on corners `vs` (any order).
+fn tag_of(m: &Mesh, vs: [u32; 3]) -> u32 {
+    let mut want = vs;
+    want.sort();
+    let f = m
+        .faces()
+        .find(|&f| {
+            let mut c = m.face_vertices(f).map(|v| v.0);
+            c.sort();
+            c == want
+        })
+        .unwrap_or_else(|| panic!("no face {vs:?}"));
+    m.tag(f)
+}
+
+/// Tags as the operators' documentation defines them, on the diamond
+/// (0,1,2) above the edge 0-1 tagged 7 and (1,0,3) below it tagged 9:
+/// a face split's three faces keep the split face's tag; an edge split's
+/// halves keep the tag of the face they were cut from; a flip keeps each
+/// face's tag on the new face with its corner 0 (resp. 1) and its old
+/// edge 2-0 (resp. 3-1); a weld gives the merged faces back their tags.
+#[test]
+fn tags_are_handed_down_by_the_stellar_operators() {
+    let s = soup(
+        &[[0., 0., 0.], [1., 0., 0.], [0.5, 1., 0.], [0.5, -1., 0.]],
+        &[&[0, 1, 2], &[1, 0, 3]],
+    );
+    let base = Mesh::from_soup_tagged(&s, &[7, 9]).unwrap();
+    assert_eq!((tag_of(&base, [0, 1, 2]), tag_of(&base, [0, 1, 3])), (7, 9));
+    // Untagged meshes have tag 0; a tag list of the wrong length is refused.
+    let plain = Mesh::from_soup(&s).unwrap();
+    assert!(plain.faces().all(|f| plain.tag(f) == 0));
+    let e = Mesh::from_soup_tagged(&s, &[7]).unwrap_err();
+    assert_eq!(e.message, "1 tags were given for 2 faces");
+
+    let mut m = base.clone();
+    let f = m.faces().find(|&f| m.tag(f) == 7).unwrap();
+    let v = m.face_split(f, DVec3::new(0.5, 0.3, 0.0)).unwrap();
+    for g in m.vertex_faces(v) {
+        assert_eq!(m.tag(g), 7);
+    }
+    assert_eq!(tag_of(&m, [0, 1, 3]), 9);
+    m.face_weld(v).unwrap();
+    assert_eq!((tag_of(&m, [0, 1, 2]), tag_of(&m, [0, 1, 3])), (7, 9));
+
+    for keep in [0, 1] {
+        let mut m = base.clone();
+        let v = m
+            .edge_split(edge_between(&m, 0, 1), DVec3::new(0.5, 0.0, 0.0))
+            .unwrap();
+        m.validate().unwrap();
+        let v4 = v.0;
+        assert_eq!(tag_of(&m, [0, v4, 2]), 7);
+        assert_eq!(tag_of(&m, [v4, 1, 2]), 7);
+        assert_eq!(tag_of(&m, [0, v4, 3]), 9);
+        assert_eq!(tag_of(&m, [v4, 1, 3]), 9);
+        m.edge_weld(v, VertexId(keep)).unwrap();
+        m.validate().unwrap();
+        assert_eq!(
+            (tag_of(&m, [0, 1, 2]), tag_of(&m, [0, 1, 3])),
+            (7, 9),
+            "welded towards vertex {keep}"
+        );
+    }
+
+    // The edge's first half-edge runs 0 -> 1 in face (0,1,2): a = 0,
+    // b = 1, c = 2, d = 3.
+    let mut m = base.clone();
+    let e = edge_between(&m, 0, 1);
+    assert_eq!(m.edge_vertices(e), (VertexId(0), VertexId(1)));
+    m.edge_flip(e).unwrap();
+    assert_eq!(tag_of(&m, [3, 2, 0]), 7);
+    assert_eq!(tag_of(&m, [2, 3, 1]), 9);
+
+    // A boundary edge split and its weld.
+    let mut m = base.clone();
+    let v = m
+        .edge_split(edge_between(&m, 1, 2), DVec3::new(0.75, 0.5, 0.0))
+        .unwrap();
+    assert!(m.vertex_faces(v).all(|g| m.tag(g) == 7));
+    m.edge_weld(v, VertexId(2)).unwrap();
+    assert_eq!((tag_of(&m, [0, 1, 2]), tag_of(&m, [0, 1, 3])), (7, 9));
+}
+
+/// Tags come back with the soup: per triangle, and per polygon where
+/// blocks merge into quads; a block whose halves have different tags
+/// stays two triangles.
+#[test]
+fn soups_come_back_with_their_tags() {
+    let s = shapes::quad_grid(2, 1);
+    let m = Mesh::from_soup_tagged(&s, &[4, 5]).unwrap();
+    let (tris, tags) = m.to_soup_tagged();
+    assert_eq!(tris.faces.len(), 4);
+    for (f, t) in tris.faces.iter().zip(&tags) {
+        // Quad 0 has x < 0.5 everywhere, quad 1 x >= 0.5.
+        let left = f.iter().all(|&v| tris.positions[v as usize].x <= 0.5);
+        let right = f.iter().all(|&v| tris.positions[v as usize].x >= 0.5);
+        assert_eq!(*t, if left && !right { 4 } else { 5 }, "{f:?}");
+    }
+    let (quads, tags) = m.to_quad_soup_tagged();
+    assert_eq!(quads, m.to_quad_soup());
+    assert_eq!(quads.faces.len(), 2);
+    let mut got: Vec<(Vec<u32>, u32)> = quads
+        .faces
+        .iter()
+        .map(|f| canonical_cycle(f))
+        .zip(tags)
+        .collect();
+    got.sort();
+    let mut want: Vec<(Vec<u32>, u32)> = s
+        .faces
+        .iter()
+        .map(|f| canonical_cycle(f))
+        .zip([4, 5])
+        .collect();
+    want.sort();
+    assert_eq!(got, want);
+    // √2 bisection of quad 0's block makes its external edges internal
+    // edges of the next blocks; the one it shares with the triangle on
+    // its right then joins a triangle tagged 4 to one tagged 5: without
+    // tags the two merge into a quad, with them they stay triangles.
+    let s = PolygonSoup {
+        faces: vec![s.faces[0].clone(), vec![1, 2, 5], vec![1, 5, 4]],
+        ..s
+    };
+    let mut m = Mesh::from_soup_tagged(&s, &[4, 6, 5]).unwrap();
+    let diagonal = m
+        .edges()
+        .find(|&e| m.is_block_edge(e) && m.edge_faces(e).iter().flatten().all(|&f| m.tag(f) == 4))
+        .unwrap();
+    let policy = subgram::mesh::Split {
+        blocks: subgram::mesh::BlockSplit::Bisection,
+        ..Default::default()
+    };
+    m.edge_split_with(diagonal, DVec3::new(0.25, 0.5, 0.0), &policy)
+        .unwrap();
+    let shared = edge_between(&m, 1, 4);
+    assert!(m.is_block_edge(shared));
+    let (q, t) = m.to_quad_soup_tagged();
+    let untagged = m.to_quad_soup();
+    let shared_faces = |faces: &[Vec<u32>]| {
+        faces
+            .iter()
+            .filter(|f| f.contains(&1) && f.contains(&4))
+            .count()
+    };
+    assert_eq!(shared_faces(&untagged.faces), 1, "merged into one quad");
+    assert_eq!(shared_faces(&q.faces), 2, "kept as two triangles");
+    for (f, tag) in q.faces.iter().zip(&t) {
+        if f.contains(&1) && f.contains(&4) {
+            assert_eq!(f.len(), 3);
+            assert!(*tag == 4 || *tag == 5);
+        }
+    }
+}

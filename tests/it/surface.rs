@@ -715,3 +715,78 @@ fn deep_function_nesting_reuses_frame_slots() {
         assert!((d - DVec3::new(16.0, 32.0, 48.0)).length() < 1e-12, "{d}");
     }
 }
+
+/// Protection (paper 003, §4.2.2 and Algorithm 2 with protected sets): a
+/// protected face gets no face point and keeps its corners, which do not
+/// move. On the octahedron (8 faces), one step of √3 with face 0
+/// protected splits the 7 others in three: 7·3 + 1 = 22 faces, where
+/// 24 are made without protection.
+#[test]
+fn protected_faces_are_not_subdivided() {
+    use subgram::mesh::FaceId;
+    use subgram::surface::Protection;
+    let g = grammar("surfaces/sqrt3.lsys");
+    let base =
+        Mesh::from_soup(&subgram::mesh::io::read(&lsys("meshes/octahedron.obj")).unwrap()).unwrap();
+    let f = FaceId(0);
+    let corners = base.face_vertices(f);
+    let mut m = base.clone();
+    let protection = Protection {
+        faces: vec![true],
+        vertices: vec![],
+    };
+    let mut run = g.start_protected(&mut m, protection).unwrap();
+    run.steps(1, |_| {}).unwrap();
+    m.validate().unwrap();
+    assert_eq!(m.face_count(), 22);
+    assert!(m.is_face(f));
+    let now = m.face_vertices(f);
+    assert!((0..3).any(|k| (0..3).all(|i| now[(k + i) % 3] == corners[i])));
+    for v in corners {
+        assert_eq!(m.position(v), base.position(v), "corner {v} moved");
+    }
+    // Without protection: 24 faces, and the corners move.
+    let mut free = base.clone();
+    g.run(&mut free, 1, |_| {}).unwrap();
+    assert_eq!(free.face_count(), 24);
+    assert!(corners
+        .iter()
+        .all(|&v| free.position(v) != base.position(v)));
+}
+
+/// A protected vertex keeps its position; edges at it still split, so
+/// Loop's counts are those of a whole step: the octahedron's 6 vertices
+/// and 12 edges give 18 vertices, then 18 + 48 = 66.
+#[test]
+fn protected_vertices_do_not_move() {
+    use subgram::surface::Protection;
+    let g = grammar("surfaces/loop.lsys");
+    let base =
+        Mesh::from_soup(&subgram::mesh::io::read(&lsys("meshes/octahedron.obj")).unwrap()).unwrap();
+    let mut m = base.clone();
+    let protection = Protection {
+        faces: vec![],
+        vertices: vec![true],
+    };
+    let mut run = g.start_protected(&mut m, protection).unwrap();
+    run.steps(2, |_| {}).unwrap();
+    m.validate().unwrap();
+    assert_eq!(m.vertex_count(), 66);
+    assert_eq!(m.position(VertexId(0)), base.position(VertexId(0)));
+    assert_ne!(m.position(VertexId(1)), base.position(VertexId(1)));
+    // Protecting what is not there is an error, not a panic.
+    let mut m = base.clone();
+    let e = g
+        .start_protected(
+            &mut m,
+            Protection {
+                faces: vec![false; 8].into_iter().chain([true]).collect(),
+                vertices: vec![],
+            },
+        )
+        .unwrap_err();
+    assert_eq!(
+        e.message,
+        "face 9 is protected but is not a face of the mesh"
+    );
+}

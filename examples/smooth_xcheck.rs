@@ -1,0 +1,116 @@
+//! Subdivide of a welded group (`shape::smooth`), outside `cargo test`.
+//!
+//! `cargo run --release --example smooth_xcheck IN.obj OUT.obj STEPS [SCHEME]`
+//! subdivides the mesh in IN.obj with nothing protected (SCHEME: sqrt3,
+//! the default, loop or catmull-clark) and writes OUT.obj; the output
+//! faces' tags (the input face each came from, counted from 0) go to
+//! OUT.obj.tags, one a line. `benches/shapes_xcheck.py` compares the
+//! output with CGAL's.
+//!
+//! `cargo run --release --example smooth_xcheck --bench` times one √3 step
+//! through `subdivide` (soup in, soup out) against `Grammar::run` on the
+//! same mesh, in the same run, on a 224 x 224 torus cut into 100,352
+//! triangles: best of 5 each.
+
+use std::path::Path;
+use std::time::Instant;
+
+use subgram::mesh::{io, shapes, Mesh, PolygonSoup};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("--bench") {
+        bench();
+        return;
+    }
+    if args.len() < 3 {
+        eprintln!("usage: smooth_xcheck IN.obj OUT.obj STEPS [SCHEME] | smooth_xcheck --bench");
+        std::process::exit(2);
+    }
+    let soup = io::read(Path::new(&args[0])).unwrap_or_else(|e| fail(&e.to_string()));
+    let steps: usize = args[2]
+        .parse()
+        .unwrap_or_else(|_| fail("STEPS must be a whole number"));
+    let g = subgram::smooth_scheme(args.get(3).map_or("sqrt3", String::as_str))
+        .unwrap_or_else(|e| fail(&e));
+    let n = soup.faces.len();
+    let tags: Vec<u32> = (0..n as u32).collect();
+    let (out, tags, _) = subgram::smooth_subdivide(
+        &g,
+        &soup,
+        &tags,
+        &vec![false; soup.positions.len()],
+        &vec![false; n],
+        steps,
+    )
+    .unwrap_or_else(|e| fail(&e));
+    io::write(Path::new(&args[1]), &out).unwrap_or_else(|e| fail(&e.to_string()));
+    let lines: Vec<String> = tags.iter().map(u32::to_string).collect();
+    std::fs::write(format!("{}.tags", args[1]), lines.join("\n") + "\n")
+        .unwrap_or_else(|e| fail(&e.to_string()));
+}
+
+fn fail(m: &str) -> ! {
+    eprintln!("smooth_xcheck: {m}");
+    std::process::exit(1)
+}
+
+fn best_of(runs: usize, mut f: impl FnMut()) -> f64 {
+    (0..runs)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::MAX, f64::min)
+}
+
+fn bench() {
+    let q = shapes::quad_torus(224, 224);
+    let soup = PolygonSoup {
+        faces: q
+            .faces
+            .iter()
+            .flat_map(|f| [vec![f[0], f[1], f[2]], vec![f[0], f[2], f[3]]])
+            .collect(),
+        ..q
+    };
+    let g = subgram::smooth_scheme("sqrt3").expect("sqrt3");
+    let n = soup.faces.len();
+    let tags: Vec<u32> = (0..n as u32).collect();
+    let (pv, pf) = (vec![false; soup.positions.len()], vec![false; n]);
+    let runs = 5;
+    let mut faces = 0;
+    let t_sub = best_of(runs, || {
+        let (out, _, _) = subgram::smooth_subdivide(&g, &soup, &tags, &pv, &pf, 1).expect("runs");
+        faces = out.faces.len();
+    });
+    let base = Mesh::from_soup(&soup).expect("valid");
+    let t_run = best_of(runs, || {
+        let mut m = base.clone();
+        g.run(&mut m, 1, |_| {}).expect("runs");
+    });
+    let t_full = best_of(runs, || {
+        let mut m = Mesh::from_soup(&soup).expect("valid");
+        g.run(&mut m, 1, |_| {}).expect("runs");
+        std::hint::black_box(m.to_quad_soup());
+    });
+    println!("sqrt(3), one step, {n} -> {faces} triangles, best of {runs}:");
+    println!(
+        "  subdivide (soup -> tagged mesh, run, tagged soup):   {:.1} ms",
+        t_sub * 1e3
+    );
+    println!(
+        "  Grammar::run on a built mesh (clone + run):          {:.1} ms",
+        t_run * 1e3
+    );
+    println!(
+        "  from_soup + Grammar::run + to_quad_soup:              {:.1} ms",
+        t_full * 1e3
+    );
+    println!(
+        "  ratio subdivide / run: {:.2}; subdivide / (build + run + soup): {:.2}",
+        t_sub / t_run,
+        t_sub / t_full
+    );
+}
