@@ -51,6 +51,14 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
         }
+        Run::Shapes(shapes) => {
+            // A shape grammar: its tree of shapes.
+            let c = shapes.counts();
+            println!(
+                "{} shapes, {} terminal, {} faces",
+                c.shapes, c.terminal_shapes, c.faces
+            );
+        }
         Run::Vv(vv) => {
             // A vertex-vertex program: its mesh's polygons.
             println!("after {} steps:\n{}", vv.steps, vv.info);

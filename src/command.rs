@@ -36,6 +36,7 @@ pub fn check(file: &str, defines: &[String], double: bool) -> Result<String, Err
             "{file}: ok (a vv program of {} functions)",
             v.program.program.functions.len()
         ),
+        System::Shapes(s) => format!("{file}: ok (a shape grammar of {} rules)", s.rules()),
     };
     // Warnings first, each with its line and caret, then the verdict.
     let mut out: Vec<String> = system.warnings();
@@ -58,6 +59,8 @@ pub struct DeriveArgs {
     pub phase: usize,
     /// Print the word after interpretation rules.
     pub interpreted: bool,
+    /// Shape grammars: `--max-shapes`, the most shapes a derivation makes.
+    pub max_shapes: Option<usize>,
     /// `--seed`: seeds every random number generator (see
     /// [`RunOptions::seed`]).
     pub seed: Option<u32>,
@@ -80,6 +83,7 @@ impl DeriveArgs {
             max_modules: DEFAULT_MAX_MODULES,
             phase: 0,
             interpreted: false,
+            max_shapes: None,
             seed: None,
             timeout: Some(DEFAULT_TIMEOUT),
             allow_writes: None,
@@ -202,6 +206,7 @@ fn derive_text(
         base_mesh: None,
         deadline,
         output: a.output.clone(),
+        max_shapes: a.max_shapes,
     };
     match system {
         System::Vv(v) => {
@@ -225,6 +230,31 @@ fn derive_text(
             let info = run.mesh.info();
             before()?;
             mesh_counts(a.json, run.steps, &info)
+        }
+        System::Shapes(s) => {
+            if a.interpreted {
+                return Err(Error::Usage(
+                    "--interpreted prints the word after interpretation rules; a shape grammar \
+                     has no word, only its tree of shapes"
+                        .into(),
+                ));
+            }
+            let run = s.derive(&opts)?;
+            before()?;
+            let counts = run.counts();
+            if a.json {
+                json(&serde_json::json!({ "counts": counts, "shapes": s.tree_json(&run) }))
+            } else {
+                Ok(format!(
+                    "{}{}shapes: {}\nterminal shapes: {}\nfaces: {}\nsmoothing groups: {}",
+                    s.tree_text(&run),
+                    s.groups_text(&run),
+                    counts.shapes,
+                    counts.terminal_shapes,
+                    counts.faces,
+                    counts.smoothing_groups
+                ))
+            }
         }
         System::Curve(c) => {
             check_steps(a.steps)?;
@@ -362,6 +392,24 @@ fn render_system(
             write_mesh_picture(&run.mesh, output, looks)?;
             Ok(Vec::new())
         }
+        System::Shapes(s) => {
+            looks.check()?;
+            if a.each {
+                return Err(Error::Usage(
+                    "--each draws the steps of an L-system side by side; a shape grammar draws \
+                     its terminal shapes"
+                        .into(),
+                ));
+            }
+            let opts = RunOptions {
+                seed: a.seed,
+                deadline,
+                ..RunOptions::default()
+            };
+            let run = s.derive(&opts)?;
+            write_shapes_picture(&run, output, looks)?;
+            Ok(Vec::new())
+        }
         System::Vv(v) => {
             looks.check()?;
             if a.each {
@@ -407,6 +455,7 @@ fn render_system(
                 base_mesh: None,
                 deadline,
                 output: a.program_output.clone(),
+                max_shapes: None,
             };
             let model = &c.program.model;
             let palette = model
@@ -502,6 +551,8 @@ pub struct SubdivideArgs {
     pub defines: Vec<String>,
     /// For pictures: iso, front, back, left, right, top or bottom.
     pub view: Option<String>,
+    /// Shape grammars: seeds the random choice of rules.
+    pub seed: Option<u32>,
     /// `--timeout`: the command stops with an error after this long.
     pub timeout: Option<Duration>,
     /// Write the output even over one of the inputs.
@@ -533,6 +584,18 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         view: a.view.as_deref(),
         wireframe: d.wireframe,
     };
+    // A shape grammar writes its terminal shapes.
+    if let Some(shapes) = shape_grammar(grammar, &a.defines)? {
+        let opts = RunOptions {
+            seed: a.seed,
+            ..opts
+        };
+        // An OBJ's MTL file is written too, never over an input either.
+        let mtl = output.with_extension("mtl");
+        refuse_overwrite(&[output, &mtl], &as_paths(&inputs), a.force)?;
+        let run = shapes.derive(&opts)?;
+        return write_shapes(&shapes, &run, output, &looks);
+    }
     // A vv program subdivides too.
     if let Some(v) = vv_program(grammar, &a.defines)? {
         if a.mesh.is_none() {
@@ -557,6 +620,73 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         return write_mesh_picture(&run.mesh, output, &looks);
     }
     Ok(mesh::io::write(output, &run.mesh.to_quad_soup())?)
+}
+
+/// The shape grammar in `file`, when it holds one.
+fn shape_grammar(file: &Path, defines: &[String]) -> Result<Option<crate::system::Shapes>, Error> {
+    let text = crate::load::read(file)?;
+    let front = crate::load::front(&file.display().to_string(), text, defines)?;
+    if !crate::shape::is_shapes(&front.tokens) {
+        return Ok(None);
+    }
+    let dir = file.parent().unwrap_or(Path::new("")).to_path_buf();
+    let g = crate::load::with_stack(move || crate::shape::from_front(front, Some(&dir)))?;
+    Ok(Some(crate::system::Shapes::new(g)))
+}
+
+/// A shape derivation to `.obj` (with its `.mtl` beside it, both or
+/// neither written), `.ply`, `.off`, or a picture.
+fn write_shapes(
+    shapes: &crate::system::Shapes,
+    run: &crate::system::ShapeRun,
+    output: &Path,
+    looks: &MeshLooks,
+) -> Result<(), Error> {
+    if Picture::from_path(output).is_ok() {
+        return write_shapes_picture(run, output, looks);
+    }
+    if mesh::io::Format::from_path(output) == Some(mesh::io::Format::Obj) {
+        let mtl = output.with_extension("mtl");
+        let mtl_name = mtl
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "shapes.mtl".into());
+        let (obj, mtl_text) = shapes.obj(run, &mtl_name);
+        return write_files(&[(output, obj.into_bytes()), (&mtl, mtl_text.into_bytes())]);
+    }
+    if run.soup.faces.is_empty() {
+        return Err(Error::Failed(
+            "the derivation left no terminal shape with faces to write".into(),
+        ));
+    }
+    Ok(mesh::io::write(output, &run.soup)?)
+}
+
+/// The terminal shapes, each face in its shape's colour, seen with y up
+/// (CityEngine's convention, which shape grammars follow).
+fn write_shapes_picture(
+    run: &crate::system::ShapeRun,
+    output: &Path,
+    looks: &MeshLooks,
+) -> Result<(), Error> {
+    let format = Picture::from_path(output)?;
+    let mut mv = looks.check()?;
+    // The mesh views are named for z up; turn them to y up.
+    let y_up = |v: glam::DVec3| glam::DVec3::new(v.x, v.z, -v.y);
+    mv.direction = y_up(mv.direction);
+    mv.up = y_up(mv.up);
+    mv.face_colours = run.colours.clone();
+    if run.soup.faces.is_empty() {
+        return Err(Error::Failed(
+            "the derivation left no terminal shape with faces to draw".into(),
+        ));
+    }
+    crate::render::mesh::validate(&run.soup, &mv)?;
+    let bytes = match format {
+        Picture::Svg => crate::render::mesh::render_svg(&run.soup, &mv).into_bytes(),
+        Picture::Png => crate::render::mesh::render_png(&run.soup, &mv)?,
+    };
+    write_file(output, &bytes)
 }
 
 /// The vv program in `file`, when it holds one.

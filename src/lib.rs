@@ -37,7 +37,6 @@ mod limits;
 mod load;
 mod production;
 mod rewrite;
-mod shape;
 mod syntax;
 mod system;
 pub mod vv;
@@ -49,6 +48,7 @@ pub mod model;
 pub mod output;
 pub mod render;
 pub mod reverse;
+pub(crate) mod shape;
 pub mod surface;
 
 pub use curve::{Curve, CurveRun, FigureOptions, Figures};
@@ -62,8 +62,8 @@ pub use rewrite::derive::{DEFAULT_MAX_MODULES, MAX_STEPS};
 pub use rewrite::{derive, Derivation, DeriveError, DeriveOptions, Derived, Word};
 pub use syntax::{Diagnostic, FileId, SourceFile, SourceMap, Span};
 pub use system::{
-    load_mesh, Progress, Run, RunOptions, Surface, SurfaceRun, System, Vv, VvInfo, VvResult,
-    MAX_SURFACE_STEPS,
+    load_mesh, Progress, Run, RunOptions, ShapeCounts, ShapeRun, Shapes, Surface, SurfaceRun,
+    System, Vv, VvInfo, VvResult, MAX_SURFACE_STEPS,
 };
 
 /// Subdivide of a welded smoothing group (`shape::smooth`), for

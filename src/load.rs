@@ -67,6 +67,10 @@ fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
     } else if crate::vv::is_vv(&front.tokens) {
         let program = with_stack(move || crate::vv::from_front(front))?;
         Ok(System::Vv(crate::system::Vv::new(program, Some(path))))
+    } else if crate::shape::is_shapes(&front.tokens) {
+        let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+        let g = with_stack(move || crate::shape::from_front(front, Some(&dir)))?;
+        Ok(System::Shapes(crate::system::Shapes::new(g)))
     } else {
         let mut c = curve(front, opts.precision)?;
         view.give_to(&mut c);
@@ -342,6 +346,9 @@ fn load_text_as(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Er
     } else if crate::vv::is_vv(&front.tokens) {
         let program = with_stack(move || crate::vv::from_front(front))?;
         Ok(System::Vv(crate::system::Vv::new(program, None)))
+    } else if crate::shape::is_shapes(&front.tokens) {
+        let g = with_stack(move || crate::shape::from_front(front, None))?;
+        Ok(System::Shapes(crate::system::Shapes::new(g)))
     } else {
         Ok(System::Curve(curve(front, opts.precision)?))
     }

@@ -46,6 +46,10 @@ enum Command {
         /// Print the word after interpretation rules instead.
         #[arg(long)]
         interpreted: bool,
+        /// Shape grammars: stop with an error when a derivation makes more
+        /// shapes than this (default: SUBGRAM_MAX_SHAPES or 2000000).
+        #[arg(long, value_name = "N")]
+        max_shapes: Option<usize>,
         /// Seed every random number generator (ran, rand, drand48,
         /// Gillespie groups) as if Start began with sran(N); srand(N);
         /// srand48(N); SeedGillespie(N). Without it, lpfg's starting state.
@@ -173,7 +177,9 @@ enum Command {
         #[arg(long, value_name = "SIZE", default_value = "64M", value_parser = parse_byte_size)]
         max_input_size: u64,
     },
-    /// Subdivide a mesh with a surface grammar.
+    /// Subdivide a mesh with a surface grammar or a vv program, or derive
+    /// a shape grammar's shapes; write the mesh (a shape grammar's .obj
+    /// with one group per terminal shape and its .mtl) or its picture.
     Subdivide {
         /// The base mesh (.obj, .off, .ply); default: the grammar's `mesh:`.
         mesh: Option<String>,
@@ -189,6 +195,9 @@ enum Command {
         /// For pictures: iso, front, back, left, right, top, bottom.
         #[arg(long)]
         view: Option<String>,
+        /// Shape grammars: seed the random choice of rules.
+        #[arg(long, value_name = "N")]
+        seed: Option<u32>,
         /// Stop with an error after this many seconds (0: no limit).
         #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
@@ -365,6 +374,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             max_modules,
             phase,
             interpreted,
+            max_shapes,
             seed,
             timeout,
             allow_writes,
@@ -379,6 +389,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 max_modules,
                 phase,
                 interpreted,
+                max_shapes,
                 seed,
                 timeout: timeout.0,
                 allow_writes,
@@ -462,6 +473,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             output,
             define,
             view,
+            seed,
             timeout,
             force,
         } => {
@@ -472,6 +484,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 output,
                 defines: define,
                 view,
+                seed,
                 timeout: timeout.0,
                 force,
                 program_output: subgram::ProgramOutput::new(),

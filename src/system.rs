@@ -25,6 +25,9 @@ pub enum System {
     Surface(Surface),
     /// A vertex-vertex program (paper 001), run on a rotation system.
     Vv(Vv),
+    /// A shape grammar (paper 003, CGA shape), derived into a tree of
+    /// shapes.
+    Shapes(Shapes),
 }
 
 /// Settings of [`System::run`].
@@ -49,6 +52,9 @@ pub struct RunOptions {
     pub deadline: Option<Deadline>,
     /// Curves: where the program's `printf`s and files go.
     pub output: ProgramOutput,
+    /// Shape grammars: the most shapes a derivation may make (default
+    /// `SUBGRAM_MAX_SHAPES` or 2,000,000).
+    pub max_shapes: Option<usize>,
 }
 
 impl Default for RunOptions {
@@ -61,6 +67,7 @@ impl Default for RunOptions {
             base_mesh: None,
             deadline: None,
             output: ProgramOutput::default(),
+            max_shapes: None,
         }
     }
 }
@@ -91,6 +98,7 @@ pub enum Run<'s> {
     Curve(CurveRun<'s>),
     Surface(SurfaceRun),
     Vv(VvResult),
+    Shapes(ShapeRun),
 }
 
 impl Run<'_> {
@@ -98,14 +106,14 @@ impl Run<'_> {
     pub fn word(&self) -> Option<&Word> {
         match self {
             Run::Curve(c) => Some(c.word()),
-            Run::Surface(_) | Run::Vv(_) => None,
+            Run::Surface(_) | Run::Vv(_) | Run::Shapes(_) => None,
         }
     }
 
     /// A surface grammar's subdivided mesh.
     pub fn mesh(&self) -> Option<&Mesh> {
         match self {
-            Run::Curve(_) | Run::Vv(_) => None,
+            Run::Curve(_) | Run::Vv(_) | Run::Shapes(_) => None,
             Run::Surface(s) => Some(&s.mesh),
         }
     }
@@ -114,6 +122,7 @@ impl Run<'_> {
     pub fn polygons(&self) -> Option<&PolygonSoup> {
         match self {
             Run::Vv(v) => Some(&v.soup),
+            Run::Shapes(s) => Some(&s.soup),
             _ => None,
         }
     }
@@ -137,6 +146,7 @@ impl System {
             System::Curve(c) => Ok(Run::Curve(c.run(opts.derive_options())?)),
             System::Surface(s) => Ok(Run::Surface(s.subdivide(opts, |_| {})?)),
             System::Vv(v) => Ok(Run::Vv(v.run(opts, |_| {})?)),
+            System::Shapes(s) => Ok(Run::Shapes(s.derive(opts)?)),
         }
     }
 
@@ -149,6 +159,7 @@ impl System {
             System::Curve(c) => (&c.sources, &c.program.warnings),
             System::Surface(s) => (&s.grammar.sources, &s.grammar.warnings),
             System::Vv(v) => (&v.program.sources, &v.program.warnings),
+            System::Shapes(s) => (&s.grammar.sources, &s.grammar.warnings),
         };
         warnings
             .iter()
@@ -162,6 +173,7 @@ impl System {
             System::Curve(c) => &c.sources,
             System::Surface(s) => &s.grammar.sources,
             System::Vv(v) => &v.program.sources,
+            System::Shapes(s) => &s.grammar.sources,
         }
     }
 }
@@ -530,4 +542,114 @@ fn in_the_file(e: &Error) -> bool {
 /// mesh, with the file's name on every message.
 pub fn load_mesh(path: &Path) -> Result<Mesh, Error> {
     Ok(crate::mesh::io::read_mesh(path)?)
+}
+
+/// A checked shape grammar (paper 003).
+#[derive(Debug)]
+pub struct Shapes {
+    pub(crate) grammar: crate::shape::ShapeGrammar,
+}
+
+/// A shape derivation: the tree of shapes, and the terminal shapes' faces
+/// with their colours.
+#[derive(Debug)]
+pub struct ShapeRun {
+    pub(crate) grammar_symbols: usize,
+    pub(crate) tree: crate::shape::ShapeTree,
+    /// The terminal shapes' faces, in tree order.
+    pub soup: PolygonSoup,
+    /// The colour of each face of `soup`.
+    pub colours: Vec<crate::render::Rgba>,
+}
+
+/// A shape derivation's counts.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct ShapeCounts {
+    /// Every shape the derivation made.
+    pub shapes: usize,
+    pub terminal_shapes: usize,
+    /// The faces of the terminal shapes.
+    pub faces: usize,
+    /// The smoothing groups subdivided.
+    pub smoothing_groups: usize,
+}
+
+impl Shapes {
+    pub(crate) fn new(grammar: crate::shape::ShapeGrammar) -> Shapes {
+        Shapes { grammar }
+    }
+
+    /// The number of rules.
+    pub fn rules(&self) -> usize {
+        self.grammar.rules.len()
+    }
+
+    /// Derives the grammar's shapes (`opts.seed` seeds its random choices;
+    /// `opts.deadline` stops it).
+    pub fn derive(&self, opts: &RunOptions) -> Result<ShapeRun, Error> {
+        let never = Deadline::after(std::time::Duration::from_secs(u64::MAX / 4));
+        let deadline = opts.deadline.as_ref().unwrap_or(&never);
+        let mut o = crate::shape::ShapeOptions {
+            seed: opts.seed.unwrap_or(1),
+            ..Default::default()
+        };
+        o.max_shapes = match opts.max_shapes {
+            Some(n) => n,
+            None => crate::limits::from_env(
+                crate::shape::run::MAX_SHAPES_VAR,
+                crate::shape::run::MAX_SHAPES as u64,
+                "a whole number",
+            )
+            .map_err(Error::Usage)? as usize,
+        };
+        let tree =
+            crate::shape::run::derive(&self.grammar, &o, deadline).map_err(|e| self.error(e))?;
+        let (soup, colours) = crate::shape::output::soup(&tree);
+        Ok(ShapeRun {
+            grammar_symbols: self.grammar.symbols.len(),
+            tree,
+            soup,
+            colours,
+        })
+    }
+
+    /// A derivation's error, located in the grammar.
+    pub fn error(&self, e: crate::shape::ShapeError) -> Error {
+        Error::at(&self.grammar.sources, Diagnostic::new(e.span, e.message))
+    }
+
+    /// The shape tree as indented text.
+    pub fn tree_text(&self, run: &ShapeRun) -> String {
+        crate::shape::output::tree_text(&self.grammar, &run.tree)
+    }
+
+    /// One line per smoothing group subdivided: its shapes, scheme and
+    /// steps, faces before and after, protected faces and vertices.
+    pub fn groups_text(&self, run: &ShapeRun) -> String {
+        crate::shape::output::groups_text(&run.tree)
+    }
+
+    /// The shape tree as JSON.
+    pub fn tree_json(&self, run: &ShapeRun) -> serde_json::Value {
+        crate::shape::output::tree_json(&self.grammar, &run.tree)
+    }
+
+    /// The OBJ text (one group per terminal shape) and its MTL text;
+    /// `mtl_name` is how the OBJ names the MTL file.
+    pub fn obj(&self, run: &ShapeRun, mtl_name: &str) -> (String, String) {
+        crate::shape::output::obj(&self.grammar, &run.tree, mtl_name)
+    }
+}
+
+impl ShapeRun {
+    pub fn counts(&self) -> ShapeCounts {
+        let (shapes, terminal_shapes, faces) = crate::shape::output::counts(&self.tree);
+        let _ = self.grammar_symbols;
+        ShapeCounts {
+            shapes,
+            terminal_shapes,
+            faces,
+            smoothing_groups: self.tree.groups.len(),
+        }
+    }
 }

@@ -47,6 +47,9 @@ pub struct MeshView {
     pub up: DVec3,
     /// Margin on every side, as a fraction of the smaller image side.
     pub margin: f64,
+    /// The colour of each face (a shape grammar's shapes); empty: the
+    /// default blue for every face.
+    pub face_colours: Vec<Rgba>,
 }
 
 impl Default for MeshView {
@@ -61,6 +64,7 @@ impl Default for MeshView {
             direction,
             up,
             margin: 0.04,
+            face_colours: Vec::new(),
         }
     }
 }
@@ -284,7 +288,14 @@ fn faces(soup: &PolygonSoup, view: &MeshView) -> Vec<Item> {
     let mut faces: Vec<Shaded> = soup
         .faces
         .iter()
-        .filter_map(|face| shade_face(soup, face, &cam, &fit, edge))
+        .enumerate()
+        .filter_map(|(k, face)| {
+            let base = view
+                .face_colours
+                .get(k)
+                .map(|c| DVec3::new(c.0 as f64, c.1 as f64, c.2 as f64) / 255.0);
+            shade_face(soup, face, &cam, &fit, edge, base)
+        })
         .collect();
     faces.sort_by(|a, b| b.depth.total_cmp(&a.depth).then(b.back.cmp(&a.back)));
     faces.into_iter().map(|f| f.item).collect()
@@ -298,6 +309,7 @@ fn shade_face(
     cam: &Camera,
     fit: &Fit,
     edge: Option<Outline>,
+    base: Option<DVec3>,
 ) -> Option<Shaded> {
     let corners: Vec<DVec3> = face
         .iter()
@@ -310,7 +322,7 @@ fn shade_face(
     let back = normal.dot(cam.dir) > 0.0;
     let seen = if back { -normal } else { normal };
     let depth = corners.iter().map(|p| p.dot(cam.dir)).sum::<f64>() / corners.len() as f64;
-    let color = shade(seen, back, cam);
+    let color = shade(seen, back, cam, base);
     let outline = edge.unwrap_or(Outline {
         color,
         width: SEAM_WIDTH,
@@ -347,11 +359,17 @@ fn newell_normal(corners: &[DVec3]) -> DVec3 {
 }
 
 /// The flat colour of a face whose visible side has unit normal `seen`.
-fn shade(seen: DVec3, back: bool, cam: &Camera) -> Rgba {
+fn shade(seen: DVec3, back: bool, cam: &Camera, base: Option<DVec3>) -> Rgba {
     let light = AMBIENT
         + KEY * seen.dot(cam.key_light()).max(0.0)
         + FILL * seen.dot(cam.fill_light()).max(0.0);
-    let base = if back { BACK_BASE } else { FRONT_BASE };
+    let base = match base {
+        // A face's own colour, darker on its back.
+        Some(c) if back => c * 0.6,
+        Some(c) => c,
+        None if back => BACK_BASE,
+        None => FRONT_BASE,
+    };
     let c = (base * light.clamp(0.0, 1.0).powf(GAMMA)).clamp(DVec3::ZERO, DVec3::ONE) * 255.0;
     Rgba(c.x.round() as u8, c.y.round() as u8, c.z.round() as u8, 255)
 }

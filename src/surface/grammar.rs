@@ -198,45 +198,7 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
             continue;
         }
         if p.peek_ident("define") {
-            p.bump();
-            let name_span = p.span_here();
-            let name = p.name("a function name after `define`")?.text;
-            if g.functions.iter().any(|f| f.name == name) {
-                return Err(Diagnostic::new(
-                    name_span,
-                    format!(
-                        "function `{name}` is already defined above; give this one another name"
-                    ),
-                ));
-            }
-            p.expect_punct("(", "after the function name")?;
-            let mut params = Vec::new();
-            if !p.eat_punct(")") {
-                loop {
-                    let at = p.span_here();
-                    let param = p.name("a parameter name")?.text;
-                    if params.contains(&param) {
-                        return Err(Diagnostic::new(
-                            at,
-                            format!("`{name}` already has a parameter `{param}`"),
-                        ));
-                    }
-                    params.push(param);
-                    if p.eat_punct(")") {
-                        break;
-                    }
-                    p.expect_punct(",", "or `)` between parameters")?;
-                }
-            }
-            p.expect_punct("=", "before the function's expression")?;
-            let body = p.expr()?;
-            p.expect_punct(";", "after the function's expression")?;
-            g.functions.push(FunctionDef {
-                name,
-                params,
-                body,
-                span: start,
-            });
+            g.functions.push(define(&mut p, &g.functions)?);
             continue;
         }
         g.rules.push(rule(&mut p, &text_of)?);
@@ -248,6 +210,49 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
         ));
     }
     Ok(g)
+}
+
+/// `define name(params) = expr;`, the inline functions of rule files
+/// (surface and shape grammars); a name defined above is refused.
+pub(crate) fn define(p: &mut Parser, above: &[FunctionDef]) -> R<FunctionDef> {
+    let start = p.span_here();
+    p.bump();
+    let name_span = p.span_here();
+    let name = p.name("a function name after `define`")?.text;
+    if above.iter().any(|f| f.name == name) {
+        return Err(Diagnostic::new(
+            name_span,
+            format!("function `{name}` is already defined above; give this one another name"),
+        ));
+    }
+    p.expect_punct("(", "after the function name")?;
+    let mut params = Vec::new();
+    if !p.eat_punct(")") {
+        loop {
+            let at = p.span_here();
+            let param = p.name("a parameter name")?.text;
+            if params.contains(&param) {
+                return Err(Diagnostic::new(
+                    at,
+                    format!("`{name}` already has a parameter `{param}`"),
+                ));
+            }
+            params.push(param);
+            if p.eat_punct(")") {
+                break;
+            }
+            p.expect_punct(",", "or `)` between parameters")?;
+        }
+    }
+    p.expect_punct("=", "before the function's expression")?;
+    let body = p.expr()?;
+    p.expect_punct(";", "after the function's expression")?;
+    Ok(FunctionDef {
+        name,
+        params,
+        body,
+        span: start,
+    })
 }
 
 /// rule := KIND '(' name [';' cond] ')' [('|' | '||') context] '->' succ ['||' counts] [';']

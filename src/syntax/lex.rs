@@ -76,6 +76,9 @@ const PUNCTS: &[&str] = &[
     "<<=", ">>=", "...", "->", "<<", ">>", "<=", ">=", "==", "!=", "&&", "||", "++", "--", "+=",
     "-=", "*=", "/=", "%=", "::", "(", ")", "{", "}", "[", "]", ",", ";", ":", ".", "?", "<", ">",
     "=", "+", "-", "*", "/", "%", "!", "#", "~", "&", "|", "^", "\\", "@", "$", "'",
+    // The arrow of paper 003's shape rules (U+21DD); `~>` and `-->` are
+    // written with the ASCII punctuators.
+    "\u{21DD}",
 ];
 
 fn ident(i: &str) -> IResult<&str, &str> {
@@ -297,17 +300,18 @@ fn char_lit(i: &str) -> Result<(&str, i64), (usize, String)> {
 }
 
 /// True when the `'` that starts `i` is a prime before a name (vv's `'v`,
-/// the old state of vertex `v`): a name follows that is not closed by a
-/// `'` as a character constant (`'a'`) would be.
+/// the old state of vertex `v`) or a number (a shape grammar's relative
+/// size, `'0.3`): a name or number follows that is not closed by a `'` as
+/// a character constant (`'a'`, `'0'`) would be.
 fn is_prime(i: &str) -> bool {
     let name = i[1..]
-        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '.'))
         .unwrap_or(i.len() - 1);
     let starts = i[1..]
         .chars()
         .next()
-        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
-    starts && !i[1 + name..].starts_with('\'')
+        .is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.');
+    starts && name > 0 && !i[1 + name..].starts_with('\'')
 }
 
 fn punct(i: &str) -> IResult<&str, &'static str> {

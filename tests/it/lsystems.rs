@@ -16,7 +16,11 @@
 //!   rules also run on `meshes/grid.obj`, as `NAME-on-grid.obj`;
 //! * a vv program (`vv/*.lsys`): as a surface grammar; those with boundary
 //!   rules also run on `meshes/pentagon-patch.obj`, as `NAME-on-patch.obj`;
-//! * a base mesh (`meshes/*.obj`): `subgram mesh info FILE` as `NAME.txt`.
+//! * a base mesh (`meshes/*.obj`): `subgram mesh info FILE` as `NAME.txt`;
+//! * a shape grammar (`shapes/*.lsys`): the OBJ file `subgram subdivide
+//!   --grammar FILE -o NAME.obj` writes (one group per terminal shape, in
+//!   tree order) as `NAME.obj`, and the shape tree `subgram derive FILE`
+//!   prints as `NAME.txt`.
 //!
 //! Regenerate with `UPDATE_GOLDEN=1 cargo test --test it lsystems::`.
 
@@ -28,7 +32,7 @@ use crate::support::root;
 
 /// The folders of `lsystems/`, each checked by its own test below.
 const FOLDERS: &[&str] = &[
-    "abop", "curves", "figures", "lplusc", "meshes", "paper", "reverse", "surfaces", "vv",
+    "abop", "curves", "figures", "lplusc", "meshes", "paper", "reverse", "shapes", "surfaces", "vv",
 ];
 
 /// Surface grammars with boundary rules, run on the open grid as well.
@@ -46,6 +50,10 @@ fn goldens(rel: &Path) -> Option<Vec<(PathBuf, Kind)>> {
     let with = |suffix: &str| base.with_file_name(format!("{stem}{suffix}"));
     match (folder, rel.extension()?.to_str()?) {
         ("meshes", "obj") => Some(vec![(with(".txt"), Kind::Exact)]),
+        ("shapes", "lsys") => Some(vec![
+            (with(".obj"), Kind::Numeric),
+            (with(".txt"), Kind::Numeric),
+        ]),
         ("surfaces" | "vv", "lsys") => {
             let mut v = vec![(with(".obj"), Kind::Numeric), (with(".txt"), Kind::Exact)];
             if folder == "surfaces" && ON_GRID.contains(&stem) {
@@ -145,6 +153,16 @@ fn outputs(rel: &Path) -> Result<Vec<Vec<u8>>, String> {
     let folder = rel.parent().and_then(Path::to_str).unwrap_or("");
     if folder == "meshes" {
         return Ok(vec![subgram(&["mesh", "info", f])?]);
+    }
+    if folder == "shapes" {
+        let stem = rel.file_stem().unwrap().to_str().unwrap();
+        let dir = std::env::temp_dir().join(format!("subgram-shapes-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let out = dir.join(format!("{stem}.obj"));
+        let o = out.to_str().unwrap();
+        subgram(&["subdivide", "--grammar", f, "-o", o])?;
+        let obj = std::fs::read(&out).map_err(|e| format!("{o}: {e}"))?;
+        return Ok(vec![obj, subgram(&["derive", f])?]);
     }
     if folder != "surfaces" && folder != "vv" {
         let json: serde_json::Value =
@@ -257,6 +275,11 @@ fn paper() {
 #[test]
 fn reverse() {
     check_folder("reverse");
+}
+
+#[test]
+fn shapes() {
+    check_folder("shapes");
 }
 
 #[test]

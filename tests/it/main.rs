@@ -28,6 +28,7 @@ mod random;
 mod render;
 mod reverse;
 mod semantics;
+mod shapes;
 mod support;
 mod surface;
 mod surface_quad;

@@ -499,7 +499,7 @@ fn ea20_arrays_are_modules_with_a_warning() {
     );
     let l = match system {
         System::Curve(c) => c,
-        System::Surface(_) | System::Vv(_) => panic!("a curve"),
+        System::Surface(_) | System::Vv(_) | System::Shapes(_) => panic!("a curve"),
     };
     let d = l.derive(Default::default()).unwrap();
     assert_eq!(

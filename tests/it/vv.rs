@@ -53,7 +53,7 @@ fn run(file: &Path, mesh: &Path, steps: u64, defines: &[&str]) -> PolygonSoup {
     match system.run(&ro).unwrap_or_else(|e| panic!("{e}")) {
         Run::Vv(v) => v.soup,
         Run::Surface(s) => s.mesh.to_soup(),
-        Run::Curve(_) => panic!("{} is a curve", file.display()),
+        Run::Curve(_) | Run::Shapes(_) => panic!("{} is not a mesh program", file.display()),
     }
 }
 

@@ -1,0 +1,254 @@
+//! What a shape derivation writes: the shape tree (text or JSON), an OBJ
+//! file with one group per terminal shape and its material, and the
+//! polygons of a picture with their colours. Everything walks the tree in
+//! order, so the bytes do not depend on the order shapes were rewritten in.
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+
+use crate::mesh::PolygonSoup;
+use crate::render::Rgba;
+
+use super::geom::Geometry;
+use super::run::{Node, ShapeTree, State};
+use super::ShapeGrammar;
+
+/// A terminal shape's colour: its own, or one of the palette's by symbol.
+pub fn colour_of(node: &Node) -> [u8; 3] {
+    match node.colour {
+        Some(c) => c,
+        None => {
+            let Rgba(r, g, b, _) = crate::render::palette(node.symbol as i64 + 1);
+            [r, g, b]
+        }
+    }
+}
+
+fn state_name(s: &State) -> &'static str {
+    match s {
+        State::Pending => "pending",
+        State::Expanded => "expanded",
+        State::Leaf => "terminal",
+        State::Removed => "removed",
+        State::Waiting => "waiting",
+    }
+}
+
+fn num(x: f64) -> String {
+    // The shortest text that reads back as the same double; -0 as 0.
+    let x = if x == 0.0 { 0.0 } else { x };
+    format!("{x}")
+}
+
+/// The tree as indented text: one line per shape.
+pub fn tree_text(g: &ShapeGrammar, t: &ShapeTree) -> String {
+    let mut out = String::new();
+    let mut stack: Vec<(u32, usize)> = t.roots.iter().rev().map(|&r| (r, 0)).collect();
+    while let Some((n, depth)) = stack.pop() {
+        let node = &t.nodes[n as usize];
+        let _ = write!(
+            out,
+            "{:indent$}{}",
+            "",
+            g.symbols[node.symbol as usize],
+            indent = 2 * depth
+        );
+        if !node.params.is_empty() {
+            let p: Vec<String> = node.params.iter().map(|&x| num(x)).collect();
+            let _ = write!(out, "({})", p.join(", "));
+        }
+        let s = &node.scope;
+        let _ = writeln!(
+            out,
+            "  {}D {} faces, scope at ({}, {}, {}) size ({}, {}, {}), {}",
+            node.geom.dim,
+            node.geom.face_count(),
+            num(s.origin.x),
+            num(s.origin.y),
+            num(s.origin.z),
+            num(s.size.x),
+            num(s.size.y),
+            num(s.size.z),
+            state_name(&node.state)
+        );
+        stack.extend(node.children.iter().rev().map(|&c| (c, depth + 1)));
+    }
+    out
+}
+
+/// The tree as JSON: an array of root shapes, each with its symbol,
+/// parameters, scope, dimension, face count, state and children.
+pub fn tree_json(g: &ShapeGrammar, t: &ShapeTree) -> serde_json::Value {
+    fn shape(g: &ShapeGrammar, t: &ShapeTree, n: u32) -> serde_json::Value {
+        let node = &t.nodes[n as usize];
+        let s = &node.scope;
+        let v3 = |v: glam::DVec3| serde_json::json!([v.x, v.y, v.z]);
+        serde_json::json!({
+            "symbol": g.symbols[node.symbol as usize],
+            "params": node.params,
+            "scope": {
+                "origin": v3(s.origin),
+                "x": v3(s.axes[0]),
+                "y": v3(s.axes[1]),
+                "z": v3(s.axes[2]),
+                "size": v3(s.size),
+            },
+            "dim": node.geom.dim,
+            "faces": node.geom.face_count(),
+            // The paper's connectivity map: the vertices shared with the
+            // parent shape.
+            "shared_with_parent": if node.parent == u32::MAX { 0 } else { shared(t, n, node.parent).len() },
+            "state": state_name(&node.state),
+            "children": node.children.iter().map(|&c| shape(g, t, c)).collect::<Vec<_>>(),
+        })
+    }
+    // Deep trees are walked with an explicit stack elsewhere; JSON nesting
+    // follows the tree, whose depth the shape limit bounds.
+    serde_json::Value::Array(t.roots.iter().map(|&r| shape(g, t, r)).collect())
+}
+
+/// The material name of a colour.
+fn material(c: [u8; 3]) -> String {
+    format!("c{:02x}{:02x}{:02x}", c[0], c[1], c[2])
+}
+
+/// An OBJ file of the terminal shapes, one group each (`g Symbol_k`, k
+/// counting the shapes of that symbol from 1) with `usemtl` of its colour,
+/// and the MTL file that defines the colours; `mtl_name` is the MTL file's
+/// name as the OBJ refers to it.
+pub fn obj(g: &ShapeGrammar, t: &ShapeTree, mtl_name: &str) -> (String, String) {
+    let leaves = t.leaves();
+    let mut index: HashMap<u32, usize> = HashMap::new();
+    let mut order: Vec<u32> = Vec::new();
+    for &l in &leaves {
+        for p in t.nodes[l as usize].geom.point_ids() {
+            index.entry(p).or_insert_with(|| {
+                order.push(p);
+                order.len()
+            });
+        }
+    }
+    let mut out = String::with_capacity(order.len() * 40 + leaves.len() * 64);
+    let _ = writeln!(
+        out,
+        "# subgram shape grammar: {} terminal shapes",
+        leaves.len()
+    );
+    let _ = writeln!(out, "mtllib {mtl_name}");
+    for &p in &order {
+        let v = t.points.pos[p as usize];
+        let _ = writeln!(out, "v {} {} {}", num(v.x), num(v.y), num(v.z));
+    }
+    let mut count: HashMap<u32, usize> = HashMap::new();
+    let mut colours: Vec<[u8; 3]> = Vec::new();
+    for &l in &leaves {
+        let node = &t.nodes[l as usize];
+        let k = count.entry(node.symbol).or_insert(0);
+        *k += 1;
+        let c = colour_of(node);
+        if !colours.contains(&c) {
+            colours.push(c);
+        }
+        let _ = writeln!(out, "g {}_{}", g.symbols[node.symbol as usize], k);
+        let _ = writeln!(out, "usemtl {}", material(c));
+        write_geometry(&mut out, &node.geom, &index);
+    }
+    let mut mtl = String::new();
+    let _ = writeln!(mtl, "# subgram shape grammar colours");
+    for c in colours {
+        let _ = writeln!(
+            mtl,
+            "newmtl {}\nKd {} {} {}\n",
+            material(c),
+            num(c[0] as f64 / 255.0),
+            num(c[1] as f64 / 255.0),
+            num(c[2] as f64 / 255.0)
+        );
+    }
+    (out, mtl)
+}
+
+fn write_geometry(out: &mut String, geom: &Geometry, index: &HashMap<u32, usize>) {
+    for f in &geom.faces {
+        out.push('f');
+        for p in &f.pts {
+            let _ = write!(out, " {}", index[p]);
+        }
+        out.push('\n');
+    }
+    for e in &geom.edges {
+        let _ = writeln!(out, "l {} {}", index[&e[0]], index[&e[1]]);
+    }
+    for v in &geom.verts {
+        let _ = writeln!(out, "p {}", index[v]);
+    }
+}
+
+/// The faces of the terminal shapes as one soup, with each face's colour
+/// (for pictures, PLY and OFF).
+pub fn soup(t: &ShapeTree) -> (PolygonSoup, Vec<Rgba>) {
+    let mut soup = PolygonSoup::default();
+    let mut colours = Vec::new();
+    let mut index: HashMap<u32, u32> = HashMap::new();
+    for l in t.leaves() {
+        let node = &t.nodes[l as usize];
+        let c = colour_of(node);
+        for f in &node.geom.faces {
+            let face = f
+                .pts
+                .iter()
+                .map(|&p| {
+                    *index.entry(p).or_insert_with(|| {
+                        soup.positions.push(t.points.pos[p as usize]);
+                        soup.positions.len() as u32 - 1
+                    })
+                })
+                .collect();
+            soup.faces.push(face);
+            colours.push(Rgba(c[0], c[1], c[2], 255));
+        }
+    }
+    (soup, colours)
+}
+
+/// One line per smoothing group subdivided.
+pub fn groups_text(t: &ShapeTree) -> String {
+    let mut out = String::new();
+    for (k, g) in t.groups.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "smoothing group {}: {} shapes, {} x {}, {} -> {} faces, {} protected faces, {} protected vertices",
+            k + 1,
+            g.members,
+            g.scheme,
+            g.steps,
+            g.faces_in,
+            g.faces_out,
+            g.protected_faces,
+            g.protected_vertices
+        );
+    }
+    out
+}
+
+/// Counts for a run's summary.
+pub fn counts(t: &ShapeTree) -> (usize, usize, usize) {
+    let leaves = t.leaves();
+    let faces = leaves
+        .iter()
+        .map(|&l| t.nodes[l as usize].geom.face_count())
+        .sum();
+    (t.nodes.len(), leaves.len(), faces)
+}
+
+/// The points that shape `a` shares with shape `b` (the paper's
+/// connectivity map between them), in `a`'s order.
+pub fn shared(t: &ShapeTree, a: u32, b: u32) -> Vec<u32> {
+    let other: std::collections::HashSet<u32> = t.nodes[b as usize].geom.point_ids().collect();
+    let mut seen = std::collections::HashSet::new();
+    t.nodes[a as usize]
+        .geom
+        .point_ids()
+        .filter(|p| other.contains(p) && seen.insert(*p))
+        .collect()
+}
