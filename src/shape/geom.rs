@@ -25,6 +25,10 @@ pub(crate) type PointId = u32;
 /// The most points one derivation may hold.
 pub(crate) const MAX_POINTS: usize = 50_000_000;
 
+/// The cell size of the index of cut points by position: two cut points
+/// closer than this (and than 1e-10 of their magnitude) are one point.
+const GRID: f64 = 1e-6;
+
 /// The most segments (or slices, stacks) a round primitive may have.
 pub(crate) const MAX_SEGMENTS: usize = 1 << 16;
 
@@ -48,8 +52,13 @@ pub(crate) struct Points {
     pub pos: Vec<DVec3>,
     /// A root edge -> the cut points on it, sorted by their parameter.
     cuts: HashMap<Root, Vec<(f64, PointId)>>,
-    /// A cut point -> its root edge and its parameter along it.
-    root: HashMap<PointId, (Root, f64)>,
+    /// A cut point -> its root edges and its parameters along them: the
+    /// root it was made on, then any root crossing it that a later cut
+    /// reached it along (where two lines of cuts cross in a face).
+    root: HashMap<PointId, Vec<(Root, f64)>>,
+    /// The cut points by position (cells of [`GRID`]), to find the point
+    /// where two lines of cuts cross whichever line reaches it.
+    grid: HashMap<[i64; 3], Vec<PointId>>,
     /// (root, the exact bits of the plane's normal and offset) -> the cut
     /// point that plane put on that root.
     planes: HashMap<(Root, [u64; 4]), PointId>,
@@ -117,18 +126,56 @@ impl Points {
         }
     }
 
-    /// The root edge that edge (a, b) lies on: the root of a or b when the
+    /// Whether cut point `p` lies on root `r` (was made or found on it).
+    fn on_root(&self, p: PointId, r: Root) -> bool {
+        self.root
+            .get(&p)
+            .is_some_and(|rs| rs.iter().any(|e| e.0 == r))
+    }
+
+    /// The root edge that edge (a, b) lies on: a root of a or b when the
     /// other is an end or a cut point of that same root, else (a, b)
     /// itself (canonically ordered).
     fn line_of(&self, a: PointId, b: PointId) -> Root {
         for (x, y) in [(a, b), (b, a)] {
-            if let Some(&(r, _)) = self.root.get(&y) {
-                if x == r.0 || x == r.1 || self.root.get(&x).map(|e| e.0) == Some(r) {
-                    return r;
+            if let Some(rs) = self.root.get(&y) {
+                for &(r, _) in rs {
+                    if x == r.0 || x == r.1 || self.on_root(x, r) {
+                        return r;
+                    }
                 }
             }
         }
         self.canonical(a, b)
+    }
+
+    fn cell(p: DVec3) -> [i64; 3] {
+        let c = (p / GRID).floor();
+        [c.x as i64, c.y as i64, c.z as i64]
+    }
+
+    /// A cut point within `tol` of `p`, if any.
+    fn near(&self, p: DVec3, tol: f64) -> Option<PointId> {
+        let c = Self::cell(p);
+        let mut best: Option<(f64, PointId)> = None;
+        for dx in -1..=1i64 {
+            for dy in -1..=1i64 {
+                for dz in -1..=1i64 {
+                    let k = [
+                        c[0].saturating_add(dx),
+                        c[1].saturating_add(dy),
+                        c[2].saturating_add(dz),
+                    ];
+                    for &q in self.grid.get(&k).map(Vec::as_slice).unwrap_or(&[]) {
+                        let e = (self.get(q) - p).abs().max_element();
+                        if e <= tol && best.is_none_or(|(b, _)| e < b) {
+                            best = Some((e, q));
+                        }
+                    }
+                }
+            }
+        }
+        best.map(|(_, q)| q)
     }
 
     /// The parameter of `p` along root edge `r` (0 at r.0, 1 at r.1).
@@ -139,9 +186,13 @@ impl Points {
         if p == r.1 {
             return 1.0;
         }
-        match self.root.get(&p) {
-            Some(&(rr, t)) if rr == r => t,
-            _ => {
+        match self
+            .root
+            .get(&p)
+            .and_then(|rs| rs.iter().find(|e| e.0 == r))
+        {
+            Some(&(_, t)) => t,
+            None => {
                 let (a, b) = (self.get(r.0), self.get(r.1));
                 let l2 = (b - a).length_squared();
                 if l2 > 0.0 {
@@ -183,26 +234,28 @@ impl Points {
         }
         let t = t.clamp(0.0, 1.0);
         let p = pa + t * (pb - pa);
-        let len = (pb - pa).length();
-        let list = self.cuts.entry(r).or_default();
-        let at = list.partition_point(|&(u, _)| u < t);
-        if len > 0.0 {
-            let slack = 1e-12 * (1.0 + p.abs().max_element()) / len;
-            let near = [at.checked_sub(1), Some(at)]
-                .into_iter()
-                .flatten()
-                .filter_map(|i| list.get(i))
-                .filter(|&&(u, _)| (u - t).abs() <= slack && u > tmin && u < tmax)
-                .min_by(|x, y| (x.0 - t).abs().total_cmp(&(y.0 - t).abs()));
-            if let Some(&(_, q)) = near {
+        // The same point reached along another line (two lines of cuts
+        // crossing), or made by another plane within rounding.
+        let tol = (1e-10 * (1.0 + p.abs().max_element())).min(GRID);
+        if let Some(q) = self.near(p, tol) {
+            let tq = self.param(r, q);
+            if tq > tmin && tq < tmax {
+                if !self.on_root(q, r) {
+                    let list = self.cuts.entry(r).or_default();
+                    let at = list.partition_point(|&(u, _)| u < tq);
+                    list.insert(at, (tq, q));
+                    self.root.entry(q).or_default().push((r, tq));
+                }
                 self.planes.insert(key, q);
                 return Ok(q);
             }
         }
         let id = self.add(p)?;
         let list = self.cuts.entry(r).or_default();
+        let at = list.partition_point(|&(u, _)| u < t);
         list.insert(at, (t, id));
-        self.root.insert(id, (r, t));
+        self.root.insert(id, vec![(r, t)]);
+        self.grid.entry(Self::cell(p)).or_default().push(id);
         self.planes.insert(key, id);
         Ok(id)
     }
@@ -2514,7 +2567,7 @@ mod tests {
     /// part split at y = 1 (cut 2), the right part at y = 2 (cut 3), in
     /// the order asked; both lower parts welded, cut 1's wall refined by
     /// the planes of the splits that crossed it, in the order they ran.
-    fn s0_s1(right_first: bool) -> (Points, Welded) {
+    fn s0_s1(right_first: bool, loose: &[u32]) -> (Points, Welded) {
         let mut points = Points::new();
         let b = box_in(&mut points, &sized(DVec3::ZERO, DVec3::new(2.0, 4.0, 2.0))).unwrap();
         let halves = split(&mut points, &b, DVec3::ZERO, DVec3::X, &[1.0], 1).unwrap();
@@ -2537,12 +2590,16 @@ mod tests {
         let (left, right) = (left.unwrap(), right.unwrap());
         assert!((volume(&points, &left[0]) - 2.0).abs() < 1e-12);
         assert!((volume(&points, &right[0]) - 4.0).abs() < 1e-12);
+        // The lower left part holds caps of cuts 1 and 2, the right one of
+        // cuts 1 and 3.
+        assert_eq!(seams_of(&left[0]).collect::<Vec<_>>(), vec![1, 2]);
+        assert_eq!(seams_of(&right[0]).collect::<Vec<_>>(), vec![1, 3]);
         let seam_planes: HashMap<u32, Vec<(DVec3, f64)>> = [(1, planes)].into_iter().collect();
         let w = weld(
             &mut points,
             &[&left[0], &right[0]],
             &[],
-            &HashSet::new(),
+            &loose.iter().copied().collect(),
             &seam_planes,
         )
         .unwrap();
@@ -2551,7 +2608,7 @@ mod tests {
 
     #[test]
     fn a_wall_cut_later_on_one_side_only_is_refined_on_both() {
-        let (points, w) = s0_s1(false);
+        let (points, w) = s0_s1(false, &[]);
         // Every edge in two faces: closed, and no T-junction (a vertex in
         // the middle of another face's edge would leave that edge in one).
         assert_closed(&w.soup.faces);
@@ -2588,8 +2645,8 @@ mod tests {
             v.sort_unstable();
             v
         };
-        let (pa, wa) = s0_s1(false);
-        let (pb, wb) = s0_s1(true);
+        let (pa, wa) = s0_s1(false, &[]);
+        let (pb, wb) = s0_s1(true, &[]);
         assert_closed(&wb.soup.faces);
         assert_eq!(sorted(&pa, &wa), sorted(&pb, &wb));
         assert_eq!(wa.soup.faces.len(), wb.soup.faces.len());
@@ -2747,5 +2804,66 @@ mod tests {
             assert_eq!(pa.get(m), pb.get(m2));
             assert_eq!(pa.get(q), pb.get(q2));
         }
+    }
+
+    #[test]
+    fn walls_refined_by_crossing_planes_from_both_sides_still_match() {
+        // A 2 x 4 x 2 box split at x = 1 (cut 1); the left part split at
+        // y = 1 (cut 2), the right part at z = 1 (cut 3): the wall's
+        // refinement puts a point where the two lines cross, reached along
+        // the y = 1 line on one side and along the z = 1 line on the other.
+        for right_first in [false, true] {
+            let mut points = Points::new();
+            let b = box_in(&mut points, &sized(DVec3::ZERO, DVec3::new(2.0, 4.0, 2.0))).unwrap();
+            let halves = split(&mut points, &b, DVec3::ZERO, DVec3::X, &[1.0], 1).unwrap();
+            let ro = DVec3::new(1.0, 0.0, 0.0);
+            let (mut left, mut right, mut planes) = (None, None, Vec::new());
+            for step in 0..2 {
+                if (step == 0) != right_first {
+                    left = Some(
+                        split(&mut points, &halves[0], DVec3::ZERO, DVec3::Y, &[1.0], 2).unwrap(),
+                    );
+                    planes.push(plane_of(DVec3::ZERO, DVec3::Y, 1.0));
+                } else {
+                    right = Some(split(&mut points, &halves[1], ro, DVec3::Z, &[1.0], 3).unwrap());
+                    planes.push(plane_of(ro, DVec3::Z, 1.0));
+                }
+            }
+            let (left, right) = (left.unwrap(), right.unwrap());
+            let seam_planes: HashMap<u32, Vec<(DVec3, f64)>> = [(1, planes)].into_iter().collect();
+            let w = weld(
+                &mut points,
+                &[&left[0], &right[0]],
+                &[],
+                &HashSet::new(),
+                &seam_planes,
+            )
+            .unwrap();
+            assert_closed(&w.soup.faces);
+            // [0, 1] x [0, 1] x [0, 2] and [1, 2] x [0, 4] x [0, 1].
+            let v = 1.0 * 1.0 * 2.0 + 1.0 * 4.0 * 1.0;
+            assert!((volume(&points, &soup_geometry(&w)) - v).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn a_loose_wall_cut_on_one_side_only_opens_where_both_sides_meet() {
+        let (points, w) = s0_s1(false, &[1]);
+        // Both parts closed on their own: the pair of wall pieces that
+        // mirror each other stays, the right part on copies of its points.
+        assert_closed(&w.soup.faces);
+        assert!((volume(&points, &soup_geometry(&w)) - 6.0).abs() < 1e-12);
+        // The left part's 8 corners, the right part's 8 corners (2 of them
+        // copies) and its 2 copied points at y = 1 on the wall: 18, and
+        // the 4 corners of the mirrored piece twice.
+        assert_eq!(w.soup.positions.len(), 18);
+        let mut at: HashMap<[u64; 3], usize> = HashMap::new();
+        for p in &w.soup.positions {
+            *at.entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+                .or_default() += 1;
+        }
+        assert_eq!(at.values().filter(|&&k| k == 2).count(), 4);
+        // Left: 6 faces; right: 5 outer faces and its wall in 2 pieces.
+        assert_eq!(w.soup.faces.len(), 13);
     }
 }
