@@ -25,23 +25,43 @@ pub(crate) type PointId = u32;
 /// The most points one derivation may hold.
 pub(crate) const MAX_POINTS: usize = 50_000_000;
 
+/// The cell size of the index of cut points by position: two cut points
+/// closer than this (and than 1e-10 of their magnitude) are one point.
+const GRID: f64 = 1e-6;
+
 /// The most segments (or slices, stacks) a round primitive may have.
 pub(crate) const MAX_SEGMENTS: usize = 1 << 16;
+
+/// A root edge: the segment that cut points lie on, its canonical end
+/// first (the end with the lexicographically smaller position, ties by id).
+type Root = (PointId, PointId);
 
 /// All points of one derivation.
 ///
 /// A shape's vertices shared with its parent, children and siblings are the
 /// ids they have in common: that is the paper's connectivity map.
+///
+/// Every cut point records its root edge (an edge whose ends are not cut
+/// points of one common edge) and its parameter along it from the
+/// canonical end. A cut of any piece of a root by a plane is looked up by
+/// (root, plane), so the same geometric point gets the same id whichever
+/// piece, face or shape asks, and its position, computed on the root from
+/// the canonical end, does not depend on the order shapes were cut in.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Points {
     pub pos: Vec<DVec3>,
-    /// A line's root edge (min id, max id) -> the cut points on it, sorted
-    /// by their parameter along min -> max. A cut of a piece of that edge
-    /// (a cut on a cut) joins the same list, so the list holds every point
-    /// that cuts put on the segment.
-    cuts: HashMap<(PointId, PointId), Vec<(f64, PointId)>>,
-    /// A cut point -> its root edge and its parameter along it.
-    root: HashMap<PointId, ((PointId, PointId), f64)>,
+    /// A root edge -> the cut points on it, sorted by their parameter.
+    cuts: HashMap<Root, Vec<(f64, PointId)>>,
+    /// A cut point -> its root edges and its parameters along them: the
+    /// root it was made on, then any root crossing it that a later cut
+    /// reached it along (where two lines of cuts cross in a face).
+    root: HashMap<PointId, Vec<(Root, f64)>>,
+    /// The cut points by position (cells of [`GRID`]), to find the point
+    /// where two lines of cuts cross whichever line reaches it.
+    grid: HashMap<[i64; 3], Vec<PointId>>,
+    /// (root, the exact bits of the plane's normal and offset) -> the cut
+    /// point that plane put on that root.
+    planes: HashMap<(Root, [u64; 4]), PointId>,
 }
 
 impl Points {
@@ -89,30 +109,90 @@ impl Points {
         }
     }
 
-    /// The root edge of the line that edge (a, b) lies on: the edge that
-    /// was cut first when a or b is a cut point on it, else (a, b) itself.
-    fn line_of(&self, a: PointId, b: PointId) -> (PointId, PointId) {
+    /// Edge (a, b) with its canonical end first: the lexicographically
+    /// smaller position (x, then y, then z), ties by id. By geometry, so
+    /// that it does not depend on the order points were made in.
+    fn canonical(&self, a: PointId, b: PointId) -> Root {
+        let (pa, pb) = (self.get(a), self.get(b));
+        let ord = |x: f64, y: f64| x.partial_cmp(&y).unwrap_or(std::cmp::Ordering::Equal);
+        let o = ord(pa.x, pb.x)
+            .then(ord(pa.y, pb.y))
+            .then(ord(pa.z, pb.z))
+            .then(a.cmp(&b));
+        if o == std::cmp::Ordering::Greater {
+            (b, a)
+        } else {
+            (a, b)
+        }
+    }
+
+    /// Whether cut point `p` lies on root `r` (was made or found on it).
+    fn on_root(&self, p: PointId, r: Root) -> bool {
+        self.root
+            .get(&p)
+            .is_some_and(|rs| rs.iter().any(|e| e.0 == r))
+    }
+
+    /// The root edge that edge (a, b) lies on: a root of a or b when the
+    /// other is an end or a cut point of that same root, else (a, b)
+    /// itself (canonically ordered).
+    fn line_of(&self, a: PointId, b: PointId) -> Root {
         for (x, y) in [(a, b), (b, a)] {
-            if let Some(&(r, _)) = self.root.get(&y) {
-                if x == r.0 || x == r.1 || self.root.get(&x).map(|e| e.0) == Some(r) {
-                    return r;
+            if let Some(rs) = self.root.get(&y) {
+                for &(r, _) in rs {
+                    if x == r.0 || x == r.1 || self.on_root(x, r) {
+                        return r;
+                    }
                 }
             }
         }
-        (a.min(b), a.max(b))
+        self.canonical(a, b)
+    }
+
+    fn cell(p: DVec3) -> [i64; 3] {
+        let c = (p / GRID).floor();
+        [c.x as i64, c.y as i64, c.z as i64]
+    }
+
+    /// A cut point within `tol` of `p`, if any.
+    fn near(&self, p: DVec3, tol: f64) -> Option<PointId> {
+        let c = Self::cell(p);
+        let mut best: Option<(f64, PointId)> = None;
+        for dx in -1..=1i64 {
+            for dy in -1..=1i64 {
+                for dz in -1..=1i64 {
+                    let k = [
+                        c[0].saturating_add(dx),
+                        c[1].saturating_add(dy),
+                        c[2].saturating_add(dz),
+                    ];
+                    for &q in self.grid.get(&k).map(Vec::as_slice).unwrap_or(&[]) {
+                        let e = (self.get(q) - p).abs().max_element();
+                        if e <= tol && best.is_none_or(|(b, _)| e < b) {
+                            best = Some((e, q));
+                        }
+                    }
+                }
+            }
+        }
+        best.map(|(_, q)| q)
     }
 
     /// The parameter of `p` along root edge `r` (0 at r.0, 1 at r.1).
-    fn param(&self, r: (PointId, PointId), p: PointId) -> f64 {
+    fn param(&self, r: Root, p: PointId) -> f64 {
         if p == r.0 {
             return 0.0;
         }
         if p == r.1 {
             return 1.0;
         }
-        match self.root.get(&p) {
-            Some(&(rr, t)) if rr == r => t,
-            _ => {
+        match self
+            .root
+            .get(&p)
+            .and_then(|rs| rs.iter().find(|e| e.0 == r))
+        {
+            Some(&(_, t)) => t,
+            None => {
                 let (a, b) = (self.get(r.0), self.get(r.1));
                 let l2 = (b - a).length_squared();
                 if l2 > 0.0 {
@@ -125,60 +205,59 @@ impl Points {
     }
 
     /// The point where the plane {x : n·x = d} crosses edge (a, b), made
-    /// once: the same id whichever face or shape asks (a sibling that cut
-    /// the same segment with the same plane included), at a position
-    /// computed from the (min id, max id) order so that it is
-    /// bit-identical whatever the direction asked.
+    /// once per root edge and plane: the same id whichever piece of the
+    /// root, face or shape asks, at a position computed on the root from
+    /// its canonical end (bit-identical whatever the direction or the
+    /// order asked). A point of another plane within rounding of it on
+    /// the same root is taken as the same point.
     pub fn cut(&mut self, a: PointId, b: PointId, n: DVec3, d: f64) -> Result<PointId, String> {
         self.check(a)?;
         self.check(b)?;
         if a == b {
             return Ok(a);
         }
-        let (lo, hi) = (a.min(b), a.max(b));
-        let (plo, phi) = (self.get(lo), self.get(hi));
-        let (da, db) = (n.dot(plo) - d, n.dot(phi) - d);
-        let mut t = da / (da - db);
-        if !t.is_finite() {
-            t = 0.5;
-        }
-        let t = t.clamp(0.0, 1.0);
-        let p = plo + t * (phi - plo);
         let r = self.line_of(a, b);
-        let (ra, rb) = (self.get(r.0), self.get(r.1));
-        let len = (rb - ra).length();
-        let tp = self.param_of_pos(r, p);
-        let tol = 1e-9 * (1.0 + d.abs() + p.length());
+        let key = (
+            r,
+            [n.x.to_bits(), n.y.to_bits(), n.z.to_bits(), d.to_bits()],
+        );
+        if let Some(&q) = self.planes.get(&key) {
+            return Ok(q);
+        }
         let (ta, tb) = (self.param(r, a), self.param(r, b));
         let (tmin, tmax) = (ta.min(tb), ta.max(tb));
-        if let Some(list) = self.cuts.get(&r) {
-            let slack = if len > 0.0 { tol / len } else { 0.0 };
-            let start = list.partition_point(|&(t, _)| t < tp - slack);
-            for &(t, q) in &list[start..] {
-                if t > tp + slack {
-                    break;
+        let (pa, pb) = (self.get(r.0), self.get(r.1));
+        let (da, db) = (n.dot(pa) - d, n.dot(pb) - d);
+        let mut t = da / (da - db);
+        if !t.is_finite() {
+            t = 0.5 * (ta + tb);
+        }
+        let t = t.clamp(0.0, 1.0);
+        let p = pa + t * (pb - pa);
+        // The same point reached along another line (two lines of cuts
+        // crossing), or made by another plane within rounding.
+        let tol = (1e-10 * (1.0 + p.abs().max_element())).min(GRID);
+        if let Some(q) = self.near(p, tol) {
+            let tq = self.param(r, q);
+            if tq > tmin && tq < tmax {
+                if !self.on_root(q, r) {
+                    let list = self.cuts.entry(r).or_default();
+                    let at = list.partition_point(|&(u, _)| u < tq);
+                    list.insert(at, (tq, q));
+                    self.root.entry(q).or_default().push((r, tq));
                 }
-                if t > tmin && t < tmax && (n.dot(self.get(q)) - d).abs() <= tol {
-                    return Ok(q);
-                }
+                self.planes.insert(key, q);
+                return Ok(q);
             }
         }
         let id = self.add(p)?;
         let list = self.cuts.entry(r).or_default();
-        let at = list.partition_point(|&(t, _)| t < tp);
-        list.insert(at, (tp, id));
-        self.root.insert(id, (r, tp));
+        let at = list.partition_point(|&(u, _)| u < t);
+        list.insert(at, (t, id));
+        self.root.insert(id, vec![(r, t)]);
+        self.grid.entry(Self::cell(p)).or_default().push(id);
+        self.planes.insert(key, id);
         Ok(id)
-    }
-
-    fn param_of_pos(&self, r: (PointId, PointId), p: DVec3) -> f64 {
-        let (a, b) = (self.get(r.0), self.get(r.1));
-        let l2 = (b - a).length_squared();
-        if l2 > 0.0 {
-            (p - a).dot(b - a) / l2
-        } else {
-            0.0
-        }
     }
 
     /// `poly` with every point that cuts put on its edges inserted in
@@ -341,7 +420,7 @@ fn check_plane(n: DVec3, d: f64, eps: f64) -> Result<(), String> {
     Ok(())
 }
 
-fn seams_of(cut: u32) -> Result<(u32, u32), String> {
+fn seam_pair(cut: u32) -> Result<(u32, u32), String> {
     if cut == 0 || cut > (u32::MAX - 1) / 2 {
         return Err(format!("cut number {cut} is out of range"));
     }
@@ -509,7 +588,7 @@ pub(crate) fn plane_cut(
     eps: f64,
 ) -> Result<(Geometry, Geometry), String> {
     check_plane(n, d, eps)?;
-    let (seam_below, seam_above) = seams_of(cut)?;
+    let (seam_below, seam_above) = seam_pair(cut)?;
     let eps = eps.abs();
     let mut below = Geometry::empty(geom.dim);
     let mut above = Geometry::empty(geom.dim);
@@ -548,6 +627,32 @@ pub(crate) fn plane_cut(
             above.edges.push([a, b]);
         } else {
             below.edges.push([a, b]);
+        }
+    }
+    // A solid with no vertex strictly on one side is not cut: it lies on
+    // the other side whole (a piece thinner than `eps`, all of its
+    // vertices on the plane, goes below), with no caps.
+    if geom.dim >= 3 {
+        let mut strictly = [false; 2];
+        for f in &geom.faces {
+            for &p in &f.pts {
+                points.check(p)?;
+                match side_of(sd(points, p)) {
+                    -1 => strictly[0] = true,
+                    1 => strictly[1] = true,
+                    _ => {}
+                }
+            }
+        }
+        if !strictly[0] || !strictly[1] {
+            let whole = if strictly[1] { &mut above } else { &mut below };
+            whole.faces = geom
+                .faces
+                .iter()
+                .filter(|f| f.pts.len() >= 3)
+                .cloned()
+                .collect();
+            return Ok((below, above));
         }
     }
     for face in &geom.faces {
@@ -688,6 +793,21 @@ fn cap_loops(
     loops
 }
 
+/// The plane {x : n·x = d} of a split at distance `c` from `origin` along
+/// `axis`: the normal is `axis` normalised. [`split`] cuts with exactly
+/// these planes, so a caller that records them (for [`weld`]'s seam
+/// refinement) gets the same bits.
+pub(crate) fn plane_of(origin: DVec3, axis: DVec3, c: f64) -> (DVec3, f64) {
+    let n = axis.normalize_or_zero();
+    (n, n.dot(origin) + c)
+}
+
+/// The distance within which a split's plane at offset `d` takes vertices
+/// as on it.
+fn split_eps(d: f64) -> f64 {
+    1e-9 * (1.0 + d.abs())
+}
+
 /// Splits `geom` across planes normal to `axis` (unit) at distances `cuts`
 /// (increasing) from `origin`: `cuts.len() + 1` pieces, lowest first, made
 /// sequentially (the whole at the first plane, the part above it at the
@@ -704,7 +824,6 @@ pub(crate) fn split(
     if !origin.is_finite() || !axis.is_finite() || axis.length_squared() == 0.0 {
         return Err("a split needs a finite origin and a non-zero axis".into());
     }
-    let axis = axis.normalize();
     for w in cuts.windows(2) {
         if w[0] > w[1] {
             return Err(format!(
@@ -716,7 +835,6 @@ pub(crate) fn split(
     if let Some(c) = cuts.iter().find(|c| !c.is_finite()) {
         return Err(format!("split position {c} is not finite"));
     }
-    let base = axis.dot(origin);
     let mut pieces = Vec::with_capacity(cuts.len() + 1);
     let mut rest = geom.clone();
     for (i, &c) in cuts.iter().enumerate() {
@@ -724,9 +842,8 @@ pub(crate) fn split(
             .ok()
             .and_then(|i| first_cut.checked_add(i))
             .ok_or_else(|| "too many cuts".to_string())?;
-        let d = base + c;
-        let eps = 1e-9 * (1.0 + d.abs());
-        let (lo, hi) = plane_cut(points, &rest, axis, d, cut, eps)?;
+        let (n, d) = plane_of(origin, axis, c);
+        let (lo, hi) = plane_cut(points, &rest, n, d, cut, split_eps(d))?;
         pieces.push(lo);
         rest = hi;
     }
@@ -1371,80 +1488,138 @@ pub(crate) struct Welded {
     pub protected_face: Vec<bool>,
 }
 
-/// The members' faces as one soup. For each cut k with caps on both sides
-/// among the members: the internal wall is dropped, unless another shape
-/// (in `others`) also has a cap of cut k, which is refused, or k is loose,
-/// where both caps stay and the upper side's members get their own copies
-/// of the wall's points that no member without cut-k caps holds (a
-/// zero-width slit, attached where another member holds the points). Every
-/// kept face is resolved (no T-junctions); points used by `others` are
-/// protected.
+/// The cut ids of a geometry's seam faces (its caps), each once, in
+/// increasing order.
+pub(crate) fn seams_of(geom: &Geometry) -> impl Iterator<Item = u32> {
+    let ks: std::collections::BTreeSet<u32> = geom
+        .faces
+        .iter()
+        .filter(|f| f.seam >= 2)
+        .map(|f| f.seam / 2)
+        .collect();
+    ks.into_iter()
+}
+
+/// `faces` with every face of a cut k that has planes in `seam_planes`
+/// cut by those planes in order, both pieces kept: the two sides of a wall
+/// cut later on one side only get the same pieces with the same ids.
+fn refine(
+    points: &mut Points,
+    faces: &[Face],
+    seam_planes: &HashMap<u32, Vec<(DVec3, f64)>>,
+) -> Result<Vec<Face>, String> {
+    let mut out = Vec::with_capacity(faces.len());
+    for f in faces {
+        for &p in &f.pts {
+            points.check(p)?;
+        }
+        let planes = match seam_planes.get(&(f.seam / 2)) {
+            Some(pl) if f.seam >= 2 && !pl.is_empty() => pl,
+            _ => {
+                out.push(f.clone());
+                continue;
+            }
+        };
+        let mut pieces = vec![f.clone()];
+        for &(n, d) in planes {
+            let eps = split_eps(d);
+            check_plane(n, d, eps)?;
+            let mut next = Vec::with_capacity(pieces.len() + 1);
+            for piece in pieces {
+                if piece.pts.len() < 3 {
+                    continue;
+                }
+                let s: Vec<f64> = piece
+                    .pts
+                    .iter()
+                    .map(|&p| n.dot(points.get(p)) - d)
+                    .collect();
+                let side: Vec<i8> = s
+                    .iter()
+                    .map(|&x| {
+                        if x > eps {
+                            1
+                        } else if x < -eps {
+                            -1
+                        } else {
+                            0
+                        }
+                    })
+                    .collect();
+                if side.contains(&-1) && side.contains(&1) {
+                    let mut below = Vec::new();
+                    split_polygon(points, &piece, (n, d), &s, &side, &mut below, &mut next)?;
+                    next.extend(below);
+                } else {
+                    next.push(piece);
+                }
+            }
+            pieces = next;
+        }
+        out.extend(pieces);
+    }
+    Ok(out)
+}
+
+/// A polygon's cycle written from its smallest id, for comparing cycles
+/// whatever vertex they start at.
+fn cycle_key(poly: &[PointId]) -> Vec<PointId> {
+    let Some(start) = (0..poly.len()).min_by_key(|&i| poly[i]) else {
+        return Vec::new();
+    };
+    poly[start..]
+        .iter()
+        .chain(&poly[..start])
+        .copied()
+        .collect()
+}
+
+/// The members' faces as one soup.
+///
+/// First every face of a cut k (members' and `others'`) is refined by the
+/// planes `seam_planes` records for k (the later splits that crossed a
+/// shape holding a part of k's wall), in order, so that both sides of the
+/// wall have the same pieces; every face is resolved (no T-junctions).
+/// Then a member's face of cut k is dropped when another member holds the
+/// same cycle reversed (an internal wall of the group) and k is not loose;
+/// every other face is kept (a wall towards a shape outside the group or
+/// removed, or a part of a wall the other side does not cover). For a
+/// loose cut both faces of each mirrored pair stay, and the members on
+/// the upper side (seam 2k + 1) get their own copies of those faces'
+/// points that no member without cut-k faces holds (a zero-width slit,
+/// attached where another member holds the points). Points used by
+/// `others` are protected.
 pub(crate) fn weld(
     points: &mut Points,
     members: &[&Geometry],
     others: &[&Geometry],
     loose: &HashSet<u32>,
+    seam_planes: &HashMap<u32, Vec<(DVec3, f64)>>,
 ) -> Result<Welded, String> {
     if members.len() > u32::MAX as usize {
         return Err("too many shapes in a smoothing group".into());
     }
-    // Which members have each side of each cut.
-    let mut sides: HashMap<u32, [Vec<usize>; 2]> = HashMap::new();
-    for (i, g) in members.iter().enumerate() {
-        for f in &g.faces {
-            if f.seam >= 2 {
-                let e = sides.entry(f.seam / 2).or_default();
-                let s = &mut e[(f.seam % 2) as usize];
-                if s.last() != Some(&i) {
-                    s.push(i);
-                }
-            }
-        }
-    }
-    let mut other_cuts = HashSet::new();
+    // The points of the shapes outside the group, their walls refined.
     let mut other_points = HashSet::new();
     for g in others {
-        for f in &g.faces {
-            if f.seam >= 2 {
-                other_cuts.insert(f.seam / 2);
-            }
-        }
-        other_points.extend(g.point_ids());
-    }
-    let mut internal = HashSet::new();
-    let mut loose_cuts = Vec::new();
-    let mut keys: Vec<u32> = sides.keys().copied().collect();
-    keys.sort_unstable();
-    for k in keys {
-        let [s0, s1] = &sides[&k];
-        if s0.is_empty() || s1.is_empty() {
-            continue;
-        }
-        if other_cuts.contains(&k) {
-            return Err(format!(
-                "the smoothing group takes part of cut {k}'s wall: shapes on both sides of the cut \
-                 are in the group and another shape outside it also has a part of that wall; put \
-                 all shapes of the cut in the group, or none on one side"
-            ));
-        }
-        if loose.contains(&k) {
-            loose_cuts.push(k);
+        if g.faces
+            .iter()
+            .any(|f| f.seam >= 2 && seam_planes.contains_key(&(f.seam / 2)))
+        {
+            let faces = refine(points, &g.faces, seam_planes)?;
+            other_points.extend(faces.iter().flat_map(|f| f.pts.iter().copied()));
         } else {
-            internal.insert(k);
+            other_points.extend(g.faces.iter().flat_map(|f| f.pts.iter().copied()));
         }
+        other_points.extend(g.edges.iter().flat_map(|e| e.iter().copied()));
+        other_points.extend(g.verts.iter().copied());
     }
-    // The kept faces, resolved, per member.
+    // The members' faces, refined and resolved.
     let mut kept: Vec<Vec<Face>> = Vec::with_capacity(members.len());
     let mut buf = Vec::new();
     for g in members {
         let mut fs = Vec::new();
-        for f in &g.faces {
-            for &p in &f.pts {
-                points.check(p)?;
-            }
-            if f.seam >= 2 && internal.contains(&(f.seam / 2)) {
-                continue;
-            }
+        for f in refine(points, &g.faces, seam_planes)? {
             points.resolve(&f.pts, &mut buf);
             dedup_ring(&mut buf);
             if buf.len() >= 3 {
@@ -1456,24 +1631,65 @@ pub(crate) fn weld(
         }
         kept.push(fs);
     }
-    // Loose walls: the upper side gets its own copies of the wall's points.
+    // Mirrored pairs: a cut-k face of one member whose reversed cycle
+    // another member holds as a cut-k face.
+    let mut cycles: HashMap<(u32, Vec<PointId>), Vec<usize>> = HashMap::new();
+    for (i, fs) in kept.iter().enumerate() {
+        for f in fs.iter().filter(|f| f.seam >= 2) {
+            cycles
+                .entry((f.seam / 2, cycle_key(&f.pts)))
+                .or_default()
+                .push(i);
+        }
+    }
+    let mut mirrored: Vec<Vec<bool>> = Vec::with_capacity(kept.len());
+    for (i, fs) in kept.iter().enumerate() {
+        let mut m = Vec::with_capacity(fs.len());
+        for f in fs {
+            let hit = f.seam >= 2 && {
+                let mut rev = f.pts.clone();
+                rev.reverse();
+                cycles
+                    .get(&(f.seam / 2, cycle_key(&rev)))
+                    .is_some_and(|who| who.iter().any(|&j| j != i))
+            };
+            m.push(hit);
+        }
+        mirrored.push(m);
+    }
+    // Loose cuts with mirrored pairs: the upper side gets its own copies of
+    // the pairs' points.
+    let mut loose_cuts: Vec<u32> = Vec::new();
+    for (fs, m) in kept.iter().zip(&mirrored) {
+        for (f, &hit) in fs.iter().zip(m) {
+            if hit && loose.contains(&(f.seam / 2)) && !loose_cuts.contains(&(f.seam / 2)) {
+                loose_cuts.push(f.seam / 2);
+            }
+        }
+    }
+    loose_cuts.sort_unstable();
     for k in loose_cuts {
-        let [s0, s1] = &sides[&k];
-        let with_cut: HashSet<usize> = s0.iter().chain(s1.iter()).copied().collect();
+        let with_cut: Vec<bool> = kept
+            .iter()
+            .map(|fs| fs.iter().any(|f| f.seam / 2 == k && f.seam >= 2))
+            .collect();
         let mut held = HashSet::new();
         for (i, fs) in kept.iter().enumerate() {
-            if !with_cut.contains(&i) {
+            if !with_cut[i] {
                 for f in fs {
                     held.extend(f.pts.iter().copied());
                 }
             }
         }
+        let mut upper = Vec::new();
         let mut dup: HashMap<PointId, PointId> = HashMap::new();
-        for &i in s1 {
-            for f in &kept[i] {
-                if f.seam != 2 * k + 1 {
+        for (i, fs) in kept.iter().enumerate() {
+            let mut any = false;
+            for (f, &hit) in fs.iter().zip(&mirrored[i]) {
+                if !hit || f.seam != 2 * k + 1 {
                     continue;
                 }
+                any = true;
                 for &p in &f.pts {
                     if !held.contains(&p) && !dup.contains_key(&p) {
                         let q = points.add(points.get(p))?;
@@ -1481,8 +1697,11 @@ pub(crate) fn weld(
                     }
                 }
             }
+            if any {
+                upper.push(i);
+            }
         }
-        for &i in s1 {
+        for i in upper {
             for f in &mut kept[i] {
                 for p in &mut f.pts {
                     if let Some(&q) = dup.get(p) {
@@ -1494,8 +1713,11 @@ pub(crate) fn weld(
     }
     let mut w = Welded::default();
     let mut index: HashMap<PointId, u32> = HashMap::new();
-    for (i, fs) in kept.into_iter().enumerate() {
-        for f in fs {
+    for (i, (fs, m)) in kept.into_iter().zip(mirrored).enumerate() {
+        for (f, hit) in fs.into_iter().zip(m) {
+            if hit && !loose.contains(&(f.seam / 2)) {
+                continue;
+            }
             let mut face = Vec::with_capacity(f.pts.len());
             for p in f.pts {
                 let v = match index.get(&p) {
@@ -1619,7 +1841,7 @@ mod tests {
         let mut points = Points::new();
         let pieces = three_pieces(&mut points);
         let members: Vec<&Geometry> = pieces.iter().collect();
-        let w = weld(&mut points, &members, &[], &HashSet::new()).unwrap();
+        let w = weld(&mut points, &members, &[], &HashSet::new(), &HashMap::new()).unwrap();
         assert_closed(&w.soup.faces);
         // 8 corners + 2 cuts x 4 points; the 4 faces across x in 3 pieces
         // each and the 2 ends: 14 faces, none of them a cap.
@@ -1643,7 +1865,7 @@ mod tests {
         let pieces = three_pieces(&mut points);
         let members: Vec<&Geometry> = pieces.iter().collect();
         let loose: HashSet<u32> = [2].into_iter().collect();
-        let w = weld(&mut points, &members, &[], &loose).unwrap();
+        let w = weld(&mut points, &members, &[], &loose, &HashMap::new()).unwrap();
         assert_closed(&w.soup.faces);
         // 16 points and the 4 points of cut 2 copied for the upper side;
         // 14 faces and both caps of cut 2.
@@ -1663,19 +1885,46 @@ mod tests {
             .all(|p| p.x == 0.7 || at[&[p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]] == 1));
     }
 
+    /// The welded soup as one geometry on point ids (for `volume`).
+    fn soup_geometry(w: &Welded) -> Geometry {
+        let mut g = Geometry::empty(3);
+        for f in &w.soup.faces {
+            g.faces.push(Face {
+                pts: f.iter().map(|&v| w.point_of[v as usize]).collect(),
+                seam: 0,
+            });
+        }
+        g
+    }
+
     #[test]
-    fn a_wall_shared_with_a_shape_outside_the_group_is_refused() {
+    fn a_wall_shared_with_a_shape_outside_the_group_keeps_its_uncovered_part() {
         let mut points = Points::new();
         let pieces = three_pieces(&mut points);
-        // Piece 1 split along z: its halves both hold a part of cut 2's wall.
+        // Piece 1 split along z (cut 3): its halves both hold a part of
+        // cut 2's wall; the plane crossed a shape with cut-2 faces.
         let halves = split(&mut points, &pieces[1], DVec3::ZERO, DVec3::Z, &[0.5], 3).unwrap();
-        let e = weld(
+        let seam_planes: HashMap<u32, Vec<(DVec3, f64)>> =
+            [(2, vec![plane_of(DVec3::ZERO, DVec3::Z, 0.5)])]
+                .into_iter()
+                .collect();
+        let w = weld(
             &mut points,
             &[&halves[0], &pieces[2]],
             &[&halves[1]],
             &HashSet::new(),
-        );
-        assert!(e.unwrap_err().contains("cut 2's wall"));
+            &seam_planes,
+        )
+        .unwrap();
+        // Piece 2's wall is cut in two: the half against halves[0] goes
+        // with its mirror, the half against halves[1] stays.
+        assert_closed(&w.soup.faces);
+        // [0.3, 1] x [0, 1] x [0, 0.5] and [0.7, 1] x [0, 1] x [0.5, 1].
+        let v = 0.7 * 0.5 + 0.3 * 0.5;
+        assert!((volume(&points, &soup_geometry(&w)) - v).abs() < 1e-12);
+        // Protected faces: halves[0]'s cut-3 cap and piece 2's kept wall
+        // half, both on points of halves[1].
+        assert_eq!(w.protected_face.iter().filter(|&&p| p).count(), 2);
     }
 
     #[test]
@@ -1685,7 +1934,11 @@ mod tests {
         let halves = split(&mut points, &pieces[1], DVec3::ZERO, DVec3::Y, &[0.5], 3).unwrap();
         assert_eq!(halves.len(), 2);
         let members = [&pieces[0], &halves[0], &halves[1], &pieces[2]];
-        let w = weld(&mut points, &members, &[], &HashSet::new()).unwrap();
+        // The y cut crossed a shape holding walls of cuts 1 and 2.
+        let y = plane_of(DVec3::ZERO, DVec3::Y, 0.5);
+        let seam_planes: HashMap<u32, Vec<(DVec3, f64)>> =
+            [(1, vec![y]), (2, vec![y])].into_iter().collect();
+        let w = weld(&mut points, &members, &[], &HashSet::new(), &seam_planes).unwrap();
         assert_closed(&w.soup.faces);
         // The y cut put 4 points on the middle slab's edges at x = 0.3 and
         // 0.7 (front and back), all used.
@@ -1696,7 +1949,14 @@ mod tests {
     fn a_shape_outside_the_group_protects_the_shared_wall() {
         let mut points = Points::new();
         let pieces = three_pieces(&mut points);
-        let w = weld(&mut points, &[&pieces[0]], &[&pieces[1]], &HashSet::new()).unwrap();
+        let w = weld(
+            &mut points,
+            &[&pieces[0]],
+            &[&pieces[1]],
+            &HashSet::new(),
+            &HashMap::new(),
+        )
+        .unwrap();
         assert_closed(&w.soup.faces);
         let protected: Vec<DVec3> = (0..w.soup.positions.len())
             .filter(|&v| w.protected_vertex[v])
@@ -1830,7 +2090,7 @@ mod tests {
         for g in members {
             assert!((volume(&points, g) - 0.25).abs() < 1e-12);
         }
-        let w = weld(&mut points, &members, &[], &HashSet::new()).unwrap();
+        let w = weld(&mut points, &members, &[], &HashSet::new(), &HashMap::new()).unwrap();
         assert_closed(&w.soup.faces);
         assert_eq!(w.soup.positions.len(), 18);
     }
@@ -2301,5 +2561,309 @@ mod tests {
         let (lo, hi) = plane_cut(&mut points, &pts, DVec3::X, 0.5, 2, 1e-9).unwrap();
         assert_eq!(lo.verts, vec![a, m]);
         assert_eq!(hi.verts, vec![b]);
+    }
+
+    /// The S0/S1 case: a 2 x 4 x 2 box split at x = 1 (cut 1); the left
+    /// part split at y = 1 (cut 2), the right part at y = 2 (cut 3), in
+    /// the order asked; both lower parts welded, cut 1's wall refined by
+    /// the planes of the splits that crossed it, in the order they ran.
+    fn s0_s1(right_first: bool, loose: &[u32]) -> (Points, Welded) {
+        let mut points = Points::new();
+        let b = box_in(&mut points, &sized(DVec3::ZERO, DVec3::new(2.0, 4.0, 2.0))).unwrap();
+        let halves = split(&mut points, &b, DVec3::ZERO, DVec3::X, &[1.0], 1).unwrap();
+        let right_origin = DVec3::new(1.0, 0.0, 0.0);
+        let mut planes = Vec::new();
+        let mut left = None;
+        let mut right = None;
+        for step in 0..2 {
+            if (step == 0) != right_first {
+                left =
+                    Some(split(&mut points, &halves[0], DVec3::ZERO, DVec3::Y, &[1.0], 2).unwrap());
+                planes.push(plane_of(DVec3::ZERO, DVec3::Y, 1.0));
+            } else {
+                right = Some(
+                    split(&mut points, &halves[1], right_origin, DVec3::Y, &[2.0], 3).unwrap(),
+                );
+                planes.push(plane_of(right_origin, DVec3::Y, 2.0));
+            }
+        }
+        let (left, right) = (left.unwrap(), right.unwrap());
+        assert!((volume(&points, &left[0]) - 2.0).abs() < 1e-12);
+        assert!((volume(&points, &right[0]) - 4.0).abs() < 1e-12);
+        // The lower left part holds caps of cuts 1 and 2, the right one of
+        // cuts 1 and 3.
+        assert_eq!(seams_of(&left[0]).collect::<Vec<_>>(), vec![1, 2]);
+        assert_eq!(seams_of(&right[0]).collect::<Vec<_>>(), vec![1, 3]);
+        let seam_planes: HashMap<u32, Vec<(DVec3, f64)>> = [(1, planes)].into_iter().collect();
+        let w = weld(
+            &mut points,
+            &[&left[0], &right[0]],
+            &[],
+            &loose.iter().copied().collect(),
+            &seam_planes,
+        )
+        .unwrap();
+        (points, w)
+    }
+
+    #[test]
+    fn a_wall_cut_later_on_one_side_only_is_refined_on_both() {
+        let (points, w) = s0_s1(false, &[]);
+        // Every edge in two faces: closed, and no T-junction (a vertex in
+        // the middle of another face's edge would leave that edge in one).
+        assert_closed(&w.soup.faces);
+        // [0, 1] x [0, 1] x [0, 2] and [1, 2] x [0, 2] x [0, 2].
+        let v = 1.0 * 1.0 * 2.0 + 1.0 * 2.0 * 2.0;
+        assert!((volume(&points, &soup_geometry(&w)) - v).abs() < 1e-12);
+        // The wall's part against the left piece went; its part above
+        // y = 1 stayed, facing -x.
+        let walls: Vec<DVec3> = w
+            .soup
+            .faces
+            .iter()
+            .filter(|f| f.iter().all(|&v| w.soup.positions[v as usize].x == 1.0))
+            .map(|f| {
+                let ids: Vec<PointId> = f.iter().map(|&v| w.point_of[v as usize]).collect();
+                newell(&points, &ids)
+            })
+            .collect();
+        assert_eq!(walls.len(), 1);
+        assert!(walls[0].x < 0.0);
+    }
+
+    #[test]
+    fn the_order_of_splits_does_not_change_positions() {
+        let sorted = |points: &Points, w: &Welded| {
+            let mut v: Vec<[u64; 3]> = w
+                .point_of
+                .iter()
+                .map(|&p| {
+                    let q = points.get(p);
+                    [q.x.to_bits(), q.y.to_bits(), q.z.to_bits()]
+                })
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        let (pa, wa) = s0_s1(false, &[]);
+        let (pb, wb) = s0_s1(true, &[]);
+        assert_closed(&wb.soup.faces);
+        assert_eq!(sorted(&pa, &wa), sorted(&pb, &wb));
+        assert_eq!(wa.soup.faces.len(), wb.soup.faces.len());
+        // Every point of the derivation too (the right piece's removed
+        // upper part included).
+        let all = |p: &Points| {
+            let mut v: Vec<[u64; 3]> = p
+                .pos
+                .iter()
+                .map(|q| [q.x.to_bits(), q.y.to_bits(), q.z.to_bits()])
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        assert_eq!(all(&pa), all(&pb));
+    }
+
+    #[test]
+    fn a_cut_on_a_root_is_found_from_any_piece_and_placed_from_its_canonical_end() {
+        let mut points = Points::new();
+        // Made in the order b, a: a (the smaller x) is the canonical end.
+        let b = points.add(DVec3::new(3.0, 0.0, 0.0)).unwrap();
+        let a = points.add(DVec3::new(0.0, 0.0, 0.0)).unwrap();
+        let m = points.cut(b, a, DVec3::X, 2.0).unwrap();
+        let q = points.cut(a, b, DVec3::X, 1.0).unwrap();
+        // The plane x = 2 asked again from the piece (q, b): the same point.
+        assert_eq!(points.cut(q, b, DVec3::X, 2.0).unwrap(), m);
+        assert_eq!(points.cut(b, q, DVec3::X, 2.0).unwrap(), m);
+        // t = 2/3 and 1/3 along a -> b.
+        assert_eq!(
+            points.get(m),
+            DVec3::new(0.0 + (2.0f64 / 3.0) * 3.0, 0.0, 0.0)
+        );
+        assert_eq!(
+            points.get(q),
+            DVec3::new(0.0 + (1.0f64 / 3.0) * 3.0, 0.0, 0.0)
+        );
+        // Two planes on one root: both points, in order, on every piece.
+        let c = points.add(DVec3::new(0.0, 1.0, 0.0)).unwrap();
+        let mut out = Vec::new();
+        points.resolve(&[b, a, c], &mut out);
+        assert_eq!(out, vec![b, m, q, a, c]);
+        points.resolve(&[q, b, c], &mut out);
+        assert_eq!(out, vec![q, m, b, c]);
+        assert_eq!(points.len(), 5);
+    }
+
+    /// Splits `g` (its scope `s`) in half along x, pieces with their scopes
+    /// (the origin moved as a split moves it).
+    fn halve(
+        points: &mut Points,
+        g: &Geometry,
+        s: Scope,
+        cut: u32,
+    ) -> Result<Vec<(Geometry, Scope)>, String> {
+        let half = s.size.x / 2.0;
+        let pieces = split(points, g, s.origin, s.axes[0], &[half], cut)?;
+        let mut off = 0.0;
+        let mut out = Vec::new();
+        for p in pieces {
+            let mut sc = s;
+            sc.origin += s.axes[0] * off;
+            sc.size.x = half;
+            off += half;
+            out.push((p, sc));
+        }
+        Ok(out)
+    }
+
+    #[test]
+    fn repeated_halving_gives_closed_pieces_of_the_right_volumes() {
+        let mut points = Points::new();
+        let s = sized(DVec3::ZERO, DVec3::new(8.0, 1.0, 1.0));
+        let b = box_in(&mut points, &s).unwrap();
+        let mut work = vec![(b, s)];
+        let mut cut = 1;
+        for _ in 0..9 {
+            let mut next = Vec::new();
+            for (g, s) in &work {
+                next.extend(halve(&mut points, g, *s, cut).unwrap());
+                cut += 1;
+            }
+            work = next;
+        }
+        // 2^9 = 512 pieces of 8/512 x 1 x 1.
+        assert_eq!(work.len(), 512);
+        for (g, _) in &work {
+            assert_closed(&face_lists(g));
+            assert!((volume(&points, g) - 8.0 / 512.0).abs() < 1e-12);
+        }
+        let members: Vec<&Geometry> = work.iter().map(|(g, _)| g).collect();
+        let w = weld(&mut points, &members, &[], &HashSet::new(), &HashMap::new()).unwrap();
+        assert_closed(&w.soup.faces);
+        assert!((volume(&points, &soup_geometry(&w)) - 8.0).abs() < 1e-9);
+        // 8 corners and 4 points on each of the 511 walls.
+        assert_eq!(w.soup.positions.len(), 8 + 4 * 511);
+    }
+
+    #[test]
+    fn halving_past_the_precision_of_the_numbers_does_not_fail() {
+        // The last piece halved again and again (a runaway grammar): past
+        // the cut tolerance a piece stops being cut (it goes whole below),
+        // and nothing fails.
+        let mut points = Points::new();
+        let s = sized(DVec3::ZERO, DVec3::new(8.0, 1.0, 1.0));
+        let b = box_in(&mut points, &s).unwrap();
+        let mut cur = (b, s);
+        let mut kept = Vec::new();
+        for cut in 1..=80 {
+            let mut two = halve(&mut points, &cur.0, cur.1, cut).unwrap();
+            cur = two.pop().unwrap();
+            kept.push(two.pop().unwrap().0);
+        }
+        kept.push(cur.0);
+        let mut total = 0.0;
+        for (i, g) in kept.iter().enumerate() {
+            if g.is_empty() {
+                continue;
+            }
+            assert_closed(&face_lists(g));
+            let v = volume(&points, g);
+            assert!(v > 0.0);
+            // While a half is well above the tolerance it is exact.
+            if i < 20 {
+                assert!((v - 8.0 / 2f64.powi(i as i32 + 1)).abs() < 1e-12);
+            }
+            total += v;
+        }
+        assert!((total - 8.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn cut_positions_do_not_depend_on_the_order_of_cuts_or_ids() {
+        // Two planes cross a segment; run A makes its ends in one order and
+        // cuts at plane 1 then plane 2 (on the piece left over), run B
+        // makes the ends the other way round and cuts at plane 2 first.
+        // The same geometric points must come out bit for bit.
+        let mut rng = Lcg(7);
+        let mut r = |s: f64| (rng.next() - 0.5) * s;
+        for _ in 0..500 {
+            let a = DVec3::new(r(10.0), r(10.0), r(10.0));
+            let b = DVec3::new(r(10.0), r(10.0), r(10.0));
+            let n = DVec3::new(r(2.0), r(2.0), r(2.0)) + (b - a).normalize();
+            let (t1, t2) = (0.1 + 0.35 * (r(1.0) + 0.5), 0.55 + 0.35 * (r(1.0) + 0.5));
+            let d1 = n.dot(a + t1 * (b - a));
+            let d2 = n.dot(a + t2 * (b - a));
+            let mut pa = Points::new();
+            let (ia, ib) = (pa.add(a).unwrap(), pa.add(b).unwrap());
+            let m = pa.cut(ia, ib, n, d1).unwrap();
+            let q = pa.cut(m, ib, n, d2).unwrap();
+            let mut pb = Points::new();
+            let (jb, ja) = (pb.add(b).unwrap(), pb.add(a).unwrap());
+            let q2 = pb.cut(jb, ja, n, d2).unwrap();
+            let m2 = pb.cut(ja, q2, n, d1).unwrap();
+            assert_eq!(pa.get(m), pb.get(m2));
+            assert_eq!(pa.get(q), pb.get(q2));
+        }
+    }
+
+    #[test]
+    fn walls_refined_by_crossing_planes_from_both_sides_still_match() {
+        // A 2 x 4 x 2 box split at x = 1 (cut 1); the left part split at
+        // y = 1 (cut 2), the right part at z = 1 (cut 3): the wall's
+        // refinement puts a point where the two lines cross, reached along
+        // the y = 1 line on one side and along the z = 1 line on the other.
+        for right_first in [false, true] {
+            let mut points = Points::new();
+            let b = box_in(&mut points, &sized(DVec3::ZERO, DVec3::new(2.0, 4.0, 2.0))).unwrap();
+            let halves = split(&mut points, &b, DVec3::ZERO, DVec3::X, &[1.0], 1).unwrap();
+            let ro = DVec3::new(1.0, 0.0, 0.0);
+            let (mut left, mut right, mut planes) = (None, None, Vec::new());
+            for step in 0..2 {
+                if (step == 0) != right_first {
+                    left = Some(
+                        split(&mut points, &halves[0], DVec3::ZERO, DVec3::Y, &[1.0], 2).unwrap(),
+                    );
+                    planes.push(plane_of(DVec3::ZERO, DVec3::Y, 1.0));
+                } else {
+                    right = Some(split(&mut points, &halves[1], ro, DVec3::Z, &[1.0], 3).unwrap());
+                    planes.push(plane_of(ro, DVec3::Z, 1.0));
+                }
+            }
+            let (left, right) = (left.unwrap(), right.unwrap());
+            let seam_planes: HashMap<u32, Vec<(DVec3, f64)>> = [(1, planes)].into_iter().collect();
+            let w = weld(
+                &mut points,
+                &[&left[0], &right[0]],
+                &[],
+                &HashSet::new(),
+                &seam_planes,
+            )
+            .unwrap();
+            assert_closed(&w.soup.faces);
+            // [0, 1] x [0, 1] x [0, 2] and [1, 2] x [0, 4] x [0, 1].
+            let v = 1.0 * 1.0 * 2.0 + 1.0 * 4.0 * 1.0;
+            assert!((volume(&points, &soup_geometry(&w)) - v).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn a_loose_wall_cut_on_one_side_only_opens_where_both_sides_meet() {
+        let (points, w) = s0_s1(false, &[1]);
+        // Both parts closed on their own: the pair of wall pieces that
+        // mirror each other stays, the right part on copies of its points.
+        assert_closed(&w.soup.faces);
+        assert!((volume(&points, &soup_geometry(&w)) - 6.0).abs() < 1e-12);
+        // The left part's 8 corners, the right part's 8 corners (2 of them
+        // copies) and its 2 copied points at y = 1 on the wall: 18, and
+        // the 4 corners of the mirrored piece twice.
+        assert_eq!(w.soup.positions.len(), 18);
+        let mut at: HashMap<[u64; 3], usize> = HashMap::new();
+        for p in &w.soup.positions {
+            *at.entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+                .or_default() += 1;
+        }
+        assert_eq!(at.values().filter(|&&k| k == 2).count(), 4);
+        // Left: 6 faces; right: 5 outer faces and its wall in 2 pieces.
+        assert_eq!(w.soup.faces.len(), 13);
     }
 }

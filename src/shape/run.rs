@@ -200,6 +200,10 @@ struct Deriver<'g> {
     pending: std::collections::VecDeque<u32>,
     waiting: Vec<Wait<'g>>,
     loose: HashSet<u32>,
+    /// For each cut (wall) id, the planes of the later splits of shapes
+    /// holding a face of that wall, in the order they ran: the weld refines
+    /// the wall's faces on both sides by them, so the two sides match.
+    seam_planes: HashMap<u32, Vec<(DVec3, f64)>>,
     next_cut: u32,
     interp: Interp<'static>,
     env: Env,
@@ -227,6 +231,7 @@ pub fn derive(g: &ShapeGrammar, opts: &ShapeOptions, deadline: &Deadline) -> R<S
         pending: Default::default(),
         waiting: Vec::new(),
         loose: HashSet::new(),
+        seam_planes: HashMap::new(),
         next_cut: 1,
         interp: Interp::new(&[]),
         env: Env::new(Vec::new()),
@@ -831,6 +836,18 @@ impl<'g> Deriver<'g> {
         }
         let first = self.next_cut;
         self.next_cut += cuts.len() as u32;
+        if !cuts.is_empty() {
+            let planes: Vec<(DVec3, f64)> = cuts
+                .iter()
+                .map(|&c| geom::plane_of(cur.scope.origin, axis_dir, c))
+                .collect();
+            for k in geom::seams_of(&cur.geom) {
+                self.seam_planes
+                    .entry(k)
+                    .or_default()
+                    .extend_from_slice(&planes);
+            }
+        }
         let pieces = geom::split(
             &mut self.points,
             &cur.geom,
@@ -1135,8 +1152,14 @@ impl<'g> Deriver<'g> {
             .map(|&m| self.nodes[m as usize].geom.clone())
             .collect();
         let refs: Vec<&Geometry> = member_geoms.iter().collect();
-        let welded = geom::weld(&mut self.points, &refs, &others, &self.loose)
-            .map_err(|m| ShapeError::at(span, m))?;
+        let welded = geom::weld(
+            &mut self.points,
+            &refs,
+            &others,
+            &self.loose,
+            &self.seam_planes,
+        )
+        .map_err(|m| ShapeError::at(span, m))?;
         let smoothed = smooth::subdivide(
             &scheme.grammar,
             &welded.soup,
