@@ -318,7 +318,7 @@ impl<'g> Deriver<'g> {
                 span,
                 format!(
                     "the derivation made {} shapes, the limit: does a rule never reach a \
-                     terminal shape? (raise it with {MAX_SHAPES_VAR})",
+                     terminal shape? (raise it with --max-shapes or {MAX_SHAPES_VAR})",
                     self.opts.max_shapes
                 ),
             ));

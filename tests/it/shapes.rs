@@ -267,3 +267,127 @@ fn volumes(s: &Shapes, run: &ShapeRun) -> HashMap<String, f64> {
     }
     vol
 }
+
+/// The faces of each OBJ group, as lists of positions.
+fn groups(s: &Shapes, run: &ShapeRun) -> Vec<(String, Vec<Vec<[f64; 3]>>)> {
+    let (obj, _) = s.obj(run, "t.mtl");
+    let mut pos: Vec<[f64; 3]> = Vec::new();
+    let mut out: Vec<(String, Vec<Vec<[f64; 3]>>)> = Vec::new();
+    for line in obj.lines() {
+        let mut w = line.split_whitespace();
+        match w.next() {
+            Some("v") => {
+                let v: Vec<f64> = w.map(|x| x.parse().unwrap()).collect();
+                pos.push([v[0], v[1], v[2]]);
+            }
+            Some("g") => out.push((w.next().unwrap().to_string(), Vec::new())),
+            Some("f") => {
+                let f = w.map(|x| pos[x.parse::<usize>().unwrap() - 1]).collect();
+                out.last_mut().unwrap().1.push(f);
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// Paper 003, Fig. 10b and Algorithm 3: two parts of a split are smoothed,
+/// the third is not. The wall between the group and the unsmoothed part is
+/// protected: after subdivision the group still covers it with faces made
+/// of the unsmoothed part's own corners, bit for bit, so the two stay
+/// attached; the far end of the group was smoothed.
+#[test]
+fn the_wall_towards_an_unsmoothed_shape_is_protected() {
+    let text = "axiom: s(6, 2, 2) i(\"box\") A\n\
+         A --> split(x) { ~1 : P | ~1 : P | ~1 : Plain }\n\
+         P --> Subdivide(STEPS) { Done }\n";
+    for steps in 1..=3 {
+        let s = load(&text.replace("STEPS", &steps.to_string()));
+        let run = derive(&s, None);
+        let g = groups(&s, &run);
+        let plain = &g.iter().find(|(n, _)| n == "Plain_1").unwrap().1;
+        // Plain's wall towards the group is its face at x = 4.
+        let wall: Vec<[f64; 3]> = plain
+            .iter()
+            .find(|f| f.iter().all(|p| p[0] == 4.0))
+            .expect("Plain has its wall at x = 4")
+            .clone();
+        let done: Vec<&Vec<[f64; 3]>> = g
+            .iter()
+            .filter(|(n, _)| n.starts_with("Done_"))
+            .flat_map(|(_, f)| f)
+            .collect();
+        // The group still has the wall, as faces made of the wall's own
+        // corners only (the quad may come back as its two triangles) that
+        // cover its area, 2 x 2.
+        let on_wall: Vec<&&Vec<[f64; 3]>> = done
+            .iter()
+            .filter(|f| f.iter().all(|p| wall.contains(p)))
+            .collect();
+        let area: f64 = on_wall
+            .iter()
+            .map(|f| {
+                (1..f.len() - 1)
+                    .map(|k| {
+                        let (a, b, c) = (f[0], f[k], f[k + 1]);
+                        let u = [b[1] - a[1], b[2] - a[2]];
+                        let v = [c[1] - a[1], c[2] - a[2]];
+                        (u[0] * v[1] - u[1] * v[0]).abs() / 2.0
+                    })
+                    .sum::<f64>()
+            })
+            .sum();
+        assert_eq!(
+            area, 4.0,
+            "after {steps} steps the wall {wall:?} is not whole: {on_wall:?}"
+        );
+        // No vertex of the group lies inside the wall or moved off it.
+        assert!(done
+            .iter()
+            .flat_map(|f| f.iter())
+            .filter(|p| p[0] == 4.0)
+            .all(|p| wall.contains(p)));
+        // The rest of the group was smoothed: no other vertex of the group
+        // is a corner of the original box at x = 0.
+        let corners = done
+            .iter()
+            .flat_map(|f| f.iter())
+            .filter(|p| p[0] == 0.0 && (p[1] == 0.0 || p[1] == 2.0))
+            .count();
+        assert_eq!(corners, 0, "the far end was not smoothed");
+    }
+}
+
+/// Paper 003, Fig. 12: each shape gets exactly the faces that came from its
+/// own. On a closed group with nothing protected, sqrt(3) turns every
+/// triangle into 3 per step whose tag is the triangle's (a face split makes
+/// 3 of the same tag, a flip keeps both slots' tags), so a shape's slice
+/// after n steps has 3^n times the triangles it brought: its quads count 2.
+#[test]
+fn slices_go_back_to_their_shapes() {
+    let before = file("fig12-slices.lsys");
+    let text_before = std::fs::read_to_string(format!(
+        "{}/lsystems/shapes/fig12-slices.lsys",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let unsmoothed = load(&text_before.replace("Subdivide(3)", "Subdivide(0)"));
+    let run0 = derive(&unsmoothed, None);
+    let run3 = derive(&before, None);
+    // Each shape's triangles before: the faces of its part of the welded
+    // group (after Subdivide(0), which welds and hands back).
+    let tri = |faces: &Vec<Vec<[f64; 3]>>| faces.iter().map(|f| f.len() - 2).sum::<usize>();
+    let g0 = groups(&unsmoothed, &run0);
+    let g3 = groups(&before, &run3);
+    assert_eq!(g0.len(), 4);
+    assert_eq!(g3.len(), 4);
+    let mut total = 0;
+    for ((n0, f0), (n3, f3)) in g0.iter().zip(&g3) {
+        assert_eq!(n0, n3);
+        assert_eq!(f3.len(), tri(f0) * 27, "{n3}");
+        total += f3.len();
+    }
+    // The union of the slices is the whole subdivided mesh.
+    assert_eq!(total, run3.soup.faces.len());
+    assert_eq!(run3.counts().faces, total);
+}
