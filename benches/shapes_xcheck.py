@@ -74,6 +74,8 @@ def main():
     ap.add_argument("--example", default=None,
                     help="a built smooth_xcheck (default: cargo run --release --example)")
     ap.add_argument("--out", default=tempfile.mkdtemp(prefix="shapes-xcheck-"))
+    ap.add_argument("--shapes", nargs="*", default=[],
+                    help="shape grammars whose unprotected sqrt3 groups to compare too")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     import compas_cgal
@@ -108,6 +110,37 @@ def main():
               f" max distance {d.max():.3e}; 3^{k} faces per input triangle {per_face}"
               f" -> {'ok' if good else 'DIFFERENT'}")
     print(f"max difference over all steps: {worst:.3e}")
+    for g in a.shapes:
+        name = os.path.splitext(os.path.basename(g))[0]
+        d = os.path.join(a.out, name)
+        cmd = ([a.example] if a.example else
+               ["cargo", "run", "-q", "--release", "--example", "smooth_xcheck", "--"])
+        subprocess.run(cmd + ["--shapes", g, d], check=True, cwd=ROOT)
+        k = 1
+        while os.path.exists(os.path.join(d, f"group-{k}-welded.obj")):
+            steps, protected, scheme = open(os.path.join(d, f"group-{k}-info.txt")).read().split()
+            steps, protected = int(steps), int(protected)
+            if protected or scheme != "sqrt3":
+                print(f"  {name} group {k}: {protected} protected faces, {scheme}: not compared")
+                k += 1
+                continue
+            v, f = read_obj(os.path.join(d, f"group-{k}-welded.obj"))
+            vm, fm = read_obj(os.path.join(d, f"group-{k}-ours.obj"))
+            vr, fr = sub.mesh_subdivide_sqrt3((v, np.asarray(f, np.int64)), steps)
+            vr, fr = np.asarray(vr, float), np.asarray(fr).tolist()
+            dist, idx = cKDTree(vr).query(vm)
+            one_to_one = len(vr) == len(vm) and len(np.unique(idx)) == len(vm)
+            same = one_to_one and ({tuple(sorted(t)) for t in fr}
+                                   == {tuple(sorted(idx[t])) for t in fm})
+            good = one_to_one and same and dist.max() < 1e-12
+            ok &= good
+            worst = max(worst, dist.max())
+            print(f"  {name} group {k}: {len(f)} triangles welded, sqrt3 x {steps}: ours {len(vm)}"
+                  f" vertices {len(fm)} faces, CGAL {len(vr)} vertices {len(fr)} faces;"
+                  f" same faces {same}; max distance {dist.max():.3e}"
+                  f" -> {'ok' if good else 'DIFFERENT'}")
+            k += 1
+    print(f"max difference overall: {worst:.3e}")
     sys.exit(0 if ok else 1)
 
 

@@ -7,6 +7,14 @@
 //! OUT.obj.tags, one a line. `benches/shapes_xcheck.py` compares the
 //! output with CGAL's.
 //!
+//! `cargo run --release --example smooth_xcheck --shapes FILE.lsys DIR`
+//! derives a shape grammar and writes each smoothing group K as
+//! `DIR/group-K-welded.obj` (the welded mesh, its polygons cut into
+//! triangles as the half-edge mesh cuts them: quads along their first
+//! diagonal, larger polygons in a fan from their first corner),
+//! `DIR/group-K-ours.obj` (its subdivision in the derivation) and
+//! `DIR/group-K-info.txt` (`steps protected-faces scheme`).
+//!
 //! `cargo run --release --example smooth_xcheck --bench` times one √3 step
 //! through `subdivide` (soup in, soup out) against `Grammar::run` on the
 //! same mesh, in the same run, on a 224 x 224 torus cut into 100,352
@@ -21,6 +29,10 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.first().map(String::as_str) == Some("--bench") {
         bench();
+        return;
+    }
+    if args.first().map(String::as_str) == Some("--shapes") && args.len() == 3 {
+        groups(Path::new(&args[1]), Path::new(&args[2]));
         return;
     }
     if args.len() < 3 {
@@ -48,6 +60,29 @@ fn main() {
     let lines: Vec<String> = tags.iter().map(u32::to_string).collect();
     std::fs::write(format!("{}.tags", args[1]), lines.join("\n") + "\n")
         .unwrap_or_else(|e| fail(&e.to_string()));
+}
+
+fn groups(file: &Path, dir: &Path) {
+    let groups = subgram::shape_groups(file, 1).unwrap_or_else(|e| fail(&e.to_string()));
+    std::fs::create_dir_all(dir).unwrap_or_else(|e| fail(&e.to_string()));
+    for (k, g) in groups.iter().enumerate() {
+        let welded = &g.welded;
+        let tris = PolygonSoup {
+            faces: welded
+                .faces
+                .iter()
+                .flat_map(|f| (1..f.len() - 1).map(|i| vec![f[0], f[i], f[i + 1]]))
+                .collect(),
+            positions: welded.positions.clone(),
+            ..PolygonSoup::default()
+        };
+        let at = |name: &str| dir.join(format!("group-{}-{name}", k + 1));
+        io::write(&at("welded.obj"), &tris).unwrap_or_else(|e| fail(&e.to_string()));
+        io::write(&at("ours.obj"), &g.subdivided).unwrap_or_else(|e| fail(&e.to_string()));
+        let info = format!("{} {} {}\n", g.steps, g.protected_faces, g.scheme);
+        std::fs::write(at("info.txt"), info).unwrap_or_else(|e| fail(&e.to_string()));
+    }
+    println!("{} groups written to {}", groups.len(), dir.display());
 }
 
 fn fail(m: &str) -> ! {

@@ -66,6 +66,49 @@ pub use system::{
     System, Vv, VvInfo, VvResult, MAX_SURFACE_STEPS,
 };
 
+/// The smoothing groups of a shape grammar's derivation: each group's
+/// welded mesh and its subdivision, with the number of protected faces, for
+/// `examples/smooth_xcheck.rs --shapes` and its cross-check against CGAL.
+#[doc(hidden)]
+pub fn shape_groups(
+    path: &std::path::Path,
+    seed: u32,
+) -> Result<Vec<ShapeGroup>, Error> {
+    let System::Shapes(s) = load(path, &LoadOptions::default())? else {
+        return Err(Error::Usage(format!("{}: not a shape grammar", path.display())));
+    };
+    let opts = shape::ShapeOptions {
+        seed,
+        keep_meshes: true,
+        ..Default::default()
+    };
+    let never = Deadline::after(std::time::Duration::from_secs(3600));
+    let tree = shape::run::derive(&s.grammar, &opts, &never).map_err(|e| s.error(e))?;
+    Ok(tree
+        .groups
+        .into_iter()
+        .filter_map(|g| {
+            g.meshes.map(|m| ShapeGroup {
+                welded: m.0,
+                subdivided: m.1,
+                protected_faces: g.protected_faces,
+                steps: g.steps,
+                scheme: g.scheme,
+            })
+        })
+        .collect())
+}
+
+/// A smoothing group of [`shape_groups`].
+#[doc(hidden)]
+pub struct ShapeGroup {
+    pub welded: mesh::PolygonSoup,
+    pub subdivided: mesh::PolygonSoup,
+    pub protected_faces: usize,
+    pub steps: usize,
+    pub scheme: String,
+}
+
 /// Subdivide of a welded smoothing group (`shape::smooth`), for
 /// `examples/smooth_xcheck.rs` and its cross-check against CGAL: the
 /// grammar of scheme `name` ("sqrt3", "loop", "catmull-clark").

@@ -28,6 +28,7 @@ use crate::deadline::Deadline;
 use crate::lang::eval::{Env, Interp};
 use crate::lang::random::{Rand48, Random};
 use crate::lang::value::Value;
+use crate::mesh::PolygonSoup;
 use crate::syntax::span::Span;
 
 use super::geom::{self, Geometry, Points, Scope, Selector};
@@ -123,6 +124,9 @@ pub struct ShapeOptions {
     /// Take pending shapes last-in first-out (the default) or first-in
     /// first-out; the result is the same, which a test checks.
     pub fifo: bool,
+    /// Keep each smoothing group's welded and subdivided meshes in its
+    /// report (for cross-checks).
+    pub keep_meshes: bool,
 }
 
 impl Default for ShapeOptions {
@@ -131,6 +135,7 @@ impl Default for ShapeOptions {
             seed: 1,
             max_shapes: MAX_SHAPES,
             fifo: false,
+            keep_meshes: false,
         }
     }
 }
@@ -155,6 +160,8 @@ pub struct GroupReport {
     pub protected_vertices: usize,
     pub scheme: String,
     pub steps: usize,
+    /// The welded group and its subdivision, with `keep_meshes`.
+    pub meshes: Option<Box<(PolygonSoup, PolygonSoup)>>,
 }
 
 impl ShapeTree {
@@ -1178,6 +1185,10 @@ impl<'g> Deriver<'g> {
             protected_vertices: welded.protected_vertex.iter().filter(|&&b| b).count(),
             scheme: scheme.name.clone(),
             steps,
+            meshes: self
+                .opts
+                .keep_meshes
+                .then(|| Box::new((welded.soup.clone(), smoothed.soup.clone()))),
         });
         // One point per output vertex, the input's where it did not move.
         let mut ids: Vec<Option<u32>> = vec![None; smoothed.soup.positions.len()];
