@@ -15,6 +15,9 @@
 //! `DIR/group-K-ours.obj` (its subdivision in the derivation) and
 //! `DIR/group-K-info.txt` (`steps protected-faces scheme`).
 //!
+//! `smooth_xcheck --obj-copy IN.obj OUT.obj` is the shape benchmark's
+//! reference: an OBJ read into arrays and written back by a hand loop.
+//!
 //! `cargo run --release --example smooth_xcheck --bench` times one √3 step
 //! through `subdivide` (soup in, soup out) against `Grammar::run` on the
 //! same mesh, in the same run, on a 224 x 224 torus cut into 100,352
@@ -29,6 +32,10 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.first().map(String::as_str) == Some("--bench") {
         bench();
+        return;
+    }
+    if args.first().map(String::as_str) == Some("--obj-copy") && args.len() == 3 {
+        obj_copy(Path::new(&args[1]), Path::new(&args[2]));
         return;
     }
     if args.first().map(String::as_str) == Some("--shapes") && args.len() == 3 {
@@ -83,6 +90,50 @@ fn groups(file: &Path, dir: &Path) {
         std::fs::write(at("info.txt"), info).unwrap_or_else(|e| fail(&e.to_string()));
     }
     println!("{} groups written to {}", groups.len(), dir.display());
+}
+
+/// The shape benchmark's reference: a hand loop that reads an OBJ's `v`,
+/// `f`, `g` and `usemtl` lines into arrays and writes them back in the same
+/// form, with no checks: the floor of files in and out for that output.
+fn obj_copy(input: &Path, output: &Path) {
+    use std::fmt::Write as _;
+    let text = std::fs::read_to_string(input).unwrap_or_else(|e| fail(&e.to_string()));
+    let mut pos: Vec<[f64; 3]> = Vec::new();
+    let mut faces: Vec<(usize, Vec<u32>)> = Vec::new();
+    let mut names: Vec<String> = Vec::new();
+    for line in text.lines() {
+        let mut w = line.split_ascii_whitespace();
+        match w.next() {
+            Some("v") => {
+                let mut p = [0.0; 3];
+                for c in &mut p {
+                    *c = w.next().and_then(|x| x.parse().ok()).unwrap_or(0.0);
+                }
+                pos.push(p);
+            }
+            Some("g") | Some("usemtl") => names.push(line.to_string()),
+            Some("f") => faces.push((names.len(), w.filter_map(|x| x.parse().ok()).collect())),
+            _ => {}
+        }
+    }
+    let mut out = String::with_capacity(text.len());
+    for p in &pos {
+        let _ = writeln!(out, "v {} {} {}", p[0], p[1], p[2]);
+    }
+    let mut named = 0;
+    for (k, f) in &faces {
+        while named < *k {
+            out.push_str(&names[named]);
+            out.push('\n');
+            named += 1;
+        }
+        out.push('f');
+        for i in f {
+            let _ = write!(out, " {i}");
+        }
+        out.push('\n');
+    }
+    std::fs::write(output, out).unwrap_or_else(|e| fail(&e.to_string()));
 }
 
 fn fail(m: &str) -> ! {

@@ -70,12 +70,12 @@ pub use system::{
 /// welded mesh and its subdivision, with the number of protected faces, for
 /// `examples/smooth_xcheck.rs --shapes` and its cross-check against CGAL.
 #[doc(hidden)]
-pub fn shape_groups(
-    path: &std::path::Path,
-    seed: u32,
-) -> Result<Vec<ShapeGroup>, Error> {
+pub fn shape_groups(path: &std::path::Path, seed: u32) -> Result<Vec<ShapeGroup>, Error> {
     let System::Shapes(s) = load(path, &LoadOptions::default())? else {
-        return Err(Error::Usage(format!("{}: not a shape grammar", path.display())));
+        return Err(Error::Usage(format!(
+            "{}: not a shape grammar",
+            path.display()
+        )));
     };
     let opts = shape::ShapeOptions {
         seed,

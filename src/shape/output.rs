@@ -35,9 +35,17 @@ fn state_name(s: &State) -> &'static str {
 }
 
 fn num(x: f64) -> String {
-    // The shortest text that reads back as the same double; -0 as 0.
-    let x = if x == 0.0 { 0.0 } else { x };
-    format!("{x}")
+    format!("{}", unsigned_zero(x))
+}
+
+/// `x`, with -0 as 0: written with `{}`, the shortest text that reads back
+/// as the same double.
+fn unsigned_zero(x: f64) -> f64 {
+    if x == 0.0 {
+        0.0
+    } else {
+        x
+    }
 }
 
 /// The tree as indented text: one line per shape.
@@ -118,14 +126,17 @@ fn material(c: [u8; 3]) -> String {
 /// name as the OBJ refers to it.
 pub fn obj(g: &ShapeGrammar, t: &ShapeTree, mtl_name: &str) -> (String, String) {
     let leaves = t.leaves();
-    let mut index: HashMap<u32, usize> = HashMap::new();
+    // Each point's OBJ number (from 1; 0: not written), by point id.
+    let mut index: Vec<u32> = vec![0; t.points.pos.len()];
     let mut order: Vec<u32> = Vec::new();
     for &l in &leaves {
         for p in t.nodes[l as usize].geom.point_ids() {
-            index.entry(p).or_insert_with(|| {
-                order.push(p);
-                order.len()
-            });
+            if let Some(slot) = index.get_mut(p as usize) {
+                if *slot == 0 {
+                    order.push(p);
+                    *slot = order.len() as u32;
+                }
+            }
         }
     }
     let mut out = String::with_capacity(order.len() * 40 + leaves.len() * 64);
@@ -137,7 +148,8 @@ pub fn obj(g: &ShapeGrammar, t: &ShapeTree, mtl_name: &str) -> (String, String) 
     let _ = writeln!(out, "mtllib {mtl_name}");
     for &p in &order {
         let v = t.points.pos[p as usize];
-        let _ = writeln!(out, "v {} {} {}", num(v.x), num(v.y), num(v.z));
+        let z = unsigned_zero;
+        let _ = writeln!(out, "v {} {} {}", z(v.x), z(v.y), z(v.z));
     }
     let mut count: HashMap<u32, usize> = HashMap::new();
     let mut colours: Vec<[u8; 3]> = Vec::new();
@@ -168,19 +180,20 @@ pub fn obj(g: &ShapeGrammar, t: &ShapeTree, mtl_name: &str) -> (String, String) 
     (out, mtl)
 }
 
-fn write_geometry(out: &mut String, geom: &Geometry, index: &HashMap<u32, usize>) {
+fn write_geometry(out: &mut String, geom: &Geometry, index: &[u32]) {
+    let at = |p: u32| index.get(p as usize).copied().unwrap_or(0);
     for f in &geom.faces {
         out.push('f');
-        for p in &f.pts {
-            let _ = write!(out, " {}", index[p]);
+        for &p in &f.pts {
+            let _ = write!(out, " {}", at(p));
         }
         out.push('\n');
     }
     for e in &geom.edges {
-        let _ = writeln!(out, "l {} {}", index[&e[0]], index[&e[1]]);
+        let _ = writeln!(out, "l {} {}", at(e[0]), at(e[1]));
     }
-    for v in &geom.verts {
-        let _ = writeln!(out, "p {}", index[v]);
+    for &v in &geom.verts {
+        let _ = writeln!(out, "p {}", at(v));
     }
 }
 
@@ -189,7 +202,8 @@ fn write_geometry(out: &mut String, geom: &Geometry, index: &HashMap<u32, usize>
 pub fn soup(t: &ShapeTree) -> (PolygonSoup, Vec<Rgba>) {
     let mut soup = PolygonSoup::default();
     let mut colours = Vec::new();
-    let mut index: HashMap<u32, u32> = HashMap::new();
+    // Each point's soup vertex, by point id (u32::MAX: none yet).
+    let mut index: Vec<u32> = vec![u32::MAX; t.points.pos.len()];
     for l in t.leaves() {
         let node = &t.nodes[l as usize];
         let c = colour_of(node);
@@ -198,10 +212,12 @@ pub fn soup(t: &ShapeTree) -> (PolygonSoup, Vec<Rgba>) {
                 .pts
                 .iter()
                 .map(|&p| {
-                    *index.entry(p).or_insert_with(|| {
+                    let slot = &mut index[p as usize];
+                    if *slot == u32::MAX {
                         soup.positions.push(t.points.pos[p as usize]);
-                        soup.positions.len() as u32 - 1
-                    })
+                        *slot = soup.positions.len() as u32 - 1;
+                    }
+                    *slot
                 })
                 .collect();
             soup.faces.push(face);
