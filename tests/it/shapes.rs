@@ -391,3 +391,77 @@ fn slices_go_back_to_their_shapes() {
     assert_eq!(total, run3.soup.faces.len());
     assert_eq!(run3.counts().faces, total);
 }
+
+/// `Subdivide` takes the project's Loop and Catmull-Clark grammars too: a
+/// box of 6 quads is 12 triangles, which one Loop step makes 4 x 12 = 48;
+/// one Catmull-Clark step makes 4 quads of each quad, 24.
+#[test]
+fn subdivide_with_loop_and_catmull_clark() {
+    for (scheme, faces, sides) in [("loop", 48, 3), ("catmull-clark", 24, 4)] {
+        let s = load(&format!(
+            "axiom: s(2, 2, 2) i(\"box\") A\nA --> Subdivide(1, \"{scheme}\") {{ Done }}\n"
+        ));
+        let run = derive(&s, None);
+        assert_eq!(run.soup.faces.len(), faces, "{scheme}");
+        assert!(run.soup.faces.iter().all(|f| f.len() == sides), "{scheme}");
+    }
+}
+
+/// Paper 003, section 4.3.1 and Algorithm 4: a group named by the
+/// `smoothingGroup` attribute is subdivided once every member is waiting
+/// or terminal, terminal members included. Here R never subdivides but is
+/// in the group, so it is smoothed with L: both halves of the box come back
+/// as 3 times the triangles they brought (one step of sqrt(3) on a closed
+/// mesh), and there is one group.
+#[test]
+fn a_named_group_waits_for_its_members_and_takes_terminal_ones() {
+    let s = load(
+        "axiom: s(4, 2, 2) i(\"box\") A\n\
+         A --> set(smoothingGroup, \"g\") split(x) { ~1 : L | ~1 : R }\n\
+         L --> Subdivide(1) { Done }\n",
+    );
+    let run = derive(&s, None);
+    assert_eq!(run.counts().smoothing_groups, 1);
+    let g = groups(&s, &run);
+    // Each half brings 5 quads (its wall towards the other is dropped):
+    // 10 triangles, 30 after one step.
+    for name in ["Done_1", "R_1"] {
+        let faces = &g.iter().find(|(n, _)| n == name).unwrap().1;
+        assert_eq!(faces.len(), 30, "{name}");
+    }
+    // Without the name, R is not waiting and not in a group: it keeps its
+    // box faces and protects the wall it shares with L.
+    let s = load(
+        "axiom: s(4, 2, 2) i(\"box\") A\n\
+         A --> split(x) { ~1 : L | ~1 : R }\n\
+         L --> Subdivide(1) { Done }\n",
+    );
+    let run = derive(&s, None);
+    let g = groups(&s, &run);
+    assert_eq!(g.iter().find(|(n, _)| n == "R_1").unwrap().1.len(), 6);
+}
+
+/// A derivation that fails writes nothing: no OBJ, no MTL.
+#[test]
+fn a_failed_derivation_writes_no_file() {
+    let dir = std::env::temp_dir().join(format!("subgram-shapes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let grammar = dir.join("bad.lsys");
+    std::fs::write(
+        &grammar,
+        "axiom: s(10, 1, 1) i(\"box\") A\nA --> split(x) { 6 : B | 6 : C }\n",
+    )
+    .unwrap();
+    let out = dir.join("out.obj");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .args(["subdivide", "--grammar"])
+        .arg(&grammar)
+        .arg("-o")
+        .arg(&out)
+        .stderr(std::process::Stdio::null())
+        .status()
+        .unwrap();
+    assert_eq!(status.code(), Some(1));
+    assert!(!out.exists() && !dir.join("out.mtl").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
