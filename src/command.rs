@@ -561,8 +561,17 @@ pub struct SubdivideArgs {
     pub program_output: ProgramOutput,
 }
 
-/// `subgram subdivide`: runs a surface grammar on a mesh and writes the
-/// mesh or its picture.
+/// What a `subdivide --grammar` file holds.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Surface,
+    Vv,
+    Shapes,
+}
+
+/// `subgram subdivide`: runs a surface grammar or a vv program on a mesh,
+/// or derives a shape grammar, and writes the mesh or its picture. The
+/// file is read and lexed once.
 pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<(), Error> {
     let deadline = a.timeout.map(Deadline::after);
     let grammar = Path::new(&a.grammar);
@@ -584,8 +593,21 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         view: a.view.as_deref(),
         wireframe: d.wireframe,
     };
+    // The file is read and lexed once; its tokens say what it is.
+    let text = crate::load::read(grammar)?;
+    let front = crate::load::front(&grammar.display().to_string(), text, &a.defines)?;
+    let kind = if crate::shape::is_shapes(&front.tokens) {
+        Kind::Shapes
+    } else if crate::vv::is_vv(&front.tokens) {
+        Kind::Vv
+    } else {
+        Kind::Surface
+    };
     // A shape grammar writes its terminal shapes.
-    if let Some(shapes) = shape_grammar(grammar, &a.defines)? {
+    if kind == Kind::Shapes {
+        let dir = grammar.parent().unwrap_or(Path::new("")).to_path_buf();
+        let g = crate::load::with_stack(move || crate::shape::from_front(front, Some(&dir)))?;
+        let shapes = crate::system::Shapes::new(g);
         let opts = RunOptions {
             seed: a.seed,
             ..opts
@@ -597,7 +619,9 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         return write_shapes(&shapes, &run, output, &looks);
     }
     // A vv program subdivides too.
-    if let Some(v) = vv_program(grammar, &a.defines)? {
+    if kind == Kind::Vv {
+        let program = crate::load::with_stack(move || crate::vv::from_front(front))?;
+        let v = crate::system::Vv::new(program, Some(grammar));
         if a.mesh.is_none() {
             inputs.extend(v.base_mesh());
             refuse_overwrite(&[output], &as_paths(&inputs), a.force)?;
@@ -608,7 +632,7 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         }
         return Ok(mesh::io::write(output, &run.soup)?);
     }
-    let g = crate::surface::load_file(grammar, &a.defines)?;
+    let g = crate::load::with_stack(move || crate::surface::from_front(front))?;
     let surface = Surface::new(g, Some(grammar));
     if a.mesh.is_none() {
         // The grammar's own `mesh:` is an input too.
@@ -620,18 +644,6 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         return write_mesh_picture(&run.mesh, output, &looks);
     }
     Ok(mesh::io::write(output, &run.mesh.to_quad_soup())?)
-}
-
-/// The shape grammar in `file`, when it holds one.
-fn shape_grammar(file: &Path, defines: &[String]) -> Result<Option<crate::system::Shapes>, Error> {
-    let text = crate::load::read(file)?;
-    let front = crate::load::front(&file.display().to_string(), text, defines)?;
-    if !crate::shape::is_shapes(&front.tokens) {
-        return Ok(None);
-    }
-    let dir = file.parent().unwrap_or(Path::new("")).to_path_buf();
-    let g = crate::load::with_stack(move || crate::shape::from_front(front, Some(&dir)))?;
-    Ok(Some(crate::system::Shapes::new(g)))
 }
 
 /// A shape derivation to `.obj` (with its `.mtl` beside it, both or
@@ -687,17 +699,6 @@ fn write_shapes_picture(
         Picture::Png => crate::render::mesh::render_png(&run.soup, &mv)?,
     };
     write_file(output, &bytes)
-}
-
-/// The vv program in `file`, when it holds one.
-fn vv_program(file: &Path, defines: &[String]) -> Result<Option<crate::system::Vv>, Error> {
-    let text = crate::load::read(file)?;
-    let front = crate::load::front(&file.display().to_string(), text, defines)?;
-    if !crate::vv::is_vv(&front.tokens) {
-        return Ok(None);
-    }
-    let program = crate::load::with_stack(move || crate::vv::from_front(front))?;
-    Ok(Some(crate::system::Vv::new(program, Some(file))))
 }
 
 /// `subgram mesh info`: counts, boundary loops, Euler characteristic, genus,
