@@ -243,7 +243,11 @@ fn derive_text(
             before()?;
             let counts = run.counts();
             if a.json {
-                json(&serde_json::json!({ "counts": counts, "shapes": s.tree_json(&run) }))
+                Ok(format!(
+                    "{{\"counts\": {},\n\"shapes\": {}}}",
+                    json(&counts)?,
+                    s.tree_json(&run)
+                ))
             } else {
                 Ok(format!(
                     "{}{}shapes: {}\nterminal shapes: {}\nfaces: {}\nsmoothing groups: {}",

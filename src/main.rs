@@ -47,7 +47,7 @@ enum Command {
         #[arg(long)]
         interpreted: bool,
         /// Shape grammars: stop with an error when a derivation makes more
-        /// shapes than this (default: SUBGRAM_MAX_SHAPES or 2000000).
+        /// shapes than this (default: SUBGRAM_MAX_SHAPES or 1000000).
         #[arg(long, value_name = "N")]
         max_shapes: Option<usize>,
         /// Seed every random number generator (ran, rand, drand48,

@@ -53,7 +53,7 @@ pub struct RunOptions {
     /// Curves: where the program's `printf`s and files go.
     pub output: ProgramOutput,
     /// Shape grammars: the most shapes a derivation may make (default
-    /// `SUBGRAM_MAX_SHAPES` or 2,000,000).
+    /// `SUBGRAM_MAX_SHAPES` or 1,000,000).
     pub max_shapes: Option<usize>,
 }
 
@@ -630,7 +630,7 @@ impl Shapes {
     }
 
     /// The shape tree as JSON.
-    pub fn tree_json(&self, run: &ShapeRun) -> serde_json::Value {
+    pub fn tree_json(&self, run: &ShapeRun) -> String {
         crate::shape::output::tree_json(&self.grammar, &run.tree)
     }
 

@@ -84,35 +84,69 @@ pub fn tree_text(g: &ShapeGrammar, t: &ShapeTree) -> String {
     out
 }
 
-/// The tree as JSON: an array of root shapes, each with its symbol,
-/// parameters, scope, dimension, face count, state and children.
-pub fn tree_json(g: &ShapeGrammar, t: &ShapeTree) -> serde_json::Value {
-    fn shape(g: &ShapeGrammar, t: &ShapeTree, n: u32) -> serde_json::Value {
+/// The tree as JSON text: an array of root shapes, each an object with its
+/// symbol, parameters, scope (origin, axes, size), dimension, face count,
+/// the number of vertices it shares with its parent (the paper's
+/// connectivity map), state and children, one shape per line. Written with
+/// an explicit stack, so a tree as deep as the shape limit allows is
+/// written without recursion.
+pub fn tree_json(g: &ShapeGrammar, t: &ShapeTree) -> String {
+    let mut out = String::from("[");
+    // (node, index among its siblings) to open, or None to close a shape.
+    let mut stack: Vec<Option<(u32, usize)>> = t
+        .roots
+        .iter()
+        .enumerate()
+        .rev()
+        .map(|(i, &r)| Some((r, i)))
+        .collect();
+    let f = |x: f64| serde_json::Value::from(unsigned_zero(x)).to_string();
+    let v3 = |v: glam::DVec3| format!("[{}, {}, {}]", f(v.x), f(v.y), f(v.z));
+    while let Some(item) = stack.pop() {
+        let Some((n, i)) = item else {
+            out.push_str("]}");
+            continue;
+        };
+        if i > 0 {
+            out.push(',');
+        }
+        out.push('\n');
         let node = &t.nodes[n as usize];
         let s = &node.scope;
-        let v3 = |v: glam::DVec3| serde_json::json!([v.x, v.y, v.z]);
-        serde_json::json!({
-            "symbol": g.symbols[node.symbol as usize],
-            "params": node.params,
-            "scope": {
-                "origin": v3(s.origin),
-                "x": v3(s.axes[0]),
-                "y": v3(s.axes[1]),
-                "z": v3(s.axes[2]),
-                "size": v3(s.size),
-            },
-            "dim": node.geom.dim,
-            "faces": node.geom.face_count(),
-            // The paper's connectivity map: the vertices shared with the
-            // parent shape.
-            "shared_with_parent": if node.parent == u32::MAX { 0 } else { shared(t, n, node.parent).len() },
-            "state": state_name(&node.state),
-            "children": node.children.iter().map(|&c| shape(g, t, c)).collect::<Vec<_>>(),
-        })
+        let params: Vec<String> = node.params.iter().map(|&x| f(x)).collect();
+        let shared = if node.parent == u32::MAX {
+            0
+        } else {
+            shared(t, n, node.parent).len()
+        };
+        let _ = write!(
+            out,
+            "{{\"symbol\": {}, \"params\": [{}], \"scope\": {{\"origin\": {}, \"x\": {}, \
+             \"y\": {}, \"z\": {}, \"size\": {}}}, \"dim\": {}, \"faces\": {}, \
+             \"shared_with_parent\": {}, \"state\": \"{}\", \"children\": [",
+            serde_json::Value::from(g.symbols[node.symbol as usize].as_str()),
+            params.join(", "),
+            v3(s.origin),
+            v3(s.axes[0]),
+            v3(s.axes[1]),
+            v3(s.axes[2]),
+            v3(s.size),
+            node.geom.dim,
+            node.geom.face_count(),
+            shared,
+            state_name(&node.state)
+        );
+        stack.push(None);
+        stack.extend(
+            node.children
+                .iter()
+                .enumerate()
+                .rev()
+                .map(|(k, &c)| Some((c, k))),
+        );
     }
-    // Deep trees are walked with an explicit stack elsewhere; JSON nesting
-    // follows the tree, whose depth the shape limit bounds.
-    serde_json::Value::Array(t.roots.iter().map(|&r| shape(g, t, r)).collect())
+    out.push_str("\n]");
+    out
 }
 
 /// The material name of a colour.

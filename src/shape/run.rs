@@ -39,7 +39,7 @@ use super::{COp, CPart, ShapeGrammar, X};
 
 /// The largest number of shapes a derivation may make (all of them, not
 /// only the terminal ones), unless `SUBGRAM_MAX_SHAPES` says otherwise.
-pub const MAX_SHAPES: usize = 2_000_000;
+pub const MAX_SHAPES: usize = 1_000_000;
 pub const MAX_SHAPES_VAR: &str = "SUBGRAM_MAX_SHAPES";
 
 /// A shape's place in the derivation.
@@ -67,7 +67,9 @@ pub struct Node {
     pub group: Option<Arc<str>>,
     pub colour: Option<[u8; 3]>,
     pub scope: Scope,
-    pub geom: Geometry,
+    /// Shared until a shape changes it: a child made by a symbol holds its
+    /// parent's geometry without a copy.
+    pub geom: Arc<Geometry>,
     /// `u32::MAX` for the axiom's shapes.
     pub parent: u32,
     pub children: Vec<u32>,
@@ -190,7 +192,7 @@ impl ShapeTree {
 #[derive(Clone, Debug)]
 struct Cur {
     scope: Scope,
-    geom: Geometry,
+    geom: Arc<Geometry>,
     group: Option<Arc<str>>,
     colour: Option<[u8; 3]>,
     split: (i64, i64),
@@ -250,7 +252,7 @@ pub fn derive(g: &ShapeGrammar, opts: &ShapeOptions, deadline: &Deadline) -> R<S
     frame.resize(g.axiom_frame.max(frame.len()), Value::Void);
     let mut cur = Cur {
         scope: Scope::world(),
-        geom: Geometry::empty(3),
+        geom: Arc::new(Geometry::empty(3)),
         group: None,
         colour: None,
         split: (0, 1),
@@ -540,7 +542,11 @@ impl<'g> Deriver<'g> {
                         cur.scope.axes[0] * t.x + cur.scope.axes[1] * t.y + cur.scope.axes[2] * t.z;
                     if d != DVec3::ZERO {
                         cur.scope.origin += d;
-                        cur.geom = self.moved(&cur.geom, &DAffine3::from_translation(d), *span)?;
+                        cur.geom = Arc::new(self.moved(
+                            &cur.geom,
+                            &DAffine3::from_translation(d),
+                            *span,
+                        )?);
                     }
                 }
                 COp::Rotate(v, span) => {
@@ -555,7 +561,7 @@ impl<'g> Deriver<'g> {
                             * DAffine3::from_mat3(rot)
                             * DAffine3::from_translation(-o);
                         cur.scope.axes = [rot * axes[0], rot * axes[1], rot * axes[2]];
-                        cur.geom = self.moved(&cur.geom, &f, *span)?;
+                        cur.geom = Arc::new(self.moved(&cur.geom, &f, *span)?);
                     }
                 }
                 COp::Scale(v, span) => {
@@ -579,7 +585,7 @@ impl<'g> Deriver<'g> {
                                 m * DMat3::from_diagonal(DVec3::new(rx, ry, rz)) * m.transpose(),
                             )
                             * DAffine3::from_translation(-o);
-                        cur.geom = self.moved(&cur.geom, &f, *span)?;
+                        cur.geom = Arc::new(self.moved(&cur.geom, &f, *span)?);
                     }
                 }
                 COp::Extrude(h, span) => {
@@ -608,8 +614,10 @@ impl<'g> Deriver<'g> {
                     } else {
                         cur.scope.axes[k]
                     };
-                    cur.geom = geom::extrude(&mut self.points, &cur.geom, dir, h)
-                        .map_err(|m| ShapeError::at(*span, m))?;
+                    cur.geom = Arc::new(
+                        geom::extrude(&mut self.points, &cur.geom, dir, h)
+                            .map_err(|m| ShapeError::at(*span, m))?,
+                    );
                     cur.scope = geom::bounding_scope(&self.points, &cur.geom, cur.scope.axes);
                 }
                 COp::Insert(kind, span) => {
@@ -636,7 +644,7 @@ impl<'g> Deriver<'g> {
                         super::Insert::Mesh(soup) => geom::mesh_in(&mut self.points, &s, soup),
                     }
                     .map_err(|m| ShapeError::at(*span, m))?;
-                    cur.geom = g;
+                    cur.geom = Arc::new(g);
                 }
                 COp::Colour(c) => cur.colour = Some(*c),
                 COp::ColourRgb(v) => {
@@ -773,7 +781,7 @@ impl<'g> Deriver<'g> {
         let x = if x == DVec3::ZERO { DVec3::X } else { x };
         let y = DVec3::Y;
         let z = x.cross(y);
-        cur.geom = g;
+        cur.geom = Arc::new(g);
         cur.scope = geom::bounding_scope(&self.points, &cur.geom, [x, y, z]);
         Ok(())
     }
@@ -909,7 +917,7 @@ impl<'g> Deriver<'g> {
             offset += len;
             let mut c = Cur {
                 scope,
-                geom: g,
+                geom: Arc::new(g),
                 group: cur.group.clone(),
                 colour: cur.colour,
                 split: (i as i64, count),
@@ -1009,7 +1017,7 @@ impl<'g> Deriver<'g> {
                 };
                 let mut c = Cur {
                     scope: s,
-                    geom: g,
+                    geom: Arc::new(g),
                     group: cur.group.clone(),
                     colour: cur.colour,
                     split: cur.split,
@@ -1152,13 +1160,13 @@ impl<'g> Deriver<'g> {
         let others: Vec<&Geometry> = live
             .iter()
             .filter(|x| !inside.contains(x))
-            .map(|&x| &self.nodes[x as usize].geom)
+            .map(|&x| &*self.nodes[x as usize].geom)
             .collect();
-        let member_geoms: Vec<Geometry> = members
+        let member_geoms: Vec<Arc<Geometry>> = members
             .iter()
             .map(|&m| self.nodes[m as usize].geom.clone())
             .collect();
-        let refs: Vec<&Geometry> = member_geoms.iter().collect();
+        let refs: Vec<&Geometry> = member_geoms.iter().map(|g| &**g).collect();
         let welded = geom::weld(
             &mut self.points,
             &refs,
@@ -1221,7 +1229,7 @@ impl<'g> Deriver<'g> {
         for (k, (&m, faces)) in members.iter().zip(slices).enumerate() {
             let _ = k;
             let node = &mut self.nodes[m as usize];
-            node.geom.faces = faces;
+            Arc::make_mut(&mut node.geom).faces = faces;
             node.scope = geom::bounding_scope(&self.points, &node.geom, node.scope.axes);
         }
         Ok(())

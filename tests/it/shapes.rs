@@ -34,7 +34,7 @@ fn derive(s: &Shapes, seed: Option<u32>) -> ShapeRun {
 
 /// The children of the first root, as (symbol, origin, size).
 fn children(s: &Shapes, run: &ShapeRun) -> Vec<(String, [f64; 3], [f64; 3])> {
-    let tree = s.tree_json(run);
+    let tree: serde_json::Value = serde_json::from_str(&s.tree_json(run)).unwrap();
     let three = |v: &serde_json::Value| -> [f64; 3] {
         let a = v.as_array().unwrap();
         [
@@ -205,7 +205,7 @@ fn paper_notation_runs_as_printed() {
     for seed in 1..40 {
         let run = derive(&s, Some(seed));
         let kids: Vec<(String, Vec<f64>)> = {
-            let tree = s.tree_json(&run);
+            let tree: serde_json::Value = serde_json::from_str(&s.tree_json(&run)).unwrap();
             tree[0]["children"]
                 .as_array()
                 .unwrap()
