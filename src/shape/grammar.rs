@@ -92,9 +92,9 @@ pub enum Op {
     /// current shape.
     Symbol { name: Name, args: Vec<Expr> },
     /// `NIL` or `epsilon`: the current shape is removed.
-    Nil,
+    Nil(Span),
     /// `[`: the current shape is saved ...
-    Push,
+    Push(Span),
     /// `]`: ... and restored.
     Pop(Span),
     /// An operation on the current shape: `t`, `r`, `s`, `extrude`, `i`,
@@ -102,6 +102,9 @@ pub enum Op {
     Call {
         name: Name,
         args: Vec<Expr>,
+        /// Which arguments were written relative, `'0.5` (a fraction of the
+        /// scope's size, for `t` and `s`).
+        relative: Vec<Option<Span>>,
         span: Span,
     },
     /// `split(x) { 1 : A | ~3 : B }`, `*` for a repeat; `psplit(x, 1, 0)`
@@ -445,7 +448,7 @@ fn successor<F: Fn(Span) -> usize>(p: &mut Parser, cx: &Cx<F>, top: bool) -> R<V
         }
         let at = p.span_here();
         if p.eat_punct("[") {
-            ops.push(Op::Push);
+            ops.push(Op::Push(at));
             continue;
         }
         if p.eat_punct("]") {
@@ -458,7 +461,7 @@ fn successor<F: Fn(Span) -> usize>(p: &mut Parser, cx: &Cx<F>, top: bool) -> R<V
         };
         let n = name.text.as_str();
         if n == "NIL" || n == "epsilon" {
-            ops.push(Op::Nil);
+            ops.push(Op::Nil(name.span));
         } else if is_split(n) {
             ops.push(split(p, name)?);
         } else if n == "Repeat" || n == "repeat" {
@@ -469,9 +472,14 @@ fn successor<F: Fn(Span) -> usize>(p: &mut Parser, cx: &Cx<F>, top: bool) -> R<V
             ops.push(subdivide(p, name, cx)?);
         } else if OPERATIONS.contains(&n) {
             p.expect_punct("(", &format!("after `{n}`"))?;
-            let args = args(p)?;
+            let (args, relative) = call_args(p)?;
             let span = name.span.to(p.prev_span());
-            ops.push(Op::Call { name, args, span });
+            ops.push(Op::Call {
+                name,
+                args,
+                relative,
+                span,
+            });
         } else {
             let mut a = Vec::new();
             if p.eat_punct("(") {
@@ -493,6 +501,24 @@ fn args(p: &mut Parser) -> R<Vec<Expr>> {
         out.push(p.expr()?);
         if p.eat_punct(")") {
             return Ok(out);
+        }
+        p.expect_punct(",", "or `)` between arguments")?;
+    }
+}
+
+/// An operation's arguments after `(`, through `)`; an argument may be
+/// written relative, `'0.5`.
+fn call_args(p: &mut Parser) -> R<(Vec<Expr>, Vec<Option<Span>>)> {
+    let (mut out, mut rel) = (Vec::new(), Vec::new());
+    if p.eat_punct(")") {
+        return Ok((out, rel));
+    }
+    loop {
+        let at = p.span_here();
+        rel.push(p.eat_punct("'").then_some(at));
+        out.push(p.expr()?);
+        if p.eat_punct(")") {
+            return Ok((out, rel));
         }
         p.expect_punct(",", "or `)` between arguments")?;
     }

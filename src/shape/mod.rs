@@ -92,9 +92,11 @@ pub(crate) enum COp {
     Nil,
     Push,
     Pop(Span),
-    Translate([X; 3], Span),
+    /// `t(x, y, z)`; each coordinate absolute, or relative to the scope's
+    /// size (`'0.5`).
+    Translate([X; 3], [bool; 3], Span),
     Rotate([X; 3], Span),
-    Scale([X; 3], Span),
+    Scale([X; 3], [bool; 3], Span),
     Extrude(X, Span),
     Insert(Insert, Span),
     Colour([u8; 3]),
@@ -367,7 +369,53 @@ impl Checker {
 
     fn ops(&mut self, ops: &[Op], arity: &HashMap<String, (usize, Span)>) -> Vec<COp> {
         let mut out = Vec::with_capacity(ops.len());
+        // `NIL` and `Subdivide` end a successor: what follows them would
+        // never run, and inside `[ ]` they would end it too.
+        let mut depth = 0usize;
+        let mut ended: Option<&str> = None;
         for op in ops {
+            let (ends, at) = match op {
+                Op::Nil(at) => (Some("`NIL`"), *at),
+                Op::Subdivide { span, .. } => (Some("`Subdivide`"), *span),
+                Op::Push(_) => {
+                    depth += 1;
+                    (None, Span::default())
+                }
+                Op::Pop(_) => {
+                    depth = depth.saturating_sub(1);
+                    (None, Span::default())
+                }
+                _ => (None, Span::default()),
+            };
+            if let Some(what) = ended {
+                let at = match op {
+                    Op::Symbol { name, .. } => name.span,
+                    Op::Call { span, .. }
+                    | Op::Split { span, .. }
+                    | Op::Comp { span, .. }
+                    | Op::Subdivide { span, .. }
+                    | Op::Pop(span)
+                    | Op::Push(span)
+                    | Op::Nil(span) => *span,
+                };
+                self.err(
+                    at,
+                    format!(
+                        "nothing follows {what} in a successor: it ends the shape's rule \
+                         (what the shape becomes after `Subdivide` goes in its braces)"
+                    ),
+                );
+                break;
+            }
+            if let Some(what) = ends {
+                if depth > 0 {
+                    self.err(
+                        at,
+                        format!("{what} ends the rule's shape, so it cannot be inside `[ ]`"),
+                    );
+                }
+                ended = Some(what);
+            }
             if let Some(c) = self.op(op, arity) {
                 out.push(c);
             }
@@ -432,10 +480,37 @@ impl Checker {
                     span: name.span,
                 }
             }
-            Op::Nil => COp::Nil,
-            Op::Push => COp::Push,
+            Op::Nil(_) => COp::Nil,
+            Op::Push(_) => COp::Push,
             Op::Pop(s) => COp::Pop(*s),
-            Op::Call { name, args, span } => return self.call(&name.text, args, *span),
+            Op::Call {
+                name,
+                args,
+                relative,
+                span,
+            } => {
+                let rel: Vec<bool> = relative.iter().map(Option::is_some).collect();
+                if !matches!(name.text.as_str(), "t" | "translate" | "s" | "scale") {
+                    if let Some(at) = relative.iter().flatten().next() {
+                        self.err(
+                            *at,
+                            format!(
+                                "a relative value (`'x`, a fraction of the scope's size) is for \
+                                 `t` and `s`, not `{}`",
+                                name.text
+                            ),
+                        );
+                        return None;
+                    }
+                }
+                let mut op = self.call(&name.text, args, *span)?;
+                if let COp::Translate(_, r, _) | COp::Scale(_, r, _) = &mut op {
+                    for (k, slot) in r.iter_mut().enumerate() {
+                        *slot = rel.get(k).copied().unwrap_or(false);
+                    }
+                }
+                op
+            }
             Op::Split {
                 axis,
                 parts,
@@ -561,9 +636,9 @@ impl Checker {
             None
         };
         Some(match name {
-            "t" | "translate" => COp::Translate(self.three(name, args, span)?, span),
+            "t" | "translate" => COp::Translate(self.three(name, args, span)?, [false; 3], span),
             "r" | "rotate" => COp::Rotate(self.three(name, args, span)?, span),
-            "s" | "scale" => COp::Scale(self.three(name, args, span)?, span),
+            "s" | "scale" => COp::Scale(self.three(name, args, span)?, [false; 3], span),
             "extrude" => {
                 if n != 1 {
                     return want(self, "one number, the height");

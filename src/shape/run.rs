@@ -536,8 +536,8 @@ impl<'g> Deriver<'g> {
                     *cur = c;
                     frame[attr_base..attr_base + nattrs].clone_from_slice(&a);
                 }
-                COp::Translate(v, span) => {
-                    let t = self.vec3(v, frame, cur, depth)?;
+                COp::Translate(v, rel, span) => {
+                    let t = relative(self.vec3(v, frame, cur, depth)?, rel, cur.scope.size);
                     let d =
                         cur.scope.axes[0] * t.x + cur.scope.axes[1] * t.y + cur.scope.axes[2] * t.z;
                     if d != DVec3::ZERO {
@@ -564,8 +564,8 @@ impl<'g> Deriver<'g> {
                         cur.geom = Arc::new(self.moved(&cur.geom, &f, *span)?);
                     }
                 }
-                COp::Scale(v, span) => {
-                    let s = self.vec3(v, frame, cur, depth)?;
+                COp::Scale(v, rel, span) => {
+                    let s = relative(self.vec3(v, frame, cur, depth)?, rel, cur.scope.size);
                     if s.min_element() < 0.0 {
                         return Err(ShapeError::at(
                             *span,
@@ -983,8 +983,27 @@ impl<'g> Deriver<'g> {
                 to[p].push(k);
             }
         }
+        // A selector that takes nothing because an earlier part took its
+        // components is fine; one the shape has no component for is an
+        // error.
+        let classes: Vec<Selector> = comps
+            .iter()
+            .map(|(_, s)| {
+                if kind == CompKind::Faces {
+                    let z = s.axes[2];
+                    let local = DVec3::new(
+                        z.dot(cur.scope.axes[0]),
+                        z.dot(cur.scope.axes[1]),
+                        z.dot(cur.scope.axes[2]),
+                    );
+                    Selector::classify(local)
+                } else {
+                    Selector::All
+                }
+            })
+            .collect();
         for (p, (sel, at, _)) in parts.iter().enumerate() {
-            if to[p].is_empty() && !parts[..p].iter().any(|(s, _, _)| s == sel) {
+            if to[p].is_empty() && !classes.iter().any(|&c| selects(*sel, c)) {
                 let what = match kind {
                     CompKind::Faces => "face",
                     CompKind::Edges => "edge",
@@ -1141,6 +1160,10 @@ impl<'g> Deriver<'g> {
             };
             let mut frame = w.frame.clone();
             let base = node.params.len();
+            // The body's random numbers are the shape's own too, whatever
+            // shape was rewritten last.
+            let key = mix(node.key, 0x5EED);
+            self.env.random = Random::new(Some((key ^ (key >> 32)) as u32));
             self.nodes[m as usize].state = State::Expanded;
             let made = self.exec(m, w.body, &mut cur, &mut frame, base)?;
             self.finish(m, made, cur);
@@ -1234,6 +1257,16 @@ impl<'g> Deriver<'g> {
         }
         Ok(())
     }
+}
+
+/// `v` with the coordinates written relative (`'0.5`) taken as fractions of
+/// the scope's `size`.
+fn relative(v: DVec3, rel: &[bool; 3], size: DVec3) -> DVec3 {
+    DVec3::new(
+        if rel[0] { v.x * size.x } else { v.x },
+        if rel[1] { v.y * size.y } else { v.y },
+        if rel[2] { v.z * size.z } else { v.z },
+    )
 }
 
 /// The direction a 2D shape faces: the sum of its faces' vector areas.
@@ -1472,7 +1505,8 @@ mod tests {
              1 : Tile ~> extrude(-0.2) Dark : 0.6\n\
              2 : Tile ~> split(x) { ~1 : Wall | ~1 : Lit(ran(1)) } : 0.4\n\
              Roof --> split(x) { ~1 : R | ~1 : R }\n\
-             R --> Subdivide(1) { Done }\n";
+             R --> Subdivide(1) { Done(ran(1)) }\n\
+             Done(k) --> t(0, k, 0)\n";
         let g = grammar(text);
         for seed in [1, 2, 3] {
             assert_eq!(obj(&g, false, seed), obj(&g, true, seed));

@@ -465,3 +465,34 @@ fn a_failed_derivation_writes_no_file() {
     assert!(!out.exists() && !dir.join("out.mtl").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// CityEngine's relative coordinates in `s` and `t`: `'0.5` is half the
+/// scope's size along that axis.
+#[test]
+fn relative_scale_and_translate() {
+    let s = load(
+        "axiom: s(4, 2, 6) i(\"box\") A\n\
+         A --> s('0.5, '1, 2) t('0.5, 0, '0.25) B\n",
+    );
+    let run = derive(&s, None);
+    let c = children(&s, &run);
+    assert_eq!(c.len(), 1);
+    // Size (2, 2, 2); moved by half the new x size (1) and a quarter of z (0.5).
+    assert_eq!(c[0].2, [2.0, 2.0, 2.0]);
+    assert_eq!(c[0].1, [1.0, 0.0, 0.5]);
+    let vols = volumes(&s, &run);
+    assert!(close(vols["B_1"], 8.0), "{vols:?}");
+}
+
+/// A selector whose faces an earlier part took selects nothing, silently;
+/// only a selector the shape has no face for at all is an error.
+#[test]
+fn a_selector_after_all_takes_nothing() {
+    let s = load(
+        "axiom: s(1, 1, 1) i(\"box\") M\n\
+         M --> comp(f) { all : F | top : T }\n",
+    );
+    let run = derive(&s, None);
+    let names: Vec<String> = children(&s, &run).into_iter().map(|c| c.0).collect();
+    assert_eq!(names, vec!["F"; 6]);
+}
