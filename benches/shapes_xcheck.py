@@ -27,6 +27,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from xcheck import read_obj  # noqa: E402  (the benches' one OBJ reader)
 
 
 def box_of_three():
@@ -59,14 +61,17 @@ def write_obj(path, v, f):
             o.write("f " + " ".join(str(i + 1) for i in t) + "\n")
 
 
-def read_obj(path):
-    v, f = [], []
-    for line in open(path):
-        if line.startswith("v "):
-            v.append([float(x) for x in line.split()[1:4]])
-        elif line.startswith("f "):
-            f.append([int(x.split("/")[0]) - 1 for x in line.split()[1:]])
-    return np.array(v, float), f
+def against_cgal(sub, v, f, vm, fm, k):
+    """Ours (vm, fm) against CGAL's sqrt3 of (v, f) after k steps: vertices
+    matched by nearest position; (one-to-one, same faces, max distance,
+    CGAL's vertex and face counts)."""
+    vr, fr = sub.mesh_subdivide_sqrt3((v, np.asarray(f, np.int64)), k)
+    vr, fr = np.asarray(vr, float), np.asarray(fr).tolist()
+    d, idx = cKDTree(vr).query(vm)
+    one_to_one = len(vr) == len(vm) and len(np.unique(idx)) == len(vm)
+    same = one_to_one and ({tuple(sorted(t)) for t in fr}
+                           == {tuple(sorted(idx[t])) for t in fm})
+    return one_to_one, same, d.max(), len(vr), len(fr)
 
 
 def main():
@@ -94,20 +99,15 @@ def main():
         subprocess.run(cmd + [src, dst, str(k), "sqrt3"], check=True, cwd=ROOT)
         vm, fm = read_obj(dst)
         tags = [int(x) for x in open(dst + ".tags").read().split()]
-        vr, fr = sub.mesh_subdivide_sqrt3((v, np.asarray(f, np.int64)), k)
-        vr, fr = np.asarray(vr, float), np.asarray(fr).tolist()
-        d, idx = cKDTree(vr).query(vm)
-        one_to_one = len(vr) == len(vm) and len(np.unique(idx)) == len(vm)
-        same = one_to_one and ({tuple(sorted(t)) for t in fr}
-                               == {tuple(sorted(idx[t])) for t in fm})
+        one_to_one, same, dmax, nv, nf = against_cgal(sub, v, f, vm, fm, k)
         counts = np.bincount(tags, minlength=len(f))
         per_face = bool((counts == 3 ** k).all())
-        worst = max(worst, d.max())
-        good = one_to_one and same and d.max() < 1e-12 and per_face
+        worst = max(worst, dmax)
+        good = one_to_one and same and dmax < 1e-12 and per_face
         ok &= good
-        print(f"  {k} step(s): ours {len(vm)} vertices {len(fm)} faces, CGAL {len(vr)} vertices"
-              f" {len(fr)} faces; one-to-one {one_to_one}; same faces {same};"
-              f" max distance {d.max():.3e}; 3^{k} faces per input triangle {per_face}"
+        print(f"  {k} step(s): ours {len(vm)} vertices {len(fm)} faces, CGAL {nv} vertices"
+              f" {nf} faces; one-to-one {one_to_one}; same faces {same};"
+              f" max distance {dmax:.3e}; 3^{k} faces per input triangle {per_face}"
               f" -> {'ok' if good else 'DIFFERENT'}")
     print(f"max difference over all steps: {worst:.3e}")
     for g in a.shapes:
@@ -126,18 +126,13 @@ def main():
                 continue
             v, f = read_obj(os.path.join(d, f"group-{k}-welded.obj"))
             vm, fm = read_obj(os.path.join(d, f"group-{k}-ours.obj"))
-            vr, fr = sub.mesh_subdivide_sqrt3((v, np.asarray(f, np.int64)), steps)
-            vr, fr = np.asarray(vr, float), np.asarray(fr).tolist()
-            dist, idx = cKDTree(vr).query(vm)
-            one_to_one = len(vr) == len(vm) and len(np.unique(idx)) == len(vm)
-            same = one_to_one and ({tuple(sorted(t)) for t in fr}
-                                   == {tuple(sorted(idx[t])) for t in fm})
-            good = one_to_one and same and dist.max() < 1e-12
+            one_to_one, same, dmax, nv, nf = against_cgal(sub, v, f, vm, fm, steps)
+            good = one_to_one and same and dmax < 1e-12
             ok &= good
-            worst = max(worst, dist.max())
+            worst = max(worst, dmax)
             print(f"  {name} group {k}: {len(f)} triangles welded, sqrt3 x {steps}: ours {len(vm)}"
-                  f" vertices {len(fm)} faces, CGAL {len(vr)} vertices {len(fr)} faces;"
-                  f" same faces {same}; max distance {dist.max():.3e}"
+                  f" vertices {len(fm)} faces, CGAL {nv} vertices {nf} faces;"
+                  f" same faces {same}; max distance {dmax:.3e}"
                   f" -> {'ok' if good else 'DIFFERENT'}")
             k += 1
     print(f"max difference overall: {worst:.3e}")

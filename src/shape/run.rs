@@ -170,13 +170,7 @@ impl ShapeTree {
     /// Every shape in tree order (parents before children, children in the
     /// order they were made).
     pub fn in_order(&self) -> Vec<u32> {
-        let mut out = Vec::with_capacity(self.nodes.len());
-        let mut stack: Vec<u32> = self.roots.iter().rev().copied().collect();
-        while let Some(n) = stack.pop() {
-            out.push(n);
-            stack.extend(self.nodes[n as usize].children.iter().rev().copied());
-        }
-        out
+        tree_order(&self.nodes, &self.roots)
     }
 
     /// The terminal shapes with geometry, in tree order.
@@ -965,27 +959,7 @@ impl<'g> Deriver<'g> {
             }
             CompKind::Vertices => geom::comp_vertices(&self.points, &cur.geom, &cur.scope),
         };
-        // Each component goes to the first part whose selector takes it.
-        let mut to: Vec<Vec<usize>> = vec![Vec::new(); parts.len()];
-        for (k, (_, s)) in comps.iter().enumerate() {
-            let class = if kind == CompKind::Faces {
-                let z = s.axes[2];
-                let local = DVec3::new(
-                    z.dot(cur.scope.axes[0]),
-                    z.dot(cur.scope.axes[1]),
-                    z.dot(cur.scope.axes[2]),
-                );
-                Selector::classify(local)
-            } else {
-                Selector::All
-            };
-            if let Some(p) = parts.iter().position(|(sel, _, _)| selects(*sel, class)) {
-                to[p].push(k);
-            }
-        }
-        // A selector that takes nothing because an earlier part took its
-        // components is fine; one the shape has no component for is an
-        // error.
+        // Each component's class: a face's by its normal in the scope.
         let classes: Vec<Selector> = comps
             .iter()
             .map(|(_, s)| {
@@ -1002,8 +976,18 @@ impl<'g> Deriver<'g> {
                 }
             })
             .collect();
+        // Each component goes to the first part whose selector takes it.
+        let mut to: Vec<Vec<usize>> = vec![Vec::new(); parts.len()];
+        for (k, &class) in classes.iter().enumerate() {
+            if let Some(p) = parts.iter().position(|(sel, _, _)| sel.takes(class)) {
+                to[p].push(k);
+            }
+        }
+        // A selector that takes nothing because an earlier part took its
+        // components is fine; one the shape has no component for is an
+        // error.
         for (p, (sel, at, _)) in parts.iter().enumerate() {
-            if to[p].is_empty() && !classes.iter().any(|&c| selects(*sel, c)) {
+            if to[p].is_empty() && !classes.iter().any(|&c| sel.takes(c)) {
                 let what = match kind {
                     CompKind::Faces => "face",
                     CompKind::Edges => "edge",
@@ -1303,16 +1287,6 @@ impl Made {
     }
 }
 
-fn selects(sel: Selector, class: Selector) -> bool {
-    use Selector::*;
-    match sel {
-        All => true,
-        Side | Vertical => matches!(class, Front | Back | Left | Right),
-        Horizontal => matches!(class, Top | Bottom),
-        s => s == class,
-    }
-}
-
 pub(crate) fn selector_name(s: Selector) -> &'static str {
     use Selector::*;
     match s {
@@ -1452,15 +1426,21 @@ struct TreeOrder<'a> {
     roots: &'a [u32],
 }
 
+/// Every shape in tree order: parents before children, children in the
+/// order they were made; with an explicit stack, for trees of any depth.
+fn tree_order(nodes: &[Node], roots: &[u32]) -> Vec<u32> {
+    let mut out = Vec::with_capacity(nodes.len());
+    let mut stack: Vec<u32> = roots.iter().rev().copied().collect();
+    while let Some(n) = stack.pop() {
+        out.push(n);
+        stack.extend(nodes[n as usize].children.iter().rev().copied());
+    }
+    out
+}
+
 impl TreeOrder<'_> {
     fn all(&self) -> Vec<u32> {
-        let mut out = Vec::with_capacity(self.nodes.len());
-        let mut stack: Vec<u32> = self.roots.iter().rev().copied().collect();
-        while let Some(n) = stack.pop() {
-            out.push(n);
-            stack.extend(self.nodes[n as usize].children.iter().rev().copied());
-        }
-        out
+        tree_order(self.nodes, self.roots)
     }
 
     fn rank(&self) -> HashMap<u32, usize> {
