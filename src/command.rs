@@ -243,7 +243,7 @@ fn derive_text(
             before()?;
             let counts = run.counts();
             if a.json {
-                json(&serde_json::json!({ "counts": counts, "shapes": s.tree_json(&run) }))
+                json(&serde_json::json!({ "counts": counts, "shapes": s.tree_json(&run)? }))
             } else {
                 Ok(format!(
                     "{}{}shapes: {}\nterminal shapes: {}\nfaces: {}\nsmoothing groups: {}",

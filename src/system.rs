@@ -629,9 +629,9 @@ impl Shapes {
         crate::shape::output::groups_text(&run.tree)
     }
 
-    /// The shape tree as JSON.
-    pub fn tree_json(&self, run: &ShapeRun) -> serde_json::Value {
-        crate::shape::output::tree_json(&self.grammar, &run.tree)
+    /// The shape tree as JSON; a tree too deep to nest is refused.
+    pub fn tree_json(&self, run: &ShapeRun) -> Result<serde_json::Value, Error> {
+        crate::shape::output::tree_json(&self.grammar, &run.tree).map_err(Error::Failed)
     }
 
     /// The OBJ text (one group per terminal shape) and its MTL text;

@@ -15,7 +15,7 @@ pub(crate) mod output;
 pub(crate) mod run;
 pub(crate) mod smooth;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
@@ -336,27 +336,39 @@ impl Checker {
                 },
             ));
         }
-        // Rules with literal probabilities and no condition must sum to 1
-        // per symbol: caught before any run.
+        // The probabilities of a symbol whose rules all apply always (no
+        // condition) and all have literal probabilities must sum to 1:
+        // caught before any run. Where a rule has a condition or a
+        // computed probability, the sum of the rules that apply is checked
+        // when they apply.
         let mut sums: HashMap<&str, (f64, usize, Span)> = HashMap::new();
+        let mut unknown: HashSet<&str> = HashSet::new();
         for r in &f.rules {
-            if r.cond.is_none() {
-                if let Some(p) = r.prob.as_ref().and_then(literal) {
+            match (r.prob.as_ref().map(literal), &r.cond) {
+                (Some(Some(p)), None) => {
                     let e = sums.entry(&r.symbol.text).or_insert((0.0, 0, r.span));
                     e.0 += p;
                     e.1 += 1;
+                }
+                // No probability: the run says that all or none have one.
+                (None, None) => {}
+                _ => {
+                    unknown.insert(&r.symbol.text);
                 }
             }
         }
         let mut bad: Vec<_> = sums
             .into_iter()
-            .filter(|(_, (s, _, _))| (s - 1.0).abs() > 1e-9)
+            .filter(|(sym, (s, _, _))| !unknown.contains(sym) && (s - 1.0).abs() > 1e-9)
             .collect();
         bad.sort_by_key(|(_, (_, _, at))| at.start);
         for (sym, (s, k, at)) in bad {
             self.err(
                 at,
-                format!("the probabilities of the {k} rules for `{sym}` sum to {s}, not 1"),
+                format!(
+                    "the probabilities of the {k} rule{} for `{sym}` sum to {s}, not 1",
+                    if k == 1 { "" } else { "s" }
+                ),
             );
         }
         if !self.diags.is_empty() {
@@ -541,7 +553,12 @@ impl Checker {
             return Some(k);
         }
         let grammar = match load_scheme(name, self.dir.as_deref()) {
-            Ok(g) => g,
+            Ok(mut g) => {
+                // A smoothing group's faces go back to its shapes, which
+                // keep them: a tighter bound than a surface run's.
+                g.max_faces = g.max_faces.min(run::MAX_SMOOTH_FACES);
+                g
+            }
             Err(m) => {
                 self.err(at, m);
                 return None;
@@ -615,6 +632,18 @@ impl Checker {
                             Some(d) => d.join(file),
                             None => PathBuf::from(file),
                         };
+                        if path.exists() && !path.is_file() {
+                            // A directory, a pipe (which would wait for a
+                            // writer forever) or a device.
+                            self.err(
+                                at,
+                                format!(
+                                    "cannot insert `{file}`: {} is not a regular file",
+                                    path.display()
+                                ),
+                            );
+                            return None;
+                        }
                         match crate::mesh::io::read(&path) {
                             Ok(soup) => COp::Insert(Insert::Mesh(soup), span),
                             Err(e) => {

@@ -48,19 +48,27 @@ fn unsigned_zero(x: f64) -> f64 {
     }
 }
 
+/// The deepest level [`tree_text`] indents; a deeper shape's line starts
+/// with its level in brackets instead, so that a line stays short whatever
+/// the depth (a chain of a million shapes is a million short lines).
+pub const MAX_INDENT: usize = 32;
+
+/// The deepest shape tree [`tree_json`] writes: JSON nests one object per
+/// level, and a deeper tree would be written (and freed) by recursion as
+/// deep, with indentation growing with it.
+pub const MAX_JSON_DEPTH: usize = 256;
+
 /// The tree as indented text: one line per shape.
 pub fn tree_text(g: &ShapeGrammar, t: &ShapeTree) -> String {
     let mut out = String::new();
     let mut stack: Vec<(u32, usize)> = t.roots.iter().rev().map(|&r| (r, 0)).collect();
     while let Some((n, depth)) = stack.pop() {
         let node = &t.nodes[n as usize];
-        let _ = write!(
-            out,
-            "{:indent$}{}",
-            "",
-            g.symbols[node.symbol as usize],
-            indent = 2 * depth
-        );
+        let _ = write!(out, "{:indent$}", "", indent = 2 * depth.min(MAX_INDENT));
+        if depth > MAX_INDENT {
+            let _ = write!(out, "[{depth}] ");
+        }
+        out.push_str(&g.symbols[node.symbol as usize]);
         if !node.params.is_empty() {
             let p: Vec<String> = node.params.iter().map(|&x| num(x)).collect();
             let _ = write!(out, "({})", p.join(", "));
@@ -85,8 +93,18 @@ pub fn tree_text(g: &ShapeGrammar, t: &ShapeTree) -> String {
 }
 
 /// The tree as JSON: an array of root shapes, each with its symbol,
-/// parameters, scope, dimension, face count, state and children.
-pub fn tree_json(g: &ShapeGrammar, t: &ShapeTree) -> serde_json::Value {
+/// parameters, scope, dimension, face count, state and children. A tree
+/// deeper than [`MAX_JSON_DEPTH`] levels is refused with a message.
+pub fn tree_json(g: &ShapeGrammar, t: &ShapeTree) -> Result<serde_json::Value, String> {
+    let deepest = t.nodes.iter().map(|n| n.depth as usize).max().unwrap_or(0);
+    if deepest >= MAX_JSON_DEPTH {
+        return Err(format!(
+            "the shape tree is {} levels deep; JSON nests one object per level, and \
+             `--format json` writes trees of at most {MAX_JSON_DEPTH} levels (the text \
+             format writes any depth)",
+            deepest + 1
+        ));
+    }
     fn shape(g: &ShapeGrammar, t: &ShapeTree, n: u32) -> serde_json::Value {
         let node = &t.nodes[n as usize];
         let s = &node.scope;
@@ -110,9 +128,10 @@ pub fn tree_json(g: &ShapeGrammar, t: &ShapeTree) -> serde_json::Value {
             "children": node.children.iter().map(|&c| shape(g, t, c)).collect::<Vec<_>>(),
         })
     }
-    // Deep trees are walked with an explicit stack elsewhere; JSON nesting
-    // follows the tree, whose depth the shape limit bounds.
-    serde_json::Value::Array(t.roots.iter().map(|&r| shape(g, t, r)).collect())
+    // JSON nesting follows the tree, whose depth is bounded above.
+    Ok(serde_json::Value::Array(
+        t.roots.iter().map(|&r| shape(g, t, r)).collect(),
+    ))
 }
 
 /// The material name of a colour.

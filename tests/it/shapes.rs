@@ -34,7 +34,7 @@ fn derive(s: &Shapes, seed: Option<u32>) -> ShapeRun {
 
 /// The children of the first root, as (symbol, origin, size).
 fn children(s: &Shapes, run: &ShapeRun) -> Vec<(String, [f64; 3], [f64; 3])> {
-    let tree = s.tree_json(run);
+    let tree = s.tree_json(run).unwrap();
     let three = |v: &serde_json::Value| -> [f64; 3] {
         let a = v.as_array().unwrap();
         [
@@ -205,7 +205,7 @@ fn paper_notation_runs_as_printed() {
     for seed in 1..40 {
         let run = derive(&s, Some(seed));
         let kids: Vec<(String, Vec<f64>)> = {
-            let tree = s.tree_json(&run);
+            let tree = s.tree_json(&run).unwrap();
             tree[0]["children"]
                 .as_array()
                 .unwrap()
@@ -390,4 +390,109 @@ fn slices_go_back_to_their_shapes() {
     // The union of the slices is the whole subdivided mesh.
     assert_eq!(total, run3.soup.faces.len());
     assert_eq!(run3.counts().faces, total);
+}
+
+// Adversarial inputs (issue 14's adversarial pass): what once misread,
+// panicked or ran without end.
+
+/// C's `k-->0` is `k-- > 0`: inside a block it does not make an L+C
+/// program a shape grammar, where a rule's arrow stands at the top level.
+#[test]
+fn cs_goes_to_operator_stays_lplusc() {
+    let text = "derivation length: 2;\nmodule A(int);\nAxiom: A(3);\n\
+                A(n) : { int k = n; while (k-->0) { } produce A(k) F(1); }\n";
+    match subgram::load_text("t.lsys", text, &LoadOptions::default()) {
+        Ok(System::Curve(_)) => {}
+        Ok(_) => panic!("an L+C program read as another kind"),
+        Err(e) => panic!("{e}"),
+    }
+    // A rule's arrow at the top level, after a parenthesised condition.
+    load("axiom: s(1, 1, 1) i(\"box\") A(1)\nA(k) : (k > 0) --> B\n");
+}
+
+/// Probabilities that are expressions, or rules with conditions, are
+/// checked when the rules apply, not summed at load: 0.25 * 2 + 0.5 is 1
+/// (by hand), so both successors occur over a few seeds.
+#[test]
+fn computed_probabilities_are_checked_when_they_apply() {
+    let s = load(
+        "axiom: s(1, 1, 1) i(\"box\") A\n\
+         1 : A ~> B : 0.25 * 2\n\
+         2 : A ~> C : 0.5\n",
+    );
+    let mut seen = HashSet::new();
+    for seed in 1..20 {
+        let run = derive(&s, Some(seed));
+        let tree = s.tree_json(&run).unwrap();
+        seen.insert(
+            tree[0]["children"][0]["symbol"]
+                .as_str()
+                .unwrap()
+                .to_string(),
+        );
+    }
+    assert_eq!(seen, HashSet::from(["B".to_string(), "C".to_string()]));
+    // A condition that always holds: 0.5 + 0.5 among the rules that apply.
+    let s = load(
+        "axiom: s(1, 1, 1) i(\"box\") A\n\
+         1 : A : scope.sx > 0 ~> B : 0.5\n\
+         2 : A ~> C : 0.5\n",
+    );
+    derive(&s, Some(1));
+}
+
+/// A chain of shapes 1,201 levels deep: the text tree indents at most 32
+/// levels (the level is written in brackets beyond), so its lines stay
+/// short; the JSON tree, one nested object per level, is refused with a
+/// message past 256 levels, and written below that on a test thread's
+/// small stack. (Indenting 2 × 40,000 columns panicked; a JSON tree of
+/// 20,000 levels ran for minutes.)
+#[test]
+fn deep_trees_are_written_in_bounded_lines_or_refused() {
+    let s = load("axiom: s(1, 1, 1) i(\"box\") A(0)\nA(k) : k < 1200 --> A(k + 1)\n");
+    let run = derive(&s, None);
+    let text = s.tree_text(&run);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 1201);
+    assert!(lines.iter().all(|l| l.len() < 200), "a line is long");
+    assert!(lines[1200].starts_with(&format!("{}[1200] A(1200)", " ".repeat(64))));
+    assert!(lines[32].starts_with(&format!("{}A(32)", " ".repeat(64))));
+    let e = s.tree_json(&run).unwrap_err().to_string();
+    assert!(e.contains("1201 levels deep"), "{e}");
+    // 256 levels are written.
+    let s = load("axiom: s(1, 1, 1) i(\"box\") A(0)\nA(k) : k < 255 --> A(k + 1)\n");
+    let run = derive(&s, None);
+    let json = s.tree_json(&run).unwrap();
+    assert!(serde_json::to_string_pretty(&json)
+        .unwrap()
+        .contains("\"A\""));
+}
+
+/// Inserting what is not a regular file (a directory named like a mesh, a
+/// named pipe, which would wait for a writer forever) is refused at the
+/// string.
+#[test]
+fn inserting_a_non_file_is_refused() {
+    let dir = std::env::temp_dir().join(format!("subgram-adv14-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("folder.obj")).unwrap();
+    let fifo = dir.join("pipe.obj");
+    let made_fifo = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    let mut names = vec!["folder.obj"];
+    if made_fifo {
+        names.push("pipe.obj");
+    }
+    for name in names {
+        let path = dir.join(name);
+        let text = format!("axiom: s(1, 1, 1) i(\"{}\") A\nA --> B\n", path.display());
+        let e = match subgram::load_text("t.lsys", &text, &LoadOptions::default()) {
+            Err(e) => e.to_string(),
+            Ok(_) => panic!("{name} was inserted"),
+        };
+        assert!(e.contains("is not a regular file"), "{e}");
+        assert!(e.contains("t.lsys:1:21"), "{e}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
