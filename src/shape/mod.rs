@@ -52,6 +52,9 @@ pub struct ShapeGrammar {
     pub(crate) warnings: Vec<Diagnostic>,
     /// The schemes `Subdivide` names, loaded once.
     pub(crate) schemes: Vec<Scheme>,
+    /// The files the grammar reads: inserted meshes and scheme files, as
+    /// found (a command never writes over them).
+    pub(crate) inputs: Vec<PathBuf>,
 }
 
 #[derive(Debug)]
@@ -167,6 +170,7 @@ pub(crate) fn from_front(front: Front, dir: Option<&Path>) -> Result<ShapeGramma
         schemes: Vec::new(),
         dir: dir.map(Path::to_path_buf),
         in_part: false,
+        inputs: Vec::new(),
     };
     let g = c.file(&file);
     let (errs, warns) = c.rc.take_diagnostics();
@@ -197,6 +201,7 @@ pub(crate) fn from_front(front: Front, dir: Option<&Path>) -> Result<ShapeGramma
         sources,
         warnings: c.warnings,
         schemes: c.schemes,
+        inputs: c.inputs,
     })
 }
 
@@ -213,6 +218,7 @@ struct Checker {
     schemes: Vec<Scheme>,
     dir: Option<PathBuf>,
     in_part: bool,
+    inputs: Vec<PathBuf>,
 }
 
 /// A constant expression's value, if it is a literal number.
@@ -552,6 +558,9 @@ impl Checker {
         if let Some(k) = self.schemes.iter().position(|x| x.name == name) {
             return Some(k);
         }
+        if !smooth::SCHEME_NAMES.contains(&name) {
+            self.inputs.push(scheme_path(name, self.dir.as_deref()));
+        }
         let grammar = match load_scheme(name, self.dir.as_deref()) {
             Ok(mut g) => {
                 // A smoothing group's faces go back to its shapes, which
@@ -644,6 +653,7 @@ impl Checker {
                             );
                             return None;
                         }
+                        self.inputs.push(path.clone());
                         match crate::mesh::io::read(&path) {
                             Ok(soup) => COp::Insert(Insert::Mesh(soup), span),
                             Err(e) => {
@@ -733,10 +743,7 @@ fn load_scheme(name: &str, dir: Option<&Path>) -> Result<crate::surface::Grammar
     if smooth::SCHEME_NAMES.contains(&name) {
         return smooth::scheme(name);
     }
-    let path = match dir {
-        Some(d) => d.join(name),
-        None => PathBuf::from(name),
-    };
+    let path = scheme_path(name, dir);
     if !path.is_file() {
         return Err(format!(
             "`{name}` is not a scheme: use \"sqrt3\", \"loop\", \"catmull-clark\" or a \
@@ -746,6 +753,14 @@ fn load_scheme(name: &str, dir: Option<&Path>) -> Result<crate::surface::Grammar
     }
     crate::surface::load_file(&path, &[])
         .map_err(|e| format!("the scheme `{name}` does not load:\n{e}"))
+}
+
+/// Where a scheme file named `name` is: relative to the grammar's folder.
+fn scheme_path(name: &str, dir: Option<&Path>) -> PathBuf {
+    match dir {
+        Some(d) => d.join(name),
+        None => PathBuf::from(name),
+    }
 }
 
 /// A unit vector along a scope axis, for tests.

@@ -59,6 +59,12 @@ pub const MAX_SMOOTH_FACES: usize = 4_000_000;
 /// planes.
 pub const MAX_SPLIT_WORK: usize = 20_000_000;
 
+/// The most rounds of smoothing (phase 2 of the schedule) a derivation may
+/// run: a `Subdivide` whose successor subdivides again without end (`A -->
+/// Subdivide(0) { A }`) would otherwise run until the shape limit, each
+/// round walking the whole tree.
+pub const MAX_ROUNDS: usize = 1000;
+
 /// A shape's place in the derivation.
 #[derive(Clone, Debug, PartialEq)]
 pub enum State {
@@ -282,6 +288,7 @@ pub fn derive(g: &ShapeGrammar, opts: &ShapeOptions, deadline: &Deadline) -> R<S
     d.env.random = Random::new(Some(opts.seed));
     let made = d.exec(u32::MAX, &g.axiom, &mut cur, &mut frame, g.attr_base_axiom)?;
     let _ = made;
+    let mut rounds = 0;
     loop {
         while let Some(n) = if d.opts.fifo {
             d.pending.pop_front()
@@ -293,6 +300,18 @@ pub fn derive(g: &ShapeGrammar, opts: &ShapeOptions, deadline: &Deadline) -> R<S
         if d.waiting.is_empty() {
             break;
         }
+        rounds += 1;
+        let span = d.waiting[0].span;
+        if rounds > MAX_ROUNDS {
+            return Err(ShapeError::at(
+                span,
+                format!(
+                    "the derivation ran {MAX_ROUNDS} rounds of smoothing; does a \
+                     `Subdivide`'s successor subdivide again without end?"
+                ),
+            ));
+        }
+        d.deadline.check().map_err(|m| ShapeError::at(span, m))?;
         d.smooth_all()?;
     }
     Ok(ShapeTree {
@@ -823,6 +842,13 @@ impl<'g> Deriver<'g> {
     fn lot(&mut self, cur: &mut Cur, corners: &[DVec3], span: Span) -> R<()> {
         let g = geom::polygon(&mut self.points, corners).map_err(|m| ShapeError::at(span, m))?;
         let n = normal_of(&self.points, &g);
+        if n == DVec3::ZERO {
+            return Err(ShapeError::at(
+                span,
+                "a lot's corners enclose no area (they lie on a line, or the outline \
+                 crosses itself)",
+            ));
+        }
         if n.y <= 0.0 {
             return Err(ShapeError::at(
                 span,
