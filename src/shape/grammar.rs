@@ -483,6 +483,20 @@ fn successor<F: Fn(Span) -> usize>(p: &mut Parser, cx: &Cx<F>, top: bool) -> R<V
             ops.push(comp(p, name, cx)?);
         } else if n == "Subdivide" || n == "subdivide" {
             ops.push(subdivide(p, name, cx)?);
+            // The shape waits at its Subdivide and goes on with the
+            // braces' successor: anything after them would never run.
+            let ends = if top {
+                cx.at_rule_end(p) || p.peek_punct(":")
+            } else {
+                p.peek_punct("|") || p.peek_punct("}") || p.at_end()
+            };
+            if !ends {
+                return p.error(
+                    "the end of the successor after `Subdivide(...) { ... }`: the shape goes on \
+                     with the successor in its braces, so what follows would never run (move it \
+                     into the braces)",
+                );
+            }
         } else if OPERATIONS.contains(&n) {
             p.expect_punct("(", &format!("after `{n}`"))?;
             let args = args(p)?;

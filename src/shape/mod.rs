@@ -102,8 +102,10 @@ pub(crate) enum COp {
     Insert(Insert, Span),
     Colour([u8; 3]),
     ColourRgb([X; 3]),
-    /// An attribute's slot (from the attributes' base) and its new value.
-    Set(u16, X),
+    /// An attribute's slot (from the attributes' base), its new value and
+    /// the attribute's type, which the value is converted to (C's
+    /// assignment: `true` for 2.5 in a truth value).
+    Set(u16, X, Ty),
     SetGroup(Option<std::sync::Arc<str>>),
     Lot(X, X, Span),
     Polygon(Vec<X>, Span),
@@ -714,7 +716,7 @@ impl Checker {
                 };
                 let ty = self.attrs[k].1;
                 let v = self.typed(value, ty)?;
-                COp::Set(k as u16, v)
+                COp::Set(k as u16, v, ty)
             }
             "lot" => {
                 if n != 2 {

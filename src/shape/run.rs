@@ -721,8 +721,8 @@ impl<'g> Deriver<'g> {
                     let b = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
                     cur.colour = Some([b(c.x), b(c.y), b(c.z)]);
                 }
-                COp::Set(slot, e) => {
-                    let v = self.eval(e, frame, cur, depth)?;
+                COp::Set(slot, e, ty) => {
+                    let v = self.eval(e, frame, cur, depth)?.convert(*ty);
                     frame[attr_base + *slot as usize] = v;
                 }
                 COp::SetGroup(name) => cur.group = name.clone(),

@@ -496,3 +496,18 @@ fn inserting_a_non_file_is_refused() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `set` converts to the attribute's type as C's assignment does: 2.5 in
+/// a truth value is true (1), 2.7 in an int is 2. (A truth value held
+/// 2.5.)
+#[test]
+fn set_converts_to_the_attributes_type() {
+    let s = load(
+        "attr b = true;\nattr n = 1;\naxiom: s(1, 1, 1) i(\"box\") A\n\
+         A --> set(b, 2.5) set(n, 2.7) B(b, n)\n",
+    );
+    let run = derive(&s, None);
+    let tree = s.tree_json(&run).unwrap();
+    let p = &tree[0]["children"][0]["params"];
+    assert_eq!(p, &serde_json::json!([1.0, 2.0]));
+}
