@@ -81,7 +81,8 @@ pub(crate) enum Insert {
     Box,
     Cylinder(X),
     Sphere(X, X),
-    Mesh(PolygonSoup),
+    /// A mesh file's soup, read once however often the grammar inserts it.
+    Mesh(std::sync::Arc<PolygonSoup>),
 }
 
 /// A checked successor operation.
@@ -173,6 +174,7 @@ pub(crate) fn from_front(front: Front, dir: Option<&Path>) -> Result<ShapeGramma
         dir: dir.map(Path::to_path_buf),
         in_part: false,
         inputs: Vec::new(),
+        meshes: HashMap::new(),
     };
     let g = c.file(&file);
     let (errs, warns) = c.rc.take_diagnostics();
@@ -221,6 +223,8 @@ struct Checker {
     dir: Option<PathBuf>,
     in_part: bool,
     inputs: Vec<PathBuf>,
+    /// The meshes read so far, by path.
+    meshes: HashMap<PathBuf, std::sync::Arc<PolygonSoup>>,
 }
 
 /// A constant expression's value, if it is a literal number.
@@ -655,9 +659,16 @@ impl Checker {
                             );
                             return None;
                         }
+                        if let Some(soup) = self.meshes.get(&path) {
+                            return Some(COp::Insert(Insert::Mesh(soup.clone()), span));
+                        }
                         self.inputs.push(path.clone());
                         match crate::mesh::io::read(&path) {
-                            Ok(soup) => COp::Insert(Insert::Mesh(soup), span),
+                            Ok(soup) => {
+                                let soup = std::sync::Arc::new(soup);
+                                self.meshes.insert(path, soup.clone());
+                                COp::Insert(Insert::Mesh(soup), span)
+                            }
                             Err(e) => {
                                 self.err(at, format!("cannot insert `{file}`: {e}"));
                                 return None;

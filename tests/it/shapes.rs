@@ -511,3 +511,17 @@ fn set_converts_to_the_attributes_type() {
     let p = &tree[0]["children"][0]["params"];
     assert_eq!(p, &serde_json::json!([1.0, 2.0]));
 }
+
+/// A mesh inserted by several operations is read once, and it and the
+/// scheme files are the grammar's inputs, which `subdivide` never
+/// overwrites.
+#[test]
+fn inserted_meshes_are_read_once_and_are_inputs() {
+    let cube = format!("{}/lsystems/meshes/cube.obj", env!("CARGO_MANIFEST_DIR"));
+    let s = load(&format!(
+        "axiom: s(1, 1, 1) i(\"{cube}\") A\nA --> i(\"{cube}\") B\nB --> [ i(\"{cube}\") C ]\n"
+    ));
+    assert_eq!(s.inputs(), vec![std::path::PathBuf::from(&cube)]);
+    let run = derive(&s, None);
+    assert_eq!(run.soup.faces.len(), 6);
+}
