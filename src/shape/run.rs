@@ -50,9 +50,9 @@ pub const MAX_SHAPES_VAR: &str = "SUBGRAM_MAX_SHAPES";
 pub const MAX_FACES: usize = 10_000_000;
 
 /// The most faces a smoothing group's subdivision may make (the surface
-/// grammar's face limit for `Subdivide`); about 1.5 GB with the shapes'
-/// copies.
-pub const MAX_SMOOTH_FACES: usize = 4_000_000;
+/// grammar's face limit for `Subdivide`): a few seconds and about 1 GB
+/// with the shapes' copies.
+pub const MAX_SMOOTH_FACES: usize = 2_000_000;
 
 /// The most face cuts one split may make: a split cuts the shape at its
 /// planes one after another, so its work is the shape's faces times its
