@@ -616,7 +616,9 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
             seed: a.seed,
             ..opts
         };
-        // An OBJ's MTL file is written too, never over an input either.
+        // An OBJ's MTL file is written too, never over an input either;
+        // the meshes the grammar inserts and its scheme files are inputs.
+        inputs.extend(shapes.inputs());
         let mtl = output.with_extension("mtl");
         refuse_overwrite(&[output, &mtl], &as_paths(&inputs), a.force)?;
         let run = shapes.derive(&opts)?;

@@ -618,6 +618,12 @@ impl Shapes {
         Error::at(&self.grammar.sources, Diagnostic::new(e.span, e.message))
     }
 
+    /// The files the grammar reads besides itself: inserted meshes and
+    /// `Subdivide` scheme files.
+    pub fn inputs(&self) -> Vec<PathBuf> {
+        self.grammar.inputs.clone()
+    }
+
     /// The shape tree as indented text.
     pub fn tree_text(&self, run: &ShapeRun) -> String {
         crate::shape::output::tree_text(&self.grammar, &run.tree)

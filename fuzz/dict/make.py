@@ -82,6 +82,17 @@ write('surface_run', 'surface grammars: directives, rule forms, host built-ins, 
       surface + surface_snippets + punct + "int float bool if else sqrt cos sin pow fabs PI #define".split())
 write('vv_run', 'vv programs: the algebra statements and built-ins, properties, the shared expression language',
       vv + vv_snippets + punct + "int float double bool if else while for return sqrt cos sin pow PI".split())
+shape = """--> ~> \xe2\x87\x9d axiom: attr define NIL epsilon split Split psplit Repeat comp Comp Subdivide f e v x y z X Y Z
+t translate r rotate s scale extrude i insert primitiveCube primitiveCylinder primitiveSphere color colour set lot polygon
+top bottom front back left right side vertical horizontal all smoothingGroup scope.sx scope.sy scope.sz scope.tx scope.ty scope.tz
+split.index split.total comp.index comp.total shape.depth shape.faces ran""".split()
+shape_snippets = ['axiom: lot(20, 12) Lot\n', 'Lot --> extrude(9) Mass\n', 'Mass --> comp(f) { top : Roof | side : Facade | bottom : NIL }\n',
+                  'Facade --> split(y) { ~3 : Floor }*\n', 'split(x) { 2 : A | \'0.3 : B | ~1 : C }', 'psplit(x, 1, 0) { ~1 : A | ~1 : B | ~1 : C }',
+                  'Subdivide(2) { Done }', 'Subdivide(1, "loop") { S }', 'Subdivide(1, "catmull-clark") { S }', 'i("box")', 'i("sphere")',
+                  'i("cylinder")', 's(1, 2, 3)', 't(1, 0, 0)', 'r(0, 45, 0)', 'set(smoothingGroup, "g")', 'attr h = 3;', '1 : A : h > 1; ~> B : 0.5\n',
+                  '[ ', ' ]', '{ ', ' }', ' | ', ' : ', '*', '\n  ', 'polygon(0, 0, 4, 0, 0, 4)', 'Split(X, 2, ~1) { A | B }', 'Repeat(X, 2) { B }']
+write('shape_derive', 'shape grammars: arrows, operations, selectors, scope identifiers, rule forms',
+      shape + shape_snippets + punct + "int float bool sqrt cos sin pow PI #define 1e308 1e15 1e-300 0.0/0.0".split())
 write('mesh_read', 'OBJ, OFF and PLY keywords, types and numbers', mesh)
 write('contour_reverse', 'contours: point lists, SVG elements and path commands, PNG signature and chunk names', contour)
 write('details_reconstruct', 'details files (JSON): keys, values, extreme numbers', details)

@@ -39,6 +39,7 @@ pub const TARGETS: &[(&str, Body)] = &[
     ("details_reconstruct", details_reconstruct),
     ("model_files", model_files),
     ("vv_run", vv_run),
+    ("shape_derive", shape_derive),
 ];
 
 /// Steps of a curve derivation.
@@ -433,4 +434,46 @@ pub fn model_files(data: &[u8]) {
         }
     }
     std::hint::black_box(notes);
+}
+
+/// The most shapes a shape grammar may make in a fuzz run.
+pub const MAX_SHAPES: usize = 2_000;
+
+/// (i) A shape grammar (paper 003) loaded, checked and derived with at
+/// most [`MAX_SHAPES`] shapes and a deadline of two seconds, from the
+/// input's length as the seed; whether it succeeds or stops with an
+/// error, its tree is written as text and JSON, its terminal shapes as an
+/// OBJ with its MTL, and its coloured faces drawn into a scene.
+pub fn shape_derive(data: &[u8]) {
+    let text = text(data);
+    let Ok(System::Shapes(shapes)) =
+        subgram::load_text("fuzz.lsys", &text, &LoadOptions::default())
+    else {
+        return;
+    };
+    let opts = subgram::RunOptions {
+        seed: Some(data.len() as u32),
+        max_shapes: Some(MAX_SHAPES),
+        deadline: Some(subgram::Deadline::after(std::time::Duration::from_secs(2))),
+        ..Default::default()
+    };
+    match shapes.derive(&opts) {
+        Ok(run) => {
+            std::hint::black_box(shapes.tree_text(&run));
+            std::hint::black_box(shapes.groups_text(&run));
+            std::hint::black_box(shapes.tree_json(&run));
+            std::hint::black_box(shapes.obj(&run, "fuzz.mtl"));
+            let view = render::mesh::MeshView {
+                width: 64,
+                height: 64,
+                ..Default::default()
+            };
+            if let Ok(scene) = render::mesh::scene(&run.soup, &view) {
+                std::hint::black_box(scene);
+            }
+        }
+        Err(e) => {
+            std::hint::black_box(e.to_string());
+        }
+    }
 }

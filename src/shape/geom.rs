@@ -25,6 +25,21 @@ pub(crate) type PointId = u32;
 /// The most points one derivation may hold.
 pub(crate) const MAX_POINTS: usize = 50_000_000;
 
+/// A number for a message: plain, or in scientific notation when it is
+/// very large or very small (1e308 is not 309 digits).
+pub(crate) fn show(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e9).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// The largest coordinate a point may have: far beyond any model (in
+/// metres, the orbit of Neptune is 4.5e12), near enough to zero that areas,
+/// volumes and normals of shapes stay finite and precise.
+pub(crate) const MAX_COORD: f64 = 1e15;
+
 /// The cell size of the index of cut points by position: two cut points
 /// closer than this (and than 1e-10 of their magnitude) are one point.
 const GRID: f64 = 1e-6;
@@ -84,12 +99,21 @@ impl Points {
     }
 
     /// A new point. Refused past [`MAX_POINTS`] and for a position that is
-    /// not finite.
+    /// not finite or has a coordinate beyond [`MAX_COORD`].
     pub fn add(&mut self, p: DVec3) -> Result<PointId, String> {
         if !p.is_finite() {
             return Err(format!(
                 "a point at ({}, {}, {}) is not finite",
                 p.x, p.y, p.z
+            ));
+        }
+        if p.abs().max_element() > MAX_COORD {
+            return Err(format!(
+                "a point at ({}, {}, {}) is farther than {MAX_COORD:e} from the origin along an \
+                 axis; shapes stay within that",
+                show(p.x),
+                show(p.y),
+                show(p.z)
             ));
         }
         if self.pos.len() >= MAX_POINTS {
@@ -351,6 +375,11 @@ impl Geometry {
 
     pub fn face_count(&self) -> usize {
         self.faces.len()
+    }
+
+    /// Its elements: faces, edges and points, what a shape holds.
+    pub fn elements(&self) -> usize {
+        self.faces.len() + self.edges.len() + self.verts.len()
     }
 }
 
@@ -1120,7 +1149,13 @@ pub(crate) fn extrude(
     if geom.faces.is_empty() {
         return Ok(Geometry::empty(3));
     }
-    if orient == 0.0 || !orient.is_finite() {
+    if !orient.is_finite() {
+        return Err(format!(
+            "an extrusion of {} makes a solid too large to measure",
+            show(h)
+        ));
+    }
+    if orient == 0.0 {
         return Err("the extrusion direction lies in the plane of the faces".into());
     }
     let up = orient > 0.0;

@@ -188,10 +188,26 @@ fn is_split(s: &str) -> bool {
     matches!(s, "split" | "Split" | "psplit" | "Psplit")
 }
 
-/// True when the tokens are a shape grammar: a rule arrow `-->`, `~>` or
-/// `⇝` (the first two as adjacent punctuators, which C never writes).
+/// True when the tokens are a shape grammar: a rule arrow `⇝`, or `-->` or
+/// `~>` (adjacent punctuators) outside every bracket. C writes `k-->0`
+/// (`k-- > 0`) only inside an expression, so within parentheses or a
+/// block: such an arrow does not make an L+C file a shape grammar, where
+/// a rule's arrow always stands at the top level.
 pub fn is_shapes(toks: &[Token]) -> bool {
-    toks.iter().any(|t| t.tok.is_punct("\u{21DD}")) || toks.windows(2).any(arrow_at)
+    if toks.iter().any(|t| t.tok.is_punct("\u{21DD}")) {
+        return true;
+    }
+    let mut depth = 0i64;
+    for (k, t) in toks.iter().enumerate() {
+        if t.tok.is_punct("(") || t.tok.is_punct("{") {
+            depth += 1;
+        } else if t.tok.is_punct(")") || t.tok.is_punct("}") {
+            depth -= 1;
+        } else if depth <= 0 && arrow_at(&toks[k..]) {
+            return true;
+        }
+    }
+    false
 }
 
 /// `--` `>` or `~` `>` with nothing between them.
@@ -469,6 +485,7 @@ fn successor<F: Fn(Span) -> usize>(p: &mut Parser, cx: &Cx<F>, top: bool) -> R<V
         } else if n == "comp" || n == "Comp" {
             ops.push(comp(p, name, cx)?);
         } else if n == "Subdivide" || n == "subdivide" {
+            // What may follow it is the checker's to say (`Checker::ops`).
             ops.push(subdivide(p, name, cx)?);
         } else if OPERATIONS.contains(&n) {
             p.expect_punct("(", &format!("after `{n}`"))?;
@@ -628,10 +645,15 @@ fn size(p: &mut Parser) -> R<(SizeKind, Expr, Span)> {
     Ok((kind, e, at.to(p.prev_span())))
 }
 
-/// A part's successor inside braces.
+/// A part's successor inside braces, one level deeper: parts nest within
+/// the parser's nesting limit, which bounds the recursion of the parse,
+/// the checker and the derivation alike.
 fn inner(p: &mut Parser) -> R<Vec<Op>> {
     let cx = Cx { col: &|_| 0usize };
-    successor(p, &cx, false)
+    p.descend()?;
+    let ops = successor(p, &cx, false);
+    p.ascend();
+    ops
 }
 
 /// paper 003's `Repeat(X, 2) { B }`: as many B of about 2 units as fit.

@@ -15,7 +15,7 @@ pub(crate) mod output;
 pub(crate) mod run;
 pub(crate) mod smooth;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
@@ -52,6 +52,9 @@ pub struct ShapeGrammar {
     pub(crate) warnings: Vec<Diagnostic>,
     /// The schemes `Subdivide` names, loaded once.
     pub(crate) schemes: Vec<Scheme>,
+    /// The files the grammar reads: inserted meshes and scheme files, as
+    /// found (a command never writes over them).
+    pub(crate) inputs: Vec<PathBuf>,
 }
 
 #[derive(Debug)]
@@ -78,7 +81,8 @@ pub(crate) enum Insert {
     Box,
     Cylinder(X),
     Sphere(X, X),
-    Mesh(PolygonSoup),
+    /// A mesh file's soup, read once however often the grammar inserts it.
+    Mesh(std::sync::Arc<PolygonSoup>),
 }
 
 /// A checked successor operation.
@@ -101,8 +105,10 @@ pub(crate) enum COp {
     Insert(Insert, Span),
     Colour([u8; 3]),
     ColourRgb([X; 3]),
-    /// An attribute's slot (from the attributes' base) and its new value.
-    Set(u16, X),
+    /// An attribute's slot (from the attributes' base), its new value and
+    /// the attribute's type, which the value is converted to (C's
+    /// assignment: `true` for 2.5 in a truth value).
+    Set(u16, X, Ty),
     SetGroup(Option<std::sync::Arc<str>>),
     Lot(X, X, Span),
     Polygon(Vec<X>, Span),
@@ -169,6 +175,8 @@ pub(crate) fn from_front(front: Front, dir: Option<&Path>) -> Result<ShapeGramma
         schemes: Vec::new(),
         dir: dir.map(Path::to_path_buf),
         in_part: false,
+        inputs: Vec::new(),
+        meshes: HashMap::new(),
     };
     let g = c.file(&file);
     let (errs, warns) = c.rc.take_diagnostics();
@@ -199,6 +207,7 @@ pub(crate) fn from_front(front: Front, dir: Option<&Path>) -> Result<ShapeGramma
         sources,
         warnings: c.warnings,
         schemes: c.schemes,
+        inputs: c.inputs,
     })
 }
 
@@ -215,6 +224,9 @@ struct Checker {
     schemes: Vec<Scheme>,
     dir: Option<PathBuf>,
     in_part: bool,
+    inputs: Vec<PathBuf>,
+    /// The meshes read so far, by path.
+    meshes: HashMap<PathBuf, std::sync::Arc<PolygonSoup>>,
 }
 
 /// A constant expression's value, if it is a literal number.
@@ -338,27 +350,39 @@ impl Checker {
                 },
             ));
         }
-        // Rules with literal probabilities and no condition must sum to 1
-        // per symbol: caught before any run.
+        // The probabilities of a symbol whose rules all apply always (no
+        // condition) and all have literal probabilities must sum to 1:
+        // caught before any run. Where a rule has a condition or a
+        // computed probability, the sum of the rules that apply is checked
+        // when they apply.
         let mut sums: HashMap<&str, (f64, usize, Span)> = HashMap::new();
+        let mut unknown: HashSet<&str> = HashSet::new();
         for r in &f.rules {
-            if r.cond.is_none() {
-                if let Some(p) = r.prob.as_ref().and_then(literal) {
+            match (r.prob.as_ref().map(literal), &r.cond) {
+                (Some(Some(p)), None) => {
                     let e = sums.entry(&r.symbol.text).or_insert((0.0, 0, r.span));
                     e.0 += p;
                     e.1 += 1;
+                }
+                // No probability: the run says that all or none have one.
+                (None, None) => {}
+                _ => {
+                    unknown.insert(&r.symbol.text);
                 }
             }
         }
         let mut bad: Vec<_> = sums
             .into_iter()
-            .filter(|(_, (s, _, _))| (s - 1.0).abs() > 1e-9)
+            .filter(|(sym, (s, _, _))| !unknown.contains(sym) && (s - 1.0).abs() > 1e-9)
             .collect();
         bad.sort_by_key(|(_, (_, _, at))| at.start);
         for (sym, (s, k, at)) in bad {
             self.err(
                 at,
-                format!("the probabilities of the {k} rules for `{sym}` sum to {s}, not 1"),
+                format!(
+                    "the probabilities of the {k} rule{} for `{sym}` sum to {s}, not 1",
+                    if k == 1 { "" } else { "s" }
+                ),
             );
         }
         if !self.diags.is_empty() {
@@ -615,8 +639,16 @@ impl Checker {
         if let Some(k) = self.schemes.iter().position(|x| x.name == name) {
             return Some(k);
         }
+        if !smooth::SCHEME_NAMES.contains(&name) {
+            self.inputs.push(scheme_path(name, self.dir.as_deref()));
+        }
         let grammar = match load_scheme(name, self.dir.as_deref()) {
-            Ok(g) => g,
+            Ok(mut g) => {
+                // A smoothing group's faces go back to its shapes, which
+                // keep them: a tighter bound than a surface run's.
+                g.max_faces = g.max_faces.min(run::MAX_SMOOTH_FACES);
+                g
+            }
             Err(m) => {
                 self.err(at, m);
                 return None;
@@ -690,8 +722,28 @@ impl Checker {
                             Some(d) => d.join(file),
                             None => PathBuf::from(file),
                         };
+                        if path.exists() && !path.is_file() {
+                            // A directory, a pipe (which would wait for a
+                            // writer forever) or a device.
+                            self.err(
+                                at,
+                                format!(
+                                    "cannot insert `{file}`: {} is not a regular file",
+                                    path.display()
+                                ),
+                            );
+                            return None;
+                        }
+                        if let Some(soup) = self.meshes.get(&path) {
+                            return Some(COp::Insert(Insert::Mesh(soup.clone()), span));
+                        }
+                        self.inputs.push(path.clone());
                         match crate::mesh::io::read(&path) {
-                            Ok(soup) => COp::Insert(Insert::Mesh(soup), span),
+                            Ok(soup) => {
+                                let soup = std::sync::Arc::new(soup);
+                                self.meshes.insert(path, soup.clone());
+                                COp::Insert(Insert::Mesh(soup), span)
+                            }
                             Err(e) => {
                                 self.err(at, format!("cannot insert `{file}`: {e}"));
                                 return None;
@@ -750,7 +802,7 @@ impl Checker {
                 };
                 let ty = self.attrs[k].1;
                 let v = self.typed(value, ty)?;
-                COp::Set(k as u16, v)
+                COp::Set(k as u16, v, ty)
             }
             "lot" => {
                 if n != 2 {
@@ -779,10 +831,7 @@ fn load_scheme(name: &str, dir: Option<&Path>) -> Result<crate::surface::Grammar
     if smooth::SCHEME_NAMES.contains(&name) {
         return smooth::scheme(name);
     }
-    let path = match dir {
-        Some(d) => d.join(name),
-        None => PathBuf::from(name),
-    };
+    let path = scheme_path(name, dir);
     if !path.is_file() {
         return Err(format!(
             "`{name}` is not a scheme: use \"sqrt3\", \"loop\", \"catmull-clark\" or a \
@@ -792,6 +841,14 @@ fn load_scheme(name: &str, dir: Option<&Path>) -> Result<crate::surface::Grammar
     }
     crate::surface::load_file(&path, &[])
         .map_err(|e| format!("the scheme `{name}` does not load:\n{e}"))
+}
+
+/// Where a scheme file named `name` is: relative to the grammar's folder.
+fn scheme_path(name: &str, dir: Option<&Path>) -> PathBuf {
+    match dir {
+        Some(d) => d.join(name),
+        None => PathBuf::from(name),
+    }
 }
 
 /// A unit vector along a scope axis, for tests.

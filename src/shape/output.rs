@@ -48,19 +48,22 @@ fn unsigned_zero(x: f64) -> f64 {
     }
 }
 
+/// The deepest level [`tree_text`] indents; a deeper shape's line starts
+/// with its level in brackets instead, so that a line stays short whatever
+/// the depth (a chain of a million shapes is a million short lines).
+pub const MAX_INDENT: usize = 32;
+
 /// The tree as indented text: one line per shape.
 pub fn tree_text(g: &ShapeGrammar, t: &ShapeTree) -> String {
     let mut out = String::new();
     let mut stack: Vec<(u32, usize)> = t.roots.iter().rev().map(|&r| (r, 0)).collect();
     while let Some((n, depth)) = stack.pop() {
         let node = &t.nodes[n as usize];
-        let _ = write!(
-            out,
-            "{:indent$}{}",
-            "",
-            g.symbols[node.symbol as usize],
-            indent = 2 * depth
-        );
+        let _ = write!(out, "{:indent$}", "", indent = 2 * depth.min(MAX_INDENT));
+        if depth > MAX_INDENT {
+            let _ = write!(out, "[{depth}] ");
+        }
+        out.push_str(&g.symbols[node.symbol as usize]);
         if !node.params.is_empty() {
             let p: Vec<String> = node.params.iter().map(|&x| num(x)).collect();
             let _ = write!(out, "({})", p.join(", "));
@@ -102,11 +105,19 @@ pub fn tree_json(g: &ShapeGrammar, t: &ShapeTree) -> String {
         .collect();
     let f = |x: f64| serde_json::Value::from(unsigned_zero(x)).to_string();
     let v3 = |v: glam::DVec3| format!("[{}, {}, {}]", f(v.x), f(v.y), f(v.z));
+    // Closing brackets in a row, so that a deep tree's run of them is
+    // broken into short lines.
+    let mut closing = 0usize;
     while let Some(item) = stack.pop() {
         let Some((n, i)) = item else {
+            if closing > 0 && closing.is_multiple_of(32) {
+                out.push('\n');
+            }
             out.push_str("]}");
+            closing += 1;
             continue;
         };
+        closing = 0;
         if i > 0 {
             out.push(',');
         }

@@ -42,6 +42,29 @@ use super::{COp, CPart, ShapeGrammar, X};
 pub const MAX_SHAPES: usize = 1_000_000;
 pub const MAX_SHAPES_VAR: &str = "SUBGRAM_MAX_SHAPES";
 
+/// The most faces (with edges and points of lower-dimensional shapes) all
+/// the shapes of a derivation may hold together, parents included: each
+/// shape keeps its own copy of its geometry, so a rule that makes many
+/// children of one large mesh would otherwise exhaust memory (about 70
+/// bytes a face).
+pub const MAX_FACES: usize = 10_000_000;
+
+/// The most faces a smoothing group's subdivision may make (the surface
+/// grammar's face limit for `Subdivide`): a few seconds and about 1 GB
+/// with the shapes' copies.
+pub const MAX_SMOOTH_FACES: usize = 2_000_000;
+
+/// The most face cuts one split may make: a split cuts the shape at its
+/// planes one after another, so its work is the shape's faces times its
+/// planes.
+pub const MAX_SPLIT_WORK: usize = 20_000_000;
+
+/// The most rounds of smoothing (phase 2 of the schedule) a derivation may
+/// run: a `Subdivide` whose successor subdivides again without end (`A -->
+/// Subdivide(0) { A }`) would otherwise run until the shape limit, each
+/// round walking the whole tree.
+pub const MAX_ROUNDS: usize = 1000;
+
 /// A shape's place in the derivation.
 #[derive(Clone, Debug, PartialEq)]
 pub enum State {
@@ -123,6 +146,8 @@ type R<T> = Result<T, ShapeError>;
 pub struct ShapeOptions {
     pub seed: u32,
     pub max_shapes: usize,
+    /// The most faces, edges and points all shapes hold ([`MAX_FACES`]).
+    pub max_faces: usize,
     /// Take pending shapes last-in first-out (the default) or first-in
     /// first-out; the result is the same, which a test checks.
     pub fifo: bool,
@@ -136,6 +161,7 @@ impl Default for ShapeOptions {
         ShapeOptions {
             seed: 1,
             max_shapes: MAX_SHAPES,
+            max_faces: MAX_FACES,
             fifo: false,
             keep_meshes: false,
         }
@@ -212,6 +238,8 @@ struct Deriver<'g> {
     env: Env,
     groups: Vec<GroupReport>,
     ticks: u32,
+    /// The faces, edges and points the shapes hold (see [`MAX_FACES`]).
+    held: usize,
 }
 
 fn mix(a: u64, b: u64) -> u64 {
@@ -240,6 +268,7 @@ pub fn derive(g: &ShapeGrammar, opts: &ShapeOptions, deadline: &Deadline) -> R<S
         env: Env::new(Vec::new()),
         groups: Vec::new(),
         ticks: 0,
+        held: 0,
     };
     // The axiom: its operations act on an empty shape at the origin.
     let mut frame = g.attr_init.clone();
@@ -255,6 +284,7 @@ pub fn derive(g: &ShapeGrammar, opts: &ShapeOptions, deadline: &Deadline) -> R<S
     d.env.random = Random::new(Some(opts.seed));
     let made = d.exec(u32::MAX, &g.axiom, &mut cur, &mut frame, g.attr_base_axiom)?;
     let _ = made;
+    let mut rounds = 0;
     loop {
         while let Some(n) = if d.opts.fifo {
             d.pending.pop_front()
@@ -266,6 +296,18 @@ pub fn derive(g: &ShapeGrammar, opts: &ShapeOptions, deadline: &Deadline) -> R<S
         if d.waiting.is_empty() {
             break;
         }
+        rounds += 1;
+        let span = d.waiting[0].span;
+        if rounds > MAX_ROUNDS {
+            return Err(ShapeError::at(
+                span,
+                format!(
+                    "the derivation ran {MAX_ROUNDS} rounds of smoothing; does a \
+                     `Subdivide`'s successor subdivide again without end?"
+                ),
+            ));
+        }
+        d.deadline.check().map_err(|m| ShapeError::at(span, m))?;
         d.smooth_all()?;
     }
     Ok(ShapeTree {
@@ -277,6 +319,24 @@ pub fn derive(g: &ShapeGrammar, opts: &ShapeOptions, deadline: &Deadline) -> R<S
 }
 
 impl<'g> Deriver<'g> {
+    /// A shape's geometry of `old` elements becomes one of `new`: refused
+    /// past the face limit.
+    fn hold(&mut self, old: usize, new: usize, span: Span) -> R<()> {
+        self.held = self.held.saturating_sub(old).saturating_add(new);
+        if self.held > self.opts.max_faces {
+            return Err(ShapeError::at(
+                span,
+                format!(
+                    "the shapes hold {} faces, edges and points, past the limit of {}: each \
+                     shape keeps its own copy of its geometry, so many children of a large \
+                     mesh, or too many shapes, hold too much",
+                    self.held, self.opts.max_faces
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     fn tick(&mut self, span: Span) -> R<()> {
         self.ticks = self.ticks.wrapping_add(1);
         if self.ticks.is_multiple_of(1024) {
@@ -334,6 +394,7 @@ impl<'g> Deriver<'g> {
             (p.key, p.depth + 1, p.children.len())
         };
         let key = mix(pkey, index as u64 + 1);
+        self.hold(0, cur.geom.elements(), span)?;
         self.nodes.push(Node {
             symbol,
             params,
@@ -463,14 +524,17 @@ impl<'g> Deriver<'g> {
         let base = params.len();
         self.nodes[n as usize].state = State::Expanded;
         let made = self.exec(n, &r.body, &mut cur, &mut frame, base)?;
-        self.finish(n, made, cur);
-        Ok(())
+        self.finish(n, made, cur, r.span)
     }
 
     /// After a successor: a shape that made no child and was neither
     /// removed nor left waiting is terminal, with the state the operations
     /// left it in.
-    fn finish(&mut self, n: u32, made: Made, cur: Cur) {
+    fn finish(&mut self, n: u32, made: Made, cur: Cur, span: Span) -> R<()> {
+        if made == Made::Nothing {
+            let old = self.nodes[n as usize].geom.elements();
+            self.hold(old, cur.geom.elements(), span)?;
+        }
         let node = &mut self.nodes[n as usize];
         match made {
             Made::Children => node.state = State::Expanded,
@@ -484,6 +548,7 @@ impl<'g> Deriver<'g> {
                 node.colour = cur.colour;
             }
         }
+        Ok(())
     }
 
     /// Runs a successor's operations on `cur` for shape `n` (the axiom's
@@ -536,6 +601,7 @@ impl<'g> Deriver<'g> {
                         cur.scope.axes[0] * t.x + cur.scope.axes[1] * t.y + cur.scope.axes[2] * t.z;
                     if d != DVec3::ZERO {
                         cur.scope.origin += d;
+                        far(cur.scope.origin, "the scope's origin", *span)?;
                         cur.geom = Arc::new(self.moved(
                             &cur.geom,
                             &DAffine3::from_translation(d),
@@ -566,6 +632,7 @@ impl<'g> Deriver<'g> {
                             format!("a scope's size is not negative; this asks for {s}"),
                         ));
                     }
+                    far(s, "the scope's size", *span)?;
                     let old = cur.scope.size;
                     let ratio = |i: usize| if old[i] > 0.0 { s[i] / old[i] } else { 1.0 };
                     let (rx, ry, rz) = (ratio(0), ratio(1), ratio(2));
@@ -584,6 +651,16 @@ impl<'g> Deriver<'g> {
                 }
                 COp::Extrude(h, span) => {
                     let h = self.num(h, frame, cur, depth)?;
+                    if h.abs() > geom::MAX_COORD {
+                        return Err(ShapeError::at(
+                            *span,
+                            format!(
+                                "this extrudes by {}, beyond the {:e} that shapes stay within",
+                                geom::show(h),
+                                geom::MAX_COORD
+                            ),
+                        ));
+                    }
                     if cur.geom.dim != 2 {
                         return Err(ShapeError::at(
                             *span,
@@ -646,8 +723,8 @@ impl<'g> Deriver<'g> {
                     let b = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
                     cur.colour = Some([b(c.x), b(c.y), b(c.z)]);
                 }
-                COp::Set(slot, e) => {
-                    let v = self.eval(e, frame, cur, depth)?;
+                COp::Set(slot, e, ty) => {
+                    let v = self.eval(e, frame, cur, depth)?.convert(*ty);
                     frame[attr_base + *slot as usize] = v;
                 }
                 COp::SetGroup(name) => cur.group = name.clone(),
@@ -723,6 +800,8 @@ impl<'g> Deriver<'g> {
                             "`Subdivide` smooths faces; this shape has none",
                         ));
                     }
+                    let old = self.nodes[n as usize].geom.elements();
+                    self.hold(old, cur.geom.elements(), *span)?;
                     let node = &mut self.nodes[n as usize];
                     node.scope = cur.scope;
                     node.geom = cur.geom.clone();
@@ -765,6 +844,13 @@ impl<'g> Deriver<'g> {
     fn lot(&mut self, cur: &mut Cur, corners: &[DVec3], span: Span) -> R<()> {
         let g = geom::polygon(&mut self.points, corners).map_err(|m| ShapeError::at(span, m))?;
         let n = normal_of(&self.points, &g);
+        if n == DVec3::ZERO {
+            return Err(ShapeError::at(
+                span,
+                "a lot's corners enclose no area (they lie on a line, or the outline \
+                 crosses itself)",
+            ));
+        }
         if n.y <= 0.0 {
             return Err(ShapeError::at(
                 span,
@@ -819,6 +905,19 @@ impl<'g> Deriver<'g> {
                 "this split makes {} parts, more than the limit of {} shapes ({MAX_SHAPES_VAR})",
                 layout.len(), self.opts.max_shapes
             ),
+            ));
+        }
+        let work = cuts_of(&layout, total).saturating_mul(cur.geom.elements());
+        if work > MAX_SPLIT_WORK {
+            return Err(ShapeError::at(
+                span,
+                format!(
+                    "this split cuts a shape of {} faces at {} planes, one after another: {work} \
+                     face cuts, more than the limit of {MAX_SPLIT_WORK}; split a coarser shape, \
+                     or into fewer parts",
+                    cur.geom.elements(),
+                    cuts_of(&layout, total)
+                ),
             ));
         }
         let mut flags = Vec::new();
@@ -1150,7 +1249,7 @@ impl<'g> Deriver<'g> {
             self.env.random = Random::new(Some((key ^ (key >> 32)) as u32));
             self.nodes[m as usize].state = State::Expanded;
             let made = self.exec(m, w.body, &mut cur, &mut frame, base)?;
-            self.finish(m, made, cur);
+            self.finish(m, made, cur, w.span)?;
         }
         Ok(())
     }
@@ -1235,6 +1334,9 @@ impl<'g> Deriver<'g> {
         }
         for (k, (&m, faces)) in members.iter().zip(slices).enumerate() {
             let _ = k;
+            let old = self.nodes[m as usize].geom.elements();
+            let new = old - self.nodes[m as usize].geom.faces.len() + faces.len();
+            self.hold(old, new, span)?;
             let node = &mut self.nodes[m as usize];
             Arc::make_mut(&mut node.geom).faces = faces;
             node.scope = geom::bounding_scope(&self.points, &node.geom, node.scope.axes);
@@ -1251,6 +1353,38 @@ fn relative(v: DVec3, rel: &[bool; 3], size: DVec3) -> DVec3 {
         if rel[1] { v.y * size.y } else { v.y },
         if rel[2] { v.z * size.z } else { v.z },
     )
+}
+
+/// Refuses a scope's origin, size or an extrusion's height beyond
+/// [`geom::MAX_COORD`], where the shapes' arithmetic would overflow.
+fn far(v: DVec3, what: &str, span: Span) -> R<()> {
+    if !v.is_finite() || v.abs().max_element() > geom::MAX_COORD {
+        return Err(ShapeError::at(
+            span,
+            format!(
+                "this makes {what} ({}, {}, {}), beyond the {:e} that shapes stay within",
+                geom::show(v.x),
+                geom::show(v.y),
+                geom::show(v.z),
+                geom::MAX_COORD
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The number of planes a split with this layout cuts at (at most): the
+/// part ends strictly inside the scope.
+fn cuts_of(layout: &[(usize, f64)], total: f64) -> usize {
+    let mut at = 0.0;
+    let mut n = 0usize;
+    for (_, len) in layout {
+        at += len;
+        if at < total {
+            n += 1;
+        }
+    }
+    n
 }
 
 /// The direction a 2D shape faces: the sum of its faces' vector areas.
@@ -1354,13 +1488,19 @@ pub(crate) fn lay_out(
         return Err("a repeated pattern has a length above zero".into());
     }
     let times = if has_float {
-        ((total / pattern).round() as usize).max(1)
+        (total / pattern).round().max(1.0)
     } else {
-        ((total + tol) / pattern).floor() as usize
+        ((total + tol) / pattern).floor()
     };
-    if times as f64 > 1e7 {
-        return Err(format!("this repeat lays its pattern {times} times; a pattern of {pattern} in {total} is too small"));
+    if times > 1e7 {
+        return Err(format!(
+            "this repeat would lay its pattern {} times (a pattern of {} in {}); at most 1e7",
+            geom::show(times),
+            geom::show(pattern),
+            geom::show(total)
+        ));
     }
+    let times = times as usize;
     if has_float && fixed_sum * times as f64 > total + tol {
         return Err(format!(
             "the repeat's fixed sizes add up to {} in {times} repetitions, more than the scope's {total}",
@@ -1492,6 +1632,57 @@ mod tests {
             assert_eq!(obj(&g, false, seed), obj(&g, true, seed));
         }
         assert_ne!(obj(&g, false, 1), obj(&g, false, 2));
+    }
+
+    fn derive_err(g: &ShapeGrammar, opts: &ShapeOptions) -> ShapeError {
+        let never = Deadline::after(std::time::Duration::from_secs(3600));
+        match derive(g, opts, &never) {
+            Ok(_) => panic!("the derivation succeeded"),
+            Err(e) => e,
+        }
+    }
+
+    /// The text at a span of the grammar.
+    fn at(g: &ShapeGrammar, span: Span) -> String {
+        let text = &g.sources.get(span.file).text;
+        text[span.start as usize..span.end as usize].to_string()
+    }
+
+    /// A smoothing group's subdivision stops at its scheme's face limit,
+    /// which load sets to at most MAX_SMOOTH_FACES, with the message at
+    /// the `Subdivide`. √3 on a box: 12 triangles, then 36, then 108 (3
+    /// per triangle a step, by hand), past a limit of 100.
+    #[test]
+    fn subdivision_stops_at_the_face_limit() {
+        let mut g = grammar("axiom: s(1, 1, 1) i(\"box\") A\nA --> Subdivide(2) { B }\n");
+        assert_eq!(g.schemes[0].grammar.max_faces, MAX_SMOOTH_FACES);
+        g.schemes[0].grammar.max_faces = 100;
+        let e = derive_err(&g, &ShapeOptions::default());
+        assert!(e.message.contains("past the limit of 100"), "{}", e.message);
+        assert_eq!(at(&g, e.span), "Subdivide(2) { B }");
+        g.schemes[0].grammar.max_faces = 108;
+        obj(&g, false, 1);
+    }
+
+    /// The faces all shapes hold together are bounded: a box's 6 faces in
+    /// the axiom's shape and each child's copy are 6 each, 18 in all, so a
+    /// limit of 17 stops at the third shape, at its symbol, and 18 does not.
+    #[test]
+    fn held_faces_are_bounded() {
+        let g = grammar("axiom: s(1, 1, 1) i(\"box\") A\nA --> B C\n");
+        let opts = ShapeOptions {
+            max_faces: 17,
+            ..Default::default()
+        };
+        let e = derive_err(&g, &opts);
+        assert!(e.message.contains("hold 18 faces"), "{}", e.message);
+        assert_eq!(at(&g, e.span), "C");
+        let opts = ShapeOptions {
+            max_faces: 18,
+            ..Default::default()
+        };
+        let never = Deadline::after(std::time::Duration::from_secs(3600));
+        derive(&g, &opts, &never).unwrap_or_else(|e| panic!("{}", e.message));
     }
 
     #[test]

@@ -120,8 +120,14 @@ pub(crate) fn subdivide(
             protected_vertex.len()
         ));
     }
-    let mut mesh = Mesh::from_soup_tagged(soup, tags)
-        .map_err(|e| format!("subdivide: the group's welded mesh is refused: {e}"))?;
+    let mut mesh = Mesh::from_soup_tagged(soup, tags).map_err(|e| {
+        format!(
+            "subdivide: the group's welded mesh is refused: {e} (the faces of a smoothing \
+                 group make one oriented surface: shapes that overlap, such as a mass and a \
+                 face taken from it by `comp`, or one shape made twice, are smoothed in \
+                 groups of their own, named by `set(smoothingGroup, ...)`)"
+        )
+    })?;
     // The mesh's faces come in the soup's order; its vertices are the
     // soup's, with the same ids.
     let ranges = Mesh::soup_face_ranges(soup);

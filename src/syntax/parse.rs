@@ -1467,7 +1467,7 @@ impl<'t> Parser<'t> {
     /// counts on a deep parse in a debug build.)
     ///
     /// [`ascend`]: Parser::ascend
-    fn descend(&mut self) -> PResult<()> {
+    pub(crate) fn descend(&mut self) -> PResult<()> {
         if self.depth + 1 > MAX_NESTING {
             return self.too_deep(self.span_here());
         }
@@ -1476,7 +1476,7 @@ impl<'t> Parser<'t> {
         Ok(())
     }
 
-    fn ascend(&mut self) {
+    pub(crate) fn ascend(&mut self) {
         self.depth -= 1;
     }
 

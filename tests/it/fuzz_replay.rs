@@ -131,6 +131,11 @@ fn vv_run() {
 }
 
 #[test]
+fn shape_derive() {
+    replay("shape_derive");
+}
+
+#[test]
 fn model_files() {
     replay("model_files");
 }

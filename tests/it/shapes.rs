@@ -444,7 +444,7 @@ fn a_named_group_waits_for_its_members_and_takes_terminal_ones() {
 /// A derivation that fails writes nothing: no OBJ, no MTL.
 #[test]
 fn a_failed_derivation_writes_no_file() {
-    let dir = std::env::temp_dir().join(format!("subgram-shapes-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("subgram-shapes-nowrite-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let grammar = dir.join("bad.lsys");
     std::fs::write(
@@ -495,4 +495,141 @@ fn a_selector_after_all_takes_nothing() {
     let run = derive(&s, None);
     let names: Vec<String> = children(&s, &run).into_iter().map(|c| c.0).collect();
     assert_eq!(names, vec!["F"; 6]);
+}
+
+// Adversarial inputs (issue 14's adversarial pass): what once misread,
+// panicked or ran without end.
+
+/// C's `k-->0` is `k-- > 0`: inside a block it does not make an L+C
+/// program a shape grammar, where a rule's arrow stands at the top level.
+#[test]
+fn cs_goes_to_operator_stays_lplusc() {
+    let text = "derivation length: 2;\nmodule A(int);\nAxiom: A(3);\n\
+                A(n) : { int k = n; while (k-->0) { } produce A(k) F(1); }\n";
+    match subgram::load_text("t.lsys", text, &LoadOptions::default()) {
+        Ok(System::Curve(_)) => {}
+        Ok(_) => panic!("an L+C program read as another kind"),
+        Err(e) => panic!("{e}"),
+    }
+    // A rule's arrow at the top level, after a parenthesised condition.
+    load("axiom: s(1, 1, 1) i(\"box\") A(1)\nA(k) : (k > 0) --> B\n");
+}
+
+/// Probabilities that are expressions, or rules with conditions, are
+/// checked when the rules apply, not summed at load: 0.25 * 2 + 0.5 is 1
+/// (by hand), so both successors occur over a few seeds.
+#[test]
+fn computed_probabilities_are_checked_when_they_apply() {
+    let s = load(
+        "axiom: s(1, 1, 1) i(\"box\") A\n\
+         1 : A ~> B : 0.25 * 2\n\
+         2 : A ~> C : 0.5\n",
+    );
+    let mut seen = HashSet::new();
+    for seed in 1..20 {
+        let run = derive(&s, Some(seed));
+        let tree: serde_json::Value = serde_json::from_str(&s.tree_json(&run)).unwrap();
+        seen.insert(
+            tree[0]["children"][0]["symbol"]
+                .as_str()
+                .unwrap()
+                .to_string(),
+        );
+    }
+    assert_eq!(seen, HashSet::from(["B".to_string(), "C".to_string()]));
+    // A condition that always holds: 0.5 + 0.5 among the rules that apply.
+    let s = load(
+        "axiom: s(1, 1, 1) i(\"box\") A\n\
+         1 : A : scope.sx > 0 ~> B : 0.5\n\
+         2 : A ~> C : 0.5\n",
+    );
+    derive(&s, Some(1));
+}
+
+/// A chain of shapes 1,201 levels deep: the text tree indents at most 32
+/// levels (the level is written in brackets beyond), so its lines stay
+/// short; the JSON tree, one nested object per level, is refused with a
+/// message past 256 levels, and written below that on a test thread's
+/// small stack. (Indenting 2 × 40,000 columns panicked; a JSON tree of
+/// 20,000 levels ran for minutes.)
+#[test]
+fn deep_trees_are_written_in_bounded_lines() {
+    let s = load("axiom: s(1, 1, 1) i(\"box\") A(0)\nA(k) : k < 1200 --> A(k + 1)\n");
+    let run = derive(&s, None);
+    let text = s.tree_text(&run);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 1201);
+    assert!(lines.iter().all(|l| l.len() < 200), "a line is long");
+    assert!(lines[1200].starts_with(&format!("{}[1200] A(1200)", " ".repeat(64))));
+    assert!(lines[32].starts_with(&format!("{}A(32)", " ".repeat(64))));
+    // The JSON is one shape per line at any depth, its closing brackets
+    // broken into short lines, balanced: 1201 objects opened and closed.
+    let json = s.tree_json(&run);
+    assert!(json.lines().all(|l| l.len() < 400), "a line is long");
+    assert_eq!(json.matches('{').count(), json.matches('}').count());
+    assert_eq!(json.matches('[').count(), json.matches(']').count());
+    assert_eq!(json.matches("\"children\": [").count(), 1201);
+    // A shallower tree parses back (serde_json refuses nesting beyond 128).
+    let s = load("axiom: s(1, 1, 1) i(\"box\") A(0)\nA(k) : k < 40 --> A(k + 1)\n");
+    let run = derive(&s, None);
+    let v: serde_json::Value = serde_json::from_str(&s.tree_json(&run)).unwrap();
+    assert_eq!(v[0]["symbol"], "A");
+}
+
+/// Inserting what is not a regular file (a directory named like a mesh, a
+/// named pipe, which would wait for a writer forever) is refused at the
+/// string.
+#[test]
+fn inserting_a_non_file_is_refused() {
+    let dir = std::env::temp_dir().join(format!("subgram-adv14-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("folder.obj")).unwrap();
+    let fifo = dir.join("pipe.obj");
+    let made_fifo = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    let mut names = vec!["folder.obj"];
+    if made_fifo {
+        names.push("pipe.obj");
+    }
+    for name in names {
+        let path = dir.join(name);
+        let text = format!("axiom: s(1, 1, 1) i(\"{}\") A\nA --> B\n", path.display());
+        let e = match subgram::load_text("t.lsys", &text, &LoadOptions::default()) {
+            Err(e) => e.to_string(),
+            Ok(_) => panic!("{name} was inserted"),
+        };
+        assert!(e.contains("is not a regular file"), "{e}");
+        assert!(e.contains("t.lsys:1:21"), "{e}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `set` converts to the attribute's type as C's assignment does: 2.5 in
+/// a truth value is true (1), 2.7 in an int is 2. (A truth value held
+/// 2.5.)
+#[test]
+fn set_converts_to_the_attributes_type() {
+    let s = load(
+        "attr b = true;\nattr n = 1;\naxiom: s(1, 1, 1) i(\"box\") A\n\
+         A --> set(b, 2.5) set(n, 2.7) B(b, n)\n",
+    );
+    let run = derive(&s, None);
+    let tree: serde_json::Value = serde_json::from_str(&s.tree_json(&run)).unwrap();
+    let p = &tree[0]["children"][0]["params"];
+    assert_eq!(p, &serde_json::json!([1.0, 2.0]));
+}
+
+/// A mesh inserted by several operations is read once, and it and the
+/// scheme files are the grammar's inputs, which `subdivide` never
+/// overwrites.
+#[test]
+fn inserted_meshes_are_read_once_and_are_inputs() {
+    let cube = format!("{}/lsystems/meshes/cube.obj", env!("CARGO_MANIFEST_DIR"));
+    let s = load(&format!(
+        "axiom: s(1, 1, 1) i(\"{cube}\") A\nA --> i(\"{cube}\") B\nB --> [ i(\"{cube}\") C ]\n"
+    ));
+    assert_eq!(s.inputs(), vec![std::path::PathBuf::from(&cube)]);
+    let run = derive(&s, None);
+    assert_eq!(run.soup.faces.len(), 6);
 }
