@@ -229,14 +229,7 @@ pub fn vv_run(data: &[u8]) {
     match vv.run_soup(&base_mesh(data), &opts) {
         Ok(run) => {
             std::hint::black_box(run.info.to_string());
-            let view = render::mesh::MeshView {
-                width: 64,
-                height: 64,
-                ..Default::default()
-            };
-            if let Ok(scene) = render::mesh::scene(&run.soup, &view) {
-                std::hint::black_box(scene);
-            }
+            draw_small(&run.soup);
         }
         Err(e) => {
             std::hint::black_box(e.to_string());
@@ -463,17 +456,22 @@ pub fn shape_derive(data: &[u8]) {
             std::hint::black_box(shapes.groups_text(&run));
             std::hint::black_box(shapes.tree_json(&run));
             std::hint::black_box(shapes.obj(&run, "fuzz.mtl"));
-            let view = render::mesh::MeshView {
-                width: 64,
-                height: 64,
-                ..Default::default()
-            };
-            if let Ok(scene) = render::mesh::scene(&run.soup, &view) {
-                std::hint::black_box(scene);
-            }
+            draw_small(&run.soup);
         }
         Err(e) => {
             std::hint::black_box(e.to_string());
         }
+    }
+}
+
+/// Draws a soup as a 64 x 64 scene, as the binary would, and drops it.
+fn draw_small(soup: &subgram::mesh::PolygonSoup) {
+    let view = render::mesh::MeshView {
+        width: 64,
+        height: 64,
+        ..Default::default()
+    };
+    if let Ok(scene) = render::mesh::scene(soup, &view) {
+        std::hint::black_box(scene);
     }
 }

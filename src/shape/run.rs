@@ -219,6 +219,25 @@ struct Cur {
     comp: (i64, i64),
 }
 
+impl Cur {
+    /// The state a shape's successor starts from: the shape as it is.
+    fn of(node: &Node) -> Cur {
+        Cur {
+            scope: node.scope,
+            geom: node.geom.clone(),
+            group: node.group.clone(),
+            colour: node.colour,
+            split: node.split,
+            comp: node.comp,
+        }
+    }
+}
+
+/// The generators `ran()` and its kin read, seeded from a shape's key.
+fn random_of(key: u64) -> Random {
+    Random::new(Some((key ^ (key >> 32)) as u32))
+}
+
 struct Deriver<'g> {
     g: &'g ShapeGrammar,
     opts: ShapeOptions,
@@ -433,16 +452,9 @@ impl<'g> Deriver<'g> {
         let node = &self.nodes[n as usize];
         // The shape's own random numbers.
         let key = node.key;
-        self.env.random = Random::new(Some((key ^ (key >> 32)) as u32));
+        self.env.random = random_of(key);
         let mut choose = Rand48::from_state(key & 0xFFFF_FFFF_FFFF);
-        let cur = Cur {
-            scope: node.scope,
-            geom: node.geom.clone(),
-            group: node.group.clone(),
-            colour: node.colour,
-            split: node.split,
-            comp: node.comp,
-        };
+        let cur = Cur::of(node);
         let depth = node.depth;
         let params: Vec<Value> = node.params.iter().map(|&x| Value::Float(x)).collect();
         let attrs = node.attrs.clone();
@@ -1233,20 +1245,12 @@ impl<'g> Deriver<'g> {
         for (m, wi) in after {
             let w = &waiting[wi];
             let node = &self.nodes[m as usize];
-            let mut cur = Cur {
-                scope: node.scope,
-                geom: node.geom.clone(),
-                group: node.group.clone(),
-                colour: node.colour,
-                split: node.split,
-                comp: node.comp,
-            };
+            let mut cur = Cur::of(node);
             let mut frame = w.frame.clone();
             let base = node.params.len();
             // The body's random numbers are the shape's own too, whatever
             // shape was rewritten last.
-            let key = mix(node.key, 0x5EED);
-            self.env.random = Random::new(Some((key ^ (key >> 32)) as u32));
+            self.env.random = random_of(mix(node.key, 0x5EED));
             self.nodes[m as usize].state = State::Expanded;
             let made = self.exec(m, w.body, &mut cur, &mut frame, base)?;
             self.finish(m, made, cur, w.span)?;
