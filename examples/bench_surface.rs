@@ -8,6 +8,14 @@
 //!   316 x 316 quad torus;
 //! - sqrt(3) (lsystems/surfaces/sqrt3.lsys), one level, on the icosphere
 //!   (CGAL's time on the same file comes from `benches/xcheck.py`).
+//!
+//! Each is also timed whole, from an indexed face list to an indexed face
+//! list, as igl.loop and Blender are: building the half-edge mesh
+//! (`Mesh::from_soup`), the grammar, and the faces out (`to_soup`, or
+//! `to_quad_soup` for Catmull-Clark), each part best of the runs, with a
+//! copy of the output's arrays as the reference for the last part.
+
+mod common;
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -25,6 +33,41 @@ fn best_of(runs: usize, base: &Mesh, g: &subgram::surface::Grammar) -> (f64, Mes
         last = Some(m);
     }
     (best, last.expect("one run"))
+}
+
+/// Times soup -> mesh -> grammar -> soup, each part best of `runs`, and
+/// prints the parts, their sum and the reference copy.
+fn faces_to_faces(
+    name: &str,
+    runs: usize,
+    soup: &subgram::mesh::PolygonSoup,
+    g: &subgram::surface::Grammar,
+    quads: bool,
+) {
+    let (t_build, base) = common::best_of(runs, || Mesh::from_soup(soup).expect("valid"));
+    let (t_run, m) = best_of(runs, &base, g);
+    let t_run = std::time::Duration::from_secs_f64(t_run);
+    let (t_out, out) = common::best_of(runs, || if quads { m.to_quad_soup() } else { m.to_soup() });
+    // The reference: copying the output's arrays (positions and indices,
+    // one list per face, as a soup holds them).
+    let (t_copy, copy) = common::best_of(runs, || out.clone());
+    assert_eq!(copy.faces.len(), out.faces.len());
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    println!(
+        "{name}, faces to faces ({} -> {} faces), best of {runs} each part:",
+        soup.faces.len(),
+        out.faces.len()
+    );
+    println!("  from_soup      {:>8.1} ms", ms(t_build));
+    println!("  grammar        {:>8.1} ms", ms(t_run));
+    println!(
+        "  {:<14} {:>8.1} ms ({:.2}x a copy of its arrays, {:.1} ms)",
+        if quads { "to_quad_soup" } else { "to_soup" },
+        ms(t_out),
+        t_out.as_secs_f64() / t_copy.as_secs_f64(),
+        ms(t_copy)
+    );
+    println!("  total          {:>8.1} ms", ms(t_build + t_run + t_out));
 }
 
 fn main() {
@@ -51,6 +94,8 @@ fn main() {
         t * 1e3
     );
 
+    faces_to_faces("Loop", runs, &sphere, &g, false);
+
     let g = subgram::surface::load_file(&root.join("lsystems/surfaces/sqrt3.lsys"), &[])
         .expect("grammar");
     let (t, m) = best_of(runs, &base, &g);
@@ -74,4 +119,5 @@ fn main() {
         m.to_quad_soup().faces.len(),
         t * 1e3
     );
+    faces_to_faces("Catmull-Clark", runs, &torus, &g, true);
 }
