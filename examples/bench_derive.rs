@@ -1,6 +1,9 @@
 //! Benchmarks of the rewriting engine against hand-written references,
 //! measured in the same run. `cargo run --release --example bench_derive`
 //!
+//! `--chaikin-only` runs the first only; `--runs N` keeps the best of N runs
+//! (10 by default) of the first two.
+//!
 //! 1. Closed Chaikin (production 13) from a 1,000-point axiom to 1,024,000
 //!    points: the engine running the `.lsys` text, in lpfg's single
 //!    precision (the default) and in double (`--double`), against two Rust
@@ -112,7 +115,13 @@ where
 }
 
 fn main() {
-    let runs = 10;
+    // `--runs N`: more runs for the best time on a busy machine.
+    let args: Vec<String> = std::env::args().collect();
+    let runs = args
+        .iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1)?.parse().ok())
+        .unwrap_or(10);
     let pts = polygon(1000);
     let steps = 10;
     let axiom: Vec<String> = pts
@@ -188,7 +197,7 @@ fn main() {
         }
     }
 
-    if std::env::args().any(|a| a == "--chaikin-only") {
+    if args.iter().any(|a| a == "--chaikin-only") {
         return;
     }
 

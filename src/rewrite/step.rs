@@ -6,6 +6,8 @@
 //! (pseudo-L-systems) partition the word without overlap, starting at the
 //! phase. `src` is never mutated.
 
+use std::ops::Range;
+
 use crate::deadline::Deadline;
 use crate::lang::eval::{Emit, Env, Flow, Host, Interp, RuntimeError};
 use crate::lang::ir::{Pattern, Program, Rule};
@@ -438,11 +440,23 @@ impl<'p> Rewriter<'p> {
                 .collect();
             let pattern: Vec<Sym> = plain.iter().map(|(s, _)| *s).collect();
             let mut end = out.len() as u32;
-            for _ in 0..n {
-                syms.extend_from_slice(&pattern);
-                for wd in &widths {
-                    end += *wd as u32;
-                    starts.push(end);
+            if pattern.iter().all(|&p| p == pattern[0]) {
+                syms.resize(syms.len() + n * pattern.len(), pattern[0]);
+            } else {
+                (0..n).for_each(|_| syms.extend_from_slice(&pattern));
+            }
+            if widths.iter().all(|&wd| wd == widths[0]) {
+                // Equal widths: the offsets are an arithmetic sequence.
+                let wd = widths[0] as u32;
+                let count = (n * widths.len()) as u32;
+                starts.extend((1..=count).map(|k| end + k * wd));
+                end += count * wd;
+            } else {
+                for _ in 0..n {
+                    for wd in &widths {
+                        end += *wd as u32;
+                        starts.push(end);
+                    }
                 }
             }
             let seam_module =
@@ -473,7 +487,33 @@ impl<'p> Rewriter<'p> {
             // `v * 0` is 0 for a finite v and NaN otherwise: a NaN guard
             // without a branch per value.
             let mut g = 0.0;
-            for i in first_inner..last_inner {
+            let inner = first_inner..last_inner;
+            // One shape for every parameter (Chaikin, and every curve scheme
+            // of paper 002): a loop compiled for it.
+            let kernel = match uniform_shape(&fixed) {
+                Some((2, 2, true)) => fixed_kernel::<2, 2, true>,
+                Some((2, 3, true)) => fixed_kernel::<2, 3, true>,
+                Some((2, 4, true)) => fixed_kernel::<2, 4, true>,
+                Some((3, 2, true)) => fixed_kernel::<3, 2, true>,
+                Some((3, 3, true)) => fixed_kernel::<3, 3, true>,
+                Some((3, 4, true)) => fixed_kernel::<3, 4, true>,
+                Some((2, 2, false)) => fixed_kernel::<2, 2, false>,
+                Some((2, 3, false)) => fixed_kernel::<2, 3, false>,
+                Some((2, 4, false)) => fixed_kernel::<2, 4, false>,
+                Some((3, 2, false)) => fixed_kernel::<3, 2, false>,
+                Some((3, 3, false)) => fixed_kernel::<3, 3, false>,
+                Some((3, 4, false)) => fixed_kernel::<3, 4, false>,
+                _ => |_: &[FixedOutput], _: &[f64], _: usize, _: Range<usize>, _: &mut Vec<f64>| None,
+            };
+            let inner = match kernel(&fixed, data, w, inner.clone(), out) {
+                Some(true) => 0..0,
+                Some(false) => {
+                    g = f64::NAN;
+                    0..0
+                }
+                None => inner,
+            };
+            for i in inner {
                 let at = (i * w) as isize;
                 for (_, combos) in &fixed {
                     for (ty, terms) in combos {
@@ -934,6 +974,78 @@ fn fixed_eval<const N: usize, const SINGLE: bool>(
             acc
         }
     }
+}
+
+/// `(N, T, single)` when every parameter of every output has `N`
+/// components, `T` terms and the same precision.
+fn uniform_shape(fixed: &[FixedOutput]) -> Option<(usize, usize, bool)> {
+    let mut all = fixed
+        .iter()
+        .flat_map(|(_, cs)| cs)
+        .map(|(ty, ts)| (ty.dim(), ts.len(), ty.is_single()));
+    let first = all.next()?;
+    all.all(|s| s == first).then_some(first)
+}
+
+/// The modules `range` of a uniform step whose parameters all have `N`
+/// components and `T` terms: `fixed_eval`'s operations in the same order,
+/// written in place a block at a time. Returns whether every value is
+/// finite, or `None` when the outputs do not have that shape.
+fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
+    fixed: &[FixedOutput],
+    data: &[f64],
+    w: usize,
+    range: Range<usize>,
+    out: &mut Vec<f64>,
+) -> Option<bool> {
+    const BLOCK: usize = 256;
+    let r = rounded::<SINGLE>;
+    let mut combos: Vec<[(isize, f64); T]> = Vec::new();
+    for (_, cs) in fixed {
+        for (ty, ts) in cs {
+            if ty.dim() != N || ty.is_single() != SINGLE {
+                return None;
+            }
+            combos.push(ts.as_slice().try_into().ok()?);
+        }
+    }
+    let per = combos.len() * N;
+    if per == 0 {
+        return None;
+    }
+    let mut ok = true;
+    let mut i = range.start;
+    while i < range.end {
+        let m = (range.end - i).min(BLOCK);
+        let from = out.len();
+        // The block is small enough to stay in the first-level cache while
+        // it is zeroed, filled, then checked.
+        out.resize(from + m * per, 0.0);
+        let block = &mut out[from..];
+        for (c_at, c) in combos.iter().enumerate() {
+            // One parameter of every module of the block at a time: a loop
+            // with no branch on the shape.
+            let cols = block[c_at * N..].chunks_mut(per);
+            for (o, i) in cols.zip(i..i + m) {
+                let at = (i * w) as isize;
+                let x: [&[f64; N]; T] = std::array::from_fn(|t| {
+                    let p = (at + c[t].0) as usize;
+                    data[p..p + N].try_into().expect("N slots")
+                });
+                let v: [f64; N] = std::array::from_fn(|k| {
+                    let mut acc = r(c[0].1 * x[0][k]);
+                    for t in 1..T {
+                        acc = r(acc + r(c[t].1 * x[t][k]));
+                    }
+                    acc
+                });
+                o[..N].copy_from_slice(&v);
+            }
+        }
+        ok &= block.iter().fold(true, |ok, x| ok & x.is_finite());
+        i += m;
+    }
+    Some(ok)
 }
 
 /// `x`, rounded to single precision when the stencil computes `float`s:
