@@ -320,11 +320,13 @@ impl<'p> Rewriter<'p> {
                     .chain(&rule.right)
                     .all(simple)
         });
+        // No early exit, so that the scan vectorises.
         rules_ok
-            && !src
-                .syms()
-                .iter()
-                .any(|&s| s == self.sb || s == self.eb || s == self.cut)
+            && src.syms().chunks(64).all(|c| {
+                c.iter().fold(true, |ok, &s| {
+                    ok & (s != self.sb) & (s != self.eb) & (s != self.cut)
+                })
+            })
     }
 
     /// On a ring whose modules are all of one kind and one width, the first
@@ -341,7 +343,8 @@ impl<'p> Rewriter<'p> {
             return None;
         }
         let s = src.sym(0);
-        if src.syms().iter().any(|&t| t != s) || !src.slot_count().is_multiple_of(n) {
+        let same = |c: &[Sym]| c.iter().fold(true, |ok, &t| ok & (t == s));
+        if !src.syms().chunks(64).all(same) || !src.slot_count().is_multiple_of(n) {
             return None;
         }
         let w = src.slot_count() / n;
@@ -1025,17 +1028,20 @@ fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
         for (c_at, c) in combos.iter().enumerate() {
             // One parameter of every module of the block at a time: a loop
             // with no branch on the shape.
+            // The weights and offsets in registers, not read per module.
+            let ws: [f64; T] = std::array::from_fn(|t| c[t].1);
+            let ds: [isize; T] = std::array::from_fn(|t| c[t].0);
             let cols = block[c_at * N..].chunks_mut(per);
             for (o, i) in cols.zip(i..i + m) {
                 let at = (i * w) as isize;
                 let x: [&[f64; N]; T] = std::array::from_fn(|t| {
-                    let p = (at + c[t].0) as usize;
+                    let p = (at + ds[t]) as usize;
                     data[p..p + N].try_into().expect("N slots")
                 });
                 let v: [f64; N] = std::array::from_fn(|k| {
-                    let mut acc = r(c[0].1 * x[0][k]);
+                    let mut acc = r(ws[0] * x[0][k]);
                     for t in 1..T {
-                        acc = r(acc + r(c[t].1 * x[t][k]));
+                        acc = r(acc + r(ws[t] * x[t][k]));
                     }
                     acc
                 });
