@@ -1012,10 +1012,14 @@ fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
             combos.push(ts.as_slice().try_into().ok()?);
         }
     }
-    let per = combos.len() * N;
-    if per == 0 {
+    let c_count = combos.len();
+    // Every term reads whole groups of `N` slots: address the word as an
+    // array of such groups, one bounds check per term.
+    let wn = w / N;
+    if c_count == 0 || w % N != 0 || combos.iter().flatten().any(|(d, _)| d % N as isize != 0) {
         return None;
     }
+    let (groups, _) = data.as_chunks::<N>();
     let mut ok = true;
     let mut i = range.start;
     while i < range.end {
@@ -1023,32 +1027,26 @@ fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
         let from = out.len();
         // The block is small enough to stay in the first-level cache while
         // it is zeroed, filled, then checked.
-        out.resize(from + m * per, 0.0);
-        let block = &mut out[from..];
+        out.resize(from + m * c_count * N, 0.0);
+        let (block, _) = out[from..].as_chunks_mut::<N>();
         for (c_at, c) in combos.iter().enumerate() {
-            // One parameter of every module of the block at a time: a loop
-            // with no branch on the shape.
-            // The weights and offsets in registers, not read per module.
+            // One parameter of every module of the block at a time, with
+            // the weights and offsets in registers.
             let ws: [f64; T] = std::array::from_fn(|t| c[t].1);
-            let ds: [isize; T] = std::array::from_fn(|t| c[t].0);
-            let cols = block[c_at * N..].chunks_mut(per);
-            for (o, i) in cols.zip(i..i + m) {
-                let at = (i * w) as isize;
-                let x: [&[f64; N]; T] = std::array::from_fn(|t| {
-                    let p = (at + ds[t]) as usize;
-                    data[p..p + N].try_into().expect("N slots")
-                });
-                let v: [f64; N] = std::array::from_fn(|k| {
+            let es: [isize; T] = std::array::from_fn(|t| c[t].0 / N as isize);
+            for (o, i) in block.chunks_exact_mut(c_count).zip(i..i + m) {
+                let at = (i * wn) as isize;
+                let x: [&[f64; N]; T] = std::array::from_fn(|t| &groups[(at + es[t]) as usize]);
+                o[c_at] = std::array::from_fn(|k| {
                     let mut acc = r(ws[0] * x[0][k]);
                     for t in 1..T {
                         acc = r(acc + r(ws[t] * x[t][k]));
                     }
                     acc
                 });
-                o[..N].copy_from_slice(&v);
             }
         }
-        ok &= block.iter().fold(true, |ok, x| ok & x.is_finite());
+        ok &= out[from..].iter().fold(true, |ok, x| ok & x.is_finite());
         i += m;
     }
     Some(ok)
