@@ -506,7 +506,9 @@ impl<'p> Rewriter<'p> {
                 Some((3, 2, false)) => fixed_kernel::<3, 2, false>,
                 Some((3, 3, false)) => fixed_kernel::<3, 3, false>,
                 Some((3, 4, false)) => fixed_kernel::<3, 4, false>,
-                _ => |_: &[FixedOutput], _: &[f64], _: usize, _: Range<usize>, _: &mut Vec<f64>| None,
+                _ => {
+                    |_: &[FixedOutput], _: &[f64], _: usize, _: Range<usize>, _: &mut Vec<f64>| None
+                }
             };
             let inner = match kernel(&fixed, data, w, inner.clone(), out) {
                 Some(true) => 0..0,
