@@ -87,7 +87,7 @@ where
     let mut dst = vec![T::default(); cap];
     src[..start.len()].copy_from_slice(start);
     let mut len = start.len();
-    assert!(len >= 4 && len % 2 == 0, "at least two points");
+    assert!(len >= 4 && len.is_multiple_of(2), "at least two points");
     for _ in 0..steps {
         let (s, d) = (&src[..len], &mut dst[..2 * len]);
         chaikin_cut(&mut d[..4], &s[len - 2..], &s[..2], &s[2..4], q, t);

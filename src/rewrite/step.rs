@@ -1018,7 +1018,10 @@ fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
     // Every term reads whole groups of `N` slots: address the word as an
     // array of such groups, one bounds check per term.
     let wn = w / N;
-    if c_count == 0 || w % N != 0 || combos.iter().flatten().any(|(d, _)| d % N as isize != 0) {
+    if c_count == 0
+        || !w.is_multiple_of(N)
+        || combos.iter().flatten().any(|(d, _)| d % N as isize != 0)
+    {
         return None;
     }
     let (groups, _) = data.as_chunks::<N>();
@@ -1210,5 +1213,133 @@ fn push_params<S: Seq>(
 ) {
     for (&i, p) in idx.iter().zip(pats) {
         out.extend(decode_all(&p.types, seq.data(i), structs));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Slots of `n` modules of `w` slots, varied and not round.
+    fn slots(n: usize, w: usize) -> Vec<f64> {
+        (0..n * w)
+            .map(|j| crate::lang::value::round32(((j * 7919) % 1013) as f64 / 37.0 - 13.1))
+            .collect()
+    }
+
+    /// `fixed_kernel` writes what `fixed_eval`, the loop it replaces, writes
+    /// module by module: the same operations, so the same bits, across
+    /// several blocks, for every shape it is compiled for.
+    #[test]
+    fn the_kernel_gives_the_bits_of_the_module_by_module_loop() {
+        fn check<const N: usize, const T: usize, const SINGLE: bool>() {
+            let (nl, nr) = (2usize, 1usize);
+            // Modules of one N-vector (Chaikin), and of two with the terms
+            // reading either.
+            for groups in [1usize, 2] {
+                let w = N * groups;
+                let n = 700; // the inner range spans three blocks
+                let data = slots(n, w);
+                let ty = match (N, SINGLE) {
+                    (2, true) => Ty::V2,
+                    (2, false) => Ty::V2d,
+                    (3, true) => Ty::V3,
+                    _ => Ty::V3d,
+                };
+                // Term t reads module t - nl (within the contexts) at the
+                // group t % groups, with a weight that is not a power of 2.
+                let terms = |s: usize| -> Vec<(isize, f64)> {
+                    (0..T)
+                        .map(|t| {
+                            let k = ((t + s) % (nl + 1 + nr)) as isize - nl as isize;
+                            let off = (((t + s) % groups) * N) as isize;
+                            (k * w as isize + off, 0.3 + 0.17 * (t + s) as f64)
+                        })
+                        .collect()
+                };
+                let fixed: Vec<FixedOutput> = vec![
+                    (Sym(0), vec![(ty, terms(0))]),
+                    (Sym(0), vec![(ty, terms(1)), (ty, terms(2))]),
+                ];
+                let range = nl..n - nr;
+                let mut got = Vec::new();
+                let ok = fixed_kernel::<N, T, SINGLE>(&fixed, &data, w, range.clone(), &mut got);
+                assert_eq!(ok, Some(true));
+                let mut want = Vec::new();
+                for i in range.clone() {
+                    for (_, cs) in &fixed {
+                        for (_, ts) in cs {
+                            want.extend(fixed_eval::<N, SINGLE>(ts, &data, (i * w) as isize));
+                        }
+                    }
+                }
+                assert_eq!(got.len(), want.len());
+                let same = got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
+                assert!(same, "N {N} T {T} single {SINGLE} groups {groups}");
+                // An infinity in the third block is reported; so is an
+                // overflow of finite values.
+                let mut bad = data.clone();
+                bad[600 * w] = f64::INFINITY;
+                let mut out = Vec::new();
+                let ok = fixed_kernel::<N, T, SINGLE>(&fixed, &bad, w, range.clone(), &mut out);
+                assert_eq!(ok, Some(false));
+                let mut big = data.clone();
+                big[600 * w] = 1e308;
+                let huge: Vec<FixedOutput> = vec![(Sym(0), vec![(ty, vec![(0, 1e10); T])])];
+                let ok = fixed_kernel::<N, T, SINGLE>(&huge, &big, w, range.clone(), &mut out);
+                assert_eq!(ok, Some(false));
+            }
+        }
+        check::<2, 2, true>();
+        check::<2, 3, true>();
+        check::<2, 4, true>();
+        check::<3, 2, true>();
+        check::<3, 3, true>();
+        check::<3, 4, true>();
+        check::<2, 2, false>();
+        check::<2, 3, false>();
+        check::<2, 4, false>();
+        check::<3, 2, false>();
+        check::<3, 3, false>();
+        check::<3, 4, false>();
+    }
+
+    /// Outputs of another shape are left to the general loop.
+    #[test]
+    fn the_kernel_declines_other_shapes() {
+        let data = slots(10, 3);
+        let mut out = Vec::new();
+        // Three slots per module do not split into 2-vectors.
+        let v2 = vec![(Sym(0), vec![(Ty::V2, vec![(0, 0.5), (3, 0.5)])])];
+        assert_eq!(fixed_kernel::<2, 2, true>(&v2, &data, 3, 1..9, &mut out), None);
+        // Three terms where the kernel has two; another precision.
+        let three = vec![(Sym(0), vec![(Ty::V3, vec![(0, 0.5), (3, 0.5), (-3, 1.0)])])];
+        assert_eq!(fixed_kernel::<3, 2, true>(&three, &data, 3, 1..9, &mut out), None);
+        assert_eq!(fixed_kernel::<3, 3, false>(&three, &data, 3, 1..9, &mut out), None);
+        assert!(out.is_empty());
+        assert_eq!(uniform_shape(&three), Some((3, 3, true)));
+        let mixed = vec![(Sym(0), vec![(Ty::V3, vec![(0, 1.0)]), three[0].1[0].clone()])];
+        assert_eq!(uniform_shape(&mixed), None);
+    }
+
+    /// An overflow in the middle of a long ring, where the kernel computes,
+    /// is reported by the general path with the production's name.
+    #[test]
+    fn an_overflow_inside_a_long_ring_names_the_production() {
+        let mut axiom = String::from("Axiom:");
+        for i in 0..1000 {
+            let x = if i == 700 { "3e38" } else { "1" };
+            axiom.push_str(&format!(" P(V2f({x}, 0))"));
+        }
+        let src = format!(
+            "module P(V2f);\nring L-system: 1;\nderivation length: 2;\n{axiom};\n\
+             P(vl) < P(v) > P(vr) -> P(0.5*vl + 2*v) P(2*v + 0.5*vr)\n"
+        );
+        let curve = crate::load_str("t.lsys", &src, &[]).expect("loads");
+        assert!(curve.program.rules[0].stencil.is_some());
+        let e = crate::derive(&curve.program, Default::default()).expect_err("overflows");
+        assert!(e.message.contains("at step 1"), "{}", e.message);
+        assert!(e.message.contains("NaN or infinite"), "{}", e.message);
+        assert!(e.message.contains("P(vl) < P(v) > P(vr)"), "{}", e.message);
     }
 }
