@@ -1274,7 +1274,10 @@ mod tests {
                     }
                 }
                 assert_eq!(got.len(), want.len());
-                let same = got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
+                let same = got
+                    .iter()
+                    .zip(&want)
+                    .all(|(a, b)| a.to_bits() == b.to_bits());
                 assert!(same, "N {N} T {T} single {SINGLE} groups {groups}");
                 // An infinity in the third block is reported; so is an
                 // overflow of finite values.
@@ -1311,14 +1314,26 @@ mod tests {
         let mut out = Vec::new();
         // Three slots per module do not split into 2-vectors.
         let v2 = vec![(Sym(0), vec![(Ty::V2, vec![(0, 0.5), (3, 0.5)])])];
-        assert_eq!(fixed_kernel::<2, 2, true>(&v2, &data, 3, 1..9, &mut out), None);
+        assert_eq!(
+            fixed_kernel::<2, 2, true>(&v2, &data, 3, 1..9, &mut out),
+            None
+        );
         // Three terms where the kernel has two; another precision.
         let three = vec![(Sym(0), vec![(Ty::V3, vec![(0, 0.5), (3, 0.5), (-3, 1.0)])])];
-        assert_eq!(fixed_kernel::<3, 2, true>(&three, &data, 3, 1..9, &mut out), None);
-        assert_eq!(fixed_kernel::<3, 3, false>(&three, &data, 3, 1..9, &mut out), None);
+        assert_eq!(
+            fixed_kernel::<3, 2, true>(&three, &data, 3, 1..9, &mut out),
+            None
+        );
+        assert_eq!(
+            fixed_kernel::<3, 3, false>(&three, &data, 3, 1..9, &mut out),
+            None
+        );
         assert!(out.is_empty());
         assert_eq!(uniform_shape(&three), Some((3, 3, true)));
-        let mixed = vec![(Sym(0), vec![(Ty::V3, vec![(0, 1.0)]), three[0].1[0].clone()])];
+        let mixed = vec![(
+            Sym(0),
+            vec![(Ty::V3, vec![(0, 1.0)]), three[0].1[0].clone()],
+        )];
         assert_eq!(uniform_shape(&mixed), None);
     }
 
