@@ -1,10 +1,15 @@
 //! Benchmarks of the rewriting engine against hand-written references,
 //! measured in the same run. `cargo run --release --example bench_derive`
 //!
+//! `--chaikin-only` runs the first only; `--runs N` keeps the best of N runs
+//! (10 by default) of the first two.
+//!
 //! 1. Closed Chaikin (production 13) from a 1,000-point axiom to 1,024,000
-//!    points: the engine running the `.lsys` text versus a Rust loop doing
-//!    the same arithmetic with double buffers, in lpfg's single precision
-//!    (the default) and in double (`--double`).
+//!    points: the engine running the `.lsys` text, in lpfg's single
+//!    precision (the default) and in double (`--double`), against two Rust
+//!    loops doing the same arithmetic: one over points with `%` per point,
+//!    and a tight one over flat buffers of coordinates (`f64`, and `f32` for
+//!    single precision) with the ring's seam handled outside the loop.
 //! 2. A context-sensitive rewrite without geometry: a signal moving through
 //!    a word of a million modules, in million modules per second.
 //! 3. The interpreter on a branching word: 50,000 modules, each with a
@@ -53,8 +58,70 @@ where
     src
 }
 
+/// One point's two successors, `0.25·l + 0.75·v` and `0.75·v + 0.25·r`,
+/// written as x, y, x, y: the same operations in the same order as the rule.
+#[inline(always)]
+fn chaikin_cut<T>(out: &mut [T], l: &[T], v: &[T], r: &[T], q: T, t: T)
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Mul<Output = T>,
+{
+    out[0] = l[0] * q + v[0] * t;
+    out[1] = l[1] * q + v[1] * t;
+    out[2] = v[0] * t + r[0] * q;
+    out[3] = v[1] * t + r[1] * q;
+}
+
+/// The tight reference (issue 16): closed Chaikin over a flat buffer of
+/// coordinates `x0, y0, x1, y1, …`; the first and the last point, whose
+/// neighbours wrap around the ring, are cut outside the loop, so the loop
+/// has no `%`; two buffers of the final size, allocated once and swapped.
+/// `T = f32` computes as lpfg's `V2f` (each product and sum rounded to
+/// single precision), `T = f64` as the engine with `--double`.
+fn chaikin_flat<T>(start: &[T], steps: usize) -> Vec<T>
+where
+    T: Copy + Default + From<f32> + std::ops::Add<Output = T> + std::ops::Mul<Output = T>,
+{
+    let (q, t) = (T::from(0.25), T::from(0.75));
+    let cap = start.len() << steps;
+    let mut src = vec![T::default(); cap];
+    let mut dst = vec![T::default(); cap];
+    src[..start.len()].copy_from_slice(start);
+    let mut len = start.len();
+    assert!(len >= 4 && len.is_multiple_of(2), "at least two points");
+    for _ in 0..steps {
+        let (s, d) = (&src[..len], &mut dst[..2 * len]);
+        chaikin_cut(&mut d[..4], &s[len - 2..], &s[..2], &s[2..4], q, t);
+        let inner = d[4..2 * len - 4]
+            .chunks_exact_mut(4)
+            .zip(s.chunks_exact(2))
+            .zip(s[2..].chunks_exact(2))
+            .zip(s[4..].chunks_exact(2));
+        for (((o, l), v), r) in inner {
+            chaikin_cut(o, l, v, r, q, t);
+        }
+        chaikin_cut(
+            &mut d[2 * len - 4..],
+            &s[len - 4..len - 2],
+            &s[len - 2..],
+            &s[..2],
+            q,
+            t,
+        );
+        std::mem::swap(&mut src, &mut dst);
+        len *= 2;
+    }
+    src.truncate(len);
+    src
+}
+
 fn main() {
-    let runs = 10;
+    // `--runs N`: more runs for the best time on a busy machine.
+    let args: Vec<String> = std::env::args().collect();
+    let runs = args
+        .iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1)?.parse().ok())
+        .unwrap_or(10);
     let pts = polygon(1000);
     let steps = 10;
     let axiom: Vec<String> = pts
@@ -73,38 +140,64 @@ fn main() {
             subgram::derive(&loaded.program, DeriveOptions::default()).expect("derives")
         });
         // Same arithmetic, same order: the results agree exactly.
-        let (t_loop, out) = if precision == subgram::Precision::Single {
+        let (t_loop, t_flat, out) = if precision == subgram::Precision::Single {
             let start: Vec<Vec2> = pts.iter().map(|p| p.as_vec2()).collect();
             let (t, reference) = best_of(runs, || chaikin_loop::<Vec2, f32>(&start, steps));
             assert_eq!(derived.word.len(), reference.len());
             for (i, r) in reference.iter().enumerate() {
                 assert_eq!(derived.word.data(i), &[r.x as f64, r.y as f64]);
             }
-            (t, reference.len())
+            let flat: Vec<f32> = start.iter().flat_map(|p| [p.x, p.y]).collect();
+            let (tf, reference) = best_of(runs, || chaikin_flat::<f32>(&flat, steps));
+            assert_eq!(derived.word.len() * 2, reference.len());
+            for (i, r) in reference.chunks_exact(2).enumerate() {
+                assert_eq!(derived.word.data(i), &[r[0] as f64, r[1] as f64]);
+            }
+            (t, tf, reference.len() / 2)
         } else {
             let (t, reference) = best_of(runs, || chaikin_loop::<DVec2, f64>(&pts, steps));
             assert_eq!(derived.word.len(), reference.len());
             for (i, r) in reference.iter().enumerate() {
                 assert_eq!(derived.word.data(i), &[r.x, r.y]);
             }
-            (t, reference.len())
+            let flat: Vec<f64> = pts.iter().flat_map(|p| [p.x, p.y]).collect();
+            let (tf, reference) = best_of(runs, || chaikin_flat::<f64>(&flat, steps));
+            assert_eq!(derived.word.len() * 2, reference.len());
+            for (i, r) in reference.chunks_exact(2).enumerate() {
+                assert_eq!(derived.word.data(i), r);
+            }
+            (t, tf, reference.len() / 2)
+        };
+        // The tight loop over `f64` whatever the precision: the issue's
+        // yardstick (single precision stores its values as `f64` too).
+        let t_flat64 = if precision == subgram::Precision::Single {
+            let flat64: Vec<f64> = pts.iter().flat_map(|p| [p.x, p.y]).collect();
+            best_of(runs, || chaikin_flat::<f64>(&flat64, steps)).0
+        } else {
+            t_flat
+        };
+        let ms = |t: std::time::Duration| t.as_secs_f64() * 1e3;
+        let ratio = |t: std::time::Duration| t_engine.as_secs_f64() / t.as_secs_f64();
+        let flat_ty = if precision == subgram::Precision::Single {
+            "f32"
+        } else {
+            "f64"
         };
         println!("chaikin 1000 -> {out} points, {precision:?} precision, best of {runs}");
-        println!(
-            "  hand-written loop   {:>9.2} ms",
-            t_loop.as_secs_f64() * 1e3
-        );
-        println!(
-            "  engine (.lsys)      {:>9.2} ms",
-            t_engine.as_secs_f64() * 1e3
-        );
-        println!(
-            "  ratio engine/loop   {:>9.2}",
-            t_engine.as_secs_f64() / t_loop.as_secs_f64()
-        );
+        println!("  loop over points, %      {:>9.2} ms", ms(t_loop));
+        println!("  flat {flat_ty} loop, no %     {:>9.2} ms", ms(t_flat));
+        if precision == subgram::Precision::Single {
+            println!("  flat f64 loop, no %      {:>9.2} ms", ms(t_flat64));
+        }
+        println!("  engine (.lsys)           {:>9.2} ms", ms(t_engine));
+        println!("  ratio engine/loop %      {:>9.2}", ratio(t_loop));
+        println!("  ratio engine/flat {flat_ty}    {:>9.2}", ratio(t_flat));
+        if precision == subgram::Precision::Single {
+            println!("  ratio engine/flat f64    {:>9.2}", ratio(t_flat64));
+        }
     }
 
-    if std::env::args().any(|a| a == "--chaikin-only") {
+    if args.iter().any(|a| a == "--chaikin-only") {
         return;
     }
 

@@ -6,6 +6,8 @@
 //! (pseudo-L-systems) partition the word without overlap, starting at the
 //! phase. `src` is never mutated.
 
+use std::ops::Range;
+
 use crate::deadline::Deadline;
 use crate::lang::eval::{Emit, Env, Flow, Host, Interp, RuntimeError};
 use crate::lang::ir::{Pattern, Program, Rule};
@@ -318,11 +320,13 @@ impl<'p> Rewriter<'p> {
                     .chain(&rule.right)
                     .all(simple)
         });
+        // No early exit, so that the scan vectorises.
         rules_ok
-            && !src
-                .syms()
-                .iter()
-                .any(|&s| s == self.sb || s == self.eb || s == self.cut)
+            && src.syms().chunks(64).all(|c| {
+                c.iter().fold(true, |ok, &s| {
+                    ok & (s != self.sb) & (s != self.eb) & (s != self.cut)
+                })
+            })
     }
 
     /// On a ring whose modules are all of one kind and one width, the first
@@ -339,7 +343,8 @@ impl<'p> Rewriter<'p> {
             return None;
         }
         let s = src.sym(0);
-        if src.syms().iter().any(|&t| t != s) || !src.slot_count().is_multiple_of(n) {
+        let same = |c: &[Sym]| c.iter().fold(true, |ok, &t| ok & (t == s));
+        if !src.syms().chunks(64).all(same) || !src.slot_count().is_multiple_of(n) {
             return None;
         }
         let w = src.slot_count() / n;
@@ -438,11 +443,23 @@ impl<'p> Rewriter<'p> {
                 .collect();
             let pattern: Vec<Sym> = plain.iter().map(|(s, _)| *s).collect();
             let mut end = out.len() as u32;
-            for _ in 0..n {
-                syms.extend_from_slice(&pattern);
-                for wd in &widths {
-                    end += *wd as u32;
-                    starts.push(end);
+            if pattern.iter().all(|&p| p == pattern[0]) {
+                syms.resize(syms.len() + n * pattern.len(), pattern[0]);
+            } else {
+                (0..n).for_each(|_| syms.extend_from_slice(&pattern));
+            }
+            if widths.iter().all(|&wd| wd == widths[0]) {
+                // Equal widths: the offsets are an arithmetic sequence.
+                let wd = widths[0] as u32;
+                let count = (n * widths.len()) as u32;
+                starts.extend((1..=count).map(|k| end + k * wd));
+                end += count * wd;
+            } else {
+                for _ in 0..n {
+                    for wd in &widths {
+                        end += *wd as u32;
+                        starts.push(end);
+                    }
                 }
             }
             let seam_module =
@@ -473,7 +490,35 @@ impl<'p> Rewriter<'p> {
             // `v * 0` is 0 for a finite v and NaN otherwise: a NaN guard
             // without a branch per value.
             let mut g = 0.0;
-            for i in first_inner..last_inner {
+            let inner = first_inner..last_inner;
+            // One shape for every parameter (Chaikin, and every curve scheme
+            // of paper 002): a loop compiled for it.
+            let kernel = match uniform_shape(&fixed) {
+                Some((2, 2, true)) => fixed_kernel::<2, 2, true>,
+                Some((2, 3, true)) => fixed_kernel::<2, 3, true>,
+                Some((2, 4, true)) => fixed_kernel::<2, 4, true>,
+                Some((3, 2, true)) => fixed_kernel::<3, 2, true>,
+                Some((3, 3, true)) => fixed_kernel::<3, 3, true>,
+                Some((3, 4, true)) => fixed_kernel::<3, 4, true>,
+                Some((2, 2, false)) => fixed_kernel::<2, 2, false>,
+                Some((2, 3, false)) => fixed_kernel::<2, 3, false>,
+                Some((2, 4, false)) => fixed_kernel::<2, 4, false>,
+                Some((3, 2, false)) => fixed_kernel::<3, 2, false>,
+                Some((3, 3, false)) => fixed_kernel::<3, 3, false>,
+                Some((3, 4, false)) => fixed_kernel::<3, 4, false>,
+                _ => {
+                    |_: &[FixedOutput], _: &[f64], _: usize, _: Range<usize>, _: &mut Vec<f64>| None
+                }
+            };
+            let inner = match kernel(&fixed, data, w, inner.clone(), out) {
+                Some(true) => 0..0,
+                Some(false) => {
+                    g = f64::NAN;
+                    0..0
+                }
+                None => inner,
+            };
+            for i in inner {
                 let at = (i * w) as isize;
                 for (_, combos) in &fixed {
                     for (ty, terms) in combos {
@@ -936,6 +981,82 @@ fn fixed_eval<const N: usize, const SINGLE: bool>(
     }
 }
 
+/// `(N, T, single)` when every parameter of every output has `N`
+/// components, `T` terms and the same precision.
+fn uniform_shape(fixed: &[FixedOutput]) -> Option<(usize, usize, bool)> {
+    let mut all = fixed
+        .iter()
+        .flat_map(|(_, cs)| cs)
+        .map(|(ty, ts)| (ty.dim(), ts.len(), ty.is_single()));
+    let first = all.next()?;
+    all.all(|s| s == first).then_some(first)
+}
+
+/// The modules `range` of a uniform step whose parameters all have `N`
+/// components and `T` terms: `fixed_eval`'s operations in the same order,
+/// written in place a block at a time. Returns whether every value is
+/// finite, or `None` when the outputs do not have that shape.
+fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
+    fixed: &[FixedOutput],
+    data: &[f64],
+    w: usize,
+    range: Range<usize>,
+    out: &mut Vec<f64>,
+) -> Option<bool> {
+    const BLOCK: usize = 256;
+    let r = rounded::<SINGLE>;
+    let mut combos: Vec<[(isize, f64); T]> = Vec::new();
+    for (_, cs) in fixed {
+        for (ty, ts) in cs {
+            if ty.dim() != N || ty.is_single() != SINGLE {
+                return None;
+            }
+            combos.push(ts.as_slice().try_into().ok()?);
+        }
+    }
+    let c_count = combos.len();
+    // Every term reads whole groups of `N` slots: address the word as an
+    // array of such groups, one bounds check per term.
+    let wn = w / N;
+    if c_count == 0
+        || !w.is_multiple_of(N)
+        || combos.iter().flatten().any(|(d, _)| d % N as isize != 0)
+    {
+        return None;
+    }
+    let (groups, _) = data.as_chunks::<N>();
+    let mut ok = true;
+    let mut i = range.start;
+    while i < range.end {
+        let m = (range.end - i).min(BLOCK);
+        let from = out.len();
+        // The block is small enough to stay in the first-level cache while
+        // it is zeroed, filled, then checked.
+        out.resize(from + m * c_count * N, 0.0);
+        let (block, _) = out[from..].as_chunks_mut::<N>();
+        for (c_at, c) in combos.iter().enumerate() {
+            // One parameter of every module of the block at a time, with
+            // the weights and offsets in registers.
+            let ws: [f64; T] = std::array::from_fn(|t| c[t].1);
+            let es: [isize; T] = std::array::from_fn(|t| c[t].0 / N as isize);
+            for (o, i) in block.chunks_exact_mut(c_count).zip(i..i + m) {
+                let at = (i * wn) as isize;
+                let x: [&[f64; N]; T] = std::array::from_fn(|t| &groups[(at + es[t]) as usize]);
+                o[c_at] = std::array::from_fn(|k| {
+                    let mut acc = r(ws[0] * x[0][k]);
+                    for t in 1..T {
+                        acc = r(acc + r(ws[t] * x[t][k]));
+                    }
+                    acc
+                });
+            }
+        }
+        ok &= out[from..].iter().fold(true, |ok, x| ok & x.is_finite());
+        i += m;
+    }
+    Some(ok)
+}
+
 /// `x`, rounded to single precision when the stencil computes `float`s:
 /// the interpreter rounds every single-precision product and sum.
 #[inline(always)]
@@ -1092,5 +1213,148 @@ fn push_params<S: Seq>(
 ) {
     for (&i, p) in idx.iter().zip(pats) {
         out.extend(decode_all(&p.types, seq.data(i), structs));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Slots of `n` modules of `w` slots, varied and not round.
+    fn slots(n: usize, w: usize) -> Vec<f64> {
+        (0..n * w)
+            .map(|j| crate::lang::value::round32(((j * 7919) % 1013) as f64 / 37.0 - 13.1))
+            .collect()
+    }
+
+    /// `fixed_kernel` writes what `fixed_eval`, the loop it replaces, writes
+    /// module by module: the same operations, so the same bits, across
+    /// several blocks, for every shape it is compiled for.
+    #[test]
+    fn the_kernel_gives_the_bits_of_the_module_by_module_loop() {
+        fn check<const N: usize, const T: usize, const SINGLE: bool>() {
+            let (nl, nr) = (2usize, 1usize);
+            // Modules of one N-vector (Chaikin), and of two with the terms
+            // reading either.
+            for groups in [1usize, 2] {
+                let w = N * groups;
+                let n = 700; // the inner range spans three blocks
+                let data = slots(n, w);
+                let ty = match (N, SINGLE) {
+                    (2, true) => Ty::V2,
+                    (2, false) => Ty::V2d,
+                    (3, true) => Ty::V3,
+                    _ => Ty::V3d,
+                };
+                // Term t reads module t - nl (within the contexts) at the
+                // group t % groups, with a weight that is not a power of 2.
+                let terms = |s: usize| -> Vec<(isize, f64)> {
+                    (0..T)
+                        .map(|t| {
+                            let k = ((t + s) % (nl + 1 + nr)) as isize - nl as isize;
+                            let off = (((t + s) % groups) * N) as isize;
+                            (k * w as isize + off, 0.3 + 0.17 * (t + s) as f64)
+                        })
+                        .collect()
+                };
+                let fixed: Vec<FixedOutput> = vec![
+                    (Sym(0), vec![(ty, terms(0))]),
+                    (Sym(0), vec![(ty, terms(1)), (ty, terms(2))]),
+                ];
+                let range = nl..n - nr;
+                let mut got = Vec::new();
+                let ok = fixed_kernel::<N, T, SINGLE>(&fixed, &data, w, range.clone(), &mut got);
+                assert_eq!(ok, Some(true));
+                let mut want = Vec::new();
+                for i in range.clone() {
+                    for (_, cs) in &fixed {
+                        for (_, ts) in cs {
+                            want.extend(fixed_eval::<N, SINGLE>(ts, &data, (i * w) as isize));
+                        }
+                    }
+                }
+                assert_eq!(got.len(), want.len());
+                let same = got
+                    .iter()
+                    .zip(&want)
+                    .all(|(a, b)| a.to_bits() == b.to_bits());
+                assert!(same, "N {N} T {T} single {SINGLE} groups {groups}");
+                // An infinity in the third block is reported; so is an
+                // overflow of finite values.
+                let mut bad = data.clone();
+                bad[600 * w] = f64::INFINITY;
+                let mut out = Vec::new();
+                let ok = fixed_kernel::<N, T, SINGLE>(&fixed, &bad, w, range.clone(), &mut out);
+                assert_eq!(ok, Some(false));
+                let mut big = data.clone();
+                big[600 * w] = 1e308;
+                let huge: Vec<FixedOutput> = vec![(Sym(0), vec![(ty, vec![(0, 1e10); T])])];
+                let ok = fixed_kernel::<N, T, SINGLE>(&huge, &big, w, range.clone(), &mut out);
+                assert_eq!(ok, Some(false));
+            }
+        }
+        check::<2, 2, true>();
+        check::<2, 3, true>();
+        check::<2, 4, true>();
+        check::<3, 2, true>();
+        check::<3, 3, true>();
+        check::<3, 4, true>();
+        check::<2, 2, false>();
+        check::<2, 3, false>();
+        check::<2, 4, false>();
+        check::<3, 2, false>();
+        check::<3, 3, false>();
+        check::<3, 4, false>();
+    }
+
+    /// Outputs of another shape are left to the general loop.
+    #[test]
+    fn the_kernel_declines_other_shapes() {
+        let data = slots(10, 3);
+        let mut out = Vec::new();
+        // Three slots per module do not split into 2-vectors.
+        let v2 = vec![(Sym(0), vec![(Ty::V2, vec![(0, 0.5), (3, 0.5)])])];
+        assert_eq!(
+            fixed_kernel::<2, 2, true>(&v2, &data, 3, 1..9, &mut out),
+            None
+        );
+        // Three terms where the kernel has two; another precision.
+        let three = vec![(Sym(0), vec![(Ty::V3, vec![(0, 0.5), (3, 0.5), (-3, 1.0)])])];
+        assert_eq!(
+            fixed_kernel::<3, 2, true>(&three, &data, 3, 1..9, &mut out),
+            None
+        );
+        assert_eq!(
+            fixed_kernel::<3, 3, false>(&three, &data, 3, 1..9, &mut out),
+            None
+        );
+        assert!(out.is_empty());
+        assert_eq!(uniform_shape(&three), Some((3, 3, true)));
+        let mixed = vec![(
+            Sym(0),
+            vec![(Ty::V3, vec![(0, 1.0)]), three[0].1[0].clone()],
+        )];
+        assert_eq!(uniform_shape(&mixed), None);
+    }
+
+    /// An overflow in the middle of a long ring, where the kernel computes,
+    /// is reported by the general path with the production's name.
+    #[test]
+    fn an_overflow_inside_a_long_ring_names_the_production() {
+        let mut axiom = String::from("Axiom:");
+        for i in 0..1000 {
+            let x = if i == 700 { "3e38" } else { "1" };
+            axiom.push_str(&format!(" P(V2f({x}, 0))"));
+        }
+        let src = format!(
+            "module P(V2f);\nring L-system: 1;\nderivation length: 2;\n{axiom};\n\
+             P(vl) < P(v) > P(vr) -> P(0.5*vl + 2*v) P(2*v + 0.5*vr)\n"
+        );
+        let curve = crate::load_str("t.lsys", &src, &[]).expect("loads");
+        assert!(curve.program.rules[0].stencil.is_some());
+        let e = crate::derive(&curve.program, Default::default()).expect_err("overflows");
+        assert!(e.message.contains("at step 1"), "{}", e.message);
+        assert!(e.message.contains("NaN or infinite"), "{}", e.message);
+        assert!(e.message.contains("P(vl) < P(v) > P(vr)"), "{}", e.message);
     }
 }
