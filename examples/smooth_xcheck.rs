@@ -26,7 +26,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use subgram::mesh::{io, shapes, Mesh, PolygonSoup};
+use subgram::mesh::{io, shapes, Mesh};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -74,15 +74,7 @@ fn groups(file: &Path, dir: &Path) {
     std::fs::create_dir_all(dir).unwrap_or_else(|e| fail(&e.to_string()));
     for (k, g) in groups.iter().enumerate() {
         let welded = &g.welded;
-        let tris = PolygonSoup {
-            faces: welded
-                .faces
-                .iter()
-                .flat_map(|f| (1..f.len() - 1).map(|i| vec![f[0], f[i], f[i + 1]]))
-                .collect(),
-            positions: welded.positions.clone(),
-            ..PolygonSoup::default()
-        };
+        let tris = welded.fanned();
         let at = |name: &str| dir.join(format!("group-{}-{name}", k + 1));
         io::write(&at("welded.obj"), &tris).unwrap_or_else(|e| fail(&e.to_string()));
         io::write(&at("ours.obj"), &g.subdivided).unwrap_or_else(|e| fail(&e.to_string()));
@@ -152,15 +144,7 @@ fn best_of(runs: usize, mut f: impl FnMut()) -> f64 {
 }
 
 fn bench() {
-    let q = shapes::quad_torus(224, 224);
-    let soup = PolygonSoup {
-        faces: q
-            .faces
-            .iter()
-            .flat_map(|f| [vec![f[0], f[1], f[2]], vec![f[0], f[2], f[3]]])
-            .collect(),
-        ..q
-    };
+    let soup = shapes::quad_torus(224, 224).fanned();
     let g = subgram::smooth_scheme("sqrt3").expect("sqrt3");
     let n = soup.faces.len();
     let tags: Vec<u32> = (0..n as u32).collect();

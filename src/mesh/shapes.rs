@@ -128,11 +128,5 @@ pub fn quad_grid(n: usize, m: usize) -> PolygonSoup {
 
 /// The same grid with each quad split into two triangles.
 pub fn triangle_grid(n: usize, m: usize) -> PolygonSoup {
-    let q = quad_grid(n, m);
-    let faces = q
-        .faces
-        .iter()
-        .flat_map(|f| [vec![f[0], f[1], f[2]], vec![f[0], f[2], f[3]]])
-        .collect();
-    PolygonSoup { faces, ..q }
+    quad_grid(n, m).fanned()
 }

@@ -61,6 +61,29 @@ impl std::fmt::Display for MeshFileError {
 impl std::error::Error for MeshFileError {}
 
 impl PolygonSoup {
+    /// The soup with every polygon cut into a fan of triangles from its
+    /// first corner: the triangles [`Mesh::from_soup`](crate::mesh::Mesh::from_soup)
+    /// makes of it (a quad along its first diagonal). Each triangle keeps
+    /// its polygon's line.
+    pub fn fanned(&self) -> PolygonSoup {
+        let mut faces = Vec::with_capacity(self.faces.len() * 2);
+        let mut face_lines = Vec::new();
+        for (k, f) in self.faces.iter().enumerate() {
+            for i in 1..f.len().saturating_sub(1) {
+                faces.push(vec![f[0], f[i], f[i + 1]]);
+                if let Some(&l) = self.face_lines.get(k) {
+                    face_lines.push(l);
+                }
+            }
+        }
+        PolygonSoup {
+            positions: self.positions.clone(),
+            faces,
+            face_lines,
+            vertex_lines: self.vertex_lines.clone(),
+        }
+    }
+
     /// The line of face `f` for messages (None when unknown).
     pub fn face_line(&self, f: usize) -> Option<usize> {
         self.face_lines.get(f).copied().filter(|&l| l > 0)

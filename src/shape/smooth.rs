@@ -210,13 +210,7 @@ mod tests {
 
     /// The same cube with each quad cut along its first diagonal.
     fn cube_triangles() -> PolygonSoup {
-        let q = cube_quads();
-        let faces = q
-            .faces
-            .iter()
-            .flat_map(|f| [vec![f[0], f[1], f[2]], vec![f[0], f[2], f[3]]])
-            .collect();
-        PolygonSoup { faces, ..q }
+        cube_quads().fanned()
     }
 
     /// Two unit cubes stacked along y and welded: what splitting a

@@ -522,13 +522,7 @@ fn loop_grammar_keeps_a_flat_grid_flat_and_unfolded() {
 /// The soup with every quad written as the two triangles `from_soup`
 /// would cut it into.
 fn as_triangles(s: &PolygonSoup) -> PolygonSoup {
-    let mut t = s.clone();
-    t.faces = s
-        .faces
-        .iter()
-        .flat_map(|f| (1..f.len() - 1).map(move |i| vec![f[0], f[i], f[i + 1]]))
-        .collect();
-    t
+    s.fanned()
 }
 
 #[test]
