@@ -631,6 +631,7 @@ impl Grammar {
             blocks: self.block_split,
             face_split_makes_blocks: self.block_used_at.is_some(),
             protect,
+            creased: mesh.has_sharpness(),
             ..RunState::default()
         };
         let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
@@ -736,6 +737,8 @@ impl Grammar {
                                 on_boundary,
                                 mesh.is_block_edge(e),
                                 mesh.is_transversal_edge(e),
+                                mesh.is_sharp_edge(e),
+                                e,
                             );
                             if ev.test(r, &val).map_err(|e| (!std::ptr::eq(r, rule), e))? {
                                 out.0.push(val);
@@ -1082,6 +1085,12 @@ impl GrammarRun<'_> {
         self.state.step += 1;
         self.grammar.apply_all(&each, self.mesh, &mut self.state)?;
         self.state.swap_positions(self.mesh);
+        // A step is one level of the scheme: semi-sharp creases and
+        // corners soften by one (OpenSubdiv's uniform rule). The rules of
+        // the step read the sharpness it started with.
+        if self.state.creased {
+            self.mesh.decrement_sharpness();
+        }
         debug_assert!(
             self.state
                 .protect
@@ -1128,6 +1137,9 @@ struct RunState {
     deadline: Option<crate::Deadline>,
     /// What no rule may match.
     protect: Option<Protected>,
+    /// Some edge or vertex was sharp when the run started: the steps
+    /// decrement sharpness (nothing else makes any).
+    creased: bool,
 }
 
 impl RunState {
