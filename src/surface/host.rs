@@ -51,6 +51,8 @@ pub mod id {
     pub const CREASES: u16 = 21;
     pub const CREASE_RING: u16 = 22;
     pub const CREASE_WEIGHT: u16 = 23;
+    /// `sharpness(v, w)`: of the edge between two vertices.
+    pub const SHARPNESS_BETWEEN: u16 = 24;
     /// Fused `l(x) OP c`: the element and the operator's code.
     pub const LEVEL_VS_CURRENT: u16 = 100;
     /// Fused fold over a one-ring: the vertex, the fold and the filter.
@@ -328,14 +330,22 @@ static FUNCTIONS: &[Builtin] = &[
     },
     Builtin {
         name: "sharpness",
-        resolve: |a| {
-            one(
-                a,
-                &[VERTEX, EDGE],
-                "`sharpness` takes an edge or a vertex: 0 smooth, more for a crease or a corner, \
-                 `inf` for ever",
-            )?;
-            Ok((Func::Host(id::SHARPNESS), Ty::Double))
+        resolve: |a| match a {
+            [V, V] => Ok((Func::Host(id::SHARPNESS_BETWEEN), Ty::Double)),
+            [_, _] => Err(SigError::Message(
+                "`sharpness` of two vertices is that of the edge between them: it takes two \
+                 vertices"
+                    .into(),
+            )),
+            _ => {
+                one(
+                    a,
+                    &[VERTEX, EDGE],
+                    "`sharpness` takes an edge or a vertex (0 smooth, more for a crease or a \
+                     corner, `inf` for ever), or two vertices",
+                )?;
+                Ok((Func::Host(id::SHARPNESS), Ty::Double))
+            }
         },
     },
     Builtin {
@@ -615,6 +625,16 @@ impl Host for MeshHost<'_> {
                 }
                 _ => 0.0,
             }),
+            id::SHARPNESS_BETWEEN => {
+                let end = |x: &Value| match x {
+                    Value::Elem(e) if e.kind == VERTEX => Some(VertexId(e.ids[0])),
+                    _ => None,
+                };
+                let between = end(&args[0])
+                    .zip(end(&args[1]))
+                    .and_then(|(a, b)| m.find_halfedge(a, b));
+                Value::Float(between.map_or(0.0, |h| m.edge_sharpness(h.edge())))
+            }
             id::CREASES => Value::Int(v().map_or(0, |v| m.sharp_edge_count(v) as i64)),
             id::CREASE_RING => match v() {
                 Some(v) => Value::Elem(Elem {
