@@ -139,7 +139,7 @@ struct Mark {
     /// An error placed at each vertex number, for messages about it.
     at: Vec<MeshFileError>,
     /// What the file calls the mark, for messages without a line (binary
-    /// PLY data): "edge 3".
+    /// PLY data): "edge 3"; empty where the message's line shows it.
     what: String,
 }
 
@@ -157,6 +157,11 @@ fn apply_sharpness(mesh: &mut Mesh, marks: &[Mark], base: i64) -> Result<(), Mes
     use super::halfedge::VertexId;
     let n = mesh.vertex_count();
     for m in marks {
+        let what = if m.what.is_empty() {
+            String::new()
+        } else {
+            format!("{}: ", m.what)
+        };
         let mut vs = Vec::with_capacity(2);
         for (k, &i) in m.ends.iter().enumerate() {
             let v = i - base;
@@ -164,9 +169,8 @@ fn apply_sharpness(mesh: &mut Mesh, marks: &[Mark], base: i64) -> Result<(), Mes
                 return Err(saying(
                     &m.at[k],
                     format!(
-                        "{}: vertex {i} is out of range: the mesh has {n} vertices, numbered \
-                         from {base}",
-                        m.what
+                        "{what}vertex {i} is out of range: the mesh has {n} vertices, numbered \
+                         from {base}"
                     ),
                 ));
             }
@@ -178,9 +182,9 @@ fn apply_sharpness(mesh: &mut Mesh, marks: &[Mark], base: i64) -> Result<(), Mes
                     return Err(saying(
                         &m.at[0],
                         format!(
-                            "{}: vertices {} and {} are opposite corners of a quad, not the ends \
-                             of an edge of the polygon mesh",
-                            m.what, m.ends[0], m.ends[1]
+                            "{what}vertices {} and {} are opposite corners of a quad, not the \
+                             ends of an edge of the polygon mesh",
+                            m.ends[0], m.ends[1]
                         ),
                     ))
                 }
@@ -189,15 +193,15 @@ fn apply_sharpness(mesh: &mut Mesh, marks: &[Mark], base: i64) -> Result<(), Mes
                     return Err(saying(
                         &m.at[0],
                         format!(
-                            "{}: vertices {} and {} are not joined by an edge of the mesh",
-                            m.what, m.ends[0], m.ends[1]
+                            "{what}vertices {} and {} are not joined by an edge of the mesh",
+                            m.ends[0], m.ends[1]
                         ),
                     ))
                 }
             },
             _ => mesh.set_vertex_sharpness(vs[0], m.sharpness),
         };
-        done.map_err(|e| saying(&m.at[m.at.len() - 1], format!("{}: {}", m.what, e.message)))?;
+        done.map_err(|e| saying(&m.at[m.at.len() - 1], format!("{what}{}", e.message)))?;
     }
     Ok(())
 }
@@ -279,12 +283,7 @@ fn read_creases(path: &Path, limit: u64) -> Result<Vec<Mark>, MeshFileError> {
         let sharpness = sharpness_value(s).map_err(|m| line.at(&name, st, m))?;
         at.push(line.at(&name, st, ""));
         marks.push(Mark {
-            what: if kind == "e" {
-                "this edge"
-            } else {
-                "this vertex"
-            }
-            .into(),
+            what: String::new(),
             ends,
             sharpness,
             at,
