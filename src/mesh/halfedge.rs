@@ -147,6 +147,10 @@ pub struct Mesh {
     /// infinite a crease for ever. The halves of a split edge inherit it;
     /// edges that splits draw are 0, and a flip refuses a sharp edge.
     pub(crate) e_sharp: Vec<f64>,
+    /// False while no edge or vertex has been given a positive sharpness
+    /// (or since the last `decrement_sharpness` left none): the crease
+    /// queries answer at once on the meshes that have no creases.
+    pub(crate) creased: bool,
     // Faces.
     pub(crate) f_he: Vec<HalfEdgeId>,
     pub(crate) f_level: Vec<u32>,
@@ -304,6 +308,7 @@ impl Mesh {
             )));
         }
         self.e_sharp[e.index()] = s;
+        self.creased |= s > 0.0;
         Ok(())
     }
 
@@ -318,17 +323,29 @@ impl Mesh {
             )));
         }
         self.v_sharp[v.index()] = s;
+        self.creased |= s > 0.0;
         Ok(())
     }
 
     /// True when some edge or vertex has positive sharpness.
     pub fn has_sharpness(&self) -> bool {
-        self.edges().any(|e| self.is_sharp_edge(e))
+        self.creased && self.edges().any(|e| self.is_sharp_edge(e))
             || self.vertices().any(|v| self.v_sharp[v.index()] > 0.0)
+    }
+
+    /// False when no edge or vertex can be sharp (nothing was given a
+    /// sharpness, or every one has dropped to 0); true says only that some
+    /// may be.
+    #[inline]
+    pub fn has_sharpness_flag(&self) -> bool {
+        self.creased
     }
 
     /// The number of sharp edges at `v`.
     pub fn sharp_edge_count(&self, v: VertexId) -> usize {
+        if !self.creased {
+            return 0;
+        }
         self.outgoing_halfedges(v)
             .filter(|h| self.is_sharp_edge(h.edge()))
             .count()
@@ -339,11 +356,15 @@ impl Mesh {
     /// stays infinite. A surface grammar's run calls it at the end of
     /// every step.
     pub fn decrement_sharpness(&mut self) {
+        if !self.creased {
+            return;
+        }
         for s in self.e_sharp.iter_mut().chain(self.v_sharp.iter_mut()) {
             if *s > 0.0 {
                 *s = (*s - 1.0).max(0.0);
             }
         }
+        self.creased = self.has_sharpness();
     }
 
     /// The step of a grammar run that made the vertex (0: the base mesh).

@@ -719,6 +719,9 @@ fn vertex_rule(vertex: f64, edges: impl Iterator<Item = f64>) -> u8 {
 /// weight of this level's rule and the rest of the next level's. 0 for a
 /// smooth vertex.
 pub fn crease_weight(m: &Mesh, v: VertexId) -> f64 {
+    if !m.has_sharpness_flag() {
+        return 0.0;
+    }
     let child = |s: f64| (s - 1.0).max(0.0);
     let sv = m.vertex_sharpness(v);
     let edges = || m.outgoing_halfedges(v).map(|h| m.edge_sharpness(h.edge()));
