@@ -13,6 +13,8 @@ its limit), `use_creases = True`, `boundary_smooth = 'ALL'` and
 `uv_smooth = 'NONE'` (the meshes are closed and carry no UVs, so neither
 changes positions).
 
+Vertex sharpness goes to the `crease_vert` attribute the same way.
+
 Blender maps a crease c in 0..1 to the sharpness 10 c^2 before OpenSubdiv
 sees it (`crease_to_sharpness` in its subdiv code), and OpenSubdiv treats a
 sharpness of 10 or more as infinite; so a sharpness s is given as
@@ -58,7 +60,8 @@ RIM = [(4, 5), (5, 7), (7, 6), (6, 4)]
 ALL_EDGES = sorted({tuple(sorted((f[i], f[(i + 1) % 4]))) for f in CUBE_F for i in range(4)})
 INF = math.inf
 
-# name -> (vertices, faces, {(a, b): sharpness}); a jittered cube keeps
+# name -> (vertices, faces, {(a, b): sharpness, a: vertex sharpness}); a
+# jittered cube keeps
 # symmetric cases from hiding a wrong weight.
 JITTER = [(0.03 * ((7 * i) % 5 - 2), 0.02 * ((3 * i) % 7 - 3), 0.025 * ((5 * i) % 3 - 1))
           for i in range(8)]
@@ -72,6 +75,9 @@ CASES = {
     "corner: three edges sharp for ever": (CUBE_J, CUBE_F, {(3, 7): INF, (5, 7): INF, (6, 7): INF}),
     "corner of 3 and 0.7 edges (to a crease)": (
         CUBE_J, CUBE_F, {(3, 7): 3.0, (5, 7): 3.0, (6, 7): 0.7}),
+    "vertex 7 sharp for ever": (CUBE_J, CUBE_F, {7: INF}),
+    "vertex 7 sharpness 1.5, vertex 0 0.5": (CUBE_J, CUBE_F, {7: 1.5, 0: 0.5}),
+    "vertex 0.6 on a crease of 2.5": (CUBE_J, CUBE_F, {**{e: 2.5 for e in RIM}, 5: 0.6}),
 }
 
 
@@ -97,8 +103,12 @@ def write_case(folder, name, vs, fs, sharp):
         for face in fs:
             f.write("f " + " ".join(str(i + 1) for i in face) + "\n")
     with open(os.path.join(folder, name + ".creases"), "w") as f:
-        for (a, b), s in sharp.items():
-            f.write("e %d %d %s\n" % (a + 1, b + 1, "inf" if s == INF else repr(s)))
+        for key, s in sharp.items():
+            text = "inf" if s == INF else repr(s)
+            if isinstance(key, tuple):
+                f.write("e %d %d %s\n" % (key[0] + 1, key[1] + 1, text))
+            else:
+                f.write("v %d %s\n" % (key + 1, text))
     return obj
 
 
@@ -122,9 +132,13 @@ def blender(vs, fs, sharp, k):
     mesh.from_pydata([list(p) for p in vs], [], [list(f) for f in fs])
     mesh.update()
     attr = mesh.attributes.new("crease_edge", "FLOAT", "EDGE")
+    vattr = mesh.attributes.new("crease_vert", "FLOAT", "POINT")
     index = {tuple(sorted(e.vertices)): e.index for e in mesh.edges}
-    for (a, b), s in sharp.items():
-        attr.data[index[tuple(sorted((a, b)))]].value = crease_of(s)
+    for key, s in sharp.items():
+        if isinstance(key, tuple):
+            attr.data[index[tuple(sorted(key))]].value = crease_of(s)
+        else:
+            vattr.data[key].value = crease_of(s)
     obj = bpy.data.objects.new("o", mesh)
     bpy.context.scene.collection.objects.link(obj)
     mod = obj.modifiers.new("subsurf", "SUBSURF")
