@@ -10,8 +10,9 @@ reads it from a `.creases` file beside an OBJ (or from the PLY edge element of
 edge in its `crease_edge` attribute, and a Subdivision Surface modifier with
 `levels = k`, `use_limit_surface = False` (the k-th refinement itself, not
 its limit), `use_creases = True`, `boundary_smooth = 'ALL'` and
-`uv_smooth = 'NONE'` (the meshes are closed and carry no UVs, so neither
-changes positions).
+`uv_smooth = 'NONE'` (no UVs). `boundary_smooth = 'ALL'` makes a boundary
+a crease whose corners of two edges are smoothed too, as the grammar's
+boundary rule does; the open grid's cases reach it.
 
 Vertex sharpness goes to the `crease_vert` attribute the same way.
 
@@ -66,6 +67,12 @@ INF = math.inf
 JITTER = [(0.03 * ((7 * i) % 5 - 2), 0.02 * ((3 * i) % 7 - 3), 0.025 * ((5 * i) % 3 - 1))
           for i in range(8)]
 CUBE_J = [tuple(c + d for c, d in zip(p, j)) for p, j in zip(CUBE_V, JITTER)]
+# A 4 x 3 grid of quads (an open mesh), ids j * 5 + i, bent in z; its row
+# j = 1 (ids 5..9) runs from boundary to boundary.
+GRID_V = [(i / 4, j / 3, 0.1 * ((i * 7 + j * 3) % 5) - 0.2) for j in range(4) for i in range(5)]
+GRID_F = [(j * 5 + i, j * 5 + i + 1, (j + 1) * 5 + i + 1, (j + 1) * 5 + i)
+          for j in range(3) for i in range(4)]
+ROW = [(5 + i, 6 + i) for i in range(4)]
 CASES = {
     "smooth cube (no creases)": (CUBE_J, CUBE_F, {}),
     "rim sharp for ever": (CUBE_J, CUBE_F, {e: INF for e in RIM}),
@@ -78,6 +85,10 @@ CASES = {
     "vertex 7 sharp for ever": (CUBE_J, CUBE_F, {7: INF}),
     "vertex 7 sharpness 1.5, vertex 0 0.5": (CUBE_J, CUBE_F, {7: 1.5, 0: 0.5}),
     "vertex 0.6 on a crease of 2.5": (CUBE_J, CUBE_F, {**{e: 2.5 for e in RIM}, 5: 0.6}),
+    "open grid, smooth": (GRID_V, GRID_F, {}),
+    "open grid, a crease across, for ever": (GRID_V, GRID_F, {e: INF for e in ROW}),
+    "open grid, a crease across, 0.5": (GRID_V, GRID_F, {e: 0.5 for e in ROW}),
+    "open grid, a crease across, 1.5": (GRID_V, GRID_F, {e: 1.5 for e in ROW}),
 }
 
 

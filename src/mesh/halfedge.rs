@@ -341,13 +341,15 @@ impl Mesh {
         self.creased
     }
 
-    /// The number of sharp edges at `v`.
+    /// The number of sharp edges at `v` that are not on the boundary (a
+    /// boundary is a crease of its own: the grammars' boundary rules keep
+    /// it a curve).
     pub fn sharp_edge_count(&self, v: VertexId) -> usize {
         if !self.creased {
             return 0;
         }
         self.outgoing_halfedges(v)
-            .filter(|h| self.is_sharp_edge(h.edge()))
+            .filter(|h| self.is_sharp_edge(h.edge()) && !self.is_boundary_edge(h.edge()))
             .count()
     }
 

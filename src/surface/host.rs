@@ -354,7 +354,7 @@ static FUNCTIONS: &[Builtin] = &[
             one(
                 a,
                 &[VERTEX],
-                "`creases` takes a vertex: the number of sharp edges at it",
+                "`creases` takes a vertex: the number of sharp edges at it (off the boundary)",
             )?;
             Ok((Func::Host(id::CREASES), Ty::Int))
         },
@@ -365,7 +365,8 @@ static FUNCTIONS: &[Builtin] = &[
             one(
                 a,
                 &[VERTEX],
-                "`crease_ring` takes a vertex: its neighbours across sharp edges",
+                "`crease_ring` takes a vertex: its neighbours across sharp edges (off the \
+                 boundary)",
             )?;
             Ok((Func::Host(id::CREASE_RING), Ty::Elem(SET)))
         },
@@ -685,7 +686,7 @@ impl Host for MeshHost<'_> {
             }
             (CREASE_RING, VERTEX) => {
                 for h in m.outgoing_halfedges(VertexId(s.ids[0])) {
-                    if m.is_sharp_edge(h.edge()) {
+                    if m.is_sharp_edge(h.edge()) && !m.is_boundary_edge(h.edge()) {
                         out.push(vertex_value(m.to(h)));
                     }
                 }
@@ -712,7 +713,7 @@ fn vertex_rule(vertex: f64, edges: impl Iterator<Item = f64>) -> u8 {
 }
 
 /// The weight of `v`'s crease or corner rule at this level, as OpenSubdiv
-/// blends its vertex rules: 1 where the vertex's rule (see
+/// blends its vertex rules (boundary edges count as sharp for ever): 1 where the vertex's rule (see
 /// [`vertex_rule`]) is the same one level down, with every sharpness one
 /// less; else the mean of the sharpnesses (of the vertex and of its edges)
 /// that drop to 0 at this level, at most 1, so that the mask is that
@@ -724,7 +725,17 @@ pub fn crease_weight(m: &Mesh, v: VertexId) -> f64 {
     }
     let child = |s: f64| (s - 1.0).max(0.0);
     let sv = m.vertex_sharpness(v);
-    let edges = || m.outgoing_halfedges(v).map(|h| m.edge_sharpness(h.edge()));
+    // A boundary edge is sharp for ever, as in OpenSubdiv: a boundary
+    // vertex is a crease, and a corner where an interior crease meets it.
+    let edges = || {
+        m.outgoing_halfedges(v).map(|h| {
+            if m.is_boundary_edge(h.edge()) {
+                f64::INFINITY
+            } else {
+                m.edge_sharpness(h.edge())
+            }
+        })
+    };
     let parent = vertex_rule(sv, edges());
     if parent == 0 {
         return 0.0;

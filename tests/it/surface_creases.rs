@@ -434,3 +434,68 @@ fn crease_weight_follows_opensubdiv() {
     assert_eq!(weight(&[], 2.0), 1.0);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `k` steps of cubic B-spline subdivision of an open polygon whose ends
+/// are corners: they stay; inner points become 1/8 a + 3/4 v + 1/8 b;
+/// every edge gets its midpoint.
+fn bspline_open(mut p: Vec<DVec3>, k: usize) -> Vec<DVec3> {
+    for _ in 0..k {
+        let n = p.len();
+        let mut q = Vec::with_capacity(2 * n - 1);
+        for i in 0..n {
+            q.push(if i == 0 || i == n - 1 {
+                p[i]
+            } else {
+                0.125 * p[i - 1] + 0.75 * p[i] + 0.125 * p[i + 1]
+            });
+            if i + 1 < n {
+                q.push(0.5 * (p[i] + p[i + 1]));
+            }
+        }
+        p = q;
+    }
+    p
+}
+
+/// A crease across an open grid, from boundary to boundary: its ends are
+/// corners (a boundary is a crease for ever, so three sharp edges meet
+/// there) and stay; the rest follows the open cubic B-spline.
+#[test]
+fn a_crease_that_meets_the_boundary_ends_in_corners() {
+    for (file, soup) in [
+        ("surfaces/loop.lsys", shapes::triangle_grid(4, 3)),
+        ("surfaces/catmull-clark.lsys", shapes::quad_grid(4, 3)),
+    ] {
+        let g = grammar(file);
+        let mut base = Mesh::from_soup(&jitter(soup, 13)).unwrap();
+        // Row j = 1 of the 5 x 4 vertices: ids 5 to 9.
+        let row: Vec<u32> = (5..10).collect();
+        for w in row.windows(2) {
+            let e = edge(&base, w[0], w[1]);
+            base.set_edge_sharpness(e, f64::INFINITY).unwrap();
+        }
+        let polygon: Vec<DVec3> = row.iter().map(|&v| base.position(VertexId(v))).collect();
+        for k in 1..=3 {
+            let m = run(&g, &base, k);
+            let want = bspline_open(polygon.clone(), k);
+            for end in [5, 9] {
+                assert_eq!(
+                    m.position(VertexId(end)),
+                    base.position(VertexId(end)),
+                    "{file}: step {k}, end {end}"
+                );
+            }
+            let inner = &want[1..want.len() - 1];
+            let (worst, count) = crease_distance(&m, inner);
+            assert_eq!(count, inner.len(), "{file}: step {k}");
+            assert!(worst < 1e-12, "{file}: step {k}: {worst}");
+        }
+        // Without the crease the ends move along the boundary curve.
+        let m = run(
+            &g,
+            &Mesh::from_soup(&jitter(shapes::quad_grid(4, 3), 13)).unwrap(),
+            1,
+        );
+        assert_ne!(m.position(VertexId(5)), base.position(VertexId(5)));
+    }
+}
