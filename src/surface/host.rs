@@ -1016,6 +1016,38 @@ impl Guard {
         })
     }
 
+    /// True when the guard is false for every element of a mesh with no
+    /// sharpness (`sharp(x)`, `creases(v) >= 2`, in a conjunction), and it
+    /// has no leaf the interpreter evaluates (which could fail): a rule
+    /// with such a guard matches nothing there, so it need not look.
+    pub fn never_without_creases(&self) -> bool {
+        fn no_invariant(g: &Guard) -> bool {
+            match g {
+                Guard::Invariant(_) => false,
+                Guard::Level(..) | Guard::Test(..) | Guard::Count(..) => true,
+                Guard::Not(a) => no_invariant(a),
+                Guard::And(a, b) | Guard::Or(a, b) => no_invariant(a) && no_invariant(b),
+            }
+        }
+        fn never(g: &Guard) -> bool {
+            match g {
+                Guard::Test(id::SHARP, _) => true,
+                Guard::Count(id::CREASES, op, k, _) => !match op {
+                    0 => 0 < *k,
+                    1 => 0 <= *k,
+                    2 => 0 > *k,
+                    3 => 0 >= *k,
+                    4 => 0 == *k,
+                    _ => 0 != *k,
+                },
+                Guard::And(a, b) => never(a) || never(b),
+                Guard::Or(a, b) => never(a) && never(b),
+                _ => false,
+            }
+        }
+        no_invariant(self) && never(self)
+    }
+
     pub fn test(&self, ev: &mut dyn Evaluate<'_>, elem: &Elem) -> Result<bool, RuntimeError> {
         Ok(match self {
             Guard::Level(op, p) => {

@@ -675,6 +675,21 @@ impl Grammar {
     ) -> Result<(Matches, Matches), (bool, RuntimeError)> {
         // `c`, kept up to date by `apply_all` as rules make vertices.
         let current = state.current_level;
+        // A crease rule on a mesh without creases matches nothing.
+        if other.is_none()
+            && !mesh.has_sharpness_flag()
+            && rule
+                .guard
+                .as_ref()
+                .is_some_and(|g| g.never_without_creases())
+        {
+            let none = || Matches {
+                current,
+                vals: Vec::new(),
+                edge_ids: Vec::new(),
+            };
+            return Ok((none(), none()));
+        }
         let step = state.step;
         let slots = match rule.op {
             Op::FaceSplit => mesh.f_alive.len(),
