@@ -663,6 +663,7 @@ impl Grammar {
             blocks: self.block_split,
             lone_triangles_join_blocks: self.block_used_at.is_some(),
             protect,
+            creased: mesh.has_sharpness(),
             ..RunState::default()
         };
         let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
@@ -731,6 +732,21 @@ impl Grammar {
     ) -> Result<(Matches, Matches), (bool, RuntimeError)> {
         // `c`, kept up to date by `apply_all` as rules make vertices.
         let current = state.current_level;
+        // A crease rule on a mesh without creases matches nothing.
+        if other.is_none()
+            && !mesh.has_sharpness_flag()
+            && rule
+                .guard
+                .as_ref()
+                .is_some_and(|g| g.never_without_creases())
+        {
+            let none = || Matches {
+                current,
+                vals: Vec::new(),
+                edge_ids: Vec::new(),
+            };
+            return Ok((none(), none()));
+        }
         let step = state.step;
         let slots = match rule.op {
             Op::FaceSplit => mesh.f_alive.len(),
@@ -793,6 +809,8 @@ impl Grammar {
                                 on_boundary,
                                 mesh.is_block_edge(e),
                                 mesh.is_transversal_edge(e),
+                                mesh.is_sharp_edge(e),
+                                e,
                             );
                             if ev.test(r, &val).map_err(|e| (!std::ptr::eq(r, rule), e))? {
                                 out.0.push(val);
@@ -1139,6 +1157,12 @@ impl GrammarRun<'_> {
         self.state.step += 1;
         self.grammar.apply_all(&each, self.mesh, &mut self.state)?;
         self.state.swap_positions(self.mesh);
+        // A step is one level of the scheme: semi-sharp creases and
+        // corners soften by one (OpenSubdiv's uniform rule). The rules of
+        // the step read the sharpness it started with.
+        if self.state.creased {
+            self.mesh.decrement_sharpness();
+        }
         debug_assert!(
             self.state
                 .protect
@@ -1185,6 +1209,9 @@ struct RunState {
     deadline: Option<crate::Deadline>,
     /// What no rule may match.
     protect: Option<Protected>,
+    /// Some edge or vertex was sharp when the run started: the steps
+    /// decrement sharpness (nothing else makes any).
+    creased: bool,
 }
 
 impl RunState {
