@@ -20,18 +20,9 @@ import argparse
 import os
 import subprocess
 import tempfile
-import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-def best(cmd, n):
-    times = []
-    for _ in range(n):
-        t = time.perf_counter()
-        subprocess.run(cmd, check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
-        times.append(time.perf_counter() - t)
-    return min(times)
+# The same timing as the shape benchmark: best of n, files in and out.
+from shapes_bench import ROOT, best
 
 
 def main():
