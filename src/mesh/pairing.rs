@@ -13,6 +13,10 @@
 //! triangle on the boundary, whose boundary edge a grammar's `init:` rule
 //! splits so that the two halves make a block.
 //!
+//! Pairs across an edge with an interior end of valence 3 or 4 are taken
+//! only where the others cannot pair every triangle: a diagonal there
+//! leaves the vertex in two quads, where the C4 scheme is not C1.
+//!
 //! The matching is Edmonds' blossom algorithm, one augmenting search per
 //! unmatched node after a greedy start, with every search's bookkeeping
 //! undone over the nodes it touched only, so that the whole runs in time
@@ -323,33 +327,58 @@ fn greedy(g: &Graph, eligible: impl Fn(u32) -> bool) -> Vec<u32> {
 /// A maximum matching of the nodes `0..real` of `g`, then augmenting paths
 /// from the nodes left free to the free nodes at and above `real` (the
 /// boundary's stand-ins): `mate[i]` for each node, `u32::MAX` where free.
-/// `budget` bounds the total work; a search that runs out leaves its node
-/// free.
-pub(crate) fn maximum_matching(g: &Graph, real: usize, budget: &mut u64) -> Vec<u32> {
-    let mate = greedy(g, |i| (i as usize) < real);
-    let mut b = Blossom::new(g, mate);
-    // Real pairs first: a maximum matching among the triangles.
-    let free: Vec<u32> = (0..real as u32)
-        .filter(|&i| b.mate[i as usize] == NONE)
-        .collect();
-    // The stand-ins are left out until the triangles are matched.
-    let extra = g.len() - real;
-    b.limit = real as u32;
-    let mut left = Vec::new();
-    for i in free {
-        if b.mate[i as usize] == NONE && !b.grow(i, budget) {
-            left.push(i);
-        }
-    }
-    if extra > 0 {
-        b.limit = g.len() as u32;
-        for i in left {
+/// The matching starts as a maximum one of `preferred` (a graph on the
+/// same nodes with some of `g`'s edges), so that `g`'s other edges are
+/// taken only where the preferred ones cannot pair the nodes. `budget`
+/// bounds the total work; a search that runs out leaves its node free.
+pub(crate) fn maximum_matching(
+    g: &Graph,
+    preferred: &Graph,
+    real: usize,
+    budget: &mut u64,
+) -> Vec<u32> {
+    let mut mate = greedy(preferred, |i| (i as usize) < real);
+    // Real pairs first, over the preferred edges, then over all.
+    for graph in [preferred, g] {
+        let mut b = Blossom::new(graph, mate);
+        b.limit = real as u32;
+        for i in 0..real as u32 {
             if b.mate[i as usize] == NONE {
                 b.grow(i, budget);
             }
         }
+        mate = b.mate;
     }
-    b.mate
+    // Each pair over an edge that is not preferred: undone, and kept only
+    // where no alternating path over preferred edges pairs its two nodes
+    // otherwise (matched pairs are followed through `mate`, so the search
+    // may cross other such pairs but never makes one).
+    let mut b = Blossom::new(preferred, mate);
+    b.limit = real as u32;
+    for i in 0..real as u32 {
+        let m = b.mate[i as usize];
+        if m == NONE || m < i || preferred.neighbours(i).contains(&m) {
+            continue;
+        }
+        b.mate[i as usize] = NONE;
+        b.mate[m as usize] = NONE;
+        if !b.grow(i, budget) {
+            b.mate[i as usize] = m;
+            b.mate[m as usize] = i;
+        }
+    }
+    mate = b.mate;
+    // Then the stand-ins, for what the triangles left.
+    if g.len() > real {
+        let mut b = Blossom::new(g, mate);
+        for i in 0..real as u32 {
+            if b.mate[i as usize] == NONE {
+                b.grow(i, budget);
+            }
+        }
+        mate = b.mate;
+    }
+    mate
 }
 
 /// What [`Mesh::match_blocks`] did.
@@ -410,8 +439,24 @@ impl Mesh {
             }
         }
         let g = Graph::from_edges(real + stand_ins.len(), &links);
+        // Preferred pairs: across an edge with no interior end of valence
+        // 3 or 4. A diagonal there leaves the vertex in two quads (k = 2
+        // in c4.lsys's terms), where the C4 scheme's subdominant
+        // eigenvalue 1/4 is not above the next one (see
+        // tests/it/surface_c4.rs); without one it is in 3 or 4 quads.
+        let low = |v| !self.is_boundary_vertex(v) && self.valence(v) <= 4;
+        let preferred: Vec<(u32, u32)> = links
+            .iter()
+            .zip(&via)
+            .filter(|&(&(_, b), &e)| {
+                let (p, q) = self.edge_vertices(e);
+                (b as usize) < real && !low(p) && !low(q)
+            })
+            .map(|(&l, _)| l)
+            .collect();
+        let preferred = Graph::from_edges(real + stand_ins.len(), &preferred);
         let mut left = budget;
-        let mate = maximum_matching(&g, real, &mut left);
+        let mate = maximum_matching(&g, &preferred, real, &mut left);
         if left == 0 {
             return Err(MeshError::new(format!(
                 "pairing triangles into blocks: the search for a maximum matching of {real} triangles \
@@ -485,7 +530,7 @@ mod tests {
     fn check(n: usize, edges: &[(u32, u32)]) -> usize {
         let g = Graph::from_edges(n, edges);
         let mut budget = u64::MAX;
-        let mate = maximum_matching(&g, n, &mut budget);
+        let mate = maximum_matching(&g, &g, n, &mut budget);
         // A matching: symmetric, along edges.
         for (i, &m) in mate.iter().enumerate() {
             if m != NONE {
@@ -552,13 +597,36 @@ mod tests {
     }
 
     #[test]
+    fn preferred_edges_win_where_they_can() {
+        // A 4-cycle 0-1-2-3-0 has two perfect matchings; with 0-1 and 2-3
+        // preferred, those are taken, whatever the greedy start would do.
+        let edges = [(0, 1), (1, 2), (2, 3), (3, 0)];
+        let g = Graph::from_edges(4, &edges);
+        for pref in [[(0, 1), (2, 3)], [(1, 2), (3, 0)]] {
+            let p = Graph::from_edges(4, &pref);
+            let mut budget = u64::MAX;
+            let mate = maximum_matching(&g, &p, 4, &mut budget);
+            for (a, b) in pref {
+                assert_eq!(mate[a as usize], b);
+            }
+        }
+        // Where the preferred edges cannot pair everything, the others do:
+        // a path 0-1-2-3 with only 1-2 preferred pairs 0-1 and 2-3.
+        let g = Graph::from_edges(4, &[(0, 1), (1, 2), (2, 3)]);
+        let p = Graph::from_edges(4, &[(1, 2)]);
+        let mut budget = u64::MAX;
+        let mate = maximum_matching(&g, &p, 4, &mut budget);
+        assert_eq!((mate[0], mate[2]), (1, 3));
+    }
+
+    #[test]
     fn stand_ins_take_only_what_real_pairs_leave() {
         // A path 0-1-2 of real nodes, with stand-in 3 on node 2 and 4 on 0:
         // one real pair, and the third node goes to its stand-in.
         let edges = [(0, 1), (1, 2), (2, 3), (0, 4)];
         let g = Graph::from_edges(5, &edges);
         let mut budget = u64::MAX;
-        let mate = maximum_matching(&g, 3, &mut budget);
+        let mate = maximum_matching(&g, &g, 3, &mut budget);
         let real_pairs = (0..3).filter(|&i| mate[i] != NONE && mate[i] < 3).count() / 2;
         assert_eq!(real_pairs, 1);
         assert!((0..3).all(|i| mate[i] != NONE));
