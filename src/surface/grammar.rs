@@ -23,6 +23,11 @@
 //! ```text
 //! init: E(e; block(e)) | F^2 -> V(v = avg(ring(v))) || E^4 F^4
 //! ```
+//!
+//! A 4-8 grammar may add `adaptive;`: its split rules' conditions then
+//! select which blocks to split, and the run splits the coarser
+//! neighbours a selected block needs first, so that the mesh stays a 4-8
+//! mesh (`surface::run`, "Adaptive 4-8 refinement").
 
 use crate::mesh::BlockSplit;
 use crate::syntax::ast::Expr;
@@ -88,6 +93,10 @@ pub struct GrammarFile {
     /// `blocks: bisection;` (4-8 meshes), `blocks: dual;` (Doo-Sabin,
     /// Peters) or `blocks: quadrisection;`.
     pub block_split: Option<(BlockSplit, Span)>,
+    /// `adaptive;`: a 4-8 grammar (`blocks: bisection;`) whose split rules
+    /// may select some blocks only; the run keeps the mesh a 4-8 mesh by
+    /// splitting the coarser neighbours first (see `surface::run`).
+    pub adaptive: Option<Span>,
 }
 
 type R<T> = Result<T, Diagnostic>;
@@ -183,6 +192,12 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
             g.block_split = Some((how, at));
             continue;
         }
+        if p.peek_ident("adaptive") && p.peek_at(1).is_some_and(|t| t.tok.is_punct(";")) {
+            g.adaptive = Some(p.span_here());
+            p.bump();
+            p.bump();
+            continue;
+        }
         if at_key(&p, "init") {
             p.bump();
             p.bump();
@@ -264,8 +279,8 @@ fn rule(p: &mut Parser, text_of: &impl Fn(Span) -> String) -> R<RuleDef> {
         Some(Tok::Ident(k)) if k == "V" => Kind::Vertex,
         _ => {
             return p.error(
-                "a rule starting with F, E or V, `init:`, `define`, `mesh:`, `blocks:` or \
-                 `derivation length:`",
+                "a rule starting with F, E or V, `init:`, `define`, `mesh:`, `blocks:`, \
+                 `adaptive;` or `derivation length:`",
             )
         }
     };

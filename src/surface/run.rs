@@ -64,6 +64,9 @@ pub struct Grammar {
     pub dual_at: Option<Span>,
     /// What splitting a block's internal edge does (`blocks:`).
     pub block_split: BlockSplit,
+    /// Where the grammar says `adaptive;`: its split rules select blocks,
+    /// and the closure keeps the mesh a 4-8 mesh (see [`GrammarRun`]).
+    pub adaptive: Option<Span>,
     /// A rule that would make more faces than this stops the run with an
     /// error instead of exhausting memory (about 110 bytes a face).
     pub max_faces: usize,
@@ -238,6 +241,25 @@ pub(crate) fn compile_with(
             })
         }
     };
+    if let Some(at) = file.adaptive {
+        if !matches!(file.block_split, Some((BlockSplit::Bisection, _))) {
+            diags.push(Diagnostic::new(
+                at,
+                "`adaptive;` is for 4-8 grammars, which refine by bisection: it needs \
+                 `blocks: bisection;`",
+            ));
+        }
+        for r in file.rules.iter().filter(|r| !r.init) {
+            if matches!(r.op, Op::FaceSplit | Op::Flip) {
+                diags.push(Diagnostic::new(
+                    r.span,
+                    "an adaptive 4-8 grammar refines by splitting blocks' internal edges only; \
+                     a face split or an edge flip would break its blocks (put it under `init:`, \
+                     or drop `adaptive;`)",
+                ));
+            }
+        }
+    }
     if !diags.is_empty() {
         diags.sort_by_key(|d| (d.span.file.0, d.span.start));
         return Err((sources, diags));
@@ -256,6 +278,7 @@ pub(crate) fn compile_with(
         block_split: file
             .block_split
             .map_or(BlockSplit::Quadrisection, |(b, _)| b),
+        adaptive: file.adaptive,
         max_faces: MAX_FACES,
         max_valence: MAX_VALENCE,
         warnings,
@@ -630,13 +653,24 @@ impl Grammar {
             valence_bound: highest,
             blocks: self.block_split,
             face_split_makes_blocks: self.block_used_at.is_some(),
+            adaptive: self.adaptive.is_some(),
             protect,
             ..RunState::default()
         };
         let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
+        // The init rules prepare the blocks; the adaptive closure starts
+        // with the first step.
+        state.adaptive = false;
         self.apply_all(&init, mesh, &mut state)?;
+        state.adaptive = self.adaptive.is_some();
         // What init's vertex rules wrote is current before the first step.
         state.swap_positions(mesh);
+        if let Some(span) = self.adaptive {
+            check_adaptive_start(mesh).map_err(|message| RunError {
+                span: Some(span),
+                message,
+            })?;
+        }
         debug_assert!(state.protect.as_ref().is_none_or(|p| p.intact(mesh)));
         Ok(GrammarRun {
             grammar: self,
@@ -726,17 +760,18 @@ impl Grammar {
                             } else {
                                 continue;
                             };
-                            // A boundary edge runs the way its face does.
-                            let h = e.halfedge();
-                            let h = if mesh.face(h).is_none() { h.twin() } else { h };
-                            let val = host::edge(
-                                mesh.from(h),
-                                mesh.to(h),
-                                mesh.edge_level(e),
-                                on_boundary,
-                                mesh.is_block_edge(e),
-                                mesh.is_transversal_edge(e),
-                            );
+                            // An adaptive split rule sees the diagonals of
+                            // diamonds, complete or not, as blocks' internal
+                            // edges, and nothing else.
+                            let block = if state.adaptive && r.op != Op::Flip {
+                                if !mesh.is_refinement_edge(e) {
+                                    continue;
+                                }
+                                true
+                            } else {
+                                mesh.is_block_edge(e)
+                            };
+                            let val = edge_value(mesh, e, block);
                             if ev.test(r, &val).map_err(|e| (!std::ptr::eq(r, rule), e))? {
                                 out.0.push(val);
                                 out.1.push(e);
@@ -834,6 +869,7 @@ impl Grammar {
         state: &mut RunState,
     ) -> Result<(), RunError> {
         let step = state.step as usize;
+        let splits = |r: &Rule| matches!(r.op, Op::EdgeSplit | Op::BoundarySplit);
         // c: the highest vertex level, raised below by the vertices that
         // splits make (rules never remove vertices).
         state.current_level = mesh
@@ -857,6 +893,22 @@ impl Grammar {
                 )
             });
             match pair {
+                _ if state.adaptive && splits(rule) => {
+                    let (a, b) = self
+                        .find_matches_with(rule, pair.copied(), mesh, state)
+                        .map_err(|(in_next, e)| {
+                            self.runtime_error(
+                                match pair {
+                                    Some(next) if in_next => next,
+                                    _ => rule,
+                                },
+                                step,
+                                e,
+                            )
+                        })?;
+                    self.apply_adaptive(rule, pair.copied(), mesh, state, a, b)?;
+                    i += 1 + pair.is_some() as usize;
+                }
                 Some(next) => {
                     let (a, b) = self
                         .find_matches_with(rule, Some(next), mesh, state)
@@ -875,6 +927,143 @@ impl Grammar {
                     i += 1;
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// Adaptive 4-8 refinement: `rule` (and `other`, the split rule of the
+    /// other context written next to it) matched `a` (and `b`) when it
+    /// started. A selected edge whose diamond is incomplete, because the
+    /// face across it is still half of a coarser block, waits until that
+    /// block's internal edge is split, which may wait in turn (the forced
+    /// splits of 4-8 and ROAM hierarchies). So the splits go in rounds:
+    /// each splits every complete diamond that is selected or needed, in
+    /// id order, interior edges by the interior rule and boundary edges by
+    /// the boundary rule, as written; their new vertices get the rule's
+    /// assignment before the next round, which may read them. Where every
+    /// diamond is selected and complete (uniform refinement), there is one
+    /// round, and it does what the rules do without `adaptive;`.
+    fn apply_adaptive(
+        &self,
+        rule: &Rule,
+        other: Option<&Rule>,
+        mesh: &mut Mesh,
+        state: &mut RunState,
+        a: Matches,
+        b: Matches,
+    ) -> Result<(), RunError> {
+        let step = state.step as usize;
+        let current = a.current;
+        let fail = |r: &Rule, m: String| RunError {
+            span: Some(r.span),
+            message: format!("at step {step}, rule `{}`: {m}", r.text),
+        };
+        let rules: Vec<&Rule> = std::iter::once(rule).chain(other).collect();
+        let rule_for = |boundary: bool| {
+            let want = if boundary {
+                Op::BoundarySplit
+            } else {
+                Op::EdgeSplit
+            };
+            rules.iter().position(|r| r.op == want)
+        };
+        // The values the selected edges had when the rule started.
+        let mut selected: std::collections::HashMap<EdgeId, Elem> = a
+            .edge_ids
+            .iter()
+            .zip(&a.vals)
+            .chain(b.edge_ids.iter().zip(&b.vals))
+            .map(|(&e, &v)| (e, v))
+            .collect();
+        let mut todo: Vec<EdgeId> = a.edge_ids.iter().chain(&b.edge_ids).copied().collect();
+        todo.sort_unstable();
+        while !todo.is_empty() {
+            if let Err(m) = crate::deadline::check(state.deadline) {
+                return Err(fail(rule, m));
+            }
+            // The complete diamonds among the edges wanted, and the
+            // blocking edges of the others, followed down to complete ones.
+            let mut now: Vec<EdgeId> = Vec::new();
+            let mut later: Vec<EdgeId> = Vec::new();
+            let mut seen = std::collections::HashSet::new();
+            let mut stack: Vec<EdgeId> = todo.iter().rev().copied().collect();
+            while let Some(e) = stack.pop() {
+                if !seen.insert(e) {
+                    continue;
+                }
+                match mesh.bisection_blocker(e) {
+                    None => now.push(e),
+                    Some(d) => {
+                        later.push(e);
+                        stack.push(d);
+                    }
+                }
+            }
+            if now.is_empty() {
+                let (p, q) = mesh.edge_vertices(todo[0]);
+                return Err(fail(
+                    rule,
+                    format!(
+                        "the edge between vertices {p} and {q} is selected, but no diamond it \
+                         waits for can be split: the blocks are not those of a 4-8 mesh"
+                    ),
+                ));
+            }
+            now.sort_unstable();
+            later.sort_unstable();
+            let mut per_rule: Vec<Vec<EdgeId>> = vec![Vec::new(); rules.len()];
+            for &e in &now {
+                let boundary = mesh.is_boundary_edge(e);
+                let Some(k) = rule_for(boundary) else {
+                    let (p, q) = mesh.edge_vertices(e);
+                    return Err(fail(
+                        rule,
+                        format!(
+                            "a selected block needs the {} edge between vertices {p} and {q} \
+                             split first, but no {} split rule is written next to this one",
+                            if boundary { "boundary" } else { "interior" },
+                            if boundary { "boundary" } else { "interior" },
+                        ),
+                    ));
+                };
+                if let Some(p) = state.protect.as_ref() {
+                    if !p.edge_free(mesh, e) {
+                        let (p, q) = mesh.edge_vertices(e);
+                        return Err(fail(
+                            rules[k],
+                            format!(
+                                "the edge between vertices {p} and {q} must be split, but it \
+                                 is protected"
+                            ),
+                        ));
+                    }
+                }
+                per_rule[k].push(e);
+            }
+            for (k, edges) in per_rule.into_iter().enumerate() {
+                if edges.is_empty() {
+                    continue;
+                }
+                let vals: Vec<Elem> = edges
+                    .iter()
+                    .map(|e| {
+                        selected
+                            .remove(e)
+                            .unwrap_or_else(|| edge_value(mesh, *e, true))
+                    })
+                    .collect();
+                self.apply_matched(
+                    rules[k],
+                    mesh,
+                    state,
+                    Matches {
+                        current,
+                        vals,
+                        edge_ids: edges,
+                    },
+                )?;
+            }
+            todo = later;
         }
         Ok(())
     }
@@ -1120,6 +1309,9 @@ struct RunState {
     blocks: BlockSplit,
     /// Set for grammars that read blocks: a face split then makes blocks.
     face_split_makes_blocks: bool,
+    /// An adaptive 4-8 run (`adaptive;`): split rules see refinement
+    /// edges only, and the closure splits coarser neighbours first.
+    adaptive: bool,
     /// The highest valence a rule may leave (see [`Grammar::max_valence`]).
     valence_limit: usize,
     /// At least the highest valence in the mesh (see `check_valence`).
@@ -1137,6 +1329,7 @@ impl RunState {
             step: self.step,
             blocks: self.blocks,
             face_split_makes_blocks: self.face_split_makes_blocks,
+            adaptive: self.adaptive,
         }
     }
 
@@ -1175,6 +1368,51 @@ impl RunState {
 
 /// Elements per parallel task: small jobs stay on one thread.
 const CHUNK: usize = 16384;
+
+/// An edge as a rule's value: its ends (a boundary edge runs the way its
+/// face does), level and marks, `block` the block mark it shows.
+fn edge_value(mesh: &Mesh, e: EdgeId, block: bool) -> Elem {
+    let h = e.halfedge();
+    let h = if mesh.face(h).is_none() { h.twin() } else { h };
+    host::edge(
+        mesh.from(h),
+        mesh.to(h),
+        mesh.edge_level(e),
+        mesh.is_boundary_edge(e),
+        block,
+        mesh.is_transversal_edge(e),
+    )
+}
+
+/// An adaptive run starts on a 4-8 mesh: every face has exactly one edge
+/// that is a block's internal edge (so every face is half of a block,
+/// or of a boundary half-block), and vertices are numbered in the order
+/// they were made ([`Mesh::refinement_edge`] reads the newest vertex).
+fn check_adaptive_start(mesh: &Mesh) -> Result<(), String> {
+    for f in mesh.faces() {
+        let marked = mesh
+            .face_edges(f)
+            .iter()
+            .filter(|&&e| mesh.is_block_edge(e))
+            .count();
+        if marked != 1 {
+            let [a, b, c] = mesh.face_vertices(f).map(|v| v.index() + 1);
+            return Err(format!(
+                "adaptive 4-8 refinement needs every triangle to be half of exactly one basic \
+                 block, but the triangle on vertices {a}, {b} and {c} has {marked} internal \
+                 edges of blocks"
+            ));
+        }
+    }
+    if mesh.reuses_vertex_slots() {
+        return Err(
+            "adaptive 4-8 refinement needs vertices numbered in the order they \
+                    were made, but this mesh has vertex slots freed for reuse"
+                .into(),
+        );
+    }
+    Ok(())
+}
 
 fn vertex_of(val: &Elem) -> VertexId {
     host::vertex_of(val).unwrap_or(VertexId(u32::MAX))
