@@ -31,6 +31,7 @@ mod semantics;
 mod shapes;
 mod support;
 mod surface;
+mod surface_adaptive;
 mod surface_quad;
 mod vv;
 mod vv_adversarial;

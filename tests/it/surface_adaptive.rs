@@ -1,0 +1,301 @@
+//! Adaptive 4-8 refinement (`adaptive;`, issue 15 part 3): the mesh stays
+//! a conforming 4-8 mesh after every step, selecting every block is
+//! uniform refinement to the bit, and a guard that selects a region
+//! refines there and in the neighbours the closure needs, counted by hand.
+
+use glam::DVec3;
+use subgram::mesh::{shapes, Mesh, PolygonSoup};
+use subgram::surface::Grammar;
+
+use crate::support::*;
+
+fn grammar_file(file: &str, defines: &[&str]) -> Grammar {
+    let defines: Vec<String> = defines.iter().map(|d| d.to_string()).collect();
+    subgram::surface::load_file(&lsys(file), &defines).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn grammar_text(text: &str) -> Grammar {
+    subgram::surface::load_str("g.lsys", text, &[]).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Everything the 4-8 structure and conformity require of `m`:
+/// * the half-edge mesh is valid (`validate`);
+/// * every face has at most one edge marked as a block's internal edge,
+///   and a marked interior edge is the refinement edge of both its faces
+///   (a mark is a complete diamond);
+/// * a face without a mark is half of an incomplete diamond: the face
+///   across its refinement edge has another refinement edge;
+/// * as a polygon soup, no edge is used by more than two faces and the
+///   number of boundary edges is `boundary_edges` (closed stays closed);
+/// * no vertex lies on the open segment of an edge of a face around a
+///   neighbour (a T-junction would put one there).
+fn assert_conforming(m: &Mesh, boundary_edges: Option<usize>, what: &str) {
+    m.validate()
+        .unwrap_or_else(|e| panic!("{what}: {}", e.message));
+    for f in m.faces() {
+        let marked: Vec<_> = m
+            .face_edges(f)
+            .into_iter()
+            .filter(|&e| m.is_block_edge(e))
+            .collect();
+        assert!(marked.len() <= 1, "{what}: face {f} has {marked:?} marked");
+        let r = m.refinement_edge(f);
+        if let Some(&e) = marked.first() {
+            assert_eq!(r, e, "{what}: face {f}");
+            for g in m.edge_faces(e).into_iter().flatten() {
+                assert_eq!(m.refinement_edge(g), e, "{what}: a mark that is no diamond");
+            }
+        } else {
+            let across = m.edge_faces(r).into_iter().flatten().find(|&g| g != f);
+            if let Some(g) = across {
+                assert_ne!(
+                    m.refinement_edge(g),
+                    r,
+                    "{what}: a complete diamond without its mark"
+                );
+            }
+        }
+    }
+    // Edges counted on the soup: no more than two faces on an edge.
+    let soup = m.to_soup();
+    let mut uses = std::collections::HashMap::new();
+    for f in &soup.faces {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            *uses.entry((a.min(b), a.max(b))).or_insert(0usize) += 1;
+        }
+    }
+    assert!(uses.values().all(|&n| n <= 2), "{what}: an edge in 3 faces");
+    if let Some(b) = boundary_edges {
+        assert_eq!(
+            uses.values().filter(|&&n| n == 1).count(),
+            b,
+            "{what}: boundary edges"
+        );
+    }
+    // T-junctions: a vertex on an edge of a face at one of its neighbours.
+    for e in m.edges() {
+        let (a, b) = m.edge_vertices(e);
+        let (pa, pb) = (m.position(a), m.position(b));
+        let near: Vec<_> = [a, b]
+            .into_iter()
+            .flat_map(|v| m.vertex_faces(v).collect::<Vec<_>>())
+            .flat_map(|f| m.face_vertices(f))
+            .collect();
+        for w in near {
+            if w == a || w == b {
+                continue;
+            }
+            let p = m.position(w);
+            let t = (p - pa).dot(pb - pa) / (pb - pa).length_squared();
+            let off = (pa + (pb - pa) * t).distance(p);
+            assert!(
+                !(0.0..=1.0).contains(&t) || off > 1e-9 * pa.distance(pb),
+                "{what}: vertex {w} lies on the edge {a}-{b}"
+            );
+        }
+    }
+}
+
+/// The marks, positions (bits) and faces of `m`, by id: what must agree
+/// to the bit.
+fn fingerprint(m: &Mesh) -> (Vec<[u64; 3]>, Vec<[u32; 3]>, Vec<bool>) {
+    let pos = m
+        .vertices()
+        .map(|v| m.position(v).to_array().map(f64::to_bits))
+        .collect();
+    let faces = m.faces().map(|f| m.face_vertices(f).map(|v| v.0)).collect();
+    let marks = m.edges().map(|e| m.is_block_edge(e)).collect();
+    (pos, faces, marks)
+}
+
+fn torus_obj() -> PolygonSoup {
+    subgram::mesh::io::read(&lsys("meshes/torus.obj")).unwrap()
+}
+
+/// Selecting every block (a radius that holds the whole mesh) is
+/// four-eight.lsys, to the bit, after every step: on the closed torus, on
+/// an open grid (the boundary rule) and on a jittered torus.
+#[test]
+fn all_selected_is_uniform_to_the_bit() {
+    let uniform = grammar_file("surfaces/four-eight.lsys", &[]);
+    let adaptive = grammar_file("surfaces/four-eight-adaptive.lsys", &["R=1e9"]);
+    let meshes = [
+        ("torus", torus_obj()),
+        ("grid", shapes::quad_grid(5, 4)),
+        ("jittered torus", jitter(shapes::quad_torus(6, 4), 7)),
+    ];
+    for (name, soup) in meshes {
+        let mut a = Mesh::from_soup(&soup).unwrap();
+        let mut b = a.clone();
+        let mut ra = uniform.start(&mut a).unwrap();
+        let mut rb = adaptive.start(&mut b).unwrap();
+        for step in 1..=6 {
+            ra.steps(1, |_| {}).unwrap();
+            rb.steps(1, |_| {}).unwrap();
+            assert!(
+                fingerprint(ra.mesh()) == fingerprint(rb.mesh()),
+                "{name}, step {step}: adaptive with everything selected differs"
+            );
+        }
+    }
+}
+
+/// The example grammar refines near its point, and the mesh is a
+/// conforming 4-8 mesh after every step; the closed torus stays closed,
+/// and the grid keeps a boundary that only grows by the boundary splits.
+#[test]
+fn conforming_after_every_step() {
+    for (defines, soup, closed) in [
+        (vec![], torus_obj(), true),
+        (
+            vec!["PX=0.3", "PY=0.6", "R=0.3"],
+            shapes::quad_grid(6, 6),
+            false,
+        ),
+        (
+            vec!["PX=0.9", "PY=0.4", "PZ=0.2", "R=0.5"],
+            jitter(shapes::quad_torus(8, 6), 11),
+            true,
+        ),
+    ] {
+        let g = grammar_file("surfaces/four-eight-adaptive.lsys", &defines);
+        let mut m = Mesh::from_soup(&soup).unwrap();
+        let mut run = g.start(&mut m).unwrap();
+        let mut faces = run.mesh().face_count();
+        for step in 1..=7 {
+            run.steps(1, |_| {}).unwrap();
+            let m = run.mesh();
+            let boundary = closed.then_some(0);
+            assert_conforming(m, boundary, &format!("{defines:?}, step {step}"));
+            assert!(m.face_count() >= faces);
+            faces = m.face_count();
+        }
+        // Adaptive: fewer than half the faces of seven uniform bisections
+        // (2^7 times the triangles).
+        assert!(
+            faces < soup.faces.len() * 2 * 128 / 2,
+            "{defines:?}: {faces}"
+        );
+        assert!(faces > soup.faces.len() * 2, "{defines:?}: nothing refined");
+    }
+}
+
+/// On the 4 × 4 grid in the unit square (16 quads, 32 triangles, 25
+/// vertices), step 1 selects the block of the quad A = [0, ¼]², step 2
+/// the right side of A, x = 0.25. Counted by hand:
+/// * step 1 splits A's diagonal: one vertex (A's centre) and two faces,
+///   34 faces and 26 vertices;
+/// * step 2: x is the refinement edge of A's right triangle, but the
+///   triangle across it is still half of the block B = [¼, ½] × [0, ¼],
+///   so B's diagonal is split first (a vertex at B's centre, two faces),
+///   then x (a vertex at the average of the diamond's corners (¼, 0),
+///   (¼, ¼), A's centre and B's centre, which is (¼, ⅛); two faces):
+///   38 faces and 28 vertices.
+///
+/// No vertex is smoothed in either step: no interior vertex has all its
+/// faces split (`refined`), so the new vertices are where the averages say.
+#[test]
+fn a_guard_refines_its_region_and_the_closure_its_neighbours() {
+    let g = grammar_text(
+        "mesh: \"x.obj\";\nblocks: bisection;\nadaptive;\n\
+         define at(e, x, y) = Length(avg(e) - point(x, y, 0)) < 0.01;\n\
+         define wanted(e) = step == 1 ? at(e, 0.125, 0.125) : at(e, 0.25, 0.125);\n\
+         E(e; block(e) && wanted(e)) | F^2 -> V(v = avg(ring(v))) || E^4 F^4;\n\
+         E(e; block(e) && wanted(e)) | F -> V(v = avg(e)) || E^3 F^2;\n\
+         V(v; !new(v) && refined(v)) | interior -> V(v = 0.5*v + 0.5*avg(w in ring(v) where !new(w)));\n",
+    );
+    let mut m = Mesh::from_soup(&shapes::quad_grid(4, 4)).unwrap();
+    assert_eq!((m.face_count(), m.vertex_count()), (32, 25));
+    let mut run = g.start(&mut m).unwrap();
+    run.steps(1, |_| {}).unwrap();
+    assert_eq!(
+        (run.mesh().face_count(), run.mesh().vertex_count()),
+        (34, 26)
+    );
+    assert_conforming(run.mesh(), Some(16), "step 1");
+    run.steps(1, |_| {}).unwrap();
+    let m = run.mesh();
+    assert_eq!((m.face_count(), m.vertex_count()), (38, 28));
+    assert_conforming(m, Some(16), "step 2");
+    let has = |p: DVec3| m.vertices().any(|v| m.position(v) == p);
+    for p in [
+        DVec3::new(0.125, 0.125, 0.0),
+        DVec3::new(0.375, 0.125, 0.0),
+        DVec3::new(0.25, 0.125, 0.0),
+    ] {
+        assert!(has(p), "no vertex at {p}");
+    }
+    // The grid's 25 vertices are where they were.
+    for j in 0..=4 {
+        for i in 0..=4 {
+            assert!(has(DVec3::new(i as f64 / 4.0, j as f64 / 4.0, 0.0)));
+        }
+    }
+}
+
+/// `area(e)` of a block's internal edge is the block's area: the grid's
+/// quads have area 1/16 = 0.0625, a bisection halves a block, and a
+/// boundary edge's area is its one face's. A threshold of 0.05 selects
+/// every block in step 1 (64 faces, as uniform) and none after (blocks of
+/// 0.03125); 0.03 selects every block in step 1 and in step 2 the 24
+/// interior diamonds (the grid's interior edges, 0.03125) but not the 16
+/// boundary half-diamonds (0.015625): 64 + 24 × 2 = 112 faces; then none.
+#[test]
+fn an_area_threshold_stops_where_blocks_get_small() {
+    for (t, want) in [(0.05, [64, 64, 64]), (0.03, [64, 112, 112])] {
+        let g = grammar_text(&format!(
+            "mesh: \"x.obj\";\nblocks: bisection;\nadaptive;\n\
+             E(e; block(e) && area(e) > {t}) | F^2 -> V(v = avg(ring(v))) || E^4 F^4;\n\
+             E(e; block(e) && area(e) > {t}) | F -> V(v = avg(e)) || E^3 F^2;\n"
+        ));
+        let mut m = Mesh::from_soup(&shapes::quad_grid(4, 4)).unwrap();
+        let mut run = g.start(&mut m).unwrap();
+        for (k, n) in want.into_iter().enumerate() {
+            run.steps(1, |_| {}).unwrap();
+            assert_eq!(run.mesh().face_count(), n, "threshold {t}, step {}", k + 1);
+            assert_conforming(run.mesh(), Some(16), "area");
+        }
+    }
+}
+
+/// `length(e)` and `angle(e)`: the grid's diagonals are √2/4 ≈ 0.354
+/// long, so `length(e) > 0.35` selects them all and `length(e) > 0.36`
+/// none. A grid folded by 45° along x = ½ (z = x - ½ beyond it) has
+/// planar quads, so no block's triangles make an angle; after one uniform
+/// step (`step == 1`) the diamonds are the old quad edges, and only the
+/// four on the fold line have triangles on both sides of it, at 45°: they
+/// alone are split in step 2, 64 + 4 × 2 = 72 faces.
+#[test]
+fn length_and_angle_guards() {
+    // The boundary keeps its 16 edges: no boundary edge is a diamond's
+    // diagonal before step 2, and none is selected there.
+    let run = |guard: &str, soup: &PolygonSoup, steps: usize| {
+        let g = grammar_text(&format!(
+            "mesh: \"x.obj\";\nblocks: bisection;\nadaptive;\n\
+             E(e; block(e) && ({guard})) | F^2 -> V(v = avg(ring(v))) || E^4 F^4;\n\
+             E(e; block(e) && ({guard})) | F -> V(v = avg(e)) || E^3 F^2;\n"
+        ));
+        let mut m = Mesh::from_soup(soup).unwrap();
+        g.run(&mut m, steps, |_| {}).unwrap();
+        assert_conforming(&m, Some(16), guard);
+        m.face_count()
+    };
+    let grid = shapes::quad_grid(4, 4);
+    assert_eq!(run("length(e) > 0.35", &grid, 1), 64);
+    assert_eq!(run("length(e) > 0.36", &grid, 1), 32);
+    let mut folded = grid.clone();
+    for p in &mut folded.positions {
+        p.z = (p.x - 0.5).max(0.0);
+    }
+    assert_eq!(run("angle(e) > 1", &folded, 1), 32);
+    assert_eq!(run("step == 1 || angle(e) > 1", &folded, 2), 72);
+    assert_eq!(
+        run(
+            "step == 1 || angle(e) > 44.99 && angle(e) < 45.01",
+            &folded,
+            2
+        ),
+        72
+    );
+}
