@@ -299,3 +299,53 @@ fn length_and_angle_guards() {
         72
     );
 }
+
+/// The closure reaches the boundary. On the 4 × 4 grid: step 1 splits
+/// every block (64 faces); step 2 the diamond on x = ¼, y ∈ [0, ¼], the
+/// right side of the corner quad A = [0, ¼]² (66 faces); step 3 selects
+/// the edge from (¼, 0) to A's centre (⅛, ⅛), which the triangle at the
+/// new vertex (¼, ⅛) would split next, but across it lies the triangle of
+/// the boundary half-diamond on y = 0, x ∈ [0, ¼]: that boundary edge is
+/// split first (one face more), then the selected edge (two): 69 faces.
+/// Without a boundary split rule the run says what it needed.
+#[test]
+fn the_closure_splits_boundary_half_diamonds() {
+    let text = |with_boundary: bool| {
+        format!(
+            "mesh: \"x.obj\";\nblocks: bisection;\nadaptive;\n\
+             define at(e, x, y) = Length(avg(e) - point(x, y, 0)) < 0.01;\n\
+             define wanted(e) = step == 1 || step == 2 && at(e, 0.25, 0.125) \
+             || step == 3 && at(e, 0.1875, 0.0625);\n\
+             E(e; block(e) && wanted(e)) | F^2 -> V(v = avg(ring(v))) || E^4 F^4;\n{}",
+            if with_boundary {
+                "E(e; block(e) && wanted(e)) | F -> V(v = avg(e)) || E^3 F^2;\n"
+            } else {
+                ""
+            }
+        )
+    };
+    let g = grammar_text(&text(true));
+    let mut m = Mesh::from_soup(&shapes::quad_grid(4, 4)).unwrap();
+    let mut run = g.start(&mut m).unwrap();
+    for (step, (faces, boundary)) in [(64, 16), (66, 16), (69, 17)].into_iter().enumerate() {
+        run.steps(1, |_| {}).unwrap();
+        assert_eq!(run.mesh().face_count(), faces, "step {}", step + 1);
+        assert_conforming(run.mesh(), Some(boundary), "boundary closure");
+    }
+    // The boundary vertex the closure made is the edge's midpoint.
+    let m = run.mesh();
+    assert!(m
+        .vertices()
+        .any(|v| m.position(v) == DVec3::new(0.125, 0.0, 0.0)));
+
+    let g = grammar_text(&text(false));
+    let mut m = Mesh::from_soup(&shapes::quad_grid(4, 4)).unwrap();
+    let err = g.run(&mut m, 3, |_| {}).unwrap_err();
+    let msg = g.render_error(&err);
+    assert!(
+        msg.contains("at step 3")
+            && msg.contains("split first, but no boundary split rule is written next to this one"),
+        "{msg}"
+    );
+    assert!(msg.contains("g.lsys:6:"), "{msg}");
+}
