@@ -349,3 +349,47 @@ fn the_closure_splits_boundary_half_diamonds() {
     );
     assert!(msg.contains("g.lsys:6:"), "{msg}");
 }
+
+/// Guards of every kind at random places: conforming after every step, on
+/// the closed torus (closed stays closed) and on the open grid.
+#[test]
+fn random_guards_stay_conforming() {
+    let mut seed = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for k in 0..8 {
+        let (x, y, z, r) = (next() * 2.0 - 1.0, next() * 2.0 - 1.0, next() * 0.4, next());
+        let guard = match k % 4 {
+            0 => format!("Length(avg(e) - point({x}, {y}, {z})) < {r}"),
+            1 => format!("Dot(avg(e) - point({x}, {y}, {z}), point(1, 0.5, 0.25)) > 0"),
+            2 => format!("step < 3 || angle(e) > {}", 2.0 + 10.0 * r),
+            _ => format!("area(e) > {} && avg(e).x > {x}", 0.002 * r),
+        };
+        let g = grammar_text(&format!(
+            "mesh: \"x.obj\";\nblocks: bisection;\nadaptive;\n\
+             E(e; block(e) && ({guard})) | F^2 -> V(v = avg(ring(v))) || E^4 F^4;\n\
+             E(e; block(e) && ({guard})) | F -> V(v = avg(e)) || E^3 F^2;\n\
+             V(v; !new(v) && refined(v)) | interior -> \
+             V(v = 0.5*v + 0.5*avg(w in ring(v) where !new(w)));\n"
+        ));
+        for (soup, closed) in [
+            (jitter(shapes::quad_torus(8, 6), k), true),
+            (shapes::quad_grid(5, 5), false),
+        ] {
+            let mut m = Mesh::from_soup(&soup).unwrap();
+            let mut run = g.start(&mut m).unwrap();
+            for step in 1..=6 {
+                run.steps(1, |_| {}).unwrap();
+                assert_conforming(
+                    run.mesh(),
+                    closed.then_some(0),
+                    &format!("{guard}, step {step}"),
+                );
+            }
+        }
+    }
+}
