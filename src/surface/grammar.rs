@@ -28,6 +28,9 @@
 //! select which blocks to split, and the run splits the coarser
 //! neighbours a selected block needs first, so that the mesh stays a 4-8
 //! mesh (`surface::run`, "Adaptive 4-8 refinement").
+//! `adaptive: incremental;` tests, from the second step on, only the
+//! diamonds at the vertices made since the step before, so that a step's
+//! work follows what the last one made rather than the mesh's size.
 
 use crate::mesh::BlockSplit;
 use crate::syntax::ast::Expr;
@@ -97,6 +100,9 @@ pub struct GrammarFile {
     /// may select some blocks only; the run keeps the mesh a 4-8 mesh by
     /// splitting the coarser neighbours first (see `surface::run`).
     pub adaptive: Option<Span>,
+    /// `adaptive: incremental;`: from the second step on, split rules test
+    /// only the diamonds at vertices made since the step before.
+    pub incremental: bool,
 }
 
 type R<T> = Result<T, Diagnostic>;
@@ -196,6 +202,18 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
             g.adaptive = Some(p.span_here());
             p.bump();
             p.bump();
+            continue;
+        }
+        if at_key(&p, "adaptive") {
+            g.adaptive = Some(p.span_here());
+            p.bump();
+            p.bump();
+            if !p.peek_ident("incremental") {
+                return p.error("`incremental` after `adaptive:` (or `adaptive;` alone)");
+            }
+            p.bump();
+            p.expect_punct(";", "after `adaptive: incremental`")?;
+            g.incremental = true;
             continue;
         }
         if at_key(&p, "init") {

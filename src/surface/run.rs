@@ -47,6 +47,9 @@ pub struct Rule {
     pub text: String,
     /// Runs once, before the first step.
     pub init: bool,
+    /// A vertex rule whose condition is `refined(v) && ...`: only corners
+    /// of faces with a vertex made in this step can match.
+    needs_refined: bool,
 }
 
 /// A checked grammar, ready to run.
@@ -67,6 +70,11 @@ pub struct Grammar {
     /// Where the grammar says `adaptive;`: its split rules select blocks,
     /// and the closure keeps the mesh a 4-8 mesh (see [`GrammarRun`]).
     pub adaptive: Option<Span>,
+    /// `adaptive: incremental;`: from the second step on, split rules test
+    /// only the refinement edges of faces at vertices made in the step
+    /// before or in this one; a diamond not selected when it appeared is
+    /// not tested again.
+    pub incremental: bool,
     /// A rule that would make more faces than this stops the run with an
     /// error instead of exhausting memory (about 110 bytes a face).
     pub max_faces: usize,
@@ -116,6 +124,18 @@ fn first_call(e: &Ex, f: u16) -> Option<Span> {
         }
     });
     found
+}
+
+/// True when `e` is `refined(x)` on the local `slot`, or a conjunction
+/// with such a term: `e` can hold only where `refined` does.
+fn requires_refined(e: &Ex, slot: u16) -> bool {
+    match e {
+        Ex::Logic(true, a, b) => requires_refined(a, slot) || requires_refined(b, slot),
+        Ex::Call(Func::Host(id::REFINED), args, _) => {
+            matches!(args.as_slice(), [Ex::Local(s)] if *s == slot)
+        }
+        _ => false,
+    }
 }
 
 /// Compiles a parsed grammar file: its conditions and assignments are
@@ -185,6 +205,9 @@ pub(crate) fn compile_with(
             guard = cond.as_ref().and_then(|c| host::Guard::of(c, elem_slot));
             affine = assign.as_ref().and_then(host::Affine::of);
         }
+        let needs_refined = cond
+            .as_ref()
+            .is_some_and(|c| requires_refined(c, elem_slot));
         rules.push(Rule {
             guard,
             affine,
@@ -198,6 +221,7 @@ pub(crate) fn compile_with(
             span: r.span,
             text: r.text.clone(),
             init: r.init,
+            needs_refined,
         });
     }
     let length = match &file.length {
@@ -279,6 +303,7 @@ pub(crate) fn compile_with(
             .block_split
             .map_or(BlockSplit::Quadrisection, |(b, _)| b),
         adaptive: file.adaptive,
+        incremental: file.incremental,
         max_faces: MAX_FACES,
         max_valence: MAX_VALENCE,
         warnings,
@@ -654,6 +679,7 @@ impl Grammar {
             blocks: self.block_split,
             face_split_makes_blocks: self.block_used_at.is_some(),
             adaptive: self.adaptive.is_some(),
+            incremental: self.incremental,
             protect,
             ..RunState::default()
         };
@@ -709,11 +735,16 @@ impl Grammar {
         // `c`, kept up to date by `apply_all` as rules make vertices.
         let current = state.current_level;
         let step = state.step;
-        let slots = match rule.op {
-            Op::FaceSplit => mesh.f_alive.len(),
-            Op::EdgeSplit | Op::BoundarySplit | Op::Flip => mesh.e_alive.len(),
-            Op::Vertex => mesh.v_alive.len(),
+        // The ids to test: every slot, or a work list where the run knows
+        // that nothing else can match.
+        let list = state.work_list(rule, mesh);
+        let slots = match (&list, rule.op) {
+            (Some(l), _) => l.len(),
+            (None, Op::FaceSplit) => mesh.f_alive.len(),
+            (None, Op::EdgeSplit | Op::BoundarySplit | Op::Flip) => mesh.e_alive.len(),
+            (None, Op::Vertex) => mesh.v_alive.len(),
         };
+        let id_at = |i: u32| list.as_ref().map_or(i, |l| l[i as usize]);
         let frame_len = rule.frame.max(other.map_or(0, |o| o.frame));
         // What a protection leaves out is never tested, so the guards and
         // every specialised path see the same elements.
@@ -731,7 +762,7 @@ impl Grammar {
                 let (mut a, mut b): (Part, Part) = Default::default();
                 match rule.op {
                     Op::FaceSplit => {
-                        for f in (lo..hi).map(crate::mesh::FaceId) {
+                        for f in (lo..hi).map(|i| crate::mesh::FaceId(id_at(i))) {
                             if mesh.is_face(f) && protect.is_none_or(|p| p.face_free(mesh, f)) {
                                 let hs = mesh.face_halfedges(f);
                                 let val = host::face(
@@ -748,7 +779,7 @@ impl Grammar {
                     }
                     Op::EdgeSplit | Op::BoundarySplit | Op::Flip => {
                         let want_boundary = rule.op == Op::BoundarySplit;
-                        for e in (lo..hi).map(crate::mesh::EdgeId) {
+                        for e in (lo..hi).map(|i| crate::mesh::EdgeId(id_at(i))) {
                             if !mesh.is_edge(e) || protect.is_some_and(|p| !p.edge_free(mesh, e)) {
                                 continue;
                             }
@@ -779,7 +810,7 @@ impl Grammar {
                         }
                     }
                     Op::Vertex => {
-                        for v in (lo..hi).map(VertexId) {
+                        for v in (lo..hi).map(|i| VertexId(id_at(i))) {
                             if !mesh.is_vertex(v)
                                 || mesh.outgoing(v).is_none()
                                 || protect.is_some_and(|p| !p.vertex_free(v))
@@ -1184,6 +1215,9 @@ impl Grammar {
                     };
                     made.push((v, val));
                 }
+                if state.adaptive {
+                    state.made_now.extend(made.iter().map(|(v, _)| *v));
+                }
                 state.check_valence(mesh).map_err(fail)?;
                 state.current_level = made
                     .iter()
@@ -1269,6 +1303,7 @@ impl GrammarRun<'_> {
         let each: Vec<&Rule> = self.grammar.rules.iter().filter(|r| !r.init).collect();
         // Vertices made from here on record this step (`new(v)`).
         self.state.step += 1;
+        self.state.made_before = std::mem::take(&mut self.state.made_now);
         self.grammar.apply_all(&each, self.mesh, &mut self.state)?;
         self.state.swap_positions(self.mesh);
         debug_assert!(
@@ -1312,6 +1347,12 @@ struct RunState {
     /// An adaptive 4-8 run (`adaptive;`): split rules see refinement
     /// edges only, and the closure splits coarser neighbours first.
     adaptive: bool,
+    /// `adaptive: incremental;`.
+    incremental: bool,
+    /// In adaptive runs: the vertices splits made in this step, and in
+    /// the step before (the work lists of matching).
+    made_now: Vec<VertexId>,
+    made_before: Vec<VertexId>,
     /// The highest valence a rule may leave (see [`Grammar::max_valence`]).
     valence_limit: usize,
     /// At least the highest valence in the mesh (see `check_valence`).
@@ -1331,6 +1372,38 @@ impl RunState {
             face_split_makes_blocks: self.face_split_makes_blocks,
             adaptive: self.adaptive,
         }
+    }
+
+    /// The ids `rule` may match, in increasing order, where an adaptive
+    /// run knows that no other element can: for a vertex rule that
+    /// requires `refined(v)`, the vertices made in this step and their
+    /// neighbours (a corner of a face with a new vertex is one of them);
+    /// for a split rule of an incremental run after its first step, the
+    /// refinement edges of the faces at the vertices made in the step
+    /// before or in this one. `None`: every slot.
+    fn work_list(&self, rule: &Rule, mesh: &Mesh) -> Option<Vec<u32>> {
+        if !self.adaptive {
+            return None;
+        }
+        let mut ids: Vec<u32> = match rule.op {
+            Op::Vertex if rule.needs_refined => self
+                .made_now
+                .iter()
+                .flat_map(|&v| std::iter::once(v).chain(mesh.one_ring(v)))
+                .map(|v| v.0)
+                .collect(),
+            Op::EdgeSplit | Op::BoundarySplit if self.incremental && self.step >= 2 => self
+                .made_before
+                .iter()
+                .chain(&self.made_now)
+                .flat_map(|&v| mesh.vertex_faces(v))
+                .map(|f| mesh.refinement_edge(f).0)
+                .collect(),
+            _ => return None,
+        };
+        ids.sort_unstable();
+        ids.dedup();
+        Some(ids)
     }
 
     /// Refuses a mesh with a vertex of higher valence than the limit.

@@ -393,3 +393,85 @@ fn random_guards_stay_conforming() {
         }
     }
 }
+
+/// `adaptive: incremental;` tests only the diamonds at the vertices made
+/// since the step before. Where a guard reads only positions that never
+/// move (no vertex rule) and not the step, a diamond that was not selected
+/// when it appeared never is, so the result is `adaptive;`'s, to the bit;
+/// where every block is selected it is `four-eight.lsys`'s.
+#[test]
+fn incremental_matching_agrees_where_it_must() {
+    let text = |how: &str, guard: &str, smooth: bool| {
+        format!(
+            "mesh: \"x.obj\";\nblocks: bisection;\n{how}\n\
+             E(e; block(e) && ({guard})) | F^2 -> V(v = avg(ring(v))) || E^4 F^4;\n\
+             E(e; block(e) && ({guard})) | F -> V(v = avg(e)) || E^3 F^2;\n{}",
+            if smooth {
+                "V(v; !new(v) && refined(v)) | interior -> \
+                 V(v = 0.5*v + 0.5*avg(w in ring(v) where !new(w)));\n"
+            } else {
+                ""
+            }
+        )
+    };
+    for (guard, smooth, soup) in [
+        (
+            "Length(avg(e) - point(0.3, 0.6, 0)) < 0.2",
+            false,
+            shapes::quad_grid(6, 6),
+        ),
+        (
+            "area(e) > 0.004 && avg(e).x > 0.2",
+            false,
+            jitter(shapes::quad_torus(8, 6), 3),
+        ),
+        ("true", true, jitter(shapes::quad_torus(8, 6), 5)),
+        ("true", true, shapes::quad_grid(5, 4)),
+    ] {
+        let full = grammar_text(&text("adaptive;", guard, smooth));
+        let incr = grammar_text(&text("adaptive: incremental;", guard, smooth));
+        let mut a = Mesh::from_soup(&soup).unwrap();
+        let mut b = a.clone();
+        let mut ra = full.start(&mut a).unwrap();
+        let mut rb = incr.start(&mut b).unwrap();
+        for step in 1..=7 {
+            ra.steps(1, |_| {}).unwrap();
+            rb.steps(1, |_| {}).unwrap();
+            assert!(
+                fingerprint(ra.mesh()) == fingerprint(rb.mesh()),
+                "{guard}, step {step}: incremental differs"
+            );
+        }
+        assert!(ra.mesh().face_count() > 2 * soup.faces.len(), "{guard}");
+    }
+    // Selecting everything, with smoothing, is uniform refinement.
+    let uniform = grammar_file("surfaces/four-eight.lsys", &[]);
+    let incr = grammar_text(&text("adaptive: incremental;", "true", true));
+    let mut a = Mesh::from_soup(&torus_obj()).unwrap();
+    let mut b = a.clone();
+    uniform.run(&mut a, 5, |_| {}).unwrap();
+    incr.run(&mut b, 5, |_| {}).unwrap();
+    assert!(fingerprint(&a) == fingerprint(&b));
+}
+
+/// What incremental matching gives up: a guard that turns true later for
+/// an old diamond (here, only from step 3 on) is never tested again, so
+/// nothing is refined; `adaptive;` splits every block at step 3.
+#[test]
+fn incremental_matching_does_not_look_back() {
+    let text = |how: &str| {
+        format!(
+            "mesh: \"x.obj\";\nblocks: bisection;\n{how}\n\
+             E(e; block(e) && step >= 3) | F^2 -> V(v = avg(ring(v))) || E^4 F^4;\n\
+             E(e; block(e) && step >= 3) | F -> V(v = avg(e)) || E^3 F^2;\n"
+        )
+    };
+    let count = |how: &str| {
+        let g = grammar_text(&text(how));
+        let mut m = Mesh::from_soup(&shapes::quad_grid(4, 4)).unwrap();
+        g.run(&mut m, 3, |_| {}).unwrap();
+        m.face_count()
+    };
+    assert_eq!(count("adaptive;"), 64);
+    assert_eq!(count("adaptive: incremental;"), 32);
+}
