@@ -475,3 +475,18 @@ fn incremental_matching_does_not_look_back() {
     assert_eq!(count("adaptive;"), 64);
     assert_eq!(count("adaptive: incremental;"), 32);
 }
+
+/// `area(f)`: the grid's triangles have area 1/32 = 0.03125, so a face
+/// split guarded by `area(f) > 0.03` splits all 32 (96 faces) and one
+/// guarded by `area(f) > 0.032` none.
+#[test]
+fn area_of_a_face() {
+    for (t, want) in [(0.03, 96), (0.032, 32)] {
+        let g = grammar_text(&format!(
+            "mesh: \"x.obj\";\nF(f; area(f) > {t}) -> V(v = avg(f)) || E^3 F^3;\n"
+        ));
+        let mut m = Mesh::from_soup(&shapes::quad_grid(4, 4)).unwrap();
+        g.run(&mut m, 1, |_| {}).unwrap();
+        assert_eq!(m.face_count(), want, "threshold {t}");
+    }
+}
