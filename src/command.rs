@@ -356,6 +356,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<Stri
         background: a.background.unwrap_or(white),
         view: a.view.as_deref(),
         wireframe: a.wireframe,
+        shading: crate::render::mesh::Shading::Lit,
     };
     if mesh::io::Format::from_path(file).is_some() {
         write_mesh_picture(&load_mesh(file)?, output, &looks)?;
@@ -555,6 +556,11 @@ pub struct SubdivideArgs {
     pub defines: Vec<String>,
     /// For pictures: iso, front, back, left, right, top or bottom.
     pub view: Option<String>,
+    /// For pictures: `lit`, `normals` or `reflection`; the last two draw
+    /// no edges.
+    pub shading: Option<String>,
+    /// For pictures: no edges.
+    pub no_wireframe: bool,
     /// Shape grammars: seeds the random choice of rules.
     pub seed: Option<u32>,
     /// `--timeout`: the command stops with an error after this long.
@@ -591,11 +597,20 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         ..RunOptions::default()
     };
     let d = crate::render::mesh::MeshView::default();
+    let shading = match a.shading.as_deref() {
+        None => d.shading,
+        Some(name) => crate::render::mesh::Shading::from_name(name).ok_or_else(|| {
+            Error::Usage(format!(
+                "`--shading {name}` is not a shading: use lit, normals or reflection"
+            ))
+        })?,
+    };
     let looks = MeshLooks {
         size: (d.width, d.height),
         background: d.background,
         view: a.view.as_deref(),
-        wireframe: d.wireframe,
+        wireframe: d.wireframe && !a.no_wireframe && shading == crate::render::mesh::Shading::Lit,
+        shading,
     };
     // The file is read and lexed once; its tokens say what it is.
     let text = crate::load::read(grammar)?;
@@ -1005,6 +1020,7 @@ struct MeshLooks<'a> {
     background: Rgba,
     view: Option<&'a str>,
     wireframe: bool,
+    shading: crate::render::mesh::Shading,
 }
 
 impl MeshLooks<'_> {
@@ -1015,6 +1031,7 @@ impl MeshLooks<'_> {
             height: self.size.1,
             background: self.background,
             wireframe: self.wireframe,
+            shading: self.shading,
             ..Default::default()
         };
         if let Some(name) = self.view {

@@ -195,6 +195,13 @@ enum Command {
         /// For pictures: iso, front, back, left, right, top, bottom.
         #[arg(long)]
         view: Option<String>,
+        /// For pictures: lit (the default), normals (a normal map) or
+        /// reflection (reflection lines); the last two draw no edges.
+        #[arg(long)]
+        shading: Option<String>,
+        /// For pictures: draw the faces without their edges.
+        #[arg(long)]
+        no_wireframe: bool,
         /// Shape grammars: seed the random choice of rules.
         #[arg(long, value_name = "N")]
         seed: Option<u32>,
@@ -473,6 +480,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             output,
             define,
             view,
+            shading,
+            no_wireframe,
             seed,
             timeout,
             force,
@@ -484,6 +493,8 @@ fn run(cli: Cli) -> Result<(), Error> {
                 output,
                 defines: define,
                 view,
+                shading,
+                no_wireframe,
                 seed,
                 timeout: timeout.0,
                 force,

@@ -35,11 +35,14 @@ pub struct Split {
     pub step: u32,
     /// What splitting a basic block's internal edge makes of the block.
     pub blocks: BlockSplit,
-    /// A face split makes its three spokes internal edges of blocks, as
-    /// splitting a block's internal edge does, so that a lone triangle
-    /// joins a quad mesh's primal quadrisection (Catmull-Clark on
-    /// triangles). Set while a grammar that reads blocks runs.
-    pub face_split_makes_blocks: bool,
+    /// Triangles in no block join the blocks: a face split makes its three
+    /// spokes internal edges of blocks, as splitting a block's internal
+    /// edge does, so that a lone triangle joins a quad mesh's primal
+    /// quadrisection (Catmull-Clark on triangles); a boundary split of a
+    /// lone triangle makes its two halves one block, the new edge inside
+    /// it the internal edge (the triangles `Mesh::match_blocks` leaves on
+    /// the boundary). Set while a grammar that reads blocks runs.
+    pub lone_triangles_join_blocks: bool,
     /// Adaptive 4-8 refinement (with [`BlockSplit::Bisection`]): an
     /// external edge of a split block becomes the internal edge of a block
     /// only once the face across it has it as its refinement edge too
@@ -121,7 +124,7 @@ impl Mesh {
     }
 
     /// [`Mesh::face_split`] under `policy`: the new vertex records
-    /// `policy.step`, and with `policy.face_split_makes_blocks` the three
+    /// `policy.step`, and with `policy.lone_triangles_join_blocks` the three
     /// new edges become internal edges of basic blocks.
     pub fn face_split_with(
         &mut self,
@@ -153,7 +156,7 @@ impl Mesh {
             let vs = self.face_vertices(g);
             self.f_level[g.index()] = self.face_level_from_vertices(vs);
         }
-        if policy.face_split_makes_blocks {
+        if policy.lone_triangles_join_blocks {
             for s in [va, vb, vc] {
                 self.e_block[s.edge().index()] = true;
             }
@@ -277,6 +280,9 @@ impl Mesh {
         let c = self.to(h_bc);
         let f1 = self.face(h).expect("h has a face");
         let boundary = self.face(t).is_none();
+        let lone = boundary
+            && policy.lone_triangles_join_blocks
+            && !self.face_edges(f1).iter().any(|&x| self.is_block_edge(x));
         if !boundary && self.to(self.next(t)) == c {
             // Both faces are a, b, c: the two spokes would join v to c twice.
             return Err(MeshError::new(format!(
@@ -294,6 +300,9 @@ impl Mesh {
         let g = self.new_edge(v, b, le + 2); // v -> b
         let k = self.new_edge(v, c, self.v_level[c.index()] + 1); // v -> c
         self.e_transversal[k.edge().index()] = true;
+        if lone {
+            self.e_block[k.edge().index()] = true;
+        }
         let f2 = self.new_face(g, 0, self.f_tag[f1.index()]);
         self.set_triangle(f1, h, k, h_ca);
         self.set_triangle(f2, g, h_bc, k.twin());

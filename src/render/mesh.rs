@@ -50,6 +50,36 @@ pub struct MeshView {
     /// The colour of each face (a shape grammar's shapes); empty: the
     /// default blue for every face.
     pub face_colours: Vec<Rgba>,
+    /// How faces are coloured.
+    pub shading: Shading,
+}
+
+/// How a face's colour follows from its normal.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Shading {
+    /// Lit by a key and a fill light (the default).
+    #[default]
+    Lit,
+    /// A normal map: the unit normal of the visible side, `(n + 1) / 2` as
+    /// red, green and blue. A crease shows as a jump of colour.
+    Normals,
+    /// Reflection lines: the view direction mirrored in the face and read
+    /// against a room of parallel black and white stripes. On a smooth
+    /// surface the lines run smooth; a kink of a line marks a jump of
+    /// curvature, a break a crease.
+    Reflection,
+}
+
+impl Shading {
+    /// By name: `lit`, `normals` or `reflection`.
+    pub fn from_name(name: &str) -> Option<Shading> {
+        match name {
+            "lit" => Some(Shading::Lit),
+            "normals" => Some(Shading::Normals),
+            "reflection" => Some(Shading::Reflection),
+            _ => None,
+        }
+    }
 }
 
 impl Default for MeshView {
@@ -65,6 +95,7 @@ impl Default for MeshView {
             up,
             margin: 0.04,
             face_colours: Vec::new(),
+            shading: Shading::Lit,
         }
     }
 }
@@ -294,7 +325,7 @@ fn faces(soup: &PolygonSoup, view: &MeshView) -> Vec<Item> {
                 .face_colours
                 .get(k)
                 .map(|c| DVec3::new(c.0 as f64, c.1 as f64, c.2 as f64) / 255.0);
-            shade_face(soup, face, &cam, &fit, edge, base)
+            shade_face(soup, face, &cam, &fit, edge, base, view.shading)
         })
         .collect();
     faces.sort_by(|a, b| b.depth.total_cmp(&a.depth).then(b.back.cmp(&a.back)));
@@ -310,6 +341,7 @@ fn shade_face(
     fit: &Fit,
     edge: Option<Outline>,
     base: Option<DVec3>,
+    shading: Shading,
 ) -> Option<Shaded> {
     let corners: Vec<DVec3> = face
         .iter()
@@ -322,7 +354,14 @@ fn shade_face(
     let back = normal.dot(cam.dir) > 0.0;
     let seen = if back { -normal } else { normal };
     let depth = corners.iter().map(|p| p.dot(cam.dir)).sum::<f64>() / corners.len() as f64;
-    let color = shade(seen, back, cam, base);
+    let color = match shading {
+        Shading::Lit => shade(seen, back, cam, base),
+        Shading::Normals => {
+            let c = (seen + DVec3::ONE) * 127.5;
+            Rgba(c.x.round() as u8, c.y.round() as u8, c.z.round() as u8, 255)
+        }
+        Shading::Reflection => reflection(seen, cam),
+    };
     let outline = edge.unwrap_or(Outline {
         color,
         width: SEAM_WIDTH,
@@ -372,6 +411,22 @@ fn shade(seen: DVec3, back: bool, cam: &Camera, base: Option<DVec3>) -> Rgba {
     };
     let c = (base * light.clamp(0.0, 1.0).powf(GAMMA)).clamp(DVec3::ZERO, DVec3::ONE) * 255.0;
     Rgba(c.x.round() as u8, c.y.round() as u8, c.z.round() as u8, 255)
+}
+
+/// Stripes per unit of the mirrored view direction's height.
+const STRIPES: f64 = 6.0;
+
+/// The colour of the stripe that the view direction, mirrored in a face of
+/// unit normal `seen`, meets: stripes run across the screen's up
+/// direction, so a plane facing the viewer shows one colour.
+fn reflection(seen: DVec3, cam: &Camera) -> Rgba {
+    let r = cam.dir - 2.0 * cam.dir.dot(seen) * seen;
+    let k = ((r.dot(cam.up) + 1.0) * STRIPES).floor() as i64;
+    if k.rem_euclid(2) == 0 {
+        Rgba(250, 250, 250, 255)
+    } else {
+        Rgba(30, 34, 44, 255)
+    }
 }
 
 /// The width of edge strokes: thin, growing slowly with the image.

@@ -24,6 +24,12 @@
 //! init: E(e; block(e)) | F^2 -> V(v = avg(ring(v))) || E^4 F^4
 //! ```
 //!
+//! `init: match_blocks;`, before the rules, is the one named operation: it
+//! pairs the triangles that are in no block into blocks, by a maximum
+//! matching of the dual graph (`Mesh::match_blocks`, paper 004's
+//! preprocess); the triangles it leaves on the boundary are `lone(e)` for
+//! an `init:` boundary split, whose two halves make a block.
+//!
 //! A 4-8 grammar may add `adaptive;`: its split rules' conditions then
 //! select which blocks to split, and the run splits the coarser
 //! neighbours a selected block needs first, so that the mesh stays a 4-8
@@ -96,6 +102,9 @@ pub struct GrammarFile {
     /// `blocks: bisection;` (4-8 meshes), `blocks: dual;` (Doo-Sabin,
     /// Peters) or `blocks: quadrisection;`.
     pub block_split: Option<(BlockSplit, Span)>,
+    /// `init: match_blocks;`: pair the triangles that are in no basic
+    /// block by a maximum matching before the `init:` rules run.
+    pub match_blocks: Option<Span>,
     /// `adaptive;`: a 4-8 grammar (`blocks: bisection;`) whose split rules
     /// may select some blocks only; the run keeps the mesh a 4-8 mesh by
     /// splitting the coarser neighbours first (see `surface::run`).
@@ -219,6 +228,26 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
         if at_key(&p, "init") {
             p.bump();
             p.bump();
+            if p.peek_ident("match_blocks") {
+                let at = p.span_here();
+                p.bump();
+                p.expect_punct(";", "after `match_blocks`")?;
+                if g.match_blocks.is_some() {
+                    return Err(Diagnostic::new(
+                        at,
+                        "`init: match_blocks;` is written twice",
+                    ));
+                }
+                if !g.rules.is_empty() {
+                    return Err(Diagnostic::new(
+                        start,
+                        "`init: match_blocks;` pairs the triangles before any rule runs, so it \
+                         comes before the rules",
+                    ));
+                }
+                g.match_blocks = Some(at);
+                continue;
+            }
             let mut r = rule(&mut p, &text_of)?;
             if g.rules.iter().any(|r| !r.init) {
                 return Err(Diagnostic::new(

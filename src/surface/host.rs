@@ -46,6 +46,7 @@ pub mod id {
     pub const CURRENT: u16 = 16;
     pub const STEP: u16 = 17;
     pub const POINT: u16 = 18;
+    pub const LONE: u16 = 19;
     /// Guards of adaptive refinement: sizes and shape of the mesh now.
     pub const AREA: u16 = 30;
     pub const LENGTH: u16 = 31;
@@ -189,6 +190,18 @@ static FUNCTIONS: &[Builtin] = &[
                  or a face (true for half of a block)",
             )?;
             Ok((Func::Host(id::BLOCK), Ty::Bool))
+        },
+    },
+    Builtin {
+        name: "lone",
+        resolve: |a| {
+            one(
+                a,
+                &[EDGE, FACE],
+                "`lone` takes a face (true for a triangle in no basic block) or an edge (true \
+                 for an edge of such a triangle; on the boundary only its first boundary edge)",
+            )?;
+            Ok((Func::Host(id::LONE), Ty::Bool))
         },
     },
     Builtin {
@@ -450,6 +463,35 @@ impl MeshHost<'_> {
         }
     }
 
+    /// `lone(x)`: a face in no basic block; an edge of such a face, where
+    /// a face with more than one boundary edge counts only the first of
+    /// them (in the face's own order), so that splitting the lone boundary
+    /// edges splits each lone triangle once. Read from the mesh as it
+    /// stands (a rule's conditions are tested before it changes anything).
+    fn lone(&self, e: &Elem) -> bool {
+        let m = self.mesh;
+        let lone_face =
+            |f: crate::mesh::FaceId| !m.face_edges(f).iter().any(|&x| m.is_block_edge(x));
+        match e.kind {
+            FACE => m
+                .find_face([VertexId(e.ids[0]), VertexId(e.ids[1]), VertexId(e.ids[2])])
+                .is_some_and(lone_face),
+            EDGE => {
+                let Some(h) = m.find_halfedge(VertexId(e.ids[0]), VertexId(e.ids[1])) else {
+                    return false;
+                };
+                let edge = h.edge();
+                m.edge_faces(edge).into_iter().flatten().any(|f| {
+                    lone_face(f)
+                        && (!m.is_boundary_edge(edge)
+                            || m.face_edges(f).into_iter().find(|&x| m.is_boundary_edge(x))
+                                == Some(edge))
+                })
+            }
+            _ => false,
+        }
+    }
+
     fn is_new(&self, v: VertexId) -> bool {
         self.mesh.vertex_step(v) == self.step
     }
@@ -628,6 +670,7 @@ impl Host for MeshHost<'_> {
             })),
             id::CURRENT => Value::Int(self.current as i64),
             id::STEP => Value::Int(self.step as i64),
+            id::LONE => Value::Bool(elem.is_some_and(|e| self.lone(&e))),
             id::POINT => Value::V3(DVec3::new(
                 args[0].as_f64(),
                 args[1].as_f64(),

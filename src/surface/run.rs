@@ -75,6 +75,9 @@ pub struct Grammar {
     /// before or in this one; a diamond not selected when it appeared is
     /// not tested again.
     pub incremental: bool,
+    /// `init: match_blocks;`: triangles in no block are paired by a
+    /// maximum matching before the `init:` rules.
+    pub match_blocks_at: Option<Span>,
     /// A rule that would make more faces than this stops the run with an
     /// error instead of exhausting memory (about 110 bytes a face).
     pub max_faces: usize,
@@ -294,7 +297,9 @@ pub(crate) fn compile_with(
         mesh: file.mesh.clone(),
         length,
         sources,
-        block_used_at: block_used_at.or(file.block_split.map(|(_, s)| s)),
+        block_used_at: block_used_at
+            .or(file.block_split.map(|(_, s)| s))
+            .or(file.match_blocks),
         dual_at: match file.block_split {
             Some((BlockSplit::Dual, at)) => Some(at),
             _ => centre_used_at,
@@ -304,6 +309,7 @@ pub(crate) fn compile_with(
             .map_or(BlockSplit::Quadrisection, |(b, _)| b),
         adaptive: file.adaptive,
         incremental: file.incremental,
+        match_blocks_at: file.match_blocks,
         max_faces: MAX_FACES,
         max_valence: MAX_VALENCE,
         warnings,
@@ -610,12 +616,15 @@ impl Grammar {
         self.start_with(mesh, Some(protection))
     }
 
-    fn start_with<'a>(
-        &'a self,
-        mesh: &'a mut Mesh,
-        protection: Option<Protection>,
-    ) -> Result<GrammarRun<'a>, RunError> {
-        if let (Some(span), Some(fan)) = (self.block_used_at, mesh.fanned_polygon()) {
+    /// A grammar that reads blocks needs a mesh of blocks (quads, or
+    /// triangles a face split makes into quads); one that reads none takes
+    /// quads as two triangles.
+    fn check_blocks(&self, mesh: &mut Mesh) -> Result<(), RunError> {
+        // Pairing takes the triangles of a fanned polygon like any other.
+        let fanned = mesh
+            .fanned_polygon()
+            .filter(|_| self.match_blocks_at.is_none());
+        if let (Some(span), Some(fan)) = (self.block_used_at, fanned) {
             let line = fan.line.map_or(String::new(), |l| format!(" (line {l})"));
             return Err(RunError {
                 span: Some(span),
@@ -636,6 +645,16 @@ impl Grammar {
             Some(span) => {
                 if let Some(f) = mesh.face_outside_blocks() {
                     let [a, b, c] = mesh.face_vertices(f).map(|v| v.index() + 1);
+                    if self.match_blocks_at.is_some() {
+                        return Err(RunError {
+                            span: self.match_blocks_at,
+                            message: format!(
+                                "the triangle on vertices {a}, {b} and {c} is on the boundary and \
+                                 in no block after pairing; split its boundary edge in an `init:` \
+                                 rule, e.g. `init: E(e; lone(e)) | F -> V(v = avg(e)) || E^3 F^2;`"
+                            ),
+                        });
+                    }
                     return Err(RunError {
                         span: Some(span),
                         message: format!(
@@ -645,6 +664,19 @@ impl Grammar {
                     });
                 }
             }
+        }
+        Ok(())
+    }
+
+    fn start_with<'a>(
+        &'a self,
+        mesh: &'a mut Mesh,
+        protection: Option<Protection>,
+    ) -> Result<GrammarRun<'a>, RunError> {
+        // With `init: match_blocks;` the checks on blocks wait until the
+        // triangles are paired and the `init:` rules have run.
+        if self.match_blocks_at.is_none() {
+            self.check_blocks(mesh)?;
         }
         if let Some(span) = self.dual_at {
             if let Some(v) = mesh.vertices().find(|&v| mesh.is_boundary_vertex(v)) {
@@ -677,7 +709,7 @@ impl Grammar {
             valence_limit,
             valence_bound: highest,
             blocks: self.block_split,
-            face_split_makes_blocks: self.block_used_at.is_some(),
+            lone_triangles_join_blocks: self.block_used_at.is_some(),
             adaptive: self.adaptive.is_some(),
             incremental: self.incremental,
             protect,
@@ -687,7 +719,32 @@ impl Grammar {
         // The init rules prepare the blocks; the adaptive closure starts
         // with the first step.
         state.adaptive = false;
-        self.apply_all(&init, mesh, &mut state)?;
+        if let Some(span) = self.match_blocks_at {
+            // Paper 004's preprocess: the triangles paired into blocks; those
+            // left on the boundary are for an `init:` boundary split. A mesh
+            // refused after this is given back as it came.
+            let budget = 1_000_000 + 400 * (mesh.face_count() as u64 + mesh.edge_count() as u64);
+            let before = mesh.clone();
+            let refuse = |mesh: &mut Mesh, message: String| {
+                *mesh = before.clone();
+                RunError {
+                    span: Some(span),
+                    message,
+                }
+            };
+            if let Err(e) = mesh.match_blocks(budget) {
+                return Err(refuse(mesh, e.message));
+            }
+            if let Err(e) = self.apply_all(&init, mesh, &mut state) {
+                *mesh = before;
+                return Err(e);
+            }
+            if let Err(e) = self.check_blocks(mesh) {
+                return Err(refuse(mesh, e.message));
+            }
+        } else {
+            self.apply_all(&init, mesh, &mut state)?;
+        }
         state.adaptive = self.adaptive.is_some();
         // What init's vertex rules wrote is current before the first step.
         state.swap_positions(mesh);
@@ -1343,7 +1400,7 @@ struct RunState {
     /// What splitting a basic block's internal edge makes of the block.
     blocks: BlockSplit,
     /// Set for grammars that read blocks: a face split then makes blocks.
-    face_split_makes_blocks: bool,
+    lone_triangles_join_blocks: bool,
     /// An adaptive 4-8 run (`adaptive;`): split rules see refinement
     /// edges only, and the closure splits coarser neighbours first.
     adaptive: bool,
@@ -1369,7 +1426,7 @@ impl RunState {
         Split {
             step: self.step,
             blocks: self.blocks,
-            face_split_makes_blocks: self.face_split_makes_blocks,
+            lone_triangles_join_blocks: self.lone_triangles_join_blocks,
             adaptive: self.adaptive,
         }
     }

@@ -36,7 +36,7 @@ const FOLDERS: &[&str] = &[
 ];
 
 /// Surface grammars with boundary rules, run on the open grid as well.
-const ON_GRID: &[&str] = &["catmull-clark", "four-eight", "loop", "sqrt3"];
+const ON_GRID: &[&str] = &["c4", "catmull-clark", "four-eight", "loop", "sqrt3"];
 
 /// vv programs with boundary rules, run on the open triangle patch as well.
 const ON_PATCH: &[&str] = &["butterfly", "loop", "sqrt3"];

@@ -32,6 +32,7 @@ mod shapes;
 mod support;
 mod surface;
 mod surface_adaptive;
+mod surface_c4;
 mod surface_quad;
 mod vv;
 mod vv_adversarial;

@@ -276,6 +276,12 @@ const C4: [[f64; 7]; 7] = [
 /// functions away from the boundary, which is too far to reach the mask).
 #[test]
 fn four_eight_grammar_gives_the_c4_box_spline() {
+    for file in ["surfaces/four-eight.lsys", "surfaces/c4.lsys"] {
+        box_spline_table(file);
+    }
+}
+
+fn box_spline_table(file: &str) {
     let n = 16;
     let mut grid = shapes::quad_grid(n, n);
     for p in &mut grid.positions {
@@ -285,7 +291,7 @@ fn four_eight_grammar_gives_the_c4_box_spline() {
     assert_eq!(grid.positions[centre], DVec3::ZERO);
     let mut impulse = grid.clone();
     impulse.positions[centre].z = 1.0;
-    let g = grammar("surfaces/four-eight.lsys");
+    let g = grammar(file);
     let mut a = Mesh::from_soup(&grid).unwrap();
     let mut b = Mesh::from_soup(&impulse).unwrap();
     g.run(&mut a, 2, |_| {}).unwrap();

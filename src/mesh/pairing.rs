@@ -1,0 +1,528 @@
+//! Pairing triangles into basic blocks: the preprocess of paper 004, §1,
+//! which turns a triangulation into a triangulated quadrangulation.
+//!
+//! Two triangles that share an edge form a block when that edge is made
+//! the block's internal edge. Which pairs to take is a matching on the dual
+//! graph (one node per triangle, one edge per interior mesh edge): a
+//! maximum matching pairs as many triangles as can be. On a closed surface
+//! it pairs them all, for the dual graph of a closed triangulation is cubic
+//! and bridgeless (the faces around either end of an edge join its two
+//! faces another way), and such a graph has a perfect matching (Petersen's
+//! theorem). On a surface with boundary a triangle may be left over; each
+//! left-over triangle is then moved, along an alternating path, to a
+//! triangle on the boundary, whose boundary edge a grammar's `init:` rule
+//! splits so that the two halves make a block.
+//!
+//! The matching is Edmonds' blossom algorithm, one augmenting search per
+//! unmatched node after a greedy start, with every search's bookkeeping
+//! undone over the nodes it touched only, so that the whole runs in time
+//! close to linear on meshes (each search is local).
+
+use super::halfedge::{EdgeId, FaceId, Mesh, MeshError};
+
+const NONE: u32 = u32::MAX;
+
+/// A graph in compressed rows: the neighbours of node `i` are
+/// `adj[start[i]..start[i + 1]]`.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Graph {
+    pub start: Vec<u32>,
+    pub adj: Vec<u32>,
+}
+
+impl Graph {
+    pub fn from_edges(n: usize, edges: &[(u32, u32)]) -> Graph {
+        let mut start = vec![0u32; n + 1];
+        for &(a, b) in edges {
+            start[a as usize + 1] += 1;
+            start[b as usize + 1] += 1;
+        }
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut adj = vec![0u32; 2 * edges.len()];
+        for &(a, b) in edges {
+            adj[fill[a as usize] as usize] = b;
+            fill[a as usize] += 1;
+            adj[fill[b as usize] as usize] = a;
+            fill[b as usize] += 1;
+        }
+        Graph { start, adj }
+    }
+
+    pub fn len(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    fn neighbours(&self, i: u32) -> &[u32] {
+        &self.adj[self.start[i as usize] as usize..self.start[i as usize + 1] as usize]
+    }
+}
+
+/// The state of Edmonds' algorithm on one graph: the matching and the
+/// scratch arrays of one augmenting search, all reset after each search
+/// over the nodes it touched.
+struct Blossom<'g> {
+    g: &'g Graph,
+    mate: Vec<u32>,
+    parent: Vec<u32>,
+    base: Vec<u32>,
+    in_tree: Vec<bool>,
+    in_blossom: Vec<bool>,
+    on_path: Vec<bool>,
+    touched: Vec<u32>,
+    queue: Vec<u32>,
+    /// Nodes at and above this are not part of the graph (yet).
+    limit: u32,
+}
+
+impl<'g> Blossom<'g> {
+    fn new(g: &'g Graph, mate: Vec<u32>) -> Blossom<'g> {
+        let n = g.len();
+        Blossom {
+            g,
+            mate,
+            parent: vec![NONE; n],
+            base: (0..n as u32).collect(),
+            in_tree: vec![false; n],
+            in_blossom: vec![false; n],
+            on_path: vec![false; n],
+            touched: Vec::new(),
+            queue: Vec::new(),
+            limit: n as u32,
+        }
+    }
+
+    fn touch(&mut self, v: u32) {
+        self.touched.push(v);
+    }
+
+    /// The base of the blossom that the tree paths from `a` and `b` meet in.
+    fn common_base(&mut self, mut a: u32, mut b: u32) -> u32 {
+        let mut marked = Vec::new();
+        loop {
+            a = self.base[a as usize];
+            self.on_path[a as usize] = true;
+            marked.push(a);
+            if self.mate[a as usize] == NONE {
+                break;
+            }
+            a = self.parent[self.mate[a as usize] as usize];
+        }
+        let found = loop {
+            b = self.base[b as usize];
+            if self.on_path[b as usize] {
+                break b;
+            }
+            b = self.parent[self.mate[b as usize] as usize];
+        };
+        for m in marked {
+            self.on_path[m as usize] = false;
+        }
+        found
+    }
+
+    /// Marks the blossom's bases on the path from `v` down to `b`, and
+    /// points the odd nodes on it back across the blossom's closing edge.
+    fn mark_path(&mut self, mut v: u32, b: u32, mut child: u32, marked: &mut Vec<u32>) {
+        while self.base[v as usize] != b {
+            let m = self.mate[v as usize];
+            for x in [self.base[v as usize], self.base[m as usize]] {
+                if !self.in_blossom[x as usize] {
+                    self.in_blossom[x as usize] = true;
+                    marked.push(x);
+                }
+            }
+            self.parent[v as usize] = child;
+            child = m;
+            v = self.parent[m as usize];
+        }
+    }
+
+    /// An augmenting path from the free node `root`: its other end, with
+    /// `parent` and `mate` describing the path, or None. `budget` bounds the
+    /// work (node visits); a search that runs out gives None.
+    fn search(&mut self, root: u32, budget: &mut u64) -> Option<u32> {
+        self.queue.clear();
+        self.in_tree[root as usize] = true;
+        self.touch(root);
+        self.queue.push(root);
+        let mut head = 0;
+        while head < self.queue.len() {
+            let v = self.queue[head];
+            head += 1;
+            for &to in self.g.neighbours(v) {
+                if *budget == 0 {
+                    return None;
+                }
+                *budget -= 1;
+                if to >= self.limit {
+                    continue;
+                }
+                if self.base[v as usize] == self.base[to as usize] || self.mate[v as usize] == to {
+                    continue;
+                }
+                let to_mate = self.mate[to as usize];
+                if to == root || (to_mate != NONE && self.parent[to_mate as usize] != NONE) {
+                    // An odd cycle: contract it into its base.
+                    let b = self.common_base(v, to);
+                    let mut marked = Vec::new();
+                    self.mark_path(v, b, to, &mut marked);
+                    self.mark_path(to, b, v, &mut marked);
+                    // Only nodes in the tree can have a base in the blossom.
+                    let n_touched = self.touched.len();
+                    for k in 0..n_touched {
+                        let i = self.touched[k];
+                        if self.in_blossom[self.base[i as usize] as usize] {
+                            self.base[i as usize] = b;
+                            if !self.in_tree[i as usize] {
+                                self.in_tree[i as usize] = true;
+                                self.queue.push(i);
+                            }
+                        }
+                    }
+                    *budget = budget.saturating_sub(n_touched as u64);
+                    for x in marked {
+                        self.in_blossom[x as usize] = false;
+                    }
+                } else if self.parent[to as usize] == NONE {
+                    self.parent[to as usize] = v;
+                    self.touch(to);
+                    if to_mate == NONE {
+                        return Some(to);
+                    }
+                    self.in_tree[to_mate as usize] = true;
+                    self.touch(to_mate);
+                    self.queue.push(to_mate);
+                }
+            }
+        }
+        None
+    }
+
+    fn augment(&mut self, mut v: u32) {
+        while v != NONE {
+            let pv = self.parent[v as usize];
+            let next = self.mate[pv as usize];
+            self.mate[v as usize] = pv;
+            self.mate[pv as usize] = v;
+            v = next;
+        }
+    }
+
+    fn reset(&mut self) {
+        for &i in &self.touched {
+            self.parent[i as usize] = NONE;
+            self.base[i as usize] = i;
+            self.in_tree[i as usize] = false;
+        }
+        self.touched.clear();
+    }
+
+    /// Searches from `root` and augments along what it finds.
+    fn grow(&mut self, root: u32, budget: &mut u64) -> bool {
+        let end = self.search(root, budget);
+        if let Some(end) = end {
+            self.augment(end);
+        }
+        self.reset();
+        end.is_some()
+    }
+}
+
+/// A greedy matching, nodes of fewest free neighbours first (on meshes it
+/// leaves few nodes for the augmenting searches).
+fn greedy(g: &Graph, eligible: impl Fn(u32) -> bool) -> Vec<u32> {
+    let n = g.len();
+    let mut mate = vec![NONE; n];
+    let mut free_deg: Vec<u32> = (0..n as u32)
+        .map(|i| g.neighbours(i).iter().filter(|&&j| eligible(j)).count() as u32)
+        .collect();
+    // Buckets by free degree (at most the largest degree).
+    let max_deg = free_deg.iter().copied().max().unwrap_or(0) as usize;
+    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); max_deg + 1];
+    for i in (0..n as u32).rev() {
+        if eligible(i) {
+            buckets[free_deg[i as usize] as usize].push(i);
+        }
+    }
+    let mut d = 0;
+    loop {
+        while d <= max_deg && buckets[d].is_empty() {
+            d += 1;
+        }
+        if d > max_deg {
+            break;
+        }
+        let i = buckets[d].pop().expect("non-empty bucket");
+        if mate[i as usize] != NONE || free_deg[i as usize] as usize != d {
+            continue; // matched meanwhile, or a stale entry
+        }
+        let pick = g
+            .neighbours(i)
+            .iter()
+            .copied()
+            .filter(|&j| eligible(j) && mate[j as usize] == NONE)
+            .min_by_key(|&j| free_deg[j as usize]);
+        let Some(j) = pick else { continue };
+        mate[i as usize] = j;
+        mate[j as usize] = i;
+        for k in [i, j] {
+            for &w in g.neighbours(k) {
+                if eligible(w) && mate[w as usize] == NONE && free_deg[w as usize] > 0 {
+                    free_deg[w as usize] -= 1;
+                    let nd = free_deg[w as usize] as usize;
+                    buckets[nd].push(w);
+                    d = d.min(nd);
+                }
+            }
+        }
+    }
+    mate
+}
+
+/// A maximum matching of the nodes `0..real` of `g`, then augmenting paths
+/// from the nodes left free to the free nodes at and above `real` (the
+/// boundary's stand-ins): `mate[i]` for each node, `u32::MAX` where free.
+/// `budget` bounds the total work; a search that runs out leaves its node
+/// free.
+pub(crate) fn maximum_matching(g: &Graph, real: usize, budget: &mut u64) -> Vec<u32> {
+    let mate = greedy(g, |i| (i as usize) < real);
+    let mut b = Blossom::new(g, mate);
+    // Real pairs first: a maximum matching among the triangles.
+    let free: Vec<u32> = (0..real as u32)
+        .filter(|&i| b.mate[i as usize] == NONE)
+        .collect();
+    // The stand-ins are left out until the triangles are matched.
+    let extra = g.len() - real;
+    b.limit = real as u32;
+    let mut left = Vec::new();
+    for i in free {
+        if b.mate[i as usize] == NONE && !b.grow(i, budget) {
+            left.push(i);
+        }
+    }
+    if extra > 0 {
+        b.limit = g.len() as u32;
+        for i in left {
+            if b.mate[i as usize] == NONE {
+                b.grow(i, budget);
+            }
+        }
+    }
+    b.mate
+}
+
+/// What [`Mesh::match_blocks`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Pairing {
+    /// Blocks made of two triangles.
+    pub pairs: usize,
+    /// Triangles left alone on the boundary, for a boundary split.
+    pub on_boundary: usize,
+}
+
+impl Mesh {
+    /// Pairs every triangle that is in no basic block with a neighbour, so
+    /// that the mesh becomes a tri-quad mesh (paper 004, §1): a maximum
+    /// matching of the dual graph; a triangle left over is moved along an
+    /// alternating path to the boundary, where it is left for a boundary
+    /// split (see the module's comment). Original vertices and positions
+    /// stay; on a base mesh (all vertices at level 0) the levels become
+    /// those of a tri-quad mesh (internal edges 0, the others 1).
+    ///
+    /// An error, with the mesh unchanged, when an interior triangle cannot
+    /// be paired or `budget` runs out.
+    pub fn match_blocks(&mut self, budget: u64) -> Result<Pairing, MeshError> {
+        let slots = self.f_alive.len();
+        let lone = |m: &Mesh, f: FaceId| !m.face_edges(f).iter().any(|&e| m.is_block_edge(e));
+        // Nodes: the lone faces, then one stand-in per boundary edge of a
+        // lone face.
+        let mut node_of = vec![NONE; slots];
+        let mut faces: Vec<FaceId> = Vec::new();
+        for f in self.faces() {
+            if lone(self, f) {
+                node_of[f.index()] = faces.len() as u32;
+                faces.push(f);
+            }
+        }
+        let real = faces.len();
+        let mut links: Vec<(u32, u32)> = Vec::new();
+        let mut via: Vec<EdgeId> = Vec::new();
+        let mut stand_ins: Vec<EdgeId> = Vec::new();
+        for e in self.edges() {
+            match self.edge_faces(e) {
+                [Some(a), Some(b)] => {
+                    let (na, nb) = (node_of[a.index()], node_of[b.index()]);
+                    if na != NONE && nb != NONE && a != b {
+                        links.push((na, nb));
+                        via.push(e);
+                    }
+                }
+                [Some(a), None] | [None, Some(a)] => {
+                    let na = node_of[a.index()];
+                    if na != NONE {
+                        links.push((na, (real + stand_ins.len()) as u32));
+                        via.push(e);
+                        stand_ins.push(e);
+                    }
+                }
+                [None, None] => {}
+            }
+        }
+        let g = Graph::from_edges(real + stand_ins.len(), &links);
+        let mut left = budget;
+        let mate = maximum_matching(&g, real, &mut left);
+        if left == 0 {
+            return Err(MeshError::new(format!(
+                "pairing triangles into blocks: the search for a maximum matching of {real} triangles \
+                 ran past its work limit"
+            )));
+        }
+        // The mesh edge between each matched pair.
+        let mut pairs = Vec::new();
+        let mut on_boundary = 0;
+        for (k, &(a, b)) in links.iter().enumerate() {
+            if mate[a as usize] == b && (b as usize) < real {
+                pairs.push(via[k]);
+            } else if mate[a as usize] == b {
+                on_boundary += 1;
+            }
+        }
+        if let Some(i) = (0..real).find(|&i| mate[i] == NONE) {
+            let [a, b, c] = self.face_vertices(faces[i]);
+            return Err(MeshError::new(format!(
+                "pairing triangles into blocks: the triangle on vertices {a}, {b} and {c} cannot be \
+                 paired with a neighbour, nor moved to the boundary along an alternating path"
+            )));
+        }
+        let base = self.vertices().all(|v| self.vertex_level(v) == 0);
+        for &e in &pairs {
+            self.e_block[e.index()] = true;
+        }
+        if base {
+            let edges: Vec<EdgeId> = self.edges().collect();
+            for e in edges {
+                self.e_level[e.index()] = if self.e_block[e.index()] { 0 } else { 1 };
+            }
+        }
+        Ok(Pairing {
+            pairs: pairs.len(),
+            on_boundary,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The size of a maximum matching by trying every subset of edges
+    /// (small graphs only): the reference.
+    fn brute_force(n: usize, edges: &[(u32, u32)]) -> usize {
+        let mut best = 0;
+        for mask in 0u32..(1 << edges.len()) {
+            let mut used = vec![false; n];
+            let mut ok = true;
+            let mut k = 0;
+            for (i, &(a, b)) in edges.iter().enumerate() {
+                if mask >> i & 1 == 1 {
+                    if used[a as usize] || used[b as usize] {
+                        ok = false;
+                        break;
+                    }
+                    used[a as usize] = true;
+                    used[b as usize] = true;
+                    k += 1;
+                }
+            }
+            if ok {
+                best = best.max(k);
+            }
+        }
+        best
+    }
+
+    fn check(n: usize, edges: &[(u32, u32)]) -> usize {
+        let g = Graph::from_edges(n, edges);
+        let mut budget = u64::MAX;
+        let mate = maximum_matching(&g, n, &mut budget);
+        // A matching: symmetric, along edges.
+        for (i, &m) in mate.iter().enumerate() {
+            if m != NONE {
+                assert_eq!(mate[m as usize], i as u32);
+                assert!(edges.contains(&(i as u32, m)) || edges.contains(&(m, i as u32)));
+            }
+        }
+        mate.iter().filter(|&&m| m != NONE).count() / 2
+    }
+
+    #[test]
+    fn odd_cycles_need_blossoms() {
+        // Two triangles joined by a path, the classic case where a search
+        // without contraction fails: 0-1-2-0, 2-3, 3-4, 4-5-6-4 plus a
+        // pendant 7 on 0 and 8 on 6.
+        let edges = [
+            (0, 1),
+            (1, 2),
+            (2, 0),
+            (2, 3),
+            (3, 4),
+            (4, 5),
+            (5, 6),
+            (6, 4),
+            (0, 7),
+            (6, 8),
+        ];
+        assert_eq!(check(9, &edges), brute_force(9, &edges));
+    }
+
+    #[test]
+    fn petersen_graph_has_a_perfect_matching() {
+        let mut edges = Vec::new();
+        for i in 0..5u32 {
+            edges.push((i, (i + 1) % 5));
+            edges.push((i, i + 5));
+            edges.push((5 + i, 5 + (i + 2) % 5));
+        }
+        assert_eq!(check(10, &edges), 5);
+    }
+
+    #[test]
+    fn random_graphs_match_brute_force() {
+        // A small linear congruential generator: the graphs are fixed.
+        let mut s = 12345u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) as u32
+        };
+        for _ in 0..300 {
+            let n = 2 + (next() % 9) as usize;
+            let mut edges = Vec::new();
+            for a in 0..n as u32 {
+                for b in a + 1..n as u32 {
+                    if next() % 3 == 0 && edges.len() < 16 {
+                        edges.push((a, b));
+                    }
+                }
+            }
+            assert_eq!(check(n, &edges), brute_force(n, &edges), "{edges:?}");
+        }
+    }
+
+    #[test]
+    fn stand_ins_take_only_what_real_pairs_leave() {
+        // A path 0-1-2 of real nodes, with stand-in 3 on node 2 and 4 on 0:
+        // one real pair, and the third node goes to its stand-in.
+        let edges = [(0, 1), (1, 2), (2, 3), (0, 4)];
+        let g = Graph::from_edges(5, &edges);
+        let mut budget = u64::MAX;
+        let mate = maximum_matching(&g, 3, &mut budget);
+        let real_pairs = (0..3).filter(|&i| mate[i] != NONE && mate[i] < 3).count() / 2;
+        assert_eq!(real_pairs, 1);
+        assert!((0..3).all(|i| mate[i] != NONE));
+    }
+}
