@@ -1,5 +1,7 @@
 //! What adaptive 4-8 refinement buys, and what it costs.
-//! `cargo run --release --example adaptive_4_8 [MESH] [REFERENCE_STEPS]`
+//! `cargo run --release --example adaptive_4_8 [MESH] [REFERENCE_STEPS] [SCHEME]`
+//! (SCHEME: `four-eight`, the default, or `c4` for triangle meshes such as
+//! `lsystems/meshes/bunny.obj`)
 //!
 //! 1. Faces against distance to the limit surface. The limit is
 //!    approximated by `REFERENCE_STEPS` uniform bisections of
@@ -42,6 +44,7 @@ fn adaptive(guard: &str) -> Grammar {
 fn adaptive_as(how: &str, guard: &str) -> Grammar {
     let text = format!(
         "mesh: \"x.obj\";\nblocks: bisection;\n{how}\n\
+         init: match_blocks;\n\
          define velh(v) = 0.5*v + 0.5*avg(w in ring(v) where !new(w));\n\
          E(e; block(e) && ({guard})) | F^2 -> V(v = avg(ring(v))) || E^4 F^4;\n\
          E(e; block(e) && ({guard})) | F -> V(v = avg(e)) || E^3 F^2;\n\
@@ -188,9 +191,16 @@ fn main() {
         .map(PathBuf::from)
         .unwrap_or_else(|| root().join("lsystems/meshes/torus.obj"));
     let reference: usize = args.get(1).map_or(10, |s| s.parse().expect("a number"));
+    // The uniform scheme: four-eight.lsys, or c4.lsys (pairing first) for
+    // triangle meshes; the adaptive grammars pair first too, which does
+    // nothing on a quad mesh.
+    let scheme = args.get(2).map_or("four-eight", |s| s.as_str());
     let base = io::read_mesh(&mesh).unwrap_or_else(|e| panic!("{e}"));
-    let uniform = load_file(&root().join("lsystems/surfaces/four-eight.lsys"), &[])
-        .unwrap_or_else(|e| panic!("{e}"));
+    let uniform = load_file(
+        &root().join(format!("lsystems/surfaces/{scheme}.lsys")),
+        &[],
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     let t = Instant::now();
     let limit = run(&uniform, &base, reference);
     let index = Index::new(&limit);
@@ -231,7 +241,22 @@ fn main() {
     // smoothed, and their neighbours inside read them, so positions
     // differ from uniform refinement's in a band along the border, a few
     // of the border's diamonds wide; the ball is kept out of it.
-    let (p, r, b, u) = (base.position(subgram::mesh::VertexId(0)), 1.0, 0.3, 4);
+    // R and the ball in proportion to the mesh: 1 and 0.3 on the torus,
+    // whose bounding box has a diagonal of 4.
+    let diagonal = {
+        let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
+        for v in base.vertices() {
+            lo = lo.min(base.position(v));
+            hi = hi.max(base.position(v));
+        }
+        lo.distance(hi)
+    };
+    let (p, r, b, u) = (
+        base.position(subgram::mesh::VertexId(0)),
+        diagonal / 4.0,
+        0.3 * diagonal / 4.0,
+        4,
+    );
     let ball = Some((p, b));
     println!(
         "\nWithin {b} of {p} ({u} uniform steps, then blocks within {r} of it refined):\n\n\

@@ -490,3 +490,52 @@ fn area_of_a_face() {
         assert_eq!(m.face_count(), want, "threshold {t}");
     }
 }
+
+/// The C4 scheme on the scanned bunny (c4.lsys: pairing by a maximum
+/// matching, then 4-8 bisection): with `adaptive;` and every block
+/// selected it is c4.lsys to the bit after each of three steps; refined
+/// near one of its vertices it stays a conforming, closed 4-8 mesh.
+#[test]
+fn bunny_adaptive_c4() {
+    let rules = |guard: &str| {
+        format!(
+            "mesh: \"x.obj\";\nblocks: bisection;\nadaptive;\ninit: match_blocks;\n\
+             define velh(v) = 0.5*v + 0.5*avg(w in ring(v) where !new(w));\n\
+             E(e; block(e) && ({guard})) | F^2 -> V(v = avg(ring(v))) || E^4 F^4;\n\
+             V(v; !new(v) && refined(v)) | interior -> V(v = velh(v));\n"
+        )
+    };
+    let soup = subgram::mesh::io::read(&lsys("meshes/bunny.obj")).unwrap();
+    let uniform = grammar_file("surfaces/c4.lsys", &[]);
+    let all = grammar_text(&rules("true"));
+    let mut a = Mesh::from_soup(&soup).unwrap();
+    let mut b = a.clone();
+    let mut ra = uniform.start(&mut a).unwrap();
+    let mut rb = all.start(&mut b).unwrap();
+    for step in 1..=3 {
+        ra.steps(1, |_| {}).unwrap();
+        rb.steps(1, |_| {}).unwrap();
+        assert!(
+            fingerprint(ra.mesh()) == fingerprint(rb.mesh()),
+            "bunny, step {step}: adaptive with everything selected differs from c4.lsys"
+        );
+    }
+    let p = soup.positions[0];
+    let near = grammar_text(&rules(&format!(
+        "Length(avg(e) - point({}, {}, {})) < 1.5",
+        p.x, p.y, p.z
+    )));
+    let mut m = Mesh::from_soup(&soup).unwrap();
+    let mut run = near.start(&mut m).unwrap();
+    let mut last = run.mesh().face_count();
+    for step in 1..=4 {
+        run.steps(1, |_| {}).unwrap();
+        assert_conforming(run.mesh(), Some(0), &format!("bunny, step {step}"));
+        assert!(
+            run.mesh().face_count() > last,
+            "step {step} refined nothing"
+        );
+        last = run.mesh().face_count();
+    }
+    assert!(last < soup.faces.len() * 16 / 2, "{last}");
+}
