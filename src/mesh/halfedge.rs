@@ -124,6 +124,10 @@ pub struct Mesh {
     /// and `init:` rules).
     pub(crate) v_step: Vec<u32>,
     pub(crate) v_alive: Vec<bool>,
+    /// The sharpness of each vertex, as OpenSubdiv has it: 0 smooth, a
+    /// positive number a corner for that many more levels, infinite a
+    /// corner for ever. New vertices get 0.
+    pub(crate) v_sharp: Vec<f64>,
     // Half-edges, in twin pairs.
     pub(crate) he_to: Vec<VertexId>,
     pub(crate) he_next: Vec<HalfEdgeId>,
@@ -138,6 +142,15 @@ pub struct Mesh {
     /// Made by an edge split, joining the new vertex to a vertex opposite
     /// the split edge, and not flipped since.
     pub(crate) e_transversal: Vec<bool>,
+    /// The sharpness of each edge (OpenSubdiv's): 0 smooth, a positive
+    /// number a crease for that many more levels (semi-sharp below 1),
+    /// infinite a crease for ever. The halves of a split edge inherit it;
+    /// edges that splits draw are 0, and a flip refuses a sharp edge.
+    pub(crate) e_sharp: Vec<f64>,
+    /// False while no edge or vertex has been given a positive sharpness
+    /// (or since the last `decrement_sharpness` left none): the crease
+    /// queries answer at once on the meshes that have no creases.
+    pub(crate) creased: bool,
     // Faces.
     pub(crate) f_he: Vec<HalfEdgeId>,
     pub(crate) f_level: Vec<u32>,
@@ -216,9 +229,9 @@ impl Mesh {
 
     /// Bytes of storage per face, for the benchmark's report.
     pub fn bytes_per_face(&self) -> f64 {
-        let v = self.v_alive.len() * (8 + 24 + 4 + 4 + 1);
+        let v = self.v_alive.len() * (8 + 24 + 4 + 4 + 1 + 8);
         let h = self.he_to.len() * (4 + 4 + 4 + 4);
-        let e = self.e_alive.len() * (4 + 1 + 1);
+        let e = self.e_alive.len() * (4 + 1 + 1 + 1 + 8);
         let f = self.f_alive.len() * (4 + 4 + 1 + 4);
         (v + h + e + f) as f64 / self.face_count().max(1) as f64
     }
@@ -263,6 +276,97 @@ impl Mesh {
     /// True for the internal edge of a basic block (tri-quad meshes).
     pub fn is_block_edge(&self, e: EdgeId) -> bool {
         self.e_block[e.index()]
+    }
+
+    /// The edge's sharpness: 0 smooth, positive creased (see
+    /// [`Mesh::decrement_sharpness`]), `f64::INFINITY` sharp for ever.
+    pub fn edge_sharpness(&self, e: EdgeId) -> f64 {
+        self.e_sharp[e.index()]
+    }
+
+    /// The vertex's sharpness: 0 smooth, positive a corner.
+    pub fn vertex_sharpness(&self, v: VertexId) -> f64 {
+        self.v_sharp[v.index()]
+    }
+
+    /// True for an edge of positive sharpness.
+    #[inline]
+    pub fn is_sharp_edge(&self, e: EdgeId) -> bool {
+        self.e_sharp[e.index()] > 0.0
+    }
+
+    /// Sets an edge's sharpness; refused for a negative or NaN value. (A
+    /// boundary edge may carry one too; boundary rules keep a boundary a
+    /// curve whatever it is.)
+    pub fn set_edge_sharpness(&mut self, e: EdgeId, s: f64) -> Result<(), MeshError> {
+        if !self.is_edge(e) {
+            return Err(MeshError::new(format!("edge {e} does not exist")));
+        }
+        if s.is_nan() || s < 0.0 {
+            return Err(MeshError::new(format!(
+                "a sharpness is 0 or more (or `inf`), not {s}"
+            )));
+        }
+        self.e_sharp[e.index()] = s;
+        self.creased |= s > 0.0;
+        Ok(())
+    }
+
+    /// Sets a vertex's sharpness; refused for a negative or NaN value.
+    pub fn set_vertex_sharpness(&mut self, v: VertexId, s: f64) -> Result<(), MeshError> {
+        if !self.is_vertex(v) {
+            return Err(MeshError::new(format!("vertex {v} does not exist")));
+        }
+        if s.is_nan() || s < 0.0 {
+            return Err(MeshError::new(format!(
+                "a sharpness is 0 or more (or `inf`), not {s}"
+            )));
+        }
+        self.v_sharp[v.index()] = s;
+        self.creased |= s > 0.0;
+        Ok(())
+    }
+
+    /// True when some edge or vertex has positive sharpness.
+    pub fn has_sharpness(&self) -> bool {
+        self.creased && self.edges().any(|e| self.is_sharp_edge(e))
+            || self.vertices().any(|v| self.v_sharp[v.index()] > 0.0)
+    }
+
+    /// False when no edge or vertex can be sharp (nothing was given a
+    /// sharpness, or every one has dropped to 0); true says only that some
+    /// may be.
+    #[inline]
+    pub fn has_sharpness_flag(&self) -> bool {
+        self.creased
+    }
+
+    /// The number of sharp edges at `v` that are not on the boundary (a
+    /// boundary is a crease of its own: the grammars' boundary rules keep
+    /// it a curve).
+    pub fn sharp_edge_count(&self, v: VertexId) -> usize {
+        if !self.creased {
+            return 0;
+        }
+        self.outgoing_halfedges(v)
+            .filter(|h| self.is_sharp_edge(h.edge()) && !self.is_boundary_edge(h.edge()))
+            .count()
+    }
+
+    /// One level of OpenSubdiv's uniform rule: every positive sharpness,
+    /// of an edge or a vertex, drops by one, to 0 at the least; infinite
+    /// stays infinite. A surface grammar's run calls it at the end of
+    /// every step.
+    pub fn decrement_sharpness(&mut self) {
+        if !self.creased {
+            return;
+        }
+        for s in self.e_sharp.iter_mut().chain(self.v_sharp.iter_mut()) {
+            if *s > 0.0 {
+                *s = (*s - 1.0).max(0.0);
+            }
+        }
+        self.creased = self.has_sharpness();
     }
 
     /// The step of a grammar run that made the vertex (0: the base mesh).
@@ -482,6 +586,7 @@ impl Mesh {
         grow(&mut self.v_level, vertices);
         grow(&mut self.v_step, vertices);
         grow(&mut self.v_alive, vertices);
+        grow(&mut self.v_sharp, vertices);
         grow(&mut self.he_next, 2 * edges);
         grow(&mut self.he_prev, 2 * edges);
         grow(&mut self.he_to, 2 * edges);
@@ -490,6 +595,7 @@ impl Mesh {
         grow(&mut self.e_alive, edges);
         grow(&mut self.e_block, edges);
         grow(&mut self.e_transversal, edges);
+        grow(&mut self.e_sharp, edges);
         grow(&mut self.f_he, faces);
         grow(&mut self.f_level, faces);
         grow(&mut self.f_alive, faces);
@@ -505,6 +611,7 @@ impl Mesh {
             self.v_level[k] = level;
             self.v_step[k] = step;
             self.v_alive[k] = true;
+            self.v_sharp[k] = 0.0;
             return VertexId(i);
         }
         self.v_out.push(None);
@@ -512,6 +619,7 @@ impl Mesh {
         self.v_level.push(level);
         self.v_step.push(step);
         self.v_alive.push(true);
+        self.v_sharp.push(0.0);
         VertexId(self.v_alive.len() as u32 - 1)
     }
 
@@ -524,12 +632,14 @@ impl Mesh {
             self.e_alive[k] = true;
             self.e_block[k] = false;
             self.e_transversal[k] = false;
+            self.e_sharp[k] = 0.0;
             EdgeId(i)
         } else {
             self.e_level.push(level);
             self.e_alive.push(true);
             self.e_block.push(false);
             self.e_transversal.push(false);
+            self.e_sharp.push(0.0);
             let e = EdgeId(self.e_alive.len() as u32 - 1);
             let dummy = HalfEdgeId(0);
             for _ in 0..2 {

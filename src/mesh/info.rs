@@ -30,6 +30,18 @@ pub struct MeshInfo {
     pub vertex_levels: BTreeMap<u32, usize>,
     pub edge_levels: BTreeMap<u32, usize>,
     pub face_levels: BTreeMap<u32, usize>,
+    /// Edges of positive sharpness (creases), and those sharp for ever.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub sharp_edges: usize,
+    #[serde(skip_serializing_if = "is_zero")]
+    pub infinitely_sharp_edges: usize,
+    /// Vertices of positive sharpness (corners by their own sharpness).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub sharp_vertices: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl Mesh {
@@ -112,6 +124,15 @@ impl Mesh {
             vertex_levels,
             edge_levels,
             face_levels,
+            sharp_edges: self.edges().filter(|&e| self.is_sharp_edge(e)).count(),
+            infinitely_sharp_edges: self
+                .edges()
+                .filter(|&e| self.edge_sharpness(e) == f64::INFINITY)
+                .count(),
+            sharp_vertices: self
+                .vertices()
+                .filter(|&v| self.vertex_sharpness(v) > 0.0)
+                .count(),
         }
     }
 }
@@ -168,6 +189,13 @@ impl std::fmt::Display for MeshInfo {
                 write!(f, " {k}:{n}")?;
             }
             writeln!(f)?;
+        }
+        if self.sharp_edges + self.sharp_vertices > 0 {
+            writeln!(
+                f,
+                "sharp edges {} ({} for ever), sharp vertices {}",
+                self.sharp_edges, self.infinitely_sharp_edges, self.sharp_vertices
+            )?;
         }
         Ok(())
     }

@@ -97,9 +97,204 @@ pub fn read(path: &Path) -> Result<PolygonSoup, MeshFileError> {
 /// mesh, refusing what is not an oriented 2-manifold (see
 /// [`Mesh::from_soup`]). A refusal that names a face or vertex shows its
 /// line, which is read from the file again for the message.
+///
+/// Sharpness (creases, OpenSubdiv's numbers) comes from the file where
+/// its format carries it, a PLY `edge` element with `vertex1`, `vertex2`
+/// and a `crease` or `sharpness` property, and from a file beside the mesh
+/// with the extension `.creases` (see [`CREASES_EXTENSION`]), which is
+/// read after it for any format.
 pub fn read_mesh(path: &Path) -> Result<Mesh, MeshFileError> {
-    let soup = read(path)?;
-    Mesh::from_soup(&soup).map_err(|e| {
+    let name = path.display().to_string();
+    let format = format_of(&name, path)?;
+    let limit = max_file_bytes().map_err(|m| error(&name, None, m))?;
+    let bytes = read_bounded_as(&name, path, limit, Some(format))?;
+    let (soup, marks) = match format {
+        Format::Ply => ply::parse_with_sharpness(&name, &bytes)?,
+        _ => (read_str(&name, format, &bytes)?, Vec::new()),
+    };
+    drop(bytes);
+    let mut mesh = build_mesh(path, &soup)?;
+    apply_sharpness(&mut mesh, &marks, 0)?;
+    let side = path.with_extension(CREASES_EXTENSION);
+    if side.is_file() {
+        let marks = read_creases(&side, limit)?;
+        apply_sharpness(&mut mesh, &marks, 1)?;
+    }
+    Ok(mesh)
+}
+
+/// The extension of the file of creases beside a mesh: `cube.creases`
+/// beside `cube.obj`. Its lines are `e A B S` (the edge between vertices A
+/// and B has sharpness S) and `v A S` (vertex A has sharpness S), vertices
+/// counted from 1 whatever the mesh's format, S a number of 0 or more or
+/// `inf`; `#` starts a comment. A later line for the same edge or vertex
+/// wins.
+pub const CREASES_EXTENSION: &str = "creases";
+
+/// A sharpness a file gives: an edge by its two vertices or a vertex, as
+/// the file numbers them, and where to point for each of them.
+struct Mark {
+    ends: Vec<i64>,
+    sharpness: f64,
+    /// An error placed at each vertex number, for messages about it.
+    at: Vec<MeshFileError>,
+    /// What the file calls the mark, for messages without a line (binary
+    /// PLY data): "edge 3"; empty where the message's line shows it.
+    what: String,
+}
+
+/// `e` with `message`.
+fn saying(e: &MeshFileError, message: String) -> MeshFileError {
+    MeshFileError {
+        message,
+        ..e.clone()
+    }
+}
+
+/// Gives the mesh the sharpness of `marks`, whose vertices the file
+/// counts from `base`.
+fn apply_sharpness(mesh: &mut Mesh, marks: &[Mark], base: i64) -> Result<(), MeshFileError> {
+    use super::halfedge::VertexId;
+    let n = mesh.vertex_count();
+    for m in marks {
+        let what = if m.what.is_empty() {
+            String::new()
+        } else {
+            format!("{}: ", m.what)
+        };
+        let mut vs = Vec::with_capacity(2);
+        for (k, &i) in m.ends.iter().enumerate() {
+            let v = i - base;
+            if v < 0 || v >= n as i64 {
+                return Err(saying(
+                    &m.at[k],
+                    format!(
+                        "{what}vertex {i} is out of range: the mesh has {n} vertices, numbered \
+                         from {base}"
+                    ),
+                ));
+            }
+            vs.push(VertexId(v as u32));
+        }
+        let done = match vs[..] {
+            [a, b] => match mesh.find_halfedge(a, b) {
+                Some(h) if mesh.is_block_edge(h.edge()) => {
+                    return Err(saying(
+                        &m.at[0],
+                        format!(
+                            "{what}vertices {} and {} are opposite corners of a quad, not the \
+                             ends of an edge of the polygon mesh",
+                            m.ends[0], m.ends[1]
+                        ),
+                    ))
+                }
+                Some(h) => mesh.set_edge_sharpness(h.edge(), m.sharpness),
+                None => {
+                    return Err(saying(
+                        &m.at[0],
+                        format!(
+                            "{what}vertices {} and {} are not joined by an edge of the mesh",
+                            m.ends[0], m.ends[1]
+                        ),
+                    ))
+                }
+            },
+            _ => mesh.set_vertex_sharpness(vs[0], m.sharpness),
+        };
+        done.map_err(|e| saying(&m.at[m.at.len() - 1], format!("{what}{}", e.message)))?;
+    }
+    Ok(())
+}
+
+/// A sharpness as written: a number of 0 or more, or `inf`.
+fn sharpness_value(s: f64) -> Result<f64, String> {
+    if s.is_nan() || s < 0.0 {
+        Err(format!(
+            "a sharpness is a number of 0 or more, or `inf` (sharp for ever), not {s}"
+        ))
+    } else {
+        Ok(s)
+    }
+}
+
+/// Reads a `.creases` file (see [`CREASES_EXTENSION`]).
+fn read_creases(path: &Path, limit: u64) -> Result<Vec<Mark>, MeshFileError> {
+    let name = path.display().to_string();
+    let bytes = read_bounded(&name, path, limit)?;
+    let text = utf8(&name, &bytes, 1)?;
+    let mut marks = Vec::new();
+    for (i, raw) in text.split('\n').enumerate() {
+        let line = Line {
+            no: i + 1,
+            text: raw.strip_suffix('\r').unwrap_or(raw),
+        };
+        let toks: Vec<&str> = strip_comment(line.text).split_whitespace().collect();
+        let Some(&kind) = toks.first() else { continue };
+        let want = match kind {
+            "e" => 4,
+            "v" => 3,
+            _ => {
+                return Err(line.at(
+                    &name,
+                    kind,
+                    format!(
+                        "expected `e A B SHARPNESS` (an edge) or `v A SHARPNESS` (a vertex), \
+                         found `{kind}`"
+                    ),
+                ))
+            }
+        };
+        if toks.len() < want {
+            return Err(line.end(
+                &name,
+                if kind == "e" {
+                    "expected `e A B SHARPNESS`: two vertex numbers and a sharpness"
+                } else {
+                    "expected `v A SHARPNESS`: a vertex number and a sharpness"
+                },
+            ));
+        }
+        if let Some(extra) = toks.get(want) {
+            return Err(line.at(
+                &name,
+                extra,
+                format!("unexpected `{extra}` after the sharpness"),
+            ));
+        }
+        let mut ends = Vec::new();
+        let mut at = Vec::new();
+        for t in &toks[1..want - 1] {
+            match t.parse::<i64>() {
+                Ok(i) if i >= 1 => ends.push(i),
+                _ => {
+                    return Err(line.at(
+                        &name,
+                        t,
+                        format!("expected a vertex number, counted from 1, found `{t}`"),
+                    ))
+                }
+            }
+            at.push(line.at(&name, t, ""));
+        }
+        let st = toks[want - 1];
+        let s = st
+            .parse::<f64>()
+            .map_err(|_| line.at(&name, st, format!("expected a sharpness, found `{st}`")))?;
+        let sharpness = sharpness_value(s).map_err(|m| line.at(&name, st, m))?;
+        at.push(line.at(&name, st, ""));
+        marks.push(Mark {
+            what: String::new(),
+            ends,
+            sharpness,
+            at,
+        });
+    }
+    Ok(marks)
+}
+
+/// The half-edge mesh of `soup`, read from `path`.
+fn build_mesh(path: &Path, soup: &PolygonSoup) -> Result<Mesh, MeshFileError> {
+    Mesh::from_soup(soup).map_err(|e| {
         let name = path.display().to_string();
         let line = e.line.and_then(|no| {
             let limit = max_file_bytes().ok()?;
@@ -496,6 +691,8 @@ struct Raw {
     face_words: Vec<u32>,
     /// How the file numbers vertices and faces (1 in OBJ, 0 otherwise).
     base: i64,
+    /// Sharpness the file gives (a PLY `edge` element's).
+    marks: Vec<Mark>,
 }
 
 impl Raw {
@@ -509,6 +706,7 @@ impl Raw {
             face_lines: Vec::new(),
             face_words: Vec::new(),
             base,
+            marks: Vec::new(),
         }
     }
 
@@ -1048,11 +1246,24 @@ mod ply {
         Vertex([usize; 3]),
         /// Faces, with the index of the vertex list property.
         Face(usize),
+        /// Sharp edges, with the indices of `vertex1`, `vertex2` and the
+        /// sharpness (`crease` or `sharpness`).
+        Edge([usize; 3]),
         Skip,
     }
 
     /// Parses a PLY file into a checked soup.
     pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<PolygonSoup, MeshFileError> {
+        parse_with_sharpness(name, bytes).map(|(soup, _)| soup)
+    }
+
+    /// Parses a PLY file into a checked soup and the sharpness of its
+    /// `edge` element, if it has one with a `crease` or `sharpness`
+    /// property.
+    pub(super) fn parse_with_sharpness(
+        name: &str,
+        bytes: &[u8],
+    ) -> Result<(PolygonSoup, Vec<Mark>), MeshFileError> {
         let header = parse_header(name, bytes)?;
         let body = &bytes[header.body..];
         if header.binary {
@@ -1060,14 +1271,17 @@ mod ply {
                 bytes: body,
                 pos: 0,
             };
-            read_elements(name, &header, &mut src)?.finish(name, None)
+            let mut raw = read_elements(name, &header, &mut src)?;
+            let marks = std::mem::take(&mut raw.marks);
+            Ok((raw.finish(name, None)?, marks))
         } else {
             let first = header.end.no + 1;
             let text = utf8(name, body, first)?;
             let mut src = Ascii::new(text, header.end);
-            let raw = read_elements(name, &header, &mut src)?;
+            let mut raw = read_elements(name, &header, &mut src)?;
             src.check_end(name)?;
-            raw.finish(name, Some(Source { text, first }))
+            let marks = std::mem::take(&mut raw.marks);
+            Ok((raw.finish(name, Some(Source { text, first }))?, marks))
         }
     }
 
@@ -1234,6 +1448,42 @@ mod ply {
                     }
                     None => fail("the `face` element has no `vertex_indices` list property".into()),
                 }
+            }
+            "edge" => {
+                let Some(si) = el
+                    .props
+                    .iter()
+                    .position(|p| p.name == "crease" || p.name == "sharpness")
+                else {
+                    return Ok(Role::Skip);
+                };
+                if !matches!(el.props[si].kind, Kind::Scalar(_)) {
+                    return fail(format!(
+                        "the edge property `{}` is a list, not one number",
+                        el.props[si].name
+                    ));
+                }
+                let mut ix = [0, 0, si];
+                for (k, end) in ["vertex1", "vertex2"].into_iter().enumerate() {
+                    match el.props.iter().position(|p| p.name == end) {
+                        Some(i) if matches!(el.props[i].kind, Kind::Scalar(t) if t.is_integer()) => {
+                            ix[k] = i
+                        }
+                        Some(_) => {
+                            return fail(format!(
+                                "the edge property `{end}` must be one integer, a vertex index"
+                            ))
+                        }
+                        None => {
+                            return fail(format!(
+                                "the `edge` element gives a `{}` but no `{end}` property: an \
+                                 edge's sharpness needs `vertex1` and `vertex2`",
+                                el.props[si].name
+                            ))
+                        }
+                    }
+                }
+                Ok(Role::Edge(ix))
             }
             _ => Ok(Role::Skip),
         }
@@ -1476,10 +1726,22 @@ mod ply {
         let (line, _) = src.position();
         let mut xyz = [0.0; 3];
         let mut face_at = (line, 0);
+        let mut edge = [0.0; 3];
+        let mut edge_at = Vec::new();
         for (p, prop) in el.props.iter().enumerate() {
             match prop.kind {
                 Kind::Scalar(ty) => {
                     let v = value(name, el, i, src, ty)?;
+                    if let Role::Edge(ix) = role {
+                        for k in (0..3).filter(|&k| ix[k] == p) {
+                            if k == 2 {
+                                sharpness_value(v)
+                                    .map_err(|m| src.at_last(name, format!("edge {i}: {m}")))?;
+                            }
+                            edge[k] = v;
+                            edge_at.push((k, src.at_last(name, String::new())));
+                        }
+                    }
                     if let Role::Vertex(ix) = role {
                         for k in (0..3).filter(|&k| ix[k] == p) {
                             if !v.is_finite() {
@@ -1519,6 +1781,20 @@ mod ply {
         match role {
             Role::Vertex(_) => raw.push_vertex(DVec3::from(xyz), line),
             Role::Face(_) => raw.end_face(face_at.0, face_at.1.saturating_add(1)),
+            Role::Edge(_) => {
+                edge_at.sort_by_key(|(k, _)| *k);
+                let at: Vec<MeshFileError> = edge_at.into_iter().map(|(_, e)| e).collect();
+                let mut ends = Vec::with_capacity(2);
+                for k in 0..2 {
+                    ends.push(index(name, src, edge[k]).map_err(|e| saying(&at[k], e.message))?);
+                }
+                raw.marks.push(Mark {
+                    ends,
+                    sharpness: edge[2],
+                    at,
+                    what: format!("edge {i}"),
+                });
+            }
             Role::Skip => {}
         }
         Ok(())

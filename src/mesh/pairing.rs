@@ -67,7 +67,10 @@ struct Blossom<'g> {
     g: &'g Graph,
     mate: Vec<u32>,
     parent: Vec<u32>,
-    base: Vec<u32>,
+    /// Union-find over contracted blossoms: `uf` the parent pointers,
+    /// `set_base` the base of the blossom at each root.
+    uf: Vec<u32>,
+    set_base: Vec<u32>,
     in_tree: Vec<bool>,
     in_blossom: Vec<bool>,
     on_path: Vec<bool>,
@@ -84,7 +87,8 @@ impl<'g> Blossom<'g> {
             g,
             mate,
             parent: vec![NONE; n],
-            base: (0..n as u32).collect(),
+            uf: (0..n as u32).collect(),
+            set_base: (0..n as u32).collect(),
             in_tree: vec![false; n],
             in_blossom: vec![false; n],
             on_path: vec![false; n],
@@ -98,11 +102,30 @@ impl<'g> Blossom<'g> {
         self.touched.push(v);
     }
 
+    fn find(&mut self, mut x: u32) -> u32 {
+        let mut r = x;
+        while self.uf[r as usize] != r {
+            r = self.uf[r as usize];
+        }
+        while self.uf[x as usize] != r {
+            let next = self.uf[x as usize];
+            self.uf[x as usize] = r;
+            x = next;
+        }
+        r
+    }
+
+    /// The base of the blossom `x` is in (`x` itself outside blossoms).
+    fn base(&mut self, x: u32) -> u32 {
+        let r = self.find(x);
+        self.set_base[r as usize]
+    }
+
     /// The base of the blossom that the tree paths from `a` and `b` meet in.
     fn common_base(&mut self, mut a: u32, mut b: u32) -> u32 {
         let mut marked = Vec::new();
         loop {
-            a = self.base[a as usize];
+            a = self.base(a);
             self.on_path[a as usize] = true;
             marked.push(a);
             if self.mate[a as usize] == NONE {
@@ -111,7 +134,7 @@ impl<'g> Blossom<'g> {
             a = self.parent[self.mate[a as usize] as usize];
         }
         let found = loop {
-            b = self.base[b as usize];
+            b = self.base(b);
             if self.on_path[b as usize] {
                 break b;
             }
@@ -123,12 +146,23 @@ impl<'g> Blossom<'g> {
         found
     }
 
-    /// Marks the blossom's bases on the path from `v` down to `b`, and
-    /// points the odd nodes on it back across the blossom's closing edge.
-    fn mark_path(&mut self, mut v: u32, b: u32, mut child: u32, marked: &mut Vec<u32>) {
-        while self.base[v as usize] != b {
+    /// Marks the blossom's bases on the path from `v` down to `b`, points
+    /// the odd nodes on it back across the blossom's closing edge, and
+    /// lists those not yet in the tree (they become even).
+    fn mark_path(
+        &mut self,
+        mut v: u32,
+        b: u32,
+        mut child: u32,
+        marked: &mut Vec<u32>,
+        odd: &mut Vec<u32>,
+    ) {
+        while self.base(v) != b {
             let m = self.mate[v as usize];
-            for x in [self.base[v as usize], self.base[m as usize]] {
+            if !self.in_tree[m as usize] {
+                odd.push(m);
+            }
+            for x in [self.base(v), self.base(m)] {
                 if !self.in_blossom[x as usize] {
                     self.in_blossom[x as usize] = true;
                     marked.push(x);
@@ -144,6 +178,7 @@ impl<'g> Blossom<'g> {
     /// `parent` and `mate` describing the path, or None. `budget` bounds the
     /// work (node visits); a search that runs out gives None.
     fn search(&mut self, root: u32, budget: &mut u64) -> Option<u32> {
+        let g = self.g;
         self.queue.clear();
         self.in_tree[root as usize] = true;
         self.touch(root);
@@ -152,7 +187,7 @@ impl<'g> Blossom<'g> {
         while head < self.queue.len() {
             let v = self.queue[head];
             head += 1;
-            for &to in self.g.neighbours(v) {
+            for &to in g.neighbours(v) {
                 if *budget == 0 {
                     return None;
                 }
@@ -160,31 +195,33 @@ impl<'g> Blossom<'g> {
                 if to >= self.limit {
                     continue;
                 }
-                if self.base[v as usize] == self.base[to as usize] || self.mate[v as usize] == to {
+                if self.mate[v as usize] == to || self.base(v) == self.base(to) {
                     continue;
                 }
                 let to_mate = self.mate[to as usize];
                 if to == root || (to_mate != NONE && self.parent[to_mate as usize] != NONE) {
-                    // An odd cycle: contract it into its base.
+                    // An odd cycle: contract it into its base. Its odd
+                    // nodes outside the tree are the only nodes it brings
+                    // in; the rest are in the tree already.
                     let b = self.common_base(v, to);
-                    let mut marked = Vec::new();
-                    self.mark_path(v, b, to, &mut marked);
-                    self.mark_path(to, b, v, &mut marked);
-                    // Only nodes in the tree can have a base in the blossom.
-                    let n_touched = self.touched.len();
-                    for k in 0..n_touched {
-                        let i = self.touched[k];
-                        if self.in_blossom[self.base[i as usize] as usize] {
-                            self.base[i as usize] = b;
-                            if !self.in_tree[i as usize] {
-                                self.in_tree[i as usize] = true;
-                                self.queue.push(i);
-                            }
+                    let (mut marked, mut odd) = (Vec::new(), Vec::new());
+                    self.mark_path(v, b, to, &mut marked, &mut odd);
+                    self.mark_path(to, b, v, &mut marked, &mut odd);
+                    let rb = self.find(b);
+                    for &x in &marked {
+                        let r = self.find(x);
+                        if r != rb {
+                            self.uf[r as usize] = rb;
                         }
-                    }
-                    *budget = budget.saturating_sub(n_touched as u64);
-                    for x in marked {
                         self.in_blossom[x as usize] = false;
+                    }
+                    self.set_base[rb as usize] = b;
+                    *budget = budget.saturating_sub(marked.len() as u64);
+                    for m in odd {
+                        if !self.in_tree[m as usize] {
+                            self.in_tree[m as usize] = true;
+                            self.queue.push(m);
+                        }
                     }
                 } else if self.parent[to as usize] == NONE {
                     self.parent[to as usize] = v;
@@ -214,7 +251,8 @@ impl<'g> Blossom<'g> {
     fn reset(&mut self) {
         for &i in &self.touched {
             self.parent[i as usize] = NONE;
-            self.base[i as usize] = i;
+            self.uf[i as usize] = i;
+            self.set_base[i as usize] = i;
             self.in_tree[i as usize] = false;
         }
         self.touched.clear();

@@ -238,6 +238,8 @@ impl Mesh {
     ///        d                 d
     /// ```
     ///
+    /// Sharpness: `av` and `vb` keep that of `ab`; the transversals are 0.
+    ///
     /// Levels: `l(v) = max(l(a), l(b)) + 1`; the bisection edges `av`, `vb`
     /// get `l(ab) + 2`; the transversal edges `vc`, `vd` get `l(c) + 1` and
     /// `l(d) + 1`, and are marked transversal. Splitting the internal edge
@@ -298,6 +300,9 @@ impl Mesh {
         self.e_block[e.index()] = false;
         self.e_transversal[e.index()] = false;
         let g = self.new_edge(v, b, le + 2); // v -> b
+                                             // Both halves keep the edge's sharpness (OpenSubdiv's child edges);
+                                             // the transversals below are drawn across faces and stay smooth.
+        self.e_sharp[g.edge().index()] = self.e_sharp[e.index()];
         let k = self.new_edge(v, c, self.v_level[c.index()] + 1); // v -> c
         self.e_transversal[k.edge().index()] = true;
         if lone {
@@ -456,6 +461,9 @@ impl Mesh {
             let bout = out[2]; // v -> n2, boundary
             let (bp, bn) = (self.prev(bin), self.next(bout));
             let le = self.e_level[x.edge().index()].saturating_sub(2);
+            // The restored edge is as sharp as the sharper of its halves.
+            let sharp = self.e_sharp[x.edge().index()].max(self.e_sharp[bout.edge().index()]);
+            self.e_sharp[x.edge().index()] = sharp;
             self.delete_edge(out[1].edge());
             self.delete_edge(out[2].edge());
             self.delete_face(g);
@@ -503,6 +511,9 @@ impl Mesh {
         let le = self.e_level[o[0].edge().index()].saturating_sub(2);
         // Reuse edge v-a: x = a -> b, x' = b -> a.
         let x = o[0].twin(); // was a -> v
+                             // The restored edge is as sharp as the sharper of its halves.
+        let sharp = self.e_sharp[o[0].edge().index()].max(self.e_sharp[o[2].edge().index()]);
+        self.e_sharp[x.edge().index()] = sharp;
         self.delete_edge(o[1].edge());
         self.delete_edge(o[2].edge());
         self.delete_edge(o[3].edge());
@@ -542,7 +553,9 @@ impl Mesh {
     /// ```
     ///
     /// Level: the flipped edge gets its parent's level plus one. Refused for
-    /// a boundary edge and when `c` and `d` are already joined.
+    /// a boundary edge, for a sharp edge (a crease stays where it is, so a
+    /// grammar's flips must not match one) and when `c` and `d` are
+    /// already joined. The flipped edge, never sharp, stays smooth.
     ///
     /// Tags: the faces keep their slots and their tags. The face that was
     /// `a-b-c` (the side of the edge's first half-edge running `a -> b`)
@@ -563,6 +576,14 @@ impl Mesh {
             let (a, b) = self.edge_vertices(e);
             return Err(MeshError::new(format!(
                 "edge flip: the edge between vertices {a} and {b} is on the boundary and cannot be flipped"
+            )));
+        }
+        if self.is_sharp_edge(e) {
+            let (a, b) = self.edge_vertices(e);
+            return Err(MeshError::new(format!(
+                "edge flip: the edge between vertices {a} and {b} is sharp (sharpness {}) and \
+                 cannot be flipped: a flip would move the crease off its curve",
+                self.e_sharp[e.index()]
             )));
         }
         let h = e.halfedge();

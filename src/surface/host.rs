@@ -16,7 +16,7 @@ use crate::lang::builtins::{Builtin, HostTable, SigError};
 use crate::lang::eval::{Host, RuntimeError};
 use crate::lang::ir::{Ex, FoldOp, Func};
 use crate::lang::value::{Elem, Ty, Value};
-use crate::mesh::{Mesh, VertexId};
+use crate::mesh::{EdgeId, Mesh, VertexId};
 use crate::syntax::ast::BinOp;
 
 /// Element kinds.
@@ -46,7 +46,14 @@ pub mod id {
     pub const CURRENT: u16 = 16;
     pub const STEP: u16 = 17;
     pub const POINT: u16 = 18;
-    pub const LONE: u16 = 19;
+    pub const SHARP: u16 = 19;
+    pub const SHARPNESS: u16 = 20;
+    pub const CREASES: u16 = 21;
+    pub const CREASE_RING: u16 = 22;
+    pub const CREASE_WEIGHT: u16 = 23;
+    /// `sharpness(v, w)`: of the edge between two vertices.
+    pub const SHARPNESS_BETWEEN: u16 = 24;
+    pub const LONE: u16 = 25;
     /// Guards of adaptive refinement: sizes and shape of the mesh now.
     pub const AREA: u16 = 30;
     pub const LENGTH: u16 = 31;
@@ -62,12 +69,15 @@ pub mod id {
 const ON_BOUNDARY: u8 = 1;
 const IN_BLOCK: u8 = 2;
 const TRANSVERSAL: u8 = 4;
+/// An edge of positive sharpness.
+const SHARP_EDGE: u8 = 8;
 
 /// Set kinds, in the low bits of a set's flags; the element the set
 /// belongs to is in the high bits.
 const RING: u8 = 0;
 const BOUNDARY_RING: u8 = 1;
 const VERTS: u8 = 2;
+const CREASE_RING: u8 = 3;
 
 pub fn vertex(v: VertexId) -> Elem {
     Elem {
@@ -81,8 +91,11 @@ fn vertex_value(v: VertexId) -> Value {
     Value::Elem(vertex(v))
 }
 
-/// An edge by its end vertices, captured before a split, with its level
-/// and marks.
+/// An edge by its end vertices, captured before a split, with its level,
+/// marks and id. The id reads the edge's sharpness while its rule runs:
+/// a split leaves it on the half at `p`, which keeps the sharpness, and
+/// sharpness changes only between steps.
+#[allow(clippy::too_many_arguments)] // the marks an edge value captures
 pub fn edge(
     p: VertexId,
     q: VertexId,
@@ -90,14 +103,17 @@ pub fn edge(
     boundary: bool,
     block: bool,
     transversal: bool,
+    sharp: bool,
+    id: EdgeId,
 ) -> Elem {
     let flags = (boundary as u8 * ON_BOUNDARY)
         | (block as u8 * IN_BLOCK)
-        | (transversal as u8 * TRANSVERSAL);
+        | (transversal as u8 * TRANSVERSAL)
+        | (sharp as u8 * SHARP_EDGE);
     Elem {
         kind: EDGE,
         flags,
-        ids: [p.0, q.0, level, 0],
+        ids: [p.0, q.0, level, id.0],
     }
 }
 
@@ -319,6 +335,73 @@ static FUNCTIONS: &[Builtin] = &[
         },
     },
     Builtin {
+        name: "sharp",
+        resolve: |a| {
+            one(
+                a,
+                &[VERTEX, EDGE],
+                "`sharp` takes an edge (true for a crease: sharpness above 0) or a vertex \
+                 (true for a corner by its own sharpness)",
+            )?;
+            Ok((Func::Host(id::SHARP), Ty::Bool))
+        },
+    },
+    Builtin {
+        name: "sharpness",
+        resolve: |a| match a {
+            [V, V] => Ok((Func::Host(id::SHARPNESS_BETWEEN), Ty::Double)),
+            [_, _] => Err(SigError::Message(
+                "`sharpness` of two vertices is that of the edge between them: it takes two \
+                 vertices"
+                    .into(),
+            )),
+            _ => {
+                one(
+                    a,
+                    &[VERTEX, EDGE],
+                    "`sharpness` takes an edge or a vertex (0 smooth, more for a crease or a \
+                     corner, `inf` for ever), or two vertices",
+                )?;
+                Ok((Func::Host(id::SHARPNESS), Ty::Double))
+            }
+        },
+    },
+    Builtin {
+        name: "creases",
+        resolve: |a| {
+            one(
+                a,
+                &[VERTEX],
+                "`creases` takes a vertex: the number of sharp edges at it (off the boundary)",
+            )?;
+            Ok((Func::Host(id::CREASES), Ty::Int))
+        },
+    },
+    Builtin {
+        name: "crease_ring",
+        resolve: |a| {
+            one(
+                a,
+                &[VERTEX],
+                "`crease_ring` takes a vertex: its neighbours across sharp edges (off the \
+                 boundary)",
+            )?;
+            Ok((Func::Host(id::CREASE_RING), Ty::Elem(SET)))
+        },
+    },
+    Builtin {
+        name: "crease_weight",
+        resolve: |a| {
+            one(
+                a,
+                &[VERTEX],
+                "`crease_weight` takes a vertex: the weight of its crease or corner rule at this \
+                 level",
+            )?;
+            Ok((Func::Host(id::CREASE_WEIGHT), Ty::Double))
+        },
+    },
+    Builtin {
         name: "point",
         resolve: |a| match a {
             [x, y, z] if x.is_numeric() && y.is_numeric() && z.is_numeric() => {
@@ -459,6 +542,8 @@ impl MeshHost<'_> {
             (id::TRANSVERSAL, EDGE) => flag(TRANSVERSAL),
             (id::NEW, VERTEX) => self.is_new(v),
             (id::CENTER, VERTEX) => self.mesh.is_block_centre(v),
+            (id::SHARP, EDGE) => flag(SHARP_EDGE),
+            (id::SHARP, VERTEX) => self.mesh.vertex_sharpness(v) > 0.0,
             _ => false,
         }
     }
@@ -668,6 +753,39 @@ impl Host for MeshHost<'_> {
                 }
                 any
             })),
+            id::SHARP => match elem {
+                Some(e) if e.kind == VERTEX => {
+                    Value::Bool(m.vertex_sharpness(VertexId(e.ids[0])) > 0.0)
+                }
+                _ => flag(SHARP_EDGE),
+            },
+            id::SHARPNESS => Value::Float(match elem {
+                Some(e) if e.kind == VERTEX => m.vertex_sharpness(VertexId(e.ids[0])),
+                Some(e) if e.kind == EDGE && e.flags & SHARP_EDGE != 0 => {
+                    m.edge_sharpness(EdgeId(e.ids[3]))
+                }
+                _ => 0.0,
+            }),
+            id::SHARPNESS_BETWEEN => {
+                let end = |x: &Value| match x {
+                    Value::Elem(e) if e.kind == VERTEX => Some(VertexId(e.ids[0])),
+                    _ => None,
+                };
+                let between = end(&args[0])
+                    .zip(end(&args[1]))
+                    .and_then(|(a, b)| m.find_halfedge(a, b));
+                Value::Float(between.map_or(0.0, |h| m.edge_sharpness(h.edge())))
+            }
+            id::CREASES => Value::Int(v().map_or(0, |v| m.sharp_edge_count(v) as i64)),
+            id::CREASE_RING => match v() {
+                Some(v) => Value::Elem(Elem {
+                    kind: SET,
+                    flags: CREASE_RING | (VERTEX << 4),
+                    ids: [v.0, 0, 0, 0],
+                }),
+                None => return Err("this is not a vertex of the mesh".into()),
+            },
+            id::CREASE_WEIGHT => Value::Float(v().map_or(0.0, |v| crease_weight(m, v))),
             id::CURRENT => Value::Int(self.current as i64),
             id::STEP => Value::Int(self.step as i64),
             id::LONE => Value::Bool(elem.is_some_and(|e| self.lone(&e))),
@@ -707,6 +825,13 @@ impl Host for MeshHost<'_> {
                     }
                 }
             }
+            (CREASE_RING, VERTEX) => {
+                for h in m.outgoing_halfedges(VertexId(s.ids[0])) {
+                    if m.is_sharp_edge(h.edge()) && !m.is_boundary_edge(h.edge()) {
+                        out.push(vertex_value(m.to(h)));
+                    }
+                }
+            }
             (_, EDGE) => out.extend(s.ids[..2].iter().map(|&i| vertex_value(VertexId(i)))),
             (_, FACE) => out.extend(s.ids[..3].iter().map(|&i| vertex_value(VertexId(i)))),
             _ => {}
@@ -733,6 +858,65 @@ fn triangle_area(m: &Mesh, vs: [VertexId; 3]) -> f64 {
 fn triangle_normal(m: &Mesh, vs: [VertexId; 3]) -> DVec3 {
     let [a, b, c] = vs.map(|v| m.position(v));
     (b - a).cross(c - a).normalize_or_zero()
+}
+
+/// OpenSubdiv's rule of a vertex from its own sharpness and the
+/// sharpness of its edges: 0 smooth (no sharp edge, or one: a dart), 1
+/// crease (two), 2 corner (three or more, or a sharp vertex).
+fn vertex_rule(vertex: f64, edges: impl Iterator<Item = f64>) -> u8 {
+    if vertex > 0.0 {
+        return 2;
+    }
+    match edges.filter(|&s| s > 0.0).count() {
+        0 | 1 => 0,
+        2 => 1,
+        _ => 2,
+    }
+}
+
+/// The weight of `v`'s crease or corner rule at this level, as OpenSubdiv
+/// blends its vertex rules (boundary edges count as sharp for ever): 1 where the vertex's rule (see
+/// [`vertex_rule`]) is the same one level down, with every sharpness one
+/// less; else the mean of the sharpnesses (of the vertex and of its edges)
+/// that drop to 0 at this level, at most 1, so that the mask is that
+/// weight of this level's rule and the rest of the next level's. 0 for a
+/// smooth vertex.
+pub fn crease_weight(m: &Mesh, v: VertexId) -> f64 {
+    if !m.has_sharpness_flag() {
+        return 0.0;
+    }
+    let child = |s: f64| (s - 1.0).max(0.0);
+    let sv = m.vertex_sharpness(v);
+    // A boundary edge is sharp for ever, as in OpenSubdiv: a boundary
+    // vertex is a crease, and a corner where an interior crease meets it.
+    let edges = || {
+        m.outgoing_halfedges(v).map(|h| {
+            if m.is_boundary_edge(h.edge()) {
+                f64::INFINITY
+            } else {
+                m.edge_sharpness(h.edge())
+            }
+        })
+    };
+    let parent = vertex_rule(sv, edges());
+    if parent == 0 {
+        return 0.0;
+    }
+    if vertex_rule(child(sv), edges().map(child)) == parent {
+        return 1.0;
+    }
+    let (mut sum, mut n) = (0.0, 0);
+    for s in std::iter::once(sv).chain(edges()) {
+        if s > 0.0 && child(s) <= 0.0 {
+            sum += s;
+            n += 1;
+        }
+    }
+    if n == 0 {
+        0.0
+    } else {
+        (sum / n as f64).min(1.0)
+    }
 }
 
 /// Rewrites the two forms every scheme evaluates for every element into
@@ -886,6 +1070,9 @@ pub enum Guard {
     Level(i64, Path),
     /// A built-in that takes the element (or an end) and gives a bool.
     Test(u16, Path),
+    /// An integer built-in of a vertex (`valence`, `creases`) against a
+    /// constant: the built-in, the operator's code, the constant.
+    Count(u16, i64, i64, Path),
     /// An expression that reads no element.
     Invariant(Box<Ex>),
     Not(Box<Guard>),
@@ -931,7 +1118,7 @@ impl Guard {
     fn is_invariant(&self) -> bool {
         match self {
             Guard::Invariant(_) => true,
-            Guard::Level(..) | Guard::Test(..) => false,
+            Guard::Level(..) | Guard::Test(..) | Guard::Count(..) => false,
             Guard::Not(a) => a.is_invariant(),
             Guard::And(a, b) | Guard::Or(a, b) => a.is_invariant() && b.is_invariant(),
         }
@@ -947,11 +1134,29 @@ impl Guard {
                 _ => return None,
             },
             Ex::Call(
-                Func::Host(f @ (id::BOUNDARY | id::BLOCK | id::TRANSVERSAL | id::NEW | id::CENTER)),
+                Func::Host(
+                    f @ (id::BOUNDARY
+                    | id::BLOCK
+                    | id::TRANSVERSAL
+                    | id::NEW
+                    | id::CENTER
+                    | id::SHARP),
+                ),
                 args,
                 _,
             ) => match args.as_slice() {
                 [x] => Guard::Test(*f, path(x, slot)?),
+                _ => return None,
+            },
+            Ex::Bin(op, a, b, _) => match (op_code(*op), &**a, &**b) {
+                (
+                    Some(code),
+                    Ex::Call(Func::Host(f @ (id::VALENCE | id::CREASES)), args, _),
+                    Ex::Const(Value::Int(k)),
+                ) => match args.as_slice() {
+                    [x] => Guard::Count(*f, code, *k, path(x, slot)?),
+                    _ => return None,
+                },
                 _ => return None,
             },
             Ex::Not(a) => Guard::Not(Box::new(Guard::leaf(a, slot)?)),
@@ -973,6 +1178,38 @@ impl Guard {
         })
     }
 
+    /// True when the guard is false for every element of a mesh with no
+    /// sharpness (`sharp(x)`, `creases(v) >= 2`, in a conjunction), and it
+    /// has no leaf the interpreter evaluates (which could fail): a rule
+    /// with such a guard matches nothing there, so it need not look.
+    pub fn never_without_creases(&self) -> bool {
+        fn no_invariant(g: &Guard) -> bool {
+            match g {
+                Guard::Invariant(_) => false,
+                Guard::Level(..) | Guard::Test(..) | Guard::Count(..) => true,
+                Guard::Not(a) => no_invariant(a),
+                Guard::And(a, b) | Guard::Or(a, b) => no_invariant(a) && no_invariant(b),
+            }
+        }
+        fn never(g: &Guard) -> bool {
+            match g {
+                Guard::Test(id::SHARP, _) => true,
+                Guard::Count(id::CREASES, op, k, _) => !match op {
+                    0 => 0 < *k,
+                    1 => 0 <= *k,
+                    2 => 0 > *k,
+                    3 => 0 >= *k,
+                    4 => 0 == *k,
+                    _ => 0 != *k,
+                },
+                Guard::And(a, b) => never(a) || never(b),
+                Guard::Or(a, b) => never(a) && never(b),
+                _ => false,
+            }
+        }
+        no_invariant(self) && never(self)
+    }
+
     pub fn test(&self, ev: &mut dyn Evaluate<'_>, elem: &Elem) -> Result<bool, RuntimeError> {
         Ok(match self {
             Guard::Level(op, p) => {
@@ -981,6 +1218,22 @@ impl Guard {
                     .is_some_and(|l| cmp(*op, l, host.current))
             }
             Guard::Test(f, p) => ev.host().test(*f, &Guard::at(*p, elem)),
+            Guard::Count(f, op, k, p) => {
+                let host = ev.host();
+                // What the call gives for something that is not a vertex.
+                let n = vertex_of(&Guard::at(*p, elem)).map_or(0, |v| match *f {
+                    id::VALENCE => host.mesh.valence(v) as i64,
+                    _ => host.mesh.sharp_edge_count(v) as i64,
+                });
+                match op {
+                    0 => n < *k,
+                    1 => n <= *k,
+                    2 => n > *k,
+                    3 => n >= *k,
+                    4 => n == *k,
+                    _ => n != *k,
+                }
+            }
             Guard::Invariant(x) => {
                 let key = &**x as *const Ex as usize;
                 if let Some((_, b)) = ev.memo().invariants.iter().find(|(k, _)| *k == key) {
@@ -1350,7 +1603,10 @@ fn integer_host(e: &Ex) -> bool {
             }
         }
         Ex::Call(Func::Host(f), ..) => {
-            if !matches!(*f, id::VALENCE | id::LEVEL | id::CURRENT | id::STEP) {
+            if !matches!(
+                *f,
+                id::VALENCE | id::LEVEL | id::CURRENT | id::STEP | id::CREASES
+            ) {
                 ok = false
             }
         }

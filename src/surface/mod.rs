@@ -121,8 +121,8 @@ mod tests {
         let g = from_front_with(front, specialise).unwrap_or_else(|e| panic!("{e}"));
         let (mesh, _) = g.mesh.clone().expect("the grammar names its mesh");
         let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("lsystems/surfaces");
-        let soup = io::read(&dir.join(mesh)).unwrap();
-        let mut m = Mesh::from_soup(&soup).unwrap();
+        // With the sharpness its file or the `.creases` file beside it gives.
+        let mut m = io::read_mesh(&dir.join(mesh)).unwrap();
         let ran = match protect {
             false => g.run(&mut m, steps, |_| {}),
             true => {
@@ -158,6 +158,16 @@ mod tests {
             .iter()
             .map(|f| (f.display().to_string(), std::fs::read_to_string(f).unwrap()))
             .collect();
+        // The crease rules, on meshes with creases (sharp, semi-sharp and
+        // corners: the `Count` guards, folds over `crease_ring`).
+        for (file, mesh, creased) in [
+            ("catmull-clark.lsys", "cube.obj", "creased-cube.ply"),
+            ("loop.lsys", "octahedron.obj", "creased-octahedron.obj"),
+        ] {
+            let text = std::fs::read_to_string(dir.join(file)).unwrap();
+            assert!(text.contains(mesh));
+            cases.push((format!("{file} on {creased}"), text.replace(mesh, creased)));
+        }
         // Forms the files do not use: differences, negations, divisions,
         // weights from counts and levels, guards on edge ends and on the
         // step alone.

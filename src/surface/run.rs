@@ -713,6 +713,7 @@ impl Grammar {
             adaptive: self.adaptive.is_some(),
             incremental: self.incremental,
             protect,
+            creased: mesh.has_sharpness(),
             ..RunState::default()
         };
         let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
@@ -791,6 +792,21 @@ impl Grammar {
     ) -> Result<(Matches, Matches), (bool, RuntimeError)> {
         // `c`, kept up to date by `apply_all` as rules make vertices.
         let current = state.current_level;
+        // A crease rule on a mesh without creases matches nothing.
+        if other.is_none()
+            && !mesh.has_sharpness_flag()
+            && rule
+                .guard
+                .as_ref()
+                .is_some_and(|g| g.never_without_creases())
+        {
+            let none = || Matches {
+                current,
+                vals: Vec::new(),
+                edge_ids: Vec::new(),
+            };
+            return Ok((none(), none()));
+        }
         let step = state.step;
         // The ids to test: every slot, or a work list where the run knows
         // that nothing else can match.
@@ -1363,6 +1379,12 @@ impl GrammarRun<'_> {
         self.state.made_before = std::mem::take(&mut self.state.made_now);
         self.grammar.apply_all(&each, self.mesh, &mut self.state)?;
         self.state.swap_positions(self.mesh);
+        // A step is one level of the scheme: semi-sharp creases and
+        // corners soften by one (OpenSubdiv's uniform rule). The rules of
+        // the step read the sharpness it started with.
+        if self.state.creased {
+            self.mesh.decrement_sharpness();
+        }
         debug_assert!(
             self.state
                 .protect
@@ -1418,6 +1440,9 @@ struct RunState {
     deadline: Option<crate::Deadline>,
     /// What no rule may match.
     protect: Option<Protected>,
+    /// Some edge or vertex was sharp when the run started: the steps
+    /// decrement sharpness (nothing else makes any).
+    creased: bool,
 }
 
 impl RunState {
@@ -1511,6 +1536,8 @@ fn edge_value(mesh: &Mesh, e: EdgeId, block: bool) -> Elem {
         mesh.is_boundary_edge(e),
         block,
         mesh.is_transversal_edge(e),
+        mesh.is_sharp_edge(e),
+        e,
     )
 }
 

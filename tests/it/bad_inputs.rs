@@ -267,7 +267,7 @@ fn lsys_run_line(path: &Path) -> Option<String> {
 }
 
 /// The folders of the non-`.lsys` kinds, by the test that runs them.
-const MESH_KINDS: &[&str] = &["obj", "off", "ply-ascii", "ply-binary"];
+const MESH_KINDS: &[&str] = &["obj", "off", "ply-ascii", "ply-binary", "creases"];
 const CONTOUR_KINDS: &[&str] = &["points", "svg", "png"];
 const DETAILS_KINDS: &[&str] = &["details"];
 const MODEL_KINDS: &[&str] = &["model"];

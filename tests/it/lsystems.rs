@@ -13,10 +13,14 @@
 //!   FILE` on the file's own base mesh as `NAME.obj` in a canonical form
 //!   ([`canonical_obj`]), and the counts, levels and valences that
 //!   `subgram derive FILE` prints as `NAME.txt`; the grammars with boundary
-//!   rules also run on `meshes/grid.obj`, as `NAME-on-grid.obj`;
+//!   rules also run on `meshes/grid.obj`, as `NAME-on-grid.obj`, and
+//!   those with crease rules on a mesh with creases, as
+//!   `NAME-creased.obj`;
 //! * a vv program (`vv/*.lsys`): as a surface grammar; those with boundary
 //!   rules also run on `meshes/pentagon-patch.obj`, as `NAME-on-patch.obj`;
-//! * a base mesh (`meshes/*.obj`): `subgram mesh info FILE` as `NAME.txt`;
+//! * a base mesh (`meshes/*.obj`, `meshes/*.ply`): `subgram mesh info
+//!   FILE` as `NAME.txt`; a `meshes/*.creases` file is read with the mesh
+//!   beside it;
 //! * a shape grammar (`shapes/*.lsys`): the OBJ file `subgram subdivide
 //!   --grammar FILE -o NAME.obj` writes (one group per terminal shape, in
 //!   tree order) as `NAME.obj`, and the shape tree `subgram derive FILE`
@@ -38,6 +42,13 @@ const FOLDERS: &[&str] = &[
 /// Surface grammars with boundary rules, run on the open grid as well.
 const ON_GRID: &[&str] = &["c4", "catmull-clark", "four-eight", "loop", "sqrt3"];
 
+/// Surface grammars with crease rules, also run on a mesh with creases,
+/// as `NAME-creased.obj`.
+const ON_CREASES: &[(&str, &str)] = &[
+    ("catmull-clark", "lsystems/meshes/creased-cube.ply"),
+    ("loop", "lsystems/meshes/creased-octahedron.obj"),
+];
+
 /// vv programs with boundary rules, run on the open triangle patch as well.
 const ON_PATCH: &[&str] = &["butterfly", "loop", "sqrt3"];
 
@@ -49,7 +60,9 @@ fn goldens(rel: &Path) -> Option<Vec<(PathBuf, Kind)>> {
     let folder = rel.parent()?.to_str()?;
     let with = |suffix: &str| base.with_file_name(format!("{stem}{suffix}"));
     match (folder, rel.extension()?.to_str()?) {
-        ("meshes", "obj") => Some(vec![(with(".txt"), Kind::Exact)]),
+        ("meshes", "obj" | "ply") => Some(vec![(with(".txt"), Kind::Exact)]),
+        // The sharpness of the mesh beside it: read with it.
+        ("meshes", "creases") => Some(vec![]),
         ("shapes", "lsys") => Some(vec![
             (with(".obj"), Kind::Numeric),
             (with(".txt"), Kind::Numeric),
@@ -58,6 +71,9 @@ fn goldens(rel: &Path) -> Option<Vec<(PathBuf, Kind)>> {
             let mut v = vec![(with(".obj"), Kind::Numeric), (with(".txt"), Kind::Exact)];
             if folder == "surfaces" && ON_GRID.contains(&stem) {
                 v.push((with("-on-grid.obj"), Kind::Numeric));
+            }
+            if folder == "surfaces" && ON_CREASES.iter().any(|(g, _)| *g == stem) {
+                v.push((with("-creased.obj"), Kind::Numeric));
             }
             if folder == "vv" && ON_PATCH.contains(&stem) {
                 v.push((with("-on-patch.obj"), Kind::Numeric));
@@ -199,6 +215,12 @@ fn outputs(rel: &Path) -> Result<Vec<Vec<u8>>, String> {
             &format!("{stem}-on-patch.obj"),
         )?);
     }
+    if let Some((_, mesh)) = ON_CREASES
+        .iter()
+        .find(|(g, _)| folder == "surfaces" && *g == stem)
+    {
+        v.push(subdivide(Some(mesh), &format!("{stem}-creased.obj"))?);
+    }
     Ok(v)
 }
 
@@ -230,6 +252,10 @@ fn check_folder(folder: &str) {
             failures.push(format!("lsystems/{}: no golden rule", rel.display()));
             continue;
         };
+        if goldens.is_empty() {
+            // An input read with another file (a `.creases` file).
+            continue;
+        }
         match outputs(&rel) {
             Ok(outs) => {
                 for ((path, kind), out) in goldens.iter().zip(outs) {

@@ -33,6 +33,7 @@ mod support;
 mod surface;
 mod surface_adaptive;
 mod surface_c4;
+mod surface_creases;
 mod surface_quad;
 mod vv;
 mod vv_adversarial;

@@ -407,7 +407,7 @@ fn surface_grammars_run_under_every_command() {
     let f = loop_file.to_str().unwrap();
     let o = bin(&["check", f]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(String::from_utf8_lossy(&o.stdout).contains("a surface grammar of 6 rules"));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("a surface grammar of 10 rules"));
     // Three Loop steps of the octahedron: 8 * 4^3 faces, valences 4 and 6.
     let o = bin(&["derive", f, "--format", "json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -663,3 +663,38 @@ fn small_open_meshes_end_in_blocks() {
         assert!(m.face_outside_blocks().is_none());
     }
 }
+
+/// The bunny through the other schemes too, each output validated, with
+/// the counts each refinement gives: Loop 4 faces a face, sqrt(3) 3 (a
+/// face split and a flip of every old edge), Catmull-Clark 3 quads a
+/// triangle and V + E + F vertices; the surface stays closed, genus 0.
+#[test]
+fn bunny_runs_through_loop_sqrt3_and_catmull_clark() {
+    let soup = subgram::mesh::io::read(&lsys("meshes/bunny.obj")).unwrap();
+    let (v, e, f) = (1839, 5511, 3674);
+    for (file, faces, vertices, quads) in [
+        ("surfaces/loop.lsys", 4 * f, v + e, None),
+        ("surfaces/sqrt3.lsys", 3 * f, v + f, None),
+        ("surfaces/catmull-clark.lsys", 6 * f, v + e + f, Some(3 * f)),
+    ] {
+        let g = grammar(file);
+        let mut m = Mesh::from_soup(&soup).unwrap();
+        g.run(&mut m, 1, |_| {})
+            .unwrap_or_else(|e| panic!("{}", g.render_error(&e)));
+        m.validate().unwrap();
+        assert_eq!(
+            (m.face_count(), m.vertex_count()),
+            (faces, vertices),
+            "{file}"
+        );
+        assert!(m.vertices().all(|v| !m.is_boundary_vertex(v)), "{file}");
+        assert_eq!(
+            m.vertex_count() as i64 - m.edge_count() as i64 + m.face_count() as i64,
+            2,
+            "{file}"
+        );
+        if let Some(q) = quads {
+            assert_eq!(m.to_quad_soup().faces.len(), q, "{file}");
+        }
+    }
+}
