@@ -43,9 +43,66 @@ pub struct Split {
     /// it the internal edge (the triangles `Mesh::match_blocks` leaves on
     /// the boundary). Set while a grammar that reads blocks runs.
     pub lone_triangles_join_blocks: bool,
+    /// Adaptive 4-8 refinement (with [`BlockSplit::Bisection`]): an
+    /// external edge of a split block becomes the internal edge of a block
+    /// only once the face across it has it as its refinement edge too
+    /// ([`Mesh::refinement_edge`]), so that a mark always means a
+    /// complete diamond. Where every block is split in a step, the marks
+    /// at the end of the step are those of plain bisection.
+    pub adaptive: bool,
 }
 
 impl Mesh {
+    /// The refinement edge of face `f` on a 4-8 mesh (a triangulated
+    /// quadrangulation refined by bisection, `blocks: bisection`): the
+    /// edge that splitting it would split. That is its block's internal
+    /// edge where it has one; a face without one was made by a bisection
+    /// whose other side is still coarser (an incomplete diamond), and its
+    /// refinement edge is the one opposite its newest vertex, the vertex
+    /// that bisection made (newest vertex bisection). Vertices are
+    /// numbered in the order they are made while no slot is reused, which
+    /// adaptive runs check ([`Mesh::reuses_vertex_slots`]).
+    pub fn refinement_edge(&self, f: FaceId) -> EdgeId {
+        let hs = self.face_halfedges(f);
+        if let Some(h) = hs.iter().find(|h| self.e_block[h.edge().index()]) {
+            return h.edge();
+        }
+        // The edge opposite the corner `from(h)` is `next(h)`.
+        let newest = hs
+            .into_iter()
+            .max_by_key(|&h| self.from(h).0)
+            .expect("a face has three half-edges");
+        self.next(newest).edge()
+    }
+
+    /// True when `e` is the refinement edge of a face beside it
+    /// ([`Mesh::refinement_edge`]): a diamond's diagonal, complete or not.
+    pub fn is_refinement_edge(&self, e: EdgeId) -> bool {
+        self.edge_faces(e)
+            .into_iter()
+            .flatten()
+            .any(|f| self.refinement_edge(f) == e)
+    }
+
+    /// For a refinement edge `e`: `None` when its diamond is complete
+    /// (every face beside it has it as its refinement edge), else the
+    /// refinement edge of the first face beside it that does not: the
+    /// edge whose split makes the diamond complete (paper 000, §9: the
+    /// refinement spreads to the neighbours as far as the rules need).
+    pub fn bisection_blocker(&self, e: EdgeId) -> Option<EdgeId> {
+        self.edge_faces(e)
+            .into_iter()
+            .flatten()
+            .map(|f| self.refinement_edge(f))
+            .find(|&r| r != e)
+    }
+
+    /// True when a vertex slot freed by a weld waits for reuse, so that a
+    /// new vertex would not have the highest number.
+    pub fn reuses_vertex_slots(&self) -> bool {
+        !self.free_v.is_empty()
+    }
+
     /// Face split: a new vertex `v` inside triangle `abc` joined to its
     /// three corners.
     ///
@@ -317,7 +374,16 @@ impl Mesh {
                     for f in faces.into_iter().flatten() {
                         for h in self.face_halfedges(f) {
                             if self.from(h) != v && self.to(h) != v {
-                                self.e_block[h.edge().index()] = true;
+                                // Adaptive: only a complete diamond is
+                                // marked; the face across may still be
+                                // half of a coarser block.
+                                let complete = !policy.adaptive
+                                    || self
+                                        .face(h.twin())
+                                        .is_none_or(|g| self.refinement_edge(g) == h.edge());
+                                if complete {
+                                    self.e_block[h.edge().index()] = true;
+                                }
                             }
                         }
                     }

@@ -29,6 +29,14 @@
 //! matching of the dual graph (`Mesh::match_blocks`, paper 004's
 //! preprocess); the triangles it leaves on the boundary are `lone(e)` for
 //! an `init:` boundary split, whose two halves make a block.
+//!
+//! A 4-8 grammar may add `adaptive;`: its split rules' conditions then
+//! select which blocks to split, and the run splits the coarser
+//! neighbours a selected block needs first, so that the mesh stays a 4-8
+//! mesh (`surface::run`, "Adaptive 4-8 refinement").
+//! `adaptive: incremental;` tests, from the second step on, only the
+//! diamonds at the vertices made since the step before, so that a step's
+//! work follows what the last one made rather than the mesh's size.
 
 use crate::mesh::BlockSplit;
 use crate::syntax::ast::Expr;
@@ -97,6 +105,13 @@ pub struct GrammarFile {
     /// `init: match_blocks;`: pair the triangles that are in no basic
     /// block by a maximum matching before the `init:` rules run.
     pub match_blocks: Option<Span>,
+    /// `adaptive;`: a 4-8 grammar (`blocks: bisection;`) whose split rules
+    /// may select some blocks only; the run keeps the mesh a 4-8 mesh by
+    /// splitting the coarser neighbours first (see `surface::run`).
+    pub adaptive: Option<Span>,
+    /// `adaptive: incremental;`: from the second step on, split rules test
+    /// only the diamonds at vertices made since the step before.
+    pub incremental: bool,
 }
 
 type R<T> = Result<T, Diagnostic>;
@@ -190,6 +205,24 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
             p.bump();
             p.expect_punct(";", "after the block refinement")?;
             g.block_split = Some((how, at));
+            continue;
+        }
+        if p.peek_ident("adaptive") && p.peek_at(1).is_some_and(|t| t.tok.is_punct(";")) {
+            g.adaptive = Some(p.span_here());
+            p.bump();
+            p.bump();
+            continue;
+        }
+        if at_key(&p, "adaptive") {
+            g.adaptive = Some(p.span_here());
+            p.bump();
+            p.bump();
+            if !p.peek_ident("incremental") {
+                return p.error("`incremental` after `adaptive:` (or `adaptive;` alone)");
+            }
+            p.bump();
+            p.expect_punct(";", "after `adaptive: incremental`")?;
+            g.incremental = true;
             continue;
         }
         if at_key(&p, "init") {
@@ -293,8 +326,8 @@ fn rule(p: &mut Parser, text_of: &impl Fn(Span) -> String) -> R<RuleDef> {
         Some(Tok::Ident(k)) if k == "V" => Kind::Vertex,
         _ => {
             return p.error(
-                "a rule starting with F, E or V, `init:`, `define`, `mesh:`, `blocks:` or \
-                 `derivation length:`",
+                "a rule starting with F, E or V, `init:`, `define`, `mesh:`, `blocks:`, \
+                 `adaptive;` or `derivation length:`",
             )
         }
     };

@@ -54,6 +54,11 @@ pub mod id {
     /// `sharpness(v, w)`: of the edge between two vertices.
     pub const SHARPNESS_BETWEEN: u16 = 24;
     pub const LONE: u16 = 25;
+    /// Guards of adaptive refinement: sizes and shape of the mesh now.
+    pub const AREA: u16 = 30;
+    pub const LENGTH: u16 = 31;
+    pub const ANGLE: u16 = 32;
+    pub const REFINED: u16 = 33;
     /// Fused `l(x) OP c`: the element and the operator's code.
     pub const LEVEL_VS_CURRENT: u16 = 100;
     /// Fused fold over a one-ring: the vertex, the fold and the filter.
@@ -406,6 +411,55 @@ static FUNCTIONS: &[Builtin] = &[
             _ => Err(SigError::Arity(3)),
         },
     },
+    // What adaptive refinement selects by (`adaptive;`), read from the
+    // positions as they are when the rule starts.
+    Builtin {
+        name: "area",
+        resolve: |a| {
+            one(
+                a,
+                &[EDGE, FACE],
+                "`area` takes a face (its area) or an edge (the area of the faces beside it: \
+                 a block's, for its internal edge)",
+            )?;
+            Ok((Func::Host(id::AREA), Ty::Double))
+        },
+    },
+    Builtin {
+        name: "length",
+        resolve: |a| {
+            one(
+                a,
+                &[EDGE],
+                "`length` takes an edge (for the length of a vector, use `Length`)",
+            )?;
+            Ok((Func::Host(id::LENGTH), Ty::Double))
+        },
+    },
+    Builtin {
+        name: "angle",
+        resolve: |a| {
+            one(
+                a,
+                &[EDGE],
+                "`angle` takes an edge: the angle in degrees between the normals of the two \
+                 faces beside it (0 on the boundary)",
+            )?;
+            Ok((Func::Host(id::ANGLE), Ty::Double))
+        },
+    },
+    Builtin {
+        name: "refined",
+        resolve: |a| {
+            one(
+                a,
+                &[VERTEX],
+                "`refined` takes a vertex: true when every face around it has a corner made \
+                 in this step",
+            )?;
+            Ok((Func::Host(id::REFINED), Ty::Bool))
+        },
+    },
 ];
 
 /// The table of the stellar topology.
@@ -655,6 +709,50 @@ impl Host for MeshHost<'_> {
                 },
                 None => return Err("this is not a vertex of the mesh".into()),
             },
+            id::AREA => match elem {
+                Some(e) if e.kind == FACE => Value::Float(triangle_area(
+                    m,
+                    [e.ids[0], e.ids[1], e.ids[2]].map(VertexId),
+                )),
+                Some(e) if e.kind == EDGE => Value::Float(
+                    edge_faces(m, &e)
+                        .into_iter()
+                        .flatten()
+                        .map(|vs| triangle_area(m, vs))
+                        .sum(),
+                ),
+                _ => Value::Float(f64::NAN),
+            },
+            id::LENGTH => match elem {
+                Some(e) if e.kind == EDGE => Value::Float(
+                    m.position(VertexId(e.ids[0]))
+                        .distance(m.position(VertexId(e.ids[1]))),
+                ),
+                _ => Value::Float(f64::NAN),
+            },
+            id::ANGLE => match elem {
+                Some(e) if e.kind == EDGE => match edge_faces(m, &e) {
+                    [Some(f), Some(g)] => {
+                        // A degenerate face has no normal: no angle.
+                        let (n, k) = (triangle_normal(m, f), triangle_normal(m, g));
+                        let cos = n.dot(k).clamp(-1.0, 1.0);
+                        let none = n == DVec3::ZERO || k == DVec3::ZERO;
+                        Value::Float(if none { 0.0 } else { cos.acos().to_degrees() })
+                    }
+                    _ => Value::Float(0.0),
+                },
+                _ => Value::Float(f64::NAN),
+            },
+            id::REFINED => Value::Bool(v().is_some_and(|v| {
+                let mut any = false;
+                for f in m.vertex_faces(v) {
+                    if !m.face_vertices(f).iter().any(|&w| self.is_new(w)) {
+                        return false;
+                    }
+                    any = true;
+                }
+                any
+            })),
             id::SHARP => match elem {
                 Some(e) if e.kind == VERTEX => {
                     Value::Bool(m.vertex_sharpness(VertexId(e.ids[0])) > 0.0)
@@ -739,6 +837,27 @@ impl Host for MeshHost<'_> {
             _ => {}
         }
     }
+}
+
+/// The corners of the faces beside edge value `e` (none for an edge that
+/// is no longer in the mesh), each counter-clockwise.
+fn edge_faces(m: &Mesh, e: &Elem) -> [Option<[VertexId; 3]>; 2] {
+    let (p, q) = (VertexId(e.ids[0]), VertexId(e.ids[1]));
+    let Some(h) = m.find_halfedge(p, q) else {
+        return [None, None];
+    };
+    [h, h.twin()].map(|h| m.face(h).map(|f| m.face_vertices(f)))
+}
+
+fn triangle_area(m: &Mesh, vs: [VertexId; 3]) -> f64 {
+    let [a, b, c] = vs.map(|v| m.position(v));
+    0.5 * (b - a).cross(c - a).length()
+}
+
+/// The unit normal of a triangle (zero for a degenerate one).
+fn triangle_normal(m: &Mesh, vs: [VertexId; 3]) -> DVec3 {
+    let [a, b, c] = vs.map(|v| m.position(v));
+    (b - a).cross(c - a).normalize_or_zero()
 }
 
 /// OpenSubdiv's rule of a vertex from its own sharpness and the

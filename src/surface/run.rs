@@ -47,6 +47,9 @@ pub struct Rule {
     pub text: String,
     /// Runs once, before the first step.
     pub init: bool,
+    /// A vertex rule whose condition is `refined(v) && ...`: only corners
+    /// of faces with a vertex made in this step can match.
+    needs_refined: bool,
 }
 
 /// A checked grammar, ready to run.
@@ -64,6 +67,14 @@ pub struct Grammar {
     pub dual_at: Option<Span>,
     /// What splitting a block's internal edge does (`blocks:`).
     pub block_split: BlockSplit,
+    /// Where the grammar says `adaptive;`: its split rules select blocks,
+    /// and the closure keeps the mesh a 4-8 mesh (see [`GrammarRun`]).
+    pub adaptive: Option<Span>,
+    /// `adaptive: incremental;`: from the second step on, split rules test
+    /// only the refinement edges of faces at vertices made in the step
+    /// before or in this one; a diamond not selected when it appeared is
+    /// not tested again.
+    pub incremental: bool,
     /// `init: match_blocks;`: triangles in no block are paired by a
     /// maximum matching before the `init:` rules.
     pub match_blocks_at: Option<Span>,
@@ -116,6 +127,18 @@ fn first_call(e: &Ex, f: u16) -> Option<Span> {
         }
     });
     found
+}
+
+/// True when `e` is `refined(x)` on the local `slot`, or a conjunction
+/// with such a term: `e` can hold only where `refined` does.
+fn requires_refined(e: &Ex, slot: u16) -> bool {
+    match e {
+        Ex::Logic(true, a, b) => requires_refined(a, slot) || requires_refined(b, slot),
+        Ex::Call(Func::Host(id::REFINED), args, _) => {
+            matches!(args.as_slice(), [Ex::Local(s)] if *s == slot)
+        }
+        _ => false,
+    }
 }
 
 /// Compiles a parsed grammar file: its conditions and assignments are
@@ -185,6 +208,9 @@ pub(crate) fn compile_with(
             guard = cond.as_ref().and_then(|c| host::Guard::of(c, elem_slot));
             affine = assign.as_ref().and_then(host::Affine::of);
         }
+        let needs_refined = cond
+            .as_ref()
+            .is_some_and(|c| requires_refined(c, elem_slot));
         rules.push(Rule {
             guard,
             affine,
@@ -198,6 +224,7 @@ pub(crate) fn compile_with(
             span: r.span,
             text: r.text.clone(),
             init: r.init,
+            needs_refined,
         });
     }
     let length = match &file.length {
@@ -241,6 +268,25 @@ pub(crate) fn compile_with(
             })
         }
     };
+    if let Some(at) = file.adaptive {
+        if !matches!(file.block_split, Some((BlockSplit::Bisection, _))) {
+            diags.push(Diagnostic::new(
+                at,
+                "`adaptive;` is for 4-8 grammars, which refine by bisection: it needs \
+                 `blocks: bisection;`",
+            ));
+        }
+        for r in file.rules.iter().filter(|r| !r.init) {
+            if matches!(r.op, Op::FaceSplit | Op::Flip) {
+                diags.push(Diagnostic::new(
+                    r.span,
+                    "an adaptive 4-8 grammar refines by splitting blocks' internal edges only; \
+                     a face split or an edge flip would break its blocks (put it under `init:`, \
+                     or drop `adaptive;`)",
+                ));
+            }
+        }
+    }
     if !diags.is_empty() {
         diags.sort_by_key(|d| (d.span.file.0, d.span.start));
         return Err((sources, diags));
@@ -261,6 +307,8 @@ pub(crate) fn compile_with(
         block_split: file
             .block_split
             .map_or(BlockSplit::Quadrisection, |(b, _)| b),
+        adaptive: file.adaptive,
+        incremental: file.incremental,
         match_blocks_at: file.match_blocks,
         max_faces: MAX_FACES,
         max_valence: MAX_VALENCE,
@@ -662,11 +710,16 @@ impl Grammar {
             valence_bound: highest,
             blocks: self.block_split,
             lone_triangles_join_blocks: self.block_used_at.is_some(),
+            adaptive: self.adaptive.is_some(),
+            incremental: self.incremental,
             protect,
             creased: mesh.has_sharpness(),
             ..RunState::default()
         };
         let init: Vec<&Rule> = self.rules.iter().filter(|r| r.init).collect();
+        // The init rules prepare the blocks; the adaptive closure starts
+        // with the first step.
+        state.adaptive = false;
         if let Some(span) = self.match_blocks_at {
             // Paper 004's preprocess: the triangles paired into blocks; those
             // left on the boundary are for an `init:` boundary split. A mesh
@@ -693,8 +746,15 @@ impl Grammar {
         } else {
             self.apply_all(&init, mesh, &mut state)?;
         }
+        state.adaptive = self.adaptive.is_some();
         // What init's vertex rules wrote is current before the first step.
         state.swap_positions(mesh);
+        if let Some(span) = self.adaptive {
+            check_adaptive_start(mesh).map_err(|message| RunError {
+                span: Some(span),
+                message,
+            })?;
+        }
         debug_assert!(state.protect.as_ref().is_none_or(|p| p.intact(mesh)));
         Ok(GrammarRun {
             grammar: self,
@@ -748,11 +808,16 @@ impl Grammar {
             return Ok((none(), none()));
         }
         let step = state.step;
-        let slots = match rule.op {
-            Op::FaceSplit => mesh.f_alive.len(),
-            Op::EdgeSplit | Op::BoundarySplit | Op::Flip => mesh.e_alive.len(),
-            Op::Vertex => mesh.v_alive.len(),
+        // The ids to test: every slot, or a work list where the run knows
+        // that nothing else can match.
+        let list = state.work_list(rule, mesh);
+        let slots = match (&list, rule.op) {
+            (Some(l), _) => l.len(),
+            (None, Op::FaceSplit) => mesh.f_alive.len(),
+            (None, Op::EdgeSplit | Op::BoundarySplit | Op::Flip) => mesh.e_alive.len(),
+            (None, Op::Vertex) => mesh.v_alive.len(),
         };
+        let id_at = |i: u32| list.as_ref().map_or(i, |l| l[i as usize]);
         let frame_len = rule.frame.max(other.map_or(0, |o| o.frame));
         // What a protection leaves out is never tested, so the guards and
         // every specialised path see the same elements.
@@ -770,7 +835,7 @@ impl Grammar {
                 let (mut a, mut b): (Part, Part) = Default::default();
                 match rule.op {
                     Op::FaceSplit => {
-                        for f in (lo..hi).map(crate::mesh::FaceId) {
+                        for f in (lo..hi).map(|i| crate::mesh::FaceId(id_at(i))) {
                             if mesh.is_face(f) && protect.is_none_or(|p| p.face_free(mesh, f)) {
                                 let hs = mesh.face_halfedges(f);
                                 let val = host::face(
@@ -787,7 +852,7 @@ impl Grammar {
                     }
                     Op::EdgeSplit | Op::BoundarySplit | Op::Flip => {
                         let want_boundary = rule.op == Op::BoundarySplit;
-                        for e in (lo..hi).map(crate::mesh::EdgeId) {
+                        for e in (lo..hi).map(|i| crate::mesh::EdgeId(id_at(i))) {
                             if !mesh.is_edge(e) || protect.is_some_and(|p| !p.edge_free(mesh, e)) {
                                 continue;
                             }
@@ -799,19 +864,18 @@ impl Grammar {
                             } else {
                                 continue;
                             };
-                            // A boundary edge runs the way its face does.
-                            let h = e.halfedge();
-                            let h = if mesh.face(h).is_none() { h.twin() } else { h };
-                            let val = host::edge(
-                                mesh.from(h),
-                                mesh.to(h),
-                                mesh.edge_level(e),
-                                on_boundary,
-                                mesh.is_block_edge(e),
-                                mesh.is_transversal_edge(e),
-                                mesh.is_sharp_edge(e),
-                                e,
-                            );
+                            // An adaptive split rule sees the diagonals of
+                            // diamonds, complete or not, as blocks' internal
+                            // edges, and nothing else.
+                            let block = if state.adaptive && r.op != Op::Flip {
+                                if !mesh.is_refinement_edge(e) {
+                                    continue;
+                                }
+                                true
+                            } else {
+                                mesh.is_block_edge(e)
+                            };
+                            let val = edge_value(mesh, e, block);
                             if ev.test(r, &val).map_err(|e| (!std::ptr::eq(r, rule), e))? {
                                 out.0.push(val);
                                 out.1.push(e);
@@ -819,7 +883,7 @@ impl Grammar {
                         }
                     }
                     Op::Vertex => {
-                        for v in (lo..hi).map(VertexId) {
+                        for v in (lo..hi).map(|i| VertexId(id_at(i))) {
                             if !mesh.is_vertex(v)
                                 || mesh.outgoing(v).is_none()
                                 || protect.is_some_and(|p| !p.vertex_free(v))
@@ -909,6 +973,7 @@ impl Grammar {
         state: &mut RunState,
     ) -> Result<(), RunError> {
         let step = state.step as usize;
+        let splits = |r: &Rule| matches!(r.op, Op::EdgeSplit | Op::BoundarySplit);
         // c: the highest vertex level, raised below by the vertices that
         // splits make (rules never remove vertices).
         state.current_level = mesh
@@ -932,6 +997,22 @@ impl Grammar {
                 )
             });
             match pair {
+                _ if state.adaptive && splits(rule) => {
+                    let (a, b) = self
+                        .find_matches_with(rule, pair.copied(), mesh, state)
+                        .map_err(|(in_next, e)| {
+                            self.runtime_error(
+                                match pair {
+                                    Some(next) if in_next => next,
+                                    _ => rule,
+                                },
+                                step,
+                                e,
+                            )
+                        })?;
+                    self.apply_adaptive(rule, pair.copied(), mesh, state, a, b)?;
+                    i += 1 + pair.is_some() as usize;
+                }
                 Some(next) => {
                     let (a, b) = self
                         .find_matches_with(rule, Some(next), mesh, state)
@@ -950,6 +1031,143 @@ impl Grammar {
                     i += 1;
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// Adaptive 4-8 refinement: `rule` (and `other`, the split rule of the
+    /// other context written next to it) matched `a` (and `b`) when it
+    /// started. A selected edge whose diamond is incomplete, because the
+    /// face across it is still half of a coarser block, waits until that
+    /// block's internal edge is split, which may wait in turn (the forced
+    /// splits of 4-8 and ROAM hierarchies). So the splits go in rounds:
+    /// each splits every complete diamond that is selected or needed, in
+    /// id order, interior edges by the interior rule and boundary edges by
+    /// the boundary rule, as written; their new vertices get the rule's
+    /// assignment before the next round, which may read them. Where every
+    /// diamond is selected and complete (uniform refinement), there is one
+    /// round, and it does what the rules do without `adaptive;`.
+    fn apply_adaptive(
+        &self,
+        rule: &Rule,
+        other: Option<&Rule>,
+        mesh: &mut Mesh,
+        state: &mut RunState,
+        a: Matches,
+        b: Matches,
+    ) -> Result<(), RunError> {
+        let step = state.step as usize;
+        let current = a.current;
+        let fail = |r: &Rule, m: String| RunError {
+            span: Some(r.span),
+            message: format!("at step {step}, rule `{}`: {m}", r.text),
+        };
+        let rules: Vec<&Rule> = std::iter::once(rule).chain(other).collect();
+        let rule_for = |boundary: bool| {
+            let want = if boundary {
+                Op::BoundarySplit
+            } else {
+                Op::EdgeSplit
+            };
+            rules.iter().position(|r| r.op == want)
+        };
+        // The values the selected edges had when the rule started.
+        let mut selected: std::collections::HashMap<EdgeId, Elem> = a
+            .edge_ids
+            .iter()
+            .zip(&a.vals)
+            .chain(b.edge_ids.iter().zip(&b.vals))
+            .map(|(&e, &v)| (e, v))
+            .collect();
+        let mut todo: Vec<EdgeId> = a.edge_ids.iter().chain(&b.edge_ids).copied().collect();
+        todo.sort_unstable();
+        while !todo.is_empty() {
+            if let Err(m) = crate::deadline::check(state.deadline) {
+                return Err(fail(rule, m));
+            }
+            // The complete diamonds among the edges wanted, and the
+            // blocking edges of the others, followed down to complete ones.
+            let mut now: Vec<EdgeId> = Vec::new();
+            let mut later: Vec<EdgeId> = Vec::new();
+            let mut seen = std::collections::HashSet::new();
+            let mut stack: Vec<EdgeId> = todo.iter().rev().copied().collect();
+            while let Some(e) = stack.pop() {
+                if !seen.insert(e) {
+                    continue;
+                }
+                match mesh.bisection_blocker(e) {
+                    None => now.push(e),
+                    Some(d) => {
+                        later.push(e);
+                        stack.push(d);
+                    }
+                }
+            }
+            if now.is_empty() {
+                let (p, q) = mesh.edge_vertices(todo[0]);
+                return Err(fail(
+                    rule,
+                    format!(
+                        "the edge between vertices {p} and {q} is selected, but no diamond it \
+                         waits for can be split: the blocks are not those of a 4-8 mesh"
+                    ),
+                ));
+            }
+            now.sort_unstable();
+            later.sort_unstable();
+            let mut per_rule: Vec<Vec<EdgeId>> = vec![Vec::new(); rules.len()];
+            for &e in &now {
+                let boundary = mesh.is_boundary_edge(e);
+                let Some(k) = rule_for(boundary) else {
+                    let (p, q) = mesh.edge_vertices(e);
+                    return Err(fail(
+                        rule,
+                        format!(
+                            "a selected block needs the {} edge between vertices {p} and {q} \
+                             split first, but no {} split rule is written next to this one",
+                            if boundary { "boundary" } else { "interior" },
+                            if boundary { "boundary" } else { "interior" },
+                        ),
+                    ));
+                };
+                if let Some(p) = state.protect.as_ref() {
+                    if !p.edge_free(mesh, e) {
+                        let (p, q) = mesh.edge_vertices(e);
+                        return Err(fail(
+                            rules[k],
+                            format!(
+                                "the edge between vertices {p} and {q} must be split, but it \
+                                 is protected"
+                            ),
+                        ));
+                    }
+                }
+                per_rule[k].push(e);
+            }
+            for (k, edges) in per_rule.into_iter().enumerate() {
+                if edges.is_empty() {
+                    continue;
+                }
+                let vals: Vec<Elem> = edges
+                    .iter()
+                    .map(|e| {
+                        selected
+                            .remove(e)
+                            .unwrap_or_else(|| edge_value(mesh, *e, true))
+                    })
+                    .collect();
+                self.apply_matched(
+                    rules[k],
+                    mesh,
+                    state,
+                    Matches {
+                        current,
+                        vals,
+                        edge_ids: edges,
+                    },
+                )?;
+            }
+            todo = later;
         }
         Ok(())
     }
@@ -1070,6 +1288,9 @@ impl Grammar {
                     };
                     made.push((v, val));
                 }
+                if state.adaptive {
+                    state.made_now.extend(made.iter().map(|(v, _)| *v));
+                }
                 state.check_valence(mesh).map_err(fail)?;
                 state.current_level = made
                     .iter()
@@ -1155,6 +1376,7 @@ impl GrammarRun<'_> {
         let each: Vec<&Rule> = self.grammar.rules.iter().filter(|r| !r.init).collect();
         // Vertices made from here on record this step (`new(v)`).
         self.state.step += 1;
+        self.state.made_before = std::mem::take(&mut self.state.made_now);
         self.grammar.apply_all(&each, self.mesh, &mut self.state)?;
         self.state.swap_positions(self.mesh);
         // A step is one level of the scheme: semi-sharp creases and
@@ -1201,6 +1423,15 @@ struct RunState {
     blocks: BlockSplit,
     /// Set for grammars that read blocks: a face split then makes blocks.
     lone_triangles_join_blocks: bool,
+    /// An adaptive 4-8 run (`adaptive;`): split rules see refinement
+    /// edges only, and the closure splits coarser neighbours first.
+    adaptive: bool,
+    /// `adaptive: incremental;`.
+    incremental: bool,
+    /// In adaptive runs: the vertices splits made in this step, and in
+    /// the step before (the work lists of matching).
+    made_now: Vec<VertexId>,
+    made_before: Vec<VertexId>,
     /// The highest valence a rule may leave (see [`Grammar::max_valence`]).
     valence_limit: usize,
     /// At least the highest valence in the mesh (see `check_valence`).
@@ -1221,7 +1452,40 @@ impl RunState {
             step: self.step,
             blocks: self.blocks,
             lone_triangles_join_blocks: self.lone_triangles_join_blocks,
+            adaptive: self.adaptive,
         }
+    }
+
+    /// The ids `rule` may match, in increasing order, where an adaptive
+    /// run knows that no other element can: for a vertex rule that
+    /// requires `refined(v)`, the vertices made in this step and their
+    /// neighbours (a corner of a face with a new vertex is one of them);
+    /// for a split rule of an incremental run after its first step, the
+    /// refinement edges of the faces at the vertices made in the step
+    /// before or in this one. `None`: every slot.
+    fn work_list(&self, rule: &Rule, mesh: &Mesh) -> Option<Vec<u32>> {
+        if !self.adaptive {
+            return None;
+        }
+        let mut ids: Vec<u32> = match rule.op {
+            Op::Vertex if rule.needs_refined => self
+                .made_now
+                .iter()
+                .flat_map(|&v| std::iter::once(v).chain(mesh.one_ring(v)))
+                .map(|v| v.0)
+                .collect(),
+            Op::EdgeSplit | Op::BoundarySplit if self.incremental && self.step >= 2 => self
+                .made_before
+                .iter()
+                .chain(&self.made_now)
+                .flat_map(|&v| mesh.vertex_faces(v))
+                .map(|f| mesh.refinement_edge(f).0)
+                .collect(),
+            _ => return None,
+        };
+        ids.sort_unstable();
+        ids.dedup();
+        Some(ids)
     }
 
     /// Refuses a mesh with a vertex of higher valence than the limit.
@@ -1259,6 +1523,53 @@ impl RunState {
 
 /// Elements per parallel task: small jobs stay on one thread.
 const CHUNK: usize = 16384;
+
+/// An edge as a rule's value: its ends (a boundary edge runs the way its
+/// face does), level and marks, `block` the block mark it shows.
+fn edge_value(mesh: &Mesh, e: EdgeId, block: bool) -> Elem {
+    let h = e.halfedge();
+    let h = if mesh.face(h).is_none() { h.twin() } else { h };
+    host::edge(
+        mesh.from(h),
+        mesh.to(h),
+        mesh.edge_level(e),
+        mesh.is_boundary_edge(e),
+        block,
+        mesh.is_transversal_edge(e),
+        mesh.is_sharp_edge(e),
+        e,
+    )
+}
+
+/// An adaptive run starts on a 4-8 mesh: every face has exactly one edge
+/// that is a block's internal edge (so every face is half of a block,
+/// or of a boundary half-block), and vertices are numbered in the order
+/// they were made ([`Mesh::refinement_edge`] reads the newest vertex).
+fn check_adaptive_start(mesh: &Mesh) -> Result<(), String> {
+    for f in mesh.faces() {
+        let marked = mesh
+            .face_edges(f)
+            .iter()
+            .filter(|&&e| mesh.is_block_edge(e))
+            .count();
+        if marked != 1 {
+            let [a, b, c] = mesh.face_vertices(f).map(|v| v.index() + 1);
+            return Err(format!(
+                "adaptive 4-8 refinement needs every triangle to be half of exactly one basic \
+                 block, but the triangle on vertices {a}, {b} and {c} has {marked} internal \
+                 edges of blocks"
+            ));
+        }
+    }
+    if mesh.reuses_vertex_slots() {
+        return Err(
+            "adaptive 4-8 refinement needs vertices numbered in the order they \
+                    were made, but this mesh has vertex slots freed for reuse"
+                .into(),
+        );
+    }
+    Ok(())
+}
 
 fn vertex_of(val: &Elem) -> VertexId {
     host::vertex_of(val).unwrap_or(VertexId(u32::MAX))

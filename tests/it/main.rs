@@ -31,6 +31,7 @@ mod semantics;
 mod shapes;
 mod support;
 mod surface;
+mod surface_adaptive;
 mod surface_c4;
 mod surface_creases;
 mod surface_quad;
