@@ -563,4 +563,141 @@ mod tests {
         assert_eq!(real_pairs, 1);
         assert!((0..3).all(|i| mate[i] != NONE));
     }
+
+    /// The size of a maximum matching by dynamic programming over subsets
+    /// of nodes (the lowest node of a subset is either left free or
+    /// matched with a neighbour in the subset): a reference for graphs of
+    /// up to 20 nodes, with no limit on the number of edges.
+    fn by_subsets(n: usize, edges: &[(u32, u32)]) -> usize {
+        let mut nb = vec![0u32; n];
+        for &(a, b) in edges {
+            nb[a as usize] |= 1 << b;
+            nb[b as usize] |= 1 << a;
+        }
+        let mut best = vec![0u8; 1 << n];
+        for mask in 1usize..1 << n {
+            let i = mask.trailing_zeros() as usize;
+            let rest = mask & !(1 << i);
+            let mut b = best[rest];
+            let mut cand = nb[i] as usize & rest;
+            while cand != 0 {
+                let j = cand.trailing_zeros() as usize;
+                cand &= cand - 1;
+                b = b.max(1 + best[rest & !(1 << j)]);
+            }
+            best[mask] = b;
+        }
+        best[(1 << n) - 1] as usize
+    }
+
+    #[test]
+    fn larger_random_graphs_match_the_subset_reference() {
+        // Graphs of 6 to 18 nodes, sparse to dense, many with odd cycles
+        // nested in one another: blossoms inside blossoms.
+        let mut s = 987654321u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) as u32
+        };
+        for round in 0..1500 {
+            let n = 6 + (next() % 13) as usize;
+            let p = 2 + round % 6; // an edge with probability 1/p
+            let mut edges = Vec::new();
+            for a in 0..n as u32 {
+                for b in a + 1..n as u32 {
+                    if next() % p as u32 == 0 {
+                        edges.push((a, b));
+                    }
+                }
+            }
+            // Shuffle the node numbers' order of search by shuffling edges.
+            for i in (1..edges.len()).rev() {
+                let j = next() as usize % (i + 1);
+                edges.swap(i, j);
+            }
+            assert_eq!(check(n, &edges), by_subsets(n, &edges), "n {n}: {edges:?}");
+        }
+    }
+
+    /// The most real nodes a matching can cover when node `i` may also be
+    /// matched with a stand-in of its own (`has_stand_in[i]`): the same
+    /// subset recursion, the lowest node left free, matched with its
+    /// stand-in (one node covered) or with a neighbour (two).
+    fn covering_by_subsets(n: usize, edges: &[(u32, u32)], has_stand_in: &[bool]) -> usize {
+        let mut nb = vec![0u32; n];
+        for &(a, b) in edges {
+            nb[a as usize] |= 1 << b;
+            nb[b as usize] |= 1 << a;
+        }
+        let mut best = vec![0u8; 1 << n];
+        for mask in 1usize..1 << n {
+            let i = mask.trailing_zeros() as usize;
+            let rest = mask & !(1 << i);
+            let mut b = best[rest] + has_stand_in[i] as u8;
+            let mut cand = nb[i] as usize & rest;
+            while cand != 0 {
+                let j = cand.trailing_zeros() as usize;
+                cand &= cand - 1;
+                b = b.max(2 + best[rest & !(1 << j)]);
+            }
+            best[mask] = b;
+        }
+        best[(1 << n) - 1] as usize
+    }
+
+    #[test]
+    fn stand_ins_cover_as_many_real_nodes_as_can_be() {
+        // Random graphs with real nodes 0..r and stand-ins r..n, each
+        // stand-in on one real node (a boundary edge) and at most one per
+        // real node: the pairing must keep a maximum matching among the
+        // real nodes and, besides, cover as many real nodes as any matching
+        // can (reference: `covering_by_subsets`).
+        let mut s = 55555u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) as u32
+        };
+        for round in 0..1500 {
+            let r = 3 + (next() % 11) as usize;
+            let p = 2 + round % 5;
+            let mut edges = Vec::new();
+            for a in 0..r as u32 {
+                for b in a + 1..r as u32 {
+                    if next() % p as u32 == 0 {
+                        edges.push((a, b));
+                    }
+                }
+            }
+            let real_edges = edges.clone();
+            let mut n = r;
+            for a in 0..r as u32 {
+                if next() % 4 == 0 {
+                    edges.push((a, n as u32));
+                    n += 1;
+                }
+            }
+            let g = Graph::from_edges(n, &edges);
+            let mut budget = u64::MAX;
+            let mate = maximum_matching(&g, r, &mut budget);
+            for (i, &m) in mate.iter().enumerate() {
+                if m != NONE {
+                    assert_eq!(mate[m as usize], i as u32);
+                    assert!(edges.contains(&(i as u32, m)) || edges.contains(&(m, i as u32)));
+                }
+            }
+            let rr = (0..r).filter(|&i| mate[i] != NONE && (mate[i] as usize) < r).count() / 2;
+            let covered = (0..r).filter(|&i| mate[i] != NONE).count();
+            let best_rr = by_subsets(r, &real_edges);
+            assert_eq!(rr, best_rr, "{edges:?}");
+            let has_stand_in: Vec<bool> = (0..r as u32)
+                .map(|a| edges.iter().any(|&(x, y)| x == a && y as usize >= r))
+                .collect();
+            let best_cover = covering_by_subsets(r, &real_edges, &has_stand_in);
+            assert_eq!(covered, best_cover, "r {r}: {edges:?}");
+        }
+    }
 }
