@@ -12,5 +12,6 @@ pub mod stellar;
 pub mod validate;
 
 pub use halfedge::{EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId};
+pub use build::SoupSharpness;
 pub use soup::{MeshFileError, Place, PolygonSoup};
 pub use stellar::{BlockSplit, Split};
