@@ -582,10 +582,7 @@ enum Kind {
 /// `subgram subdivide`: runs a surface grammar or a vv program on a mesh,
 /// or derives a shape grammar, and writes the mesh or its picture. The
 /// file is read and lexed once.
-pub fn subdivide(
-    a: &SubdivideArgs,
-    progress: impl FnMut(Progress),
-) -> Result<Vec<String>, Error> {
+pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<Vec<String>, Error> {
     let deadline = a.timeout.map(Deadline::after);
     let grammar = Path::new(&a.grammar);
     let output = Path::new(&a.output);
@@ -702,7 +699,12 @@ fn write_mesh(output: &Path, m: &Mesh, triangles: bool) -> Result<Vec<String>, E
     }
     let mut warnings: Vec<String> = lost
         .into_iter()
-        .map(|what| format!("{}: warning: the file does not keep {what}", output.display()))
+        .map(|what| {
+            format!(
+                "{}: warning: the file does not keep {what}",
+                output.display()
+            )
+        })
         .collect();
     // A file of creases beside the output is read with it from now on.
     let side = output.with_extension(mesh::io::CREASES_EXTENSION);

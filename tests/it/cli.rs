@@ -464,25 +464,43 @@ fn writing_a_creased_mesh_keeps_or_reports_its_sharpness() {
         assert_eq!(r.code, Some(0), "{}", r.stderr);
         assert_eq!(r.stderr, "", "a PLY keeps every sharp edge");
         let back = read_mesh(&dir.join("c.ply")).unwrap();
-        assert_eq!(sharp_edges(&back), sharp_edges(&source), "--triangles {triangles}");
+        assert_eq!(
+            sharp_edges(&back),
+            sharp_edges(&source),
+            "--triangles {triangles}"
+        );
     }
     let r = run_in(&dir, &["mesh", "convert", cube, "c.obj"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(
-        r.stderr.starts_with("c.obj: warning: the file does not keep 6 sharp edges"),
+        r.stderr
+            .starts_with("c.obj: warning: the file does not keep 6 sharp edges"),
         "{}",
         r.stderr
     );
     let r = run_in(&dir, &["mesh", "convert", octa, "o.ply"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(
-        r.stderr.starts_with("o.ply: warning: the file does not keep 1 sharp vertex"),
+        r.stderr
+            .starts_with("o.ply: warning: the file does not keep 1 sharp vertex"),
         "{}",
         r.stderr
     );
-    assert_eq!(sharp_edges(&read_mesh(&dir.join("o.ply")).unwrap()).len(), 5);
+    assert_eq!(
+        sharp_edges(&read_mesh(&dir.join("o.ply")).unwrap()).len(),
+        5
+    );
     let cc = lsys("surfaces/catmull-clark.lsys");
-    let args = ["subdivide", cube, "--grammar", cc.to_str().unwrap(), "-n", "2", "-o", "s.ply"];
+    let args = [
+        "subdivide",
+        cube,
+        "--grammar",
+        cc.to_str().unwrap(),
+        "-n",
+        "2",
+        "-o",
+        "s.ply",
+    ];
     let r = run_in(&dir, &args);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     let s = sharp_edges(&read_mesh(&dir.join("s.ply")).unwrap());
