@@ -326,7 +326,7 @@ pub fn write(path: &Path, soup: &PolygonSoup) -> Result<(), MeshFileError> {
         .map_err(|e| error(&name, None, format!("cannot write the file: {e}")))
 }
 
-/// Writes `soup` to `path` as [`write`] does, with the sharp `edges` (two
+/// Writes `soup` to `path` as [`write()`] does, with the sharp `edges` (two
 /// soup vertices, from 0, and a sharpness) where the format carries them:
 /// a PLY `edge` element with `vertex1`, `vertex2` and `crease`, which
 /// [`read_mesh`] reads back. OBJ and OFF have no place for them; the
