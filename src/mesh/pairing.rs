@@ -386,6 +386,9 @@ impl Mesh {
     /// stay; on a base mesh (all vertices at level 0) the levels become
     /// those of a tri-quad mesh (internal edges 0, the others 1).
     ///
+    /// Two triangles across a sharp edge are never paired (the edge would
+    /// become a quad's diagonal).
+    ///
     /// An error, with the mesh unchanged, when an interior triangle cannot
     /// be paired or `budget` runs out.
     pub fn match_blocks(&mut self, budget: u64) -> Result<Pairing, MeshError> {
@@ -407,6 +410,10 @@ impl Mesh {
         let mut stand_ins: Vec<EdgeId> = Vec::new();
         for e in self.edges() {
             match self.edge_faces(e) {
+                // Never across a crease: a sharp edge made a block's
+                // internal edge would be a quad's diagonal, which the
+                // crease rules (and the mesh files) do not have.
+                [Some(_), Some(_)] if self.is_sharp_edge(e) => {}
                 [Some(a), Some(b)] => {
                     let (na, nb) = (node_of[a.index()], node_of[b.index()]);
                     if na != NONE && nb != NONE && a != b {
@@ -446,9 +453,14 @@ impl Mesh {
         }
         if let Some(i) = (0..real).find(|&i| mate[i] == NONE) {
             let [a, b, c] = self.face_vertices(faces[i]);
+            let creases = if self.has_sharpness_flag() {
+                " (no pair is made across a sharp edge)"
+            } else {
+                ""
+            };
             return Err(MeshError::new(format!(
                 "pairing triangles into blocks: the triangle on vertices {a}, {b} and {c} cannot be \
-                 paired with a neighbour, nor moved to the boundary along an alternating path"
+                 paired with a neighbour, nor moved to the boundary along an alternating path{creases}"
             )));
         }
         let base = self.vertices().all(|v| self.vertex_level(v) == 0);
