@@ -582,7 +582,7 @@ enum Kind {
 /// `subgram subdivide`: runs a surface grammar or a vv program on a mesh,
 /// or derives a shape grammar, and writes the mesh or its picture. The
 /// file is read and lexed once.
-pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<(), Error> {
+pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<Vec<String>, Error> {
     let deadline = a.timeout.map(Deadline::after);
     let grammar = Path::new(&a.grammar);
     let output = Path::new(&a.output);
@@ -637,7 +637,7 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         let mtl = output.with_extension("mtl");
         refuse_overwrite(&[output, &mtl], &as_paths(&inputs), a.force)?;
         let run = shapes.derive(&opts)?;
-        return write_shapes(&shapes, &run, output, &looks);
+        return write_shapes(&shapes, &run, output, &looks).map(|()| Vec::new());
     }
     // A vv program subdivides too.
     if kind == Kind::Vv {
@@ -649,9 +649,10 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
         }
         let run = v.run(&opts, progress)?;
         if Picture::from_path(output).is_ok() {
-            return write_soup_picture(&run.soup, output, &looks);
+            return write_soup_picture(&run.soup, output, &looks).map(|()| Vec::new());
         }
-        return Ok(mesh::io::write(output, &run.soup)?);
+        mesh::io::write(output, &run.soup)?;
+        return Ok(Vec::new());
     }
     let g = crate::load::with_stack(move || crate::surface::from_front(front))?;
     let surface = Surface::new(g, Some(grammar));
@@ -662,9 +663,60 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<()
     }
     let run = surface.subdivide(&opts, progress)?;
     if Picture::from_path(output).is_ok() {
-        return write_mesh_picture(&run.mesh, output, &looks);
+        return write_mesh_picture(&run.mesh, output, &looks).map(|()| Vec::new());
     }
-    Ok(mesh::io::write(output, &run.mesh.to_quad_soup())?)
+    write_mesh(output, &run.mesh, false)
+}
+
+/// Writes `m` to `output` (basic blocks as quads unless `triangles`) with
+/// its sharp edges where the format carries them (PLY); a warning for
+/// each kind of sharpness the file cannot hold, which would otherwise be
+/// lost without a word.
+fn write_mesh(output: &Path, m: &Mesh, triangles: bool) -> Result<Vec<String>, Error> {
+    let (soup, sharp) = m.to_soup_with_sharpness(triangles);
+    mesh::io::write_with_sharpness(output, &soup, &sharp.edges)?;
+    let ply = mesh::io::Format::from_path(output) == Some(mesh::io::Format::Ply);
+    let edges = |n: usize| format!("{n} sharp edge{}", if n == 1 { "" } else { "s" });
+    let mut lost = Vec::new();
+    if !ply && !sharp.edges.is_empty() {
+        lost.push(format!(
+            "{} (write .ply, which keeps them)",
+            edges(sharp.edges.len())
+        ));
+    }
+    if sharp.edges_left_out > 0 {
+        lost.push(format!(
+            "{} that are no edges of its polygons (quad diagonals)",
+            edges(sharp.edges_left_out)
+        ));
+    }
+    if sharp.vertices_left_out > 0 {
+        let n = sharp.vertices_left_out;
+        lost.push(format!(
+            "{n} sharp vert{} (no mesh format carries them)",
+            if n == 1 { "ex" } else { "ices" }
+        ));
+    }
+    let mut warnings: Vec<String> = lost
+        .into_iter()
+        .map(|what| {
+            format!(
+                "{}: warning: the file does not keep {what}",
+                output.display()
+            )
+        })
+        .collect();
+    // A file of creases beside the output is read with it from now on.
+    let side = output.with_extension(mesh::io::CREASES_EXTENSION);
+    if side.is_file() {
+        warnings.push(format!(
+            "{}: warning: `{}` beside it, which this command did not write, will be read with \
+             it as its creases",
+            output.display(),
+            side.display()
+        ));
+    }
+    Ok(warnings)
 }
 
 /// A shape derivation to `.obj` (with its `.mtl` beside it, both or
@@ -737,7 +789,12 @@ pub fn mesh_info(file: &str, as_json: bool) -> Result<String, Error> {
 /// `output`'s extension, basic blocks as quads unless `triangles`. The
 /// output may be the input only with `force` (a conversion may lose what
 /// subgram does not keep, such as texture coordinates and normals).
-pub fn mesh_convert(input: &str, output: &str, triangles: bool, force: bool) -> Result<(), Error> {
+pub fn mesh_convert(
+    input: &str,
+    output: &str,
+    triangles: bool,
+    force: bool,
+) -> Result<Vec<String>, Error> {
     let (input, output) = (Path::new(input), Path::new(output));
     if mesh::io::Format::from_path(output).is_none() {
         // As for pictures: an output whose format cannot be told is a
@@ -752,12 +809,7 @@ pub fn mesh_convert(input: &str, output: &str, triangles: bool, force: bool) -> 
     }
     refuse_overwrite(&[output], &[input], force)?;
     let m = load_mesh(input)?;
-    let soup = if triangles {
-        m.to_soup()
-    } else {
-        m.to_quad_soup()
-    };
-    Ok(mesh::io::write(output, &soup)?)
+    write_mesh(output, &m, triangles)
 }
 
 /// The arguments of `subgram reverse`.

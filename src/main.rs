@@ -502,7 +502,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             };
             let result = with_progress(|p| command::subdivide(&args, p));
             print_program_output(&args.program_output, false)?;
-            result
+            print_warnings(&result?);
+            Ok(())
         }
         Command::Mesh { command } => match command {
             MeshCommand::Info { file, format } => {
@@ -513,7 +514,10 @@ fn run(cli: Cli) -> Result<(), Error> {
                 output,
                 triangles,
                 force,
-            } => command::mesh_convert(&input, &output, triangles, force),
+            } => {
+                print_warnings(&command::mesh_convert(&input, &output, triangles, force)?);
+                Ok(())
+            }
         },
         Command::Reverse {
             input,

@@ -459,6 +459,46 @@ impl Mesh {
         self.soup_with(|e| self.is_block_edge(e)).0
     }
 
+    /// The mesh as a soup (basic blocks merged into polygons unless
+    /// `triangles`) with what of its sharpness a file can carry: each sharp
+    /// edge of the soup's polygons as two soup vertices and a sharpness.
+    /// The second part counts what cannot be written that way: sharp
+    /// vertices, and sharp edges that are a quad's diagonal or end at a
+    /// vertex the soup leaves out (a dual block's centre).
+    pub fn to_soup_with_sharpness(&self, triangles: bool) -> (PolygonSoup, SoupSharpness) {
+        let (soup, _, vertices) = if triangles {
+            self.soup_with(|_| false)
+        } else {
+            self.soup_with(|e| self.is_block_edge(e))
+        };
+        let mut out = SoupSharpness::default();
+        if !self.has_sharpness_flag() {
+            return (soup, out);
+        }
+        let mut index = vec![u32::MAX; self.v_alive.len()];
+        for (i, v) in vertices.iter().enumerate() {
+            index[v.index()] = i as u32;
+        }
+        for e in self.edges() {
+            let s = self.edge_sharpness(e);
+            if s <= 0.0 {
+                continue;
+            }
+            let (a, b) = self.edge_vertices(e);
+            let (a, b) = (index[a.index()], index[b.index()]);
+            if a == u32::MAX || b == u32::MAX || (!triangles && self.is_block_edge(e)) {
+                out.edges_left_out += 1;
+            } else {
+                out.edges.push((a, b, s));
+            }
+        }
+        out.vertices_left_out = self
+            .vertices()
+            .filter(|&v| self.vertex_sharpness(v) > 0.0)
+            .count();
+        (soup, out)
+    }
+
     /// [`Mesh::to_quad_soup`] and the tag of each of its faces. A basic
     /// block whose triangles have different tags (a √2 bisection's block
     /// across two tagged quads) stays two triangles, so that every
@@ -1263,4 +1303,17 @@ mod tests {
             soups_agree(&m);
         }
     }
+}
+
+/// The sharpness [`Mesh::to_soup_with_sharpness`] finds for a soup.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SoupSharpness {
+    /// Sharp edges of the soup's polygons: two soup vertices (from 0) and
+    /// the sharpness.
+    pub edges: Vec<(u32, u32, f64)>,
+    /// Sharp edges no polygon edge carries (quad diagonals, edges to a
+    /// vertex the soup leaves out).
+    pub edges_left_out: usize,
+    /// Sharp vertices (no mesh format subgram writes carries them).
+    pub vertices_left_out: usize,
 }

@@ -326,6 +326,26 @@ pub fn write(path: &Path, soup: &PolygonSoup) -> Result<(), MeshFileError> {
         .map_err(|e| error(&name, None, format!("cannot write the file: {e}")))
 }
 
+/// Writes `soup` to `path` as [`write()`] does, with the sharp `edges` (two
+/// soup vertices, from 0, and a sharpness) where the format carries them:
+/// a PLY `edge` element with `vertex1`, `vertex2` and `crease`, which
+/// [`read_mesh`] reads back. OBJ and OFF have no place for them; the
+/// caller says so.
+pub fn write_with_sharpness(
+    path: &Path,
+    soup: &PolygonSoup,
+    edges: &[(u32, u32, f64)],
+) -> Result<(), MeshFileError> {
+    let name = path.display().to_string();
+    let format = format_of(&name, path)?;
+    let bytes = match format {
+        Format::Ply if !edges.is_empty() => write_ply_with_edges(soup, edges).into_bytes(),
+        _ => to_bytes(format, soup),
+    };
+    crate::atomic::write_atomic(path, &bytes)
+        .map_err(|e| error(&name, None, format!("cannot write the file: {e}")))
+}
+
 /// The text of `soup` in `format` (PLY as ASCII).
 pub fn to_bytes(format: Format, soup: &PolygonSoup) -> Vec<u8> {
     let text = match format {
@@ -1873,6 +1893,24 @@ fn write_off(soup: &PolygonSoup) -> String {
     for face in &soup.faces {
         out.push_str(&face.len().to_string());
         push_indices(&mut out, face, 0);
+    }
+    out
+}
+
+/// [`write_ply`] with an `edge` element after the faces: `vertex1`,
+/// `vertex2` and the sharpness as `crease` (`inf` for ever).
+fn write_ply_with_edges(soup: &PolygonSoup, edges: &[(u32, u32, f64)]) -> String {
+    let text = write_ply(soup);
+    let (header, body) = text
+        .split_once("end_header\n")
+        .expect("write_ply writes a header");
+    let mut out = format!(
+        "{header}element edge {}\nproperty int vertex1\nproperty int vertex2\n\
+         property double crease\nend_header\n{body}",
+        edges.len()
+    );
+    for &(a, b, s) in edges {
+        out.push_str(&format!("{a} {b} {s:?}\n"));
     }
     out
 }

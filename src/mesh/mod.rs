@@ -11,6 +11,7 @@ pub mod soup;
 pub mod stellar;
 pub mod validate;
 
+pub use build::SoupSharpness;
 pub use halfedge::{EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId};
 pub use soup::{MeshFileError, Place, PolygonSoup};
 pub use stellar::{BlockSplit, Split};

@@ -26,6 +26,10 @@ use super::halfedge::{EdgeId, FaceId, Mesh, MeshError};
 
 const NONE: u32 = u32::MAX;
 
+/// The work (node visits) one repair of a pair over an edge that is not
+/// preferred may take.
+const REPAIR_WORK: u64 = 20_000;
+
 /// A graph in compressed rows: the neighbours of node `i` are
 /// `adj[start[i]..start[i + 1]]`.
 #[derive(Clone, Debug, Default)]
@@ -78,6 +82,18 @@ struct Blossom<'g> {
     in_tree: Vec<bool>,
     in_blossom: Vec<bool>,
     on_path: Vec<bool>,
+    /// Nodes of the trees of searches that failed: no augmenting path
+    /// passes through them later (the tree is Hungarian: every node in it
+    /// is matched within it but its root, and every edge out of it leaves
+    /// an odd node), so later searches leave them out. Without this, each
+    /// failed search walked the same large tree again: a triangle cut into
+    /// 800^2 triangles (800 more up than down, so 800 searches that fail)
+    /// took 31 s.
+    dead: Vec<bool>,
+    /// Whether a failed search marks its tree `dead`: not where the
+    /// matching changes other than by augmenting (the repairs of
+    /// `maximum_matching` undo a pair and may put it back).
+    remember_failures: bool,
     touched: Vec<u32>,
     queue: Vec<u32>,
     /// Nodes at and above this are not part of the graph (yet).
@@ -96,6 +112,8 @@ impl<'g> Blossom<'g> {
             in_tree: vec![false; n],
             in_blossom: vec![false; n],
             on_path: vec![false; n],
+            dead: vec![false; n],
+            remember_failures: true,
             touched: Vec::new(),
             queue: Vec::new(),
             limit: n as u32,
@@ -196,7 +214,7 @@ impl<'g> Blossom<'g> {
                     return None;
                 }
                 *budget -= 1;
-                if to >= self.limit {
+                if to >= self.limit || self.dead[to as usize] {
                     continue;
                 }
                 if self.mate[v as usize] == to || self.base(v) == self.base(to) {
@@ -267,6 +285,11 @@ impl<'g> Blossom<'g> {
         let end = self.search(root, budget);
         if let Some(end) = end {
             self.augment(end);
+        } else if *budget > 0 && self.remember_failures {
+            // A whole search failed (not one cut short by the budget).
+            for &i in &self.touched {
+                self.dead[i as usize] = true;
+            }
         }
         self.reset();
         end.is_some()
@@ -355,6 +378,7 @@ pub(crate) fn maximum_matching(
     // may cross other such pairs but never makes one).
     let mut b = Blossom::new(preferred, mate);
     b.limit = real as u32;
+    b.remember_failures = false;
     for i in 0..real as u32 {
         let m = b.mate[i as usize];
         if m == NONE || m < i || preferred.neighbours(i).contains(&m) {
@@ -362,7 +386,12 @@ pub(crate) fn maximum_matching(
         }
         b.mate[i as usize] = NONE;
         b.mate[m as usize] = NONE;
-        if !b.grow(i, budget) {
+        // A repair is local or not at all: a search that walks far is
+        // given up, and the pair kept.
+        let mut local = REPAIR_WORK.min(*budget);
+        let found = b.grow(i, &mut local);
+        *budget -= REPAIR_WORK.min(*budget) - local;
+        if !found {
             b.mate[i as usize] = m;
             b.mate[m as usize] = i;
         }
@@ -399,6 +428,9 @@ impl Mesh {
     /// stay; on a base mesh (all vertices at level 0) the levels become
     /// those of a tri-quad mesh (internal edges 0, the others 1).
     ///
+    /// Two triangles across a sharp edge are never paired (the edge would
+    /// become a quad's diagonal).
+    ///
     /// An error, with the mesh unchanged, when an interior triangle cannot
     /// be paired or `budget` runs out.
     pub fn match_blocks(&mut self, budget: u64) -> Result<Pairing, MeshError> {
@@ -420,6 +452,10 @@ impl Mesh {
         let mut stand_ins: Vec<EdgeId> = Vec::new();
         for e in self.edges() {
             match self.edge_faces(e) {
+                // Never across a crease: a sharp edge made a block's
+                // internal edge would be a quad's diagonal, which the
+                // crease rules (and the mesh files) do not have.
+                [Some(_), Some(_)] if self.is_sharp_edge(e) => {}
                 [Some(a), Some(b)] => {
                     let (na, nb) = (node_of[a.index()], node_of[b.index()]);
                     if na != NONE && nb != NONE && a != b {
@@ -475,9 +511,14 @@ impl Mesh {
         }
         if let Some(i) = (0..real).find(|&i| mate[i] == NONE) {
             let [a, b, c] = self.face_vertices(faces[i]);
+            let creases = if self.has_sharpness_flag() {
+                " (no pair is made across a sharp edge)"
+            } else {
+                ""
+            };
             return Err(MeshError::new(format!(
                 "pairing triangles into blocks: the triangle on vertices {a}, {b} and {c} cannot be \
-                 paired with a neighbour, nor moved to the boundary along an alternating path"
+                 paired with a neighbour, nor moved to the boundary along an alternating path{creases}"
             )));
         }
         let base = self.vertices().all(|v| self.vertex_level(v) == 0);
@@ -630,5 +671,191 @@ mod tests {
         let real_pairs = (0..3).filter(|&i| mate[i] != NONE && mate[i] < 3).count() / 2;
         assert_eq!(real_pairs, 1);
         assert!((0..3).all(|i| mate[i] != NONE));
+    }
+
+    /// The size of a maximum matching by dynamic programming over subsets
+    /// of nodes (the lowest node of a subset is either left free or
+    /// matched with a neighbour in the subset): a reference for graphs of
+    /// up to 20 nodes, with no limit on the number of edges.
+    fn by_subsets(n: usize, edges: &[(u32, u32)]) -> usize {
+        let mut nb = vec![0u32; n];
+        for &(a, b) in edges {
+            nb[a as usize] |= 1 << b;
+            nb[b as usize] |= 1 << a;
+        }
+        let mut best = vec![0u8; 1 << n];
+        for mask in 1usize..1 << n {
+            let i = mask.trailing_zeros() as usize;
+            let rest = mask & !(1 << i);
+            let mut b = best[rest];
+            let mut cand = nb[i] as usize & rest;
+            while cand != 0 {
+                let j = cand.trailing_zeros() as usize;
+                cand &= cand - 1;
+                b = b.max(1 + best[rest & !(1 << j)]);
+            }
+            best[mask] = b;
+        }
+        best[(1 << n) - 1] as usize
+    }
+
+    #[test]
+    fn larger_random_graphs_match_the_subset_reference() {
+        // Graphs of 6 to 18 nodes, sparse to dense, many with odd cycles
+        // nested in one another: blossoms inside blossoms.
+        let mut s = 987654321u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) as u32
+        };
+        for round in 0..1500 {
+            let n = 6 + (next() % 13) as usize;
+            let p = 2 + round % 6; // an edge with probability 1/p
+            let mut edges = Vec::new();
+            for a in 0..n as u32 {
+                for b in a + 1..n as u32 {
+                    if next() % p as u32 == 0 {
+                        edges.push((a, b));
+                    }
+                }
+            }
+            // Shuffle the node numbers' order of search by shuffling edges.
+            for i in (1..edges.len()).rev() {
+                let j = next() as usize % (i + 1);
+                edges.swap(i, j);
+            }
+            assert_eq!(check(n, &edges), by_subsets(n, &edges), "n {n}: {edges:?}");
+        }
+    }
+
+    /// The most real nodes a matching can cover when node `i` may also be
+    /// matched with a stand-in of its own (`has_stand_in[i]`): the same
+    /// subset recursion, the lowest node left free, matched with its
+    /// stand-in (one node covered) or with a neighbour (two).
+    fn covering_by_subsets(n: usize, edges: &[(u32, u32)], has_stand_in: &[bool]) -> usize {
+        let mut nb = vec![0u32; n];
+        for &(a, b) in edges {
+            nb[a as usize] |= 1 << b;
+            nb[b as usize] |= 1 << a;
+        }
+        let mut best = vec![0u8; 1 << n];
+        for mask in 1usize..1 << n {
+            let i = mask.trailing_zeros() as usize;
+            let rest = mask & !(1 << i);
+            let mut b = best[rest] + has_stand_in[i] as u8;
+            let mut cand = nb[i] as usize & rest;
+            while cand != 0 {
+                let j = cand.trailing_zeros() as usize;
+                cand &= cand - 1;
+                b = b.max(2 + best[rest & !(1 << j)]);
+            }
+            best[mask] = b;
+        }
+        best[(1 << n) - 1] as usize
+    }
+
+    #[test]
+    fn stand_ins_cover_as_many_real_nodes_as_can_be() {
+        // Random graphs with real nodes 0..r and stand-ins r..n, each
+        // stand-in on one real node (a boundary edge) and at most one per
+        // real node: the pairing must keep a maximum matching among the
+        // real nodes and, besides, cover as many real nodes as any matching
+        // can (reference: `covering_by_subsets`).
+        let mut s = 55555u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) as u32
+        };
+        for round in 0..1500 {
+            let r = 3 + (next() % 11) as usize;
+            let p = 2 + round % 5;
+            let mut edges = Vec::new();
+            for a in 0..r as u32 {
+                for b in a + 1..r as u32 {
+                    if next() % p as u32 == 0 {
+                        edges.push((a, b));
+                    }
+                }
+            }
+            let real_edges = edges.clone();
+            let mut n = r;
+            for a in 0..r as u32 {
+                if next() % 4 == 0 {
+                    edges.push((a, n as u32));
+                    n += 1;
+                }
+            }
+            let g = Graph::from_edges(n, &edges);
+            let mut budget = u64::MAX;
+            let mate = maximum_matching(&g, &g, r, &mut budget);
+            for (i, &m) in mate.iter().enumerate() {
+                if m != NONE {
+                    assert_eq!(mate[m as usize], i as u32);
+                    assert!(edges.contains(&(i as u32, m)) || edges.contains(&(m, i as u32)));
+                }
+            }
+            let rr = (0..r)
+                .filter(|&i| mate[i] != NONE && (mate[i] as usize) < r)
+                .count()
+                / 2;
+            let covered = (0..r).filter(|&i| mate[i] != NONE).count();
+            let best_rr = by_subsets(r, &real_edges);
+            assert_eq!(rr, best_rr, "{edges:?}");
+            let has_stand_in: Vec<bool> = (0..r as u32)
+                .map(|a| edges.iter().any(|&(x, y)| x == a && y as usize >= r))
+                .collect();
+            let best_cover = covering_by_subsets(r, &real_edges, &has_stand_in);
+            assert_eq!(covered, best_cover, "r {r}: {edges:?}");
+        }
+    }
+
+    /// The dual graph of a triangle cut into k^2 triangles: k(k+1)/2 up
+    /// and k(k-1)/2 down, each down triangle beside three up ones. It is
+    /// bipartite with k more up nodes, so a maximum matching pairs every
+    /// down triangle and leaves k up ones: k searches that fail.
+    fn cut_triangle(k: u32) -> (usize, Vec<(u32, u32)>) {
+        let up = |i: u32, j: u32| {
+            // Row i holds k - i up triangles.
+            (0..i).map(|r| k - r).sum::<u32>() + j
+        };
+        let ups = k * (k + 1) / 2;
+        let mut edges = Vec::new();
+        let mut down = ups;
+        for i in 0..k {
+            for j in 0..k - i {
+                if i + j + 1 < k {
+                    edges.push((down, up(i, j)));
+                    edges.push((down, up(i + 1, j)));
+                    edges.push((down, up(i, j + 1)));
+                    down += 1;
+                }
+            }
+        }
+        (down as usize, edges)
+    }
+
+    #[test]
+    fn failed_searches_are_not_walked_again() {
+        let k = 120;
+        let (n, edges) = cut_triangle(k);
+        assert_eq!(n as u32, k * k);
+        let g = Graph::from_edges(n, &edges);
+        let start = u64::MAX;
+        let mut budget = start;
+        let mate = maximum_matching(&g, &g, n, &mut budget);
+        let matched = mate.iter().filter(|&&m| m != NONE).count() / 2;
+        assert_eq!(
+            matched as u32,
+            k * (k - 1) / 2,
+            "every down triangle paired"
+        );
+        // The work: a few visits per edge end, not one walk of the graph
+        // per failed search (120 of them, 2 * 21,420 edge ends each).
+        let used = start - budget;
+        assert!(used < 20 * 2 * edges.len() as u64, "{used} visits");
     }
 }

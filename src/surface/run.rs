@@ -157,6 +157,7 @@ pub(crate) fn compile_with(
     let mut warnings = Vec::new();
     let mut block_used_at = None;
     let mut centre_used_at = None;
+    let mut lone_used = false;
     let mut c = RuleCompiler::new(
         <GrammarRun as crate::production::Topology>::host_table(),
         &file.functions,
@@ -199,6 +200,7 @@ pub(crate) fn compile_with(
                 .or(first_call(x, id::BLOCK))
                 .or(first_call(x, id::CENTER));
             centre_used_at = centre_used_at.or(first_call(x, id::CENTER));
+            lone_used |= first_call(x, id::LONE).is_some();
         }
         let (mut guard, mut affine) = (None, None);
         if specialise {
@@ -285,6 +287,21 @@ pub(crate) fn compile_with(
                      or drop `adaptive;`)",
                 ));
             }
+        }
+    }
+    // Pairs that nothing reads would not be idle: the splits of a grammar
+    // with blocks keep them, which changes what its rules match (√3 gives
+    // another mesh) and what it writes (quads).
+    // (Only where every rule compiled: a rule with an error reads nothing.)
+    if let Some(at) = file.match_blocks.filter(|_| diags.is_empty()) {
+        if block_used_at.is_none() && !lone_used && file.block_split.is_none() {
+            diags.push(Diagnostic::new(
+                at,
+                "`init: match_blocks;` pairs the triangles into basic blocks, but this grammar \
+                 reads none (no `block(x)` or `lone(x)` in its rules, no `blocks:` line), and \
+                 pairs it does not read would still change what its rules match; leave it out \
+                 for a scheme on triangles",
+            ));
         }
     }
     if !diags.is_empty() {

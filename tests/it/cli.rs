@@ -420,3 +420,100 @@ Axiom: F(1);
     assert_eq!(stdout(&o).trim(), "F(1)");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Writing a creased mesh keeps its sharp edges in PLY (an `edge` element
+/// that reading gives back) and says what a file cannot keep (before, both
+/// were dropped without a word). Expected values: the source files'
+/// own sharpness (creased-cube.ply: six edges, four for ever; the
+/// octahedron: five edges and one sharp vertex in its .creases), and after
+/// two Catmull-Clark steps the four infinite rim edges split twice, 4 * 2 *
+/// 2 = 16 edges, while the finite ones (2 and 0.5) have dropped to 0.
+#[test]
+fn writing_a_creased_mesh_keeps_or_reports_its_sharpness() {
+    use crate::reverse::{run_in, scratch};
+    use subgram::mesh::io::read_mesh;
+    let dir = scratch("write-creases");
+    let cube = lsys("meshes/creased-cube.ply");
+    let octa = lsys("meshes/creased-octahedron.obj");
+    let (cube, octa) = (cube.to_str().unwrap(), octa.to_str().unwrap());
+    // The sharpness of every edge, by the positions of its ends.
+    let sharp_edges = |m: &subgram::mesh::Mesh| {
+        let mut v: Vec<String> = m
+            .edges()
+            .filter(|&e| m.edge_sharpness(e) > 0.0)
+            .map(|e| {
+                let (a, b) = m.edge_vertices(e);
+                let (mut p, mut q) = (m.position(a).to_array(), m.position(b).to_array());
+                if q < p {
+                    std::mem::swap(&mut p, &mut q);
+                }
+                format!("{p:?} {q:?} {}", m.edge_sharpness(e))
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    let source = read_mesh(std::path::Path::new(cube)).unwrap();
+    assert_eq!(sharp_edges(&source).len(), 6);
+    for triangles in [false, true] {
+        let mut args = vec!["mesh", "convert", cube, "c.ply"];
+        if triangles {
+            args.push("--triangles");
+        }
+        let r = run_in(&dir, &args);
+        assert_eq!(r.code, Some(0), "{}", r.stderr);
+        assert_eq!(r.stderr, "", "a PLY keeps every sharp edge");
+        let back = read_mesh(&dir.join("c.ply")).unwrap();
+        assert_eq!(
+            sharp_edges(&back),
+            sharp_edges(&source),
+            "--triangles {triangles}"
+        );
+    }
+    let r = run_in(&dir, &["mesh", "convert", cube, "c.obj"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(
+        r.stderr
+            .starts_with("c.obj: warning: the file does not keep 6 sharp edges"),
+        "{}",
+        r.stderr
+    );
+    let r = run_in(&dir, &["mesh", "convert", octa, "o.ply"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(
+        r.stderr
+            .starts_with("o.ply: warning: the file does not keep 1 sharp vertex"),
+        "{}",
+        r.stderr
+    );
+    assert_eq!(
+        sharp_edges(&read_mesh(&dir.join("o.ply")).unwrap()).len(),
+        5
+    );
+    let cc = lsys("surfaces/catmull-clark.lsys");
+    let args = [
+        "subdivide",
+        cube,
+        "--grammar",
+        cc.to_str().unwrap(),
+        "-n",
+        "2",
+        "-o",
+        "s.ply",
+    ];
+    let r = run_in(&dir, &args);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let s = sharp_edges(&read_mesh(&dir.join("s.ply")).unwrap());
+    assert_eq!(s.len(), 16);
+    assert!(s.iter().all(|e| e.ends_with(" inf")), "{s:?}");
+    // A file of creases left beside the output is named: it will be read
+    // with the new mesh.
+    std::fs::write(dir.join("s.creases"), "e 1 2 inf\n").unwrap();
+    let r = run_in(&dir, &args);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("s.ply: warning: `s.creases` beside it"),
+        "{}",
+        r.stderr
+    );
+}

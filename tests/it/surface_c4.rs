@@ -714,3 +714,42 @@ fn bunny_runs_through_loop_sqrt3_and_catmull_clark() {
         }
     }
 }
+
+/// Pairs never join across a crease: on creased-octahedron.obj the
+/// equator is sharp for ever, so the pairs must form within each half, a
+/// cycle of four triangles around a pole (two pairs each, by hand); before,
+/// the matching made the equator the quads' diagonals and the crease was
+/// lost inside them. A triangle whose only partners are across creases is
+/// refused, and the message says why.
+#[test]
+fn pairing_never_crosses_a_crease() {
+    let mut m = subgram::mesh::io::read_mesh(&lsys("meshes/creased-octahedron.obj")).unwrap();
+    let sharp = m.edges().filter(|&e| m.is_sharp_edge(e)).count();
+    assert_eq!(sharp, 5, "the equator and one edge from the top");
+    let p = m.match_blocks(u64::MAX).unwrap();
+    assert_eq!((p.pairs, p.on_boundary), (4, 0));
+    assert!(m.face_outside_blocks().is_none());
+    for e in m.edges() {
+        assert!(
+            !(m.is_sharp_edge(e) && m.is_block_edge(e)),
+            "sharp edge {e:?} inside a block"
+        );
+    }
+    // Every edge of the octahedron sharp: no triangle has a partner.
+    let soup = subgram::mesh::io::read(&lsys("meshes/octahedron.obj")).unwrap();
+    let mut m = Mesh::from_soup(&soup).unwrap();
+    let edges: Vec<_> = m.edges().collect();
+    for e in edges {
+        m.set_edge_sharpness(e, f64::INFINITY).unwrap();
+    }
+    let err = m.match_blocks(u64::MAX).unwrap_err();
+    assert!(
+        err.message.contains("cannot be paired") && err.message.contains("across a sharp edge"),
+        "{}",
+        err.message
+    );
+    assert!(
+        m.edges().all(|e| !m.is_block_edge(e)),
+        "the mesh is left as it was"
+    );
+}
