@@ -542,6 +542,17 @@ impl Mesh {
 mod tests {
     use super::*;
 
+    /// A small linear congruential generator: the random graphs are fixed.
+    fn lcg(seed: u64) -> impl FnMut() -> u32 {
+        let mut s = seed;
+        move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) as u32
+        }
+    }
+
     /// The size of a maximum matching by trying every subset of edges
     /// (small graphs only): the reference.
     fn brute_force(n: usize, edges: &[(u32, u32)]) -> usize {
@@ -615,14 +626,7 @@ mod tests {
 
     #[test]
     fn random_graphs_match_brute_force() {
-        // A small linear congruential generator: the graphs are fixed.
-        let mut s = 12345u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 33) as u32
-        };
+        let mut next = lcg(12345);
         for _ in 0..300 {
             let n = 2 + (next() % 9) as usize;
             let mut edges = Vec::new();
@@ -678,38 +682,14 @@ mod tests {
     /// matched with a neighbour in the subset): a reference for graphs of
     /// up to 20 nodes, with no limit on the number of edges.
     fn by_subsets(n: usize, edges: &[(u32, u32)]) -> usize {
-        let mut nb = vec![0u32; n];
-        for &(a, b) in edges {
-            nb[a as usize] |= 1 << b;
-            nb[b as usize] |= 1 << a;
-        }
-        let mut best = vec![0u8; 1 << n];
-        for mask in 1usize..1 << n {
-            let i = mask.trailing_zeros() as usize;
-            let rest = mask & !(1 << i);
-            let mut b = best[rest];
-            let mut cand = nb[i] as usize & rest;
-            while cand != 0 {
-                let j = cand.trailing_zeros() as usize;
-                cand &= cand - 1;
-                b = b.max(1 + best[rest & !(1 << j)]);
-            }
-            best[mask] = b;
-        }
-        best[(1 << n) - 1] as usize
+        covering_by_subsets(n, edges, &vec![false; n]) / 2
     }
 
     #[test]
     fn larger_random_graphs_match_the_subset_reference() {
         // Graphs of 6 to 18 nodes, sparse to dense, many with odd cycles
         // nested in one another: blossoms inside blossoms.
-        let mut s = 987654321u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 33) as u32
-        };
+        let mut next = lcg(987654321);
         for round in 0..1500 {
             let n = 6 + (next() % 13) as usize;
             let p = 2 + round % 6; // an edge with probability 1/p
@@ -763,13 +743,7 @@ mod tests {
         // real node: the pairing must keep a maximum matching among the
         // real nodes and, besides, cover as many real nodes as any matching
         // can (reference: `covering_by_subsets`).
-        let mut s = 55555u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 33) as u32
-        };
+        let mut next = lcg(55555);
         for round in 0..1500 {
             let r = 3 + (next() % 11) as usize;
             let p = 2 + round % 5;
