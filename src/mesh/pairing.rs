@@ -632,7 +632,7 @@ mod tests {
             let mut edges = Vec::new();
             for a in 0..n as u32 {
                 for b in a + 1..n as u32 {
-                    if next() % 3 == 0 && edges.len() < 16 {
+                    if next().is_multiple_of(3) && edges.len() < 16 {
                         edges.push((a, b));
                     }
                 }
@@ -696,7 +696,7 @@ mod tests {
             let mut edges = Vec::new();
             for a in 0..n as u32 {
                 for b in a + 1..n as u32 {
-                    if next() % p as u32 == 0 {
+                    if next().is_multiple_of(p as u32) {
                         edges.push((a, b));
                     }
                 }
@@ -750,7 +750,7 @@ mod tests {
             let mut edges = Vec::new();
             for a in 0..r as u32 {
                 for b in a + 1..r as u32 {
-                    if next() % p as u32 == 0 {
+                    if next().is_multiple_of(p as u32) {
                         edges.push((a, b));
                     }
                 }
@@ -758,7 +758,7 @@ mod tests {
             let real_edges = edges.clone();
             let mut n = r;
             for a in 0..r as u32 {
-                if next() % 4 == 0 {
+                if next().is_multiple_of(4) {
                     edges.push((a, n as u32));
                     n += 1;
                 }
