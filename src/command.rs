@@ -597,6 +597,17 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<Ve
         ..RunOptions::default()
     };
     let d = crate::render::mesh::MeshView::default();
+    if Picture::from_path(output).is_err() && (a.shading.is_some() || a.no_wireframe) {
+        let flag = if a.shading.is_some() {
+            "--shading"
+        } else {
+            "--no-wireframe"
+        };
+        return Err(Error::Usage(format!(
+            "`{flag}` is for pictures, and `{}` is not one (name it .png or .svg)",
+            output.display()
+        )));
+    }
     let shading = match a.shading.as_deref() {
         None => d.shading,
         Some(name) => crate::render::mesh::Shading::from_name(name).ok_or_else(|| {

@@ -122,6 +122,39 @@ fn usage_errors_exit_with_2() {
 }
 
 #[test]
+fn picture_options_with_a_mesh_output_are_usage_errors() {
+    let dir = std::env::temp_dir().join(format!("subgram-cli-shading-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("out.obj");
+    let g = lsys("surfaces/c4.lsys");
+    for flags in [&["--shading", "normals"][..], &["--no-wireframe"][..]] {
+        let mut args = vec!["subdivide", "--grammar", g.to_str().unwrap(), "-n", "1"];
+        args.extend(flags);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let o = subgram(&args);
+        assert_eq!(o.status.code(), Some(2), "{flags:?}");
+        assert!(stderr(&o).contains("is for pictures"), "{}", stderr(&o));
+        assert!(!out.exists());
+    }
+    let png = dir.join("out.png");
+    let o = subgram(&[
+        "subdivide",
+        "--grammar",
+        g.to_str().unwrap(),
+        "-n",
+        "1",
+        "--shading",
+        "glossy",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("use lit, normals or reflection"));
+    assert!(!png.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_missing_file_is_an_input_error() {
     let o = subgram(&["derive", "no/such/file.lsys"]);
     assert_eq!(o.status.code(), Some(1));
