@@ -294,7 +294,16 @@ pub(crate) fn compile_with(
     // another mesh) and what it writes (quads).
     // (Only where every rule compiled: a rule with an error reads nothing.)
     if let Some(at) = file.match_blocks.filter(|_| diags.is_empty()) {
-        if block_used_at.is_none() && !lone_used && file.block_split.is_none() {
+        let dual =
+            matches!(file.block_split, Some((BlockSplit::Dual, _))) || centre_used_at.is_some();
+        if dual {
+            diags.push(Diagnostic::new(
+                at,
+                "`init: match_blocks;` pairs triangles into quads, the blocks of primal schemes; \
+                 this grammar is a dual scheme (`blocks: dual;` or `center(v)`), whose blocks are \
+                 fans around a centre, so leave it out",
+            ));
+        } else if block_used_at.is_none() && !lone_used && file.block_split.is_none() {
             diags.push(Diagnostic::new(
                 at,
                 "`init: match_blocks;` pairs the triangles into basic blocks, but this grammar \
