@@ -28,11 +28,13 @@ curve_snippets = ["module P(V2f);", "Axiom: P(v1) P(v2);", "derivation length: 3
                   "L::A", "l.a()", "typedef struct S T;", "for (int i = 0; i < 3; i++) { }", "x ? y : z", "(float) 1"]
 surface = """mesh: blocks: dual bisection quadrisection define init: F(f) V(v E(e F^2 F^3 F^4 E^3 E^4 || | ^
 l( c step valence( boundary( new( block( center( centre( transversal( avg( sum( count( ring( boundary_ring( verts( tail( head( bnext( bprev( pos(
-where in interior boundary""".split() + ["derivation length:"]
+where in interior boundary lone( match_blocks adaptive adaptive: incremental area( length( angle( refined(
+sharp( sharpness( creases( crease_ring( crease_weight(""".split() + ["derivation length:"]
 surface_snippets = ['mesh: "cube.obj";', "F(f) -> V(v = avg(f)) || E^3 F^3;", "E(e; l(e) < c) || F^2 -> E || F^2;",
                     "E(e) | F^2 -> V(v = avg(e)) || E^4 F^4;", "E(e) | F -> V || E^3 F^2;", "V(v; l(v) < c) -> V(v = v);",
                     "define a(n) = 1.0/n;", "sum(w in ring(v) where l(w) < c)", "V(v) | boundary -> V(v = v);", "blocks: dual;",
-                    "init: F(f) -> V || E^3 F^3;"]
+                    "init: F(f) -> V || E^3 F^3;", "init: match_blocks;", "init: E(e; lone(e)) | F -> V(v = avg(e)) || E^3 F^2;",
+                    "blocks: bisection;", "adaptive;"]
 mesh = ["v ", "vt ", "vn ", "vp ", "f ", "l ", "p ", "o ", "g ", "s ", "s off", "usemtl ", "mtllib ", "#", "/", "//", "-1", "1/1/1", "1//1",
         "OFF", "COFF", "NOFF", "STOFF", "4OFF", "nOFF", "OFF BINARY",
         "ply", "format ascii 1.0", "format binary_little_endian 1.0", "format binary_big_endian 1.0", "comment ", "obj_info ",
