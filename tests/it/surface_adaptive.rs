@@ -99,6 +99,25 @@ fn assert_conforming(m: &Mesh, boundary_edges: Option<usize>, what: &str) {
 
 /// The marks, positions (bits) and faces of `m`, by id: what must agree
 /// to the bit.
+/// Runs `a` and `b` on `soup` side by side for `steps` steps and checks
+/// that their meshes are the same, to the bit, after every step; the face
+/// count at the end.
+fn in_step(a: &Grammar, b: &Grammar, soup: &PolygonSoup, steps: usize, what: &str) -> usize {
+    let mut ma = Mesh::from_soup(soup).unwrap();
+    let mut mb = ma.clone();
+    let mut ra = a.start(&mut ma).unwrap();
+    let mut rb = b.start(&mut mb).unwrap();
+    for step in 1..=steps {
+        ra.steps(1, |_| {}).unwrap();
+        rb.steps(1, |_| {}).unwrap();
+        assert!(
+            fingerprint(ra.mesh()) == fingerprint(rb.mesh()),
+            "{what}, step {step}: differs"
+        );
+    }
+    ra.mesh().face_count()
+}
+
 fn fingerprint(m: &Mesh) -> (Vec<[u64; 3]>, Vec<[u32; 3]>, Vec<bool>) {
     let pos = m
         .vertices()
@@ -126,18 +145,13 @@ fn all_selected_is_uniform_to_the_bit() {
         ("jittered torus", jitter(shapes::quad_torus(6, 4), 7)),
     ];
     for (name, soup) in meshes {
-        let mut a = Mesh::from_soup(&soup).unwrap();
-        let mut b = a.clone();
-        let mut ra = uniform.start(&mut a).unwrap();
-        let mut rb = adaptive.start(&mut b).unwrap();
-        for step in 1..=6 {
-            ra.steps(1, |_| {}).unwrap();
-            rb.steps(1, |_| {}).unwrap();
-            assert!(
-                fingerprint(ra.mesh()) == fingerprint(rb.mesh()),
-                "{name}, step {step}: adaptive with everything selected differs"
-            );
-        }
+        in_step(
+            &uniform,
+            &adaptive,
+            &soup,
+            6,
+            &format!("{name}: adaptive with everything selected"),
+        );
     }
 }
 
@@ -430,19 +444,8 @@ fn incremental_matching_agrees_where_it_must() {
     ] {
         let full = grammar_text(&text("adaptive;", guard, smooth));
         let incr = grammar_text(&text("adaptive: incremental;", guard, smooth));
-        let mut a = Mesh::from_soup(&soup).unwrap();
-        let mut b = a.clone();
-        let mut ra = full.start(&mut a).unwrap();
-        let mut rb = incr.start(&mut b).unwrap();
-        for step in 1..=7 {
-            ra.steps(1, |_| {}).unwrap();
-            rb.steps(1, |_| {}).unwrap();
-            assert!(
-                fingerprint(ra.mesh()) == fingerprint(rb.mesh()),
-                "{guard}, step {step}: incremental differs"
-            );
-        }
-        assert!(ra.mesh().face_count() > 2 * soup.faces.len(), "{guard}");
+        let faces = in_step(&full, &incr, &soup, 7, &format!("{guard}: incremental"));
+        assert!(faces > 2 * soup.faces.len(), "{guard}");
     }
     // Selecting everything, with smoothing, is uniform refinement.
     let uniform = grammar_file("surfaces/four-eight.lsys", &[]);
@@ -508,18 +511,13 @@ fn bunny_adaptive_c4() {
     let soup = subgram::mesh::io::read(&lsys("meshes/bunny.obj")).unwrap();
     let uniform = grammar_file("surfaces/c4.lsys", &[]);
     let all = grammar_text(&rules("true"));
-    let mut a = Mesh::from_soup(&soup).unwrap();
-    let mut b = a.clone();
-    let mut ra = uniform.start(&mut a).unwrap();
-    let mut rb = all.start(&mut b).unwrap();
-    for step in 1..=3 {
-        ra.steps(1, |_| {}).unwrap();
-        rb.steps(1, |_| {}).unwrap();
-        assert!(
-            fingerprint(ra.mesh()) == fingerprint(rb.mesh()),
-            "bunny, step {step}: adaptive with everything selected differs from c4.lsys"
-        );
-    }
+    in_step(
+        &uniform,
+        &all,
+        &soup,
+        3,
+        "bunny: adaptive with everything selected, against c4.lsys",
+    );
     let p = soup.positions[0];
     let near = grammar_text(&rules(&format!(
         "Length(avg(e) - point({}, {}, {})) < 1.5",
