@@ -332,12 +332,7 @@ mod tests {
             assert!(n.dot(p(0) - mid) > 0.0, "{f:?} faces inwards");
         }
         let tags: Vec<u32> = (0..s.faces.len() as u32).map(|i| 100 + i).collect();
-        let pv: Vec<bool> = s.positions.iter().map(|p| p.x == 1.0).collect();
-        let pf: Vec<bool> = s
-            .faces
-            .iter()
-            .map(|f| f.iter().all(|&v| pv[v as usize]))
-            .collect();
+        let (pv, pf) = wall_at_x1(&s);
         assert_eq!(pf.iter().filter(|&&p| p).count(), 2);
         for name in SCHEME_NAMES {
             let g = scheme(name).unwrap();
@@ -549,15 +544,22 @@ mod tests {
     /// protected face can have fewer new neighbours or an odd valence
     /// than a whole step gives (Loop's and Catmull-Clark's rules are
     /// written so that their weights sum to one for any count).
-    #[test]
-    fn protected_runs_commute_with_translation() {
-        let s = stacked_cubes();
+    /// The vertices on the plane x = 1 and the faces all of whose corners
+    /// are there: the wall a neighbouring shape shares, protected.
+    fn wall_at_x1(s: &PolygonSoup) -> (Vec<bool>, Vec<bool>) {
         let pv: Vec<bool> = s.positions.iter().map(|p| p.x == 1.0).collect();
-        let pf: Vec<bool> = s
+        let pf = s
             .faces
             .iter()
             .map(|f| f.iter().all(|&v| pv[v as usize]))
             .collect();
+        (pv, pf)
+    }
+
+    #[test]
+    fn protected_runs_commute_with_translation() {
+        let s = stacked_cubes();
+        let (pv, pf) = wall_at_x1(&s);
         let off = DVec3::new(10.0, -3.0, 7.0);
         let moved = PolygonSoup {
             positions: s.positions.iter().map(|&p| p + off).collect(),
