@@ -25,30 +25,346 @@ pub fn write_word_text(
     alphabet: &Alphabet,
     structs: &[StructDef],
 ) -> std::io::Result<()> {
+    let mut buf = Chunks::new(out);
+    let mut num = Numbers::default();
+    let mut layouts = Layouts::new(alphabet, structs);
     for i in 0..word.len() {
         let sym = word.syms()[i];
         if i > 0 {
-            out.write_all(b" ")?;
+            buf.push(b" ");
         }
-        out.write_all(alphabet.name(sym).as_bytes())?;
-        if word.data(i).is_empty() && alphabet.layout(sym, 0, structs).is_empty() {
-            continue;
-        }
-        let params = word.values(i, alphabet, structs);
-        if !params.is_empty() {
-            let tys = alphabet.layout(sym, word.data(i).len(), structs);
-            out.write_all(b"(")?;
-            for (j, p) in params.iter().enumerate() {
+        buf.push(alphabet.name(sym).as_bytes());
+        let data = word.data(i);
+        let tys = layouts.of(sym, data.len());
+        if !tys.is_empty() {
+            buf.push(b"(");
+            let mut slots = data;
+            for (j, &ty) in tys.iter().enumerate() {
                 if j > 0 {
-                    out.write_all(b", ")?;
+                    buf.push(b", ");
                 }
-                let ty = tys.get(j).copied().unwrap_or(Ty::Double);
-                out.write_all(value_text(p, ty, structs).as_bytes())?;
+                slots = num.value_text(&mut buf.text, ty, slots, structs);
             }
-            out.write_all(b")")?;
+            buf.push(b")");
+        }
+        buf.flush_if_full()?;
+    }
+    buf.finish()
+}
+
+/// Each symbol's parameter types for the number of slots it was last met
+/// with, so that an overloaded module (`F`, `F(l)`) is looked up once.
+struct Layouts<'a> {
+    alphabet: &'a Alphabet,
+    structs: &'a [StructDef],
+    known: Vec<Option<(usize, &'a [Ty])>>,
+}
+
+impl<'a> Layouts<'a> {
+    fn new(alphabet: &'a Alphabet, structs: &'a [StructDef]) -> Self {
+        Layouts {
+            alphabet,
+            structs,
+            known: vec![None; alphabet.kinds.len()],
         }
     }
-    Ok(())
+
+    fn of(&mut self, sym: crate::lang::Sym, slots: usize) -> &'a [Ty] {
+        match self.known.get(sym.0 as usize) {
+            Some(Some((n, tys))) if *n == slots => tys,
+            _ => {
+                let tys = self.alphabet.layout(sym, slots, self.structs);
+                if let Some(k) = self.known.get_mut(sym.0 as usize) {
+                    *k = Some((slots, tys));
+                }
+                tys
+            }
+        }
+    }
+}
+
+/// Bytes gathered in memory and written to `out` a large chunk at a time,
+/// so that a word of millions of modules costs a few hundred writes.
+struct Chunks<'a, W: Write> {
+    out: &'a mut W,
+    text: Vec<u8>,
+}
+
+impl<'a, W: Write> Chunks<'a, W> {
+    const SIZE: usize = 1 << 16;
+
+    fn new(out: &'a mut W) -> Self {
+        Chunks {
+            out,
+            text: Vec::with_capacity(Self::SIZE + 256),
+        }
+    }
+
+    fn push(&mut self, bytes: &[u8]) {
+        self.text.extend_from_slice(bytes);
+    }
+
+    fn flush_if_full(&mut self) -> std::io::Result<()> {
+        if self.text.len() >= Self::SIZE {
+            self.out.write_all(&self.text)?;
+            self.text.clear();
+        }
+        Ok(())
+    }
+
+    fn finish(mut self) -> std::io::Result<()> {
+        self.out.write_all(&self.text)?;
+        self.text.clear();
+        Ok(())
+    }
+}
+
+/// Numbers written without allocating: integers by `itoa`, floats from
+/// the shortest digits `zmij` finds (the digits `std` and `serde_json`
+/// print, laid out as each of them lays them out).
+#[derive(Default)]
+struct Numbers {
+    ints: itoa::Buffer,
+    floats: zmij::Buffer,
+}
+
+impl Numbers {
+    /// Writes one parameter of type `ty` read from the front of `slots` as
+    /// [`value_text`] writes it, and returns the slots after it.
+    fn value_text<'s>(
+        &mut self,
+        out: &mut Vec<u8>,
+        ty: Ty,
+        slots: &'s [f64],
+        structs: &[StructDef],
+    ) -> &'s [f64] {
+        let at = |i: usize| slots.get(i).copied().unwrap_or(0.0);
+        let single = ty.is_single();
+        let used = match ty {
+            Ty::Int => {
+                out.extend_from_slice(self.ints.format(at(0).to_bits() as i64).as_bytes());
+                1
+            }
+            Ty::Float | Ty::Double => {
+                self.float_text(out, at(0), single);
+                1
+            }
+            Ty::V2 | Ty::V2d | Ty::V3 | Ty::V3d => {
+                let n = if matches!(ty, Ty::V2 | Ty::V2d) { 2 } else { 3 };
+                out.push(b'[');
+                for k in 0..n {
+                    if k > 0 {
+                        out.extend_from_slice(b", ");
+                    }
+                    self.float_text(out, at(k), single);
+                }
+                out.push(b']');
+                n
+            }
+            _ => {
+                let (v, n) = crate::lang::value::decode(ty, slots, structs);
+                out.extend_from_slice(value_text(&v, ty, structs).as_bytes());
+                n
+            }
+        };
+        slots.get(used..).unwrap_or(&[])
+    }
+
+    /// Writes one parameter of type `ty` read from the front of `slots` as
+    /// [`value_json`] writes it, and returns the slots after it.
+    fn value_json<'s>(
+        &mut self,
+        out: &mut Vec<u8>,
+        ty: Ty,
+        slots: &'s [f64],
+        structs: &[StructDef],
+    ) -> &'s [f64] {
+        let at = |i: usize| slots.get(i).copied().unwrap_or(0.0);
+        let single = ty.is_single();
+        let used = match ty {
+            Ty::Int => {
+                out.extend_from_slice(self.ints.format(at(0).to_bits() as i64).as_bytes());
+                1
+            }
+            Ty::Float | Ty::Double => {
+                self.float_json(out, at(0), single);
+                1
+            }
+            Ty::V2 | Ty::V2d | Ty::V3 | Ty::V3d => {
+                let n = if matches!(ty, Ty::V2 | Ty::V2d) { 2 } else { 3 };
+                out.push(b'[');
+                for k in 0..n {
+                    if k > 0 {
+                        out.push(b',');
+                    }
+                    self.float_json(out, at(k), single);
+                }
+                out.push(b']');
+                n
+            }
+            _ => {
+                let (v, n) = crate::lang::value::decode(ty, slots, structs);
+                value_json(out, &v, ty, structs).expect("writing into memory does not fail");
+                n
+            }
+        };
+        slots.get(used..).unwrap_or(&[])
+    }
+
+    /// [`float_text`]'s text.
+    fn float_text(&mut self, out: &mut Vec<u8>, x: f64, single: bool) {
+        let single = single && (x as f32) as f64 == x;
+        // Integers print as integers; below 2^24 (2^53) every one is a
+        // `float` (`double`) whose shortest decimal is itself.
+        let exact = if single {
+            16_777_216.0
+        } else {
+            9_007_199_254_740_992.0
+        };
+        if x == x.trunc() && x.abs() < exact {
+            if x == 0.0 && x.is_sign_negative() {
+                out.push(b'-');
+            }
+            out.extend_from_slice(self.ints.format(x as i64).as_bytes());
+            return;
+        }
+        if !x.is_finite() {
+            out.extend_from_slice(float_text(x, single).as_bytes());
+            return;
+        }
+        let shortest = if single {
+            self.floats.format_finite(x as f32)
+        } else {
+            self.floats.format_finite(x)
+        };
+        if may_tie(shortest.as_bytes(), single) {
+            out.extend_from_slice(float_text(x, single).as_bytes());
+        } else {
+            display_layout(out, shortest.as_bytes());
+        }
+    }
+
+    /// [`float_json`]'s text.
+    fn float_json(&mut self, out: &mut Vec<u8>, x: f64, single: bool) {
+        let single = single && (x as f32) as f64 == x;
+        let exact = if single {
+            16_777_216.0
+        } else {
+            9_007_199_254_740_992.0
+        };
+        if x == x.trunc() && x.abs() < exact {
+            // An integral `double` below 2^53 prints as `12.0` (`zmij`
+            // switches to exponents at 1e16), and so does an integral
+            // `float` below 2^24, whose shortest decimal is that integer.
+            if x == 0.0 && x.is_sign_negative() {
+                out.push(b'-');
+            }
+            out.extend_from_slice(self.ints.format(x as i64).as_bytes());
+            out.extend_from_slice(b".0");
+        } else if !x.is_finite() {
+            out.extend_from_slice(b"null");
+        } else if single {
+            // The `double` nearest the `float`'s shortest decimal, laid out
+            // as a `double`.
+            let shortest = self.floats.format_finite(x as f32);
+            let decimal = if may_tie(shortest.as_bytes(), true) {
+                (x as f32).to_string().parse()
+            } else {
+                shortest.parse()
+            };
+            let near = decimal.unwrap_or(x);
+            out.extend_from_slice(self.floats.format_finite(near).as_bytes());
+        } else {
+            out.extend_from_slice(self.floats.format_finite(x).as_bytes());
+        }
+    }
+}
+
+/// True when the shortest decimal `zmij` wrote has so many digits that
+/// another of the same length may lie as close to the number, so that
+/// `std` may break the tie the other way (`zmij` rounds half to even, `std`
+/// does not). Two candidates one unit `u` of the last of `n` digits apart
+/// both read back as the number only when `u` is at most its spacing,
+/// which is at most 2^-52 of it for a normal `double` (2^-23 for a
+/// `float`), while `u` is more than 10^-n of it: so only at `n` ≥ 16 (7).
+/// Subnormal numbers have a coarser spacing; they are below 1e-300
+/// (1e-37) and are passed on too.
+fn may_tie(shortest: &[u8], single: bool) -> bool {
+    let (limit, tiny) = if single { (7, -37) } else { (16, -300) };
+    let (mantissa, exponent) = match shortest.iter().position(|&c| c == b'e') {
+        Some(k) => {
+            let e = std::str::from_utf8(&shortest[k + 1..])
+                .ok()
+                .and_then(|e| e.trim_start_matches('+').parse::<i32>().ok())
+                .unwrap_or(i32::MIN);
+            (&shortest[..k], e)
+        }
+        None => (shortest, 0),
+    };
+    if exponent <= tiny {
+        return true;
+    }
+    let digits = || mantissa.iter().filter(|c| c.is_ascii_digit());
+    let leading = digits().take_while(|&&c| c == b'0').count();
+    let trailing = digits().rev().take_while(|&&c| c == b'0').count();
+    let all = digits().count();
+    all.saturating_sub(leading + trailing) >= limit
+}
+
+/// Lays out the digits of a finite, non-integral number that `zmij` wrote
+/// (`-1.25`, `0.0001`, `1e-7`, `1.5e+16`) as Rust's `Display` does: every
+/// digit in place, with no exponent (`0.0000001`).
+fn display_layout(out: &mut Vec<u8>, shortest: &[u8]) {
+    let (negative, rest) = match shortest.split_first() {
+        Some((b'-', rest)) => (true, rest),
+        _ => (false, shortest),
+    };
+    let (mantissa, exponent) = match rest.iter().position(|&c| c == b'e') {
+        Some(k) => {
+            let e = std::str::from_utf8(&rest[k + 1..])
+                .ok()
+                .and_then(|e| e.trim_start_matches('+').parse::<i64>().ok())
+                .unwrap_or(0);
+            (&rest[..k], e)
+        }
+        None => (rest, 0),
+    };
+    let whole = mantissa
+        .iter()
+        .position(|&c| c == b'.')
+        .unwrap_or(mantissa.len());
+    // At most 17 significant digits (and zeros `zmij` puts before them).
+    let mut buf = [0u8; 40];
+    let mut len = 0;
+    for &c in mantissa.iter().filter(|&&c| c != b'.').take(buf.len()) {
+        buf[len] = c;
+        len += 1;
+    }
+    // The decimal point falls after `point` of the digits.
+    let mut point = whole as i64 + exponent;
+    let leading = buf[..len].iter().take_while(|&&c| c == b'0').count();
+    point -= leading as i64;
+    let mut digits = &buf[leading..len];
+    while let [rest @ .., b'0'] = digits {
+        digits = rest;
+    }
+    if negative {
+        out.push(b'-');
+    }
+    if digits.is_empty() {
+        out.push(b'0');
+    } else if point <= 0 {
+        out.extend_from_slice(b"0.");
+        out.extend(std::iter::repeat_n(b'0', (-point) as usize));
+        out.extend_from_slice(digits);
+    } else if point as usize >= digits.len() {
+        out.extend_from_slice(digits);
+        out.extend(std::iter::repeat_n(b'0', point as usize - digits.len()));
+    } else {
+        out.extend_from_slice(&digits[..point as usize]);
+        out.push(b'.');
+        out.extend_from_slice(&digits[point as usize..]);
+    }
 }
 
 /// `x` as text: a single-precision value as the shortest decimal of its
@@ -107,40 +423,39 @@ pub fn write_word_json(
     alphabet: &Alphabet,
     structs: &[StructDef],
 ) -> std::io::Result<()> {
-    out.write_all(b"{\"modules\":[")?;
-    // Each symbol's name as a JSON string, and whether it has parameters
-    // when it takes no slots (a struct of no fields is one), made once.
-    let mut names: Vec<Option<(Vec<u8>, bool)>> = Vec::new();
+    let mut buf = Chunks::new(out);
+    let mut num = Numbers::default();
+    let mut layouts = Layouts::new(alphabet, structs);
+    buf.push(b"{\"modules\":[");
+    let mut names: Vec<Option<Vec<u8>>> = Vec::new();
     for i in 0..word.len() {
         if i > 0 {
-            out.write_all(b",")?;
+            buf.push(b",");
         }
         let sym = word.syms()[i];
         let k = sym.0 as usize;
         if names.len() <= k {
             names.resize(k + 1, None);
         }
-        let (name, bare) = names[k].get_or_insert_with(|| {
-            (
-                serde_json::to_vec(alphabet.name(sym)).expect("a string is JSON"),
-                alphabet.layout(sym, 0, structs).is_empty(),
-            )
+        let name = names[k].get_or_insert_with(|| {
+            serde_json::to_vec(alphabet.name(sym)).expect("a string is JSON")
         });
-        out.write_all(b"{\"params\":[")?;
-        if !(word.data(i).is_empty() && *bare) {
-            let tys = alphabet.layout(sym, word.data(i).len(), structs);
-            for (j, p) in word.values(i, alphabet, structs).iter().enumerate() {
-                if j > 0 {
-                    out.write_all(b",")?;
-                }
-                value_json(out, p, tys.get(j).copied().unwrap_or(Ty::Double), structs)?;
+        buf.push(b"{\"params\":[");
+        let data = word.data(i);
+        let mut slots = data;
+        for (j, &ty) in layouts.of(sym, data.len()).iter().enumerate() {
+            if j > 0 {
+                buf.push(b",");
             }
+            slots = num.value_json(&mut buf.text, ty, slots, structs);
         }
-        out.write_all(b"],\"symbol\":")?;
-        out.write_all(name)?;
-        out.write_all(b"}")?;
+        buf.push(b"],\"symbol\":");
+        buf.push(name);
+        buf.push(b"}");
+        buf.flush_if_full()?;
     }
-    write!(out, "],\"ring\":{ring},\"step\":{step}}}")
+    buf.push(format!("],\"ring\":{ring},\"step\":{step}}}").as_bytes());
+    buf.finish()
 }
 
 /// [`write_word_json`] into a string.
@@ -280,6 +595,144 @@ mod tests {
             })
             .collect();
         json!({ "ring": ring, "step": step, "modules": modules })
+    }
+
+    /// Numbers to compare the fast writers with `std` and `serde_json` on:
+    /// random bit patterns of both widths, numbers as programs make them,
+    /// and the edges of the integer and exponent ranges.
+    fn numbers() -> Vec<f64> {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.1,
+            90.0,
+            1e-7,
+            1e-5,
+            1e15,
+            1e16,
+            1e17,
+            1e21,
+            1e22,
+            1e-300,
+            5e-324,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            f64::NAN,
+            f64::INFINITY,
+            -f64::INFINITY,
+            16_777_215.0,
+            16_777_216.0,
+            16_777_218.0,
+            123_456_792.0,
+            3.4e38,
+            9_007_199_254_740_991.0,
+            9_007_199_254_740_992.0,
+            9_007_199_254_740_994.0,
+        ];
+        for _ in 0..100_000 {
+            let r = next();
+            xs.push(f64::from_bits(r));
+            xs.push(f32::from_bits(r as u32) as f64);
+            let k = (r >> 11) as i64 % 2_000_001 - 1_000_000;
+            xs.push(k as f64 / 1000.0);
+            xs.push((k as f64 / 7.0) as f32 as f64);
+            xs.push((k as f64) * 10f64.powi((r % 40) as i32 - 10));
+        }
+        xs
+    }
+
+    #[test]
+    fn fast_float_text_is_std_display() {
+        let mut num = Numbers::default();
+        let mut out = Vec::new();
+        for x in numbers() {
+            for single in [false, true] {
+                out.clear();
+                num.float_text(&mut out, x, single);
+                assert_eq!(
+                    std::str::from_utf8(&out).unwrap(),
+                    float_text(x, single),
+                    "{x:e} (single: {single})"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn fast_float_json_is_serde_json() {
+        let mut num = Numbers::default();
+        let (mut fast, mut slow) = (Vec::new(), Vec::new());
+        for x in numbers() {
+            for single in [false, true] {
+                fast.clear();
+                slow.clear();
+                num.float_json(&mut fast, x, single);
+                float_json(&mut slow, x, single).unwrap();
+                assert_eq!(
+                    std::str::from_utf8(&fast).unwrap(),
+                    std::str::from_utf8(&slow).unwrap(),
+                    "{x:e} (single: {single})"
+                );
+            }
+        }
+    }
+
+    /// The text as this module wrote it before it wrote numbers itself:
+    /// each module's values decoded, then printed with `std`.
+    fn text_by_values(word: &Word, alphabet: &Alphabet, structs: &[StructDef]) -> String {
+        let mut out = String::new();
+        for i in 0..word.len() {
+            let sym = word.syms()[i];
+            if i > 0 {
+                out.push(' ');
+            }
+            out.push_str(alphabet.name(sym));
+            let params = word.values(i, alphabet, structs);
+            if !params.is_empty() {
+                let tys = alphabet.layout(sym, word.data(i).len(), structs);
+                let texts: Vec<String> = params
+                    .iter()
+                    .enumerate()
+                    .map(|(j, p)| value_text(p, tys.get(j).copied().unwrap_or(Ty::Double), structs))
+                    .collect();
+                out.push_str(&format!("({})", texts.join(", ")));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn the_fast_text_is_the_values_text() {
+        let text = r#"
+            struct S { int k; float w; V2f v; };
+            struct E { };
+            module A(float, double, int, bool);
+            module D(E);
+            module B(V2f, V3d);
+            module C(S);
+            module T(float);
+            Axiom: A(0.1, 1e-7, -3, true) B(V2f(1.5, -2.25), V3d(1e300, 0, -0.5)) C(S(7, 0.3f, V2f(0, 1e-30))) D(E()) F F(2) T(1);
+            derivation length: 6;
+            T(x) : { produce T(x / 3) T(x * 7.1) F(x + 0.1); }
+        "#;
+        let curve = crate::load_str("t.lsys", text, &[]).unwrap_or_else(|e| panic!("{e}"));
+        let run = curve.run(Default::default()).unwrap();
+        let (alphabet, structs) = (&curve.program.alphabet, &curve.program.structs);
+        let word = run.word();
+        assert!(word.len() > 100);
+        assert_eq!(
+            word_text(word, alphabet, structs),
+            text_by_values(word, alphabet, structs)
+        );
     }
 
     /// Every kind of parameter, streamed, prints as the tree prints.
