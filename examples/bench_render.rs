@@ -1,9 +1,18 @@
-//! Rendering 1,048,576 segments (a Koch snowflake curve, 10 steps) to PNG
-//! and to SVG. `cargo run --release --example bench_render`
+//! Rendering and word output, against the derivation they follow.
+//! `cargo build --release && cargo run --release --example bench_render`
 //!
-//! Reported: derivation, turtle interpretation, layout, PNG encoding and SVG
-//! writing separately, with a reference measured in the same run: tiny-skia
-//! stroking the same points as one path, with no engine around it.
+//! 1. 1,048,576 segments (a Koch snowflake curve, 10 steps) to PNG and to
+//!    SVG: derivation, turtle interpretation, layout, PNG and SVG
+//!    separately, with a reference measured in the same run: tiny-skia
+//!    stroking the same points as one path, with no engine around it.
+//! 2. The quadratic Koch island of lpfg's corpus at 7 steps (3,894,711
+//!    modules, 2,097,152 segments; issue 16, items 1 and 2) through the
+//!    command line, files in and out, each against the derivation alone in
+//!    this process: `subgram derive --format text` and `--format json`
+//!    into a file, and `subgram render` to an 800x800 PNG; and tiny-skia
+//!    stroking the island's segments as one path.
+//!
+//! `--runs N` keeps the best of N runs (3 by default).
 
 mod common;
 
@@ -18,7 +27,17 @@ fn ms(d: Duration) -> f64 {
 }
 
 fn main() {
-    let runs = 3;
+    let args: Vec<String> = std::env::args().collect();
+    let runs = args
+        .iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1)?.parse().ok())
+        .unwrap_or(3);
+    snowflake(runs);
+    island(runs);
+}
+
+fn snowflake(runs: usize) {
     let src = "derivation length: 10;\nAxiom: F(1);\n\
                F(x) -> F(x) Left(60) F(x) Right(120) F(x) Left(60) F(x)\n";
     let loaded = subgram::load_str("koch.lsys", src, &[]).expect("loads");
@@ -34,7 +53,8 @@ fn main() {
     let (t_draw, events) = best_of(runs, || {
         subgram::draw::draw(&word, &p.alphabet, &p.structs, &Default::default()).unwrap()
     });
-    assert_eq!(events.len(), 1 << 20);
+    let segments: usize = events.iter().map(|e| e.segments().count()).sum();
+    assert_eq!(segments, 1 << 20);
     let opts = subgram::render::RenderOptions::default();
     let (t_layout, scene) = best_of(runs, || {
         subgram::render::scene(std::slice::from_ref(&events), &opts).unwrap()
@@ -42,38 +62,7 @@ fn main() {
     let (t_png, png_bytes) = best_of(runs, || png::render(&scene).unwrap());
     let (t_svg, svg_text) = best_of(runs, || svg::render(&scene));
 
-    // Reference: the same points stroked directly with tiny-skia.
-    let points: Vec<glam::DVec2> = scene
-        .items
-        .iter()
-        .flat_map(|i| match i {
-            Item::Polyline { points, .. } => points.clone(),
-            _ => Vec::new(),
-        })
-        .collect();
-    let (t_ref, _) = best_of(runs, || {
-        let mut pm = tiny_skia::Pixmap::new(800, 800).unwrap();
-        pm.fill(tiny_skia::Color::WHITE);
-        let mut pb = tiny_skia::PathBuilder::new();
-        pb.move_to(points[0].x as f32, points[0].y as f32);
-        for q in &points[1..] {
-            pb.line_to(q.x as f32, q.y as f32);
-        }
-        let path = pb.finish().unwrap();
-        let mut paint = tiny_skia::Paint::default();
-        paint.set_color_rgba8(0, 0, 0, 255);
-        paint.anti_alias = true;
-        let stroke = tiny_skia::Stroke::default();
-        pm.stroke_path(
-            &path,
-            &paint,
-            &stroke,
-            tiny_skia::Transform::identity(),
-            None,
-        );
-        pm.encode_png().unwrap()
-    });
-
+    let (t_ref, _) = best_of(runs, || stroke_alone(&scene));
     println!("1,048,576 segments, 800x800, best of {runs}");
     println!("  derive + interpret      {:>8.1} ms", ms(t_derive));
     println!("  turtle -> events        {:>8.1} ms", ms(t_draw));
@@ -96,5 +85,125 @@ fn main() {
         "  total to PNG {:.1} ms, to SVG {:.1} ms",
         ms(t_derive + t_draw + t_layout + t_png),
         ms(t_derive + t_draw + t_layout + t_svg)
+    );
+}
+
+/// tiny-skia stroking every polyline point of `scene` as one path (a pen
+/// of one pixel, antialiased) and encoding the PNG: the reference.
+fn stroke_alone(scene: &subgram::render::Scene) -> Vec<u8> {
+    let mut pm = tiny_skia::Pixmap::new(scene.width, scene.height).unwrap();
+    pm.fill(tiny_skia::Color::WHITE);
+    let mut pb = tiny_skia::PathBuilder::new();
+    for item in &scene.items {
+        if let Item::Polyline { points, .. } = item {
+            pb.move_to(points[0].x as f32, points[0].y as f32);
+            for q in &points[1..] {
+                pb.line_to(q.x as f32, q.y as f32);
+            }
+        }
+    }
+    let path = pb.finish().unwrap();
+    let mut paint = tiny_skia::Paint::default();
+    paint.set_color_rgba8(0, 0, 0, 255);
+    paint.anti_alias = true;
+    let stroke = tiny_skia::Stroke::default();
+    pm.stroke_path(
+        &path,
+        &paint,
+        &stroke,
+        tiny_skia::Transform::identity(),
+        None,
+    );
+    pm.encode_png().unwrap()
+}
+
+/// The quadratic Koch island (lpfg corpus `01-quadratic-Koch.l`, same
+/// rules) at 7 steps through the command line.
+fn island(runs: usize) {
+    let src = "derivation length: 7;\nAxiom: Right(90) F(1.0);\n\
+               F(v) : { produce F(v) Left(90) F(v) Right(90) F(v) Right(90) F(v) \
+               F(v) Left(90) F(v) Left(90) F(v) Right(90) F(v); }\n";
+    let dir = std::env::temp_dir().join(format!("subgram-bench-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("island.lsys");
+    std::fs::write(&file, src).unwrap();
+    let loaded = subgram::load_str("island.lsys", src, &[]).expect("loads");
+    let p = &loaded.program;
+    let (t_derive, d) = best_of(runs, || {
+        let mut d = Derivation::new(p, DeriveOptions::default()).unwrap();
+        while d.has_next() {
+            d.next_step().unwrap();
+        }
+        d
+    });
+    let word = &d.word;
+    assert_eq!(word.len(), 3_894_711);
+    let events = subgram::draw::draw(word, &p.alphabet, &p.structs, &Default::default()).unwrap();
+    let scene = subgram::render::scene(&[events], &Default::default()).unwrap();
+    let (t_skia, _) = best_of(runs, || stroke_alone(&scene));
+    let (t_png, _) = best_of(runs, || png::render(&scene).unwrap());
+
+    let exe = std::env::current_exe().unwrap();
+    let bin = exe
+        .parent()
+        .and_then(|d| d.parent())
+        .unwrap()
+        .join("subgram");
+    if !bin.exists() {
+        println!(
+            "\n{} is missing: run `cargo build --release` first",
+            bin.display()
+        );
+        return;
+    }
+    let cli = |args: &[&str], out: &str| {
+        let target = dir.join(out);
+        let (t, ok) = best_of(runs, || {
+            let stdout = std::fs::File::create(&target).unwrap();
+            let mut cmd = std::process::Command::new(&bin);
+            cmd.args(args).arg(&file);
+            if out.ends_with(".png") {
+                cmd.arg("-o").arg(&target);
+            } else {
+                cmd.stdout(stdout);
+            }
+            cmd.status().unwrap().success()
+        });
+        assert!(ok, "subgram {args:?} failed");
+        (t, std::fs::metadata(&target).unwrap().len())
+    };
+    let (t_text, text_len) = cli(&["derive", "--format", "text"], "island.txt");
+    let (t_json, json_len) = cli(&["derive", "--format", "json"], "island.json");
+    let (t_render, _) = cli(&["render"], "island.png");
+    let _ = std::fs::remove_dir_all(&dir);
+
+    let r = |t: Duration| t.as_secs_f64() / t_derive.as_secs_f64();
+    println!("\nquadratic Koch island, 7 steps: 3,894,711 modules, best of {runs}");
+    println!(
+        "  derivation in this process   {:>8.1} ms  (the reference)",
+        ms(t_derive)
+    );
+    println!(
+        "  subgram derive --format text {:>8.1} ms  {:>5.2}x  ({} MB)",
+        ms(t_text),
+        r(t_text),
+        text_len >> 20
+    );
+    println!(
+        "  subgram derive --format json {:>8.1} ms  {:>5.2}x  ({} MB)",
+        ms(t_json),
+        r(t_json),
+        json_len >> 20
+    );
+    println!(
+        "  subgram render -o PNG        {:>8.1} ms  {:>5.2}x",
+        ms(t_render),
+        r(t_render)
+    );
+    println!(
+        "  in this process: PNG of the laid-out scene {:.1} ms; tiny-skia stroking its segments as one path {:.1} ms ({:.2}x)",
+        ms(t_png),
+        ms(t_skia),
+        t_skia.as_secs_f64() / t_png.as_secs_f64()
     );
 }

@@ -197,8 +197,8 @@ impl Curve {
         let mut panel = |d: &mut Derivation| -> Result<(), Error> {
             let others: Vec<i64> = d.views().iter().copied().filter(|v| *v != 0).collect();
             for view in std::iter::once(0).chain(others) {
-                let word = d.interpret_view(view).map_err(fail)?;
                 let step = d.step;
+                let word = d.interpreted_view(view).map_err(fail)?;
                 let events =
                     draw::draw(&word, &p.alphabet, &p.structs, &draw_opts).map_err(|e| {
                         let maker = (e.module)
@@ -338,10 +338,10 @@ impl<'c> CurveRun<'c> {
     pub fn polylines(&mut self) -> Result<Vec<Vec<DVec3>>, Error> {
         let mut lines: Vec<Vec<DVec3>> = Vec::new();
         for e in self.events()? {
-            if let Event::Line { a, b, .. } = e {
+            if let Event::Path { points, .. } = e {
                 match lines.last_mut() {
-                    Some(l) if l.last() == Some(&a) => l.push(b),
-                    _ => lines.push(vec![a, b]),
+                    Some(l) if l.last() == points.first() => l.extend_from_slice(&points[1..]),
+                    _ => lines.push(points),
                 }
             }
         }

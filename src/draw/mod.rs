@@ -20,8 +20,10 @@ pub struct Pen {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Event {
-    /// A straight segment.
-    Line { a: DVec3, b: DVec3, pen: Pen },
+    /// Connected straight segments drawn with one pen: at least two
+    /// points. The turtle extends the last path while its lines follow on
+    /// with the same pen, so a curve of a million segments is one path.
+    Path { points: Vec<DVec3>, pen: Pen },
     /// A filled disc of world radius `r` (`Circle`, `Sphere`).
     Disc { c: DVec3, r: f64, color: i64 },
     /// A filled disc whose diameter is the pen width in pixels (`Circle0`).
@@ -30,6 +32,17 @@ pub enum Event {
     Ring { c: DVec3, r: f64, pen: Pen },
     /// A filled polygon (`SP() ... PP() ... EP()`).
     Polygon { points: Vec<DVec3>, color: i64 },
+}
+
+impl Event {
+    /// The straight segments of a path, in order; none for other events.
+    pub fn segments(&self) -> impl Iterator<Item = (DVec3, DVec3)> + '_ {
+        let points: &[DVec3] = match self {
+            Event::Path { points, .. } => points,
+            _ => &[],
+        };
+        points.windows(2).map(|w| (w[0], w[1]))
+    }
 }
 
 /// What a predefined module does to the turtle.
@@ -226,6 +239,11 @@ impl Turtle {
     /// Rotates by `deg` degrees about one of the turtle's own axes.
     fn turn(&mut self, axis: DVec3Axis, deg: f64) {
         let (s, c) = deg.to_radians().sin_cos();
+        self.turn_by(axis, s, c);
+    }
+
+    /// [`Turtle::turn`] by the angle whose sine and cosine are `s`, `c`.
+    fn turn_by(&mut self, axis: DVec3Axis, s: f64, c: f64) {
         let rot = |a: DVec3, b: DVec3| (a * c + b * s, b * c - a * s);
         match axis {
             // Left: heading turns towards the left vector.
@@ -375,6 +393,45 @@ pub fn is_query(name: &str) -> bool {
     matches!(name, "GetPos" | "GetHead" | "GetLeft" | "GetUp")
 }
 
+/// The sines and cosines of the last two angles turned by: words turn by
+/// a few angles over and over (`+(90) ... -(90)`), and `sin_cos` is most
+/// of a turn's cost.
+#[derive(Default)]
+struct TurnCache {
+    slots: [Option<(u64, f64, f64)>; 2],
+    next: usize,
+}
+
+impl TurnCache {
+    fn sin_cos(&mut self, deg: f64) -> (f64, f64) {
+        let bits = deg.to_bits();
+        for (b, s, c) in self.slots.iter().flatten() {
+            if *b == bits {
+                return (*s, *c);
+            }
+        }
+        let (s, c) = deg.to_radians().sin_cos();
+        self.slots[self.next] = Some((bits, s, c));
+        self.next ^= 1;
+        (s, c)
+    }
+}
+
+/// Appends the segment `a`..`b` to the last event when that is a path
+/// with the same pen ending at `a`, or else starts a path.
+fn line(out: &mut Vec<Event>, a: DVec3, b: DVec3, pen: Pen) {
+    if let Some(Event::Path { points, pen: p }) = out.last_mut() {
+        if *p == pen && points.last() == Some(&a) {
+            points.push(b);
+            return;
+        }
+    }
+    out.push(Event::Path {
+        points: vec![a, b],
+        pen,
+    });
+}
+
 /// Interprets `word` with the turtle and returns the drawing events.
 pub fn draw(
     word: &Word,
@@ -418,6 +475,7 @@ pub fn draw_with_queries(
     };
     let mut polygons: Vec<Vec<DVec3>> = Vec::new();
     let mut out = Vec::new();
+    let mut turns = TurnCache::default();
     let mut i = 0;
     let n = word.len();
     while i < n {
@@ -453,11 +511,7 @@ pub fn draw_with_queries(
                 field.adjust(&mut t.head, &mut t.left, &mut t.up);
                 let to = t.pos + t.head * arg(0, opts.step);
                 if draw {
-                    out.push(Event::Line {
-                        a: t.pos,
-                        b: to,
-                        pen: t.pen,
-                    });
+                    line(&mut out, t.pos, to, t.pen);
                 }
                 t.pos = to;
                 if record {
@@ -478,11 +532,7 @@ pub fn draw_with_queries(
                 // lpfg ignores a line shorter than epsilon; a drawn one
                 // moves as `F` does, and so records a polygon vertex.
                 if t.pos.distance(to) >= EPSILON {
-                    out.push(Event::Line {
-                        a: t.pos,
-                        b: to,
-                        pen: t.pen,
-                    });
+                    line(&mut out, t.pos, to, t.pen);
                     t.pos = to;
                     if let Some(p) = polygons.last_mut() {
                         p.push(to);
@@ -498,7 +548,7 @@ pub fn draw_with_queries(
                 let (a, b) = (t.frame.place(a), t.frame.place(b));
                 // lpfg ignores a line shorter than epsilon altogether.
                 if a.distance(b) >= EPSILON {
-                    out.push(Event::Line { a, b, pen: t.pen });
+                    line(&mut out, a, b, t.pen);
                     t.pos = b;
                     if let Some(p) = polygons.last_mut() {
                         p.push(b);
@@ -510,7 +560,9 @@ pub fn draw_with_queries(
                     DVec3Axis::Up => sign,
                     DVec3Axis::Left | DVec3Axis::Head => sign * sense,
                 };
-                t.turn(axis, sign * arg(0, opts.angle))
+                let deg = sign * arg(0, opts.angle);
+                let (s, c) = turns.sin_cos(deg);
+                t.turn_by(axis, s, c)
             }
             Cmd::TurnAround => t.turn(DVec3Axis::Up, 180.0),
             Cmd::SetColor => {

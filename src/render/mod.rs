@@ -3,6 +3,7 @@
 //! events are laid out here; [`mesh`] turns a polygon mesh into shaded
 //! polygons of a scene.
 
+mod ink;
 pub mod mesh;
 pub mod png;
 pub mod svg;
@@ -269,10 +270,7 @@ fn fit_panel(
     };
     for e in events {
         match e {
-            Event::Line { a, b, .. } => {
-                grow(v.project(*a), 0.0);
-                grow(v.project(*b), 0.0);
-            }
+            Event::Path { points, .. } => points.iter().for_each(|p| grow(v.project(*p), 0.0)),
             Event::Disc { c, r, .. } | Event::Ring { c, r, .. } => grow(v.project(*c), r.abs()),
             Event::Dot { c, .. } => grow(v.project(*c), 0.0),
             Event::Polygon { points, .. } => points.iter().for_each(|p| grow(v.project(*p), 0.0)),
@@ -308,18 +306,20 @@ fn fit_panel(
         }
     };
     for e in events {
-        if let Event::Line { a, b, pen } = e {
-            let (pa, pb) = (px(*a), px(*b));
+        if let Event::Path { points, pen } = e {
             let color = palette(pen.color);
-            let joined = matches!(&run, Some((pts, c, w))
-                if *c == color && *w == width(pen.width) && pts.last().is_some_and(|l| l.distance(pa) < 1e-9));
-            if joined {
-                if let Some((pts, _, _)) = run.as_mut() {
-                    pts.push(pb);
-                }
-            } else {
+            let w = width(pen.width);
+            let Some(first) = points.first().map(|p| px(*p)) else {
+                continue;
+            };
+            let joined = matches!(&run, Some((pts, c, rw))
+                if *c == color && *rw == w && pts.last().is_some_and(|l| l.distance(first) < 1e-9));
+            if !joined {
                 flush(&mut run, items);
-                run = Some((vec![pa, pb], color, width(pen.width)));
+                run = Some((vec![first], color, w));
+            }
+            if let Some((pts, _, _)) = run.as_mut() {
+                pts.extend(points[1..].iter().map(|p| px(*p)));
             }
             continue;
         }
@@ -346,7 +346,7 @@ fn fit_panel(
                 color: palette(*color),
                 outline: None,
             },
-            Event::Line { .. } => unreachable!("handled above"),
+            Event::Path { .. } => unreachable!("handled above"),
         });
     }
     flush(&mut run, items);

@@ -1,5 +1,6 @@
 //! PNG output with tiny-skia: antialiased fills, and strokes with round caps
-//! and joins.
+//! and joins; polylines with a pen of at most a pixel by their ink
+//! ([`super::ink`]).
 
 use tiny_skia::{
     Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, Transform,
@@ -31,6 +32,7 @@ pub fn render(scene: &Scene) -> Result<Vec<u8>, RenderError> {
     let b = scene.background;
     pm.fill(Color::from_rgba8(b.0, b.1, b.2, b.3));
     let id = Transform::identity();
+    let mut ink = super::ink::Ink::new(scene.width, scene.height);
     for item in &scene.items {
         match item {
             Item::Polyline {
@@ -38,6 +40,13 @@ pub fn render(scene: &Scene) -> Result<Vec<u8>, RenderError> {
                 color,
                 width,
             } => {
+                if *width <= 1.0 {
+                    // A thin pen: its ink (a pen of width 0 is a hairline).
+                    let pen = if *width > 0.0 { *width } else { 1.0 };
+                    ink.polyline(points, pen);
+                    ink.blend(&mut pm, *color);
+                    continue;
+                }
                 let [first, rest @ ..] = points.as_slice() else {
                     continue;
                 };

@@ -723,14 +723,12 @@ pub fn figure_events(
     let v3 = |p: DVec2| glam::DVec3::new(p.x, p.y, 0.0);
     let mut ev = Vec::new();
     let poly = |pts: &[DVec2], closed: bool, pen: Pen, ev: &mut Vec<Event>| {
-        let n = pts.len();
-        let last = if closed { n } else { n.saturating_sub(1) };
-        for i in 0..last {
-            ev.push(Event::Line {
-                a: v3(pts[i]),
-                b: v3(pts[(i + 1) % n]),
-                pen,
-            });
+        let mut points: Vec<glam::DVec3> = pts.iter().map(|p| v3(*p)).collect();
+        if closed {
+            points.extend(points.first().copied());
+        }
+        if points.len() >= 2 {
+            ev.push(Event::Path { points, pen });
         }
     };
     poly(

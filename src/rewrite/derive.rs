@@ -667,6 +667,29 @@ impl<'p> Derivation<'p> {
         word
     }
 
+    /// [`Derivation::interpret_view`], borrowing the word when no
+    /// interpretation rule of the view applies (a large word is not
+    /// copied to be drawn).
+    pub fn interpreted_view(
+        &mut self,
+        view: i64,
+    ) -> Result<std::borrow::Cow<'_, Word>, DeriveError> {
+        self.view = view;
+        let rewritten = self.depth(Section::Interpretation).and_then(|depth| {
+            if self.candidates(Section::Interpretation).is_empty() {
+                return Ok(None);
+            }
+            let word = self.word.clone();
+            self.rewrite_to_depth(Section::Interpretation, word, depth, &mut None)
+                .map(Some)
+        });
+        self.view = 0;
+        Ok(match rewritten? {
+            Some(word) => std::borrow::Cow::Owned(word),
+            None => std::borrow::Cow::Borrowed(&self.word),
+        })
+    }
+
     /// The views `UseView` activated so far, in order.
     pub fn views(&self) -> &[i64] {
         &self.env.views

@@ -40,13 +40,9 @@ fn single_character_turtle_reads_as_printed() {
     };
     let events =
         subgram::draw::draw(&d.word, &l.program.alphabet, &l.program.structs, &opts).unwrap();
-    let dirs: Vec<glam::DVec3> = events
-        .iter()
-        .map(|e| match e {
-            subgram::draw::Event::Line { a, b, .. } => *b - *a,
-            other => panic!("unexpected {other:?}"),
-        })
-        .collect();
+    // One path: each line starts where the last ended, `[F]` included.
+    assert_eq!(events.len(), 1, "{events:?}");
+    let dirs: Vec<glam::DVec3> = events[0].segments().map(|(a, b)| b - a).collect();
     let (s30, c30) = (0.5, 3f64.sqrt() / 2.0);
     let want = [
         glam::DVec3::Y,

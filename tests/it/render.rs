@@ -172,9 +172,8 @@ fn an_empty_drawing_is_an_error() {
 
 #[test]
 fn a_nan_coordinate_is_an_error() {
-    let nan = subgram::draw::Event::Line {
-        a: glam::DVec3::ZERO,
-        b: glam::DVec3::new(f64::NAN, 0.0, 0.0),
+    let nan = subgram::draw::Event::Path {
+        points: vec![glam::DVec3::ZERO, glam::DVec3::new(f64::NAN, 0.0, 0.0)],
         pen: subgram::draw::Pen {
             color: 1,
             width: 1.0,
@@ -264,12 +263,10 @@ fn the_view_projects_the_3d_turtle() {
         &Default::default(),
     )
     .unwrap();
-    let seg = |e: &subgram::draw::Event| match e {
-        subgram::draw::Event::Line { a, b, .. } => (*a, *b),
-        other => panic!("{other:?}"),
+    let segments: Vec<_> = events.iter().flat_map(|e| e.segments()).collect();
+    let [(a0, b0), (a1, b1)] = segments[..] else {
+        panic!("{events:?}");
     };
-    let (a0, b0) = seg(&events[0]);
-    let (a1, b1) = seg(&events[1]);
     assert!((b0 - a0).abs_diff_eq(glam::DVec3::Z, 1e-12), "{}", b0 - a0);
     assert!(
         (b1 - a1).abs_diff_eq(glam::DVec3::NEG_X, 1e-12),
@@ -357,4 +354,83 @@ fn an_svg_background_keeps_its_opacity() {
     assert!(!opaque.contains("fill-opacity"), "{opaque}");
     let none = svg::render(&square_scene(None, render::Rgba(0, 0, 0, 0)));
     assert!(!none.contains("<rect"), "{none}");
+}
+
+/// The coverage of thin lines in a PNG against the exact coverage of the
+/// same strokes: the scene's polylines stroked one pixel wide by tiny-skia
+/// without antialiasing at 8x8 samples per pixel, each pixel the mean of its
+/// samples. A Koch island whose segments shrink to a few pixels, then to
+/// fractions of one, where a curve passes a pixel many times.
+#[test]
+fn thin_lines_cover_pixels_as_the_strokes_do() {
+    let src = "derivation length: 5;\nAxiom: Right(90) F(1);\n\
+               F(v) : { produce F(v) Left(90) F(v) Right(90) F(v) Right(90) F(v) \
+               F(v) Left(90) F(v) Left(90) F(v) Right(90) F(v); }\n";
+    let l = load_text(src);
+    for (steps, mean_bound) in [(2, 0.35), (3, 0.8), (4, 1.2), (5, 1.8)] {
+        let opts = FigureOptions {
+            derive: DeriveOptions {
+                steps: Some(steps),
+                ..Default::default()
+            },
+            render: RenderOptions {
+                width: 240,
+                height: 240,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let scene = l.figure(&opts).unwrap();
+        let got = tiny_skia::Pixmap::decode_png(&png::render(&scene).unwrap()).unwrap();
+        let k = 8u32;
+        let mut fine = tiny_skia::Pixmap::new(240 * k, 240 * k).unwrap();
+        fine.fill(tiny_skia::Color::WHITE);
+        for item in &scene.items {
+            let Item::Polyline { points, color, .. } = item else {
+                panic!("only polylines expected: {item:?}");
+            };
+            let mut pb = tiny_skia::PathBuilder::new();
+            pb.move_to(points[0].x as f32 * k as f32, points[0].y as f32 * k as f32);
+            for q in &points[1..] {
+                pb.line_to(q.x as f32 * k as f32, q.y as f32 * k as f32);
+            }
+            let mut paint = tiny_skia::Paint::default();
+            paint.set_color_rgba8(color.0, color.1, color.2, color.3);
+            paint.anti_alias = false;
+            let stroke = tiny_skia::Stroke {
+                width: k as f32,
+                line_cap: tiny_skia::LineCap::Butt,
+                line_join: tiny_skia::LineJoin::Round,
+                ..Default::default()
+            };
+            let path = pb.finish().unwrap();
+            fine.stroke_path(&path, &paint, &stroke, Default::default(), None);
+        }
+        let (mut error, mut ink, mut exact_ink) = (0.0, 0.0, 0.0);
+        for y in 0..240 {
+            for x in 0..240 {
+                let mut sum = 0.0;
+                for j in 0..k {
+                    for i in 0..k {
+                        sum += fine.pixel(x * k + i, y * k + j).unwrap().red() as f64;
+                    }
+                }
+                let exact = sum / (k * k) as f64;
+                let drawn = got.pixel(x, y).unwrap().red() as f64;
+                error += (drawn - exact).abs();
+                ink += 255.0 - drawn;
+                exact_ink += 255.0 - exact;
+            }
+        }
+        let mean = error / (240.0 * 240.0);
+        assert!(
+            mean < mean_bound,
+            "{steps} steps: mean difference {mean} from the exact coverage"
+        );
+        let ratio = ink / exact_ink;
+        assert!(
+            (0.9..1.1).contains(&ratio),
+            "{steps} steps: {ratio} of the exact coverage's ink"
+        );
+    }
 }

@@ -1,0 +1,239 @@
+//! Thin polylines (a pen of at most one pixel) drawn by the ink they lay
+//! down: each segment, cut into pieces of at most half a pixel, adds its
+//! area (length times pen width) to the four pixels around each piece's
+//! middle, weighted bilinearly; a pixel's coverage is the ink it gathered,
+//! at most one; then the path's colour is blended over the picture once
+//! per pixel it touched.
+//!
+//! For a straight line this is exact box coverage across the line (a
+//! horizontal line at y = 10.25 covers a quarter of row 9 and three
+//! quarters of row 10), and a curve of millions of segments shorter than a
+//! pixel costs a few operations per segment. Overlaps within one path do
+//! not darken it (a stroke covers a pixel at most once), where drawing each
+//! segment as its own antialiased hairline does; and where a dense curve
+//! fills a pixel, the pixel is filled. Paths with wider pens are stroked by
+//! tiny-skia.
+
+use glam::DVec2;
+use tiny_skia::{Pixmap, PremultipliedColorU8};
+
+use super::Rgba;
+
+/// The longest piece a segment is cut into, in pixels.
+const PIECE: f64 = 0.5;
+
+/// The ink of one path at a time, over a picture of a given size.
+pub(crate) struct Ink {
+    width: usize,
+    height: usize,
+    /// The ink on each pixel, row by row.
+    ink: Vec<f32>,
+    /// The pixels with ink, each once.
+    touched: Vec<u32>,
+}
+
+impl Ink {
+    pub(crate) fn new(width: u32, height: u32) -> Ink {
+        Ink {
+            width: width as usize,
+            height: height as usize,
+            ink: vec![0.0; width as usize * height as usize],
+            touched: Vec::new(),
+        }
+    }
+
+    /// Lays down the ink of `points`, joined in order, with a pen `pen`
+    /// pixels wide (at most one).
+    pub(crate) fn polyline(&mut self, points: &[DVec2], pen: f64) {
+        let (w, h) = (self.width as f64, self.height as f64);
+        let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= w && p.y <= h;
+        for pair in points.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            let Some((a, b)) = (if inside(a) && inside(b) {
+                Some((a, b))
+            } else {
+                clip(a, b, w, h)
+            }) else {
+                continue;
+            };
+            let d = b - a;
+            let length = d.length();
+            if length == 0.0 {
+                continue;
+            }
+            // As many pieces as `PIECE` needs (`ceil` without the call;
+            // clipped lengths are a few times the picture's side at most).
+            let whole = (length / PIECE) as usize;
+            let pieces = whole + usize::from((whole as f64) * PIECE < length);
+            let step = d / pieces as f64;
+            let area = (length / pieces as f64 * pen) as f32;
+            let mut c = a + step * 0.5;
+            for _ in 0..pieces {
+                self.splat(c, area);
+                c += step;
+            }
+        }
+    }
+
+    /// Adds `area` to the four pixels whose centres surround `c`.
+    #[inline]
+    fn splat(&mut self, c: DVec2, area: f32) {
+        // Clipped points lie above -1, so that truncating after adding 2
+        // is `floor` (without a call into libm).
+        let (fx, fy) = (c.x + 1.5, c.y + 1.5);
+        let (x0, y0) = (fx as i64, fy as i64);
+        let (tx, ty) = ((fx - x0 as f64) as f32, (fy - y0 as f64) as f32);
+        let (x0, y0) = (x0 - 2, y0 - 2);
+        let weights = [
+            (1.0 - tx) * (1.0 - ty),
+            tx * (1.0 - ty),
+            (1.0 - tx) * ty,
+            tx * ty,
+        ];
+        if x0 >= 0 && y0 >= 0 && x0 + 1 < self.width as i64 && y0 + 1 < self.height as i64 {
+            // All four inside: no bounds to check.
+            let i = y0 as usize * self.width + x0 as usize;
+            for (k, weight) in weights.into_iter().enumerate() {
+                let i = i + (k & 1) + (k >> 1) * self.width;
+                let cell = &mut self.ink[i];
+                if *cell == 0.0 && weight > 0.0 {
+                    self.touched.push(i as u32);
+                }
+                *cell += area * weight;
+            }
+            return;
+        }
+        for (dx, dy, weight) in [
+            (0, 0, (1.0 - tx) * (1.0 - ty)),
+            (1, 0, tx * (1.0 - ty)),
+            (0, 1, (1.0 - tx) * ty),
+            (1, 1, tx * ty),
+        ] {
+            let (x, y) = (x0 + dx, y0 + dy);
+            if x < 0 || y < 0 || x >= self.width as i64 || y >= self.height as i64 {
+                continue;
+            }
+            let i = y as usize * self.width + x as usize;
+            let cell = &mut self.ink[i];
+            if *cell == 0.0 && weight > 0.0 {
+                self.touched.push(i as u32);
+            }
+            *cell += area * weight;
+        }
+    }
+
+    /// Blends `color` over `pm` where the ink lies, by the ink's coverage,
+    /// and clears the ink for the next path.
+    pub(crate) fn blend(&mut self, pm: &mut Pixmap, color: Rgba) {
+        let alpha = color.3 as f32 / 255.0;
+        let src = [color.0 as f32, color.1 as f32, color.2 as f32, 255.0];
+        let pixels = pm.pixels_mut();
+        for &i in &self.touched {
+            let i = i as usize;
+            let a = self.ink[i].min(1.0) * alpha;
+            self.ink[i] = 0.0;
+            let p = pixels[i];
+            let dst = [p.red(), p.green(), p.blue(), p.alpha()].map(f32::from);
+            let mix = |k: usize| (src[k] * a + dst[k] * (1.0 - a)).round().clamp(0.0, 255.0) as u8;
+            let out_a = mix(3);
+            let out = PremultipliedColorU8::from_rgba(
+                mix(0).min(out_a),
+                mix(1).min(out_a),
+                mix(2).min(out_a),
+                out_a,
+            );
+            if let Some(out) = out {
+                pixels[i] = out;
+            }
+        }
+        self.touched.clear();
+    }
+}
+
+/// The part of the segment `a`..`b` within a pixel of the picture
+/// `0..w` x `0..h` (Liang and Barsky's clipping), or `None`.
+fn clip(a: DVec2, b: DVec2, w: f64, h: f64) -> Option<(DVec2, DVec2)> {
+    let d = b - a;
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [
+        (-d.x, a.x + 1.0),
+        (d.x, w + 1.0 - a.x),
+        (-d.y, a.y + 1.0),
+        (d.y, h + 1.0 - a.y),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let r = q / p;
+            if p < 0.0 {
+                t0 = t0.max(r);
+            } else {
+                t1 = t1.min(r);
+            }
+        }
+    }
+    (t0 <= t1 && t0.is_finite() && t1.is_finite()).then(|| (a + d * t0, a + d * t1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ink_of(points: &[DVec2], pen: f64) -> Ink {
+        let mut ink = Ink::new(20, 20);
+        ink.polyline(points, pen);
+        ink
+    }
+
+    #[test]
+    fn a_horizontal_line_covers_the_rows_it_crosses_by_area() {
+        // A pen of one pixel along y = 10.25 spans y in 9.75..10.75: a
+        // quarter of row 9 and three quarters of row 10.
+        let ink = ink_of(&[DVec2::new(2.0, 10.25), DVec2::new(18.0, 10.25)], 1.0);
+        for x in 4..16 {
+            let at = |y: usize| ink.ink[y * 20 + x];
+            assert!((at(9) - 0.25).abs() < 1e-5, "{}", at(9));
+            assert!((at(10) - 0.75).abs() < 1e-5, "{}", at(10));
+            assert_eq!(at(8) + at(11), 0.0);
+        }
+        // All the ink is the line's area.
+        let total: f32 = ink.ink.iter().sum();
+        assert!((total - 16.0).abs() < 1e-3, "{total}");
+    }
+
+    #[test]
+    fn a_thin_pen_lays_down_its_share() {
+        let ink = ink_of(&[DVec2::new(3.0, 3.0), DVec2::new(15.0, 12.0)], 0.5);
+        let total: f32 = ink.ink.iter().sum();
+        // Length 15 (a 9-12-15 triangle) times half a pixel.
+        assert!((total - 7.5).abs() < 1e-3, "{total}");
+    }
+
+    #[test]
+    fn segments_far_outside_are_clipped_not_walked() {
+        let far = ink_of(&[DVec2::new(-1e12, 5.5), DVec2::new(1e12, 5.5)], 1.0);
+        // Only the 22 pixels of the row (and its margin) inside the picture.
+        let total: f32 = far.ink.iter().sum();
+        assert!((total - 20.0).abs() < 0.6, "{total}");
+        let none = ink_of(&[DVec2::new(-50.0, -50.0), DVec2::new(-10.0, 80.0)], 1.0);
+        assert!(none.touched.is_empty());
+    }
+
+    #[test]
+    fn blending_full_ink_paints_the_colour_and_clears() {
+        let mut ink = Ink::new(4, 4);
+        let mut pm = Pixmap::new(4, 4).unwrap();
+        pm.fill(tiny_skia::Color::WHITE);
+        // Two passes over the same pixels: coverage stays at most one.
+        ink.polyline(&[DVec2::new(0.0, 1.5), DVec2::new(4.0, 1.5)], 1.0);
+        ink.polyline(&[DVec2::new(4.0, 1.5), DVec2::new(0.0, 1.5)], 1.0);
+        ink.blend(&mut pm, Rgba(10, 20, 30, 255));
+        let p = pm.pixel(2, 1).unwrap();
+        assert_eq!((p.red(), p.green(), p.blue(), p.alpha()), (10, 20, 30, 255));
+        let q = pm.pixel(2, 2).unwrap();
+        assert_eq!((q.red(), q.alpha()), (255, 255));
+        assert!(ink.touched.is_empty() && ink.ink.iter().all(|&x| x == 0.0));
+    }
+}
