@@ -32,6 +32,7 @@ mod atomic;
 mod curve;
 mod deadline;
 mod error;
+mod huge;
 mod lang;
 mod limits;
 mod load;

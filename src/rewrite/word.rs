@@ -61,7 +61,7 @@ impl Word {
         fn fit<T>(v: &mut Vec<T>, n: usize) {
             v.clear();
             if v.capacity() < n {
-                *v = Vec::with_capacity(n);
+                *v = crate::huge::with_capacity(n);
             }
         }
         fit(&mut self.syms, modules);
