@@ -97,6 +97,8 @@ fn main() {
         .unwrap_or(5);
     let only = |name: &str| !args.iter().any(|a| a == "--only") || args.iter().any(|a| a == name);
 
+    // `--subgram-only`: the engine alone, for a profile.
+    let alone = args.iter().any(|a| a == "--subgram-only");
     if only("branching") {
         let steps = 11;
         let src = format!(
@@ -108,43 +110,47 @@ fn main() {
         let (t_ours, ours) = best_of_with(runs, &(), |()| {
             subgram::derive(&loaded.program, DeriveOptions::default()).expect("derives")
         });
-        let mut sys = symbios::System::new();
-        sys.max_capacity = 4_000_000;
-        sys.add_rule(
-            "A(l, w) : l > 0.01 -> F(l) [ +(30) A(l * 0.7, w * 0.7) ] \
+        if alone {
+            println!("subgram alone {:.2} ms", t_ours.as_secs_f64() * 1e3);
+        } else {
+            let mut sys = symbios::System::new();
+            sys.max_capacity = 4_000_000;
+            sys.add_rule(
+                "A(l, w) : l > 0.01 -> F(l) [ +(30) A(l * 0.7, w * 0.7) ] \
              [ -(25) A(l * 0.6, w * 0.7) ] A(l * 0.9, w * 0.9)",
-        )
-        .expect("symbios parses");
-        sys.set_axiom("A(1, 1)").expect("symbios axiom");
-        let (t_theirs, theirs) = best_of_with(runs, &sys, |mut s| {
-            s.derive(steps).expect("symbios derives");
-            s
-        });
-        let want = branching_count(steps);
-        assert_eq!(ours.word.len(), want, "subgram's module count");
-        assert_eq!(theirs.state.len(), want, "symbios's module count");
-        // The same symbols in the same order, and the same F lengths to
-        // single precision.
-        let mut sum_ours = 0.0;
-        let mut sum_theirs = 0.0;
-        for i in 0..want {
-            let a = names(loaded.program.alphabet.name(ours.word.sym(i)));
-            let v = theirs.state.get_view(i).expect("module");
-            let b = theirs.interner.resolve(v.sym).expect("symbol");
-            assert_eq!(a, b, "module {i}");
-            if a == "F" {
-                sum_ours += ours.word.data(i)[0];
-                sum_theirs += v.params[0];
+            )
+            .expect("symbios parses");
+            sys.set_axiom("A(1, 1)").expect("symbios axiom");
+            let (t_theirs, theirs) = best_of_with(runs, &sys, |mut s| {
+                s.derive(steps).expect("symbios derives");
+                s
+            });
+            let want = branching_count(steps);
+            assert_eq!(ours.word.len(), want, "subgram's module count");
+            assert_eq!(theirs.state.len(), want, "symbios's module count");
+            // The same symbols in the same order, and the same F lengths to
+            // single precision.
+            let mut sum_ours = 0.0;
+            let mut sum_theirs = 0.0;
+            for i in 0..want {
+                let a = names(loaded.program.alphabet.name(ours.word.sym(i)));
+                let v = theirs.state.get_view(i).expect("module");
+                let b = theirs.interner.resolve(v.sym).expect("symbol");
+                assert_eq!(a, b, "module {i}");
+                if a == "F" {
+                    sum_ours += ours.word.data(i)[0];
+                    sum_theirs += v.params[0];
+                }
             }
-        }
-        assert!((sum_ours - sum_theirs).abs() <= 1e-5 * sum_theirs);
-        report(
+            assert!((sum_ours - sum_theirs).abs() <= 1e-5 * sum_theirs);
+            report(
             &format!(
                 "guarded branching system, 11 steps, {want} modules, best of {runs} (parsing not timed)"
             ),
             t_ours,
             t_theirs,
         );
+        }
     }
 
     if only("signal") {
@@ -162,33 +168,37 @@ fn main() {
         let (t_ours, ours) = best_of_with(runs, &(), |()| {
             subgram::derive(&loaded.program, DeriveOptions::default()).expect("derives")
         });
-        let mut sys = symbios::System::new();
-        sys.max_capacity = 4_000_000;
-        sys.add_rule("A(x) < A(y) : x > y -> A(x * 0.5 + y + 1)")
-            .expect("symbios parses");
-        sys.add_rule("A(x) < A(y) : x <= y -> A(y * 0.5)")
-            .expect("symbios parses");
-        sys.set_axiom(&axiom).expect("symbios axiom");
-        let (t_theirs, theirs) = best_of_with(runs, &sys, |mut s| {
-            s.derive(steps).expect("symbios derives");
-            s
-        });
-        assert_eq!(ours.word.len(), n);
-        assert_eq!(theirs.state.len(), n);
-        for i in 0..n {
-            let v = theirs.state.get_view(i).expect("module");
-            assert_eq!(
-                ours.word.data(i)[0].to_bits(),
-                v.params[0].to_bits(),
-                "module {i}"
-            );
-        }
-        report(
+        if alone {
+            println!("subgram alone {:.2} ms", t_ours.as_secs_f64() * 1e3);
+        } else {
+            let mut sys = symbios::System::new();
+            sys.max_capacity = 4_000_000;
+            sys.add_rule("A(x) < A(y) : x > y -> A(x * 0.5 + y + 1)")
+                .expect("symbios parses");
+            sys.add_rule("A(x) < A(y) : x <= y -> A(y * 0.5)")
+                .expect("symbios parses");
+            sys.set_axiom(&axiom).expect("symbios axiom");
+            let (t_theirs, theirs) = best_of_with(runs, &sys, |mut s| {
+                s.derive(steps).expect("symbios derives");
+                s
+            });
+            assert_eq!(ours.word.len(), n);
+            assert_eq!(theirs.state.len(), n);
+            for i in 0..n {
+                let v = theirs.state.get_view(i).expect("module");
+                assert_eq!(
+                    ours.word.data(i)[0].to_bits(),
+                    v.params[0].to_bits(),
+                    "module {i}"
+                );
+            }
+            report(
             &format!(
                 "context-sensitive signal, {n} modules x {steps} steps, best of {runs} (parsing not timed)"
             ),
             t_ours,
             t_theirs,
         );
+        }
     }
 }
