@@ -872,3 +872,254 @@ fn bin(op: BinOp, a: C, b: C, span: Option<Span>) -> Option<C> {
         _ => return None,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{DeriveOptions, Word};
+
+    /// A derivation's result as text that is equal only when the words
+    /// are equal to the bit: symbols, every slot's bits, the globals after
+    /// `End`, or the error's message.
+    fn fingerprint(text: &str, compiled: bool) -> String {
+        set_enabled(compiled);
+        let out = (|| {
+            let curve = crate::load_str("t.lsys", text, &[]).map_err(|e| e.to_string())?;
+            let d = curve
+                .derive(DeriveOptions::default())
+                .map_err(|e| e.to_string())?;
+            Ok::<_, String>(format!("{}\n{:?}", word_bits(&d.word), d.env.globals))
+        })();
+        set_enabled(true);
+        out.unwrap_or_else(|e| format!("error: {e}"))
+    }
+
+    fn word_bits(w: &Word) -> String {
+        let mut s = String::new();
+        for i in 0..w.len() {
+            s.push_str(&format!("{}(", w.sym(i).0));
+            for x in w.data(i) {
+                s.push_str(&format!("{:x},", x.to_bits()));
+            }
+            s.push(')');
+        }
+        s
+    }
+
+    /// The same result with and without compiled bodies; returns it.
+    fn both(text: &str) -> String {
+        let on = fingerprint(text, true);
+        let off = fingerprint(text, false);
+        assert_eq!(on, off, "compiled and interpreted differ on\n{text}");
+        on
+    }
+
+    /// The parameters of the final word's modules, read as `f64`s (ints
+    /// are stored by their bits; these tests read floats only).
+    fn params(text: &str) -> Vec<f64> {
+        both(text);
+        let curve = crate::load_str("t.lsys", text, &[]).expect("loads");
+        let d = curve.derive(DeriveOptions::default()).expect("derives");
+        d.word.all_slots().to_vec()
+    }
+
+    fn compiles(text: &str) -> Vec<bool> {
+        let curve = crate::load_str("t.lsys", text, &[]).expect("loads");
+        let p = &curve.program;
+        p.rules
+            .iter()
+            .map(|r| compile(r, &p.globals).is_some())
+            .collect()
+    }
+
+    #[test]
+    fn common_bodies_compile() {
+        // Guards on parameters, arithmetic, locals, if/else, loops with
+        // break and continue, maths built-ins, `?:`, `define`d functions,
+        // globals read and written, int and bool parameters.
+        let text = "#define HALF(x) ((x) * 0.5)\n\
+            module A(float, float); module B(int, bool);\n\
+            int count = 0;\n\
+            derivation length: 2;\nAxiom: A(1, 1) B(3, true);\n\
+            A(l, w) : { if (l > 0.01) produce F(l) SB() Left(30) A(l * 0.7, w) EB() A(HALF(l), w); }\n\
+            B(n, b) : { float s = 0; int i; for (i = 0; i < 10; i++) { if (i == 2) continue; if (i > 6) break; s += sqrt(i); }\n\
+                count += 1; if (b && n > 2) produce B(n / 2, !b) A(s > 3 ? s : 0, pow(2, n)); else produce B(n - 1, b); }\n";
+        assert_eq!(compiles(text), vec![true, true]);
+        both(text);
+        // Not compiled: vectors, user functions; these run interpreted.
+        let text = "module P(V2f); module A(float);\nfloat f(float x) { return x * 2; }\n\
+            derivation length: 1;\nAxiom: P(V2f(1, 2)) A(1);\n\
+            P(v) : { produce P(v * 2); }\nA(x) : { produce A(f(x)); }\n";
+        assert_eq!(compiles(text), vec![false, false]);
+        both(text);
+    }
+
+    #[test]
+    fn single_precision_rounding() {
+        // float: each product rounded to single precision, as C does:
+        // 0.1 is a double constant, l * 0.1 in double, then stored into
+        // the float parameter.
+        let text = "module A(float);\nderivation length: 1;\nAxiom: A(3);\n\
+            A(l) : { float t = l * 0.1; produce A(t + 1e-9); }\n";
+        assert_eq!(compiles(text), vec![true]);
+        let t = (3.0f64 * 0.1) as f32 as f64;
+        let want = (t + 1e-9) as f32 as f64;
+        assert_eq!(params(text), vec![want]);
+    }
+
+    #[test]
+    fn float_to_int_and_int_arithmetic() {
+        // C truncates toward zero; 7 / 2 is 3, -7 / 2 is -3, -7 % 2 is -1.
+        let text = "module A(int, int, int, int);\nderivation length: 1;\nAxiom: A(0, 0, 0, 0);\n\
+            A(a, b, c, d) : { int k = 2.7; int m = -2.7; produce A(k, m, 7 / 2 + -7 / 2, -7 % 2); }\n";
+        assert_eq!(compiles(text), vec![true]);
+        let got: Vec<i64> = params(text).iter().map(|x| x.to_bits() as i64).collect();
+        assert_eq!(got, vec![2, -2, 0, -1]);
+    }
+
+    #[test]
+    fn integer_division_by_zero_is_the_same_error() {
+        let text = "module A(int);\nderivation length: 1;\nAxiom: A(0);\n\
+            A(n) : { produce A(1 / n); }\n";
+        assert_eq!(compiles(text), vec![true]);
+        let out = both(text);
+        assert!(out.contains("integer division by zero"), "{out}");
+        // `x /= 0` reports the same message (and no span, as interpreted).
+        let text = "module A(int);\nderivation length: 1;\nAxiom: A(0);\n\
+            A(n) : { int k = 5; k /= n; produce A(k); }\n";
+        assert_eq!(compiles(text), vec![true]);
+        assert!(both(text).contains("integer division by zero"));
+    }
+
+    #[test]
+    fn short_circuit_and_conditional() {
+        // The right operand of `||` (`&&`) is not evaluated when the left
+        // one decides: no division by zero here.
+        let text = "module A(int, int);\nderivation length: 1;\nAxiom: A(1, 0);\n\
+            A(x, z) : { int a = x > 0 || 1 / z > 0; int b = x < 0 && 1 / z > 0; \
+            produce A(a ? 10 : 1 / z, b ? 1 / z : 20); }\n";
+        assert_eq!(compiles(text), vec![true]);
+        let got: Vec<i64> = params(text).iter().map(|x| x.to_bits() as i64).collect();
+        assert_eq!(got, vec![10, 20]);
+    }
+
+    #[test]
+    fn loops_with_break_and_continue() {
+        // Sum of the odd i below 10 until i reaches 7: 1 + 3 + 5 = 9; the
+        // do-while runs its body once even though its condition is false.
+        let text = "module A(int, int);\nderivation length: 1;\nAxiom: A(0, 0);\n\
+            A(a, b) : { int s = 0; int i; for (i = 0; i < 10; i++) { if (i % 2 == 0) continue; \
+            if (i >= 7) break; s += i; } int n = 0; do { n++; } while (n > 5); \
+            int w = 0; while (w < 4) w = w + 1; produce A(s, n * 100 + w); }\n";
+        assert_eq!(compiles(text), vec![true]);
+        let got: Vec<i64> = params(text).iter().map(|x| x.to_bits() as i64).collect();
+        assert_eq!(got, vec![9, 104]);
+    }
+
+    #[test]
+    fn loop_limit_and_non_finite_successors() {
+        // A loop that never ends stops at the limit with the same message
+        // and place as interpreted.
+        let text = "module A(int);\nderivation length: 1;\nAxiom: A(0);\n\
+            A(n) : { int i = 0; while (n == 0) { i++; } produce A(i); }\n";
+        assert_eq!(compiles(text), vec![true]);
+        let out = both(text);
+        assert!(
+            out.contains("a loop ran more than 10000000 iterations"),
+            "{out}"
+        );
+        // NaN in a successor: the same message naming the parameter.
+        let text = "module A(float, float);\nderivation length: 1;\nAxiom: A(0, 1);\n\
+            A(x, y) : { produce A(y, x / x); }\n";
+        assert_eq!(compiles(text), vec![true]);
+        let out = both(text);
+        assert!(
+            out.contains("parameter 2 of this successor module is NaN"),
+            "{out}"
+        );
+    }
+
+    #[test]
+    fn deadline_stops_a_compiled_loop() {
+        let text = "module A(int);\nderivation length: 1;\nAxiom: A(0);\n\
+            A(n) : { int i = 0; while (n == 0) { i++; } produce A(i); }\n";
+        let curve = crate::load_str("t.lsys", text, &[]).expect("loads");
+        assert!(compile(&curve.program.rules[0], &curve.program.globals).is_some());
+        let opts = DeriveOptions {
+            deadline: Some(crate::Deadline::after(std::time::Duration::from_millis(1))),
+            ..DeriveOptions::default()
+        };
+        let e = curve.derive(opts).expect_err("times out").to_string();
+        assert!(e.contains("time limit"), "{e}");
+    }
+
+    /// Every program of `lsystems/` and of the test data that loads as a
+    /// curve derives to the same word, to the bit, with and without
+    /// compiled bodies (or fails with the same message).
+    #[test]
+    fn corpus_same_with_and_without() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut files = Vec::new();
+        fn walk(d: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+            let Ok(rd) = std::fs::read_dir(d) else { return };
+            for e in rd.flatten() {
+                let p = e.path();
+                if p.is_dir() {
+                    walk(&p, out);
+                } else if p.extension().is_some_and(|x| x == "lsys" || x == "l") {
+                    out.push(p);
+                }
+            }
+        }
+        walk(&root.join("lsystems"), &mut files);
+        walk(&root.join("tests/data"), &mut files);
+        files.sort();
+        let (mut programs, mut compiled) = (0, 0);
+        for f in &files {
+            let mut run = |on: bool| -> Option<String> {
+                set_enabled(on);
+                let curve = crate::load_file(f, &[]);
+                let out = curve.ok().map(|c| {
+                    if on {
+                        compiled += c
+                            .program
+                            .rules
+                            .iter()
+                            .filter(|r| compile(r, &c.program.globals).is_some())
+                            .count();
+                    }
+                    let opts = DeriveOptions {
+                        max_modules: 200_000,
+                        deadline: Some(crate::Deadline::after(std::time::Duration::from_secs(5))),
+                        ..DeriveOptions::default()
+                    };
+                    match c.run(opts) {
+                        Ok(mut r) => {
+                            let i = r.interpreted().map(|w| word_bits(&w));
+                            format!(
+                                "{}\n{:?}",
+                                word_bits(r.word()),
+                                i.map_err(|e| e.to_string())
+                            )
+                        }
+                        Err(e) => format!("error: {e}"),
+                    }
+                });
+                set_enabled(true);
+                out
+            };
+            let on = run(true);
+            let off = run(false);
+            let timed_out =
+                |s: &Option<String>| s.as_ref().is_some_and(|s| s.contains("time limit"));
+            if on.is_some() && !timed_out(&on) && !timed_out(&off) {
+                programs += 1;
+                assert_eq!(on, off, "{}", f.display());
+            }
+        }
+        // The corpus has curves and plants whose bodies compile.
+        eprintln!("{programs} programs compared, {compiled} bodies compiled");
+        assert!(programs > 60, "{programs} programs compared");
+        assert!(compiled > 20, "{compiled} bodies compiled");
+    }
+}
