@@ -48,7 +48,8 @@ thread_local! {
 
 /// Turns compiled bodies on or off for the rewriters made on this thread
 /// from now on (on by default). Results are the same either way.
-pub fn set_enabled(on: bool) {
+#[cfg(test)]
+pub(crate) fn set_enabled(on: bool) {
     ENABLED.with(|e| e.set(on));
 }
 
@@ -290,8 +291,10 @@ impl Body {
         env: &mut Env,
         sink: &mut dyn Emit,
     ) -> Result<Flow, RuntimeError> {
-        m.frame.clear();
-        m.frame.resize(self.frame_size, 0);
+        if m.frame.len() < self.frame_size {
+            m.frame.resize(self.frame_size, 0);
+        }
+        m.frame[..self.frame_size].fill(0);
         for (k, b) in self.binds.iter().enumerate() {
             let data = params(k);
             for (j, &(slot, ty)) in b.iter().enumerate() {

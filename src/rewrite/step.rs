@@ -808,14 +808,48 @@ impl<'p> Rewriter<'p> {
 
         if let Some(body) = &self.bodies[r] {
             // The compiled body reads the matched modules' slots itself.
-            self.tmp.clear();
             self.machine.loop_limit = self.interp.loop_limit;
             self.machine.deadline = self.interp.deadline;
+            let matched = &self.matched;
+            if opts.forward {
+                // Straight into the new word, taken back when the body
+                // does not produce: the word is full at the same module.
+                let before = dst.len();
+                let mut successor = Successor {
+                    word: dst,
+                    room: opts.max_modules,
+                };
+                let result = body.run(
+                    &mut self.machine,
+                    |k| src.data(matched[k]),
+                    env,
+                    &mut successor,
+                );
+                let full = successor.full();
+                return match result {
+                    Ok(flow) if flow == Flow::Produced || any_flow => Ok(true),
+                    Ok(_) => {
+                        dst.truncate(before);
+                        Ok(false)
+                    }
+                    Err(error) => {
+                        dst.truncate(before);
+                        Err(if full {
+                            StepError::TooLong {
+                                limit: opts.max_modules,
+                                rule: Some(r),
+                            }
+                        } else {
+                            StepError::Runtime { rule: r, error }
+                        })
+                    }
+                };
+            }
+            self.tmp.clear();
             let mut successor = Successor {
                 word: &mut self.tmp,
                 room: opts.max_modules.saturating_sub(dst.len()),
             };
-            let matched = &self.matched;
             let flow = body
                 .run(
                     &mut self.machine,
