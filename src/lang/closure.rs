@@ -93,6 +93,8 @@ type FE = Box<dyn Fn(&mut Cx) -> R<f64> + Send + Sync>;
 type IE = Box<dyn Fn(&mut Cx) -> R<i64> + Send + Sync>;
 type BE = Box<dyn Fn(&mut Cx) -> R<bool> + Send + Sync>;
 type SE = Box<dyn Fn(&mut Cx) -> R<Flow> + Send + Sync>;
+/// A value's 64 bits as the frame holds them.
+type UE = Box<dyn Fn(&mut Cx) -> R<u64> + Send + Sync>;
 
 /// The kind of a value at run time: `Value::Int`, `Value::Float`,
 /// `Value::Bool`.
@@ -157,7 +159,7 @@ impl C {
 
     /// The value's 64 bits as the frame holds them: an `f64`'s bits, an
     /// `i64`'s, 0 or 1.
-    fn bits(self) -> Box<dyn Fn(&mut Cx) -> R<u64> + Send + Sync> {
+    fn bits(self) -> UE {
         match self {
             C::F(f) => Box::new(move |cx| Ok(f(cx)?.to_bits())),
             C::I(f) => Box::new(move |cx| Ok(f(cx)? as u64)),
@@ -734,12 +736,7 @@ fn pure(e: &Ex) -> bool {
 }
 
 /// One successor module: its parameters, checked finite, as slots.
-fn produce(
-    cx: &mut Cx,
-    sym: Sym,
-    args: &[(Kind, Box<dyn Fn(&mut Cx) -> R<u64> + Send + Sync>)],
-    span: Span,
-) -> R<()> {
+fn produce(cx: &mut Cx, sym: Sym, args: &[(Kind, UE)], span: Span) -> R<()> {
     let base = cx.m.slots.len();
     for (k, (kind, a)) in args.iter().enumerate() {
         let x = match a(cx) {
