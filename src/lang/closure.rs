@@ -114,6 +114,25 @@ fn kind_of(ty: Ty) -> Option<Kind> {
     }
 }
 
+/// An operand read without a call: a local or a number, as `f64`.
+#[derive(Clone, Copy)]
+enum Leaf {
+    Float(usize),
+    Int(usize),
+    Const(f64),
+}
+
+impl Leaf {
+    #[inline(always)]
+    fn get(self, frame: &[u64]) -> f64 {
+        match self {
+            Leaf::Float(s) => f64::from_bits(frame[s]),
+            Leaf::Int(s) => frame[s] as i64 as f64,
+            Leaf::Const(x) => x,
+        }
+    }
+}
+
 /// A compiled expression of its kind.
 enum C {
     I(IE),
@@ -352,11 +371,71 @@ impl Compiler<'_> {
         }
     }
 
+    /// A leaf read as a floating-point operand (`Value::as_f64`): a local
+    /// of known kind `F` or `I`, or a number.
+    fn leaf(&self, e: &Ex) -> Option<Leaf> {
+        match e {
+            Ex::Local(s) => match self.kinds.get(*s as usize)? {
+                Some(Kind::F) => Some(Leaf::Float(*s as usize)),
+                Some(Kind::I) => Some(Leaf::Int(*s as usize)),
+                _ => None,
+            },
+            Ex::Const(Value::Float(x)) => Some(Leaf::Const(*x)),
+            Ex::Const(Value::Int(i)) => Some(Leaf::Const(*i as f64)),
+            _ => None,
+        }
+    }
+
+    /// `a op b` on two leaves of which one at least is floating, in one
+    /// closure (rounded to single precision with `round`): the floating
+    /// branch of [`bin`] without a call per operand.
+    fn fused(&self, op: BinOp, a: &Ex, b: &Ex, round: bool) -> Option<C> {
+        use BinOp::*;
+        let (x, y) = (self.leaf(a)?, self.leaf(b)?);
+        let floating = |l: Leaf, e: &Ex| {
+            matches!(l, Leaf::Float(_)) || matches!(e, Ex::Const(Value::Float(_)))
+        };
+        if !floating(x, a) && !floating(y, b) {
+            return None;
+        }
+        macro_rules! f {
+            ($f:expr) => {
+                C::F(Box::new(move |cx| {
+                    let v = $f(x.get(&cx.m.frame), y.get(&cx.m.frame));
+                    Ok(if round { round32(v) } else { v })
+                }))
+            };
+        }
+        macro_rules! b {
+            ($f:expr) => {
+                C::B(Box::new(move |cx| {
+                    Ok($f(x.get(&cx.m.frame), y.get(&cx.m.frame)))
+                }))
+            };
+        }
+        Some(match op {
+            Add => f!(|p: f64, q: f64| p + q),
+            Sub => f!(|p: f64, q: f64| p - q),
+            Mul => f!(|p: f64, q: f64| p * q),
+            Div => f!(|p: f64, q: f64| p / q),
+            Lt if !round => b!(|p: f64, q: f64| p < q),
+            Le if !round => b!(|p: f64, q: f64| p <= q),
+            Gt if !round => b!(|p: f64, q: f64| p > q),
+            Ge if !round => b!(|p: f64, q: f64| p >= q),
+            Eq if !round => b!(|p: f64, q: f64| p == q),
+            Ne if !round => b!(|p: f64, q: f64| p != q),
+            _ => return None,
+        })
+    }
+
     fn block(&mut self, body: &[St]) -> Option<SE> {
-        let sts = body
+        let mut sts = body
             .iter()
             .map(|s| self.stmt(s))
             .collect::<Option<Vec<_>>>()?;
+        if sts.len() == 1 {
+            return sts.pop();
+        }
         Some(Box::new(move |cx| {
             for s in &sts {
                 match s(cx)? {
@@ -459,13 +538,6 @@ impl Compiler<'_> {
                         .iter()
                         .map(|a| self.expr(a))
                         .collect::<Option<Vec<_>>>()?;
-                    let args: Vec<_> = args
-                        .into_iter()
-                        .map(|c| {
-                            let k = c.kind();
-                            (k, c.bits())
-                        })
-                        .collect();
                     ms.push((m.sym, args, m.span));
                 }
                 let first = modules.first().map(|m| m.span);
@@ -513,6 +585,9 @@ impl Compiler<'_> {
                 C::B(Box::new(move |cx| Ok(!a(cx)?)))
             }
             Ex::Bin(op, a, b, span) => {
+                if let Some(c) = self.fused(*op, a, b, false) {
+                    return Some(c);
+                }
                 let (a, b) = (self.expr(a)?, self.expr(b)?);
                 bin(*op, a, b, Some(*span))?
             }
@@ -540,6 +615,11 @@ impl Compiler<'_> {
                 }
             }
             Ex::Convert(ty, a) => {
+                if let (Ty::Float, Ex::Bin(op, x, y, _)) = (ty, &**a) {
+                    if let Some(c) = self.fused(*op, x, y, true) {
+                        return Some(c);
+                    }
+                }
                 let a = self.expr(a)?;
                 convert(*ty, a)?
             }
@@ -736,20 +816,25 @@ fn pure(e: &Ex) -> bool {
 }
 
 /// One successor module: its parameters, checked finite, as slots.
-fn produce(cx: &mut Cx, sym: Sym, args: &[(Kind, UE)], span: Span) -> R<()> {
+fn produce(cx: &mut Cx, sym: Sym, args: &[C], span: Span) -> R<()> {
     let base = cx.m.slots.len();
-    for (k, (kind, a)) in args.iter().enumerate() {
-        let x = match a(cx) {
+    for (k, a) in args.iter().enumerate() {
+        // `value::encode`: an int's bits, a float, a bool as 0 or 1.
+        let x = match a {
+            C::F(a) => a(cx),
+            C::I(a) => a(cx).map(|i| f64::from_bits(i as u64)),
+            C::B(a) => a(cx).map(|b| b as u8 as f64),
+        };
+        let x = match x {
             Ok(x) => x,
             Err(e) => {
                 cx.m.slots.truncate(base);
                 return Err(e);
             }
         };
-        // `value::encode`: an int's bits, a float, a bool as 0 or 1.
-        let slot = match kind {
-            Kind::F => {
-                let f = f64::from_bits(x);
+        let slot = match a {
+            C::F(_) => {
+                let f = x;
                 if !f.is_finite() {
                     cx.m.slots.truncate(base);
                     return Err(rt(
@@ -763,8 +848,7 @@ fn produce(cx: &mut Cx, sym: Sym, args: &[(Kind, UE)], span: Span) -> R<()> {
                 }
                 f
             }
-            Kind::I => f64::from_bits(x),
-            Kind::B => (x != 0) as u8 as f64,
+            _ => x,
         };
         cx.m.slots.push(slot);
     }
@@ -946,6 +1030,12 @@ mod tests {
                 count += 1; if (b && n > 2) produce B(n / 2, !b) A(s > 3 ? s : 0, pow(2, n)); else produce B(n - 1, b); }\n";
         assert_eq!(compiles(text), vec![true, true]);
         both(text);
+        // Off, nothing compiles: the comparisons of these tests are not
+        // of the compiled path with itself.
+        set_enabled(false);
+        let off = compiles(text);
+        set_enabled(true);
+        assert_eq!(off, vec![false, false]);
         // Not compiled: vectors, user functions; these run interpreted.
         let text = "module P(V2f); module A(float);\nfloat f(float x) { return x * 2; }\n\
             derivation length: 1;\nAxiom: P(V2f(1, 2)) A(1);\n\
@@ -975,6 +1065,20 @@ mod tests {
         assert_eq!(compiles(text), vec![true]);
         let got: Vec<i64> = params(text).iter().map(|x| x.to_bits() as i64).collect();
         assert_eq!(got, vec![2, -2, 0, -1]);
+    }
+
+    #[test]
+    fn mixed_int_and_float_operands() {
+        // C's usual conversions: 7 / 2 is 3 (both int), 7 / 2.0 is 3.5,
+        // 7 * 0.5 is 3.5, 0.5 < 7 is true (1 in a float parameter);
+        // 0.1 + 0.2 in double is 0.30000000000000004, then rounded to
+        // single precision by the float parameter.
+        let text = "module A(float, float, float, float, float); module B(int, float);\n\
+            derivation length: 1;\nAxiom: B(7, 0.5);\n\
+            B(n, x) : { double d = 0.1; produce A(n / 2, n / 2.0, n * x, x < n, d + 0.2); }\n";
+        assert_eq!(compiles(text), vec![true]);
+        let sum = (0.1f64 + 0.2) as f32 as f64;
+        assert_eq!(params(text), vec![3.0, 3.5, 3.5, 1.0, sum]);
     }
 
     #[test]
