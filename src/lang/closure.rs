@@ -231,9 +231,10 @@ fn convert(ty: Ty, c: C) -> Option<C> {
 
 /// A body compiled to closures, with the slots its pattern parameters go to.
 pub struct Body {
-    /// Per pattern (left, strict, right context in order), the slot and
-    /// type of each parameter.
-    binds: Vec<Vec<(usize, Ty)>>,
+    /// Per parameter of the patterns (left, strict, right context in
+    /// order): the pattern's number, the parameter's, its slot, and
+    /// whether it is a `bool`.
+    binds: Vec<(usize, usize, usize, bool)>,
     frame_size: usize,
     body: SE,
 }
@@ -258,18 +259,16 @@ pub fn compile(rule: &Rule, globals: &[super::ir::GlobalVar]) -> Option<Body> {
         .collect();
     let mut seeds = vec![None; rule.frame_size];
     let mut binds = Vec::new();
-    for p in &pats {
-        let mut b = Vec::new();
-        for (&slot, &ty) in p.slots.iter().zip(&p.types) {
+    for (n, p) in pats.iter().enumerate() {
+        for (j, (&slot, &ty)) in p.slots.iter().zip(&p.types).enumerate() {
             let k = kind_of(ty)?;
             let s = slot as usize;
             if s >= seeds.len() || seeds[s].is_some_and(|o| o != k) {
                 return None;
             }
             seeds[s] = Some(k);
-            b.push((s, ty));
+            binds.push((n, j, s, ty == Ty::Bool));
         }
-        binds.push(b);
     }
     // The kinds of the locals: what is known grows pass by pass until the
     // compiled body reads no slot of unknown kind.
@@ -312,20 +311,27 @@ impl Body {
         env: &mut Env,
         sink: &mut dyn Emit,
     ) -> Result<Flow, RuntimeError> {
+        // Cleared, though a body reads a local only after its declaration
+        // stored into it or a pattern bound it: nothing of the last body
+        // can show.
         if m.frame.len() < self.frame_size {
             m.frame.resize(self.frame_size, 0);
         }
         m.frame[..self.frame_size].fill(0);
-        for (k, b) in self.binds.iter().enumerate() {
-            let data = params(k);
-            for (j, &(slot, ty)) in b.iter().enumerate() {
-                // `value::decode` of one slot.
-                let x = data.get(j).copied().unwrap_or(0.0);
-                m.frame[slot] = match ty {
-                    Ty::Bool => (x != 0.0) as u64,
-                    _ => x.to_bits(),
-                };
+        let mut data: &[f64] = &[];
+        let mut at = usize::MAX;
+        for &(k, j, slot, boolean) in &self.binds {
+            if k != at {
+                data = params(k);
+                at = k;
             }
+            // `value::decode` of one slot.
+            let x = data.get(j).copied().unwrap_or(0.0);
+            m.frame[slot] = if boolean {
+                (x != 0.0) as u64
+            } else {
+                x.to_bits()
+            };
         }
         m.fuel = m.loop_limit;
         let mut cx = Cx { m, env, sink };
