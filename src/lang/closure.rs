@@ -19,9 +19,10 @@
 //! the same spans), single-precision rounding where the IR converts,
 //! short-circuit `&&` and `||`, the same loop limit and deadline checks,
 //! the same check for NaN and infinity in successors and the same
-//! limit on the word. Anything else (vectors, structs, arrays, strings,
-//! user functions, context queries, random numbers, I/O, `switch`) makes
-//! [`compile`] give `None`, and the interpreter runs that body.
+//! limit on the word, the random number generators drawn in the same
+//! order. Anything else (vectors, structs, arrays, strings, user
+//! functions, context queries, seeding the generators, I/O, `switch`)
+//! makes [`compile`] give `None`, and the interpreter runs that body.
 
 use std::cell::Cell;
 
@@ -666,6 +667,36 @@ impl Compiler<'_> {
                             }))
                         }
                     }
+                    Func::Random(op) => {
+                        use super::random::Op;
+                        let op = *op;
+                        let float = match op {
+                            Op::Ran | Op::Drand48 | Op::GillespieTime => true,
+                            Op::Rand | Op::Lrand48 | Op::Mrand48 => false,
+                            // The seeding calls give no value.
+                            _ => return None,
+                        };
+                        let arg = next().map(|c| (c.kind(), c.bits()));
+                        if next().is_some() {
+                            return None;
+                        }
+                        // `Random::call` on the argument as the interpreter
+                        // holds it.
+                        let call = move |cx: &mut Cx| -> R<Value> {
+                            Ok(match &arg {
+                                Some((k, a)) => {
+                                    let v = value_of(*k, a(cx)?);
+                                    cx.env.random.call(op, std::slice::from_ref(&v))
+                                }
+                                None => cx.env.random.call(op, &[]),
+                            })
+                        };
+                        if float {
+                            C::F(Box::new(move |cx| Ok(call(cx)?.as_f64())))
+                        } else {
+                            C::I(Box::new(move |cx| Ok(call(cx)?.as_i64())))
+                        }
+                    }
                     _ => return None,
                 }
             }
@@ -1085,6 +1116,20 @@ mod tests {
         assert_eq!(compiles(text), vec![true]);
         let sum = (0.1f64 + 0.2) as f32 as f64;
         assert_eq!(params(text), vec![3.0, 3.5, 3.5, 1.0, sum]);
+    }
+
+    #[test]
+    fn random_numbers_in_bodies() {
+        // The generators advance in the same order, compiled or not: the
+        // words are equal to the bit (their values are checked against
+        // lpfg's in tests/it/random.rs), and two modules drew different
+        // numbers.
+        let text = "module A(float, int);\nderivation length: 3;\nAxiom: A(0, 0) A(0, 0);\n\
+            A(x, n) : { if (ran(1) < 2) produce A(x + ran(2), rand() % 1000 + n) A(drand48(), lrand48() % 7); }\n";
+        assert_eq!(compiles(text), vec![true]);
+        let p = params(text);
+        assert_eq!(p.len(), 32);
+        assert_ne!(p[0], p[2]);
     }
 
     #[test]
