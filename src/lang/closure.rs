@@ -1229,13 +1229,14 @@ mod tests {
         walk(&root.join("lsystems"), &mut files);
         walk(&root.join("tests/data"), &mut files);
         files.sort();
-        let (mut programs, mut compiled) = (0, 0);
+        let (mut programs, mut compiled, mut rules) = (0, 0, 0);
         for f in &files {
             let mut run = |on: bool| -> Option<String> {
                 set_enabled(on);
                 let curve = crate::load_file(f, &[]);
                 let out = curve.ok().map(|c| {
                     if on {
+                        rules += c.program.rules.len();
                         compiled += c
                             .program
                             .rules
@@ -1273,7 +1274,7 @@ mod tests {
             }
         }
         // The corpus has curves and plants whose bodies compile.
-        eprintln!("{programs} programs compared, {compiled} bodies compiled");
+        eprintln!("{programs} programs compared, {compiled} of {rules} bodies compiled");
         assert!(programs > 60, "{programs} programs compared");
         assert!(compiled > 20, "{compiled} bodies compiled");
     }
