@@ -117,6 +117,14 @@ fn rt(span: Option<Span>, m: impl Into<String>) -> Box<RuntimeError> {
 pub trait Emit {
     fn emit(&mut self, sym: Sym, args: &[Value]);
 
+    /// A module whose parameters are given as a word stores them
+    /// (`value::encode`): what compiled bodies ([`super::closure`]) emit.
+    /// By default, each slot as a `float` (which encodes as itself).
+    fn emit_slots(&mut self, sym: Sym, slots: &[f64]) {
+        let args: Vec<Value> = slots.iter().map(|&x| Value::Float(x)).collect();
+        self.emit(sym, &args);
+    }
+
     /// True when the sink holds more than it may: the interpreter stops
     /// the body after the `produce` that filled it.
     fn full(&self) -> bool {

@@ -2,6 +2,7 @@
 
 pub mod builtins;
 pub mod cfmt;
+pub mod closure;
 pub mod compile;
 pub mod eval;
 pub mod ir;

@@ -9,6 +9,7 @@
 use std::ops::Range;
 
 use crate::deadline::Deadline;
+use crate::lang::closure;
 use crate::lang::eval::{Emit, Env, Flow, Host, Interp, RuntimeError};
 use crate::lang::ir::{Pattern, Program, Rule};
 use crate::lang::stencil::Stencil;
@@ -81,6 +82,10 @@ impl Emit for Successor<'_> {
         self.word.push(sym, args);
     }
 
+    fn emit_slots(&mut self, sym: Sym, slots: &[f64]) {
+        self.word.push_raw(sym, slots);
+    }
+
     fn full(&self) -> bool {
         self.word.len() > self.room
     }
@@ -92,6 +97,9 @@ impl std::error::Error for StepError {}
 pub struct Rewriter<'p> {
     program: &'p Program,
     interp: Interp<'p>,
+    /// Per rule, its body compiled to closures, where it can be.
+    bodies: Vec<Option<closure::Body>>,
+    machine: closure::Machine,
     sb: Sym,
     eb: Sym,
     cut: Sym,
@@ -112,6 +120,12 @@ impl<'p> Rewriter<'p> {
         Rewriter {
             program,
             interp: Interp::for_program(program, None),
+            bodies: program
+                .rules
+                .iter()
+                .map(|r| closure::compile(r, &program.globals))
+                .collect(),
+            machine: closure::Machine::default(),
             sb: program.alphabet.builtin("SB"),
             eb: program.alphabet.builtin("EB"),
             cut: program.alphabet.builtin("Cut"),
@@ -792,6 +806,70 @@ impl<'p> Rewriter<'p> {
             return Ok(true);
         }
 
+        if let Some(body) = &self.bodies[r] {
+            // The compiled body reads the matched modules' slots itself.
+            self.machine.loop_limit = self.interp.loop_limit;
+            self.machine.deadline = self.interp.deadline;
+            let matched = &self.matched;
+            if opts.forward {
+                // Straight into the new word, taken back when the body
+                // does not produce: the word is full at the same module.
+                let before = dst.len();
+                let mut successor = Successor {
+                    word: dst,
+                    room: opts.max_modules,
+                };
+                let result = body.run(
+                    &mut self.machine,
+                    |k| src.data(matched[k]),
+                    env,
+                    &mut successor,
+                );
+                let full = successor.full();
+                return match result {
+                    Ok(flow) if flow == Flow::Produced || any_flow => Ok(true),
+                    Ok(_) => {
+                        dst.truncate(before);
+                        Ok(false)
+                    }
+                    Err(error) => {
+                        dst.truncate(before);
+                        Err(if full {
+                            StepError::TooLong {
+                                limit: opts.max_modules,
+                                rule: Some(r),
+                            }
+                        } else {
+                            StepError::Runtime { rule: r, error }
+                        })
+                    }
+                };
+            }
+            self.tmp.clear();
+            let mut successor = Successor {
+                word: &mut self.tmp,
+                room: opts.max_modules.saturating_sub(dst.len()),
+            };
+            let flow = body
+                .run(
+                    &mut self.machine,
+                    |k| src.data(matched[k]),
+                    env,
+                    &mut successor,
+                )
+                .map_err(|error| {
+                    if successor.full() {
+                        StepError::TooLong {
+                            limit: opts.max_modules,
+                            rule: Some(r),
+                        }
+                    } else {
+                        StepError::Runtime { rule: r, error }
+                    }
+                })?;
+            return Ok(self.append_successor(flow, any_flow, opts, dst));
+        }
+
         // Bind the parameters: slots are allocated in pattern order
         // new-left, left, strict, right, new-right.
         self.frame.clear();
@@ -854,8 +932,20 @@ impl<'p> Rewriter<'p> {
                     StepError::Runtime { rule: r, error }
                 }
             })?;
+        Ok(self.append_successor(flow, any_flow, opts, dst))
+    }
+
+    /// After a body ran: appends the successor it emitted to `dst` when it
+    /// ended with `produce` (or with `any_flow`), and says whether it did.
+    fn append_successor(
+        &mut self,
+        flow: Flow,
+        any_flow: bool,
+        opts: &StepOptions,
+        dst: &mut Word,
+    ) -> bool {
         if flow != Flow::Produced && !any_flow {
-            return Ok(false);
+            return false;
         }
         if opts.forward {
             for j in 0..self.tmp.len() {
@@ -866,7 +956,7 @@ impl<'p> Rewriter<'p> {
                 dst.push_from(&self.tmp, j);
             }
         }
-        Ok(true)
+        true
     }
 }
 
