@@ -11,7 +11,7 @@
 //! vertices.
 
 use super::halfedge::{EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId};
-use super::soup::PolygonSoup;
+use super::soup::{Faces, PolygonSoup};
 
 fn at_line(soup: &PolygonSoup, face: usize) -> String {
     match soup.face_line(face) {
@@ -471,13 +471,23 @@ impl Mesh {
         } else {
             self.soup_with(|e| self.is_block_edge(e))
         };
-        let mut out = SoupSharpness::default();
         if !self.has_sharpness_flag() {
-            return (soup, out);
+            return (soup, SoupSharpness::default());
         }
         let mut index = vec![u32::MAX; self.v_alive.len()];
         for (i, v) in vertices.iter().enumerate() {
             index[v.index()] = i as u32;
+        }
+        let out = self.soup_sharpness(&index, triangles);
+        (soup, out)
+    }
+
+    /// The sharpness of [`Mesh::to_soup_with_sharpness`], for a soup whose
+    /// vertex of each mesh vertex is `index` (`u32::MAX`: left out).
+    pub(crate) fn soup_sharpness(&self, index: &[u32], triangles: bool) -> SoupSharpness {
+        let mut out = SoupSharpness::default();
+        if !self.has_sharpness_flag() {
+            return out;
         }
         for e in self.edges() {
             let s = self.edge_sharpness(e);
@@ -496,7 +506,15 @@ impl Mesh {
             .vertices()
             .filter(|&v| self.vertex_sharpness(v) > 0.0)
             .count();
-        (soup, out)
+        out
+    }
+
+    /// True when [`Mesh::to_quad_soup`] joins some faces into a polygon
+    /// (a basic block with both its triangles); false when it gives the
+    /// triangles as they are, the same soup as [`Mesh::to_soup`].
+    pub(crate) fn quad_soup_merges(&self) -> bool {
+        self.edges()
+            .any(|e| self.is_block_edge(e) && matches!(self.edge_faces(e), [Some(_), Some(_)]))
     }
 
     /// [`Mesh::to_quad_soup`] and the tag of each of its faces. A basic
@@ -566,16 +584,16 @@ impl Mesh {
                 positions.push(self.position(v));
                 verts.push(v);
             }
-            let mut faces = Vec::with_capacity(self.face_count());
+            let mut corners = Vec::with_capacity(3 * self.face_count());
             let mut tags = Vec::with_capacity(self.face_count());
             for f in self.faces() {
                 let [a, b, c] = self.face_vertices(f);
-                faces.push(vec![index[a.index()], index[b.index()], index[c.index()]]);
+                corners.extend([index[a.index()], index[b.index()], index[c.index()]]);
                 tags.push(self.tag(f));
             }
             let soup = PolygonSoup {
                 positions,
-                faces,
+                faces: Faces::uniform(3, corners),
                 ..PolygonSoup::default()
             };
             return (soup, tags, verts);
@@ -707,18 +725,16 @@ impl Mesh {
                 verts.push(v);
             }
         }
+        let mut faces = Faces::with_capacity(ends.len(), corners.len());
+        let mut face = Vec::new();
         let mut start = 0;
-        soup.faces = ends
-            .iter()
-            .map(|&end| {
-                let p = corners[start..end]
-                    .iter()
-                    .map(|v| index[v.index()])
-                    .collect();
-                start = end;
-                p
-            })
-            .collect();
+        for &end in &ends {
+            face.clear();
+            face.extend(corners[start..end].iter().map(|v| index[v.index()]));
+            faces.push(&face);
+            start = end;
+        }
+        soup.faces = faces;
         (soup, tags, verts)
     }
 }
@@ -993,7 +1009,7 @@ mod tests {
                         self.face_vertices(f)
                             .iter()
                             .map(|v| index[v.index()])
-                            .collect()
+                            .collect::<Vec<u32>>()
                     })
                     .collect();
                 let tags = self.faces().map(|f| self.tag(f)).collect();
@@ -1098,7 +1114,7 @@ mod tests {
             }
             soup.faces = polygons
                 .into_iter()
-                .map(|p| p.iter().map(|v| index[v.index()]).collect())
+                .map(|p| p.iter().map(|v| index[v.index()]).collect::<Vec<u32>>())
                 .collect();
             (soup, tags, verts)
         }
@@ -1125,7 +1141,7 @@ mod tests {
     /// hexagons, so that polygons get fanned.
     fn hexagon_grid() -> PolygonSoup {
         let mut s = shapes::quad_grid(4, 3);
-        let (a, b) = (s.faces[0].clone(), s.faces[1].clone());
+        let (a, b) = (s.faces[0].to_vec(), s.faces[1].to_vec());
         // Quads (p0 p1 p2 p3) and (p1 q1 q2 p2) share edge p1 p2.
         let shared: Vec<u32> = a.iter().copied().filter(|v| b.contains(v)).collect();
         assert_eq!(shared.len(), 2, "neighbouring quads");
@@ -1146,7 +1162,9 @@ mod tests {
             }
         }
         assert_eq!(hex.len(), 6);
-        s.faces.splice(0..2, [hex]);
+        let mut faces = s.faces.to_vecs();
+        faces.splice(0..2, [hex]);
+        s.faces = faces.into();
         s
     }
 
@@ -1168,29 +1186,30 @@ mod tests {
     /// in half of the cases.
     fn mutate(rng: &mut Rng, soup: &PolygonSoup) -> (PolygonSoup, Vec<u32>) {
         let mut s = soup.clone();
+        let mut faces = s.faces.to_vecs();
         for _ in 0..rng.below(4) {
-            let n = s.faces.len();
+            let n = faces.len();
             let i = rng.below(n);
             match rng.below(7) {
                 0 | 1 if n > 1 => {
-                    s.faces.remove(i);
+                    faces.remove(i);
                 }
-                2 => s.faces[i].reverse(),
+                2 => faces[i].reverse(),
                 3 => {
-                    let k = rng.below(s.faces[i].len());
-                    s.faces[i].rotate_left(k);
+                    let k = rng.below(faces[i].len());
+                    faces[i].rotate_left(k);
                 }
                 4 => {
-                    let mut f = s.faces[i].clone();
+                    let mut f = faces[i].clone();
                     if rng.below(2) == 0 {
                         f.reverse();
                     }
                     let at = rng.below(n + 1);
-                    s.faces.insert(at, f);
+                    faces.insert(at, f);
                 }
                 5 => {
                     let j = rng.below(n);
-                    s.faces.swap(i, j);
+                    faces.swap(i, j);
                 }
                 _ => {
                     let nv = s.positions.len();
@@ -1199,10 +1218,11 @@ mod tests {
                         rng.below(nv) as u32,
                         rng.below(nv) as u32,
                     ];
-                    s.faces.insert(rng.below(n + 1), f);
+                    faces.insert(rng.below(n + 1), f);
                 }
             }
         }
+        s.faces = faces.into();
         if rng.below(2) == 0 {
             s.face_lines = (0..s.faces.len()).map(|i| 100 + i).collect();
             s.vertex_lines = (0..s.positions.len()).map(|i| 1 + i).collect();

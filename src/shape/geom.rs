@@ -1803,9 +1803,10 @@ mod tests {
 
     /// Every undirected edge in exactly two faces, once each way (a closed,
     /// consistently oriented 2-manifold surface).
-    fn assert_closed(faces: &[Vec<u32>]) {
+    fn assert_closed<F: AsRef<[u32]>>(faces: impl IntoIterator<Item = F>) {
         let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
         for f in faces {
+            let f = f.as_ref();
             for i in 0..f.len() {
                 *directed.entry((f[i], f[(i + 1) % f.len()])).or_default() += 1;
             }
@@ -2385,7 +2386,7 @@ mod tests {
         // A tetrahedron with outward faces, volume 1/6, in [0,1]^3.
         let soup = PolygonSoup {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
-            faces: vec![vec![0, 2, 1], vec![0, 1, 3], vec![0, 3, 2], vec![1, 2, 3]],
+            faces: vec![vec![0, 2, 1], vec![0, 1, 3], vec![0, 3, 2], vec![1, 2, 3]].into(),
             ..PolygonSoup::default()
         };
         let s = sized(DVec3::new(5.0, 0.0, 0.0), DVec3::new(2.0, 3.0, 4.0));
@@ -2399,13 +2400,13 @@ mod tests {
         // A flat soup lands on the scope's origin plane.
         let flat = PolygonSoup {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
-            faces: vec![vec![0, 1, 2]],
+            faces: vec![vec![0, 1, 2]].into(),
             ..PolygonSoup::default()
         };
         let g = mesh_in(&mut points, &s, &flat).unwrap();
         assert!(g.point_ids().all(|p| points.get(p).z == 0.0));
         let bad = PolygonSoup {
-            faces: vec![vec![0, 1, 7]],
+            faces: vec![vec![0, 1, 7]].into(),
             ..flat
         };
         assert!(mesh_in(&mut points, &s, &bad).is_err());

@@ -723,7 +723,7 @@ fn soups_come_back_with_their_tags() {
     // its right then joins a triangle tagged 4 to one tagged 5: without
     // tags the two merge into a quad, with them they stay triangles.
     let s = PolygonSoup {
-        faces: vec![s.faces[0].clone(), vec![1, 2, 5], vec![1, 5, 4]],
+        faces: vec![s.faces[0].to_vec(), vec![1, 2, 5], vec![1, 5, 4]].into(),
         ..s
     };
     let mut m = Mesh::from_soup_tagged(&s, &[4, 6, 5]).unwrap();
@@ -741,7 +741,7 @@ fn soups_come_back_with_their_tags() {
     assert!(m.is_block_edge(shared));
     let (q, t) = m.to_quad_soup_tagged();
     let untagged = m.to_quad_soup();
-    let shared_faces = |faces: &[Vec<u32>]| {
+    let shared_faces = |faces: &subgram::mesh::Faces| {
         faces
             .iter()
             .filter(|f| f.contains(&1) && f.contains(&4))
