@@ -13,7 +13,10 @@
 //! list, as igl.loop and Blender are: building the half-edge mesh
 //! (`Mesh::from_soup`), the grammar, and the faces out (`to_soup`, or
 //! `to_quad_soup` for Catmull-Clark), each part best of the runs, with a
-//! copy of the output's arrays as the reference for the last part.
+//! copy of the output's arrays as the reference for the last part, and
+//! the three in one go (`whole`), best of the runs. `benches/peers.py
+//! --faces` runs this and igl.loop and Blender on the same files, round
+//! after round.
 
 mod common;
 
@@ -52,6 +55,17 @@ fn faces_to_faces(
     // one list per face, as a soup holds them).
     let (t_copy, copy) = common::best_of(runs, || out.clone());
     assert_eq!(copy.faces.len(), out.faces.len());
+    // The whole chain in one go, as a user's call runs it.
+    let (t_whole, whole) = common::best_of(runs, || {
+        let mut m = Mesh::from_soup(soup).expect("valid");
+        g.run(&mut m, 1, |_| {}).expect("runs");
+        if quads {
+            m.to_quad_soup()
+        } else {
+            m.to_soup()
+        }
+    });
+    assert_eq!(whole, out);
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     println!(
         "{name}, faces to faces ({} -> {} faces), best of {runs} each part:",
@@ -68,6 +82,10 @@ fn faces_to_faces(
         ms(t_copy)
     );
     println!("  total          {:>8.1} ms", ms(t_build + t_run + t_out));
+    println!(
+        "  whole          {:>8.1} ms (the three in one go)",
+        ms(t_whole)
+    );
 }
 
 fn main() {

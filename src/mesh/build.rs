@@ -10,7 +10,9 @@
 //! edge at level 0. Vertices start at level 0, faces one above their
 //! vertices.
 
-use super::halfedge::{EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId};
+use super::halfedge::{
+    Column, EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId,
+};
 use super::soup::{Faces, PolygonSoup};
 
 fn at_line(soup: &PolygonSoup, face: usize) -> String {
@@ -326,7 +328,7 @@ impl Mesh {
             v_level: vec![0; nv],
             v_step: vec![0; nv],
             v_alive: vec![true; nv],
-            v_sharp: vec![0.0; nv],
+            v_sharp: Column::defaults(nv),
             he_to: vec![VertexId(0); 2 * ne],
             he_next: vec![HalfEdgeId(0); 2 * ne],
             he_prev: vec![HalfEdgeId(0); 2 * ne],
@@ -335,13 +337,13 @@ impl Mesh {
             e_alive: vec![true; ne],
             e_block: vec![false; ne],
             e_transversal: vec![false; ne],
-            e_sharp: vec![0.0; ne],
+            e_sharp: Column::defaults(ne),
             f_he: Vec::with_capacity(nt),
             f_level: vec![1; nt],
             f_alive: vec![true; nt],
             f_tag: match tags {
-                Some(t) => source.iter().map(|&fi| t[fi as usize]).collect(),
-                None => vec![0; nt],
+                Some(t) => Column::from_vec(source.iter().map(|&fi| t[fi as usize]).collect()),
+                None => Column::defaults(nt),
             },
             ..Mesh::default()
         };

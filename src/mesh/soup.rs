@@ -341,3 +341,79 @@ pub(crate) fn first_repeat(face: &[u32]) -> Option<usize> {
     let mut seen = std::collections::HashSet::with_capacity(face.len());
     face.iter().position(|&v| !seen.insert(v))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The faces as lists, written out by hand for each case.
+    fn lists(f: &Faces) -> Vec<Vec<u32>> {
+        f.iter().map(<[u32]>::to_vec).collect()
+    }
+
+    #[test]
+    fn same_sized_faces_keep_no_ends_and_mixed_ones_do() {
+        let mut f = Faces::new();
+        f.push([0, 1, 2]);
+        f.push(vec![2, 1, 3]);
+        assert_eq!(f.arity(), Some(3));
+        assert_eq!(f.indices(), [0, 1, 2, 2, 1, 3]);
+        // A quad after two triangles: every face keeps its end from now on.
+        f.push([3, 4, 5, 6]);
+        f.push([6, 5, 7]);
+        assert_eq!(f.arity(), None);
+        assert_eq!(f.len(), 4);
+        assert_eq!(
+            lists(&f),
+            [
+                vec![0, 1, 2],
+                vec![2, 1, 3],
+                vec![3, 4, 5, 6],
+                vec![6, 5, 7]
+            ]
+        );
+        assert_eq!(&f[2], [3, 4, 5, 6]);
+        assert_eq!(f.get(3), Some(&[6, 5, 7][..]));
+        assert_eq!(f.get(4), None);
+        assert_eq!(
+            f.iter().rev().map(<[u32]>::len).collect::<Vec<_>>(),
+            [3, 4, 3, 3]
+        );
+    }
+
+    #[test]
+    fn editing_in_place_and_retaining() {
+        let mut f: Faces = vec![vec![0, 1, 2], vec![3, 4, 5, 6], vec![7, 8, 9]].into();
+        for face in f.iter_mut() {
+            face.reverse();
+        }
+        f[0][0] = 10;
+        assert_eq!(lists(&f), [vec![10, 1, 0], vec![6, 5, 4, 3], vec![9, 8, 7]]);
+        // Dropping the quad leaves triangles only: kept without ends, and
+        // equal to the same triangles pushed one by one.
+        f.retain(|face| face.len() == 3);
+        assert_eq!(f.arity(), Some(3));
+        let same: Faces = [[10, 1, 0], [9, 8, 7]].into_iter().collect();
+        assert_eq!(f, same);
+        assert_ne!(f, Faces::uniform(3, vec![10, 1, 0]));
+        assert!(Faces::new().is_empty());
+        assert_eq!(Faces::new().arity(), None);
+    }
+
+    #[test]
+    fn fanned_soup_cuts_polygons_from_their_first_corner() {
+        let soup = PolygonSoup {
+            positions: vec![DVec3::ZERO; 6],
+            faces: vec![vec![0, 1, 2, 3, 4], vec![0, 4, 5]].into(),
+            face_lines: vec![7, 8],
+            ..PolygonSoup::default()
+        };
+        let f = soup.fanned();
+        // A pentagon makes 3 triangles (0 1 2, 0 2 3, 0 3 4), a triangle 1.
+        assert_eq!(
+            lists(&f.faces),
+            [vec![0, 1, 2], vec![0, 2, 3], vec![0, 3, 4], vec![0, 4, 5]]
+        );
+        assert_eq!(f.face_lines, [7, 7, 7, 8]);
+    }
+}
