@@ -424,7 +424,32 @@ impl Mesh {
 
     /// The mesh as triangles, with dead slots removed.
     pub fn to_soup(&self) -> PolygonSoup {
-        self.soup_with(|_| false).0
+        // What `soup_with(|_| false)` gives, without the tags and vertices
+        // it gives with it. With no dead vertex slot, a soup vertex is its
+        // mesh vertex: the positions are copied whole.
+        let mut corners = Vec::with_capacity(3 * self.face_count());
+        let positions = if self.free_v.is_empty() {
+            for f in self.faces() {
+                corners.extend(self.face_vertices(f).map(|v| v.0));
+            }
+            self.pos.clone()
+        } else {
+            let mut index = vec![u32::MAX; self.v_alive.len()];
+            let mut positions = Vec::with_capacity(self.vertex_count());
+            for v in self.vertices() {
+                index[v.index()] = positions.len() as u32;
+                positions.push(self.position(v));
+            }
+            for f in self.faces() {
+                corners.extend(self.face_vertices(f).map(|v| index[v.index()]));
+            }
+            positions
+        };
+        PolygonSoup {
+            positions,
+            faces: Faces::uniform(3, corners),
+            ..PolygonSoup::default()
+        }
     }
 
     /// [`Mesh::to_soup`] and the tag of each of its faces.
@@ -540,6 +565,95 @@ impl Mesh {
         })
     }
 
+    /// [`Mesh::soup_with`] where no face has two `merge` edges (a mesh of
+    /// basic blocks, as a primal quad scheme leaves it), so that every
+    /// region is one face or two: each pair is met at its smaller face and
+    /// its border walked directly, with no union-find or region lists.
+    /// None where some face has two `merge` edges between faces.
+    #[allow(clippy::type_complexity)]
+    fn soup_of_pairs(
+        &self,
+        merge: &impl Fn(EdgeId) -> bool,
+    ) -> Option<(PolygonSoup, Vec<u32>, Vec<VertexId>)> {
+        // The half-edge of each face that its pair's diagonal runs along.
+        let mut diagonal = vec![HalfEdgeId(u32::MAX); self.f_alive.len()];
+        let mut any = false;
+        for e in self.edges() {
+            if !merge(e) {
+                continue;
+            }
+            let h = e.halfedge();
+            let (Some(f), Some(g)) = (self.face(h), self.face(h.twin())) else {
+                continue;
+            };
+            if diagonal[f.index()].0 != u32::MAX || diagonal[g.index()].0 != u32::MAX {
+                return None;
+            }
+            diagonal[f.index()] = h;
+            diagonal[g.index()] = h.twin();
+            any = true;
+        }
+        if !any {
+            return None;
+        }
+        // Every vertex of a face is a corner of its polygon (a pair's four
+        // or a triangle's three), so every live vertex stays.
+        let mut index = vec![u32::MAX; self.v_alive.len()];
+        let mut positions = Vec::with_capacity(self.vertex_count());
+        let mut verts = Vec::with_capacity(self.vertex_count());
+        for v in self.vertices() {
+            index[v.index()] = positions.len() as u32;
+            positions.push(self.position(v));
+            verts.push(v);
+        }
+        let mut faces = Faces::with_capacity(self.face_count() / 2, 2 * self.face_count());
+        let mut tags = Vec::with_capacity(self.face_count() / 2);
+        for f in self.faces() {
+            let d = diagonal[f.index()];
+            let tri = |faces: &mut Faces, tags: &mut Vec<u32>, g: FaceId| {
+                faces.push(self.face_vertices(g).map(|v| index[v.index()]));
+                tags.push(self.tag(g));
+            };
+            if d.0 == u32::MAX {
+                tri(&mut faces, &mut tags, f);
+                continue;
+            }
+            let g = self.face(d.twin()).expect("a pair");
+            if g.0 < f.0 {
+                continue; // met at g, its smaller face
+            }
+            // The border is f's half-edges after the diagonal, then g's
+            // after its twin; the general walk starts it at the first of
+            // f's half-edges (from its recorded one) that is not the
+            // diagonal.
+            let (n1, n2) = (self.next(d), self.prev(d));
+            let (m1, m2) = (self.next(d.twin()), self.prev(d.twin()));
+            let mut quad = [self.from(n1), self.from(n2), self.from(m1), self.from(m2)];
+            if self.face_halfedge(f) == n1 {
+                // f's half-edges run n1, n2, d: the walk starts at n1.
+            } else if self.face_halfedge(f) == d {
+                // d, n1, n2: starts at n1.
+            } else {
+                // n2, d, n1: starts at n2.
+                quad.rotate_left(1);
+            }
+            let distinct = (0..4).all(|i| (i + 1..4).all(|j| quad[i] != quad[j]));
+            if distinct {
+                faces.push(quad.map(|v| index[v.index()]));
+                tags.push(self.tag(f));
+            } else {
+                tri(&mut faces, &mut tags, f);
+                tri(&mut faces, &mut tags, g);
+            }
+        }
+        let soup = PolygonSoup {
+            positions,
+            faces,
+            ..PolygonSoup::default()
+        };
+        Some((soup, tags, verts))
+    }
+
     /// The mesh with the faces on either side of each `merge` edge joined
     /// into polygons. A region of faces joined this way becomes one polygon
     /// when its border is a single loop through distinct vertices (a
@@ -549,6 +663,9 @@ impl Mesh {
     /// polygon's tag (that of its first triangle) and each soup vertex's
     /// mesh vertex.
     fn soup_with(&self, merge: impl Fn(EdgeId) -> bool) -> (PolygonSoup, Vec<u32>, Vec<VertexId>) {
+        if let Some(out) = self.soup_of_pairs(&merge) {
+            return out;
+        }
         // Regions by union-find over the faces; a region's root is its
         // smallest face.
         let nf = self.f_alive.len();
@@ -1234,6 +1351,7 @@ mod tests {
     }
 
     fn soups_agree(m: &Mesh) {
+        assert_eq!(m.to_soup(), m.soup_with_reference(|_| false).0);
         assert_eq!(m.soup_with(|_| false), m.soup_with_reference(|_| false));
         let block = |e: EdgeId| m.is_block_edge(e);
         assert_eq!(m.soup_with(block), m.soup_with_reference(block));

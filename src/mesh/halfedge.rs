@@ -556,9 +556,11 @@ impl Mesh {
         [h0, h1, self.next(h1)]
     }
 
-    /// The vertices of a face, counter-clockwise.
+    /// The vertices of a face, counter-clockwise: where each of its
+    /// half-edges starts (read from the twin, which lies next to it).
+    #[inline]
     pub fn face_vertices(&self, f: FaceId) -> [VertexId; 3] {
-        self.face_halfedges(f).map(|h| self.to(self.prev(h)))
+        self.face_halfedges(f).map(|h| self.from(h))
     }
 
     pub fn face_edges(&self, f: FaceId) -> [EdgeId; 3] {
