@@ -114,6 +114,21 @@ fn main() {
 
     faces_to_faces("Loop", runs, &sphere, &g, false);
 
+    // Where the memory of `subdivide -n 3` goes: the mesh's own arrays
+    // after three levels, against the output as an indexed face list.
+    let mut m = base.clone();
+    g.run(&mut m, 3, |_| {}).expect("runs");
+    let mb = |b: usize| b as f64 / 1e6;
+    println!(
+        "Loop, 3 levels: {} triangles; the mesh's arrays {:.0} MB ({:.1} bytes per face); \
+         the output indexed (3 f64 a vertex, 3 u32 a face) {:.0} MB",
+        m.face_count(),
+        mb(m.bytes()),
+        m.bytes_per_face(),
+        mb(m.vertex_count() * 24 + m.face_count() * 12)
+    );
+    drop(m);
+
     let g = subgram::surface::load_file(&root.join("lsystems/surfaces/sqrt3.lsys"), &[])
         .expect("grammar");
     let (t, m) = best_of(runs, &base, &g);

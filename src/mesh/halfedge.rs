@@ -227,13 +227,35 @@ impl Mesh {
         self.f_alive.get(f.index()).copied().unwrap_or(false)
     }
 
-    /// Bytes of storage per face, for the benchmark's report.
+    /// Bytes of storage per face, for the benchmark's report: the arrays'
+    /// lengths times their elements' sizes (sharpness and tags count only
+    /// where stored).
     pub fn bytes_per_face(&self) -> f64 {
-        let v = self.v_alive.len() * (8 + 24 + 4 + 4 + 1 + 8);
-        let h = self.he_to.len() * (4 + 4 + 4 + 4);
-        let e = self.e_alive.len() * (4 + 1 + 1 + 1 + 8);
-        let f = self.f_alive.len() * (4 + 4 + 1 + 4);
-        (v + h + e + f) as f64 / self.face_count().max(1) as f64
+        self.bytes() as f64 / self.face_count().max(1) as f64
+    }
+
+    /// Bytes of the mesh's arrays (their lengths, not their capacities).
+    pub fn bytes(&self) -> usize {
+        fn size<T>(v: &[T]) -> usize {
+            std::mem::size_of_val(v)
+        }
+        let v = size(&self.v_out)
+            + size(&self.pos)
+            + size(&self.v_level)
+            + size(&self.v_step)
+            + size(&self.v_alive)
+            + self.v_sharp.stored_bytes();
+        let h = size(&self.he_to) + size(&self.he_next) + size(&self.he_prev) + size(&self.he_face);
+        let e = size(&self.e_level)
+            + size(&self.e_alive)
+            + size(&self.e_block)
+            + size(&self.e_transversal)
+            + self.e_sharp.stored_bytes();
+        let f = size(&self.f_he)
+            + size(&self.f_level)
+            + size(&self.f_alive)
+            + self.f_tag.stored_bytes();
+        v + h + e + f
     }
 
     // ----- element data ----------------------------------------------
@@ -875,6 +897,11 @@ impl<T: Copy + Default + PartialEq> Column<T> {
         if !self.stored.is_empty() {
             grow(&mut self.stored, additional);
         }
+    }
+
+    /// The bytes the stored values take.
+    fn stored_bytes(&self) -> usize {
+        std::mem::size_of_val(&self.stored[..])
     }
 
     /// The stored values: every element's, or none while all are the
