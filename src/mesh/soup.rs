@@ -131,7 +131,10 @@ impl Faces {
     /// Faces of `arity` corners each, from their corners one after another
     /// (`indices.len()` a multiple of `arity`, which is at least 1).
     pub fn uniform(arity: usize, indices: Vec<u32>) -> Faces {
-        assert!(arity > 0 && indices.len() % arity == 0, "whole faces");
+        assert!(
+            arity > 0 && indices.len().is_multiple_of(arity),
+            "whole faces"
+        );
         Faces {
             len: indices.len() / arity,
             indices,

@@ -2207,7 +2207,7 @@ mod tests {
                 .collect();
             assert_eq!(
                 canonical_faces(&renumbered),
-                canonical_faces(&r.faces(&set).unwrap())
+                canonical_faces(r.faces(&set).unwrap())
             );
             assert_eq!(
                 back.holes(&set2).unwrap().len(),

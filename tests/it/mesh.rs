@@ -421,8 +421,8 @@ fn quads_become_basic_blocks_and_come_back() {
     assert!(m.vertices().all(|v| m.vertex_level(v) == 0));
     let back = m.to_quad_soup();
     assert_eq!(back.faces.len(), 6);
-    let mut a: Vec<Vec<u32>> = s.faces.iter().map(|f| canonical_cycle(f)).collect();
-    let mut b: Vec<Vec<u32>> = back.faces.iter().map(|f| canonical_cycle(f)).collect();
+    let mut a: Vec<Vec<u32>> = s.faces.iter().map(canonical_cycle).collect();
+    let mut b: Vec<Vec<u32>> = back.faces.iter().map(canonical_cycle).collect();
     a.sort();
     b.sort();
     assert_eq!(a, b);
@@ -703,19 +703,9 @@ fn soups_come_back_with_their_tags() {
     let (quads, tags) = m.to_quad_soup_tagged();
     assert_eq!(quads, m.to_quad_soup());
     assert_eq!(quads.faces.len(), 2);
-    let mut got: Vec<(Vec<u32>, u32)> = quads
-        .faces
-        .iter()
-        .map(|f| canonical_cycle(f))
-        .zip(tags)
-        .collect();
+    let mut got: Vec<(Vec<u32>, u32)> = quads.faces.iter().map(canonical_cycle).zip(tags).collect();
     got.sort();
-    let mut want: Vec<(Vec<u32>, u32)> = s
-        .faces
-        .iter()
-        .map(|f| canonical_cycle(f))
-        .zip([4, 5])
-        .collect();
+    let mut want: Vec<(Vec<u32>, u32)> = s.faces.iter().map(canonical_cycle).zip([4, 5]).collect();
     want.sort();
     assert_eq!(got, want);
     // √2 bisection of quad 0's block makes its external edges internal

@@ -71,7 +71,7 @@ fn fan(k: usize, m: usize) -> Fan {
                     id(&mut f, t, i + 1, j + 1),
                     id(&mut f, t, i, j + 1),
                 ];
-                f.soup.faces.push(q.to_vec());
+                f.soup.faces.push(q);
                 f.quads.push(q);
             }
         }
