@@ -786,9 +786,10 @@ impl Iterator for OutgoingIter<'_> {
     }
 }
 
-/// Makes room for `additional` more elements. A large array moves to a
-/// new allocation that the kernel is asked to back with huge pages before
-/// anything is written to it: a subdivision step writes hundreds of
+/// Makes room for `additional` more elements. A large array grows in place
+/// or is moved by the allocator (for large blocks, `realloc` remaps pages
+/// rather than copying them), and the kernel is asked to back the part not
+/// yet written with huge pages: a subdivision step writes hundreds of
 /// megabytes, and with 4 KiB pages much of its time goes to page faults.
 /// The advice changes how memory is backed, never what it holds.
 fn grow<T: Copy>(v: &mut Vec<T>, additional: usize) {
@@ -803,16 +804,17 @@ fn grow<T: Copy>(v: &mut Vec<T>, additional: usize) {
         v.reserve(additional);
         return;
     }
-    let mut fresh: Vec<T> = Vec::with_capacity(cap);
+    v.reserve_exact(cap - v.len());
     #[cfg(target_os = "linux")]
     {
-        let start = fresh.as_ptr() as usize;
+        let size = std::mem::size_of::<T>();
+        let start = v.as_ptr() as usize + v.len() * size;
         let aligned = (start + HUGE - 1) & !(HUGE - 1);
-        let end = (start + bytes) & !(HUGE - 1);
+        let end = (v.as_ptr() as usize + v.capacity() * size) & !(HUGE - 1);
         if end > aligned {
-            // SAFETY: the range lies inside `fresh`'s own allocation, and
-            // MADV_HUGEPAGE never changes memory's contents; a failure
-            // leaves ordinary pages.
+            // SAFETY: the range lies inside `v`'s own allocation, past its
+            // elements, and MADV_HUGEPAGE never changes memory's contents;
+            // a failure leaves ordinary pages.
             unsafe {
                 libc::madvise(
                     aligned as *mut libc::c_void,
@@ -822,8 +824,6 @@ fn grow<T: Copy>(v: &mut Vec<T>, additional: usize) {
             }
         }
     }
-    fresh.extend_from_slice(v);
-    *v = fresh;
 }
 
 /// A per-element column whose elements all hold the default value (0)
