@@ -13,7 +13,10 @@
 //! list, as igl.loop and Blender are: building the half-edge mesh
 //! (`Mesh::from_soup`), the grammar, and the faces out (`to_soup`, or
 //! `to_quad_soup` for Catmull-Clark), each part best of the runs, with a
-//! copy of the output's arrays as the reference for the last part.
+//! copy of the output's arrays as the reference for the last part, and
+//! the three in one go (`whole`), best of the runs. `benches/peers.py
+//! --faces` runs this and igl.loop and Blender on the same files, round
+//! after round.
 
 mod common;
 
@@ -52,6 +55,17 @@ fn faces_to_faces(
     // one list per face, as a soup holds them).
     let (t_copy, copy) = common::best_of(runs, || out.clone());
     assert_eq!(copy.faces.len(), out.faces.len());
+    // The whole chain in one go, as a user's call runs it.
+    let (t_whole, whole) = common::best_of(runs, || {
+        let mut m = Mesh::from_soup(soup).expect("valid");
+        g.run(&mut m, 1, |_| {}).expect("runs");
+        if quads {
+            m.to_quad_soup()
+        } else {
+            m.to_soup()
+        }
+    });
+    assert_eq!(whole, out);
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     println!(
         "{name}, faces to faces ({} -> {} faces), best of {runs} each part:",
@@ -68,6 +82,10 @@ fn faces_to_faces(
         ms(t_copy)
     );
     println!("  total          {:>8.1} ms", ms(t_build + t_run + t_out));
+    println!(
+        "  whole          {:>8.1} ms (the three in one go)",
+        ms(t_whole)
+    );
 }
 
 fn main() {
@@ -95,6 +113,21 @@ fn main() {
     );
 
     faces_to_faces("Loop", runs, &sphere, &g, false);
+
+    // Where the memory of `subdivide -n 3` goes: the mesh's own arrays
+    // after three levels, against the output as an indexed face list.
+    let mut m = base.clone();
+    g.run(&mut m, 3, |_| {}).expect("runs");
+    let mb = |b: usize| b as f64 / 1e6;
+    println!(
+        "Loop, 3 levels: {} triangles; the mesh's arrays {:.0} MB ({:.1} bytes per face); \
+         the output indexed (3 f64 a vertex, 3 u32 a face) {:.0} MB",
+        m.face_count(),
+        mb(m.bytes()),
+        m.bytes_per_face(),
+        mb(m.vertex_count() * 24 + m.face_count() * 12)
+    );
+    drop(m);
 
     let g = subgram::surface::load_file(&root.join("lsystems/surfaces/sqrt3.lsys"), &[])
         .expect("grammar");

@@ -129,17 +129,17 @@ fn hand_loop(s: &PolygonSoup) -> PolygonSoup {
             0.375 * (p[a as usize] + p[b as usize]) + 0.125 * (p[c as usize] + p[d as usize]),
         );
     }
-    let mut faces = Vec::with_capacity(s.faces.len() * 4);
+    let mut faces = subgram::mesh::Faces::with_capacity(s.faces.len() * 4, s.faces.len() * 12);
     for f in &s.faces {
         let m = |k: usize| {
             let (a, b) = (f[k], f[(k + 1) % 3]);
             edge[&(a.min(b), a.max(b))]
         };
         let (m0, m1, m2) = (m(0), m(1), m(2));
-        faces.push(vec![f[0], m0, m2]);
-        faces.push(vec![f[1], m1, m0]);
-        faces.push(vec![f[2], m2, m1]);
-        faces.push(vec![m0, m1, m2]);
+        faces.push([f[0], m0, m2]);
+        faces.push([f[1], m1, m0]);
+        faces.push([f[2], m2, m1]);
+        faces.push([m0, m1, m2]);
     }
     PolygonSoup {
         positions,

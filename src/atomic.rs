@@ -6,6 +6,15 @@ use std::path::{Path, PathBuf};
 /// Writes `bytes` to a temporary file next to `path` and returns its name;
 /// on failure nothing is left behind.
 fn write_temp(path: &Path, bytes: &[u8]) -> std::io::Result<PathBuf> {
+    write_temp_with(path, |w| w.write_all(bytes))
+}
+
+/// Writes what `fill` writes to a temporary file next to `path` (through
+/// a buffer) and returns its name; on failure nothing is left behind.
+fn write_temp_with(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<PathBuf> {
     let dir = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
@@ -16,9 +25,9 @@ fn write_temp(path: &Path, bytes: &[u8]) -> std::io::Result<PathBuf> {
         .unwrap_or_else(|| "out".into());
     let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
     let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()
+        let mut f = std::io::BufWriter::with_capacity(1 << 16, std::fs::File::create(&tmp)?);
+        fill(&mut f)?;
+        f.into_inner().map_err(|e| e.into_error())?.sync_all()
     })();
     match result {
         Ok(()) => Ok(tmp),
@@ -33,6 +42,21 @@ fn write_temp(path: &Path, bytes: &[u8]) -> std::io::Result<PathBuf> {
 /// a rename, so that a failure never leaves a truncated file behind.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let tmp = write_temp(path, bytes)?;
+    let result = std::fs::rename(&tmp, path);
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// [`write_atomic`] for a file written piece by piece: `fill` writes it
+/// (buffered) to the temporary file, so that a large file never has to be
+/// held in memory whole.
+pub fn write_atomic_with(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let tmp = write_temp_with(path, fill)?;
     let result = std::fs::rename(&tmp, path);
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);

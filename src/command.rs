@@ -684,8 +684,7 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<Ve
 /// each kind of sharpness the file cannot hold, which would otherwise be
 /// lost without a word.
 fn write_mesh(output: &Path, m: &Mesh, triangles: bool) -> Result<Vec<String>, Error> {
-    let (soup, sharp) = m.to_soup_with_sharpness(triangles);
-    mesh::io::write_with_sharpness(output, &soup, &sharp.edges)?;
+    let sharp = mesh::io::write_mesh(output, m, triangles)?;
     let ply = mesh::io::Format::from_path(output) == Some(mesh::io::Format::Ply);
     let edges = |n: usize| format!("{n} sharp edge{}", if n == 1 { "" } else { "s" });
     let mut lost = Vec::new();

@@ -10,8 +10,10 @@
 //! edge at level 0. Vertices start at level 0, faces one above their
 //! vertices.
 
-use super::halfedge::{EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId};
-use super::soup::PolygonSoup;
+use super::halfedge::{
+    Column, EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId,
+};
+use super::soup::{Faces, PolygonSoup};
 
 fn at_line(soup: &PolygonSoup, face: usize) -> String {
     match soup.face_line(face) {
@@ -326,7 +328,7 @@ impl Mesh {
             v_level: vec![0; nv],
             v_step: vec![0; nv],
             v_alive: vec![true; nv],
-            v_sharp: vec![0.0; nv],
+            v_sharp: Column::defaults(nv),
             he_to: vec![VertexId(0); 2 * ne],
             he_next: vec![HalfEdgeId(0); 2 * ne],
             he_prev: vec![HalfEdgeId(0); 2 * ne],
@@ -335,13 +337,13 @@ impl Mesh {
             e_alive: vec![true; ne],
             e_block: vec![false; ne],
             e_transversal: vec![false; ne],
-            e_sharp: vec![0.0; ne],
+            e_sharp: Column::defaults(ne),
             f_he: Vec::with_capacity(nt),
             f_level: vec![1; nt],
             f_alive: vec![true; nt],
             f_tag: match tags {
-                Some(t) => source.iter().map(|&fi| t[fi as usize]).collect(),
-                None => vec![0; nt],
+                Some(t) => Column::from_vec(source.iter().map(|&fi| t[fi as usize]).collect()),
+                None => Column::defaults(nt),
             },
             ..Mesh::default()
         };
@@ -422,7 +424,32 @@ impl Mesh {
 
     /// The mesh as triangles, with dead slots removed.
     pub fn to_soup(&self) -> PolygonSoup {
-        self.soup_with(|_| false).0
+        // What `soup_with(|_| false)` gives, without the tags and vertices
+        // it gives with it. With no dead vertex slot, a soup vertex is its
+        // mesh vertex: the positions are copied whole.
+        let mut corners = Vec::with_capacity(3 * self.face_count());
+        let positions = if self.free_v.is_empty() {
+            for f in self.faces() {
+                corners.extend(self.face_vertices(f).map(|v| v.0));
+            }
+            self.pos.clone()
+        } else {
+            let mut index = vec![u32::MAX; self.v_alive.len()];
+            let mut positions = Vec::with_capacity(self.vertex_count());
+            for v in self.vertices() {
+                index[v.index()] = positions.len() as u32;
+                positions.push(self.position(v));
+            }
+            for f in self.faces() {
+                corners.extend(self.face_vertices(f).map(|v| index[v.index()]));
+            }
+            positions
+        };
+        PolygonSoup {
+            positions,
+            faces: Faces::uniform(3, corners),
+            ..PolygonSoup::default()
+        }
     }
 
     /// [`Mesh::to_soup`] and the tag of each of its faces.
@@ -471,13 +498,23 @@ impl Mesh {
         } else {
             self.soup_with(|e| self.is_block_edge(e))
         };
-        let mut out = SoupSharpness::default();
         if !self.has_sharpness_flag() {
-            return (soup, out);
+            return (soup, SoupSharpness::default());
         }
         let mut index = vec![u32::MAX; self.v_alive.len()];
         for (i, v) in vertices.iter().enumerate() {
             index[v.index()] = i as u32;
+        }
+        let out = self.soup_sharpness(&index, triangles);
+        (soup, out)
+    }
+
+    /// The sharpness of [`Mesh::to_soup_with_sharpness`], for a soup whose
+    /// vertex of each mesh vertex is `index` (`u32::MAX`: left out).
+    pub(crate) fn soup_sharpness(&self, index: &[u32], triangles: bool) -> SoupSharpness {
+        let mut out = SoupSharpness::default();
+        if !self.has_sharpness_flag() {
+            return out;
         }
         for e in self.edges() {
             let s = self.edge_sharpness(e);
@@ -496,7 +533,15 @@ impl Mesh {
             .vertices()
             .filter(|&v| self.vertex_sharpness(v) > 0.0)
             .count();
-        (soup, out)
+        out
+    }
+
+    /// True when [`Mesh::to_quad_soup`] joins some faces into a polygon
+    /// (a basic block with both its triangles); false when it gives the
+    /// triangles as they are, the same soup as [`Mesh::to_soup`].
+    pub(crate) fn quad_soup_merges(&self) -> bool {
+        self.edges()
+            .any(|e| self.is_block_edge(e) && matches!(self.edge_faces(e), [Some(_), Some(_)]))
     }
 
     /// [`Mesh::to_quad_soup`] and the tag of each of its faces. A basic
@@ -520,6 +565,95 @@ impl Mesh {
         })
     }
 
+    /// [`Mesh::soup_with`] where no face has two `merge` edges (a mesh of
+    /// basic blocks, as a primal quad scheme leaves it), so that every
+    /// region is one face or two: each pair is met at its smaller face and
+    /// its border walked directly, with no union-find or region lists.
+    /// None where some face has two `merge` edges between faces.
+    #[allow(clippy::type_complexity)]
+    fn soup_of_pairs(
+        &self,
+        merge: &impl Fn(EdgeId) -> bool,
+    ) -> Option<(PolygonSoup, Vec<u32>, Vec<VertexId>)> {
+        // The half-edge of each face that its pair's diagonal runs along.
+        let mut diagonal = vec![HalfEdgeId(u32::MAX); self.f_alive.len()];
+        let mut any = false;
+        for e in self.edges() {
+            if !merge(e) {
+                continue;
+            }
+            let h = e.halfedge();
+            let (Some(f), Some(g)) = (self.face(h), self.face(h.twin())) else {
+                continue;
+            };
+            if diagonal[f.index()].0 != u32::MAX || diagonal[g.index()].0 != u32::MAX {
+                return None;
+            }
+            diagonal[f.index()] = h;
+            diagonal[g.index()] = h.twin();
+            any = true;
+        }
+        if !any {
+            return None;
+        }
+        // Every vertex of a face is a corner of its polygon (a pair's four
+        // or a triangle's three), so every live vertex stays.
+        let mut index = vec![u32::MAX; self.v_alive.len()];
+        let mut positions = Vec::with_capacity(self.vertex_count());
+        let mut verts = Vec::with_capacity(self.vertex_count());
+        for v in self.vertices() {
+            index[v.index()] = positions.len() as u32;
+            positions.push(self.position(v));
+            verts.push(v);
+        }
+        let mut faces = Faces::with_capacity(self.face_count() / 2, 2 * self.face_count());
+        let mut tags = Vec::with_capacity(self.face_count() / 2);
+        for f in self.faces() {
+            let d = diagonal[f.index()];
+            let tri = |faces: &mut Faces, tags: &mut Vec<u32>, g: FaceId| {
+                faces.push(self.face_vertices(g).map(|v| index[v.index()]));
+                tags.push(self.tag(g));
+            };
+            if d.0 == u32::MAX {
+                tri(&mut faces, &mut tags, f);
+                continue;
+            }
+            let g = self.face(d.twin()).expect("a pair");
+            if g.0 < f.0 {
+                continue; // met at g, its smaller face
+            }
+            // The border is f's half-edges after the diagonal, then g's
+            // after its twin; the general walk starts it at the first of
+            // f's half-edges (from its recorded one) that is not the
+            // diagonal.
+            let (n1, n2) = (self.next(d), self.prev(d));
+            let (m1, m2) = (self.next(d.twin()), self.prev(d.twin()));
+            let mut quad = [self.from(n1), self.from(n2), self.from(m1), self.from(m2)];
+            if self.face_halfedge(f) == n1 {
+                // f's half-edges run n1, n2, d: the walk starts at n1.
+            } else if self.face_halfedge(f) == d {
+                // d, n1, n2: starts at n1.
+            } else {
+                // n2, d, n1: starts at n2.
+                quad.rotate_left(1);
+            }
+            let distinct = (0..4).all(|i| (i + 1..4).all(|j| quad[i] != quad[j]));
+            if distinct {
+                faces.push(quad.map(|v| index[v.index()]));
+                tags.push(self.tag(f));
+            } else {
+                tri(&mut faces, &mut tags, f);
+                tri(&mut faces, &mut tags, g);
+            }
+        }
+        let soup = PolygonSoup {
+            positions,
+            faces,
+            ..PolygonSoup::default()
+        };
+        Some((soup, tags, verts))
+    }
+
     /// The mesh with the faces on either side of each `merge` edge joined
     /// into polygons. A region of faces joined this way becomes one polygon
     /// when its border is a single loop through distinct vertices (a
@@ -529,6 +663,9 @@ impl Mesh {
     /// polygon's tag (that of its first triangle) and each soup vertex's
     /// mesh vertex.
     fn soup_with(&self, merge: impl Fn(EdgeId) -> bool) -> (PolygonSoup, Vec<u32>, Vec<VertexId>) {
+        if let Some(out) = self.soup_of_pairs(&merge) {
+            return out;
+        }
         // Regions by union-find over the faces; a region's root is its
         // smallest face.
         let nf = self.f_alive.len();
@@ -566,16 +703,16 @@ impl Mesh {
                 positions.push(self.position(v));
                 verts.push(v);
             }
-            let mut faces = Vec::with_capacity(self.face_count());
+            let mut corners = Vec::with_capacity(3 * self.face_count());
             let mut tags = Vec::with_capacity(self.face_count());
             for f in self.faces() {
                 let [a, b, c] = self.face_vertices(f);
-                faces.push(vec![index[a.index()], index[b.index()], index[c.index()]]);
+                corners.extend([index[a.index()], index[b.index()], index[c.index()]]);
                 tags.push(self.tag(f));
             }
             let soup = PolygonSoup {
                 positions,
-                faces,
+                faces: Faces::uniform(3, corners),
                 ..PolygonSoup::default()
             };
             return (soup, tags, verts);
@@ -707,18 +844,16 @@ impl Mesh {
                 verts.push(v);
             }
         }
+        let mut faces = Faces::with_capacity(ends.len(), corners.len());
+        let mut face = Vec::new();
         let mut start = 0;
-        soup.faces = ends
-            .iter()
-            .map(|&end| {
-                let p = corners[start..end]
-                    .iter()
-                    .map(|v| index[v.index()])
-                    .collect();
-                start = end;
-                p
-            })
-            .collect();
+        for &end in &ends {
+            face.clear();
+            face.extend(corners[start..end].iter().map(|v| index[v.index()]));
+            faces.push(&face);
+            start = end;
+        }
+        soup.faces = faces;
         (soup, tags, verts)
     }
 }
@@ -993,7 +1128,7 @@ mod tests {
                         self.face_vertices(f)
                             .iter()
                             .map(|v| index[v.index()])
-                            .collect()
+                            .collect::<Vec<u32>>()
                     })
                     .collect();
                 let tags = self.faces().map(|f| self.tag(f)).collect();
@@ -1098,7 +1233,7 @@ mod tests {
             }
             soup.faces = polygons
                 .into_iter()
-                .map(|p| p.iter().map(|v| index[v.index()]).collect())
+                .map(|p| p.iter().map(|v| index[v.index()]).collect::<Vec<u32>>())
                 .collect();
             (soup, tags, verts)
         }
@@ -1125,7 +1260,7 @@ mod tests {
     /// hexagons, so that polygons get fanned.
     fn hexagon_grid() -> PolygonSoup {
         let mut s = shapes::quad_grid(4, 3);
-        let (a, b) = (s.faces[0].clone(), s.faces[1].clone());
+        let (a, b) = (s.faces[0].to_vec(), s.faces[1].to_vec());
         // Quads (p0 p1 p2 p3) and (p1 q1 q2 p2) share edge p1 p2.
         let shared: Vec<u32> = a.iter().copied().filter(|v| b.contains(v)).collect();
         assert_eq!(shared.len(), 2, "neighbouring quads");
@@ -1146,7 +1281,9 @@ mod tests {
             }
         }
         assert_eq!(hex.len(), 6);
-        s.faces.splice(0..2, [hex]);
+        let mut faces = s.faces.to_vecs();
+        faces.splice(0..2, [hex]);
+        s.faces = faces.into();
         s
     }
 
@@ -1168,29 +1305,30 @@ mod tests {
     /// in half of the cases.
     fn mutate(rng: &mut Rng, soup: &PolygonSoup) -> (PolygonSoup, Vec<u32>) {
         let mut s = soup.clone();
+        let mut faces = s.faces.to_vecs();
         for _ in 0..rng.below(4) {
-            let n = s.faces.len();
+            let n = faces.len();
             let i = rng.below(n);
             match rng.below(7) {
                 0 | 1 if n > 1 => {
-                    s.faces.remove(i);
+                    faces.remove(i);
                 }
-                2 => s.faces[i].reverse(),
+                2 => faces[i].reverse(),
                 3 => {
-                    let k = rng.below(s.faces[i].len());
-                    s.faces[i].rotate_left(k);
+                    let k = rng.below(faces[i].len());
+                    faces[i].rotate_left(k);
                 }
                 4 => {
-                    let mut f = s.faces[i].clone();
+                    let mut f = faces[i].clone();
                     if rng.below(2) == 0 {
                         f.reverse();
                     }
                     let at = rng.below(n + 1);
-                    s.faces.insert(at, f);
+                    faces.insert(at, f);
                 }
                 5 => {
                     let j = rng.below(n);
-                    s.faces.swap(i, j);
+                    faces.swap(i, j);
                 }
                 _ => {
                     let nv = s.positions.len();
@@ -1199,10 +1337,11 @@ mod tests {
                         rng.below(nv) as u32,
                         rng.below(nv) as u32,
                     ];
-                    s.faces.insert(rng.below(n + 1), f);
+                    faces.insert(rng.below(n + 1), f);
                 }
             }
         }
+        s.faces = faces.into();
         if rng.below(2) == 0 {
             s.face_lines = (0..s.faces.len()).map(|i| 100 + i).collect();
             s.vertex_lines = (0..s.positions.len()).map(|i| 1 + i).collect();
@@ -1212,6 +1351,7 @@ mod tests {
     }
 
     fn soups_agree(m: &Mesh) {
+        assert_eq!(m.to_soup(), m.soup_with_reference(|_| false).0);
         assert_eq!(m.soup_with(|_| false), m.soup_with_reference(|_| false));
         let block = |e: EdgeId| m.is_block_edge(e);
         assert_eq!(m.soup_with(block), m.soup_with_reference(block));

@@ -127,7 +127,7 @@ pub struct Mesh {
     /// The sharpness of each vertex, as OpenSubdiv has it: 0 smooth, a
     /// positive number a corner for that many more levels, infinite a
     /// corner for ever. New vertices get 0.
-    pub(crate) v_sharp: Vec<f64>,
+    pub(crate) v_sharp: Column<f64>,
     // Half-edges, in twin pairs.
     pub(crate) he_to: Vec<VertexId>,
     pub(crate) he_next: Vec<HalfEdgeId>,
@@ -146,7 +146,7 @@ pub struct Mesh {
     /// number a crease for that many more levels (semi-sharp below 1),
     /// infinite a crease for ever. The halves of a split edge inherit it;
     /// edges that splits draw are 0, and a flip refuses a sharp edge.
-    pub(crate) e_sharp: Vec<f64>,
+    pub(crate) e_sharp: Column<f64>,
     /// False while no edge or vertex has been given a positive sharpness
     /// (or since the last `decrement_sharpness` left none): the crease
     /// queries answer at once on the meshes that have no creases.
@@ -159,7 +159,7 @@ pub struct Mesh {
     /// ([`Mesh::from_soup_tagged`]; 0 otherwise), handed down by the
     /// stellar operators to the faces cut from it: which part of a welded
     /// group of shapes a face belongs to.
-    pub(crate) f_tag: Vec<u32>,
+    pub(crate) f_tag: Column<u32>,
     // Free slots.
     pub(crate) free_v: Vec<u32>,
     pub(crate) free_e: Vec<u32>,
@@ -227,13 +227,35 @@ impl Mesh {
         self.f_alive.get(f.index()).copied().unwrap_or(false)
     }
 
-    /// Bytes of storage per face, for the benchmark's report.
+    /// Bytes of storage per face, for the benchmark's report: the arrays'
+    /// lengths times their elements' sizes (sharpness and tags count only
+    /// where stored).
     pub fn bytes_per_face(&self) -> f64 {
-        let v = self.v_alive.len() * (8 + 24 + 4 + 4 + 1 + 8);
-        let h = self.he_to.len() * (4 + 4 + 4 + 4);
-        let e = self.e_alive.len() * (4 + 1 + 1 + 1 + 8);
-        let f = self.f_alive.len() * (4 + 4 + 1 + 4);
-        (v + h + e + f) as f64 / self.face_count().max(1) as f64
+        self.bytes() as f64 / self.face_count().max(1) as f64
+    }
+
+    /// Bytes of the mesh's arrays (their lengths, not their capacities).
+    pub fn bytes(&self) -> usize {
+        fn size<T>(v: &[T]) -> usize {
+            std::mem::size_of_val(v)
+        }
+        let v = size(&self.v_out)
+            + size(&self.pos)
+            + size(&self.v_level)
+            + size(&self.v_step)
+            + size(&self.v_alive)
+            + self.v_sharp.stored_bytes();
+        let h = size(&self.he_to) + size(&self.he_next) + size(&self.he_prev) + size(&self.he_face);
+        let e = size(&self.e_level)
+            + size(&self.e_alive)
+            + size(&self.e_block)
+            + size(&self.e_transversal)
+            + self.e_sharp.stored_bytes();
+        let f = size(&self.f_he)
+            + size(&self.f_level)
+            + size(&self.f_alive)
+            + self.f_tag.stored_bytes();
+        v + h + e + f
     }
 
     // ----- element data ----------------------------------------------
@@ -262,7 +284,7 @@ impl Mesh {
     /// The face's tag: that of the soup face it was cut from
     /// ([`Mesh::from_soup_tagged`]), 0 for an untagged mesh.
     pub fn tag(&self, f: FaceId) -> u32 {
-        self.f_tag[f.index()]
+        self.f_tag.get(f.index())
     }
 
     pub fn set_vertex_level(&mut self, v: VertexId, l: u32) {
@@ -281,18 +303,18 @@ impl Mesh {
     /// The edge's sharpness: 0 smooth, positive creased (see
     /// [`Mesh::decrement_sharpness`]), `f64::INFINITY` sharp for ever.
     pub fn edge_sharpness(&self, e: EdgeId) -> f64 {
-        self.e_sharp[e.index()]
+        self.e_sharp.get(e.index())
     }
 
     /// The vertex's sharpness: 0 smooth, positive a corner.
     pub fn vertex_sharpness(&self, v: VertexId) -> f64 {
-        self.v_sharp[v.index()]
+        self.v_sharp.get(v.index())
     }
 
     /// True for an edge of positive sharpness.
     #[inline]
     pub fn is_sharp_edge(&self, e: EdgeId) -> bool {
-        self.e_sharp[e.index()] > 0.0
+        self.e_sharp.get(e.index()) > 0.0
     }
 
     /// Sets an edge's sharpness; refused for a negative or NaN value. (A
@@ -307,7 +329,7 @@ impl Mesh {
                 "a sharpness is 0 or more (or `inf`), not {s}"
             )));
         }
-        self.e_sharp[e.index()] = s;
+        self.e_sharp.set(e.index(), s);
         self.creased |= s > 0.0;
         Ok(())
     }
@@ -322,7 +344,7 @@ impl Mesh {
                 "a sharpness is 0 or more (or `inf`), not {s}"
             )));
         }
-        self.v_sharp[v.index()] = s;
+        self.v_sharp.set(v.index(), s);
         self.creased |= s > 0.0;
         Ok(())
     }
@@ -330,7 +352,7 @@ impl Mesh {
     /// True when some edge or vertex has positive sharpness.
     pub fn has_sharpness(&self) -> bool {
         self.creased && self.edges().any(|e| self.is_sharp_edge(e))
-            || self.vertices().any(|v| self.v_sharp[v.index()] > 0.0)
+            || self.vertices().any(|v| self.v_sharp.get(v.index()) > 0.0)
     }
 
     /// False when no edge or vertex can be sharp (nothing was given a
@@ -361,7 +383,8 @@ impl Mesh {
         if !self.creased {
             return;
         }
-        for s in self.e_sharp.iter_mut().chain(self.v_sharp.iter_mut()) {
+        let (e, v) = (self.e_sharp.stored_mut(), self.v_sharp.stored_mut());
+        for s in e.iter_mut().chain(v.iter_mut()) {
             if *s > 0.0 {
                 *s = (*s - 1.0).max(0.0);
             }
@@ -555,9 +578,11 @@ impl Mesh {
         [h0, h1, self.next(h1)]
     }
 
-    /// The vertices of a face, counter-clockwise.
+    /// The vertices of a face, counter-clockwise: where each of its
+    /// half-edges starts (read from the twin, which lies next to it).
+    #[inline]
     pub fn face_vertices(&self, f: FaceId) -> [VertexId; 3] {
-        self.face_halfedges(f).map(|h| self.to(self.prev(h)))
+        self.face_halfedges(f).map(|h| self.from(h))
     }
 
     pub fn face_edges(&self, f: FaceId) -> [EdgeId; 3] {
@@ -586,7 +611,7 @@ impl Mesh {
         grow(&mut self.v_level, vertices);
         grow(&mut self.v_step, vertices);
         grow(&mut self.v_alive, vertices);
-        grow(&mut self.v_sharp, vertices);
+        self.v_sharp.reserve(vertices);
         grow(&mut self.he_next, 2 * edges);
         grow(&mut self.he_prev, 2 * edges);
         grow(&mut self.he_to, 2 * edges);
@@ -595,11 +620,11 @@ impl Mesh {
         grow(&mut self.e_alive, edges);
         grow(&mut self.e_block, edges);
         grow(&mut self.e_transversal, edges);
-        grow(&mut self.e_sharp, edges);
+        self.e_sharp.reserve(edges);
         grow(&mut self.f_he, faces);
         grow(&mut self.f_level, faces);
         grow(&mut self.f_alive, faces);
-        grow(&mut self.f_tag, faces);
+        self.f_tag.reserve(faces);
     }
 
     /// A new vertex at `p`, made in grammar step `step`.
@@ -611,7 +636,7 @@ impl Mesh {
             self.v_level[k] = level;
             self.v_step[k] = step;
             self.v_alive[k] = true;
-            self.v_sharp[k] = 0.0;
+            self.v_sharp.set(k, 0.0);
             return VertexId(i);
         }
         self.v_out.push(None);
@@ -632,7 +657,7 @@ impl Mesh {
             self.e_alive[k] = true;
             self.e_block[k] = false;
             self.e_transversal[k] = false;
-            self.e_sharp[k] = 0.0;
+            self.e_sharp.set(k, 0.0);
             EdgeId(i)
         } else {
             self.e_level.push(level);
@@ -664,7 +689,7 @@ impl Mesh {
             self.f_he[i as usize] = h;
             self.f_level[i as usize] = level;
             self.f_alive[i as usize] = true;
-            self.f_tag[i as usize] = tag;
+            self.f_tag.set(i as usize, tag);
             return FaceId(i);
         }
         self.f_he.push(h);
@@ -761,9 +786,10 @@ impl Iterator for OutgoingIter<'_> {
     }
 }
 
-/// Makes room for `additional` more elements. A large array moves to a
-/// new allocation that the kernel is asked to back with huge pages before
-/// anything is written to it: a subdivision step writes hundreds of
+/// Makes room for `additional` more elements. A large array grows in place
+/// or is moved by the allocator (for large blocks, `realloc` remaps pages
+/// rather than copying them), and the kernel is asked to back the part not
+/// yet written with huge pages: a subdivision step writes hundreds of
 /// megabytes, and with 4 KiB pages much of its time goes to page faults.
 /// The advice changes how memory is backed, never what it holds.
 fn grow<T: Copy>(v: &mut Vec<T>, additional: usize) {
@@ -778,16 +804,17 @@ fn grow<T: Copy>(v: &mut Vec<T>, additional: usize) {
         v.reserve(additional);
         return;
     }
-    let mut fresh: Vec<T> = Vec::with_capacity(cap);
+    v.reserve_exact(cap - v.len());
     #[cfg(target_os = "linux")]
     {
-        let start = fresh.as_ptr() as usize;
+        let size = std::mem::size_of::<T>();
+        let start = v.as_ptr() as usize + v.len() * size;
         let aligned = (start + HUGE - 1) & !(HUGE - 1);
-        let end = (start + bytes) & !(HUGE - 1);
+        let end = (v.as_ptr() as usize + v.capacity() * size) & !(HUGE - 1);
         if end > aligned {
-            // SAFETY: the range lies inside `fresh`'s own allocation, and
-            // MADV_HUGEPAGE never changes memory's contents; a failure
-            // leaves ordinary pages.
+            // SAFETY: the range lies inside `v`'s own allocation, past its
+            // elements, and MADV_HUGEPAGE never changes memory's contents;
+            // a failure leaves ordinary pages.
             unsafe {
                 libc::madvise(
                     aligned as *mut libc::c_void,
@@ -797,6 +824,122 @@ fn grow<T: Copy>(v: &mut Vec<T>, additional: usize) {
             }
         }
     }
-    fresh.extend_from_slice(v);
-    *v = fresh;
+}
+
+/// A per-element column whose elements all hold the default value (0)
+/// until one is given another: only then is it stored, whole. Sharpness
+/// and tags are 0 on most meshes, and a large mesh need not carry a number
+/// per element for them.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Column<T> {
+    /// Empty while every element holds the default; else one per element.
+    stored: Vec<T>,
+    len: usize,
+}
+
+impl<T: Copy + Default + PartialEq> Column<T> {
+    /// `len` elements holding the default.
+    pub(crate) fn defaults(len: usize) -> Column<T> {
+        Column {
+            stored: Vec::new(),
+            len,
+        }
+    }
+
+    /// A column of these values (kept only if some is not the default).
+    pub(crate) fn from_vec(values: Vec<T>) -> Column<T> {
+        let len = values.len();
+        if values.iter().all(|&x| x == T::default()) {
+            Column::defaults(len)
+        } else {
+            Column {
+                stored: values,
+                len,
+            }
+        }
+    }
+
+    #[inline]
+    pub(crate) fn get(&self, i: usize) -> T {
+        debug_assert!(i < self.len);
+        if self.stored.is_empty() {
+            T::default()
+        } else {
+            self.stored[i]
+        }
+    }
+
+    #[inline]
+    pub(crate) fn set(&mut self, i: usize, x: T) {
+        assert!(i < self.len, "element {i} of {}", self.len);
+        if self.stored.is_empty() {
+            if x == T::default() {
+                return;
+            }
+            self.stored = vec![T::default(); self.len];
+        }
+        self.stored[i] = x;
+    }
+
+    #[inline]
+    pub(crate) fn push(&mut self, x: T) {
+        if !self.stored.is_empty() || x != T::default() {
+            if self.stored.is_empty() {
+                self.stored = vec![T::default(); self.len];
+            }
+            self.stored.push(x);
+        }
+        self.len += 1;
+    }
+
+    /// Room for `additional` more elements, where they are stored.
+    fn reserve(&mut self, additional: usize) {
+        if !self.stored.is_empty() {
+            grow(&mut self.stored, additional);
+        }
+    }
+
+    /// The bytes the stored values take.
+    fn stored_bytes(&self) -> usize {
+        std::mem::size_of_val(&self.stored[..])
+    }
+
+    /// The stored values: every element's, or none while all are the
+    /// default.
+    pub(crate) fn stored_mut(&mut self) -> &mut [T] {
+        &mut self.stored
+    }
+}
+
+/// Columns are equal when every element holds the same value, however
+/// they are kept.
+impl<T: Copy + Default + PartialEq> PartialEq for Column<T> {
+    fn eq(&self, other: &Column<T>) -> bool {
+        self.len == other.len && (0..self.len).all(|i| self.get(i) == other.get(i))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Column;
+
+    #[test]
+    fn a_column_is_stored_only_once_an_element_differs_from_0() {
+        let mut c: Column<f64> = Column::defaults(3);
+        c.set(1, 0.0);
+        c.push(0.0);
+        assert!(c.stored_mut().is_empty());
+        assert_eq!((0..4).map(|i| c.get(i)).collect::<Vec<_>>(), [0.0; 4]);
+        c.set(2, 1.5);
+        c.push(2.0);
+        assert_eq!(c.stored_mut(), [0.0, 0.0, 1.5, 0.0, 2.0]);
+        // Equality is element by element, however the columns are kept.
+        let mut d: Column<f64> = Column::defaults(5);
+        assert_ne!(c, d);
+        d.set(2, 1.5);
+        d.set(4, 2.0);
+        assert_eq!(c, d);
+        assert_eq!(Column::<u32>::from_vec(vec![0, 0]), Column::defaults(2));
+        assert_ne!(Column::<u32>::from_vec(vec![0, 1]), Column::defaults(2));
+    }
 }

@@ -18,14 +18,15 @@
 //! Coordinates are written with `{:?}`, the shortest text that parses back to
 //! the same `f64`, so a soup written and read again is bit-for-bit the same.
 
-use std::io::Read;
+use std::io::{self, Read, Write};
 use std::ops::Range;
 use std::path::Path;
 
 use glam::DVec3;
 
+use super::build::SoupSharpness;
 use super::halfedge::Mesh;
-use super::soup::{first_repeat, MeshFileError, Place, PolygonSoup};
+use super::soup::{first_repeat, Faces, MeshFileError, Place, PolygonSoup};
 
 /// The largest mesh file [`read`] reads unless the environment variable
 /// [`MAX_FILE_BYTES_VAR`] sets another limit: 2 GiB, about 40 million
@@ -320,10 +321,7 @@ pub fn read_str(name: &str, format: Format, bytes: &[u8]) -> Result<PolygonSoup,
 /// Writes `soup` to `path` atomically, its format chosen by extension (PLY
 /// is written as ASCII).
 pub fn write(path: &Path, soup: &PolygonSoup) -> Result<(), MeshFileError> {
-    let name = path.display().to_string();
-    let format = format_of(&name, path)?;
-    crate::atomic::write_atomic(path, &to_bytes(format, soup))
-        .map_err(|e| error(&name, None, format!("cannot write the file: {e}")))
+    write_with_sharpness(path, soup, &[])
 }
 
 /// Writes `soup` to `path` as [`write()`] does, with the sharp `edges` (two
@@ -336,24 +334,45 @@ pub fn write_with_sharpness(
     soup: &PolygonSoup,
     edges: &[(u32, u32, f64)],
 ) -> Result<(), MeshFileError> {
+    write_streamed(path, soup, edges)
+}
+
+/// Writes the mesh `m` to `path` as [`write_with_sharpness`] writes
+/// [`Mesh::to_soup_with_sharpness`]`(triangles)`, the same bytes, and
+/// gives that sharpness. Where the soup would be the mesh's triangles as
+/// they are (`triangles`, or no basic block to merge), they are written
+/// straight from the mesh: no copy of a large mesh is made.
+pub fn write_mesh(path: &Path, m: &Mesh, triangles: bool) -> Result<SoupSharpness, MeshFileError> {
+    if triangles || !m.quad_soup_merges() {
+        let view = MeshTriangles::new(m);
+        let sharp = m.soup_sharpness(&view.index, triangles);
+        write_streamed(path, &view, &sharp.edges)?;
+        Ok(sharp)
+    } else {
+        let (soup, sharp) = m.to_soup_with_sharpness(triangles);
+        write_streamed(path, &soup, &sharp.edges)?;
+        Ok(sharp)
+    }
+}
+
+/// Writes `s` to `path` atomically, piece by piece, in the format of the
+/// path's extension.
+fn write_streamed(
+    path: &Path,
+    s: &dyn Polygons,
+    edges: &[(u32, u32, f64)],
+) -> Result<(), MeshFileError> {
     let name = path.display().to_string();
     let format = format_of(&name, path)?;
-    let bytes = match format {
-        Format::Ply if !edges.is_empty() => write_ply_with_edges(soup, edges).into_bytes(),
-        _ => to_bytes(format, soup),
-    };
-    crate::atomic::write_atomic(path, &bytes)
+    crate::atomic::write_atomic_with(path, |w| write_polygons(w, format, s, edges))
         .map_err(|e| error(&name, None, format!("cannot write the file: {e}")))
 }
 
 /// The text of `soup` in `format` (PLY as ASCII).
 pub fn to_bytes(format: Format, soup: &PolygonSoup) -> Vec<u8> {
-    let text = match format {
-        Format::Obj => write_obj(soup),
-        Format::Off => write_off(soup),
-        Format::Ply => write_ply(soup),
-    };
-    text.into_bytes()
+    let mut out = Vec::new();
+    write_polygons(&mut out, format, soup, &[]).expect("writing to memory");
+    out
 }
 
 // ---------------------------------------------------------------------------
@@ -769,9 +788,10 @@ impl Raw {
                 None => error(name, known(line), message),
             });
         }
-        let faces = (0..self.face_count())
-            .map(|f| self.check_face(name, source, f))
-            .collect::<Result<Vec<_>, _>>()?;
+        let mut faces = Faces::with_capacity(self.face_count(), self.indices.len());
+        for f in 0..self.face_count() {
+            faces.push(self.check_face(name, source, f)?);
+        }
         if faces.is_empty() {
             return Err(error(name, None, "the mesh has no faces"));
         }
@@ -1852,87 +1872,216 @@ mod ply {
 // ---------------------------------------------------------------------------
 // Writing
 
-/// Appends one face's indices (plus `base`) to `out`, space-separated.
-fn push_indices(out: &mut String, face: &[u32], base: u64) {
+/// What the writers read: the positions and the polygons of a soup, or of
+/// a mesh's triangles read in place ([`MeshTriangles`]), so that a large
+/// mesh is written without a copy of it.
+trait Polygons {
+    fn vertex_count(&self) -> usize;
+    fn face_count(&self) -> usize;
+    /// The most corners of any face (0 without faces).
+    fn longest(&self) -> usize;
+    /// Calls `f` on every position in order, stopping at an error.
+    fn each_position(&self, f: &mut dyn FnMut(DVec3) -> io::Result<()>) -> io::Result<()>;
+    /// Calls `f` on every face's corners in order, stopping at an error.
+    fn each_face(&self, f: &mut dyn FnMut(&[u32]) -> io::Result<()>) -> io::Result<()>;
+}
+
+impl Polygons for PolygonSoup {
+    fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    fn face_count(&self) -> usize {
+        self.faces.len()
+    }
+
+    fn longest(&self) -> usize {
+        match self.faces.arity() {
+            Some(n) => n,
+            None => self.faces.iter().map(<[u32]>::len).max().unwrap_or(0),
+        }
+    }
+
+    fn each_position(&self, f: &mut dyn FnMut(DVec3) -> io::Result<()>) -> io::Result<()> {
+        self.positions.iter().try_for_each(|&p| f(p))
+    }
+
+    fn each_face(&self, f: &mut dyn FnMut(&[u32]) -> io::Result<()>) -> io::Result<()> {
+        self.faces.iter().try_for_each(f)
+    }
+}
+
+/// A mesh's triangles as [`Mesh::to_soup`] gives them (its live vertices
+/// and faces in order), read from the mesh as they are written.
+struct MeshTriangles<'m> {
+    mesh: &'m Mesh,
+    /// The soup vertex of each vertex slot (`u32::MAX` for a dead slot).
+    index: Vec<u32>,
+    vertices: usize,
+}
+
+impl<'m> MeshTriangles<'m> {
+    fn new(mesh: &'m Mesh) -> MeshTriangles<'m> {
+        let mut index = vec![u32::MAX; mesh.v_alive.len()];
+        let mut vertices = 0;
+        for v in mesh.vertices() {
+            index[v.index()] = vertices as u32;
+            vertices += 1;
+        }
+        MeshTriangles {
+            mesh,
+            index,
+            vertices,
+        }
+    }
+}
+
+impl Polygons for MeshTriangles<'_> {
+    fn vertex_count(&self) -> usize {
+        self.vertices
+    }
+
+    fn face_count(&self) -> usize {
+        self.mesh.face_count()
+    }
+
+    fn longest(&self) -> usize {
+        if self.mesh.face_count() > 0 {
+            3
+        } else {
+            0
+        }
+    }
+
+    fn each_position(&self, f: &mut dyn FnMut(DVec3) -> io::Result<()>) -> io::Result<()> {
+        self.mesh
+            .vertices()
+            .try_for_each(|v| f(self.mesh.position(v)))
+    }
+
+    fn each_face(&self, f: &mut dyn FnMut(&[u32]) -> io::Result<()>) -> io::Result<()> {
+        self.mesh.faces().try_for_each(|g| {
+            let [a, b, c] = self.mesh.face_vertices(g);
+            f(&[
+                self.index[a.index()],
+                self.index[b.index()],
+                self.index[c.index()],
+            ])
+        })
+    }
+}
+
+/// Writes one face's indices (plus `base`), each after a space, and a
+/// newline.
+fn put_indices(w: &mut dyn Write, face: &[u32], base: u64) -> io::Result<()> {
+    // Decimal digits by hand into one buffer per face: the same text as
+    // `to_string` of each, without an allocation per index.
+    let mut buf = [0u8; 256];
+    let mut n = 0;
     for &i in face {
-        out.push(' ');
-        out.push_str(&(u64::from(i) + base).to_string());
+        if n + 22 > buf.len() {
+            w.write_all(&buf[..n])?;
+            n = 0;
+        }
+        buf[n] = b' ';
+        n += 1;
+        let mut x = u64::from(i) + base;
+        let mut digits = [0u8; 20];
+        let mut k = digits.len();
+        loop {
+            k -= 1;
+            digits[k] = b'0' + (x % 10) as u8;
+            x /= 10;
+            if x == 0 {
+                break;
+            }
+        }
+        let d = &digits[k..];
+        buf[n..n + d.len()].copy_from_slice(d);
+        n += d.len();
     }
-    out.push('\n');
+    buf[n] = b'\n';
+    w.write_all(&buf[..n + 1])
 }
 
-/// Appends `x y z` with exactly round-tripping coordinates.
-fn push_position(out: &mut String, p: DVec3) {
-    out.push_str(&format!("{:?} {:?} {:?}\n", p.x, p.y, p.z));
+/// Writes `x y z` with exactly round-tripping coordinates.
+fn put_position(w: &mut dyn Write, p: DVec3) -> io::Result<()> {
+    writeln!(w, "{:?} {:?} {:?}", p.x, p.y, p.z)
 }
 
-/// OBJ text: `v` lines then 1-based `f` lines.
-fn write_obj(soup: &PolygonSoup) -> String {
-    let mut out = format!(
-        "# subgram mesh: {} vertices, {} faces\n",
-        soup.positions.len(),
-        soup.faces.len()
-    );
-    for &p in &soup.positions {
-        out.push_str("v ");
-        push_position(&mut out, p);
-    }
-    for face in &soup.faces {
-        out.push('f');
-        push_indices(&mut out, face, 1);
-    }
-    out
+/// OBJ: `v` lines then 1-based `f` lines.
+fn write_obj(w: &mut dyn Write, s: &dyn Polygons) -> io::Result<()> {
+    writeln!(
+        w,
+        "# subgram mesh: {} vertices, {} faces",
+        s.vertex_count(),
+        s.face_count()
+    )?;
+    s.each_position(&mut |p| {
+        w.write_all(b"v ")?;
+        put_position(w, p)
+    })?;
+    s.each_face(&mut |f| {
+        w.write_all(b"f")?;
+        put_indices(w, f, 1)
+    })
 }
 
-/// OFF text: header, counts, vertices, `k i1 .. ik` faces.
-fn write_off(soup: &PolygonSoup) -> String {
-    let mut out = format!("OFF\n{} {} 0\n", soup.positions.len(), soup.faces.len());
-    for &p in &soup.positions {
-        push_position(&mut out, p);
-    }
-    for face in &soup.faces {
-        out.push_str(&face.len().to_string());
-        push_indices(&mut out, face, 0);
-    }
-    out
+/// OFF: header, counts, vertices, `k i1 .. ik` faces.
+fn write_off(w: &mut dyn Write, s: &dyn Polygons) -> io::Result<()> {
+    write!(w, "OFF\n{} {} 0\n", s.vertex_count(), s.face_count())?;
+    s.each_position(&mut |p| put_position(w, p))?;
+    s.each_face(&mut |f| {
+        write!(w, "{}", f.len())?;
+        put_indices(w, f, 0)
+    })
 }
 
-/// [`write_ply`] with an `edge` element after the faces: `vertex1`,
-/// `vertex2` and the sharpness as `crease` (`inf` for ever).
-fn write_ply_with_edges(soup: &PolygonSoup, edges: &[(u32, u32, f64)]) -> String {
-    let text = write_ply(soup);
-    let (header, body) = text
-        .split_once("end_header\n")
-        .expect("write_ply writes a header");
-    let mut out = format!(
-        "{header}element edge {}\nproperty int vertex1\nproperty int vertex2\n\
-         property double crease\nend_header\n{body}",
-        edges.len()
-    );
-    for &(a, b, s) in edges {
-        out.push_str(&format!("{a} {b} {s:?}\n"));
-    }
-    out
-}
-
-/// ASCII PLY text with double coordinates and a `vertex_indices` list
-/// (uchar counts where every face has at most 255 vertices).
-fn write_ply(soup: &PolygonSoup) -> String {
-    let longest = soup.faces.iter().map(Vec::len).max().unwrap_or(0);
-    let count_type = if longest <= 255 { "uchar" } else { "uint" };
-    let mut out = format!(
+/// ASCII PLY with double coordinates and a `vertex_indices` list (uchar
+/// counts where every face has at most 255 vertices), and after the faces
+/// an `edge` element where `edges` has any: `vertex1`, `vertex2` and the
+/// sharpness as `crease` (`inf` for ever).
+fn write_ply(w: &mut dyn Write, s: &dyn Polygons, edges: &[(u32, u32, f64)]) -> io::Result<()> {
+    let count_type = if s.longest() <= 255 { "uchar" } else { "uint" };
+    write!(
+        w,
         "ply\nformat ascii 1.0\ncomment written by subgram\n\
          element vertex {}\nproperty double x\nproperty double y\nproperty double z\n\
-         element face {}\nproperty list {count_type} uint vertex_indices\nend_header\n",
-        soup.positions.len(),
-        soup.faces.len()
-    );
-    for &p in &soup.positions {
-        push_position(&mut out, p);
+         element face {}\nproperty list {count_type} uint vertex_indices\n",
+        s.vertex_count(),
+        s.face_count()
+    )?;
+    if !edges.is_empty() {
+        write!(
+            w,
+            "element edge {}\nproperty int vertex1\nproperty int vertex2\n\
+             property double crease\n",
+            edges.len()
+        )?;
     }
-    for face in &soup.faces {
-        out.push_str(&face.len().to_string());
-        push_indices(&mut out, face, 0);
+    w.write_all(b"end_header\n")?;
+    s.each_position(&mut |p| put_position(w, p))?;
+    s.each_face(&mut |f| {
+        write!(w, "{}", f.len())?;
+        put_indices(w, f, 0)
+    })?;
+    for &(a, b, sharp) in edges {
+        writeln!(w, "{a} {b} {sharp:?}")?;
     }
-    out
+    Ok(())
+}
+
+/// Writes `s` in `format`, with the sharp `edges` where the format
+/// carries them (PLY).
+fn write_polygons(
+    w: &mut dyn Write,
+    format: Format,
+    s: &dyn Polygons,
+    edges: &[(u32, u32, f64)],
+) -> io::Result<()> {
+    match format {
+        Format::Obj => write_obj(w, s),
+        Format::Off => write_off(w, s),
+        Format::Ply => write_ply(w, s, edges),
+    }
 }

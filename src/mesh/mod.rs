@@ -13,5 +13,5 @@ pub mod validate;
 
 pub use build::SoupSharpness;
 pub use halfedge::{EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId};
-pub use soup::{MeshFileError, Place, PolygonSoup};
+pub use soup::{Faces, MeshFileError, Place, PolygonSoup};
 pub use stellar::{BlockSplit, Split};

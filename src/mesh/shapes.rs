@@ -59,7 +59,7 @@ pub fn icosphere(levels: u32) -> PolygonSoup {
     let mut s = icosahedron();
     for _ in 0..levels {
         let mut mid = std::collections::HashMap::new();
-        let mut faces = Vec::with_capacity(s.faces.len() * 4);
+        let mut faces = crate::mesh::Faces::with_capacity(s.faces.len() * 4, s.faces.len() * 12);
         let mut m = |a: u32, b: u32, pos: &mut Vec<DVec3>| -> u32 {
             *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
                 pos.push(((pos[a as usize] + pos[b as usize]) * 0.5).normalize());
@@ -71,12 +71,7 @@ pub fn icosphere(levels: u32) -> PolygonSoup {
             let ab = m(a, b, &mut s.positions);
             let bc = m(b, c, &mut s.positions);
             let ca = m(c, a, &mut s.positions);
-            faces.extend([
-                vec![a, ab, ca],
-                vec![b, bc, ab],
-                vec![c, ca, bc],
-                vec![ab, bc, ca],
-            ]);
+            faces.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
         }
         s.faces = faces;
     }

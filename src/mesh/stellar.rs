@@ -145,7 +145,7 @@ impl Mesh {
         let va = self.new_edge(v, a, lv);
         let vb = self.new_edge(v, b, lv);
         let vc = self.new_edge(v, c, lv);
-        let tag = self.f_tag[f.index()];
+        let tag = self.f_tag.get(f.index());
         let f1 = self.new_face(h1, 0, tag);
         let f2 = self.new_face(h2, 0, tag);
         self.set_triangle(f, h0, vb.twin(), va);
@@ -302,13 +302,14 @@ impl Mesh {
         let g = self.new_edge(v, b, le + 2); // v -> b
                                              // Both halves keep the edge's sharpness (OpenSubdiv's child edges);
                                              // the transversals below are drawn across faces and stay smooth.
-        self.e_sharp[g.edge().index()] = self.e_sharp[e.index()];
+        self.e_sharp
+            .set(g.edge().index(), self.e_sharp.get(e.index()));
         let k = self.new_edge(v, c, self.v_level[c.index()] + 1); // v -> c
         self.e_transversal[k.edge().index()] = true;
         if lone {
             self.e_block[k.edge().index()] = true;
         }
-        let f2 = self.new_face(g, 0, self.f_tag[f1.index()]);
+        let f2 = self.new_face(g, 0, self.f_tag.get(f1.index()));
         self.set_triangle(f1, h, k, h_ca);
         self.set_triangle(f2, g, h_bc, k.twin());
         if boundary {
@@ -331,7 +332,7 @@ impl Mesh {
             let d = self.to(t_ad);
             let m = self.new_edge(v, d, self.v_level[d.index()] + 1); // v -> d
             self.e_transversal[m.edge().index()] = true;
-            let f4 = self.new_face(g.twin(), 0, self.f_tag[f3.index()]);
+            let f4 = self.new_face(g.twin(), 0, self.f_tag.get(f3.index()));
             self.set_triangle(f3, t, t_ad, m.twin());
             self.set_triangle(f4, g.twin(), m, t_db);
             self.v_out[v.index()] = Some(g);
@@ -462,8 +463,11 @@ impl Mesh {
             let (bp, bn) = (self.prev(bin), self.next(bout));
             let le = self.e_level[x.edge().index()].saturating_sub(2);
             // The restored edge is as sharp as the sharper of its halves.
-            let sharp = self.e_sharp[x.edge().index()].max(self.e_sharp[bout.edge().index()]);
-            self.e_sharp[x.edge().index()] = sharp;
+            let sharp = self
+                .e_sharp
+                .get(x.edge().index())
+                .max(self.e_sharp.get(bout.edge().index()));
+            self.e_sharp.set(x.edge().index(), sharp);
             self.delete_edge(out[1].edge());
             self.delete_edge(out[2].edge());
             self.delete_face(g);
@@ -512,8 +516,11 @@ impl Mesh {
         // Reuse edge v-a: x = a -> b, x' = b -> a.
         let x = o[0].twin(); // was a -> v
                              // The restored edge is as sharp as the sharper of its halves.
-        let sharp = self.e_sharp[o[0].edge().index()].max(self.e_sharp[o[2].edge().index()]);
-        self.e_sharp[x.edge().index()] = sharp;
+        let sharp = self
+            .e_sharp
+            .get(o[0].edge().index())
+            .max(self.e_sharp.get(o[2].edge().index()));
+        self.e_sharp.set(x.edge().index(), sharp);
         self.delete_edge(o[1].edge());
         self.delete_edge(o[2].edge());
         self.delete_edge(o[3].edge());
@@ -528,7 +535,8 @@ impl Mesh {
         self.set_triangle(faces[1], o_bd, o_da, x);
         // faces[1] was v-c-b; it is now b-d-a, whose half on a's side was
         // v-d-a, faces[3].
-        self.f_tag[faces[1].index()] = self.f_tag[faces[3].index()];
+        self.f_tag
+            .set(faces[1].index(), self.f_tag.get(faces[3].index()));
         for (w, h) in [(a, x), (b, x.twin()), (c, o_cb), (d, o_da)] {
             self.v_out[w.index()] = Some(h);
             self.fix_outgoing(w);
@@ -583,7 +591,7 @@ impl Mesh {
             return Err(MeshError::new(format!(
                 "edge flip: the edge between vertices {a} and {b} is sharp (sharpness {}) and \
                  cannot be flipped: a flip would move the crease off its curve",
-                self.e_sharp[e.index()]
+                self.e_sharp.get(e.index())
             )));
         }
         let h = e.halfedge();

@@ -1877,7 +1877,7 @@ mod tests {
         let pieces = three_pieces(&mut points);
         let members: Vec<&Geometry> = pieces.iter().collect();
         let w = weld(&mut points, &members, &[], &HashSet::new(), &HashMap::new()).unwrap();
-        assert_closed(&w.soup.faces);
+        assert_closed(&w.soup.faces.to_vecs());
         // 8 corners + 2 cuts x 4 points; the 4 faces across x in 3 pieces
         // each and the 2 ends: 14 faces, none of them a cap.
         assert_eq!(w.soup.positions.len(), 16);
@@ -1901,7 +1901,7 @@ mod tests {
         let members: Vec<&Geometry> = pieces.iter().collect();
         let loose: HashSet<u32> = [2].into_iter().collect();
         let w = weld(&mut points, &members, &[], &loose, &HashMap::new()).unwrap();
-        assert_closed(&w.soup.faces);
+        assert_closed(&w.soup.faces.to_vecs());
         // 16 points and the 4 points of cut 2 copied for the upper side;
         // 14 faces and both caps of cut 2.
         assert_eq!(w.soup.positions.len(), 20);
@@ -1953,7 +1953,7 @@ mod tests {
         .unwrap();
         // Piece 2's wall is cut in two: the half against halves[0] goes
         // with its mirror, the half against halves[1] stays.
-        assert_closed(&w.soup.faces);
+        assert_closed(&w.soup.faces.to_vecs());
         // [0.3, 1] x [0, 1] x [0, 0.5] and [0.7, 1] x [0, 1] x [0.5, 1].
         let v = 0.7 * 0.5 + 0.3 * 0.5;
         assert!((volume(&points, &soup_geometry(&w)) - v).abs() < 1e-12);
@@ -1974,7 +1974,7 @@ mod tests {
         let seam_planes: HashMap<u32, Vec<(DVec3, f64)>> =
             [(1, vec![y]), (2, vec![y])].into_iter().collect();
         let w = weld(&mut points, &members, &[], &HashSet::new(), &seam_planes).unwrap();
-        assert_closed(&w.soup.faces);
+        assert_closed(&w.soup.faces.to_vecs());
         // The y cut put 4 points on the middle slab's edges at x = 0.3 and
         // 0.7 (front and back), all used.
         assert_eq!(w.soup.positions.len(), 20);
@@ -1992,7 +1992,7 @@ mod tests {
             &HashMap::new(),
         )
         .unwrap();
-        assert_closed(&w.soup.faces);
+        assert_closed(&w.soup.faces.to_vecs());
         let protected: Vec<DVec3> = (0..w.soup.positions.len())
             .filter(|&v| w.protected_vertex[v])
             .map(|v| w.soup.positions[v])
@@ -2126,7 +2126,7 @@ mod tests {
             assert!((volume(&points, g) - 0.25).abs() < 1e-12);
         }
         let w = weld(&mut points, &members, &[], &HashSet::new(), &HashMap::new()).unwrap();
-        assert_closed(&w.soup.faces);
+        assert_closed(&w.soup.faces.to_vecs());
         assert_eq!(w.soup.positions.len(), 18);
     }
 
@@ -2385,7 +2385,7 @@ mod tests {
         // A tetrahedron with outward faces, volume 1/6, in [0,1]^3.
         let soup = PolygonSoup {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
-            faces: vec![vec![0, 2, 1], vec![0, 1, 3], vec![0, 3, 2], vec![1, 2, 3]],
+            faces: vec![vec![0, 2, 1], vec![0, 1, 3], vec![0, 3, 2], vec![1, 2, 3]].into(),
             ..PolygonSoup::default()
         };
         let s = sized(DVec3::new(5.0, 0.0, 0.0), DVec3::new(2.0, 3.0, 4.0));
@@ -2399,13 +2399,13 @@ mod tests {
         // A flat soup lands on the scope's origin plane.
         let flat = PolygonSoup {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
-            faces: vec![vec![0, 1, 2]],
+            faces: vec![vec![0, 1, 2]].into(),
             ..PolygonSoup::default()
         };
         let g = mesh_in(&mut points, &s, &flat).unwrap();
         assert!(g.point_ids().all(|p| points.get(p).z == 0.0));
         let bad = PolygonSoup {
-            faces: vec![vec![0, 1, 7]],
+            faces: vec![vec![0, 1, 7]].into(),
             ..flat
         };
         assert!(mesh_in(&mut points, &s, &bad).is_err());
@@ -2646,7 +2646,7 @@ mod tests {
         let (points, w) = s0_s1(false, &[]);
         // Every edge in two faces: closed, and no T-junction (a vertex in
         // the middle of another face's edge would leave that edge in one).
-        assert_closed(&w.soup.faces);
+        assert_closed(&w.soup.faces.to_vecs());
         // [0, 1] x [0, 1] x [0, 2] and [1, 2] x [0, 2] x [0, 2].
         let v = 1.0 * 1.0 * 2.0 + 1.0 * 2.0 * 2.0;
         assert!((volume(&points, &soup_geometry(&w)) - v).abs() < 1e-12);
@@ -2682,7 +2682,7 @@ mod tests {
         };
         let (pa, wa) = s0_s1(false, &[]);
         let (pb, wb) = s0_s1(true, &[]);
-        assert_closed(&wb.soup.faces);
+        assert_closed(&wb.soup.faces.to_vecs());
         assert_eq!(sorted(&pa, &wa), sorted(&pb, &wb));
         assert_eq!(wa.soup.faces.len(), wb.soup.faces.len());
         // Every point of the derivation too (the right piece's removed
@@ -2774,7 +2774,7 @@ mod tests {
         }
         let members: Vec<&Geometry> = work.iter().map(|(g, _)| g).collect();
         let w = weld(&mut points, &members, &[], &HashSet::new(), &HashMap::new()).unwrap();
-        assert_closed(&w.soup.faces);
+        assert_closed(&w.soup.faces.to_vecs());
         assert!((volume(&points, &soup_geometry(&w)) - 8.0).abs() < 1e-9);
         // 8 corners and 4 points on each of the 511 walls.
         assert_eq!(w.soup.positions.len(), 8 + 4 * 511);
@@ -2874,7 +2874,7 @@ mod tests {
                 &seam_planes,
             )
             .unwrap();
-            assert_closed(&w.soup.faces);
+            assert_closed(&w.soup.faces.to_vecs());
             // [0, 1] x [0, 1] x [0, 2] and [1, 2] x [0, 4] x [0, 1].
             let v = 1.0 * 1.0 * 2.0 + 1.0 * 4.0 * 1.0;
             assert!((volume(&points, &soup_geometry(&w)) - v).abs() < 1e-12);
@@ -2886,7 +2886,7 @@ mod tests {
         let (points, w) = s0_s1(false, &[1]);
         // Both parts closed on their own: the pair of wall pieces that
         // mirror each other stays, the right part on copies of its points.
-        assert_closed(&w.soup.faces);
+        assert_closed(&w.soup.faces.to_vecs());
         assert!((volume(&points, &soup_geometry(&w)) - 6.0).abs() < 1e-12);
         // The left part's 8 corners, the right part's 8 corners (2 of them
         // copies) and its 2 copied points at y = 1 on the wall: 18, and

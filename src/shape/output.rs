@@ -264,7 +264,7 @@ pub fn soup(t: &ShapeTree) -> (PolygonSoup, Vec<Rgba>) {
                     }
                     *slot
                 })
-                .collect();
+                .collect::<Vec<u32>>();
             soup.faces.push(face);
             colours.push(Rgba(c[0], c[1], c[2], 255));
         }

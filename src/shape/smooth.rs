@@ -183,7 +183,7 @@ mod tests {
     fn soup(positions: Vec<DVec3>, faces: Vec<Vec<u32>>) -> PolygonSoup {
         PolygonSoup {
             positions,
-            faces,
+            faces: faces.into(),
             ..Default::default()
         }
     }
@@ -307,7 +307,7 @@ mod tests {
 
     /// `poly` is among `faces` (as the same cycle, from any corner), with
     /// tag `tag`.
-    fn has_face(faces: &[Vec<u32>], tags: &[u32], poly: &[u32], tag: u32) -> bool {
+    fn has_face(faces: &crate::mesh::Faces, tags: &[u32], poly: &[u32], tag: u32) -> bool {
         faces.iter().zip(tags).any(|(f, &t)| {
             t == tag
                 && f.len() == poly.len()

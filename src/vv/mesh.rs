@@ -1240,13 +1240,13 @@ impl Rotation {
                 *i = k as u32;
             }
         }
-        let mut faces = Vec::new();
+        let mut faces = crate::mesh::Faces::new();
         let mut holes = 0;
         self.trace(set, true, |hole, vs| {
             if hole {
                 holes += 1;
             } else {
-                faces.push(vs.iter().map(|&v| index[v as usize]).collect());
+                faces.push(vs.iter().map(|&v| index[v as usize]).collect::<Vec<u32>>());
             }
         })?;
         let soup = PolygonSoup {
@@ -1293,8 +1293,8 @@ mod tests {
         f[k..].iter().chain(&f[..k]).copied().collect()
     }
 
-    fn canonical_faces(faces: &[Vec<u32>]) -> Vec<Vec<u32>> {
-        let mut out: Vec<Vec<u32>> = faces.iter().map(|f| canonical(f)).collect();
+    fn canonical_faces<F: AsRef<[u32]>>(faces: impl IntoIterator<Item = F>) -> Vec<Vec<u32>> {
+        let mut out: Vec<Vec<u32>> = faces.into_iter().map(|f| canonical(f.as_ref())).collect();
         out.sort();
         out
     }
@@ -1353,7 +1353,8 @@ mod tests {
                 vec![2, 3, 7, 6],
                 vec![0, 4, 7, 3],
                 vec![1, 2, 6, 5],
-            ],
+            ]
+            .into(),
             ..Default::default()
         }
     }
@@ -1385,7 +1386,7 @@ mod tests {
         }
         PolygonSoup {
             positions,
-            faces,
+            faces: faces.into(),
             ..Default::default()
         }
     }
@@ -2206,7 +2207,7 @@ mod tests {
                 .collect();
             assert_eq!(
                 canonical_faces(&renumbered),
-                canonical_faces(&r.faces(&set).unwrap())
+                canonical_faces(r.faces(&set).unwrap())
             );
             assert_eq!(
                 back.holes(&set2).unwrap().len(),
@@ -2229,7 +2230,7 @@ mod tests {
     fn from_soup_refuses_bow_ties_and_flipped_faces() {
         let soup = |faces: Vec<Vec<u32>>| PolygonSoup {
             positions: vec![DVec3::ZERO; 6],
-            faces,
+            faces: faces.into(),
             ..Default::default()
         };
         // Two triangles that meet only at vertex 0.

@@ -421,8 +421,8 @@ fn quads_become_basic_blocks_and_come_back() {
     assert!(m.vertices().all(|v| m.vertex_level(v) == 0));
     let back = m.to_quad_soup();
     assert_eq!(back.faces.len(), 6);
-    let mut a: Vec<Vec<u32>> = s.faces.iter().map(|f| canonical_cycle(f)).collect();
-    let mut b: Vec<Vec<u32>> = back.faces.iter().map(|f| canonical_cycle(f)).collect();
+    let mut a: Vec<Vec<u32>> = s.faces.iter().map(canonical_cycle).collect();
+    let mut b: Vec<Vec<u32>> = back.faces.iter().map(canonical_cycle).collect();
     a.sort();
     b.sort();
     assert_eq!(a, b);
@@ -703,19 +703,9 @@ fn soups_come_back_with_their_tags() {
     let (quads, tags) = m.to_quad_soup_tagged();
     assert_eq!(quads, m.to_quad_soup());
     assert_eq!(quads.faces.len(), 2);
-    let mut got: Vec<(Vec<u32>, u32)> = quads
-        .faces
-        .iter()
-        .map(|f| canonical_cycle(f))
-        .zip(tags)
-        .collect();
+    let mut got: Vec<(Vec<u32>, u32)> = quads.faces.iter().map(canonical_cycle).zip(tags).collect();
     got.sort();
-    let mut want: Vec<(Vec<u32>, u32)> = s
-        .faces
-        .iter()
-        .map(|f| canonical_cycle(f))
-        .zip([4, 5])
-        .collect();
+    let mut want: Vec<(Vec<u32>, u32)> = s.faces.iter().map(canonical_cycle).zip([4, 5]).collect();
     want.sort();
     assert_eq!(got, want);
     // √2 bisection of quad 0's block makes its external edges internal
@@ -723,7 +713,7 @@ fn soups_come_back_with_their_tags() {
     // its right then joins a triangle tagged 4 to one tagged 5: without
     // tags the two merge into a quad, with them they stay triangles.
     let s = PolygonSoup {
-        faces: vec![s.faces[0].clone(), vec![1, 2, 5], vec![1, 5, 4]],
+        faces: vec![s.faces[0].to_vec(), vec![1, 2, 5], vec![1, 5, 4]].into(),
         ..s
     };
     let mut m = Mesh::from_soup_tagged(&s, &[4, 6, 5]).unwrap();
@@ -741,7 +731,7 @@ fn soups_come_back_with_their_tags() {
     assert!(m.is_block_edge(shared));
     let (q, t) = m.to_quad_soup_tagged();
     let untagged = m.to_quad_soup();
-    let shared_faces = |faces: &[Vec<u32>]| {
+    let shared_faces = |faces: &subgram::mesh::Faces| {
         faces
             .iter()
             .filter(|f| f.contains(&1) && f.contains(&4))

@@ -395,7 +395,7 @@ fn circle(n: usize) -> PolygonSoup {
         .collect();
     PolygonSoup {
         positions,
-        faces: vec![(0..n as u32).collect()],
+        faces: vec![(0..n as u32).collect()].into(),
         ..PolygonSoup::default()
     }
 }

@@ -15,7 +15,7 @@ use tiny_skia::Pixmap;
 fn soup(positions: Vec<DVec3>, faces: Vec<Vec<u32>>) -> PolygonSoup {
     PolygonSoup {
         positions,
-        faces,
+        faces: faces.into(),
         ..PolygonSoup::default()
     }
 }
@@ -98,7 +98,7 @@ fn sphere(levels: usize) -> PolygonSoup {
                 vec![ab, bc, ca],
             ]);
         }
-        s.faces = faces;
+        s.faces = faces.into();
     }
     for p in &mut s.positions {
         *p = p.normalize();

@@ -63,7 +63,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn faces(soup: &PolygonSoup) -> Vec<Vec<u32>> {
-    soup.faces.clone()
+    soup.faces.to_vecs()
 }
 
 /// Positions as bit patterns, for exact comparisons (telling -0.0 from 0.0).
@@ -168,7 +168,8 @@ fn mixed_soup() -> PolygonSoup {
             vec![1, 2, 4],
             vec![2, 3, 4],
             vec![3, 0, 4],
-        ],
+        ]
+        .into(),
         face_lines: Vec::new(),
         vertex_lines: Vec::new(),
     }

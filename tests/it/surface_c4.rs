@@ -71,7 +71,7 @@ fn fan(k: usize, m: usize) -> Fan {
                     id(&mut f, t, i + 1, j + 1),
                     id(&mut f, t, i, j + 1),
                 ];
-                f.soup.faces.push(q.to_vec());
+                f.soup.faces.push(q);
                 f.quads.push(q);
             }
         }
@@ -568,7 +568,7 @@ fn open_meshes_pair_and_keep_a_b_spline_boundary() {
             .map(|(i, &v)| (v, i as u32))
             .collect();
         soup.positions = used.iter().map(|&v| bunny.positions[v as usize]).collect();
-        for f in &mut soup.faces {
+        for f in soup.faces.iter_mut() {
             for v in f.iter_mut() {
                 *v = renumber[v];
             }
@@ -667,7 +667,7 @@ fn small_open_meshes_end_in_blocks() {
             DVec3::new(-0.5, 0.8, 0.0),
             DVec3::new(-1.0, 0.0, 0.0),
         ],
-        faces: vec![vec![0, 1, 2], vec![0, 2, 3], vec![0, 3, 4]],
+        faces: vec![vec![0, 1, 2], vec![0, 2, 3], vec![0, 3, 4]].into(),
         ..Default::default()
     };
     let patch = subgram::mesh::io::read(&lsys("meshes/pentagon-patch.obj")).unwrap();

@@ -424,7 +424,8 @@ fn block_grammars_refuse_fanned_polygons() {
             vec![2, 5, 3],
             vec![3, 5, 4],
             vec![4, 5, 0],
-        ],
+        ]
+        .into(),
         ..PolygonSoup::default()
     };
     for file in ["surfaces/catmull-clark.lsys", "surfaces/doo-sabin.lsys"] {

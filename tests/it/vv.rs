@@ -108,7 +108,7 @@ fn assert_same_mesh(a: &PolygonSoup, b: &PolygonSoup, tol: f64, what: &str) {
             )
         })
         .collect();
-    let mut fb: Vec<Vec<u32>> = b.faces.iter().map(|f| canon(f)).collect();
+    let mut fb: Vec<Vec<u32>> = b.faces.iter().map(canon).collect();
     fa.sort();
     fb.sort();
     assert_eq!(fa, fb, "{what}: faces");
