@@ -6,21 +6,47 @@
 /// The size of a huge page on the machines that have them.
 const HUGE: usize = 2 << 20;
 
-/// An empty `Vec` with room for `cap` elements; when that is at least two
-/// huge pages, the kernel is asked to back it with huge pages before
-/// anything is written to it.
+/// An empty `Vec` with room for `cap` elements, in huge pages when that is
+/// at least two of them.
 pub(crate) fn with_capacity<T>(cap: usize) -> Vec<T> {
-    let v: Vec<T> = Vec::with_capacity(cap);
-    let bytes = cap.saturating_mul(std::mem::size_of::<T>());
+    let v = Vec::with_capacity(cap);
+    advise(&v);
+    v
+}
+
+/// Makes room for `additional` more elements of `v`, growing it at least
+/// twofold; a large array is reallocated (which moves its pages without
+/// copying them) and the new room asked for in huge pages.
+pub(crate) fn grow<T: Copy>(v: &mut Vec<T>, additional: usize) {
+    let need = v.len().saturating_add(additional);
+    if need <= v.capacity() {
+        return;
+    }
+    let cap = need.max(2 * v.capacity());
+    if cap.saturating_mul(std::mem::size_of::<T>()) < 2 * HUGE {
+        v.reserve(additional);
+        return;
+    }
+    v.reserve_exact(cap - v.len());
+    advise(v);
+}
+
+/// Asks for huge pages over the room of `v` past its elements, when that
+/// spans at least two of them.
+fn advise<T>(v: &Vec<T>) {
+    let size = std::mem::size_of::<T>();
+    if v.capacity().saturating_sub(v.len()).saturating_mul(size) < 2 * HUGE {
+        return;
+    }
     #[cfg(target_os = "linux")]
-    if bytes >= 2 * HUGE {
-        let start = v.as_ptr() as usize;
+    {
+        let start = v.as_ptr() as usize + v.len() * size;
         let aligned = (start + HUGE - 1) & !(HUGE - 1);
-        let end = (start + bytes) & !(HUGE - 1);
+        let end = (v.as_ptr() as usize + v.capacity() * size) & !(HUGE - 1);
         if end > aligned {
-            // SAFETY: the range lies inside `v`'s own allocation, and
-            // MADV_HUGEPAGE never changes memory's contents; a failure
-            // leaves ordinary pages.
+            // SAFETY: the range lies inside `v`'s own allocation, past its
+            // elements, and MADV_HUGEPAGE never changes memory's contents;
+            // a failure leaves ordinary pages.
             unsafe {
                 libc::madvise(
                     aligned as *mut libc::c_void,
@@ -30,7 +56,4 @@ pub(crate) fn with_capacity<T>(cap: usize) -> Vec<T> {
             }
         }
     }
-    #[cfg(not(target_os = "linux"))]
-    let _ = bytes;
-    v
 }

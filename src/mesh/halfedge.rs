@@ -606,24 +606,24 @@ impl Mesh {
     /// Makes room for this many more vertices, edges and faces, so that a
     /// refinement step does not grow its arrays piece by piece.
     pub fn reserve(&mut self, vertices: usize, edges: usize, faces: usize) {
-        grow(&mut self.v_out, vertices);
-        grow(&mut self.pos, vertices);
-        grow(&mut self.v_level, vertices);
-        grow(&mut self.v_step, vertices);
-        grow(&mut self.v_alive, vertices);
+        crate::huge::grow(&mut self.v_out, vertices);
+        crate::huge::grow(&mut self.pos, vertices);
+        crate::huge::grow(&mut self.v_level, vertices);
+        crate::huge::grow(&mut self.v_step, vertices);
+        crate::huge::grow(&mut self.v_alive, vertices);
         self.v_sharp.reserve(vertices);
-        grow(&mut self.he_next, 2 * edges);
-        grow(&mut self.he_prev, 2 * edges);
-        grow(&mut self.he_to, 2 * edges);
-        grow(&mut self.he_face, 2 * edges);
-        grow(&mut self.e_level, edges);
-        grow(&mut self.e_alive, edges);
-        grow(&mut self.e_block, edges);
-        grow(&mut self.e_transversal, edges);
+        crate::huge::grow(&mut self.he_next, 2 * edges);
+        crate::huge::grow(&mut self.he_prev, 2 * edges);
+        crate::huge::grow(&mut self.he_to, 2 * edges);
+        crate::huge::grow(&mut self.he_face, 2 * edges);
+        crate::huge::grow(&mut self.e_level, edges);
+        crate::huge::grow(&mut self.e_alive, edges);
+        crate::huge::grow(&mut self.e_block, edges);
+        crate::huge::grow(&mut self.e_transversal, edges);
         self.e_sharp.reserve(edges);
-        grow(&mut self.f_he, faces);
-        grow(&mut self.f_level, faces);
-        grow(&mut self.f_alive, faces);
+        crate::huge::grow(&mut self.f_he, faces);
+        crate::huge::grow(&mut self.f_level, faces);
+        crate::huge::grow(&mut self.f_alive, faces);
         self.f_tag.reserve(faces);
     }
 
@@ -786,45 +786,6 @@ impl Iterator for OutgoingIter<'_> {
     }
 }
 
-/// Makes room for `additional` more elements. A large array grows in place
-/// or is moved by the allocator (for large blocks, `realloc` remaps pages
-/// rather than copying them), and the kernel is asked to back the part not
-/// yet written with huge pages: a subdivision step writes hundreds of
-/// megabytes, and with 4 KiB pages much of its time goes to page faults.
-/// The advice changes how memory is backed, never what it holds.
-fn grow<T: Copy>(v: &mut Vec<T>, additional: usize) {
-    const HUGE: usize = 2 << 20;
-    let need = v.len() + additional;
-    if need <= v.capacity() {
-        return;
-    }
-    let cap = need.max(2 * v.capacity());
-    let bytes = cap * std::mem::size_of::<T>();
-    if bytes < 2 * HUGE || !cfg!(target_os = "linux") {
-        v.reserve(additional);
-        return;
-    }
-    v.reserve_exact(cap - v.len());
-    #[cfg(target_os = "linux")]
-    {
-        let size = std::mem::size_of::<T>();
-        let start = v.as_ptr() as usize + v.len() * size;
-        let aligned = (start + HUGE - 1) & !(HUGE - 1);
-        let end = (v.as_ptr() as usize + v.capacity() * size) & !(HUGE - 1);
-        if end > aligned {
-            // SAFETY: the range lies inside `v`'s own allocation, past its
-            // elements, and MADV_HUGEPAGE never changes memory's contents;
-            // a failure leaves ordinary pages.
-            unsafe {
-                libc::madvise(
-                    aligned as *mut libc::c_void,
-                    end - aligned,
-                    libc::MADV_HUGEPAGE,
-                );
-            }
-        }
-    }
-}
 
 /// A per-element column whose elements all hold the default value (0)
 /// until one is given another: only then is it stored, whole. Sharpness
@@ -895,7 +856,7 @@ impl<T: Copy + Default + PartialEq> Column<T> {
     /// Room for `additional` more elements, where they are stored.
     fn reserve(&mut self, additional: usize) {
         if !self.stored.is_empty() {
-            grow(&mut self.stored, additional);
+            crate::huge::grow(&mut self.stored, additional);
         }
     }
 
