@@ -226,9 +226,12 @@ impl Curve {
         if !opts.each {
             panel(&mut d)?;
         }
+        // The word is drawn: free it before the pictures are laid out, and
+        // each view's events once its picture is.
+        drop(d);
         let mut scenes = Vec::with_capacity(panels.len());
-        for (view, list) in &panels {
-            scenes.push((*view, render::scene(list, &opts.render)?));
+        for (view, list) in panels {
+            scenes.push((view, render::scene(&list, &opts.render)?));
         }
         let (_, main) = scenes.remove(0);
         Ok(Figures {
