@@ -786,7 +786,6 @@ impl Iterator for OutgoingIter<'_> {
     }
 }
 
-
 /// A per-element column whose elements all hold the default value (0)
 /// until one is given another: only then is it stored, whole. Sharpness
 /// and tags are 0 on most meshes, and a large mesh need not carry a number

@@ -456,9 +456,17 @@ impl<'p> Rewriter<'p> {
                 .map(|(_, cs)| cs.iter().map(|c| c.ty.dim().max(1)).sum())
                 .collect();
             let pattern: Vec<Sym> = plain.iter().map(|(s, _)| *s).collect();
+            // On a long word they are written on rayon's pool, which also
+            // shares the first touch of the new pages between the threads.
+            use rayon::prelude::*;
+            let parallel = n >= PARALLEL_MODULES;
             let mut end = out.len() as u32;
             if pattern.iter().all(|&p| p == pattern[0]) {
-                syms.resize(syms.len() + n * pattern.len(), pattern[0]);
+                if parallel {
+                    syms.par_extend(rayon::iter::repeat_n(pattern[0], n * pattern.len()));
+                } else {
+                    syms.resize(syms.len() + n * pattern.len(), pattern[0]);
+                }
             } else {
                 (0..n).for_each(|_| syms.extend_from_slice(&pattern));
             }
@@ -466,7 +474,11 @@ impl<'p> Rewriter<'p> {
                 // Equal widths: the offsets are an arithmetic sequence.
                 let wd = widths[0] as u32;
                 let count = (n * widths.len()) as u32;
-                starts.extend((1..=count).map(|k| end + k * wd));
+                if parallel {
+                    starts.par_extend((1..=count).into_par_iter().map(|k| end + k * wd));
+                } else {
+                    starts.extend((1..=count).map(|k| end + k * wd));
+                }
                 end += count * wd;
             } else {
                 for _ in 0..n {
@@ -1082,10 +1094,29 @@ fn uniform_shape(fixed: &[FixedOutput]) -> Option<(usize, usize, bool)> {
     all.all(|s| s == first).then_some(first)
 }
 
+/// A uniform step's inner range runs on rayon's pool from this many modules
+/// on; below it, one thread (the pool's start-up would cost more than it
+/// saves).
+pub(crate) const PARALLEL_MODULES: usize = 1 << 16;
+
+/// The modules one parallel task computes: many blocks, so that a task
+/// outweighs its scheduling, and few enough that two threads share a step
+/// evenly.
+const TASK_MODULES: usize = 64 * KERNEL_BLOCK;
+
+/// The modules `fixed_kernel` computes, checks and copies out at a time.
+const KERNEL_BLOCK: usize = 256;
+
 /// The modules `range` of a uniform step whose parameters all have `N`
 /// components and `T` terms: `fixed_eval`'s operations in the same order,
-/// written in place a block at a time. Returns whether every value is
+/// appended to `out` a block at a time. Returns whether every value is
 /// finite, or `None` when the outputs do not have that shape.
+///
+/// A range of `PARALLEL_MODULES` or more is cut into tasks of
+/// `TASK_MODULES` that run on rayon's pool, each writing its own part of
+/// `out`'s room. Every value depends only on the old word, and the
+/// finiteness of the whole is the `&` of the tasks', so the result is the
+/// same, to the bit, for any number of threads.
 fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
     fixed: &[FixedOutput],
     data: &[f64],
@@ -1093,8 +1124,6 @@ fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
     range: Range<usize>,
     out: &mut Vec<f64>,
 ) -> Option<bool> {
-    const BLOCK: usize = 256;
-    let r = rounded::<SINGLE>;
     let mut combos: Vec<[(isize, f64); T]> = Vec::new();
     for (_, cs) in fixed {
         for (ty, ts) in cs {
@@ -1104,26 +1133,64 @@ fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
             combos.push(ts.as_slice().try_into().ok()?);
         }
     }
-    let c_count = combos.len();
     // Every term reads whole groups of `N` slots: address the word as an
     // array of such groups, one bounds check per term.
-    let wn = w / N;
-    if c_count == 0
+    if combos.is_empty()
         || !w.is_multiple_of(N)
         || combos.iter().flatten().any(|(d, _)| d % N as isize != 0)
     {
         return None;
     }
     let (groups, _) = data.as_chunks::<N>();
+    let per_module = combos.len() * N;
+    let len = range.len() * per_module;
+    out.reserve(len);
+    let room = &mut out.spare_capacity_mut()[..len];
+    let wn = w / N;
+    let ok = if range.len() < PARALLEL_MODULES {
+        fixed_blocks::<N, T, SINGLE>(&combos, groups, wn, range, room)
+    } else {
+        use rayon::prelude::*;
+        let first = range.start;
+        room.par_chunks_mut(TASK_MODULES * per_module)
+            .enumerate()
+            .map(|(k, part)| {
+                let from = first + k * TASK_MODULES;
+                let modules = from..from + part.len() / per_module;
+                fixed_blocks::<N, T, SINGLE>(&combos, groups, wn, modules, part)
+            })
+            .reduce(|| true, |a, b| a & b)
+    };
+    // SAFETY: `fixed_blocks` wrote every element of `room`, which is the
+    // first `len` elements of `out`'s spare capacity (its blocks cover
+    // `room` and each is written whole by `write_copy_of_slice`); a panic
+    // would leave before this line, with `out` as it was.
+    unsafe { out.set_len(out.len() + len) };
+    Some(ok)
+}
+
+/// `fixed_kernel` for the modules `range`, written into `room`, which holds
+/// exactly their slots; returns whether every value is finite.
+fn fixed_blocks<const N: usize, const T: usize, const SINGLE: bool>(
+    combos: &[[(isize, f64); T]],
+    groups: &[[f64; N]],
+    wn: usize,
+    range: Range<usize>,
+    room: &mut [std::mem::MaybeUninit<f64>],
+) -> bool {
+    let r = rounded::<SINGLE>;
+    let c_count = combos.len();
+    let per_module = c_count * N;
+    debug_assert_eq!(room.len(), range.len() * per_module);
+    // The block is computed in a buffer small enough to stay in the
+    // first-level cache while it is filled, checked and copied out.
+    let mut scratch = vec![0.0; KERNEL_BLOCK.min(range.len()) * per_module];
     let mut ok = true;
-    let mut i = range.start;
-    while i < range.end {
-        let m = (range.end - i).min(BLOCK);
-        let from = out.len();
-        // The block is small enough to stay in the first-level cache while
-        // it is zeroed, filled, then checked.
-        out.resize(from + m * c_count * N, 0.0);
-        let (block, _) = out[from..].as_chunks_mut::<N>();
+    let starts = range.step_by(KERNEL_BLOCK);
+    for (i, dst) in starts.zip(room.chunks_mut(KERNEL_BLOCK * per_module)) {
+        let m = dst.len() / per_module;
+        let flat = &mut scratch[..dst.len()];
+        let (block, _) = flat.as_chunks_mut::<N>();
         for (c_at, c) in combos.iter().enumerate() {
             // One parameter of every module of the block at a time, with
             // the weights and offsets in registers.
@@ -1141,10 +1208,10 @@ fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
                 });
             }
         }
-        ok &= out[from..].iter().fold(true, |ok, x| ok & x.is_finite());
-        i += m;
+        ok &= flat.iter().fold(true, |ok, x| ok & x.is_finite());
+        dst.write_copy_of_slice(flat);
     }
-    Some(ok)
+    ok
 }
 
 /// `x`, rounded to single precision when the stencil computes `float`s:
