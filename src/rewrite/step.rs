@@ -459,7 +459,7 @@ impl<'p> Rewriter<'p> {
             // On a long word they are written on rayon's pool, which also
             // shares the first touch of the new pages between the threads.
             use rayon::prelude::*;
-            let parallel = n >= PARALLEL_MODULES;
+            let parallel = n >= PARALLEL_MODULES && rayon::current_num_threads() > 1;
             let mut end = out.len() as u32;
             if pattern.iter().all(|&p| p == pattern[0]) {
                 if parallel {
@@ -1104,7 +1104,7 @@ pub(crate) const PARALLEL_MODULES: usize = 1 << 16;
 /// evenly.
 const TASK_MODULES: usize = 64 * KERNEL_BLOCK;
 
-/// The modules `fixed_kernel` computes, checks and copies out at a time.
+/// The modules `fixed_kernel` computes and checks at a time.
 const KERNEL_BLOCK: usize = 256;
 
 /// The modules `range` of a uniform step whose parameters all have `N`
@@ -1112,9 +1112,9 @@ const KERNEL_BLOCK: usize = 256;
 /// appended to `out` a block at a time. Returns whether every value is
 /// finite, or `None` when the outputs do not have that shape.
 ///
-/// A range of `PARALLEL_MODULES` or more is cut into tasks of
-/// `TASK_MODULES` that run on rayon's pool, each writing its own part of
-/// `out`'s room. Every value depends only on the old word, and the
+/// A range of `PARALLEL_MODULES` or more, on a pool of several threads, is
+/// cut into tasks of `TASK_MODULES` that run on rayon's pool, each writing
+/// its own part of `out`'s room. Every value depends only on the old word, and the
 /// finiteness of the whole is the `&` of the tasks', so the result is the
 /// same, to the bit, for any number of threads.
 fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
@@ -1143,75 +1143,84 @@ fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
     }
     let (groups, _) = data.as_chunks::<N>();
     let per_module = combos.len() * N;
+    let wn = w / N;
+    if range.len() < PARALLEL_MODULES || rayon::current_num_threads() == 1 {
+        // One thread: each block is written in place.
+        let mut ok = true;
+        for i in range.clone().step_by(KERNEL_BLOCK) {
+            let m = (range.end - i).min(KERNEL_BLOCK);
+            let from = out.len();
+            out.resize(from + m * per_module, 0.0);
+            ok &= fixed_block::<N, T, SINGLE>(&combos, groups, wn, i, &mut out[from..]);
+        }
+        return Some(ok);
+    }
     let len = range.len() * per_module;
     out.reserve(len);
     let room = &mut out.spare_capacity_mut()[..len];
-    let wn = w / N;
-    let ok = if range.len() < PARALLEL_MODULES {
-        fixed_blocks::<N, T, SINGLE>(&combos, groups, wn, range, room)
-    } else {
+    let first = range.start;
+    let ok = {
         use rayon::prelude::*;
-        let first = range.start;
         room.par_chunks_mut(TASK_MODULES * per_module)
             .enumerate()
             .map(|(k, part)| {
+                // The task's blocks are computed in a buffer that stays in
+                // the first-level cache, then copied out.
+                let mut scratch = vec![0.0; KERNEL_BLOCK * per_module];
+                let mut ok = true;
                 let from = first + k * TASK_MODULES;
-                let modules = from..from + part.len() / per_module;
-                fixed_blocks::<N, T, SINGLE>(&combos, groups, wn, modules, part)
+                for (b, dst) in part.chunks_mut(KERNEL_BLOCK * per_module).enumerate() {
+                    let block = &mut scratch[..dst.len()];
+                    let i = from + b * KERNEL_BLOCK;
+                    ok &= fixed_block::<N, T, SINGLE>(&combos, groups, wn, i, block);
+                    dst.write_copy_of_slice(block);
+                }
+                ok
             })
             .reduce(|| true, |a, b| a & b)
     };
-    // SAFETY: `fixed_blocks` wrote every element of `room`, which is the
-    // first `len` elements of `out`'s spare capacity (its blocks cover
-    // `room` and each is written whole by `write_copy_of_slice`); a panic
-    // would leave before this line, with `out` as it was.
+    // SAFETY: the tasks wrote every element of `room`, the first `len`
+    // elements of `out`'s spare capacity: their parts cover `room`, and
+    // each part's blocks cover it and are written whole by
+    // `write_copy_of_slice`. A panic would leave before this line, with
+    // `out` as it was.
     unsafe { out.set_len(out.len() + len) };
     Some(ok)
 }
 
-/// `fixed_kernel` for the modules `range`, written into `room`, which holds
-/// exactly their slots; returns whether every value is finite.
-fn fixed_blocks<const N: usize, const T: usize, const SINGLE: bool>(
+/// One block of `fixed_kernel`: the slots of the modules from `i` on that
+/// fill `block`, which is small enough to stay in the first-level cache
+/// while it is filled, then checked. Returns whether every value is finite.
+#[inline(always)]
+fn fixed_block<const N: usize, const T: usize, const SINGLE: bool>(
     combos: &[[(isize, f64); T]],
     groups: &[[f64; N]],
     wn: usize,
-    range: Range<usize>,
-    room: &mut [std::mem::MaybeUninit<f64>],
+    i: usize,
+    block: &mut [f64],
 ) -> bool {
     let r = rounded::<SINGLE>;
     let c_count = combos.len();
-    let per_module = c_count * N;
-    debug_assert_eq!(room.len(), range.len() * per_module);
-    // The block is computed in a buffer small enough to stay in the
-    // first-level cache while it is filled, checked and copied out.
-    let mut scratch = vec![0.0; KERNEL_BLOCK.min(range.len()) * per_module];
-    let mut ok = true;
-    let starts = range.step_by(KERNEL_BLOCK);
-    for (i, dst) in starts.zip(room.chunks_mut(KERNEL_BLOCK * per_module)) {
-        let m = dst.len() / per_module;
-        let flat = &mut scratch[..dst.len()];
-        let (block, _) = flat.as_chunks_mut::<N>();
-        for (c_at, c) in combos.iter().enumerate() {
-            // One parameter of every module of the block at a time, with
-            // the weights and offsets in registers.
-            let ws: [f64; T] = std::array::from_fn(|t| c[t].1);
-            let es: [isize; T] = std::array::from_fn(|t| c[t].0 / N as isize);
-            for (o, i) in block.chunks_exact_mut(c_count).zip(i..i + m) {
-                let at = (i * wn) as isize;
-                let x: [&[f64; N]; T] = std::array::from_fn(|t| &groups[(at + es[t]) as usize]);
-                o[c_at] = std::array::from_fn(|k| {
-                    let mut acc = r(ws[0] * x[0][k]);
-                    for t in 1..T {
-                        acc = r(acc + r(ws[t] * x[t][k]));
-                    }
-                    acc
-                });
-            }
+    let m = block.len() / (c_count * N);
+    let (groups_out, _) = block.as_chunks_mut::<N>();
+    for (c_at, c) in combos.iter().enumerate() {
+        // One parameter of every module of the block at a time, with the
+        // weights and offsets in registers.
+        let ws: [f64; T] = std::array::from_fn(|t| c[t].1);
+        let es: [isize; T] = std::array::from_fn(|t| c[t].0 / N as isize);
+        for (o, i) in groups_out.chunks_exact_mut(c_count).zip(i..i + m) {
+            let at = (i * wn) as isize;
+            let x: [&[f64; N]; T] = std::array::from_fn(|t| &groups[(at + es[t]) as usize]);
+            o[c_at] = std::array::from_fn(|k| {
+                let mut acc = r(ws[0] * x[0][k]);
+                for t in 1..T {
+                    acc = r(acc + r(ws[t] * x[t][k]));
+                }
+                acc
+            });
         }
-        ok &= flat.iter().fold(true, |ok, x| ok & x.is_finite());
-        dst.write_copy_of_slice(flat);
     }
-    ok
+    block.iter().fold(true, |ok, x| ok & x.is_finite())
 }
 
 /// `x`, rounded to single precision when the stencil computes `float`s:
@@ -1449,6 +1458,50 @@ mod tests {
                 let ok = fixed_kernel::<N, T, SINGLE>(&huge, &big, w, range.clone(), &mut out);
                 assert_eq!(ok, Some(false));
             }
+            // A range long enough to be cut into tasks, in pools of 2 and 3
+            // threads (5 tasks and a short one): the bits of the loop, and
+            // a NaN in the last task is reported.
+            let w = N;
+            let n = PARALLEL_MODULES + TASK_MODULES + 1000;
+            let mut data = slots(n, w);
+            let ty = match (N, SINGLE) {
+                (2, true) => Ty::V2,
+                (2, false) => Ty::V2d,
+                (3, true) => Ty::V3,
+                _ => Ty::V3d,
+            };
+            let terms: Vec<(isize, f64)> = (0..T)
+                .map(|t| ((t as isize - 1) * w as isize, 0.3 + 0.17 * t as f64))
+                .collect();
+            let fixed: Vec<FixedOutput> = vec![(Sym(0), vec![(ty, terms.clone()), (ty, terms)])];
+            let range = 1..n - (T - 1);
+            let mut want = Vec::new();
+            for i in range.clone() {
+                for (_, ts) in &fixed[0].1 {
+                    want.extend(fixed_eval::<N, SINGLE>(ts, &data, (i * w) as isize));
+                }
+            }
+            let want: Vec<u64> = want.iter().map(|x| x.to_bits()).collect();
+            for threads in [2, 3] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .expect("a pool");
+                let mut got = vec![7.0];
+                let ok = pool.install(|| {
+                    fixed_kernel::<N, T, SINGLE>(&fixed, &data, w, range.clone(), &mut got)
+                });
+                assert_eq!(ok, Some(true));
+                assert_eq!(got[0], 7.0, "what was there is kept");
+                let got: Vec<u64> = got[1..].iter().map(|x| x.to_bits()).collect();
+                assert!(got == want, "N {N} T {T} single {SINGLE} threads {threads}");
+            }
+            data[(n - 10) * w] = f64::NAN;
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build();
+            let ok = pool.expect("a pool").install(|| {
+                fixed_kernel::<N, T, SINGLE>(&fixed, &data, w, range.clone(), &mut Vec::new())
+            });
+            assert_eq!(ok, Some(false));
         }
         check::<2, 2, true>();
         check::<2, 3, true>();
