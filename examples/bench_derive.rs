@@ -13,7 +13,8 @@
 //! 2. Threads (issue 16, item 6): the last step of the same run (512,000 ->
 //!    1,024,000 points) and the whole run, in a pool of one rayon thread and
 //!    one of two, alternating, with the speedup; the words are checked to
-//!    be the same to the bit. `--threads-only` runs this section only.
+//!    be the same to the bit. `--threads-only` runs this section only; run
+//!    it with `MALLOC_ARENA_MAX=1` (benches/README.md says why).
 //! 3. A context-sensitive rewrite without geometry: a signal moving through
 //!    a word of a million modules, in million modules per second.
 //! 4. The interpreter on a branching word: 50,000 modules, each with a
