@@ -1114,9 +1114,9 @@ const KERNEL_BLOCK: usize = 256;
 ///
 /// A range of `PARALLEL_MODULES` or more, on a pool of several threads, is
 /// cut into tasks of `TASK_MODULES` that run on rayon's pool, each writing
-/// its own part of `out`'s room. Every value depends only on the old word, and the
-/// finiteness of the whole is the `&` of the tasks', so the result is the
-/// same, to the bit, for any number of threads.
+/// its own part of `out`'s room. Every value depends only on the old word,
+/// and the finiteness of the whole is the `&` of the tasks', so the result
+/// is the same, to the bit, for any number of threads.
 fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
     fixed: &[FixedOutput],
     data: &[f64],
