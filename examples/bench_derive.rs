@@ -2,7 +2,7 @@
 //! measured in the same run. `cargo run --release --example bench_derive`
 //!
 //! `--chaikin-only` runs the first only; `--runs N` keeps the best of N runs
-//! (10 by default) of the first two.
+//! (10 by default) of the first three.
 //!
 //! 1. Closed Chaikin (production 13) from a 1,000-point axiom to 1,024,000
 //!    points: the engine running the `.lsys` text, in lpfg's single
@@ -10,9 +10,14 @@
 //!    loops doing the same arithmetic: one over points with `%` per point,
 //!    and a tight one over flat buffers of coordinates (`f64`, and `f32` for
 //!    single precision) with the ring's seam handled outside the loop.
-//! 2. A context-sensitive rewrite without geometry: a signal moving through
+//! 2. Threads (issue 16, item 6): the last step of the same run (512,000 ->
+//!    1,024,000 points) and the whole run, in a pool of one rayon thread and
+//!    one of two, alternating, with the speedup; the words are checked to
+//!    be the same to the bit. `--threads-only` runs this section only; run
+//!    it with `MALLOC_ARENA_MAX=1` (benches/README.md says why).
+//! 3. A context-sensitive rewrite without geometry: a signal moving through
 //!    a word of a million modules, in million modules per second.
-//! 3. The interpreter on a branching word: 50,000 modules, each with a
+//! 4. The interpreter on a branching word: 50,000 modules, each with a
 //!    lateral branch that its right context skips, and a body with a loop
 //!    of 20 iterations, in million modules per second.
 
@@ -133,6 +138,10 @@ fn main() {
          P(vl) < P(v) > P(vr) -> P(0.25*vl + 0.75*v) P(0.75*v + 0.25*vr)\n",
         axiom.join(" ")
     );
+    if args.iter().any(|a| a == "--threads-only") {
+        threads(&src, runs);
+        return;
+    }
     for precision in [subgram::Precision::Single, subgram::Precision::Double] {
         let loaded = subgram::load_str_with("bench.lsys", &src, &[], precision).expect("loads");
         assert!(loaded.program.rules[0].stencil.is_some());
@@ -200,6 +209,7 @@ fn main() {
     if args.iter().any(|a| a == "--chaikin-only") {
         return;
     }
+    threads(&src, runs);
 
     // A signal S travels right through a sea of A modules: S moves one
     // place per step, and every module looks at both neighbours.
@@ -249,4 +259,68 @@ fn main() {
         t.as_secs_f64() * 1e3,
         modules / t.as_secs_f64() / 1e6
     );
+}
+
+/// Section 2: the Chaikin run `src` in a pool of 1 and of 2 threads,
+/// alternating run by run so that both see the same load; best of `runs`.
+fn threads(src: &str, runs: usize) {
+    use std::time::{Duration, Instant};
+    let pools: Vec<rayon::ThreadPool> = [1, 2]
+        .iter()
+        .map(|&k| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(k)
+                .build()
+                .expect("a thread pool")
+        })
+        .collect();
+    for precision in [subgram::Precision::Single, subgram::Precision::Double] {
+        let loaded = subgram::load_str_with("bench.lsys", src, &[], precision).expect("loads");
+        let program = &loaded.program;
+        let (mut last, mut whole) = ([Duration::MAX; 2], [Duration::MAX; 2]);
+        let mut words: Vec<subgram::Word> = Vec::new();
+        for _ in 0..runs {
+            for (k, pool) in pools.iter().enumerate() {
+                pool.install(|| {
+                    // The last step alone: the steps before it untimed.
+                    let mut d = subgram::Derivation::new(program, DeriveOptions::default())
+                        .expect("starts");
+                    while d.step + 1 < d.length {
+                        d.next_step().expect("steps");
+                    }
+                    let t = Instant::now();
+                    d.next_step().expect("steps");
+                    last[k] = last[k].min(t.elapsed());
+                    let t = Instant::now();
+                    let all = subgram::derive(program, DeriveOptions::default()).expect("derives");
+                    whole[k] = whole[k].min(t.elapsed());
+                    assert_eq!(d.word.len(), all.word.len());
+                    if words.len() < 2 {
+                        words.push(all.word);
+                    }
+                });
+            }
+        }
+        // The same word, to the bit, from either pool.
+        let bits =
+            |w: &subgram::Word| -> Vec<u64> { w.all_slots().iter().map(|x| x.to_bits()).collect() };
+        assert_eq!(words[0].syms(), words[1].syms());
+        assert_eq!(bits(&words[0]), bits(&words[1]));
+        let n = words[0].len();
+        let ms = |t: Duration| t.as_secs_f64() * 1e3;
+        println!("chaikin threads, {precision:?} precision, best of {runs}, 1 vs 2 threads");
+        println!(
+            "  last step {} -> {n} points  {:>8.2} ms  {:>8.2} ms  speedup {:.2}",
+            n / 2,
+            ms(last[0]),
+            ms(last[1]),
+            last[0].as_secs_f64() / last[1].as_secs_f64()
+        );
+        println!(
+            "  whole run 1000 -> {n}      {:>8.2} ms  {:>8.2} ms  speedup {:.2}",
+            ms(whole[0]),
+            ms(whole[1]),
+            whole[0].as_secs_f64() / whole[1].as_secs_f64()
+        );
+    }
 }

@@ -460,9 +460,17 @@ impl<'p> Rewriter<'p> {
                 .map(|(_, cs)| cs.iter().map(|c| c.ty.dim().max(1)).sum())
                 .collect();
             let pattern: Vec<Sym> = plain.iter().map(|(s, _)| *s).collect();
+            // On a long word they are written on rayon's pool, which also
+            // shares the first touch of the new pages between the threads.
+            use rayon::prelude::*;
+            let parallel = n >= PARALLEL_MODULES && rayon::current_num_threads() > 1;
             let mut end = out.len() as u32;
             if pattern.iter().all(|&p| p == pattern[0]) {
-                syms.resize(syms.len() + n * pattern.len(), pattern[0]);
+                if parallel {
+                    syms.par_extend(rayon::iter::repeat_n(pattern[0], n * pattern.len()));
+                } else {
+                    syms.resize(syms.len() + n * pattern.len(), pattern[0]);
+                }
             } else {
                 (0..n).for_each(|_| syms.extend_from_slice(&pattern));
             }
@@ -470,7 +478,11 @@ impl<'p> Rewriter<'p> {
                 // Equal widths: the offsets are an arithmetic sequence.
                 let wd = widths[0] as u32;
                 let count = (n * widths.len()) as u32;
-                starts.extend((1..=count).map(|k| end + k * wd));
+                if parallel {
+                    starts.par_extend((1..=count).into_par_iter().map(|k| end + k * wd));
+                } else {
+                    starts.extend((1..=count).map(|k| end + k * wd));
+                }
                 end += count * wd;
             } else {
                 for _ in 0..n {
@@ -1086,10 +1098,29 @@ fn uniform_shape(fixed: &[FixedOutput]) -> Option<(usize, usize, bool)> {
     all.all(|s| s == first).then_some(first)
 }
 
+/// A uniform step's inner range runs on rayon's pool from this many modules
+/// on; below it, one thread (the pool's start-up would cost more than it
+/// saves).
+pub(crate) const PARALLEL_MODULES: usize = 1 << 16;
+
+/// The modules one parallel task computes: many blocks, so that a task
+/// outweighs its scheduling, and few enough that two threads share a step
+/// evenly.
+const TASK_MODULES: usize = 64 * KERNEL_BLOCK;
+
+/// The modules `fixed_kernel` computes and checks at a time.
+const KERNEL_BLOCK: usize = 256;
+
 /// The modules `range` of a uniform step whose parameters all have `N`
 /// components and `T` terms: `fixed_eval`'s operations in the same order,
-/// written in place a block at a time. Returns whether every value is
+/// appended to `out` a block at a time. Returns whether every value is
 /// finite, or `None` when the outputs do not have that shape.
+///
+/// A range of `PARALLEL_MODULES` or more, on a pool of several threads, is
+/// cut into tasks of `TASK_MODULES` that run on rayon's pool, each writing
+/// its own part of `out`'s room. Every value depends only on the old word,
+/// and the finiteness of the whole is the `&` of the tasks', so the result
+/// is the same, to the bit, for any number of threads.
 fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
     fixed: &[FixedOutput],
     data: &[f64],
@@ -1097,8 +1128,6 @@ fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
     range: Range<usize>,
     out: &mut Vec<f64>,
 ) -> Option<bool> {
-    const BLOCK: usize = 256;
-    let r = rounded::<SINGLE>;
     let mut combos: Vec<[(isize, f64); T]> = Vec::new();
     for (_, cs) in fixed {
         for (ty, ts) in cs {
@@ -1108,47 +1137,94 @@ fn fixed_kernel<const N: usize, const T: usize, const SINGLE: bool>(
             combos.push(ts.as_slice().try_into().ok()?);
         }
     }
-    let c_count = combos.len();
     // Every term reads whole groups of `N` slots: address the word as an
     // array of such groups, one bounds check per term.
-    let wn = w / N;
-    if c_count == 0
+    if combos.is_empty()
         || !w.is_multiple_of(N)
         || combos.iter().flatten().any(|(d, _)| d % N as isize != 0)
     {
         return None;
     }
     let (groups, _) = data.as_chunks::<N>();
-    let mut ok = true;
-    let mut i = range.start;
-    while i < range.end {
-        let m = (range.end - i).min(BLOCK);
-        let from = out.len();
-        // The block is small enough to stay in the first-level cache while
-        // it is zeroed, filled, then checked.
-        out.resize(from + m * c_count * N, 0.0);
-        let (block, _) = out[from..].as_chunks_mut::<N>();
-        for (c_at, c) in combos.iter().enumerate() {
-            // One parameter of every module of the block at a time, with
-            // the weights and offsets in registers.
-            let ws: [f64; T] = std::array::from_fn(|t| c[t].1);
-            let es: [isize; T] = std::array::from_fn(|t| c[t].0 / N as isize);
-            for (o, i) in block.chunks_exact_mut(c_count).zip(i..i + m) {
-                let at = (i * wn) as isize;
-                let x: [&[f64; N]; T] = std::array::from_fn(|t| &groups[(at + es[t]) as usize]);
-                o[c_at] = std::array::from_fn(|k| {
-                    let mut acc = r(ws[0] * x[0][k]);
-                    for t in 1..T {
-                        acc = r(acc + r(ws[t] * x[t][k]));
-                    }
-                    acc
-                });
-            }
+    let per_module = combos.len() * N;
+    let wn = w / N;
+    if range.len() < PARALLEL_MODULES || rayon::current_num_threads() == 1 {
+        // One thread: each block is written in place.
+        let mut ok = true;
+        for i in range.clone().step_by(KERNEL_BLOCK) {
+            let m = (range.end - i).min(KERNEL_BLOCK);
+            let from = out.len();
+            out.resize(from + m * per_module, 0.0);
+            ok &= fixed_block::<N, T, SINGLE>(&combos, groups, wn, i, &mut out[from..]);
         }
-        ok &= out[from..].iter().fold(true, |ok, x| ok & x.is_finite());
-        i += m;
+        return Some(ok);
     }
+    let len = range.len() * per_module;
+    out.reserve(len);
+    let room = &mut out.spare_capacity_mut()[..len];
+    let first = range.start;
+    let ok = {
+        use rayon::prelude::*;
+        room.par_chunks_mut(TASK_MODULES * per_module)
+            .enumerate()
+            .map(|(k, part)| {
+                // The task's blocks are computed in a buffer that stays in
+                // the first-level cache, then copied out.
+                let mut scratch = vec![0.0; KERNEL_BLOCK * per_module];
+                let mut ok = true;
+                let from = first + k * TASK_MODULES;
+                for (b, dst) in part.chunks_mut(KERNEL_BLOCK * per_module).enumerate() {
+                    let block = &mut scratch[..dst.len()];
+                    let i = from + b * KERNEL_BLOCK;
+                    ok &= fixed_block::<N, T, SINGLE>(&combos, groups, wn, i, block);
+                    dst.write_copy_of_slice(block);
+                }
+                ok
+            })
+            .reduce(|| true, |a, b| a & b)
+    };
+    // SAFETY: the tasks wrote every element of `room`, the first `len`
+    // elements of `out`'s spare capacity: their parts cover `room`, and
+    // each part's blocks cover it and are written whole by
+    // `write_copy_of_slice`. A panic would leave before this line, with
+    // `out` as it was.
+    unsafe { out.set_len(out.len() + len) };
     Some(ok)
+}
+
+/// One block of `fixed_kernel`: the slots of the modules from `i` on that
+/// fill `block`, which is small enough to stay in the first-level cache
+/// while it is filled, then checked. Returns whether every value is finite.
+#[inline(always)]
+fn fixed_block<const N: usize, const T: usize, const SINGLE: bool>(
+    combos: &[[(isize, f64); T]],
+    groups: &[[f64; N]],
+    wn: usize,
+    i: usize,
+    block: &mut [f64],
+) -> bool {
+    let r = rounded::<SINGLE>;
+    let c_count = combos.len();
+    let m = block.len() / (c_count * N);
+    let (groups_out, _) = block.as_chunks_mut::<N>();
+    for (c_at, c) in combos.iter().enumerate() {
+        // One parameter of every module of the block at a time, with the
+        // weights and offsets in registers.
+        let ws: [f64; T] = std::array::from_fn(|t| c[t].1);
+        let es: [isize; T] = std::array::from_fn(|t| c[t].0 / N as isize);
+        for (o, i) in groups_out.chunks_exact_mut(c_count).zip(i..i + m) {
+            let at = (i * wn) as isize;
+            let x: [&[f64; N]; T] = std::array::from_fn(|t| &groups[(at + es[t]) as usize]);
+            o[c_at] = std::array::from_fn(|k| {
+                let mut acc = r(ws[0] * x[0][k]);
+                for t in 1..T {
+                    acc = r(acc + r(ws[t] * x[t][k]));
+                }
+                acc
+            });
+        }
+    }
+    block.iter().fold(true, |ok, x| ok & x.is_finite())
 }
 
 /// `x`, rounded to single precision when the stencil computes `float`s:
@@ -1386,6 +1462,50 @@ mod tests {
                 let ok = fixed_kernel::<N, T, SINGLE>(&huge, &big, w, range.clone(), &mut out);
                 assert_eq!(ok, Some(false));
             }
+            // A range long enough to be cut into tasks, in pools of 2 and 3
+            // threads (5 tasks and a short one): the bits of the loop, and
+            // a NaN in the last task is reported.
+            let w = N;
+            let n = PARALLEL_MODULES + TASK_MODULES + 1000;
+            let mut data = slots(n, w);
+            let ty = match (N, SINGLE) {
+                (2, true) => Ty::V2,
+                (2, false) => Ty::V2d,
+                (3, true) => Ty::V3,
+                _ => Ty::V3d,
+            };
+            let terms: Vec<(isize, f64)> = (0..T)
+                .map(|t| ((t as isize - 1) * w as isize, 0.3 + 0.17 * t as f64))
+                .collect();
+            let fixed: Vec<FixedOutput> = vec![(Sym(0), vec![(ty, terms.clone()), (ty, terms)])];
+            let range = 1..n - (T - 1);
+            let mut want = Vec::new();
+            for i in range.clone() {
+                for (_, ts) in &fixed[0].1 {
+                    want.extend(fixed_eval::<N, SINGLE>(ts, &data, (i * w) as isize));
+                }
+            }
+            let want: Vec<u64> = want.iter().map(|x| x.to_bits()).collect();
+            for threads in [2, 3] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .expect("a pool");
+                let mut got = vec![7.0];
+                let ok = pool.install(|| {
+                    fixed_kernel::<N, T, SINGLE>(&fixed, &data, w, range.clone(), &mut got)
+                });
+                assert_eq!(ok, Some(true));
+                assert_eq!(got[0], 7.0, "what was there is kept");
+                let got: Vec<u64> = got[1..].iter().map(|x| x.to_bits()).collect();
+                assert!(got == want, "N {N} T {T} single {SINGLE} threads {threads}");
+            }
+            data[(n - 10) * w] = f64::NAN;
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build();
+            let ok = pool.expect("a pool").install(|| {
+                fixed_kernel::<N, T, SINGLE>(&fixed, &data, w, range.clone(), &mut Vec::new())
+            });
+            assert_eq!(ok, Some(false));
         }
         check::<2, 2, true>();
         check::<2, 3, true>();

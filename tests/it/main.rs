@@ -35,5 +35,6 @@ mod surface_adaptive;
 mod surface_c4;
 mod surface_creases;
 mod surface_quad;
+mod threads;
 mod vv;
 mod vv_adversarial;

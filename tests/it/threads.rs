@@ -1,0 +1,149 @@
+//! Large uniform stencil steps run on rayon's pool (issue 16, item 6): the
+//! same word, to the bit, and the same error, whatever the number of
+//! threads. A step splits its word into tasks from 65,536 modules on, so
+//! the runs here reach 98,304 modules (6 · 2^14), whose last step is cut
+//! into tasks of 16,384 modules and a shorter last one, which neither two
+//! nor three threads share evenly.
+
+use glam::{DVec3, Vec2};
+use subgram::{Derivation, DeriveOptions, Precision, Program, Word};
+
+use crate::support::*;
+
+/// 6 · 2^15 points: the last step reads 98,304 modules.
+const STEPS: u64 = 15;
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
+}
+
+fn bits(w: &Word) -> Vec<u64> {
+    w.all_slots().iter().map(|x| x.to_bits()).collect()
+}
+
+/// The word after `STEPS` steps in a pool of 1, 2 and 3 threads: all three
+/// the same to the bit; returns the first.
+fn same_in_every_pool(program: &Program) -> Word {
+    let words: Vec<Word> = [1, 2, 3]
+        .iter()
+        .map(|&k| {
+            pool(k).install(|| {
+                let opts = DeriveOptions::default().with_steps(STEPS);
+                subgram::derive(program, opts).expect("derives").word
+            })
+        })
+        .collect();
+    for (k, w) in words.iter().enumerate().skip(1) {
+        assert_eq!(w.syms(), words[0].syms(), "{} threads", k + 1);
+        assert!(bits(w) == bits(&words[0]), "{} threads", k + 1);
+    }
+    words.into_iter().next().expect("three words")
+}
+
+/// Runs `program` to its last step, replaces the slots of module `at` by
+/// NaN before that step, and returns the step's error message, in a pool
+/// of `threads`.
+fn error_with_nan_at(program: &Program, at: usize, threads: usize) -> String {
+    pool(threads).install(|| {
+        let opts = DeriveOptions::default().with_steps(STEPS);
+        let mut d = Derivation::new(program, opts).expect("starts");
+        while d.step + 1 < STEPS {
+            d.next_step().expect("steps");
+        }
+        assert!(d.word.len() >= 65_536, "{} modules", d.word.len());
+        let mut w = Word::new();
+        for i in 0..d.word.len() {
+            let nan = vec![f64::NAN; d.word.data(i).len()];
+            let slots = if i == at { &nan[..] } else { d.word.data(i) };
+            w.push_raw(d.word.sym(i), slots);
+        }
+        d.word = w;
+        d.next_step().expect_err("a NaN spreads").message
+    })
+}
+
+/// The error of a NaN is the same in every pool, wherever it sits: at the
+/// ring's seam, in the first task, in the middle of a task, in the last
+/// (short) one.
+fn same_error_in_every_pool(program: &Program) {
+    for at in [0, 5, 40_000, 98_300, 98_303] {
+        let one = error_with_nan_at(program, at, 1);
+        assert!(one.contains("NaN or infinite"), "{one}");
+        assert!(one.contains(&format!("at step {STEPS}")), "{one}");
+        for k in [2, 3] {
+            assert_eq!(error_with_nan_at(program, at, k), one, "NaN at {at}");
+        }
+    }
+}
+
+/// Closed Chaikin (production 13 of paper 002) in lpfg's single precision.
+/// Besides agreeing across pools, the word is the one a loop over `f32`
+/// points computes: lpfg computes `V2f` in `float`, each product and sum
+/// rounded, and the rule's sums run left to right.
+#[test]
+fn chaikin_13_is_the_same_word_for_any_number_of_threads() {
+    let l = load(&lsys("curves/chaikin-13.lsys"));
+    let word = same_in_every_pool(&l.program);
+    let mut p: Vec<Vec2> = hexagon().iter().map(|v| v.as_vec2()).collect();
+    for _ in 0..STEPS {
+        let n = p.len();
+        p = (0..n)
+            .flat_map(|i| {
+                let (vl, v, vr) = (p[(i + n - 1) % n], p[i], p[(i + 1) % n]);
+                [vl * 0.25 + v * 0.75, v * 0.75 + vr * 0.25]
+            })
+            .collect();
+    }
+    assert_eq!(word.len(), 6 << STEPS);
+    let want: Vec<u64> = p
+        .iter()
+        .flat_map(|v| [(v.x as f64).to_bits(), (v.y as f64).to_bits()])
+        .collect();
+    assert!(bits(&word) == want);
+    same_error_in_every_pool(&l.program);
+}
+
+/// Closed Chaikin on `V3f` points in double precision. The hexagon's
+/// coordinates are small integers and the weights 1/4 and 3/4, so after 15
+/// steps every coordinate is a multiple of 2^-30 below 8 in magnitude:
+/// about 33 significant bits, which a double holds exactly. Any correct
+/// computation, in any order, therefore gives these very bits.
+#[test]
+fn chaikin_in_3d_double_is_the_same_word_for_any_number_of_threads() {
+    let hex: Vec<DVec3> = hexagon()
+        .iter()
+        .enumerate()
+        .map(|(i, v)| DVec3::new(v.x, v.y, (i % 3) as f64 - 1.0))
+        .collect();
+    let axiom: Vec<String> = hex
+        .iter()
+        .map(|v| format!("P(V3f({}, {}, {}))", v.x, v.y, v.z))
+        .collect();
+    let src = format!(
+        "module P(V3f);\nring L-system: 1;\nderivation length: 1;\nAxiom: {};\n\
+         P(vl) < P(v) > P(vr) -> P(0.25*vl + 0.75*v) P(0.75*v + 0.25*vr)\n",
+        axiom.join(" ")
+    );
+    let l = subgram::load_str_with("chaikin3.lsys", &src, &[], Precision::Double).expect("loads");
+    let word = same_in_every_pool(&l.program);
+    let mut p = hex;
+    for _ in 0..STEPS {
+        let n = p.len();
+        p = (0..n)
+            .flat_map(|i| {
+                let (vl, v, vr) = (p[(i + n - 1) % n], p[i], p[(i + 1) % n]);
+                [(vl + 3.0 * v) / 4.0, (3.0 * v + vr) / 4.0]
+            })
+            .collect();
+    }
+    assert_eq!(word.len(), 6 << STEPS);
+    let want: Vec<u64> = p
+        .iter()
+        .flat_map(|v| v.to_array().map(f64::to_bits))
+        .collect();
+    assert!(bits(&word) == want);
+    same_error_in_every_pool(&l.program);
+}
