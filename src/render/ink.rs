@@ -156,21 +156,32 @@ impl Ink {
 
 /// The part of the segment `a`..`b` within a pixel of the picture
 /// `0..w` x `0..h` (Liang and Barsky's clipping), or `None`.
+///
+/// Where a side of the clip box cuts the segment, that end lies on the
+/// side exactly (not at `a + d * t`, which loses the picture's scale when
+/// the segment's ends are far away: from -1e17 to 1e17 both cuts fell at
+/// the segment's middle and the line vanished), and both ends are kept in
+/// the box.
 fn clip(a: DVec2, b: DVec2, w: f64, h: f64) -> Option<(DVec2, DVec2)> {
     let d = b - a;
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    for (p, q) in [
+    let sides = [
         (-d.x, a.x + 1.0),
         (d.x, w + 1.0 - a.x),
         (-d.y, a.y + 1.0),
         (d.y, h + 1.0 - a.y),
-    ] {
+    ];
+    // The value of the coordinate on each side.
+    let on = [-1.0, w + 1.0, -1.0, h + 1.0];
+    let mut rs = [f64::NAN; 4];
+    for (k, (p, q)) in sides.into_iter().enumerate() {
         if p == 0.0 {
             if q < 0.0 {
                 return None;
             }
         } else {
             let r = q / p;
+            rs[k] = r;
             if p < 0.0 {
                 t0 = t0.max(r);
             } else {
@@ -178,7 +189,27 @@ fn clip(a: DVec2, b: DVec2, w: f64, h: f64) -> Option<(DVec2, DVec2)> {
             }
         }
     }
-    (t0 <= t1 && t0.is_finite() && t1.is_finite()).then(|| (a + d * t0, a + d * t1))
+    if !(t0 <= t1 && t0.is_finite() && t1.is_finite()) {
+        return None;
+    }
+    let (mut s, mut e) = (a + d * t0, a + d * t1);
+    for k in 0..4 {
+        let entering = sides[k].0 < 0.0;
+        let end = if entering && t0 > 0.0 && rs[k] == t0 {
+            &mut s
+        } else if !entering && t1 < 1.0 && rs[k] == t1 {
+            &mut e
+        } else {
+            continue;
+        };
+        if k < 2 {
+            end.x = on[k];
+        } else {
+            end.y = on[k];
+        }
+    }
+    let (lo, hi) = (DVec2::splat(-1.0), DVec2::new(w + 1.0, h + 1.0));
+    Some((s.clamp(lo, hi), e.clamp(lo, hi)))
 }
 
 #[cfg(test)]
@@ -353,5 +384,24 @@ mod tests {
         let ink = ink_of(paths[5], 1.0);
         let total: f32 = ink.ink.iter().sum();
         assert!(total > 19.0 && total < 21.5, "{total}");
+    }
+
+    #[test]
+    fn far_ends_keep_the_picture_scale() {
+        // A row crossing the picture from -1e17 to 1e17 (and from -1e300
+        // to 1e300): the clip used to put both cuts at the middle of the
+        // segment (a + d * 0.5, the +1 of the box lost against 1e17), and
+        // nothing was drawn; now it covers the row as the 1e12 one does.
+        for far in [1e17, 1e300] {
+            let ink = ink_of(&[DVec2::new(-far, 5.5), DVec2::new(far, 5.5)], 1.0);
+            let total: f32 = ink.ink.iter().sum();
+            assert!((total - 20.0).abs() < 0.6, "{far}: {total}");
+            // The diagonal: through the corners of the box.
+            let ink = ink_of(&[DVec2::new(-far, -far), DVec2::new(far, far)], 1.0);
+            let total: f32 = ink.ink.iter().sum();
+            // 20 * sqrt(2) pixels of pen inside the picture, less the
+            // half-pen margins at the two corners.
+            assert!(total > 26.0 && total < 29.0, "{far}: {total}");
+        }
     }
 }
