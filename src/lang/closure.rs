@@ -1496,7 +1496,7 @@ mod tests {
     /// effects in `&&`, `||` and `?:`.
     fn gen_program(seed: u64) -> String {
         let mut g = Gen(seed);
-        let friendly = seed % 2 == 0;
+        let friendly = seed.is_multiple_of(2);
         let mut p = String::from(
             "module A(float, int); module B(int, double, bool);\n\
              int gi = 3; float gf = 0.5; double gd = 1.25; bool gb = true;\n\
