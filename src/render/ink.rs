@@ -95,11 +95,7 @@ impl Ink {
             let i = y0 as usize * self.width + x0 as usize;
             for (k, weight) in weights.into_iter().enumerate() {
                 let i = i + (k & 1) + (k >> 1) * self.width;
-                let cell = &mut self.ink[i];
-                if *cell == 0.0 && weight > 0.0 {
-                    self.touched.push(i as u32);
-                }
-                *cell += area * weight;
+                self.add(i, area * weight);
             }
             return;
         }
@@ -113,13 +109,21 @@ impl Ink {
             if x < 0 || y < 0 || x >= self.width as i64 || y >= self.height as i64 {
                 continue;
             }
-            let i = y as usize * self.width + x as usize;
-            let cell = &mut self.ink[i];
-            if *cell == 0.0 && weight > 0.0 {
-                self.touched.push(i as u32);
-            }
-            *cell += area * weight;
+            self.add(y as usize * self.width + x as usize, area * weight);
         }
+    }
+
+    /// Adds `ink` to pixel `i`, noting the pixel when it gets its first
+    /// ink: a piece whose ink is zero (a pen or a piece so thin that its
+    /// area rounds to nothing) notes nothing, so that a pixel is noted once
+    /// however many of them fall on it.
+    #[inline(always)]
+    fn add(&mut self, i: usize, ink: f32) {
+        let cell = &mut self.ink[i];
+        if *cell == 0.0 && ink > 0.0 {
+            self.touched.push(i as u32);
+        }
+        *cell += ink;
     }
 
     /// Blends `color` over `pm` where the ink lies, by the ink's coverage,
@@ -152,21 +156,32 @@ impl Ink {
 
 /// The part of the segment `a`..`b` within a pixel of the picture
 /// `0..w` x `0..h` (Liang and Barsky's clipping), or `None`.
+///
+/// Where a side of the clip box cuts the segment, that end lies on the
+/// side exactly (not at `a + d * t`, which loses the picture's scale when
+/// the segment's ends are far away: from -1e17 to 1e17 both cuts fell at
+/// the segment's middle and the line vanished), and both ends are kept in
+/// the box.
 fn clip(a: DVec2, b: DVec2, w: f64, h: f64) -> Option<(DVec2, DVec2)> {
     let d = b - a;
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    for (p, q) in [
+    let sides = [
         (-d.x, a.x + 1.0),
         (d.x, w + 1.0 - a.x),
         (-d.y, a.y + 1.0),
         (d.y, h + 1.0 - a.y),
-    ] {
+    ];
+    // The value of the coordinate on each side.
+    let on = [-1.0, w + 1.0, -1.0, h + 1.0];
+    let mut rs = [f64::NAN; 4];
+    for (k, (p, q)) in sides.into_iter().enumerate() {
         if p == 0.0 {
             if q < 0.0 {
                 return None;
             }
         } else {
             let r = q / p;
+            rs[k] = r;
             if p < 0.0 {
                 t0 = t0.max(r);
             } else {
@@ -174,7 +189,27 @@ fn clip(a: DVec2, b: DVec2, w: f64, h: f64) -> Option<(DVec2, DVec2)> {
             }
         }
     }
-    (t0 <= t1 && t0.is_finite() && t1.is_finite()).then(|| (a + d * t0, a + d * t1))
+    if !(t0 <= t1 && t0.is_finite() && t1.is_finite()) {
+        return None;
+    }
+    let (mut s, mut e) = (a + d * t0, a + d * t1);
+    for k in 0..4 {
+        let entering = sides[k].0 < 0.0;
+        let end = if entering && t0 > 0.0 && rs[k] == t0 {
+            &mut s
+        } else if !entering && t1 < 1.0 && rs[k] == t1 {
+            &mut e
+        } else {
+            continue;
+        };
+        if k < 2 {
+            end.x = on[k];
+        } else {
+            end.y = on[k];
+        }
+    }
+    let (lo, hi) = (DVec2::splat(-1.0), DVec2::new(w + 1.0, h + 1.0));
+    Some((s.clamp(lo, hi), e.clamp(lo, hi)))
 }
 
 #[cfg(test)]
@@ -235,5 +270,138 @@ mod tests {
         let q = pm.pixel(2, 2).unwrap();
         assert_eq!((q.red(), q.alpha()), (255, 255));
         assert!(ink.touched.is_empty() && ink.ink.iter().all(|&x| x == 0.0));
+    }
+
+    #[test]
+    fn pieces_with_no_ink_note_no_pixel() {
+        // A pen so thin that each piece's ink rounds to zero in `f32`
+        // (1e-50 of a pixel): before, every piece noted its four pixels
+        // again (their ink stayed zero), so that a long path noted a pixel
+        // over and over; now no pixel is noted, and none is blended.
+        let ink = ink_of(&[DVec2::new(2.0, 2.0), DVec2::new(18.0, 18.0)], 1e-50);
+        assert!(ink.touched.is_empty(), "{} pixels noted", ink.touched.len());
+        // A normal pen notes each pixel once: the diagonal's pieces fall
+        // on at most the pixels of the 3-pixel-wide band around it.
+        let ink = ink_of(&[DVec2::new(2.0, 2.0), DVec2::new(18.0, 18.0)], 1.0);
+        let mut seen = ink.touched.clone();
+        seen.sort_unstable();
+        seen.dedup();
+        assert_eq!(seen.len(), ink.touched.len());
+        assert!(!ink.touched.is_empty());
+    }
+
+    #[test]
+    fn blending_is_tiny_skias_source_over() {
+        // The ink's blend against tiny-skia filling one pixel with the
+        // colour at the coverage's alpha (source-over on premultiplied
+        // pixels), over transparent, half-transparent and opaque
+        // backgrounds: equal to within one level of rounding.
+        let backgrounds = [
+            tiny_skia::Color::TRANSPARENT,
+            tiny_skia::Color::from_rgba8(200, 40, 90, 128),
+            tiny_skia::Color::from_rgba8(255, 255, 255, 255),
+        ];
+        let mut compared = 0;
+        for bg in backgrounds {
+            for alpha in [1u8, 77, 128, 254, 255] {
+                for coverage in [0.1f32, 0.25, 0.5, 0.77, 1.0, 1.5] {
+                    let color = Rgba(30, 200, 120, alpha);
+                    let mut ours = Pixmap::new(1, 1).unwrap();
+                    ours.fill(bg);
+                    let mut theirs = ours.clone();
+                    let mut ink = Ink::new(1, 1);
+                    ink.ink[0] = coverage;
+                    ink.touched.push(0);
+                    ink.blend(&mut ours, color);
+                    let mut paint = tiny_skia::Paint::default();
+                    paint.set_color(
+                        tiny_skia::Color::from_rgba(
+                            30.0 / 255.0,
+                            200.0 / 255.0,
+                            120.0 / 255.0,
+                            alpha as f32 / 255.0 * coverage.min(1.0),
+                        )
+                        .unwrap(),
+                    );
+                    let rect = tiny_skia::Rect::from_xywh(0.0, 0.0, 1.0, 1.0).unwrap();
+                    theirs.fill_rect(rect, &paint, tiny_skia::Transform::identity(), None);
+                    let (p, q) = (ours.pixel(0, 0).unwrap(), theirs.pixel(0, 0).unwrap());
+                    let a = [p.red(), p.green(), p.blue(), p.alpha()];
+                    let b = [q.red(), q.green(), q.blue(), q.alpha()];
+                    for k in 0..4 {
+                        assert!(
+                            a[k].abs_diff(b[k]) <= 1,
+                            "{a:?} against tiny-skia's {b:?} (alpha {alpha}, coverage {coverage})"
+                        );
+                    }
+                    compared += 1;
+                }
+            }
+        }
+        assert_eq!(compared, 90);
+    }
+
+    #[test]
+    fn hostile_points_neither_panic_nor_walk() {
+        // NaN and infinite points (which the scene refuses before this),
+        // coordinates of 1e300, zero-length segments and points on the
+        // border: no panic, and no piece walked outside the clip box.
+        let nan = f64::NAN;
+        let inf = f64::INFINITY;
+        let paths: [&[DVec2]; 6] = [
+            &[
+                DVec2::new(nan, 1.0),
+                DVec2::new(5.0, 5.0),
+                DVec2::new(nan, nan),
+            ],
+            &[
+                DVec2::new(inf, 1.0),
+                DVec2::new(-inf, 5.0),
+                DVec2::new(5.0, inf),
+            ],
+            &[DVec2::new(1e300, 1e300), DVec2::new(-1e300, -1e300)],
+            &[DVec2::new(1e308, 3.0), DVec2::new(-1e308, 3.0)],
+            &[DVec2::new(7.0, 7.0), DVec2::new(7.0, 7.0)],
+            &[
+                DVec2::new(0.0, 0.0),
+                DVec2::new(20.0, 0.0),
+                DVec2::new(20.0, 20.0),
+            ],
+        ];
+        for (k, points) in paths.iter().enumerate() {
+            for pen in [0.3, 1.0] {
+                let ink = ink_of(points, pen);
+                let total: f32 = ink.ink.iter().sum();
+                assert!(total.is_finite(), "path {k}: {total}");
+                // At most the area of the longest clipped segments: two
+                // sides of the box (22 pixels each) and a diagonal.
+                assert!(total <= 3.0 * 22.0 * pen as f32 + 1e-3, "path {k}: {total}");
+            }
+        }
+        // The border path (last) lays down its whole length: 40 pixels
+        // of pen, less what falls outside the picture (half the pen along
+        // each side, on the outer side of the border lines).
+        let ink = ink_of(paths[5], 1.0);
+        let total: f32 = ink.ink.iter().sum();
+        assert!(total > 19.0 && total < 21.5, "{total}");
+    }
+
+    #[test]
+    fn far_ends_keep_the_picture_scale() {
+        // A row crossing the picture from -1e17 to 1e17 (and from -1e300
+        // to 1e300): the clip used to put both cuts at the middle of the
+        // segment (a + d * 0.5, the +1 of the box lost against 1e17), and
+        // nothing was drawn; now it covers the row as the 1e12 one does.
+        for far in [1e17, 1e300] {
+            let ink = ink_of(&[DVec2::new(-far, 5.5), DVec2::new(far, 5.5)], 1.0);
+            let total: f32 = ink.ink.iter().sum();
+            assert!((total - 20.0).abs() < 0.6, "{far}: {total}");
+            // The diagonal: through the corners of the box.
+            let ink = ink_of(&[DVec2::new(-far, -far), DVec2::new(far, far)], 1.0);
+            let total: f32 = ink.ink.iter().sum();
+            // 20 * sqrt(2) pixels of pen inside the picture, less the
+            // half-pen margins at the two corners.
+            assert!(total > 26.0 && total < 29.0, "{far}: {total}");
+        }
     }
 }

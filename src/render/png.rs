@@ -1,6 +1,6 @@
 //! PNG output with tiny-skia: antialiased fills, and strokes with round caps
 //! and joins; polylines with a pen of at most a pixel by their ink
-//! ([`super::ink`]).
+//! (`render::ink`, a private module).
 
 use tiny_skia::{
     Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, Transform,
