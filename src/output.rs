@@ -31,21 +31,21 @@ pub fn write_word_text(
     for i in 0..word.len() {
         let sym = word.syms()[i];
         if i > 0 {
-            buf.push(b" ");
+            buf.text.push(b' ');
         }
         buf.push(alphabet.name(sym).as_bytes());
         let data = word.data(i);
         let tys = layouts.of(sym, data.len());
         if !tys.is_empty() {
-            buf.push(b"(");
+            buf.text.push(b'(');
             let mut slots = data;
             for (j, &ty) in tys.iter().enumerate() {
                 if j > 0 {
-                    buf.push(b", ");
+                    buf.text.extend_from_slice(b", ");
                 }
                 slots = num.value_text(&mut buf.text, ty, slots, structs);
             }
-            buf.push(b")");
+            buf.text.push(b')');
         }
         buf.flush_if_full()?;
     }
@@ -69,6 +69,7 @@ impl<'a> Layouts<'a> {
         }
     }
 
+    #[inline]
     fn of(&mut self, sym: crate::lang::Sym, slots: usize) -> &'a [Ty] {
         match self.known.get(sym.0 as usize) {
             Some(Some((n, tys))) if *n == slots => tys,
@@ -221,7 +222,7 @@ impl Numbers {
         } else {
             9_007_199_254_740_992.0
         };
-        if x == x.trunc() && x.abs() < exact {
+        if x.abs() < exact && (x as i64) as f64 == x {
             if x == 0.0 && x.is_sign_negative() {
                 out.push(b'-');
             }
@@ -252,7 +253,7 @@ impl Numbers {
         } else {
             9_007_199_254_740_992.0
         };
-        if x == x.trunc() && x.abs() < exact {
+        if x.abs() < exact && (x as i64) as f64 == x {
             // An integral `double` below 2^53 prints as `12.0` (`zmij`
             // switches to exponents at 1e16), and so does an integral
             // `float` below 2^24, whose shortest decimal is that integer.
