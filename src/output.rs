@@ -43,7 +43,7 @@ pub fn write_word_text(
                 if j > 0 {
                     buf.text.extend_from_slice(b", ");
                 }
-                slots = num.value_text(&mut buf.text, ty, slots, structs);
+                slots = num.value(Style::Text, &mut buf.text, ty, slots, structs);
             }
             buf.text.push(b')');
         }
@@ -120,6 +120,13 @@ impl<'a, W: Write> Chunks<'a, W> {
     }
 }
 
+/// Text or JSON.
+#[derive(Clone, Copy)]
+enum Style {
+    Text,
+    Json,
+}
+
 /// Numbers written without allocating: integers by `itoa`, floats from
 /// the shortest digits `zmij` finds (the digits `std` and `serde_json`
 /// print, laid out as each of them lays them out).
@@ -131,9 +138,11 @@ struct Numbers {
 
 impl Numbers {
     /// Writes one parameter of type `ty` read from the front of `slots` as
-    /// [`value_text`] writes it, and returns the slots after it.
-    fn value_text<'s>(
+    /// [`value_text`] or [`value_json`] writes it, and returns the slots
+    /// after it.
+    fn value<'s>(
         &mut self,
+        style: Style,
         out: &mut Vec<u8>,
         ty: Ty,
         slots: &'s [f64],
@@ -141,54 +150,17 @@ impl Numbers {
     ) -> &'s [f64] {
         let at = |i: usize| slots.get(i).copied().unwrap_or(0.0);
         let single = ty.is_single();
-        let used = match ty {
-            Ty::Int => {
-                out.extend_from_slice(self.ints.format(at(0).to_bits() as i64).as_bytes());
-                1
-            }
-            Ty::Float | Ty::Double => {
-                self.float_text(out, at(0), single);
-                1
-            }
-            Ty::V2 | Ty::V2d | Ty::V3 | Ty::V3d => {
-                let n = if matches!(ty, Ty::V2 | Ty::V2d) { 2 } else { 3 };
-                out.push(b'[');
-                for k in 0..n {
-                    if k > 0 {
-                        out.extend_from_slice(b", ");
-                    }
-                    self.float_text(out, at(k), single);
-                }
-                out.push(b']');
-                n
-            }
-            _ => {
-                let (v, n) = crate::lang::value::decode(ty, slots, structs);
-                out.extend_from_slice(value_text(&v, ty, structs).as_bytes());
-                n
-            }
+        let mut float = |out: &mut Vec<u8>, x: f64| match style {
+            Style::Text => self.float_text(out, x, single),
+            Style::Json => self.float_json(out, x, single),
         };
-        slots.get(used..).unwrap_or(&[])
-    }
-
-    /// Writes one parameter of type `ty` read from the front of `slots` as
-    /// [`value_json`] writes it, and returns the slots after it.
-    fn value_json<'s>(
-        &mut self,
-        out: &mut Vec<u8>,
-        ty: Ty,
-        slots: &'s [f64],
-        structs: &[StructDef],
-    ) -> &'s [f64] {
-        let at = |i: usize| slots.get(i).copied().unwrap_or(0.0);
-        let single = ty.is_single();
         let used = match ty {
             Ty::Int => {
                 out.extend_from_slice(self.ints.format(at(0).to_bits() as i64).as_bytes());
                 1
             }
             Ty::Float | Ty::Double => {
-                self.float_json(out, at(0), single);
+                float(out, at(0));
                 1
             }
             Ty::V2 | Ty::V2d | Ty::V3 | Ty::V3d => {
@@ -196,16 +168,24 @@ impl Numbers {
                 out.push(b'[');
                 for k in 0..n {
                     if k > 0 {
-                        out.push(b',');
+                        out.extend_from_slice(match style {
+                            Style::Text => b", ",
+                            Style::Json => b",",
+                        });
                     }
-                    self.float_json(out, at(k), single);
+                    float(out, at(k));
                 }
                 out.push(b']');
                 n
             }
             _ => {
                 let (v, n) = crate::lang::value::decode(ty, slots, structs);
-                value_json(out, &v, ty, structs).expect("writing into memory does not fail");
+                match style {
+                    Style::Text => out.extend_from_slice(value_text(&v, ty, structs).as_bytes()),
+                    Style::Json => {
+                        value_json(out, &v, ty, structs).expect("writing into memory does not fail")
+                    }
+                }
                 n
             }
         };
@@ -448,7 +428,7 @@ pub fn write_word_json(
             if j > 0 {
                 buf.push(b",");
             }
-            slots = num.value_json(&mut buf.text, ty, slots, structs);
+            slots = num.value(Style::Json, &mut buf.text, ty, slots, structs);
         }
         buf.push(b"],\"symbol\":");
         buf.push(name);
