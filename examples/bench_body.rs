@@ -26,6 +26,8 @@
 //! system with its rules and axiom set. Parsing is outside the timing on
 //! both sides.
 
+mod common;
+
 use std::time::{Duration, Instant};
 
 use subgram::DeriveOptions;
@@ -90,11 +92,7 @@ fn report(what: &str, ours: Duration, theirs: Duration) {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let runs = args
-        .iter()
-        .position(|a| a == "--runs")
-        .and_then(|i| args.get(i + 1)?.parse().ok())
-        .unwrap_or(5);
+    let runs = common::runs_arg(&args, 5);
     let only = |name: &str| !args.iter().any(|a| a == "--only") || args.iter().any(|a| a == name);
 
     // `--subgram-only`: the engine alone, for a profile.

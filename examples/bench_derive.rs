@@ -122,11 +122,7 @@ where
 fn main() {
     // `--runs N`: more runs for the best time on a busy machine.
     let args: Vec<String> = std::env::args().collect();
-    let runs = args
-        .iter()
-        .position(|a| a == "--runs")
-        .and_then(|i| args.get(i + 1)?.parse().ok())
-        .unwrap_or(10);
+    let runs = common::runs_arg(&args, 10);
     let pts = polygon(1000);
     let steps = 10;
     let axiom: Vec<String> = pts

@@ -1,5 +1,8 @@
 //! Timing shared by the benchmark examples.
 
+// Each benchmark uses part of this.
+#![allow(dead_code)]
+
 use std::time::{Duration, Instant};
 
 /// The fastest of `runs` runs of `f`, and the last run's result.
@@ -13,4 +16,12 @@ pub fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
         last = Some(r);
     }
     (best, last.expect("at least one run"))
+}
+
+/// The number after `--runs` in `args`, or `default`.
+pub fn runs_arg(args: &[String], default: usize) -> usize {
+    args.iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1)?.parse().ok())
+        .unwrap_or(default)
 }
