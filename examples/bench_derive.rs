@@ -188,7 +188,10 @@ fn main() {
         } else {
             "f64"
         };
-        println!("chaikin 1000 -> {out} points, {precision:?} precision, best of {runs}");
+        println!(
+            "chaikin 1000 -> {out} points, {precision:?} precision, best of {runs}, the engine on {} thread(s) (RAYON_NUM_THREADS), the loops on one",
+            rayon::current_num_threads()
+        );
         println!("  loop over points, %      {:>9.2} ms", ms(t_loop));
         println!("  flat {flat_ty} loop, no %     {:>9.2} ms", ms(t_flat));
         if precision == subgram::Precision::Single {
