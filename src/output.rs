@@ -192,21 +192,29 @@ impl Numbers {
         slots.get(used..).unwrap_or(&[])
     }
 
-    /// [`float_text`]'s text.
-    fn float_text(&mut self, out: &mut Vec<u8>, x: f64, single: bool) {
-        let single = single && (x as f32) as f64 == x;
-        // Integers print as integers; below 2^24 (2^53) every one is a
-        // `float` (`double`) whose shortest decimal is itself.
+    /// Writes `x` as an integer (`-0` for negative zero) and returns true
+    /// when it is one whose shortest decimal is itself: every integer below
+    /// 2^24 is such a `float` (`single`), and below 2^53 such a `double`.
+    fn integer(&mut self, out: &mut Vec<u8>, x: f64, single: bool) -> bool {
         let exact = if single {
             16_777_216.0
         } else {
             9_007_199_254_740_992.0
         };
-        if x.abs() < exact && (x as i64) as f64 == x {
-            if x == 0.0 && x.is_sign_negative() {
-                out.push(b'-');
-            }
-            out.extend_from_slice(self.ints.format(x as i64).as_bytes());
+        if !(x.abs() < exact && (x as i64) as f64 == x) {
+            return false;
+        }
+        if x == 0.0 && x.is_sign_negative() {
+            out.push(b'-');
+        }
+        out.extend_from_slice(self.ints.format(x as i64).as_bytes());
+        true
+    }
+
+    /// [`float_text`]'s text.
+    fn float_text(&mut self, out: &mut Vec<u8>, x: f64, single: bool) {
+        let single = single && (x as f32) as f64 == x;
+        if self.integer(out, x, single) {
             return;
         }
         if !x.is_finite() {
@@ -228,19 +236,9 @@ impl Numbers {
     /// [`float_json`]'s text.
     fn float_json(&mut self, out: &mut Vec<u8>, x: f64, single: bool) {
         let single = single && (x as f32) as f64 == x;
-        let exact = if single {
-            16_777_216.0
-        } else {
-            9_007_199_254_740_992.0
-        };
-        if x.abs() < exact && (x as i64) as f64 == x {
-            // An integral `double` below 2^53 prints as `12.0` (`zmij`
-            // switches to exponents at 1e16), and so does an integral
-            // `float` below 2^24, whose shortest decimal is that integer.
-            if x == 0.0 && x.is_sign_negative() {
-                out.push(b'-');
-            }
-            out.extend_from_slice(self.ints.format(x as i64).as_bytes());
+        if self.integer(out, x, single) {
+            // `zmij` writes such a number as `12.0` (it switches to
+            // exponents only at 1e16).
             out.extend_from_slice(b".0");
         } else if !x.is_finite() {
             out.extend_from_slice(b"null");
