@@ -55,6 +55,20 @@ fn bucket<T: Copy + Default>(
 }
 
 impl Mesh {
+    /// The live vertices in order, numbered from 0: each slot's number
+    /// (`u32::MAX` for a dead slot), their positions and their ids.
+    fn live_vertices(&self) -> (Vec<u32>, Vec<glam::DVec3>, Vec<VertexId>) {
+        let mut index = vec![u32::MAX; self.v_alive.len()];
+        let mut positions = Vec::with_capacity(self.vertex_count());
+        let mut verts = Vec::with_capacity(self.vertex_count());
+        for v in self.vertices() {
+            index[v.index()] = positions.len() as u32;
+            positions.push(self.position(v));
+            verts.push(v);
+        }
+        (index, positions, verts)
+    }
+
     /// Builds a mesh, refusing anything that is not an oriented 2-manifold:
     /// out-of-range indices, non-finite coordinates, degenerate faces, edges
     /// with three or more faces, inconsistent orientation, and bow-tie
@@ -598,14 +612,7 @@ impl Mesh {
         }
         // Every vertex of a face is a corner of its polygon (a pair's four
         // or a triangle's three), so every live vertex stays.
-        let mut index = vec![u32::MAX; self.v_alive.len()];
-        let mut positions = Vec::with_capacity(self.vertex_count());
-        let mut verts = Vec::with_capacity(self.vertex_count());
-        for v in self.vertices() {
-            index[v.index()] = positions.len() as u32;
-            positions.push(self.position(v));
-            verts.push(v);
-        }
+        let (index, positions, verts) = self.live_vertices();
         let mut faces = Faces::with_capacity(self.face_count() / 2, 2 * self.face_count());
         let mut tags = Vec::with_capacity(self.face_count() / 2);
         for f in self.faces() {
@@ -695,14 +702,7 @@ impl Mesh {
         }
         let merged_any = parent.iter().enumerate().any(|(i, &p)| p as usize != i);
         if !merged_any {
-            let mut index = vec![u32::MAX; self.v_alive.len()];
-            let mut positions = Vec::with_capacity(self.vertex_count());
-            let mut verts = Vec::with_capacity(self.vertex_count());
-            for v in self.vertices() {
-                index[v.index()] = positions.len() as u32;
-                positions.push(self.position(v));
-                verts.push(v);
-            }
+            let (index, positions, verts) = self.live_vertices();
             let mut corners = Vec::with_capacity(3 * self.face_count());
             let mut tags = Vec::with_capacity(self.face_count());
             for f in self.faces() {
@@ -1114,14 +1114,11 @@ mod tests {
             }
             let merged_any = parent.iter().enumerate().any(|(i, &p)| p as usize != i);
             if !merged_any {
-                let mut index = vec![u32::MAX; self.v_alive.len()];
-                let mut soup = PolygonSoup::default();
-                let mut verts = Vec::with_capacity(self.vertex_count());
-                for v in self.vertices() {
-                    index[v.index()] = soup.positions.len() as u32;
-                    soup.positions.push(self.position(v));
-                    verts.push(v);
-                }
+                let (index, positions, verts) = self.live_vertices();
+                let mut soup = PolygonSoup {
+                    positions,
+                    ..Default::default()
+                };
                 soup.faces = self
                     .faces()
                     .map(|f| {
