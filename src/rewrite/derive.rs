@@ -661,15 +661,14 @@ impl<'p> Derivation<'p> {
     /// The word after the interpretation rules of view `view` (those after
     /// `vgroup view:`; view 0 is the main view, [`Derivation::interpret`]).
     pub fn interpret_view(&mut self, view: i64) -> Result<Word, DeriveError> {
-        self.view = view;
-        let word = self.interpret();
-        self.view = 0;
-        word
+        self.interpreted_view(view)
+            .map(std::borrow::Cow::into_owned)
     }
 
     /// [`Derivation::interpret_view`], borrowing the word when no
     /// interpretation rule of the view applies (a large word is not
-    /// copied to be drawn).
+    /// copied to be drawn): the rules, when some apply, rewrite a copy of
+    /// it to the interpretation's depth.
     pub fn interpreted_view(
         &mut self,
         view: i64,
