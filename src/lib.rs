@@ -49,6 +49,7 @@ pub mod model;
 pub mod output;
 pub mod render;
 pub mod reverse;
+pub mod scene3;
 pub(crate) mod shape;
 pub mod surface;
 
