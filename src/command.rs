@@ -835,6 +835,8 @@ pub struct ReverseArgs {
     pub phase: Phase,
     /// Treat the contour as open.
     pub open: bool,
+    /// How a PNG silhouette is read (threshold, which side is the shape).
+    pub silhouette: reverse::input::Silhouette,
     /// The picture of input, coarse polygon and reconstruction.
     pub figure: Option<String>,
     /// Return the report (point counts and reconstruction errors).
@@ -860,6 +862,7 @@ impl ReverseArgs {
             scheme: None,
             phase: Phase::Auto,
             open: false,
+            silhouette: reverse::input::Silhouette::default(),
             figure: None,
             report: false,
             json: false,
@@ -892,7 +895,7 @@ pub fn reverse(a: &ReverseArgs) -> Result<Option<String>, Error> {
         .map(Path::new)
         .collect();
     refuse_overwrite(&outputs, &inputs, a.force)?;
-    let mut contour = reverse::input::read_with_limit(input, a.max_input)?;
+    let mut contour = reverse::input::read_with(input, a.max_input, &a.silhouette)?;
     if a.open {
         contour.closed = false;
     }

@@ -131,6 +131,14 @@ enum Command {
         /// Treat the contour as open (end points kept).
         #[arg(long)]
         open: bool,
+        /// A PNG silhouette's shape is the light side (by default the side
+        /// that does not touch the image's border, or the smaller one).
+        #[arg(long)]
+        invert: bool,
+        /// A PNG silhouette's grey level between shape and ground, from 0
+        /// (black) to 1 (white).
+        #[arg(long, default_value_t = 0.5)]
+        threshold: f64,
         /// Draw input, coarse polygon and reconstruction: .png or .svg.
         #[arg(long)]
         figure: Option<String>,
@@ -526,6 +534,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             scheme,
             phase,
             open,
+            invert,
+            threshold,
             figure,
             report,
             format,
@@ -541,6 +551,14 @@ fn run(cli: Cli) -> Result<(), Error> {
                 scheme,
                 phase,
                 open,
+                silhouette: subgram::reverse::input::Silhouette {
+                    threshold,
+                    side: if invert {
+                        subgram::reverse::input::Side::Light
+                    } else {
+                        subgram::reverse::input::Side::Auto
+                    },
+                },
                 figure,
                 report,
                 json: matches!(format, Format::Json),

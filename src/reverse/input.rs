@@ -132,10 +132,17 @@ pub fn read(path: &Path) -> Result<Contour, Error> {
     read_with_limit(path, MAX_INPUT_BYTES)
 }
 
+/// Reads a contour with a PNG silhouette read the default way; see
+/// [`read_with`].
+pub fn read_with_limit(path: &Path, max_bytes: u64) -> Result<Contour, Error> {
+    read_with(path, max_bytes, &Silhouette::default())
+}
+
 /// Reads a contour; the format follows the file's extension (`.svg`,
 /// `.png`, anything else is a point list). Point lists are closed. A file
-/// larger than `max_bytes` is refused before it is read whole.
-pub fn read_with_limit(path: &Path, max_bytes: u64) -> Result<Contour, Error> {
+/// larger than `max_bytes` is refused before it is read whole; a PNG
+/// image is traced as `silhouette` says.
+pub fn read_with(path: &Path, max_bytes: u64, silhouette: &Silhouette) -> Result<Contour, Error> {
     let name = path.display().to_string();
     let ext = path
         .extension()
@@ -143,7 +150,7 @@ pub fn read_with_limit(path: &Path, max_bytes: u64) -> Result<Contour, Error> {
         .unwrap_or_default();
     let bytes = read_bounded(path, max_bytes)?;
     let c = match ext.as_str() {
-        "png" => read_png(&name, &bytes)?,
+        "png" => read_png_with(&name, &bytes, silhouette)?,
         "svg" => read_svg(&name, &utf8_text(&name, bytes, "an SVG file")?)?,
         _ => read_points(&name, &utf8_text(&name, bytes, "a point list")?)?,
     };
@@ -522,6 +529,31 @@ fn parse_path(name: &str, text: &str, attr: &Attr) -> Result<(Vec<DVec2>, bool),
     Ok(best)
 }
 
+/// Whether the light side of `field` (values at or above `t`) is the
+/// shape: the side that does not touch the image's border, or, where both
+/// or neither do, the side with fewer pixels.
+fn light_is_the_shape(field: &[f64], w: usize, h: usize, t: f64) -> bool {
+    let border = (0..w)
+        .flat_map(|x| [x, (h - 1) * w + x])
+        .chain((0..h).flat_map(|y| [y * w, y * w + w - 1]));
+    let (mut dark_edge, mut light_edge) = (false, false);
+    for k in border {
+        if field[k] < t {
+            dark_edge = true;
+        } else {
+            light_edge = true;
+        }
+    }
+    match (dark_edge, light_edge) {
+        (true, false) => true,
+        (false, true) => false,
+        _ => {
+            let dark = field.iter().filter(|&&v| v < t).count();
+            dark > field.len() - dark
+        }
+    }
+}
+
 /// Width and height from a PNG's header, when it has one.
 fn png_size(bytes: &[u8]) -> Option<(u64, u64)> {
     if bytes.len() < 24 || &bytes[..8] != b"\x89PNG\r\n\x1a\n" || &bytes[12..16] != b"IHDR" {
@@ -531,9 +563,55 @@ fn png_size(bytes: &[u8]) -> Option<(u64, u64)> {
     Some((be(&bytes[16..20]), be(&bytes[20..24])))
 }
 
-/// Traces the largest closed outline of the dark shape in a PNG image, with
-/// sub-pixel marching squares at mid-grey. Transparent pixels count as white.
+/// Which side of a PNG image's threshold is the shape.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Side {
+    /// The side that does not touch the image's border; where both or
+    /// neither do, the one with fewer pixels.
+    #[default]
+    Auto,
+    /// The pixels darker than the threshold (a dark shape on a light
+    /// ground).
+    Dark,
+    /// The pixels as light as the threshold or lighter (`--invert`).
+    Light,
+}
+
+/// How a PNG silhouette is read: the grey level (0 black … 1 white) that
+/// separates shape from ground, and which side is the shape.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Silhouette {
+    pub threshold: f64,
+    pub side: Side,
+}
+
+impl Default for Silhouette {
+    fn default() -> Self {
+        Silhouette {
+            threshold: 0.5,
+            side: Side::Auto,
+        }
+    }
+}
+
+/// Traces a PNG silhouette the default way; see [`read_png_with`].
 pub fn read_png(name: &str, bytes: &[u8]) -> Result<Contour, Error> {
+    read_png_with(name, bytes, &Silhouette::default())
+}
+
+/// Traces the largest closed outline of the shape in a PNG image, with
+/// sub-pixel marching squares at the threshold. Transparent pixels count as
+/// white. The shape is the side `silhouette` names; the image's frame is
+/// never returned as the outline: a shape that reaches all four edges is
+/// refused with a message.
+pub fn read_png_with(name: &str, bytes: &[u8], silhouette: &Silhouette) -> Result<Contour, Error> {
+    let t = silhouette.threshold;
+    if !(t > 0.0 && t < 1.0) {
+        return Err(Error::file(
+            name,
+            format!("the threshold is {t}; it must lie strictly between 0 (black) and 1 (white)"),
+        ));
+    }
     if let Some((w, h)) = png_size(bytes) {
         if w * h > MAX_IMAGE_PIXELS {
             return Err(Error::file(
@@ -561,17 +639,50 @@ pub fn read_png(name: &str, bytes: &[u8]) -> Result<Contour, Error> {
             a * lum + (1.0 - a)
         })
         .collect();
-    let loops = trace::contours(&field, w, h, 0.5, 1.0);
+    let light = match silhouette.side {
+        Side::Dark => false,
+        Side::Light => true,
+        Side::Auto => light_is_the_shape(&field, w, h, t),
+    };
+    // The tracer follows the dark side (below the level, outside white):
+    // a light shape is traced on the negative image.
+    let (field, level) = if light {
+        (field.iter().map(|v| 1.0 - v).collect(), 1.0 - t)
+    } else {
+        (field, t)
+    };
+    let loops = trace::contours(&field, w, h, level, 1.0);
     let Some(mut best) = loops.into_iter().max_by(|a, b| {
         trace::signed_area2(a)
             .abs()
             .total_cmp(&trace::signed_area2(b).abs())
     }) else {
+        let (shade, than) = if light {
+            ("light", "as light as")
+        } else {
+            ("dark", "darker than")
+        };
         return Err(Error::file(
             name,
-            "the image has no dark shape to trace (nothing darker than mid-grey)",
+            format!("the image has no {shade} shape to trace (nothing {than} the threshold {t})"),
         ));
     };
+    // The outline of a shape that fills the image runs along its frame.
+    let (lo, hi) = best.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    if lo.x <= 0.0 && lo.y <= 0.0 && hi.x >= (w - 1) as f64 && hi.y >= (h - 1) as f64 {
+        let other = if light { "dark" } else { "light" };
+        return Err(Error::file(
+            name,
+            format!(
+                "the {} shape reaches all four edges of the image, so its outline would be the image's frame; \
+                 if the shape is the {other} side, say so (`--invert` for a light shape), or crop the image",
+                if light { "light" } else { "dark" }
+            ),
+        ));
+    }
     // Image rows grow downwards; flip so that the outline stands upright.
     for p in &mut best {
         p.y = (h as f64 - 1.0) - p.y;

@@ -992,3 +992,168 @@ fn noise_stops_at_the_measurement_budget_and_fixed_phases_still_run() {
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// tests/data/horse.png with every pixel inverted (over white first, as
+/// transparent pixels count as white): a light horse on a dark ground.
+fn inverted_horse() -> tiny_skia::Pixmap {
+    let bytes = std::fs::read(root().join("tests/data/horse.png")).unwrap();
+    let mut pm = tiny_skia::Pixmap::decode_png(&bytes).unwrap();
+    for p in pm.pixels_mut() {
+        let c = p.demultiply();
+        let a = c.alpha() as u32;
+        let over = |v: u8| ((v as u32 * a + 255 * (255 - a)) / 255) as u8;
+        *p = tiny_skia::ColorU8::from_rgba(
+            255 - over(c.red()),
+            255 - over(c.green()),
+            255 - over(c.blue()),
+            255,
+        )
+        .premultiply();
+    }
+    pm
+}
+
+/// The binary reverses the light horse as it reverses the dark one, with
+/// the side found by itself or given by `--invert`, at `--threshold`.
+#[test]
+fn reverse_reads_a_light_silhouette_through_the_binary() {
+    let dir = scratch("rev-light");
+    let light = dir.join("light.png");
+    std::fs::write(&light, inverted_horse().encode_png().unwrap()).unwrap();
+    let horse = root().join("tests/data/horse.png");
+    let coarse = |input: &std::path::Path, extra: &[&str], out: &str| {
+        let out = dir.join(out);
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+            .args(["reverse", input.to_str().unwrap(), "-n", "3", "-o"])
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        reverse::input::read(&out).unwrap().points
+    };
+    // The same points up to the last bits: 1 − l interpolates as l does,
+    // not bit for bit.
+    let want = coarse(&horse, &[], "dark.txt");
+    assert_points_eq(&coarse(&light, &[], "auto.txt"), &want, 1e-9);
+    let told = coarse(&light, &["--invert", "--threshold", "0.5"], "told.txt");
+    assert_points_eq(&told, &want, 1e-9);
+    assert!(want.len() > 100, "a horse, not a frame");
+}
+
+/// The horse of scikit-image as a light silhouette on a dark ground (each
+/// pixel of tests/data/horse.png inverted here): the light side is the
+/// shape, found because the dark side touches the image's border, and
+/// its outline is the horse's, point for point (luminance l at level 1/2
+/// and 1 − l at level 1/2 cross at the same places).
+#[test]
+fn a_light_silhouette_on_a_dark_ground_traces_the_shape_not_the_frame() {
+    let bytes = std::fs::read(root().join("tests/data/horse.png")).unwrap();
+    let original = reverse::input::read_png("horse.png", &bytes).unwrap();
+    let pm = inverted_horse();
+    let inverted = pm.encode_png().unwrap();
+    let (w, h) = (pm.width() as f64, pm.height() as f64);
+    let traced = reverse::input::read_png("inverted.png", &inverted).unwrap();
+    assert_eq!(traced.points.len(), original.points.len());
+    assert_points_eq(&traced.points, &original.points, 1e-9);
+    let (lo, hi) = traced.points.iter().fold(
+        (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
+        |(a, b), &p| (a.min(p), b.max(p)),
+    );
+    assert!(lo.x > 0.0 && lo.y > 0.0 && hi.x < w - 1.0 && hi.y < h - 1.0);
+    // Told which side: the same again; told the wrong side, the dark ground
+    // reaches every edge and is refused rather than traced as the frame.
+    let light = reverse::input::Silhouette {
+        side: reverse::input::Side::Light,
+        ..Default::default()
+    };
+    let told = reverse::input::read_png_with("inverted.png", &inverted, &light).unwrap();
+    assert_points_eq(&told.points, &original.points, 1e-9);
+    let dark = reverse::input::Silhouette {
+        side: reverse::input::Side::Dark,
+        ..Default::default()
+    };
+    let e = reverse::input::read_png_with("inverted.png", &inverted, &dark)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("reaches all four edges"), "{e}");
+    assert!(e.contains("--invert"), "{e}");
+}
+
+/// A shape that spans the image from edge to edge on both axes (a cross)
+/// is never answered with the image's frame.
+#[test]
+fn a_shape_reaching_every_edge_is_refused_not_framed() {
+    let mut pm = tiny_skia::Pixmap::new(60, 40).unwrap();
+    pm.fill(tiny_skia::Color::WHITE);
+    let mut paint = tiny_skia::Paint::default();
+    paint.set_color_rgba8(0, 0, 0, 255);
+    let id = tiny_skia::Transform::identity();
+    pm.fill_rect(
+        tiny_skia::Rect::from_xywh(0.0, 15.0, 60.0, 10.0).unwrap(),
+        &paint,
+        id,
+        None,
+    );
+    pm.fill_rect(
+        tiny_skia::Rect::from_xywh(25.0, 0.0, 10.0, 40.0).unwrap(),
+        &paint,
+        id,
+        None,
+    );
+    let e = reverse::input::read_png("cross.png", &pm.encode_png().unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("cross.png") && e.contains("all four edges"),
+        "{e}"
+    );
+    // A threshold outside (0, 1) is refused.
+    let bad = reverse::input::Silhouette {
+        threshold: 1.5,
+        ..Default::default()
+    };
+    let e = reverse::input::read_png_with("cross.png", &pm.encode_png().unwrap(), &bad)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("threshold"), "{e}");
+}
+
+/// The threshold moves the traced outline: a grey disc (level 0.6) on
+/// white is found at threshold 0.7 and absent at 0.5.
+#[test]
+fn the_threshold_chooses_the_grey_level() {
+    let mut pm = tiny_skia::Pixmap::new(80, 80).unwrap();
+    pm.fill(tiny_skia::Color::WHITE);
+    let mut paint = tiny_skia::Paint::default();
+    paint.set_color_rgba8(153, 153, 153, 255);
+    let path = tiny_skia::PathBuilder::from_circle(40.0, 40.0, 25.0).unwrap();
+    pm.fill_path(
+        &path,
+        &paint,
+        tiny_skia::FillRule::Winding,
+        tiny_skia::Transform::identity(),
+        None,
+    );
+    let png = pm.encode_png().unwrap();
+    let at = |t: f64| {
+        reverse::input::read_png_with(
+            "grey.png",
+            &png,
+            &reverse::input::Silhouette {
+                threshold: t,
+                ..Default::default()
+            },
+        )
+    };
+    let c = at(0.7).unwrap();
+    // The shoelace area of the outline, as the radius of a circle.
+    let p = &c.points;
+    let twice: f64 = (0..p.len())
+        .map(|i| p[i].perp_dot(p[(i + 1) % p.len()]))
+        .sum();
+    let r = (twice.abs() / 2.0 / std::f64::consts::PI).sqrt();
+    assert!((r - 25.0).abs() < 1.0, "radius {r}");
+    let e = at(0.5).unwrap_err().to_string();
+    assert!(e.contains("no dark shape"), "{e}");
+}
