@@ -289,8 +289,9 @@ pub struct RenderArgs {
     /// The picture: `.png` or `.svg`.
     pub output: String,
     pub steps: Option<u64>,
-    /// Width and height in pixels.
-    pub size: (u32, u32),
+    /// Width and height in pixels; `None`: 800×800, and with `each` the
+    /// height the panels' drawings need.
+    pub size: Option<(u32, u32)>,
     /// Draw every step 0..=N side by side (curves).
     pub each: bool,
     /// The background; `None`: colour 0 of the model's colour map or
@@ -325,7 +326,7 @@ impl RenderArgs {
             file: file.into(),
             output: output.into(),
             steps: None,
-            size: (800, 800),
+            size: None,
             each: false,
             background: None,
             view: None,
@@ -351,8 +352,9 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<Stri
     let output = Path::new(&a.output);
     refuse_overwrite(&[output], &[file], a.force)?;
     let white = Rgba(255, 255, 255, 255);
+    let size = a.size.unwrap_or((800, 800));
     let looks = MeshLooks {
-        size: a.size,
+        size,
         background: a.background.unwrap_or(white),
         view: a.view.as_deref(),
         wireframe: a.wireframe,
@@ -475,8 +477,9 @@ fn render_system(
                 each: a.each,
                 draw: Default::default(),
                 render: render::RenderOptions {
-                    width: a.size.0,
-                    height: a.size.1,
+                    width: a.size.map_or(800, |s| s.0),
+                    height: a.size.map_or(800, |s| s.1),
+                    fit_height: a.each && a.size.is_none(),
                     background: a.background.or(model_background).unwrap_or(white),
                     view,
                     palette,

@@ -71,9 +71,10 @@ enum Command {
         output: String,
         #[arg(short = 'n', long = "steps")]
         steps: Option<u64>,
-        /// Image size in pixels, WIDTHxHEIGHT.
-        #[arg(long, default_value = "800x800", value_parser = parse_size)]
-        size: (u32, u32),
+        /// Image size in pixels, WIDTHxHEIGHT [default: 800x800; with
+        /// --each, 800 wide and as tall as the panels need].
+        #[arg(long, value_parser = parse_size)]
+        size: Option<(u32, u32)>,
         /// Draw every step 0..N side by side.
         #[arg(long)]
         each: bool,

@@ -110,6 +110,10 @@ pub struct RenderOptions {
     /// Line widths are in the drawing's units (lpfg's `line style:
     /// polygon` or `cylinder`), not in pixels.
     pub widths_in_units: bool,
+    /// Lower the height to what the panels' drawings need (`--each`
+    /// without `--size`): wide drawings side by side make a strip, not a
+    /// strip in an empty square.
+    pub fit_height: bool,
 }
 
 impl Default for RenderOptions {
@@ -122,6 +126,7 @@ impl Default for RenderOptions {
             view: View::Xy,
             palette: None,
             widths_in_units: false,
+            fit_height: false,
         }
     }
 }
@@ -236,10 +241,25 @@ pub fn scene(panels: &[Vec<Event>], opts: &RenderOptions) -> Result<Scene, Rende
         ));
     }
     let cell_w = opts.width as f64 / panels.len() as f64;
+    let mut opts = std::borrow::Cow::Borrowed(opts);
+    if opts.fit_height {
+        // The tallest drawing as the panels are fitted, plus the margins.
+        let h = opts.height as f64;
+        let mut needed: f64 = 0.0;
+        for events in panels {
+            if let Some((lo, hi)) = panel_bounds(events, opts.view)? {
+                let fit = Fit::new(lo, hi, 0.0, cell_w, h, opts.margin);
+                needed = needed.max((hi.y - lo.y) * fit.scale);
+            }
+        }
+        let m = opts.margin * cell_w.min(h);
+        let height = (needed + 2.0 * m).ceil().clamp(1.0, h) as u32;
+        opts.to_mut().height = height;
+    }
     let mut items = Vec::new();
     for (k, events) in panels.iter().enumerate() {
         let x0 = k as f64 * cell_w;
-        fit_panel(events, opts, x0, cell_w, &mut items)?;
+        fit_panel(events, &opts, x0, cell_w, &mut items)?;
     }
     Ok(Scene {
         width: opts.width,
@@ -249,17 +269,13 @@ pub fn scene(panels: &[Vec<Event>], opts: &RenderOptions) -> Result<Scene, Rende
     })
 }
 
-fn fit_panel(
-    events: &[Event],
-    opts: &RenderOptions,
-    x0: f64,
-    cell_w: f64,
-    items: &mut Vec<Item>,
-) -> Result<(), RenderError> {
+/// The bounds of a panel's events in the drawing plane (discs and rings
+/// with their radius); `None` for no events, an error for a coordinate that
+/// is not finite.
+fn panel_bounds(events: &[Event], v: View) -> Result<Option<(DVec2, DVec2)>, RenderError> {
     if events.is_empty() {
-        return Ok(());
+        return Ok(None);
     }
-    let v = opts.view;
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
     let mut finite = true;
@@ -281,6 +297,20 @@ fn fit_panel(
             "the drawing has a NaN or infinite coordinate and cannot be fitted",
         ));
     }
+    Ok(Some((lo, hi)))
+}
+
+fn fit_panel(
+    events: &[Event],
+    opts: &RenderOptions,
+    x0: f64,
+    cell_w: f64,
+    items: &mut Vec<Item>,
+) -> Result<(), RenderError> {
+    let v = opts.view;
+    let Some((lo, hi)) = panel_bounds(events, v)? else {
+        return Ok(());
+    };
     let fit = Fit::new(lo, hi, x0, cell_w, opts.height as f64, opts.margin);
     let width = |w: f64| {
         if opts.widths_in_units {

@@ -550,3 +550,40 @@ fn writing_a_creased_mesh_keeps_or_reports_its_sharpness() {
         r.stderr
     );
 }
+
+/// `--each` without `--size` sizes the canvas to the panels: four square
+/// drawings side by side in 800 pixels are cells of 200, each drawing
+/// fitted to 200 − 2 × 8 (the 4% margin of the cell's smaller side), so
+/// the picture is 184 + 2 × 8 = 200 pixels tall, not 800 with three
+/// quarters empty. `--size` is kept as given.
+#[test]
+fn render_each_sizes_the_canvas_to_its_panels() {
+    let dir = std::env::temp_dir().join(format!("subgram-each-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = lsys("figures/fig01-chaikin-square.lsys");
+    let size = |extra: &[&str], name: &str| {
+        let out = dir.join(name);
+        let mut args = vec!["render", f.to_str().unwrap(), "--each", "-o"];
+        args.push(out.to_str().unwrap());
+        args.extend_from_slice(extra);
+        let o = subgram(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let pm = tiny_skia::Pixmap::decode_png(&std::fs::read(&out).unwrap()).unwrap();
+        (pm.width(), pm.height())
+    };
+    assert_eq!(size(&[], "strip.png"), (800, 200));
+    assert_eq!(size(&["--size", "800x800"], "square.png"), (800, 800));
+    assert_eq!(size(&["--size", "400x300"], "given.png"), (400, 300));
+    // One tall drawing keeps the default square.
+    let tall = lsys("abop/bush.lsys");
+    let out = dir.join("one.png");
+    let o = subgram(&[
+        "render",
+        tall.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let pm = tiny_skia::Pixmap::decode_png(&std::fs::read(&out).unwrap()).unwrap();
+    assert_eq!((pm.width(), pm.height()), (800, 800));
+}

@@ -25,6 +25,7 @@ mod one_language;
 mod precision;
 mod preprocessor;
 mod random;
+mod readme;
 mod render;
 mod reverse;
 mod semantics;

@@ -746,3 +746,29 @@ fn soups_come_back_with_their_tags() {
         }
     }
 }
+
+/// The README's storage figure for the half-edge mesh is what the arrays
+/// hold: `Mesh::bytes_per_face` on a large closed triangle mesh (an
+/// icosphere of 81,920 faces, where V/F is within 0.01% of its limit
+/// 1/2), to a tenth of a byte.
+#[test]
+fn the_readme_states_the_mesh_storage_per_face_that_the_arrays_take() {
+    let m = Mesh::from_soup(&shapes::icosphere(6)).unwrap();
+    assert_eq!(m.face_count(), 81_920);
+    let readme = std::fs::read_to_string(crate::support::root().join("README.md")).unwrap();
+    let at = readme
+        .find(" bytes a face, positions double-buffered")
+        .expect("the README states the storage per face");
+    let stated: f64 = readme[..at]
+        .rsplit('(')
+        .next()
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    let actual = m.bytes_per_face();
+    assert!(
+        (stated - actual).abs() < 0.1,
+        "README says {stated} bytes a face, the arrays take {actual:.2}"
+    );
+}
