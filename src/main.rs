@@ -64,55 +64,19 @@ enum Command {
         timeout: Timeout,
     },
     /// Render an .lsys file's picture to PNG or SVG.
-    Render {
-        file: String,
-        /// The picture: OUT.png or OUT.svg.
-        #[arg(short = 'o', long = "output")]
-        output: String,
-        #[arg(short = 'n', long = "steps")]
-        steps: Option<u64>,
-        /// Image size in pixels, WIDTHxHEIGHT [default: 800x800; with
-        /// --each, 800 wide and as tall as the panels need].
-        #[arg(long, value_parser = parse_size)]
-        size: Option<(u32, u32)>,
-        /// Draw every step 0..N side by side.
-        #[arg(long)]
-        each: bool,
-        /// white, black, none, #rrggbb; by default a model's colour 0, else
-        /// white.
-        #[arg(long, value_parser = parse_color)]
-        background: Option<subgram::render::Rgba>,
-        /// The projection of 3D drawings: xy, xz or yz for L-systems;
-        /// iso, front, back, left, right, top or bottom for meshes.
-        #[arg(long)]
-        view: Option<String>,
-        /// Meshes: draw the faces without their edges.
-        #[arg(long)]
-        no_wireframe: bool,
-        #[arg(short = 'D', value_name = "NAME=VALUE")]
-        define: Vec<String>,
-        /// Compute float, V2f and V3f in double precision (lpfg: single).
-        #[arg(long)]
-        double: bool,
-        #[arg(long, default_value_t = subgram::DEFAULT_MAX_MODULES)]
-        max_modules: usize,
-        #[arg(long, default_value_t = 0)]
-        phase: usize,
-        /// Seed every random number generator (ran, rand, drand48,
-        /// Gillespie groups) as if Start began with sran(N); srand(N);
-        /// srand48(N); SeedGillespie(N). Without it, lpfg's starting state.
-        #[arg(long, value_name = "N")]
-        seed: Option<u32>,
-        /// Let the program write files (fopen), under this folder.
-        #[arg(long, value_name = "DIR")]
-        allow_writes: Option<std::path::PathBuf>,
-        /// Stop with an error after this many seconds (0: no limit).
-        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
-              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
-        timeout: Timeout,
-        /// Write the output even when it is one of the inputs.
-        #[arg(long)]
-        force: bool,
+    Render(RenderCli),
+    /// Render, then render again whenever the file or a file it reads
+    /// changes (a model's files, a base mesh); an edit with an error keeps
+    /// the last good picture and prints the error. Ctrl-C stops.
+    Watch {
+        #[command(flatten)]
+        render: RenderCli,
+        /// How often to look at the files, in milliseconds.
+        #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(10..=60_000))]
+        poll_ms: u64,
+        /// Stop after this many renders (for scripts and tests).
+        #[arg(long, hide = true)]
+        max_renders: Option<usize>,
     },
     /// Reverse-subdivide a contour into a compact control polygon.
     Reverse {
@@ -273,6 +237,83 @@ fn parse_timeout(s: &str) -> Result<Timeout, String> {
 }
 
 /// `1048576`, `512K`, `64M`, `2G` (powers of 1024).
+/// The options of `render` and `watch`.
+#[derive(clap::Args)]
+struct RenderCli {
+    file: String,
+    /// The picture: OUT.png or OUT.svg.
+    #[arg(short = 'o', long = "output")]
+    output: String,
+    #[arg(short = 'n', long = "steps")]
+    steps: Option<u64>,
+    /// Image size in pixels, WIDTHxHEIGHT [default: 800x800; with
+    /// --each, 800 wide and as tall as the panels need].
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(u32, u32)>,
+    /// Draw every step 0..N side by side.
+    #[arg(long)]
+    each: bool,
+    /// white, black, none, #rrggbb; by default a model's colour 0, else
+    /// white.
+    #[arg(long, value_parser = parse_color)]
+    background: Option<subgram::render::Rgba>,
+    /// The projection of 3D drawings: xy, xz or yz for L-systems;
+    /// iso, front, back, left, right, top or bottom for meshes.
+    #[arg(long)]
+    view: Option<String>,
+    /// Meshes: draw the faces without their edges.
+    #[arg(long)]
+    no_wireframe: bool,
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    define: Vec<String>,
+    /// Compute float, V2f and V3f in double precision (lpfg: single).
+    #[arg(long)]
+    double: bool,
+    #[arg(long, default_value_t = subgram::DEFAULT_MAX_MODULES)]
+    max_modules: usize,
+    #[arg(long, default_value_t = 0)]
+    phase: usize,
+    /// Seed every random number generator (ran, rand, drand48,
+    /// Gillespie groups) as if Start began with sran(N); srand(N);
+    /// srand48(N); SeedGillespie(N). Without it, lpfg's starting state.
+    #[arg(long, value_name = "N")]
+    seed: Option<u32>,
+    /// Let the program write files (fopen), under this folder.
+    #[arg(long, value_name = "DIR")]
+    allow_writes: Option<std::path::PathBuf>,
+    /// Stop with an error after this many seconds (0: no limit).
+    #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+          default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+    timeout: Timeout,
+    /// Write the output even when it is one of the inputs.
+    #[arg(long)]
+    force: bool,
+}
+
+impl RenderCli {
+    fn into_args(self) -> RenderArgs {
+        RenderArgs {
+            file: self.file,
+            output: self.output,
+            steps: self.steps,
+            size: self.size,
+            each: self.each,
+            background: self.background,
+            view: self.view,
+            wireframe: !self.no_wireframe,
+            defines: self.define,
+            double: self.double,
+            max_modules: self.max_modules,
+            phase: self.phase,
+            seed: self.seed,
+            timeout: self.timeout.0,
+            force: self.force,
+            allow_writes: self.allow_writes,
+            program_output: subgram::ProgramOutput::new(),
+        }
+    }
+}
+
 fn parse_byte_size(s: &str) -> Result<u64, String> {
     let t = s.trim();
     let (digits, unit) = match t.find(|c: char| !c.is_ascii_digit()) {
@@ -440,47 +481,48 @@ fn run(cli: Cli) -> Result<(), Error> {
             }
             result
         }
-        Command::Render {
-            file,
-            output,
-            steps,
-            size,
-            each,
-            background,
-            view,
-            no_wireframe,
-            define,
-            double,
-            max_modules,
-            phase,
-            seed,
-            timeout,
-            force,
-            allow_writes,
-        } => {
-            let args = RenderArgs {
-                file,
-                output,
-                steps,
-                size,
-                each,
-                background,
-                view,
-                wireframe: !no_wireframe,
-                defines: define,
-                double,
-                max_modules,
-                phase,
-                seed,
-                timeout: timeout.0,
-                force,
-                allow_writes,
-                program_output: subgram::ProgramOutput::new(),
-            };
+        Command::Render(cli) => {
+            let args = cli.into_args();
             let result = with_progress(|p| command::render(&args, p));
             print_program_output(&args.program_output, false)?;
             print_warnings(&result?);
             Ok(())
+        }
+        Command::Watch {
+            render,
+            poll_ms,
+            max_renders,
+        } => {
+            let args = render.into_args();
+            let opts = command::WatchOptions {
+                poll: Duration::from_millis(poll_ms),
+                max_renders,
+            };
+            let mut watched: Vec<std::path::PathBuf> = Vec::new();
+            command::watch(&args, &opts, |event| match event {
+                command::WatchEvent::Rendered {
+                    output,
+                    seconds,
+                    warnings,
+                } => {
+                    let _ = print_program_output(&args.program_output, false);
+                    print_warnings(warnings);
+                    eprintln!("wrote {output} in {seconds:.2} s");
+                }
+                command::WatchEvent::Failed { error } => {
+                    let _ = print_program_output(&args.program_output, false);
+                    eprintln!("{error}");
+                    eprintln!("(the last good picture is kept; waiting for a change)");
+                }
+                command::WatchEvent::Watching { files } => {
+                    if files != watched.as_slice() {
+                        let names: Vec<String> =
+                            files.iter().map(|f| f.display().to_string()).collect();
+                        eprintln!("watching {} (Ctrl-C to stop)", names.join(", "));
+                        watched = files.to_vec();
+                    }
+                }
+            })
         }
         Command::Subdivide {
             mesh,

@@ -167,6 +167,28 @@ impl System {
             .collect()
     }
 
+    /// Every file a run of the system reads: its own text (and the texts
+    /// it includes), a model's files (view, functions, contours, surfaces,
+    /// colours), a base mesh, a shape grammar's meshes and schemes. `watch`
+    /// re-renders when one of them changes.
+    pub fn inputs(&self) -> Vec<PathBuf> {
+        let mut files: Vec<PathBuf> = self
+            .sources()
+            .names()
+            .map(PathBuf::from)
+            .filter(|p| p.is_file())
+            .collect();
+        match self {
+            System::Curve(c) => files.extend(c.program.model.files.iter().cloned()),
+            System::Surface(s) => files.extend(s.base_mesh()),
+            System::Vv(v) => files.extend(v.base_mesh()),
+            System::Shapes(s) => files.extend(s.inputs()),
+        }
+        let mut seen = std::collections::HashSet::new();
+        files.retain(|f| seen.insert(f.clone()));
+        files
+    }
+
     /// The texts the system was checked from: the file and its `-D` values.
     pub fn sources(&self) -> &SourceMap {
         match self {

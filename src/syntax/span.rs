@@ -116,6 +116,11 @@ impl SourceMap {
         &self.files[id.0 as usize]
     }
 
+    /// The names of the texts, in the order they were added.
+    pub fn names(&self) -> impl Iterator<Item = &str> + '_ {
+        self.files.iter().map(|f| f.name.as_str())
+    }
+
     /// Renders `file:line:col: error: message`, the source line and a caret.
     pub fn render(&self, span: Span, message: &str) -> String {
         self.render_as("error", span, message)

@@ -39,3 +39,4 @@ mod surface_quad;
 mod threads;
 mod vv;
 mod vv_adversarial;
+mod watch;
