@@ -310,8 +310,9 @@ def main():
                     help="faces to faces: run these bench_surface binaries (default: "
                          "target/release/examples/bench_surface), igl.loop and Blender, "
                          "--rounds times")
-    ap.add_argument("--bpy-python", default="/tmp/venv-bpy/bin/python",
-                    help="a Python with bpy, for --faces")
+    ap.add_argument("--bpy-python", default=sys.executable,
+                    help="a Python with bpy, for --faces (default: this one; Blender runs "
+                         "in a process of its own, as bpy cannot load after pymeshlab)")
     ap.add_argument("--blender-whole", metavar="OBJ", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.blender_whole:
