@@ -361,7 +361,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<Stri
         shading: crate::render::mesh::Shading::Lit,
     };
     if mesh::io::Format::from_path(file).is_some() {
-        write_mesh_picture(&load_mesh(file)?, output, &looks)?;
+        write_mesh_picture(&load_mesh(file)?, output, &looks, &mut Out::Files)?;
         return Ok(Vec::new());
     }
     let format = Picture::from_path(output)?;
@@ -373,8 +373,63 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<Stri
         (&looks, format),
         deadline,
         progress,
+        &mut Out::Files,
     )?);
     Ok(warnings)
+}
+
+/// A picture computed in memory and not written: what `serve` shows.
+#[derive(Clone, Debug)]
+pub struct Drawn {
+    /// The main picture's bytes (SVG or PNG, as `RenderArgs::output`'s
+    /// extension says).
+    pub picture: Vec<u8>,
+    /// The program's warnings.
+    pub warnings: Vec<String>,
+}
+
+/// Renders as [`render`] does, with the program's text replaced by `text`
+/// (see [`crate::load::load_edited`]), and writes nothing: the picture
+/// comes back in memory. A program's own files (`fopen`) are refused as
+/// without `--allow-writes`.
+pub fn render_edited(a: &RenderArgs, text: &str) -> Result<Drawn, Error> {
+    let deadline = a.timeout.map(Deadline::after);
+    let file = Path::new(&a.file);
+    let output = Path::new(&a.output);
+    let white = Rgba(255, 255, 255, 255);
+    let looks = MeshLooks {
+        size: a.size.unwrap_or((800, 800)),
+        background: a.background.unwrap_or(white),
+        view: a.view.as_deref(),
+        wireframe: a.wireframe,
+        shading: crate::render::mesh::Shading::Lit,
+    };
+    let format = Picture::from_path(output)?;
+    let system = crate::load::load_edited(file, text, &load_options(&a.defines, a.double))?;
+    let mut warnings = system.warnings();
+    let mut a = a.clone();
+    a.allow_writes = None;
+    a.force = true;
+    let mut out = Out::Memory(Vec::new());
+    warnings.extend(render_system(
+        &a,
+        system,
+        (&looks, format),
+        deadline,
+        |_| {},
+        &mut out,
+    )?);
+    let mut files = match out {
+        Out::Memory(files) => files,
+        Out::Files => Vec::new(),
+    };
+    if files.is_empty() {
+        return Err(Error::Failed("nothing was drawn".into()));
+    }
+    Ok(Drawn {
+        picture: files.swap_remove(0).1,
+        warnings,
+    })
 }
 
 /// How `watch` watches.
@@ -482,6 +537,7 @@ fn render_system(
     (looks, format): (&MeshLooks, Picture),
     deadline: Option<Deadline>,
     progress: impl FnMut(Progress),
+    out: &mut Out,
 ) -> Result<Vec<String>, Error> {
     let output = Path::new(&a.output);
     let file = Path::new(&a.file);
@@ -495,7 +551,7 @@ fn render_system(
                 ..RunOptions::default()
             };
             let run = s.subdivide(&opts, progress)?;
-            write_mesh_picture(&run.mesh, output, looks)?;
+            write_mesh_picture(&run.mesh, output, looks, out)?;
             Ok(Vec::new())
         }
         System::Shapes(s) => {
@@ -513,7 +569,7 @@ fn render_system(
                 ..RunOptions::default()
             };
             let run = s.derive(&opts)?;
-            write_shapes_picture(&run, output, looks)?;
+            write_shapes_picture(&run, output, looks, out)?;
             Ok(Vec::new())
         }
         System::Vv(v) => {
@@ -537,7 +593,7 @@ fn render_system(
             let mut inputs = vec![file.to_path_buf(), output.to_path_buf()];
             inputs.extend(v.base_mesh());
             write_program_files(&a.program_output, dir.as_deref(), &as_paths(&inputs))?;
-            write_soup_picture(&run.soup, output, looks)?;
+            write_soup_picture(&run.soup, output, looks, out)?;
             Ok(Vec::new())
         }
         System::Curve(c) => {
@@ -588,7 +644,7 @@ fn render_system(
             };
             let figures = c.figures(&figure)?;
             write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
-            write_views(&figures, Path::new(&a.file), output, format, a.force)
+            write_views(&figures, Path::new(&a.file), output, (format, a.force), out)
         }
     }
 }
@@ -762,7 +818,8 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<Ve
         }
         let run = v.run(&opts, progress)?;
         if Picture::from_path(output).is_ok() {
-            return write_soup_picture(&run.soup, output, &looks).map(|()| Vec::new());
+            return write_soup_picture(&run.soup, output, &looks, &mut Out::Files)
+                .map(|()| Vec::new());
         }
         mesh::io::write(output, &run.soup)?;
         return Ok(Vec::new());
@@ -776,7 +833,7 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<Ve
     }
     let run = surface.subdivide(&opts, progress)?;
     if Picture::from_path(output).is_ok() {
-        return write_mesh_picture(&run.mesh, output, &looks).map(|()| Vec::new());
+        return write_mesh_picture(&run.mesh, output, &looks, &mut Out::Files).map(|()| Vec::new());
     }
     write_mesh(output, &run.mesh, false)
 }
@@ -840,7 +897,7 @@ fn write_shapes(
     looks: &MeshLooks,
 ) -> Result<(), Error> {
     if Picture::from_path(output).is_ok() {
-        return write_shapes_picture(run, output, looks);
+        return write_shapes_picture(run, output, looks, &mut Out::Files);
     }
     if mesh::io::Format::from_path(output) == Some(mesh::io::Format::Obj) {
         let mtl = output.with_extension("mtl");
@@ -865,6 +922,7 @@ fn write_shapes_picture(
     run: &crate::system::ShapeRun,
     output: &Path,
     looks: &MeshLooks,
+    out: &mut Out,
 ) -> Result<(), Error> {
     let format = Picture::from_path(output)?;
     let mut mv = looks.check()?;
@@ -883,7 +941,7 @@ fn write_shapes_picture(
         Picture::Svg => crate::render::mesh::render_svg(&run.soup, &mv).into_bytes(),
         Picture::Png => crate::render::mesh::render_png(&run.soup, &mv)?,
     };
-    write_file(output, &bytes)
+    out.put(vec![(output.to_path_buf(), bytes)])
 }
 
 /// `subgram mesh info`: counts, boundary loops, Euler characteristic, genus,
@@ -1132,8 +1190,8 @@ fn write_views(
     figures: &crate::Figures,
     program: &Path,
     output: &Path,
-    format: Picture,
-    force: bool,
+    (format, force): (Picture, bool),
+    out: &mut Out,
 ) -> Result<Vec<String>, Error> {
     let names = crate::load::window_names(program);
     let mut files: Vec<(PathBuf, Vec<u8>)> =
@@ -1155,11 +1213,7 @@ fn write_views(
     }
     let outputs: Vec<&Path> = files.iter().map(|(p, _)| p.as_path()).collect();
     refuse_overwrite(&outputs, &[program], force)?;
-    let all: Vec<(&Path, &[u8])> = files
-        .iter()
-        .map(|(p, b)| (p.as_path(), b.as_slice()))
-        .collect();
-    crate::atomic::write_all_atomic(&all).map_err(|(path, e)| Error::write(path, e))?;
+    out.put(files)?;
     Ok(warnings)
 }
 
@@ -1179,6 +1233,32 @@ fn picture_bytes(scene: &Scene, format: Picture) -> Result<Vec<u8>, Error> {
         Picture::Svg => render::svg::render(scene).into_bytes(),
         Picture::Png => render::png::render(scene)?,
     })
+}
+
+/// Where pictures go: written to their files (atomically, all or none),
+/// or kept in memory (`serve` writes nothing).
+enum Out {
+    Files,
+    Memory(Vec<(PathBuf, Vec<u8>)>),
+}
+
+impl Out {
+    /// Writes, or keeps, every file or none.
+    fn put(&mut self, files: Vec<(PathBuf, Vec<u8>)>) -> Result<(), Error> {
+        match self {
+            Out::Files => {
+                let all: Vec<(&Path, &[u8])> = files
+                    .iter()
+                    .map(|(p, b)| (p.as_path(), b.as_slice()))
+                    .collect();
+                crate::atomic::write_all_atomic(&all).map_err(|(path, e)| Error::write(path, e))
+            }
+            Out::Memory(kept) => {
+                kept.extend(files);
+                Ok(())
+            }
+        }
+    }
 }
 
 /// How a mesh is drawn.
@@ -1215,11 +1295,21 @@ impl MeshLooks<'_> {
 }
 
 /// A mesh's picture, flat-shaded, to `.png` or `.svg`.
-fn write_mesh_picture(m: &Mesh, output: &Path, looks: &MeshLooks) -> Result<(), Error> {
-    write_soup_picture(&m.to_quad_soup(), output, looks)
+fn write_mesh_picture(
+    m: &Mesh,
+    output: &Path,
+    looks: &MeshLooks,
+    out: &mut Out,
+) -> Result<(), Error> {
+    write_soup_picture(&m.to_quad_soup(), output, looks, out)
 }
 
-fn write_soup_picture(soup: &PolygonSoup, output: &Path, looks: &MeshLooks) -> Result<(), Error> {
+fn write_soup_picture(
+    soup: &PolygonSoup,
+    output: &Path,
+    looks: &MeshLooks,
+    out: &mut Out,
+) -> Result<(), Error> {
     let format = Picture::from_path(output)?;
     let mv = looks.check()?;
     crate::render::mesh::validate(soup, &mv)?;
@@ -1227,7 +1317,7 @@ fn write_soup_picture(soup: &PolygonSoup, output: &Path, looks: &MeshLooks) -> R
         Picture::Svg => crate::render::mesh::render_svg(soup, &mv).into_bytes(),
         Picture::Png => crate::render::mesh::render_png(soup, &mv)?,
     };
-    write_file(output, &bytes)
+    out.put(vec![(output.to_path_buf(), bytes)])
 }
 
 fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Error> {

@@ -50,6 +50,8 @@ pub mod output;
 pub mod render;
 pub mod reverse;
 pub mod scene3;
+#[cfg(feature = "cli")]
+pub mod serve;
 pub(crate) mod shape;
 pub mod surface;
 

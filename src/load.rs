@@ -48,16 +48,43 @@ impl LoadOptions {
 /// # Ok(()) }
 /// ```
 pub fn load(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<System, Error> {
-    load_path(path.as_ref(), opts).map_err(at_most_some)
+    load_path(path.as_ref(), None, opts).map_err(at_most_some)
 }
 
-fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
+/// Loads `path` as [`load`] does, with its program's text replaced by
+/// `text` (an editor's unsaved buffer): the files beside it (a model's
+/// files, the view file, a base mesh) are read from the disk as usual. For
+/// a model folder, `text` is its L-system's.
+pub fn load_edited(
+    path: impl AsRef<Path>,
+    text: &str,
+    opts: &LoadOptions,
+) -> Result<System, Error> {
+    load_path(path.as_ref(), Some(text), opts).map_err(at_most_some)
+}
+
+/// The L-system file that [`load`] reads for `path`: the model folder's
+/// L-system, or the file itself.
+pub fn program_file(path: impl AsRef<Path>) -> Result<PathBuf, Error> {
+    let path = path.as_ref();
+    Ok(match model::find(path)? {
+        Some(files) => files.lsystem,
+        None => path.to_path_buf(),
+    })
+}
+
+fn load_path(path: &Path, edited: Option<&str>, opts: &LoadOptions) -> Result<System, Error> {
+    let text_of = |p: &Path| match edited {
+        Some(t) => Ok(t.to_string()),
+        None => read(p),
+    };
     if let Some(files) = model::find(path)? {
         let m = Model::read(&files.files)?;
-        let c = load_model_file(&files.lsystem, m, &opts.defines, opts.precision)?;
+        let text = text_of(&files.lsystem)?;
+        let c = load_model_file(&files.lsystem, text, m, &opts.defines, opts.precision)?;
         return Ok(System::Curve(c));
     }
-    let text = read(path)?;
+    let text = text_of(path)?;
     let view = read_view_file(path)?;
     let defines = view.defines(&opts.defines);
     let front = front(&path.display().to_string(), text, &defines)?;
@@ -84,11 +111,11 @@ fn load_path(path: &Path, opts: &LoadOptions) -> Result<System, Error> {
 /// refusing the program joins the checker's warnings.
 fn load_model_file(
     path: &Path,
+    text: String,
     m: Model,
     user: &[String],
     precision: Precision,
 ) -> Result<Curve, Error> {
-    let text = read(path)?;
     let view = read_view_file(path)?;
     let mut defines = m.defines();
     defines.retain(|d| {

@@ -78,6 +78,28 @@ enum Command {
         #[arg(long, hide = true)]
         max_renders: Option<usize>,
     },
+    /// A live preview page on 127.0.0.1: edit the program, see its picture.
+    Serve {
+        /// An .lsys file, or an lpfg model folder.
+        file: String,
+        /// The port (0: any free one).
+        #[arg(long, default_value_t = 8080)]
+        port: u16,
+        /// Let the page write the program back (atomically).
+        #[arg(long)]
+        save: bool,
+        #[arg(short = 'D', value_name = "NAME=VALUE")]
+        define: Vec<String>,
+        /// Compute float, V2f and V3f in double precision (lpfg: single).
+        #[arg(long)]
+        double: bool,
+        /// The largest word a render may make.
+        #[arg(long, default_value_t = 2_000_000)]
+        max_modules: usize,
+        /// The longest a render may take, in seconds.
+        #[arg(long, value_name = "SECONDS", default_value_t = 10)]
+        timeout: u64,
+    },
     /// Reverse-subdivide a contour into a compact control polygon.
     Reverse {
         /// Points (`x y` or CSV), an SVG shape, or a PNG silhouette.
@@ -486,6 +508,34 @@ fn run(cli: Cli) -> Result<(), Error> {
             let result = with_progress(|p| command::render(&args, p));
             print_program_output(&args.program_output, false)?;
             print_warnings(&result?);
+            Ok(())
+        }
+        Command::Serve {
+            file,
+            port,
+            save,
+            define,
+            double,
+            max_modules,
+            timeout,
+        } => {
+            let opts = subgram::serve::ServeOptions {
+                path: file.into(),
+                port,
+                save,
+                limits: subgram::serve::Limits {
+                    max_modules,
+                    timeout: Duration::from_secs(timeout.max(1)),
+                    ..Default::default()
+                },
+                defines: define,
+                double,
+            };
+            let server = subgram::serve::Server::bind(opts)?;
+            println!("serving {} (Ctrl-C to stop)", server.url());
+            use std::io::Write;
+            let _ = std::io::stdout().flush();
+            server.run();
             Ok(())
         }
         Command::Watch {

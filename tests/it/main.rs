@@ -29,6 +29,7 @@ mod readme;
 mod render;
 mod reverse;
 mod semantics;
+mod serve;
 mod shapes;
 mod support;
 mod surface;

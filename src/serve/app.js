@@ -1,0 +1,261 @@
+// The page of `subgram serve`: an editor for the program, the picture
+// re-derived a moment after each edit, the diagnostics at their places, a
+// step slider and the #define values. Everything is computed by the
+// server (POST /api/render); nothing is fetched from anywhere else.
+"use strict";
+
+const $ = (id) => document.getElementById(id);
+const text = $("text"), highlight = $("highlight"), gutter = $("gutter");
+const picture = $("picture"), messages = $("messages"), status = $("status");
+const steps = $("steps"), stepsOut = $("steps-out"), definesBox = $("defines");
+
+const state = {
+  overrides: new Map(), // define name -> value typed in its field
+  stepsTouched: false,  // the slider was moved away from the last step
+  inFlight: null,       // the AbortController of the running request
+  timer: null,
+  version: 0,           // renders shown so far (the browser test reads it)
+  marks: [],            // [{line, col, endLine, endCol, severity}] in the program
+};
+window.subgram = state;
+
+const KEYWORDS = new Set(("Axiom axiom module produce nproduce derivation length ring L-system " +
+  "interpretation decomposition homomorphism maximum depth ignore consider group endgroup " +
+  "vgroup Start StartEach EndEach End if else for while do return switch case default break " +
+  "continue struct typedef const static mesh init adaptive define attr").split(" "));
+const TYPES = new Set("int float double bool void char V2f V3f V2d V3d vertex edge face".split(" "));
+
+const esc = (s) => s.replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/>/g, "&gt;");
+
+// One pass of a sticky regex over the text: comments, strings, the
+// preprocessor, numbers, words, arrows; everything else is plain.
+const TOKEN = /(\/\/[^\n]*|\/\*[\s\S]*?(?:\*\/|$))|("(?:\\.|[^"\\\n])*"?)|(^[ \t]*#[ \t]*\w+)|(\b\d+(?:\.\d*)?(?:[eE][+-]?\d+)?[fFuUlL]?\b|\.\d+(?:[eE][+-]?\d+)?[fF]?)|([A-Za-z_][\w]*)|(-->|->|~>|<<|>>|<|>|:)/gmy;
+
+function colour(src) {
+  let out = "", at = 0;
+  TOKEN.lastIndex = 0;
+  while (at < src.length) {
+    TOKEN.lastIndex = at;
+    const m = TOKEN.exec(src);
+    if (!m) { out += esc(src[at]); at += 1; continue; }
+    const [all, comment, string, pre, number, word, punct] = m;
+    let cls = "";
+    if (comment) cls = "c";
+    else if (string) cls = "s";
+    else if (pre) cls = "k";
+    else if (number) cls = "n";
+    else if (word) cls = KEYWORDS.has(word) ? "k" : TYPES.has(word) ? "t" : /^[A-Z]/.test(word) ? "m" : "";
+    else if (punct) cls = "p";
+    out += cls ? `<span class="${cls}">${esc(all)}</span>` : esc(all);
+    at += all.length;
+  }
+  return out;
+}
+
+// The text with the marked ranges underlined, the rest invisible: a layer
+// over the coloured one.
+function marked(src) {
+  const lines = src.split("\n");
+  const offset = (line, col) => {
+    let o = 0;
+    for (let i = 0; i < line - 1 && i < lines.length; i++) o += lines[i].length + 1;
+    return Math.min(src.length, o + Math.max(0, col - 1));
+  };
+  const ranges = state.marks
+    .map((m) => {
+      const a = offset(m.line, m.col);
+      const b = Math.max(a + 1, offset(m.endLine, m.endCol));
+      return [a, Math.min(b, Math.max(a + 1, src.length))];
+    })
+    .sort((x, y) => x[0] - y[0]);
+  let out = "", at = 0;
+  for (const [a, b] of ranges) {
+    if (a < at) continue;
+    out += esc(src.slice(at, a)) + `<span class="err">${esc(src.slice(a, b) || " ")}</span>`;
+    at = b;
+  }
+  return out + esc(src.slice(at));
+}
+
+function paint() {
+  const src = text.value;
+  highlight.innerHTML = colour(src) + "\n";
+  let errs = $("marks");
+  if (!errs) {
+    errs = document.createElement("pre");
+    errs.id = "marks";
+    errs.setAttribute("aria-hidden", "true");
+    errs.className = "overlay";
+    highlight.after(errs);
+  }
+  errs.innerHTML = marked(src) + "\n";
+  const n = src.split("\n").length;
+  const bad = new Map(state.marks.map((m) => [m.line, m.severity]));
+  let g = "";
+  for (let i = 1; i <= n; i++) {
+    const sev = bad.get(i);
+    g += sev ? `<span class="${sev === "error" ? "bad" : "warn"}" data-line="${i}">${i}</span>\n`
+             : `<span data-line="${i}">${i}</span>\n`;
+  }
+  gutter.innerHTML = g;
+  text.style.height = (n + 1) * 18 + 12 + "px";
+  const longest = Math.max(...src.split("\n").map((l) => l.length));
+  text.style.width = `max(100%, ${longest + 4}ch)`;
+}
+
+// `#define NAME VALUE` lines with a number: fields for `-D NAME=VALUE`.
+function defines(src) {
+  const found = [];
+  for (const m of src.matchAll(/^[ \t]*#[ \t]*define[ \t]+([A-Za-z_]\w*)[ \t]+(-?[\d.]+(?:[eE][+-]?\d+)?)[ \t]*(?:\/\/.*)?$/gm)) {
+    found.push([m[1], m[2]]);
+  }
+  const key = found.map((d) => d[0]).join(" ");
+  if (definesBox.dataset.key !== key) {
+    definesBox.dataset.key = key;
+    definesBox.innerHTML = "";
+    for (const [name, value] of found) {
+      const label = document.createElement("label");
+      label.textContent = name + " ";
+      const input = document.createElement("input");
+      input.name = name;
+      input.value = state.overrides.get(name) ?? value;
+      input.placeholder = value;
+      input.addEventListener("input", () => {
+        if (input.value === "" || input.value === input.placeholder) state.overrides.delete(name);
+        else state.overrides.set(name, input.value);
+        schedule(0);
+      });
+      label.append(input);
+      definesBox.append(label);
+    }
+  }
+  for (const input of definesBox.querySelectorAll("input")) {
+    const d = found.find((f) => f[0] === input.name);
+    if (d) input.placeholder = d[1];
+  }
+  return new Map(found);
+}
+
+// The slider goes from 0 to the derivation length (a number, or a define).
+function lengthOf(src, defs) {
+  const m = src.match(/derivation\s+length\s*:\s*([A-Za-z_]\w*|\d+)/);
+  if (!m) return null;
+  const v = /^\d+$/.test(m[1]) ? m[1] : state.overrides.get(m[1]) ?? defs.get(m[1]);
+  const n = Number.parseInt(v, 10);
+  return Number.isFinite(n) && n >= 0 ? n : null;
+}
+
+function schedule(ms) {
+  clearTimeout(state.timer);
+  state.timer = setTimeout(render, ms);
+}
+
+async function render() {
+  const src = text.value;
+  const defs = defines(src);
+  const n = lengthOf(src, defs);
+  if (n !== null) {
+    const atEnd = !state.stepsTouched;
+    steps.max = Math.max(n, 0);
+    if (atEnd) steps.value = steps.max;
+  }
+  stepsOut.textContent = steps.value;
+  if (state.inFlight) state.inFlight.abort();
+  const ctl = new AbortController();
+  state.inFlight = ctl;
+  status.className = "";
+  status.textContent = "deriving…";
+  const body = {
+    text: src,
+    steps: n === null ? null : Number(steps.value),
+    defines: [...state.overrides].map(([k, v]) => `${k}=${v}`),
+  };
+  let reply;
+  try {
+    const r = await fetch("/api/render", { method: "POST", body: JSON.stringify(body), signal: ctl.signal,
+                                           headers: { "content-type": "application/json" } });
+    reply = await r.json();
+  } catch (e) {
+    if (e.name === "AbortError") return;
+    reply = { ok: false, messages: [{ severity: "error", message: `the server did not answer: ${e}` }] };
+  }
+  if (state.inFlight !== ctl) return;
+  state.inFlight = null;
+  show(reply);
+}
+
+function show(reply) {
+  const list = reply.messages || [];
+  state.marks = list.filter((m) => m.line && m.program).map((m) => ({
+    line: m.line, col: m.col, endLine: m.end_line || m.line, endCol: m.end_col || m.col + 1,
+    severity: m.severity,
+  }));
+  messages.innerHTML = "";
+  for (const m of list) {
+    const li = document.createElement("li");
+    li.className = m.severity;
+    const where = m.line ? `${m.file}:${m.line}:${m.col}: ` : m.file ? `${m.file}: ` : "";
+    li.textContent = `${where}${m.severity}: ${m.message}`;
+    if (m.line) li.dataset.line = m.line;
+    li.addEventListener("click", () => goTo(m.line, m.col));
+    messages.append(li);
+  }
+  if (reply.ok) {
+    const url = "data:image/svg+xml;charset=utf-8," + encodeURIComponent(reply.svg);
+    let img = picture.querySelector("img");
+    if (!img) { img = document.createElement("img"); img.alt = "the picture"; picture.append(img); }
+    img.src = url;
+    picture.classList.remove("stale");
+    state.version += 1;
+    picture.dataset.version = state.version;
+    status.textContent = `drawn in ${reply.seconds.toFixed(2)} s`;
+  } else {
+    picture.classList.add("stale");
+    status.className = "error";
+    status.textContent = reply.limit ? `stopped by the ${reply.limit} limit` : "error: the last good picture is kept";
+  }
+  paint();
+}
+
+function goTo(line, col) {
+  if (!line) return;
+  const lines = text.value.split("\n");
+  let o = 0;
+  for (let i = 0; i < line - 1 && i < lines.length; i++) o += lines[i].length + 1;
+  o += Math.max(0, (col || 1) - 1);
+  text.focus();
+  text.setSelectionRange(o, o);
+}
+
+text.addEventListener("input", () => { paint(); schedule(150); });
+text.addEventListener("keydown", (e) => {
+  if (e.key === "Tab" && !e.ctrlKey && !e.metaKey) {
+    e.preventDefault();
+    const a = text.selectionStart;
+    text.setRangeText("    ", a, text.selectionEnd, "end");
+    paint(); schedule(150);
+  }
+});
+steps.addEventListener("input", () => {
+  state.stepsTouched = Number(steps.value) !== Number(steps.max);
+  stepsOut.textContent = steps.value;
+  schedule(0);
+});
+$("save").addEventListener("click", async () => {
+  const r = await fetch("/api/save", { method: "POST", body: JSON.stringify({ text: text.value }),
+                                       headers: { "content-type": "application/json" } });
+  const reply = await r.json();
+  status.className = reply.ok ? "" : "error";
+  status.textContent = reply.ok ? "saved" : `not saved: ${reply.message}`;
+});
+
+(async () => {
+  const r = await fetch("/api/source");
+  const src = await r.json();
+  $("file").textContent = src.name;
+  document.title = `${src.name} — subgram`;
+  $("save").hidden = !src.save;
+  text.value = src.text;
+  paint();
+  render();
+})();
