@@ -86,7 +86,8 @@ function paint() {
     errs.id = "marks";
     errs.setAttribute("aria-hidden", "true");
     errs.className = "overlay";
-    highlight.after(errs);
+    // Under the coloured text: the underline shows, the glyphs stay on top.
+    highlight.before(errs);
   }
   errs.innerHTML = marked(src) + "\n";
   const n = src.split("\n").length;

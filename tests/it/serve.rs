@@ -237,3 +237,25 @@ fn with_save_the_page_writes_the_program_back_and_nothing_else() {
     let (_, source) = request(&addr, "GET", "/api/source", "");
     assert!(source.contains("derivation length: 2"));
 }
+
+/// A surface grammar on the page: the shaded mesh, one polygon per face
+/// of the subdivided octahedron (8 · 4² after two Loop steps), its base
+/// mesh read from the disk as the grammar names it.
+#[test]
+fn a_surface_grammar_shows_its_shaded_mesh() {
+    let mesh = crate::support::root().join("lsystems/meshes/octahedron.obj");
+    let grammar = std::fs::read_to_string(crate::support::lsys("surfaces/loop.lsys"))
+        .unwrap()
+        .replace(
+            "mesh: \"../meshes/octahedron.obj\";",
+            &format!("mesh: {:?};", mesh.to_str().unwrap()),
+        );
+    assert!(grammar.contains(mesh.to_str().unwrap()));
+    let (addr, _dir) = start("surface", &grammar, false, Limits::default());
+    let r = render(&addr, &grammar, ", \"steps\": 2");
+    assert_eq!(r["ok"], true, "{r}");
+    assert_eq!(
+        r["svg"].as_str().unwrap().matches("<polygon").count(),
+        8 * 16
+    );
+}
