@@ -100,6 +100,43 @@ enum Command {
         #[arg(long, value_name = "SECONDS", default_value_t = 10)]
         timeout: u64,
     },
+    /// Infer L-system productions from a subdivision matrix or mask
+    /// (paper 002, sections 5-7).
+    Infer {
+        /// The matrix, rows separated by `;`: a whole closed matrix, one old
+        /// point's band of rows ("1/4 3/4 0; 0 3/4 1/4"), or with --open a
+        /// matrix with boundary rows.
+        #[arg(long, allow_hyphen_values = true)]
+        rows: Option<String>,
+        /// The matrix from a file, a row per line.
+        #[arg(long, value_name = "FILE")]
+        rows_file: Option<String>,
+        /// A mask: "1/4 3/4 3/4 1/4" (new_j = sum a_(j - arity i) old_i).
+        #[arg(long, allow_hyphen_values = true)]
+        mask: Option<String>,
+        /// New points per old point, for a mask [default: 2].
+        #[arg(long)]
+        arity: Option<usize>,
+        /// The matrix has boundary rows: endmarker productions.
+        #[arg(long)]
+        open: bool,
+        /// A reverse subdivision matrix: a pseudo-L-system production.
+        #[arg(long)]
+        reverse: bool,
+        /// The grouping to write (old point i takes new points
+        /// a*i+d-a+1 ..= a*i+d); by default the shortest symmetric one.
+        #[arg(long, allow_hyphen_values = true)]
+        shift: Option<i64>,
+        /// List every grouping with its context sizes instead.
+        #[arg(long)]
+        list: bool,
+        /// Open schemes: the short form whose productions apply first to last.
+        #[arg(long)]
+        ordered: bool,
+        /// Write the .lsys file here (atomically) instead of printing it.
+        #[arg(short = 'o', long = "output")]
+        output: Option<String>,
+    },
     /// Reverse-subdivide a contour into a compact control polygon.
     Reverse {
         /// Points (`x y` or CSV), an SVG shape, or a PNG silhouette.
@@ -509,6 +546,32 @@ fn run(cli: Cli) -> Result<(), Error> {
             print_program_output(&args.program_output, false)?;
             print_warnings(&result?);
             Ok(())
+        }
+        Command::Infer {
+            rows,
+            rows_file,
+            mask,
+            arity,
+            open,
+            reverse,
+            shift,
+            list,
+            ordered,
+            output,
+        } => {
+            let args = command::InferArgs {
+                rows,
+                rows_file,
+                mask,
+                arity,
+                open,
+                reverse,
+                shift,
+                list,
+                ordered,
+                output,
+            };
+            print_out(&command::infer(&args)?)
         }
         Command::Serve {
             file,

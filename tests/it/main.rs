@@ -11,6 +11,7 @@ mod fuzz_replay;
 mod gillespie;
 mod golden;
 mod golden_tests;
+mod infer;
 mod lang_features;
 mod limits;
 mod lpfg_agreement;
