@@ -501,6 +501,7 @@ pub fn infer(a: &InferArgs) -> Result<String, Error> {
         let c = infer::infer_closed(&matrix, None)?.chosen;
         let r = matrix.rows.len() as i64;
         matrix.rows.rotate_left(c.rem_euclid(r) as usize);
+        let mask = mask.split_whitespace().collect::<Vec<_>>().join(" ");
         (format!("the mask {mask}"), matrix)
     } else {
         let (name, text) = match (&a.rows, &a.rows_file) {
@@ -537,7 +538,10 @@ pub fn infer(a: &InferArgs) -> Result<String, Error> {
             infer::band_matrix(&m, (4 * m.cols + 8).max(16))
         };
         let what = if a.rows.is_some() {
-            format!("the rows {}", text.trim())
+            format!(
+                "the rows {}",
+                text.split_whitespace().collect::<Vec<_>>().join(" ")
+            )
         } else {
             format!("the matrix in {name}")
         };
