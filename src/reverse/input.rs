@@ -664,7 +664,9 @@ pub fn read_png_with(name: &str, bytes: &[u8], silhouette: &Silhouette) -> Resul
         };
         return Err(Error::file(
             name,
-            format!("the image has no {shade} shape to trace (nothing {than} the threshold {t})"),
+            format!(
+                "the image has no {shade} shape to trace (nothing {than} the threshold {t}; --threshold moves it)"
+            ),
         ));
     };
     // The outline of a shape that fills the image runs along its frame.
