@@ -147,3 +147,49 @@ fn chaikin_in_3d_double_is_the_same_word_for_any_number_of_threads() {
     assert!(bits(&word) == want);
     same_error_in_every_pool(&l.program);
 }
+
+/// The word written as text and as JSON (issue 16, item 1): tasks of
+/// 32,768 modules formatted on the pool a round at a time and written in
+/// order, so the 196,608 modules here make six tasks, which neither two
+/// nor three threads share evenly. The bytes are the same for 1, 2 and 3
+/// threads; the JSON is valid, and every number in it reads back as the
+/// word's value (single precision: the `f32` that the slot holds).
+#[test]
+fn text_and_json_are_the_same_bytes_for_any_number_of_threads() {
+    let l = load(&lsys("curves/chaikin-13.lsys"));
+    let word = pool(1).install(|| {
+        subgram::derive(&l.program, DeriveOptions::default().with_steps(STEPS))
+            .expect("derives")
+            .word
+    });
+    assert_eq!(word.len(), 196_608);
+    let (a, s) = (&l.program.alphabet, &l.program.structs);
+    let outputs: Vec<(Vec<u8>, Vec<u8>)> = [1, 2, 3]
+        .iter()
+        .map(|&k| {
+            pool(k).install(|| {
+                let mut text = Vec::new();
+                subgram::output::write_word_text(&mut text, &word, a, s).unwrap();
+                let mut json = Vec::new();
+                subgram::output::write_word_json(&mut json, &word, true, STEPS, a, s).unwrap();
+                (text, json)
+            })
+        })
+        .collect();
+    for (k, o) in outputs.iter().enumerate().skip(1) {
+        assert!(o.0 == outputs[0].0, "text with {} threads", k + 1);
+        assert!(o.1 == outputs[0].1, "JSON with {} threads", k + 1);
+    }
+    let v: serde_json::Value = serde_json::from_slice(&outputs[0].1).unwrap();
+    let modules = v["modules"].as_array().unwrap();
+    assert_eq!(modules.len(), word.len());
+    for (i, m) in modules.iter().enumerate() {
+        let xy = m["params"][0].as_array().unwrap();
+        let got: Vec<f32> = xy.iter().map(|x| x.as_f64().unwrap() as f32).collect();
+        let want: Vec<f32> = word.data(i).iter().map(|&x| x as f32).collect();
+        assert_eq!(got, want, "module {i}");
+    }
+    // The text has one module per space-separated word.
+    let text = String::from_utf8(outputs[0].0.clone()).unwrap();
+    assert_eq!(text.matches("P(").count(), word.len());
+}
