@@ -503,7 +503,8 @@ pub(crate) trait Sink {
         Ok(())
     }
     /// `SetWidth` (after the pen took it) and the modules of
-    /// [`Cmd::Shape`], with the module's parameters.
+    /// [`Cmd::Shape`], with the module's parameters as numbers (missing
+    /// ones 0).
     fn shape(&mut self, _t: &Turtle, _cmd: Option<Shaping>, _d: &[f64]) -> Result<(), String> {
         Ok(())
     }
@@ -737,7 +738,18 @@ pub(crate) fn walk<S: Sink>(
                 t.pen.width = arg(0, 1.0);
                 sink.shape(&t, None, d).map_err(|m| at(i, m))?;
             }
-            Cmd::Shape(s) => sink.shape(&t, Some(s), d).map_err(|m| at(i, m))?,
+            Cmd::Shape(s) => {
+                // Integer parameters (contour ids, sides) are decoded from
+                // the word; these modules are few.
+                let mut args = [0.0; 3];
+                for (a, v) in args.iter_mut().zip(word.values(i, alphabet, structs)) {
+                    *a = match v {
+                        Value::Int(n) => n as f64,
+                        v => v.as_f64(),
+                    };
+                }
+                sink.shape(&t, Some(s), &args).map_err(|m| at(i, m))?
+            }
             Cmd::Push => {
                 stack.push(t.clone());
                 sink.push();

@@ -60,7 +60,7 @@ use super::{walk, DrawError, DrawOptions, Round, Shaping, Sink, Turtle};
 use crate::lang::value::StructDef;
 use crate::lang::Alphabet;
 use crate::model::view::{LineStyle, DEFAULT_CONTOUR_SIDES, MAX_CONTOUR_SIDES, MIN_CONTOUR_SIDES};
-use crate::model::{Colours, Model};
+use crate::model::{Colours, Contour, Model};
 use crate::rewrite::Word;
 use crate::scene3::{Look, Scene3, TriMesh};
 
@@ -408,14 +408,11 @@ impl<'m> Builder<'m> {
         if self.sections.len() >= 64 {
             self.sections.clear();
         }
-        let contours = &self.model.contours;
         let sample = |id: usize| {
-            let c = &contours[id];
-            let c = if c.samples == key.samples as usize {
-                std::borrow::Cow::Borrowed(c)
-            } else {
-                std::borrow::Cow::Owned(c.resampled(key.samples as usize))
-            };
+            let mut c = self.contour(id);
+            if c.samples != key.samples as usize {
+                c = std::borrow::Cow::Owned(c.resampled(key.samples as usize));
+            }
             let mut pts: Vec<[f64; 2]> = c
                 .vertices
                 .iter()
@@ -652,12 +649,22 @@ impl<'m> Builder<'m> {
         }
     }
 
+    /// Contour `id` of the model (checked), 0 lpfg's circle.
+    fn contour(&self, id: usize) -> std::borrow::Cow<'_, Contour> {
+        match self.model.contours.get(id) {
+            Some(c) => std::borrow::Cow::Borrowed(c),
+            // A model made in code may lack the circle that
+            // `Model::read` puts first.
+            None => std::borrow::Cow::Owned(Contour::default_circle()),
+        }
+    }
+
     /// The samples of a generalized cylinder starting now.
     fn gc_samples(&self) -> u32 {
         if let Some(s) = self.cur.sides {
             return s + 1;
         }
-        let c = &self.model.contours[self.cur.contour];
+        let c = self.contour(self.cur.contour);
         if c.samples_given {
             c.samples as u32
         } else {
@@ -1047,7 +1054,7 @@ impl Sink for Builder<'_> {
 
     fn shape(&mut self, t: &Turtle, cmd: Option<Shaping>, d: &[f64]) -> Result<(), String> {
         let arg = |k: usize| d.get(k).copied().unwrap_or(0.0);
-        let contours = self.model.contours.len();
+        let contours = self.model.contours.len().max(1);
         let contour = |v: f64| -> Result<usize, String> {
             if v >= 0.0 && (v as usize) < contours {
                 Ok(v as usize)

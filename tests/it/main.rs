@@ -29,6 +29,7 @@ mod render;
 mod reverse;
 mod semantics;
 mod shapes;
+mod solid;
 mod support;
 mod surface;
 mod surface_adaptive;
