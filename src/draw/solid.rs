@@ -382,6 +382,7 @@ impl<'m> Builder<'m> {
         if m.positions.len() + v > u32::MAX as usize {
             return Err("makes a mesh of more than 2^32 vertices".into());
         }
+        // Large meshes grow into huge pages (fewer page faults).
         m.positions.reserve(v);
         m.normals.reserve(v);
         m.triangles.reserve(t);
@@ -470,12 +471,18 @@ impl<'m> Builder<'m> {
             }
         }
         let s = std::mem::take(slot(self, tube, sec));
+        // Unit section normals stay unit under a uniform scale.
+        let uniform = sx == sy;
         let result = self.room(mesh, s.points.len(), 0).map(|m| {
             let base = m.positions.len() as u32;
             for (p, q) in s.points.iter().zip(&s.normals) {
                 m.positions.push((c + ls * p[0] + us * p[1]).as_vec3());
-                m.normals
-                    .push((ln * q[0] + un * q[1]).normalize_or_zero().as_vec3());
+                let n = if uniform {
+                    l * q[0] + u * q[1]
+                } else {
+                    (ln * q[0] + un * q[1]).normalize_or_zero()
+                };
+                m.normals.push(n.as_vec3());
             }
             base
         });
