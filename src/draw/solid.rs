@@ -1,5 +1,5 @@
 //! The turtle's 3D geometry: the same walk as the 2D drawing
-//! ([`super::walk`]), with a sink that makes shaded triangle meshes
+//! (`draw::walk`), with a sink that makes shaded triangle meshes
 //! ([`Scene3`]) instead of events.
 //!
 //! What each module makes (lpfg's manual, §5.5 to §5.8 and §8.1.3):
