@@ -337,7 +337,9 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
             view.capped_cylinders = match ws.first().map(|w| w.text) {
                 Some("on") => true,
                 Some("off") => false,
-                Some(_) => return Err(lines.error(ws[0], "expected `on` or `off`")),
+                Some(w) => {
+                    return Err(lines.error(ws[0], format!("expected `on` or `off`, found `{w}`")))
+                }
                 None => return Err(lines.error_at_end("expected `on` or `off`")),
             };
             continue;

@@ -109,19 +109,20 @@ fn d(v: Vec3) -> DVec3 {
     v.as_dvec3()
 }
 
-/// Every triangle's face normal agrees with its vertices' normals: the
-/// winding faces the side the normals give.
+/// Every triangle's face normal agrees with the mean of its vertices'
+/// normals: the winding faces the side the normals give. (Each vertex's
+/// normal alone may lean past 90 degrees where a coarse section turns
+/// sharply.)
 fn assert_wound_with_normals(m: &TriMesh) {
     assert_eq!(m.normals.len(), m.positions.len());
     for t in &m.triangles {
         let [a, b, c] = t.map(|i| d(m.positions[i as usize]));
         let face = (b - a).cross(c - a);
-        for &i in t {
-            assert!(
-                face.dot(d(m.normals[i as usize])) > 0.0,
-                "triangle {t:?} is wound against its normals"
-            );
-        }
+        let mean: DVec3 = t.iter().map(|&i| d(m.normals[i as usize])).sum();
+        assert!(
+            face.dot(mean) > 0.0,
+            "triangle {t:?} is wound against its normals"
+        );
     }
 }
 
@@ -503,6 +504,9 @@ fn a_generalized_cylinder_keeps_its_section_on_a_twisting_path() {
         }
     }
     assert_eq!(strips, 4 * 16);
+    // The contour runs counter-clockwise, lpfg's circle clockwise: either
+    // way the triangles face where the normals point.
+    assert_wound_with_normals(m);
 }
 
 #[test]
@@ -562,4 +566,77 @@ fn a_runaway_word_stops_at_the_limit_and_huge_widths_are_refused() {
     let mut run = c.run(Default::default()).unwrap();
     let e = run.solid(&SolidOptions::default()).unwrap_err().to_string();
     assert!(e.contains("infinite coordinate"), "{e}");
+}
+
+#[test]
+fn a_generalized_cylinder_goes_on_into_branches_and_from_pointgc() {
+    // Contour 0, lpfg's circle, sampled at 8 + 1 points: 8 a ring.
+    let gc = |body: &str| {
+        solid_of(
+            &format!("derivation length: 0;\nAxiom: {body};\n"),
+            cylinders(8, false),
+        )
+    };
+    // The branch draws from the cylinder's section where it started, and
+    // after `EB` the cylinder goes on from there too (lpfg): four rings
+    // (start, branch point, the branch's end, the axis' end), three
+    // strips.
+    let s = gc("StartGC() F(1) SB() Left(30) F(1) EB() F(1) EndGC()");
+    let m = only_mesh(&s);
+    assert_eq!((m.positions.len(), m.triangles.len()), (4 * 8, 3 * 16));
+    // `PointGC` moves the section without drawing: the strip after it
+    // starts at the turtle there.
+    let s = gc("StartGC() F(1) f(1) PointGC() F(1) EndGC()");
+    let m = only_mesh(&s);
+    assert_eq!(m.triangles.len(), 2 * 16);
+    let ys: Vec<f32> = m
+        .positions
+        .iter()
+        .map(|p| (p.y * 1e4).round() / 1e4)
+        .collect();
+    for y in [0.0, 1.0, 2.0, 3.0] {
+        assert_eq!(
+            ys.iter().filter(|v| **v == y).count(),
+            8,
+            "a ring at y = {y}"
+        );
+    }
+    // Outside `cylinder` style, lpfg ignores generalized cylinders.
+    let s = solid_of(
+        "derivation length: 0;\nAxiom: StartGC() F(1) EndGC();\n",
+        Model::default(),
+    );
+    assert_eq!(s.triangle_count(), 0);
+}
+
+#[test]
+fn tubes_follow_the_path_that_tropism_bends() {
+    let path = models("solid-tropism");
+    let c = match subgram::load(&path, &LoadOptions::default()) {
+        Ok(System::Curve(c)) => c,
+        _ => panic!("loads"),
+    };
+    let mut run = c.run(Default::default()).unwrap();
+    let s = run.solid(&SolidOptions::default()).unwrap();
+    let events = run.events().unwrap();
+    let mut points: Vec<DVec3> = Vec::new();
+    for e in &events {
+        for (a, b) in e.segments() {
+            points.extend([a, b]);
+        }
+    }
+    // The bend is real: the path leaves the y axis.
+    assert!(points.iter().any(|p| p.x > 0.1), "{points:?}");
+    let m = only_mesh(&s);
+    // Six rings on the axis (five segments, through the branch point),
+    // three on the branch.
+    assert_eq!(m.positions.len(), 9 * 8);
+    for ring in m.positions.chunks(8) {
+        let centre = ring.iter().map(|v| d(*v)).sum::<DVec3>() / 8.0;
+        let on = points.iter().any(|p| p.distance(centre) < 1e-5);
+        assert!(on, "a ring centred at {centre}, off the turtle's path");
+        for v in ring {
+            assert!((d(*v).distance(centre) - 0.1).abs() < 1e-5);
+        }
+    }
 }
