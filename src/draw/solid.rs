@@ -38,7 +38,8 @@
 //!   of the `.s` file placed as in the 2D drawing (contact point at the
 //!   turtle, heading and up on the turtle's) and cut into s × t quads (the
 //!   view file's `sdiv tdiv`, `SetUPrecision`/`SetVPrecision`, else lpfg's
-//!   10 × 10), with normals from the patch's derivatives.
+//!   10 × 10; s runs down the rows of control points, t along a row, as in
+//!   lpfg's own OBJ output), with normals from the patch's derivatives.
 //! * `Sphere(r)`, `Sphere0()`: `contour sides` slices and (sides + 1) / 2
 //!   stacks about the turtle's heading. `Circle(r)`, `Circle0()`: discs in
 //!   the HL plane; `CircleFront(r)`, `CircleFront0()`: in the plane facing
@@ -997,10 +998,13 @@ impl Sink for Builder<'_> {
         s: &crate::model::Surface,
         scale: DVec3,
     ) -> Result<(), String> {
+        // lpfg's s (`sdiv`, the U precision) runs down the rows of control
+        // points, t (`tdiv`, V) along a row: its OBJ output of the test
+        // surface has them so.
         let def = crate::model::surface::DEFAULT_DIVISIONS;
-        let (su, sv) = s.divisions.unwrap_or((def, def));
-        let nu = self.cur.precision.0.unwrap_or(su).max(1) as usize;
-        let nv = self.cur.precision.1.unwrap_or(sv).max(1) as usize;
+        let (ds, dt) = s.divisions.unwrap_or((def, def));
+        let nv = self.cur.precision.0.unwrap_or(ds).max(1) as usize;
+        let nu = self.cur.precision.1.unwrap_or(dt).max(1) as usize;
         let place = super::placement(s, t, scale);
         // Tangents map linearly: the placement less its translation.
         let origin = place.point([0.0; 3]);

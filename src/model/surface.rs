@@ -32,8 +32,9 @@ pub struct Surface {
     pub size: f64,
     /// The view file's scale for this surface (`surface: leaf.s 2`).
     pub scale: f64,
-    /// The view file's divisions of each patch along s (a row) and t
-    /// (down the rows); lpfg's default, 10 × 10, when `None`.
+    /// The view file's divisions of each patch along s (down the rows of
+    /// control points) and t (along a row); lpfg's default, 10 × 10, when
+    /// `None`.
     pub divisions: Option<(u32, u32)>,
     pub patches: Vec<Patch>,
 }

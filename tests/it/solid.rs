@@ -424,6 +424,21 @@ fn bezier_patches_are_tessellated_on_the_turtles_frame() {
     let place = |q: DVec3| f.p + linear(q);
     for patch in &surface.patches {
         let net: [[DVec3; 4]; 4] = patch.points.map(|r| r.map(DVec3::from_array));
+        // s (`sdiv`, 4) down the rows of control points, t (`tdiv`, 2)
+        // along a row, as lpfg's own OBJ output of this surface has them
+        // (see `lpfg_draws_the_same_cylinder_and_surface`): every grid
+        // point is a vertex.
+        for i in 0..=4 {
+            for j in 0..=2 {
+                let (p, _, _) = patch_point(&net, j as f64 / 2.0, i as f64 / 4.0);
+                let (_, dist) = nearest(m, place(p));
+                assert!(
+                    dist < 1e-5,
+                    "patch {} at s {i}/4, t {j}/2: off by {dist}",
+                    patch.name
+                );
+            }
+        }
         for (u, v) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)] {
             let (p, pu, pv) = patch_point(&net, u, v);
             let (i, dist) = nearest(m, place(p));
@@ -637,6 +652,60 @@ fn tubes_follow_the_path_that_tropism_bends() {
         assert!(on, "a ring centred at {centre}, off the turtle's path");
         for v in ring {
             assert!((d(*v).distance(centre) - 0.1).abs() < 1e-5);
+        }
+    }
+}
+
+/// The vertices and the number of triangles (a quad counted as two) of an
+/// OBJ file that lpfg wrote.
+fn lpfg_obj(path: PathBuf) -> (Vec<DVec3>, usize) {
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut v = Vec::new();
+    let mut triangles = 0;
+    for line in text.lines() {
+        let w: Vec<&str> = line.split_whitespace().collect();
+        match w.first() {
+            Some(&"v") => v.push(DVec3::new(
+                w[1].parse().unwrap(),
+                w[2].parse().unwrap(),
+                w[3].parse().unwrap(),
+            )),
+            Some(&"f") => triangles += w.len() - 3,
+            _ => {}
+        }
+    }
+    (v, triangles)
+}
+
+/// lpfg's own geometry of `gc.l` and `leaf.l`, written by lpfg (vlab
+/// commit 9bf820d, under Xvfb: `lpfg -w 400 400 view.v section.con
+/// material.mat leaf.s PROGRAM.l -out PROGRAM.obj`) into
+/// tests/data/models/solid/lpfg/ with six significant digits: the same
+/// points (lpfg shares the vertices that subgram repeats for caps and
+/// between patches) and the same number of triangles.
+#[test]
+fn lpfg_draws_the_same_cylinder_and_surface() {
+    for program in ["gc", "leaf"] {
+        let (_, scene) = model_solid(models(&format!("solid/{program}.l")));
+        let m = only_mesh(&scene);
+        let (theirs, triangles) = lpfg_obj(models(&format!("solid/lpfg/{program}.obj")));
+        assert_eq!(m.triangles.len(), triangles, "{program}");
+        for p in &theirs {
+            let (_, dist) = nearest(m, *p);
+            assert!(
+                dist < 1e-5,
+                "{program}: lpfg's vertex {p} is {dist} from ours"
+            );
+        }
+        for q in &m.positions {
+            let dist = theirs
+                .iter()
+                .map(|p| p.distance(d(*q)))
+                .fold(f64::MAX, f64::min);
+            assert!(
+                dist < 1e-5,
+                "{program}: our vertex {q} is {dist} from lpfg's"
+            );
         }
     }
 }
