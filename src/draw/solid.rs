@@ -925,7 +925,11 @@ impl Sink for Builder<'_> {
 
     fn round(&mut self, t: &Turtle, kind: Round, r: f64) -> Result<(), String> {
         let w = t.pen.width.abs();
-        let r = if kind.is_dot() { 0.5 * w } else { r.abs() };
+        let r = if kind.is_dot() { 0.5 * t.pen.width } else { r };
+        // lpfg draws no circle or sphere of a radius that is not positive.
+        if r <= 0.0 {
+            return Ok(());
+        }
         if !fits(t.pos, r + w) {
             return Err("draws a circle that reaches an infinite coordinate".into());
         }

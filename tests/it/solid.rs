@@ -616,6 +616,9 @@ fn a_generalized_cylinder_goes_on_into_branches_and_from_pointgc() {
             "a ring at y = {y}"
         );
     }
+    // lpfg draws no circle or sphere of a radius that is not positive.
+    let s = gc("Circle(0) Sphere(-1) CircleB(0) SetWidth(0) Sphere0()");
+    assert_eq!(s.triangle_count(), 0);
     // Outside `cylinder` style, lpfg ignores generalized cylinders.
     let s = solid_of(
         "derivation length: 0;\nAxiom: StartGC() F(1) EndGC();\n",
