@@ -712,3 +712,40 @@ fn lpfg_draws_the_same_cylinder_and_surface() {
         }
     }
 }
+
+#[test]
+fn a_blended_contour_lies_between_its_two_and_a_missing_one_is_an_error() {
+    let path = models("solid/missing-contour.l");
+    let c = match subgram::load(&path, &LoadOptions::default()) {
+        Ok(System::Curve(c)) => c,
+        _ => panic!("loads"),
+    };
+    let mut run = c.run(Default::default()).unwrap();
+    let e = run.solid(&SolidOptions::default()).unwrap_err().to_string();
+    // The model has contours 0 (lpfg's circle) and 1 (`section`).
+    assert!(
+        e.contains("module 2 of the interpreted word, `CurrentContour`, names contour 5, but the model has contours 0 to 1"),
+        "{e}"
+    );
+    // `BlendedContour(section, 0, 0.25)` is 3/4 of `section` (9 samples,
+    // 8 a ring) and 1/4 of lpfg's circle sampled alike, point by point:
+    // (sin, cos) of i/8 turns.
+    let (c, s) = model_solid(models("solid/blend.l"));
+    let m = only_mesh(&s);
+    let section = &c.program.model.contours[1];
+    for (k, y) in [(0, 0.0), (1, 1.0)] {
+        for i in 0..8 {
+            let (sn, cs) = (std::f64::consts::TAU * i as f64 / 8.0).sin_cos();
+            let v = section.vertices[i];
+            let (x, z) = (
+                0.75 * v[0] as f64 + 0.25 * sn,
+                0.75 * v[1] as f64 + 0.25 * cs,
+            );
+            // `ScaleContour(2, 2)`: a contour unit is one unit; left is
+            // −x, up +z.
+            let p = DVec3::new(-x, y, z);
+            let (_, dist) = nearest(m, p);
+            assert!(dist < 1e-5, "ring {k} point {i} off by {dist}");
+        }
+    }
+}
