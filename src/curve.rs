@@ -177,6 +177,16 @@ impl Curve {
         Ok(self.figures(opts)?.main)
     }
 
+    /// Derives (see [`Curve::run`]) and makes the 3D geometry of the
+    /// main view's interpreted word: [`CurveRun::solid`] in one call.
+    pub fn solid(
+        &self,
+        derive: DeriveOptions,
+        sopts: &draw::solid::SolidOptions,
+    ) -> Result<Scene3, Error> {
+        self.run(derive)?.solid(sopts)
+    }
+
     /// Derives once and lays out the picture of every view: the main view
     /// (the interpretation rules outside any `vgroup`), and each view that
     /// `UseView` activated (the rules after its `vgroup`), in the order of

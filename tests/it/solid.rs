@@ -92,11 +92,9 @@ fn model_solid(path: PathBuf) -> (subgram::Curve, Scene3) {
         Ok(_) => panic!("{} is not an L-system", path.display()),
         Err(e) => panic!("{} does not load:\n{e}", path.display()),
     };
-    let scene = {
-        let mut run = c.run(Default::default()).unwrap_or_else(|e| panic!("{e}"));
-        run.solid(&SolidOptions::default())
-            .unwrap_or_else(|e| panic!("{e}"))
-    };
+    let scene = c
+        .solid(Default::default(), &SolidOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
     (c, scene)
 }
 
