@@ -645,7 +645,13 @@ pub(crate) fn walk<S: Sink>(
                 _ => DVec3::ZERO,
             }
         };
-        if d.iter().any(|x| !x.is_finite()) && cmd != Cmd::None && !matches!(cmd, Cmd::Query(_)) {
+        // An integer parameter is held as its bits, which may read as a
+        // NaN (`SetColor(-1)`): only the decoded numbers are checked then.
+        if d.iter().any(|x| !x.is_finite())
+            && cmd != Cmd::None
+            && !matches!(cmd, Cmd::Query(_))
+            && !word.values(i, alphabet, structs).iter().all(finite)
+        {
             return Err(DrawError {
                 message: format!(
                     "module {} of the word, `{}`, has a NaN or infinite parameter and cannot be drawn",
@@ -952,6 +958,17 @@ fn surface_events(s: &crate::model::Surface, t: &Turtle, scale: DVec3, out: &mut
             points: ring.into_iter().map(|p| place.point(p)).collect(),
             color: t.pen.color,
         });
+    }
+}
+
+/// True when every number of `v` is finite.
+fn finite(v: &Value) -> bool {
+    match v {
+        Value::Float(x) => x.is_finite(),
+        Value::V2(p) => p.is_finite(),
+        Value::V3(p) => p.is_finite(),
+        Value::Struct(fs) => fs.iter().all(finite),
+        _ => true,
     }
 }
 

@@ -747,3 +747,24 @@ fn a_blended_contour_lies_between_its_two_and_a_missing_one_is_an_error() {
         }
     }
 }
+
+#[test]
+fn negative_integer_parameters_are_numbers_not_nans() {
+    // Manual 5.3: `SetColor(n)` with n < 1 is ignored, so the sphere keeps
+    // colour 1. (A negative int in the word once read as a NaN.)
+    let s = solid_of(
+        "derivation length: 0;\nAxiom: SetColor(-1) Sphere(1);\n",
+        Model::default(),
+    );
+    assert_eq!(s.looks[0].index, 1);
+    let mut c = load_text("derivation length: 0;\nAxiom: CurrentContour(-1);\n");
+    c.program.model = Arc::new(cylinders(8, false));
+    let e = c
+        .solid(Default::default(), &SolidOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("names contour -1, but the model has contours 0 to 0"),
+        "{e}"
+    );
+}
