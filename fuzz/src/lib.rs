@@ -103,6 +103,7 @@ pub fn lsys_derive(data: &[u8]) {
         line_style: Some(subgram::model::view::LineStyle::Cylinder),
         max_triangles: 200_000,
         max_vertices: 200_000,
+        pixel_tubes: None,
     };
     match run.solid(&sopts) {
         Ok(scene) => {

@@ -19,7 +19,9 @@
 //!   `capped cylinders: on` tube ends are closed by discs. With
 //!   `line style: polygon` a line is a flat band of the line width facing
 //!   the default viewer (+z); with `pixel` (the default) lines make no
-//!   triangles.
+//!   triangles, unless [`SolidOptions::pixel_tubes`] gives the model units
+//!   of a pixel, which makes them tubes of that many units per pixel of
+//!   width.
 //! * Generalized cylinders (`StartGC`, `F` ..., `PointGC`, `EndGC`; only
 //!   with `line style: cylinder`, as in lpfg) sweep the current contour
 //!   (`CurrentContour`, `BlendedContour`; contour 0 is lpfg's circle) in
@@ -80,6 +82,11 @@ pub struct SolidOptions {
     /// The line style; `None`: the model's view file's (`pixel` without
     /// one).
     pub line_style: Option<LineStyle>,
+    /// In `pixel` line style, where lpfg draws lines a number of pixels
+    /// wide, make them tubes anyway: their diameter is the line width
+    /// times this many model units per pixel (the caller knows the
+    /// picture's scale). `None`: such lines make no triangles.
+    pub pixel_tubes: Option<f64>,
     /// More triangles than this stop the walk with an error.
     pub max_triangles: usize,
     /// More vertices than this stop the walk with an error.
@@ -90,6 +97,7 @@ impl Default for SolidOptions {
     fn default() -> Self {
         SolidOptions {
             line_style: None,
+            pixel_tubes: None,
             max_triangles: MAX_TRIANGLES,
             max_vertices: MAX_VERTICES,
         }
@@ -246,6 +254,7 @@ struct Branch {
 struct Builder<'m> {
     model: &'m Model,
     style: LineStyle,
+    pixel_tubes: Option<f64>,
     sides: u32,
     capped: bool,
     scene: Scene3,
@@ -299,6 +308,7 @@ impl<'m> Builder<'m> {
         Builder {
             model,
             style: sopts.line_style.unwrap_or(model.line_style),
+            pixel_tubes: sopts.pixel_tubes.filter(|k| k.is_finite() && *k > 0.0),
             sides,
             capped: model.capped_cylinders,
             scene: Scene3::default(),
@@ -892,7 +902,16 @@ fn triangulate(pts: &[DVec3], normal: DVec3) -> Vec<[u32; 3]> {
 impl Sink for Builder<'_> {
     fn line(&mut self, t: &Turtle, a: DVec3, b: DVec3) -> Result<(), String> {
         match self.style {
-            LineStyle::Pixel => Ok(()),
+            LineStyle::Pixel => match self.pixel_tubes {
+                Some(k) => {
+                    let scale = self.cur.scale;
+                    self.cur.scale = (scale.0 * k, scale.1 * k);
+                    let made = self.tube(t, a, b);
+                    self.cur.scale = scale;
+                    made
+                }
+                None => Ok(()),
+            },
             LineStyle::Cylinder => match self.cur.gc {
                 Some(g) => self.gc_segment(t, g),
                 None => self.tube(t, a, b),

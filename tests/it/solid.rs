@@ -768,3 +768,32 @@ fn negative_integer_parameters_are_numbers_not_nans() {
         "{e}"
     );
 }
+
+#[test]
+fn pixel_lines_become_tubes_only_when_asked_with_the_size_of_a_pixel() {
+    let src = "derivation length: 0;\nAxiom: SetWidth(3) F(1) F(1);\n";
+    let mut c = load_text(src);
+    c.program.model = Arc::new(Model::default());
+    let none = c
+        .solid(Default::default(), &SolidOptions::default())
+        .unwrap();
+    assert_eq!(none.triangle_count(), 0);
+    // 3 pixels at 0.01 units a pixel: radius 0.015; lpfg's 16 sides.
+    let s = c
+        .solid(
+            Default::default(),
+            &SolidOptions {
+                pixel_tubes: Some(0.01),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    let m = only_mesh(&s);
+    assert_eq!((m.positions.len(), m.triangles.len()), (3 * 16, 2 * 2 * 16));
+    for (k, ring) in m.positions.chunks(16).enumerate() {
+        for v in ring {
+            let r = d(*v) - DVec3::new(0.0, k as f64, 0.0);
+            assert!((r.length() - 0.015).abs() < 1e-7 && r.y.abs() < 1e-7);
+        }
+    }
+}
