@@ -9,6 +9,7 @@ use crate::lang::Program;
 use crate::render;
 use crate::rewrite::derive::{rule_kind, Maker, MAX_STEPS};
 use crate::rewrite::{Derivation, DeriveError, DeriveOptions, Derived, Word};
+use crate::scene3::Scene3;
 use crate::syntax::{Diagnostic, FileId, SourceMap};
 
 /// A checked curve L-system together with the sources its spans point into.
@@ -176,6 +177,16 @@ impl Curve {
         Ok(self.figures(opts)?.main)
     }
 
+    /// Derives (see [`Curve::run`]) and makes the 3D geometry of the
+    /// main view's interpreted word: [`CurveRun::solid`] in one call.
+    pub fn solid(
+        &self,
+        derive: DeriveOptions,
+        sopts: &draw::solid::SolidOptions,
+    ) -> Result<Scene3, Error> {
+        self.run(derive)?.solid(sopts)
+    }
+
     /// Derives once and lays out the picture of every view: the main view
     /// (the interpretation rules outside any `vgroup`), and each view that
     /// `UseView` activated (the rules after its `vgroup`), in the order of
@@ -306,6 +317,34 @@ impl<'c> CurveRun<'c> {
     /// polygons, in 3D.
     pub fn events(&mut self) -> Result<Vec<Event>, Error> {
         let curve = self.curve;
+        let opts = self.draw_options()?;
+        let word = self.interpreted()?;
+        let p = &curve.program;
+        draw::draw(&word, &p.alphabet, &p.structs, &opts).map_err(|e| {
+            let maker = (e.module).and_then(|m| self.maker(&word, m));
+            curve.draw_error(e, self.step(), maker)
+        })
+    }
+
+    /// The 3D geometry the turtle makes from the interpreted word (tubes,
+    /// surfaces, generalized cylinders, polygons, spheres, discs), one
+    /// triangle mesh per colour or material of the model: see
+    /// [`draw::solid`].
+    pub fn solid(&mut self, sopts: &draw::solid::SolidOptions) -> Result<Scene3, Error> {
+        let curve = self.curve;
+        let opts = self.draw_options()?;
+        let word = self.interpreted()?;
+        let p = &curve.program;
+        draw::solid::solid(&word, &p.alphabet, &p.structs, &opts, sopts).map_err(|e| {
+            let maker = (e.module).and_then(|m| self.maker(&word, m));
+            curve.draw_error(e, self.step(), maker)
+        })
+    }
+
+    /// The turtle's settings for this run: the model, the view file's, the
+    /// program's angle.
+    fn draw_options(&mut self) -> Result<draw::DrawOptions, Error> {
+        let curve = self.curve;
         let mut opts = draw::DrawOptions {
             model: curve.program.model.clone(),
             view: curve.view.clone(),
@@ -314,12 +353,7 @@ impl<'c> CurveRun<'c> {
         if let Some(a) = self.d.angle().map_err(|e| curve.error(e))? {
             opts.angle = a;
         }
-        let word = self.interpreted()?;
-        let p = &curve.program;
-        draw::draw(&word, &p.alphabet, &p.structs, &opts).map_err(|e| {
-            let maker = (e.module).and_then(|m| self.maker(&word, m));
-            curve.draw_error(e, self.step(), maker)
-        })
+        Ok(opts)
     }
 
     /// What made module `module` of `drawn`, this run's interpreted word:

@@ -76,8 +76,9 @@ pub fn lsys_check(data: &[u8]) {
 }
 
 /// (b) A curve L-system loaded, derived a few steps with a small module
-/// limit, printed as text and JSON, interpreted, and drawn: turtle events,
-/// the scene fitted to a small picture, and its SVG.
+/// limit, printed as text and JSON, interpreted, and drawn: its 3D
+/// geometry (checked), turtle events, the scene fitted to a small picture,
+/// and its SVG.
 pub fn lsys_derive(data: &[u8]) {
     let text = text(data);
     let Ok(System::Curve(curve)) = subgram::load_text("fuzz.lsys", &text, &LoadOptions::default())
@@ -96,6 +97,27 @@ pub fn lsys_derive(data: &[u8]) {
     };
     std::hint::black_box(run.text());
     std::hint::black_box(run.json());
+    // The 3D geometry, lines as tubes, within a small limit: every index
+    // names a vertex, every vertex has a normal, every number is finite.
+    let sopts = subgram::draw::solid::SolidOptions {
+        line_style: Some(subgram::model::view::LineStyle::Cylinder),
+        max_triangles: 200_000,
+        max_vertices: 200_000,
+        pixel_tubes: None,
+    };
+    match run.solid(&sopts) {
+        Ok(scene) => {
+            for m in &scene.meshes {
+                assert_eq!(m.normals.len(), m.positions.len());
+                assert!(m.positions.iter().chain(&m.normals).all(|p| p.is_finite()));
+                let n = m.positions.len() as u32;
+                assert!(m.triangles.iter().flatten().all(|i| *i < n));
+            }
+        }
+        Err(e) => {
+            std::hint::black_box(e.to_string());
+        }
+    }
     let events = match run.events() {
         Ok(ev) => ev,
         Err(e) => {

@@ -29,15 +29,12 @@ fn gap(name: &str) -> Option<String> {
         "Label" => not_drawn("the text it writes"),
         "Terrain" => not_drawn("the terrain"),
         "Orient" => not_drawn("the turtle's axes it draws"),
-        "StartGC" | "PointGC" | "EndGC" => Some(format!(
-            "`{name}`: subgram draws generalized cylinders (`StartGC` ... `EndGC`) as plain \
-             lines, not as tubes"
-        )),
-        "CurrentContour" | "BlendedContour" | "ScaleContour" | "ContourSides" | "ContourNormal" => {
-            no_effect("it shapes generalized cylinders, which subgram draws as plain lines")
+        // Generalized cylinders, their contours and the precision of
+        // surfaces shape the 3D geometry (`draw::solid`).
+        "ContourNormal" => {
+            no_effect("subgram's generalized cylinders take their normals from the contour's shape")
         }
         "CurrentTexture" | "TextureVCoeff" => no_effect("subgram does not map textures"),
-        "SetUPrecision" | "SetVPrecision" => no_effect("subgram does not draw surfaces yet"),
         "Camera" => no_effect("subgram fits the view to the drawing"),
         "PovRayStart" => no_effect("subgram does not write POV-Ray files"),
         "E1" | "E2" | "EA20" => Some(format!(
@@ -93,7 +90,6 @@ pub fn warnings(program: &Program) -> Vec<Diagnostic> {
 /// Modules that one warning covers.
 fn family(name: &str) -> &str {
     match name {
-        "StartGC" | "PointGC" | "EndGC" => "generalized cylinders",
         "InitSurface" | "SurfacePoint" | "DrawSurface" => "L-system surface",
         "E1" | "E2" | "EA20" => "environment",
         _ => name,

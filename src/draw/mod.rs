@@ -3,6 +3,7 @@
 //! events, so the two always agree.
 
 pub(crate) mod coverage;
+pub mod solid;
 pub mod tropism;
 
 use glam::DVec3;
@@ -66,9 +67,8 @@ enum Cmd {
     SetWidth,
     Push,
     Pop,
-    Disc,
-    Dot,
-    Ring,
+    /// Circles, discs and spheres (manual 5.5).
+    Round(Round),
     StartPolygon,
     PolygonPoint,
     EndPolygon,
@@ -90,6 +90,50 @@ enum Cmd {
     /// `Elasticity(e)`: the simple tropism's.
     Elasticity,
     SetTropismDirection,
+    /// Modules that only shape 3D geometry (generalized cylinders, their
+    /// contours, the precision of surfaces): the walk leaves them to the
+    /// sink.
+    Shape(Shaping),
+}
+
+/// The circles and spheres of manual 5.5.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Round {
+    /// `Circle(r)`: a disc in the HL plane.
+    Circle,
+    /// `CircleFront(r)`: a disc in the screen plane.
+    CircleFront,
+    /// `Sphere(r)`.
+    Sphere,
+    /// `Circle0()`, `CircleFront0()`, `Sphere0()`: their diameter the line
+    /// width.
+    Circle0,
+    CircleFront0,
+    Sphere0,
+    /// `CircleB(r)`, `CircleFrontB(r)`: outlines of the line width.
+    CircleB,
+    CircleFrontB,
+}
+
+impl Round {
+    /// A circle of the pen's width (`Circle0` and its kin).
+    fn is_dot(self) -> bool {
+        matches!(self, Round::Circle0 | Round::CircleFront0 | Round::Sphere0)
+    }
+}
+
+/// The modules of [`Cmd::Shape`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Shaping {
+    StartGC,
+    PointGC,
+    EndGC,
+    CurrentContour,
+    BlendedContour,
+    ScaleContour,
+    ContourSides,
+    SetUPrecision,
+    SetVPrecision,
 }
 
 /// The turtle axis a rotation turns about.
@@ -101,7 +145,7 @@ enum DVec3Axis {
 }
 
 #[derive(Clone, Debug)]
-struct Turtle {
+pub(crate) struct Turtle {
     pos: DVec3,
     head: DVec3,
     left: DVec3,
@@ -352,9 +396,23 @@ fn command(name: &str) -> Cmd {
         "SetWidth" => Cmd::SetWidth,
         "SB" => Cmd::Push,
         "EB" => Cmd::Pop,
-        "Circle" | "CircleFront" | "Sphere" => Cmd::Disc,
-        "Circle0" | "CircleFront0" | "Sphere0" => Cmd::Dot,
-        "CircleB" | "CircleFrontB" => Cmd::Ring,
+        "Circle" => Cmd::Round(Round::Circle),
+        "CircleFront" => Cmd::Round(Round::CircleFront),
+        "Sphere" => Cmd::Round(Round::Sphere),
+        "Circle0" => Cmd::Round(Round::Circle0),
+        "CircleFront0" => Cmd::Round(Round::CircleFront0),
+        "Sphere0" => Cmd::Round(Round::Sphere0),
+        "CircleB" => Cmd::Round(Round::CircleB),
+        "CircleFrontB" => Cmd::Round(Round::CircleFrontB),
+        "StartGC" => Cmd::Shape(Shaping::StartGC),
+        "PointGC" => Cmd::Shape(Shaping::PointGC),
+        "EndGC" => Cmd::Shape(Shaping::EndGC),
+        "CurrentContour" => Cmd::Shape(Shaping::CurrentContour),
+        "BlendedContour" => Cmd::Shape(Shaping::BlendedContour),
+        "ScaleContour" => Cmd::Shape(Shaping::ScaleContour),
+        "ContourSides" => Cmd::Shape(Shaping::ContourSides),
+        "SetUPrecision" => Cmd::Shape(Shaping::SetUPrecision),
+        "SetVPrecision" => Cmd::Shape(Shaping::SetVPrecision),
         "SP" => Cmd::StartPolygon,
         "PP" => Cmd::PolygonPoint,
         "EP" => Cmd::EndPolygon,
@@ -417,19 +475,94 @@ impl TurnCache {
     }
 }
 
-/// Appends the segment `a`..`b` to the last event when that is a path
-/// with the same pen ending at `a`, or else starts a path.
-fn line(out: &mut Vec<Event>, a: DVec3, b: DVec3, pen: Pen) {
-    if let Some(Event::Path { points, pen: p }) = out.last_mut() {
-        if *p == pen && points.last() == Some(&a) {
-            points.push(b);
-            return;
-        }
+/// What the turtle's walk hands its drawing to: the 2D events of
+/// [`draw`], or the 3D geometry of [`solid::solid`]. The walk moves and
+/// turns the turtle; a sink only makes what the turtle draws, from the
+/// turtle as it stands. An `Err` is a message about the module at hand.
+pub(crate) trait Sink {
+    /// A drawn line from `a` to `b` (`F`, `G`, `LineTo`, ...); the turtle
+    /// is already at `b`, turned as it is after the module.
+    fn line(&mut self, t: &Turtle, a: DVec3, b: DVec3) -> Result<(), String>;
+    /// A circle or sphere of radius `r` (the pen's width for the `0`
+    /// kinds) at the turtle.
+    fn round(&mut self, t: &Turtle, kind: Round, r: f64) -> Result<(), String>;
+    /// A filled polygon of three or more points (`SP ... EP`, `Rhombus`,
+    /// `Triangle`), drawn by the turtle `t` where it ends.
+    fn polygon(&mut self, t: &Turtle, points: Vec<DVec3>) -> Result<(), String>;
+    /// Surface `s` of the model at the turtle, scaled by `scale`.
+    fn surface(
+        &mut self,
+        t: &Turtle,
+        s: &crate::model::Surface,
+        scale: DVec3,
+    ) -> Result<(), String>;
+    /// `SB`: the turtle was pushed.
+    fn push(&mut self) {}
+    /// `EB`: the turtle was popped (only when the stack held one).
+    fn pop(&mut self) -> Result<(), String> {
+        Ok(())
     }
-    out.push(Event::Path {
-        points: vec![a, b],
-        pen,
-    });
+    /// `SetWidth` (after the pen took it) and the modules of
+    /// [`Cmd::Shape`], with the module's parameters as numbers (missing
+    /// ones 0).
+    fn shape(&mut self, _t: &Turtle, _cmd: Option<Shaping>, _d: &[f64]) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// The 2D drawing: renderer-neutral events.
+struct Events(Vec<Event>);
+
+impl Sink for Events {
+    /// Appends the segment `a`..`b` to the last event when that is a path
+    /// with the same pen ending at `a`, or else starts a path.
+    #[inline]
+    fn line(&mut self, t: &Turtle, a: DVec3, b: DVec3) -> Result<(), String> {
+        let pen = t.pen;
+        if let Some(Event::Path { points, pen: p }) = self.0.last_mut() {
+            if *p == pen && points.last() == Some(&a) {
+                points.push(b);
+                return Ok(());
+            }
+        }
+        self.0.push(Event::Path {
+            points: vec![a, b],
+            pen,
+        });
+        Ok(())
+    }
+
+    fn round(&mut self, t: &Turtle, kind: Round, r: f64) -> Result<(), String> {
+        let c = t.pos;
+        self.0.push(match kind {
+            Round::Circle | Round::CircleFront | Round::Sphere => Event::Disc {
+                c,
+                r,
+                color: t.pen.color,
+            },
+            Round::Circle0 | Round::CircleFront0 | Round::Sphere0 => Event::Dot { c, pen: t.pen },
+            Round::CircleB | Round::CircleFrontB => Event::Ring { c, r, pen: t.pen },
+        });
+        Ok(())
+    }
+
+    fn polygon(&mut self, t: &Turtle, points: Vec<DVec3>) -> Result<(), String> {
+        self.0.push(Event::Polygon {
+            points,
+            color: t.pen.color,
+        });
+        Ok(())
+    }
+
+    fn surface(
+        &mut self,
+        t: &Turtle,
+        s: &crate::model::Surface,
+        scale: DVec3,
+    ) -> Result<(), String> {
+        surface_events(s, t, scale, &mut self.0);
+        Ok(())
+    }
 }
 
 /// Interprets `word` with the turtle and returns the drawing events.
@@ -450,8 +583,22 @@ pub fn draw_with_queries(
     alphabet: &Alphabet,
     structs: &[StructDef],
     opts: &DrawOptions,
-    mut queries: Option<&mut Vec<(usize, [f64; 3])>>,
+    queries: Option<&mut Vec<(usize, [f64; 3])>>,
 ) -> Result<Vec<Event>, DrawError> {
+    let mut events = Events(Vec::new());
+    walk(word, alphabet, structs, opts, queries, &mut events)?;
+    Ok(events.0)
+}
+
+/// The turtle's walk over `word`, drawing into `sink`.
+pub(crate) fn walk<S: Sink>(
+    word: &Word,
+    alphabet: &Alphabet,
+    structs: &[StructDef],
+    opts: &DrawOptions,
+    mut queries: Option<&mut Vec<(usize, [f64; 3])>>,
+    sink: &mut S,
+) -> Result<(), DrawError> {
     let cmds: Vec<Cmd> = alphabet
         .kinds
         .iter()
@@ -474,10 +621,18 @@ pub fn draw_with_queries(
         -1.0
     };
     let mut polygons: Vec<Vec<DVec3>> = Vec::new();
-    let mut out = Vec::new();
     let mut turns = TurnCache::default();
     let mut i = 0;
     let n = word.len();
+    // A sink's message about module `i`, located.
+    let at = |i: usize, message: String| DrawError {
+        message: format!(
+            "module {} of the interpreted word, `{}`, {message}",
+            i + 1,
+            alphabet.name(word.sym(i))
+        ),
+        module: Some(i),
+    };
     while i < n {
         let sym: Sym = word.sym(i);
         let cmd = cmds[sym.0 as usize];
@@ -490,7 +645,13 @@ pub fn draw_with_queries(
                 _ => DVec3::ZERO,
             }
         };
-        if d.iter().any(|x| !x.is_finite()) && cmd != Cmd::None && !matches!(cmd, Cmd::Query(_)) {
+        // An integer parameter is held as its bits, which may read as a
+        // NaN (`SetColor(-1)`): only the decoded numbers are checked then.
+        if d.iter().any(|x| !x.is_finite())
+            && cmd != Cmd::None
+            && !matches!(cmd, Cmd::Query(_))
+            && !word.values(i, alphabet, structs).iter().all(finite)
+        {
             return Err(DrawError {
                 message: format!(
                     "module {} of the word, `{}`, has a NaN or infinite parameter and cannot be drawn",
@@ -509,10 +670,8 @@ pub fn draw_with_queries(
             Cmd::None => {}
             Cmd::Forward { draw, record } => {
                 field.adjust(&mut t.head, &mut t.left, &mut t.up);
+                let from = t.pos;
                 let to = t.pos + t.head * arg(0, opts.step);
-                if draw {
-                    line(&mut out, t.pos, to, t.pen);
-                }
                 t.pos = to;
                 if record {
                     if let Some(p) = polygons.last_mut() {
@@ -520,6 +679,9 @@ pub fn draw_with_queries(
                     }
                 }
                 tropism::bend(&t.simple, &mut t.head, &mut t.left, &mut t.up);
+                if draw && to.is_finite() {
+                    sink.line(&t, from, to).map_err(|m| at(i, m))?;
+                }
             }
             Cmd::MoveTo => t.pos = t.frame.place(point()),
             Cmd::MoveRel => t.pos += t.frame.place(point()),
@@ -532,10 +694,13 @@ pub fn draw_with_queries(
                 // lpfg ignores a line shorter than epsilon; a drawn one
                 // moves as `F` does, and so records a polygon vertex.
                 if t.pos.distance(to) >= EPSILON {
-                    line(&mut out, t.pos, to, t.pen);
+                    let from = t.pos;
                     t.pos = to;
                     if let Some(p) = polygons.last_mut() {
                         p.push(to);
+                    }
+                    if to.is_finite() {
+                        sink.line(&t, from, to).map_err(|m| at(i, m))?;
                     }
                 }
             }
@@ -548,10 +713,12 @@ pub fn draw_with_queries(
                 let (a, b) = (t.frame.place(a), t.frame.place(b));
                 // lpfg ignores a line shorter than epsilon altogether.
                 if a.distance(b) >= EPSILON {
-                    line(&mut out, a, b, t.pen);
                     t.pos = b;
                     if let Some(p) = polygons.last_mut() {
                         p.push(b);
+                    }
+                    if a.is_finite() && b.is_finite() {
+                        sink.line(&t, a, b).map_err(|m| at(i, m))?;
                     }
                 }
             }
@@ -573,12 +740,31 @@ pub fn draw_with_queries(
             }
             Cmd::IncColor => t.pen.color += 1,
             Cmd::DecColor => t.pen.color -= 1,
-            Cmd::SetWidth => t.pen.width = arg(0, 1.0),
-            Cmd::Push => stack.push(t.clone()),
+            Cmd::SetWidth => {
+                t.pen.width = arg(0, 1.0);
+                sink.shape(&t, None, d).map_err(|m| at(i, m))?;
+            }
+            Cmd::Shape(s) => {
+                // Integer parameters (contour ids, sides) are decoded from
+                // the word; these modules are few.
+                let mut args = [0.0; 3];
+                for (a, v) in args.iter_mut().zip(word.values(i, alphabet, structs)) {
+                    *a = match v {
+                        Value::Int(n) => n as f64,
+                        v => v.as_f64(),
+                    };
+                }
+                sink.shape(&t, Some(s), &args).map_err(|m| at(i, m))?
+            }
+            Cmd::Push => {
+                stack.push(t.clone());
+                sink.push();
+            }
             Cmd::Pop => {
                 if let Some(s) = stack.pop() {
                     t = s;
                     field.restore(&t.elasticity);
+                    sink.pop().map_err(|m| at(i, m))?;
                 }
             }
             Cmd::SetElasticity(sign) => {
@@ -595,8 +781,8 @@ pub fn draw_with_queries(
             }
             Cmd::Elasticity => t.simple.elasticity = arg(0, 0.0),
             Cmd::SetTropismDirection => t.simple.direction = point(),
-            Cmd::Disc | Cmd::Ring => {
-                let r = arg(0, 1.0);
+            Cmd::Round(kind) => {
+                let r = if kind.is_dot() { 0.0 } else { arg(0, 1.0) };
                 if !(t.pos.abs().max_element() + r.abs()).is_finite() {
                     return Err(beyond(
                         word,
@@ -606,24 +792,8 @@ pub fn draw_with_queries(
                         "draws a circle that reaches",
                     ));
                 }
-                out.push(if cmd == Cmd::Disc {
-                    Event::Disc {
-                        c: t.pos,
-                        r,
-                        color: t.pen.color,
-                    }
-                } else {
-                    Event::Ring {
-                        c: t.pos,
-                        r,
-                        pen: t.pen,
-                    }
-                })
+                sink.round(&t, kind, r).map_err(|m| at(i, m))?;
             }
-            Cmd::Dot => out.push(Event::Dot {
-                c: t.pos,
-                pen: t.pen,
-            }),
             Cmd::Query(q) => {
                 if let Some(qs) = queries.as_deref_mut() {
                     let v = [t.pos, t.head, t.left, t.up][q as usize];
@@ -654,7 +824,7 @@ pub fn draw_with_queries(
                 } else {
                     DVec3::splat(arg(1, 1.0))
                 };
-                surface_events(s, &t, scale, &mut out);
+                sink.surface(&t, s, scale).map_err(|m| at(i, m))?;
             }
             Cmd::SetHead => t.set_head(
                 DVec3::new(arg(0, 0.0), arg(1, 0.0), arg(2, 0.0)),
@@ -701,10 +871,7 @@ pub fn draw_with_queries(
                         "draws a shape that reaches",
                     ));
                 }
-                out.push(Event::Polygon {
-                    points,
-                    color: t.pen.color,
-                });
+                sink.polygon(&t, points).map_err(|m| at(i, m))?;
             }
             Cmd::StartPolygon => polygons.push(Vec::new()),
             Cmd::PolygonPoint => {
@@ -715,10 +882,7 @@ pub fn draw_with_queries(
             Cmd::EndPolygon => {
                 if let Some(points) = polygons.pop() {
                     if points.len() >= 3 {
-                        out.push(Event::Polygon {
-                            points,
-                            color: t.pen.color,
-                        });
+                        sink.polygon(&t, points).map_err(|m| at(i, m))?;
                     }
                 }
             }
@@ -729,25 +893,58 @@ pub fn draw_with_queries(
         }
         i += 1;
     }
-    Ok(out)
+    Ok(())
 }
 
-/// Each patch of surface `s` as a filled polygon, its outline: the
-/// surface's contact point at the turtle, its heading and up vectors on
-/// the turtle's, scaled by `scale` × the view file's scale / `SIZE:`.
-fn surface_events(s: &crate::model::Surface, t: &Turtle, scale: DVec3, out: &mut Vec<Event>) {
-    const STEPS: usize = 8;
+/// Where a surface's points go: the surface's contact point at the
+/// turtle, its heading and up vectors on the turtle's, scaled by `scale` ×
+/// the view file's scale / `SIZE:`.
+pub(crate) struct Placement {
+    pos: DVec3,
+    /// The turtle's heading, left and up, each times its scale.
+    axes: [DVec3; 3],
+    /// The surface's heading, left and up and its contact point.
+    h: DVec3,
+    l: DVec3,
+    u: DVec3,
+    contact: DVec3,
+}
+
+impl Placement {
+    /// Where the surface's point `p` lies.
+    #[inline]
+    pub(crate) fn point(&self, p: [f64; 3]) -> DVec3 {
+        let q = DVec3::from_array(p) - self.contact;
+        self.pos
+            + self.axes[0] * q.dot(self.h)
+            + self.axes[1] * q.dot(self.l)
+            + self.axes[2] * q.dot(self.u)
+    }
+}
+
+/// The placement of surface `s` drawn by turtle `t` at `scale`.
+pub(crate) fn placement(s: &crate::model::Surface, t: &Turtle, scale: DVec3) -> Placement {
     let v = |a: [f64; 3]| DVec3::from_array(a);
     let (h, u) = (
         v(s.heading).normalize_or_zero(),
         v(s.up).normalize_or_zero(),
     );
-    let l = u.cross(h);
     let k = scale * (s.scale / s.size);
-    let place = |p: [f64; 3]| {
-        let q = v(p) - v(s.contact);
-        t.pos + t.head * (q.dot(h) * k.y) + t.left * (q.dot(l) * k.x) + t.up * (q.dot(u) * k.z)
-    };
+    Placement {
+        pos: t.pos,
+        axes: [t.head * k.y, t.left * k.x, t.up * k.z],
+        h,
+        l: u.cross(h),
+        u,
+        contact: v(s.contact),
+    }
+}
+
+/// Each patch of surface `s` as a filled polygon, its outline, placed by
+/// [`placement`].
+fn surface_events(s: &crate::model::Surface, t: &Turtle, scale: DVec3, out: &mut Vec<Event>) {
+    const STEPS: usize = 8;
+    let place = placement(s, t, scale);
     for patch in &s.patches {
         // Around the patch: along the first row, down the last column,
         // back along the last row, up the first column.
@@ -758,9 +955,20 @@ fn surface_events(s: &crate::model::Surface, t: &Turtle, scale: DVec3, out: &mut
         ring.extend((0..STEPS).map(|i| patch.point(1.0 - f(i), 1.0)));
         ring.extend((0..STEPS).map(|i| patch.point(0.0, 1.0 - f(i))));
         out.push(Event::Polygon {
-            points: ring.into_iter().map(place).collect(),
+            points: ring.into_iter().map(|p| place.point(p)).collect(),
             color: t.pen.color,
         });
+    }
+}
+
+/// True when every number of `v` is finite.
+fn finite(v: &Value) -> bool {
+    match v {
+        Value::Float(x) => x.is_finite(),
+        Value::V2(p) => p.is_finite(),
+        Value::V3(p) => p.is_finite(),
+        Value::Struct(fs) => fs.iter().all(finite),
+        _ => true,
     }
 }
 

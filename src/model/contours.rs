@@ -36,6 +36,9 @@ pub struct Contour {
     pub original: Vec<[f32; 3]>,
     pub end_points: bool,
     pub samples: usize,
+    /// The file gives `samples:` (format 1 3); otherwise lpfg samples a
+    /// generalized cylinder's contour at its `contour sides`.
+    pub samples_given: bool,
     pub vertices: Vec<[f32; 3]>,
     pub normals: Vec<[f32; 3]>,
 }
@@ -75,6 +78,7 @@ impl Contour {
             original: Vec::new(),
             end_points: false,
             samples: n,
+            samples_given: false,
             normals: vertices.clone(),
             vertices,
         }
@@ -132,6 +136,28 @@ impl Contour {
     /// `curveRecalculate`: the samples from the current control points.
     pub fn recalculate(&mut self) {
         self.calculate();
+    }
+
+    /// The contour sampled at `samples` points (at least 2) instead; the
+    /// default circle stays a circle.
+    pub fn resampled(&self, samples: usize) -> Contour {
+        let samples = samples.max(2);
+        let mut c = self.clone();
+        c.samples = samples;
+        if self.controls.is_empty() {
+            // The default circle: `samples` points, the last the first.
+            let step = std::f32::consts::PI / (0.5 * (samples - 1) as f32);
+            c.vertices = (0..samples)
+                .map(|i| {
+                    let a = step * (i % (samples - 1)) as f32;
+                    [a.sin(), a.cos(), 0.0]
+                })
+                .collect();
+            c.normals = c.vertices.clone();
+        } else {
+            c.calculate();
+        }
+        c
     }
 
     /// `curveReset`: the file's control points back; as in lpfg, the
@@ -363,6 +389,7 @@ fn read_contour(lines: &mut Lines<'_>, file: &str) -> Result<Contour, Error> {
         controls,
         end_points,
         samples,
+        samples_given: minor == 3,
         vertices: Vec::new(),
         normals: Vec::new(),
     };

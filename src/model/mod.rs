@@ -76,6 +76,13 @@ pub struct Model {
     pub colours: Option<Colours>,
     /// The view file's `line style:` makes widths the model's units.
     pub widths_in_units: bool,
+    /// The view file's `line style:`.
+    pub line_style: view::LineStyle,
+    /// The view file's `contour sides:` (0 in a model made by `default()`:
+    /// lpfg's default, [`view::DEFAULT_CONTOUR_SIDES`]).
+    pub contour_sides: u32,
+    /// The view file's `capped cylinders:`.
+    pub capped_cylinders: bool,
     /// The view file's lights.
     pub lights: Vec<view::Light>,
     /// The files read, in order.
@@ -307,6 +314,9 @@ impl Model {
             let (n, t) = text_of(p)?;
             let v = view::read_v(&n, &t, &mut m.notes)?;
             m.widths_in_units = v.widths_in_units;
+            m.line_style = v.line_style;
+            m.contour_sides = v.contour_sides;
+            m.capped_cylinders = v.capped_cylinders;
             m.lights = v.lights.clone();
             let dir = p.parent().unwrap_or(Path::new(""));
             for s in &v.surfaces {
@@ -331,6 +341,7 @@ impl Model {
                 let mut surf =
                     surface::read_s(&sp.display().to_string(), &stem, &text::read_text(&sp)?)?;
                 surf.scale = s.scale;
+                surf.divisions = s.divisions;
                 m.surfaces.push(surf);
                 m.files.push(sp);
             }

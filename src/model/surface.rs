@@ -32,8 +32,15 @@ pub struct Surface {
     pub size: f64,
     /// The view file's scale for this surface (`surface: leaf.s 2`).
     pub scale: f64,
+    /// The view file's divisions of each patch along s (down the rows of
+    /// control points) and t (along a row); lpfg's default, 10 × 10, when
+    /// `None`.
+    pub divisions: Option<(u32, u32)>,
     pub patches: Vec<Patch>,
 }
+
+/// lpfg's divisions of a patch along s and t when the view file gives none.
+pub const DEFAULT_DIVISIONS: u32 = 10;
 
 /// Reads `KEY X: x Y: y Z: z` (the key may be several words).
 fn labelled(lines: &mut Lines<'_>, key: &str) -> Result<V3, Error> {
@@ -111,6 +118,7 @@ pub fn read_s(path: &str, name: &str, text: &str) -> Result<Surface, Error> {
         up,
         size,
         scale: 1.0,
+        divisions: None,
         patches,
     })
 }
@@ -121,7 +129,37 @@ fn bernstein(t: f64) -> [f64; 4] {
     [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t]
 }
 
+/// The derivatives of the Bernstein polynomials of degree 3 at `t`.
+fn bernstein_derivative(t: f64) -> [f64; 4] {
+    let s = 1.0 - t;
+    [
+        -3.0 * s * s,
+        3.0 * s * s - 6.0 * t * s,
+        6.0 * t * s - 3.0 * t * t,
+        3.0 * t * t,
+    ]
+}
+
 impl Patch {
+    /// The point at (u, v) and the partial derivatives there along u and
+    /// along v.
+    pub fn point_and_tangents(&self, u: f64, v: f64) -> (V3, V3, V3) {
+        let (bu, bv) = (bernstein(u), bernstein(v));
+        let (du, dv) = (bernstein_derivative(u), bernstein_derivative(v));
+        let (mut p, mut pu, mut pv) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+        for (r, row) in self.points.iter().enumerate() {
+            for (c, q) in row.iter().enumerate() {
+                let (w, wu, wv) = (bv[r] * bu[c], bv[r] * du[c], dv[r] * bu[c]);
+                for k in 0..3 {
+                    p[k] += w * q[k];
+                    pu[k] += wu * q[k];
+                    pv[k] += wv * q[k];
+                }
+            }
+        }
+        (p, pu, pv)
+    }
+
     /// The point at (u, v) in \[0,1\]²: u along a row, v down the rows.
     pub fn point(&self, u: f64, v: f64) -> V3 {
         let (bu, bv) = (bernstein(u), bernstein(v));

@@ -95,17 +95,62 @@ pub struct SurfaceRef {
     /// The file name's byte range in the view file's text.
     pub at: (usize, usize),
     pub scale: f64,
+    /// `sdiv tdiv`: the divisions of each patch along s and t, when given
+    /// (both or neither, each 2 to 64 as lpfg takes them).
+    pub divisions: Option<(u32, u32)>,
 }
 
+/// lpfg's bounds on a surface's divisions along s and t.
+pub const MIN_SURFACE_DIVISIONS: i64 = 2;
+pub const MAX_SURFACE_DIVISIONS: i64 = 64;
+
 /// What subgram keeps of a view file.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ViewFile {
     pub surfaces: Vec<SurfaceRef>,
     /// `line style: polygon` or `cylinder`: `SetWidth` is in the model's
     /// units; `pixel` (the default): in pixels.
     pub widths_in_units: bool,
+    /// `line style:` itself.
+    pub line_style: LineStyle,
+    /// `contour sides:` (manual 8.1.3: 16 by default, at least 3).
+    pub contour_sides: u32,
+    /// `capped cylinders: on` (off by default).
+    pub capped_cylinders: bool,
     /// `light:` commands, in order.
     pub lights: Vec<Light>,
+}
+
+impl Default for ViewFile {
+    fn default() -> Self {
+        ViewFile {
+            surfaces: Vec::new(),
+            widths_in_units: false,
+            line_style: LineStyle::Pixel,
+            contour_sides: DEFAULT_CONTOUR_SIDES,
+            capped_cylinders: false,
+            lights: Vec::new(),
+        }
+    }
+}
+
+/// lpfg's `contour sides:` when the view file does not say (manual 8.1.3).
+pub const DEFAULT_CONTOUR_SIDES: u32 = 16;
+/// lpfg's bounds on the sides of a contour (and its samples).
+pub const MIN_CONTOUR_SIDES: u32 = 3;
+pub const MAX_CONTOUR_SIDES: u32 = 10_000;
+
+/// How lines (`F`) are drawn (manual 8.1.3, `line style:`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LineStyle {
+    /// Lines of a width in pixels (the default).
+    #[default]
+    Pixel,
+    /// Flat bands of the line width facing the viewer.
+    Polygon,
+    /// Cylinders of the line width; generalized cylinders are drawn only
+    /// in this style.
+    Cylinder,
 }
 
 /// A light source of the view file: its direction (towards the light),
@@ -169,6 +214,18 @@ fn light(lines: &Lines<'_>, line: &str, after: usize) -> Result<Light, Error> {
         i += 1 + n;
     }
     Ok(l)
+}
+
+/// The words of `text`, which starts at byte `after` of its line.
+fn shifted(text: &str, after: usize) -> Vec<super::text::Word<'_>> {
+    words(text)
+        .into_iter()
+        .map(|w| super::text::Word {
+            text: w.text,
+            start: w.start + after,
+            end: w.end + after,
+        })
+        .collect()
 }
 
 /// The text with C and C++ comments blanked out (newlines and byte
@@ -268,8 +325,33 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
             // shading of curved surfaces are beyond a flat picture.
             continue;
         }
+        if k == "contour sides" {
+            let ws = shifted(&line[after..], after);
+            let n = number(&lines, &ws, 0, "the number of sides")?;
+            // lpfg clamps the value to its bounds.
+            view.contour_sides = n.clamp(MIN_CONTOUR_SIDES as f64, MAX_CONTOUR_SIDES as f64) as u32;
+            continue;
+        }
+        if k == "capped cylinders" {
+            let ws = shifted(&line[after..], after);
+            view.capped_cylinders = match ws.first().map(|w| w.text) {
+                Some("on") => true,
+                Some("off") => false,
+                Some(w) => {
+                    return Err(lines.error(ws[0], format!("expected `on` or `off`, found `{w}`")))
+                }
+                None => return Err(lines.error_at_end("expected `on` or `off`")),
+            };
+            continue;
+        }
         if k == "line style" {
             let ws = words(&line[after..]);
+            view.line_style = match ws.first().map(|w| w.text) {
+                Some("pixel") => LineStyle::Pixel,
+                Some("polygon") => LineStyle::Polygon,
+                Some("cylinder") => LineStyle::Cylinder,
+                _ => LineStyle::Pixel,
+            };
             view.widths_in_units = match ws.first().map(|w| w.text) {
                 Some("pixel") => false,
                 Some("polygon") | Some("cylinder") => true,
@@ -311,11 +393,28 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
             } else {
                 1.0
             };
+            // `sdiv tdiv` come together (manual 8.1.5); lpfg keeps its
+            // default for a value out of its bounds, and so does subgram.
+            let divisions = if shifted.len() > 3 {
+                let div = |k: usize, what: &str| -> Result<Option<u32>, Error> {
+                    let v = number(&lines, &shifted, k, what)?;
+                    let ok = v.fract() == 0.0
+                        && (MIN_SURFACE_DIVISIONS as f64..=MAX_SURFACE_DIVISIONS as f64)
+                            .contains(&v);
+                    Ok(ok.then_some(v as u32))
+                };
+                let s = div(2, "the surface's divisions along s")?;
+                let t = div(3, "the surface's divisions along t")?;
+                s.zip(t)
+            } else {
+                None
+            };
             view.surfaces.push(SurfaceRef {
                 file: f.text.to_string(),
                 line: n,
                 at: (base + f.start + after, base + f.end + after),
                 scale,
+                divisions,
             });
             continue;
         }

@@ -32,6 +32,7 @@ mod reverse;
 mod semantics;
 mod serve;
 mod shapes;
+mod solid;
 mod support;
 mod surface;
 mod surface_adaptive;

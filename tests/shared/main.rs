@@ -17,6 +17,7 @@ use std::path::PathBuf;
 mod golden;
 mod lpfg;
 mod render;
+mod solid;
 #[allow(dead_code)]
 #[path = "../it/support.rs"]
 mod support;

@@ -1,0 +1,2 @@
+line style: cylinder
+capped cylinders: yes

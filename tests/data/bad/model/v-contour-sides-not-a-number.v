@@ -1,0 +1,2 @@
+line style: cylinder
+contour sides: many
