@@ -78,6 +78,8 @@ pub struct Model {
     pub widths_in_units: bool,
     /// The view file's lights.
     pub lights: Vec<view::Light>,
+    /// The view file's camera and render mode.
+    pub camera: view::ViewCamera,
     /// The files read, in order.
     pub files: Vec<PathBuf>,
     pub notes: Vec<Note>,
@@ -308,6 +310,7 @@ impl Model {
             let v = view::read_v(&n, &t, &mut m.notes)?;
             m.widths_in_units = v.widths_in_units;
             m.lights = v.lights.clone();
+            m.camera = v.camera.clone();
             let dir = p.parent().unwrap_or(Path::new(""));
             for s in &v.surfaces {
                 let sp = dir.join(&s.file);

@@ -650,8 +650,9 @@ impl<'a> Frame<'a> {
         (k, (id - self.tri_start[k]) as usize)
     }
 
-    /// Rasterises the triangles with global indices in `range` into `keys`.
-    fn raster_range(&self, range: std::ops::Range<usize>, keys: &mut [u64]) {
+    /// Rasterises the triangles with global indices in `range` into a
+    /// depth and triangle buffer.
+    fn raster_range(&self, range: std::ops::Range<usize>, depth: &mut [f32], ids: &mut [u32]) {
         let mut k = self.locate(range.start as u32).0;
         let mut id = range.start;
         while id < range.end {
@@ -664,62 +665,117 @@ impl<'a> Frame<'a> {
             let last = (range.end - self.tri_start[k] as usize).min(m.triangles.len());
             for (t, tri) in m.triangles[first..last].iter().enumerate() {
                 let v = tri.map(|i| self.screen[base + i as usize]);
-                raster_triangle(keys, self.sw, self.sh, v, (id + t) as u32);
+                raster_triangle(depth, ids, self.sw, self.sh, v, (id + t) as u32);
             }
             id += last - first;
         }
     }
 
-    /// The key buffer: every sample's nearest (depth, triangle).
-    fn raster(&self) -> Vec<u64> {
+    /// Every sample's nearest triangle (`NO_TRIANGLE` where none), the
+    /// smallest (depth, index) over all triangles that cover it.
+    fn raster(&self) -> Vec<u32> {
         let total = *self.tri_start.last().unwrap_or(&0) as usize;
-        let mut keys = vec![u64::MAX; self.sw * self.sh];
+        let n = self.sw * self.sh;
+        let mut depth = vec![FAR; n];
+        let mut ids = vec![NO_TRIANGLE; n];
         let threads = rayon::current_num_threads().clamp(1, 8);
         if total < 1 << 16 || threads == 1 {
-            self.raster_range(0..total, &mut keys);
-            return keys;
+            self.raster_range(0..total, &mut depth, &mut ids);
+            return ids;
         }
         let chunk = total.div_ceil(threads);
-        let mut others: Vec<Vec<u64>> = Vec::new();
+        let mut others: Vec<(Vec<f32>, Vec<u32>)> = Vec::new();
         rayon::scope(|scope| {
-            let (first, rest) = (&mut keys, &mut others);
-            rest.resize_with(threads - 1, Vec::new);
-            for (j, buf) in rest.iter_mut().enumerate() {
+            others.resize_with(threads - 1, Default::default);
+            for (j, (d, i)) in others.iter_mut().enumerate() {
                 let range = (j + 1) * chunk..((j + 2) * chunk).min(total);
                 scope.spawn(move |_| {
-                    *buf = vec![u64::MAX; self.sw * self.sh];
-                    self.raster_range(range, buf);
+                    *d = vec![FAR; n];
+                    *i = vec![NO_TRIANGLE; n];
+                    self.raster_range(range, d, i);
                 });
             }
-            self.raster_range(0..chunk.min(total), first);
+            self.raster_range(0..chunk.min(total), &mut depth, &mut ids);
         });
-        keys.par_chunks_mut(1 << 14)
+        // The smallest (depth, index) wins, whichever chunk drew it.
+        depth
+            .par_chunks_mut(1 << 14)
+            .zip(ids.par_chunks_mut(1 << 14))
             .enumerate()
-            .for_each(|(c, out)| {
+            .for_each(|(c, (d, i))| {
                 let at = c << 14;
-                let n = out.len();
-                for o in &others {
-                    for (a, b) in out.iter_mut().zip(&o[at..at + n]) {
-                        *a = (*a).min(*b);
+                for (od, oi) in &others {
+                    let (od, oi) = (&od[at..at + d.len()], &oi[at..at + i.len()]);
+                    for k in 0..d.len() {
+                        if (od[k], oi[k]) < (d[k], i[k]) {
+                            d[k] = od[k];
+                            i[k] = oi[k];
+                        }
                     }
                 }
             });
-        keys
+        ids
+    }
+}
+
+/// The depth buffer's value where nothing was drawn: just past the far
+/// plane (1), so that `d < FAR` keeps every depth in 0..=1.
+const FAR: f32 = 1.000_000_1;
+
+/// The triangle buffer's value where nothing was drawn.
+const NO_TRIANGLE: u32 = u32::MAX;
+
+/// The smallest integer at least `v` (`v` finite and within `i32`),
+/// without a call to `ceilf` on targets without SSE4.1.
+#[inline(always)]
+fn ceil_i(v: f32) -> i32 {
+    let i = v as i32;
+    if (i as f32) < v {
+        i + 1
+    } else {
+        i
+    }
+}
+
+/// The largest integer at most `v` (as [`ceil_i`]).
+#[inline(always)]
+fn floor_i(v: f32) -> i32 {
+    let i = v as i32;
+    if (i as f32) > v {
+        i - 1
+    } else {
+        i
     }
 }
 
 /// One triangle into the key buffer. `v` in sample units (sample centres
 /// at integers); a NaN coordinate (unprojectable vertex) drops it.
+///
+/// Each row starts from the edge functions evaluated exactly there in
+/// `f64` (from the canonical coefficients) and rounded to `f32`; a sample
+/// adds its column offset times the edge's `x` coefficient. Rounding is
+/// symmetric, so the two triangles of a shared edge still see exactly
+/// opposite values at every sample, and no sample is lost between them.
 #[inline]
-fn raster_triangle(keys: &mut [u64], sw: usize, sh: usize, v: [Screen; 3], id: u32) {
-    let min_x = v[0].x.min(v[1].x).min(v[2].x).ceil().max(0.0);
-    let max_x = v[0].x.max(v[1].x).max(v[2].x).floor().min(sw as f32 - 1.0);
-    if !(min_x <= max_x) {
+fn raster_triangle(
+    depth: &mut [f32],
+    ids: &mut [u32],
+    sw: usize,
+    sh: usize,
+    v: [Screen; 3],
+    id: u32,
+) {
+    let lo_x = v[0].x.min(v[1].x).min(v[2].x).max(-1.0);
+    let hi_x = v[0].x.max(v[1].x).max(v[2].x).min(sw as f32);
+    let lo_y = v[0].y.min(v[1].y).min(v[2].y).max(-1.0);
+    let hi_y = v[0].y.max(v[1].y).max(v[2].y).min(sh as f32);
+    // NaN fails these too.
+    if !(lo_x <= hi_x && lo_y <= hi_y) {
         return;
     }
-    let min_y = v[0].y.min(v[1].y).min(v[2].y).ceil().max(0.0);
-    let max_y = v[0].y.max(v[1].y).max(v[2].y).floor().min(sh as f32 - 1.0);
-    if !(min_y <= max_y) || v.iter().any(|p| p.z.is_nan()) {
+    let (x0, x1) = (ceil_i(lo_x).max(0), floor_i(hi_x).min(sw as i32 - 1));
+    let (y0, y1) = (ceil_i(lo_y).max(0), floor_i(hi_y).min(sh as i32 - 1));
+    if x0 > x1 || y0 > y1 || v.iter().any(|p| p.z.is_nan()) {
         return;
     }
     let p = v.map(|q| (q.x as f64, q.y as f64));
@@ -735,39 +791,36 @@ fn raster_triangle(keys: &mut [u64], sw: usize, sh: usize, v: [Screen; 3], id: u
         edge(p[2], p[0], orient),
         edge(p[0], p[1], orient),
     ];
-    let inv_area = 1.0 / area.abs();
+    // The depth plane z = dzx·x + dzy·y + dzc, from the weights.
+    let inv = 1.0 / area.abs();
     let z = [v[0].z as f64, v[1].z as f64, v[2].z as f64];
-    let (x0, x1, y0, y1) = (
-        min_x as usize,
-        max_x as usize,
-        min_y as usize,
-        max_y as usize,
-    );
-    let idk = id as u64;
+    let dzx = (e[0].0 * z[0] + e[1].0 * z[1] + e[2].0 * z[2]) * inv;
+    let dzy = (e[0].1 * z[0] + e[1].1 * z[1] + e[2].1 * z[2]) * inv;
+    let dzc = (e[0].2 * z[0] + e[1].2 * z[1] + e[2].2 * z[2]) * inv;
+    let a = [e[0].0 as f32, e[1].0 as f32, e[2].0 as f32];
+    let dz = dzx as f32;
+    let fx0 = x0 as f64;
     for y in y0..=y1 {
         let fy = y as f64;
-        let row = &mut keys[y * sw..y * sw + sw];
         let r = [
-            e[0].1 * fy + e[0].2,
-            e[1].1 * fy + e[1].2,
-            e[2].1 * fy + e[2].2,
+            (e[0].0 * fx0 + e[0].1 * fy + e[0].2) as f32,
+            (e[1].0 * fx0 + e[1].1 * fy + e[1].2) as f32,
+            (e[2].0 * fx0 + e[2].1 * fy + e[2].2) as f32,
         ];
-        for (x, slot) in row.iter_mut().enumerate().take(x1 + 1).skip(x0) {
-            let fx = x as f64;
-            let w0 = e[0].0 * fx + r[0];
-            let w1 = e[1].0 * fx + r[1];
-            let w2 = e[2].0 * fx + r[2];
-            if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
-                continue;
-            }
-            let d = ((w0 * z[0] + w1 * z[1] + w2 * z[2]) * inv_area) as f32;
-            if !(0.0..=1.0).contains(&d) {
-                continue;
-            }
-            let key = ((d + 0.0).to_bits() as u64) << 32 | idk;
-            if key < *slot {
-                *slot = key;
-            }
+        let zr = (dzx * fx0 + dzy * fy + dzc) as f32;
+        let span = y as usize * sw + x0 as usize..=y as usize * sw + x1 as usize;
+        let (zs, is) = (&mut depth[span.clone()], &mut ids[span]);
+        // Branch-free, so that it vectorises: a sample takes the triangle
+        // where it is inside and nearer (an earlier triangle keeps a tie).
+        for (k, (zk, ik)) in zs.iter_mut().zip(is.iter_mut()).enumerate() {
+            let fk = k as f32;
+            let w0 = r[0] + fk * a[0];
+            let w1 = r[1] + fk * a[1];
+            let w2 = r[2] + fk * a[2];
+            let d = zr + fk * dz;
+            let take = (w0 >= 0.0) & (w1 >= 0.0) & (w2 >= 0.0) & (d >= 0.0) & (d < *zk);
+            *zk = if take { d } else { *zk };
+            *ik = if take { id } else { *ik };
         }
     }
 }
@@ -809,19 +862,16 @@ impl Frame<'_> {
 
     /// The polygon a sample shows (`u32::MAX` for the background) when
     /// there is a wireframe.
-    fn polygon(&self, w: &Wireframe, key: u64) -> u32 {
-        if key == u64::MAX {
+    fn polygon(&self, w: &Wireframe, id: u32) -> u32 {
+        if id == NO_TRIANGLE {
             u32::MAX
         } else {
-            w.polygons
-                .get(key as u32 as usize)
-                .copied()
-                .unwrap_or(u32::MAX - 1)
+            w.polygons.get(id as usize).copied().unwrap_or(u32::MAX - 1)
         }
     }
 
     /// The premultiplied RGBA8 pixels.
-    fn resolve(&self, keys: &[u64]) -> Vec<u8> {
+    fn resolve(&self, keys: &[u32]) -> Vec<u8> {
         let cam = &self.opts.camera;
         let (w, h) = (cam.width as usize, cam.height as usize);
         let s = self.s as usize;
@@ -840,32 +890,19 @@ impl Frame<'_> {
         let inv = 1.0 / (s * s) as f32;
         let mut out = vec![0u8; w * h * 4];
         out.par_chunks_mut(w * 4).enumerate().for_each(|(py, row)| {
+            // Shading once per pixel and triangle, at the pixel's centre
+            // (as multisampling does): the distinct triangles of a pixel's
+            // samples, at most s² of them.
+            let mut seen: Vec<(u32, [f32; 3])> = Vec::with_capacity(s * s);
+            let centre = (s as f32 - 1.0) * 0.5;
             for px in 0..w {
+                seen.clear();
                 let mut sum = [0.0f32; 4];
-                let first = keys[(py * s) * self.sw + px * s];
-                let uniform = (0..s)
-                    .all(|j| (0..s).all(|i| keys[(py * s + j) * self.sw + px * s + i] == first));
-                let shared = if uniform && first != u64::MAX && edge.is_none() {
-                    let centre = (s as f32 - 1.0) * 0.5;
-                    Some(self.shade(
-                        first as u32,
-                        (px * s) as f32 + centre,
-                        (py * s) as f32 + centre,
-                    ))
-                } else {
-                    None
-                };
-                let mut last: Option<(u32, [f32; 3])> = None;
+                let (cx, cy) = ((px * s) as f32 + centre, (py * s) as f32 + centre);
                 for j in 0..s {
                     for i in 0..s {
                         let (sx, sy) = (px * s + i, py * s + j);
                         let key = keys[sy * self.sw + sx];
-                        if key == u64::MAX && edge.is_none() {
-                            for (a, b) in sum.iter_mut().zip(bgp) {
-                                *a += b;
-                            }
-                            continue;
-                        }
                         if let Some((wf, ec)) = &edge {
                             let g = self.polygon(wf, key);
                             let differs = |dx: isize, dy: isize| {
@@ -889,25 +926,19 @@ impl Frame<'_> {
                                 sum[3] += 1.0;
                                 continue;
                             }
-                            if key == u64::MAX {
-                                for (a, b) in sum.iter_mut().zip(bgp) {
-                                    *a += b;
-                                }
-                                continue;
-                            }
                         }
-                        let id = key as u32;
-                        let c = match (shared, last) {
-                            (Some(c), _) => c,
-                            (None, Some((l, c)))
-                                if l == id
-                                    && self.scene.meshes[self.locate(id).0].normals.is_empty() =>
-                            {
-                                c
+                        if key == NO_TRIANGLE {
+                            for (a, b) in sum.iter_mut().zip(bgp) {
+                                *a += b;
                             }
-                            _ => {
-                                let c = self.shade(id, sx as f32, sy as f32);
-                                last = Some((id, c));
+                            continue;
+                        }
+                        let id = key;
+                        let c = match seen.iter().find(|(t, _)| *t == id) {
+                            Some((_, c)) => *c,
+                            None => {
+                                let c = self.shade(id, cx, cy);
+                                seen.push((id, c));
                                 c
                             }
                         };
@@ -1045,11 +1076,12 @@ pub fn render(scene: &Scene3, opts: &RasterOptions) -> Result<Image, RenderError
         }
     }
     let frame = Frame::new(scene, opts);
-    let keys = frame.raster();
+    let ids = frame.raster();
+    let pixels = frame.resolve(&ids);
     Ok(Image {
         width: cam.width,
         height: cam.height,
-        pixels: frame.resolve(&keys),
+        pixels,
     })
 }
 

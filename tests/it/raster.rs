@@ -491,3 +491,82 @@ fn bad_scenes_are_refused_with_a_message() {
     assert!(Camera::from_view(&ViewSpec::default(), &mut std::iter::empty(), 10, 10).is_err());
     assert!(Camera::from_view(&ViewSpec::default(), &mut [Vec3::ONE].into_iter(), 0, 10).is_err());
 }
+
+#[test]
+fn the_view_files_camera_commands_are_kept() {
+    use subgram::model::view::{read_v, RenderMode};
+    let text = "projection: perspective\nscale factor: 0.8\n\
+                view: 0 dir: 1 0 0 up: 0 0 1 fov: 30 shift: 12\n\
+                box: 0 -1 1 -2 2 0 3\nfront distance: -4\nback distance: 5\n\
+                render mode: shaded\nview: 1 dir: 0 1 0\n";
+    let mut notes = Vec::new();
+    let v = read_v("view.v", text, &mut notes).expect("reads");
+    let c = &v.camera;
+    assert!(c.perspective);
+    assert_eq!(c.scale, Some(0.8));
+    assert_eq!(c.dir, Some([1.0, 0.0, 0.0]));
+    assert_eq!(c.up, Some([0.0, 0.0, 1.0]));
+    assert_eq!((c.fov, c.shift), (Some(30.0), Some(12.0)));
+    assert_eq!(c.bbox, Some([-1.0, 1.0, -2.0, 2.0, 0.0, 3.0]));
+    assert_eq!((c.front, c.back), (Some(-4.0), Some(5.0)));
+    assert_eq!(c.render_mode, RenderMode::Shaded);
+    // View 1 (multiple views) is left out with a note at its number.
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(notes[0].message.contains("only view 0"));
+    // The renderer's view: the box framed from +x looking along it.
+    let spec = c.spec();
+    assert_eq!(spec.projection, Projection::Perspective);
+    assert_eq!((spec.scale, spec.fov, spec.shift), (0.8, 30.0, Some(12.0)));
+    assert_eq!(spec.clip, Some((-4.0, 5.0)));
+    let cam = Camera::from_view(&spec, &mut std::iter::empty(), 100, 100).expect("a camera");
+    // The eye stands `shift` before the box's centre (0, 0, 1.5).
+    assert!(
+        (cam.eye - Vec3::new(-12.0, 0.0, 1.5)).length() < 1e-4,
+        "{}",
+        cam.eye
+    );
+    // The deprecated form: rotations about x, y, z in degrees. 90° about
+    // x turns the default direction (0, 0, -1) to (0, 1, 0) and the up
+    // (0, 1, 0) to (0, 0, 1): (x, y cos - z sin, y sin + z cos).
+    let mut notes = Vec::new();
+    let v = read_v("view.v", "view: 0 90 0 0 0.5 1 2 3\n", &mut notes).expect("reads");
+    let d = v.camera.dir.expect("a direction");
+    let u = v.camera.up.expect("an up");
+    for (a, b) in d
+        .iter()
+        .zip([0.0, 1.0, 0.0])
+        .chain(u.iter().zip([0.0, 0.0, 1.0]))
+    {
+        assert!((a - b).abs() < 1e-12, "{d:?} {u:?}");
+    }
+    assert_eq!(
+        (v.camera.scale, v.camera.pan),
+        (Some(0.5), Some([1.0, 2.0, 3.0]))
+    );
+    // Malformed values are errors at their place.
+    for (bad, col) in [
+        ("view: 0 dir: 1 x 0\n", 16),
+        ("box: 0 1 -1 0 1 0 1\n", 8),
+        ("scale: 0\n", 8),
+        ("view: 0 tilt: 3\n", 9),
+    ] {
+        let e = read_v("view.v", bad, &mut Vec::new())
+            .expect_err("refused")
+            .to_string();
+        assert!(e.starts_with(&format!("view.v:1:{col}:")), "{bad}: {e}");
+    }
+    // Lights keep their specular colour; none gives lpfg's default light.
+    let v = read_v(
+        "view.v",
+        "light: V: 0 1 0 S: 0.5 0.4 0.3\n",
+        &mut Vec::new(),
+    )
+    .expect("reads");
+    let l = subgram::model::view::raster_lights(&v.lights);
+    assert_eq!(l[0].specular, [0.5, 0.4, 0.3]);
+    assert_eq!(l[0].direction, Vec3::Y);
+    assert_eq!(
+        subgram::model::view::raster_lights(&[]),
+        vec![Light::default()]
+    );
+}
