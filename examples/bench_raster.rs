@@ -1,7 +1,7 @@
 //! The z-buffer renderer (`render::raster`) on a synthetic plant, against
 //! tiny-skia filling the same triangles projected to 2D (issue 17, item 4).
 //! `cargo build --release --example bench_raster`, then
-//! `target/release/examples/bench_raster [SEGMENTS] [--runs N] [--radius R] [--only zbuffer|skia] [--skia-max K] [--png FILE]`
+//! `target/release/examples/bench_raster [SEGMENTS] [--runs N] [--radius R] [--only zbuffer|skia|export] [--skia-max K] [--png FILE] [--export DIR]`
 //!
 //! The plant: SEGMENTS turtle segments (1,000,000 by default) as 8-sided
 //! tubes with smooth normals (8 vertices and 16 triangles a segment,
@@ -14,6 +14,9 @@
 //! look's colour, the way a painter's renderer draws them (all the
 //! triangles, or `--skia-max K` of them and the time scaled). Peak memory:
 //! run with `--only zbuffer` or `--only skia` under `/usr/bin/time -v`.
+//! `--export DIR` writes the plant as `plant.obj` (with `plant.mtl`),
+//! `plant.ply` and `plant.glb`, and its counts and bounds as `plant.json`,
+//! for `benches/export_xcheck.py`.
 
 mod common;
 
@@ -132,6 +135,28 @@ fn main() {
         ms(t.elapsed()),
         rayon::current_num_threads()
     );
+    if let Some(dir) = value("--export") {
+        // The plant as OBJ+MTL, PLY and GLB, and what an independent
+        // reader should find in them (benches/export_xcheck.py).
+        let dir = std::path::Path::new(&dir);
+        for name in ["plant.obj", "plant.ply", "plant.glb"] {
+            let (d, r) = best_of(1, || subgram::export::write(&scene, &dir.join(name)));
+            r.expect("exports");
+            println!("export {name}: {:8.1} ms", ms(d));
+        }
+        let (lo, hi) = scene.bounds().expect("bounds");
+        let summary = serde_json::json!({
+            "vertices": scene.vertex_count(),
+            "triangles": scene.triangle_count(),
+            "looks": scene.looks.len(),
+            "min": lo.to_array(),
+            "max": hi.to_array(),
+        });
+        std::fs::write(dir.join("plant.json"), summary.to_string()).expect("writes");
+        if only.as_deref() == Some("export") {
+            return;
+        }
+    }
     let camera = Camera::from_view(
         &ViewSpec {
             dir: Vec3::new(-0.3, -0.2, -1.0),

@@ -250,7 +250,7 @@ pub fn glb_bytes(scene: &Scene3) -> Result<Vec<u8>, Error> {
     let mut view = |bin: &mut Vec<u8>, bytes: &[u8], target: u32| -> usize {
         let offset = bin.len();
         bin.extend_from_slice(bytes);
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         views.push(json!({
@@ -349,7 +349,7 @@ pub fn glb_bytes(scene: &Scene3) -> Result<Vec<u8>, Error> {
         "accessors": accessors,
     });
     let mut text = serde_json::to_vec(&doc).map_err(|e| Error::Failed(e.to_string()))?;
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let total = 12 + 8 + text.len() + 8 + bin.len();

@@ -338,7 +338,7 @@ impl Camera {
     }
 
     /// The unit vector from a world point towards the viewer.
-    fn to_viewer(&self, p: Vec3) -> Vec3 {
+    fn towards_viewer(&self, p: Vec3) -> Vec3 {
         match self.projection {
             Projection::Parallel => -self.dir,
             Projection::Perspective => (self.eye - p).normalize_or(-self.dir),
@@ -392,8 +392,8 @@ pub fn lighting(look: &Look, n: Vec3, lights: &[Light], global_ambient: [f32; 3]
         } else {
             0.0
         };
-        for k in 0..3 {
-            c[k] += look.ambient[k] * l.ambient[k]
+        for (k, ck) in c.iter_mut().enumerate() {
+            *ck += look.ambient[k] * l.ambient[k]
                 + look.diffuse[k] * l.diffuse[k] * diffuse
                 + look.specular[k] * l.specular[k] * specular;
         }
@@ -989,7 +989,7 @@ fn colour(scene: &Scene3, opts: &RasterOptions, k: usize, tri: [u32; 3], w: [f32
     let [a, b, c] = tri.map(|i| m.positions[i as usize]);
     let geometric = (b - a).cross(c - a);
     let centroid = (a + b + c) / 3.0;
-    let back = geometric.dot(cam.to_viewer(centroid)) < 0.0;
+    let back = geometric.dot(cam.towards_viewer(centroid)) < 0.0;
     let flat = geometric.normalize_or_zero();
     let mut n = if m.normals.is_empty() {
         flat

@@ -178,9 +178,9 @@ fn a_flat_quad_gets_the_colour_of_opengls_lighting_formula() {
         ..light
     };
     let c = lighting(&look, Vec3::Z, &[away], [global; 3]);
-    for k in 0..3 {
+    for (k, ck) in c.iter().enumerate() {
         let only = look.emission[k] + look.ambient[k] * (global + light.ambient[k]);
-        assert!((c[k] - only).abs() < 1e-6);
+        assert!((ck - only).abs() < 1e-6);
     }
 }
 
