@@ -179,6 +179,32 @@ impl ViewCamera {
     }
 }
 
+impl ViewCamera {
+    /// The renderer's settings for geometry whose vertices are `points`,
+    /// in an image of `width`×`height`: the camera of [`ViewCamera::spec`],
+    /// the view file's `lights` (see [`raster_lights`]), and lit shading
+    /// for `render mode: shaded` or `shadows`, unlit colours for `filled`
+    /// (lpfg's default) and `wireframe`.
+    pub fn raster_options(
+        &self,
+        lights: &[Light],
+        points: &mut dyn Iterator<Item = glam::Vec3>,
+        width: u32,
+        height: u32,
+    ) -> Result<crate::render::raster::RasterOptions, crate::render::RenderError> {
+        use crate::render::raster::{Camera, RasterOptions, Shading};
+        let camera = Camera::from_view(&self.spec(), points, width, height)?;
+        Ok(RasterOptions {
+            lights: raster_lights(lights),
+            shading: match self.render_mode {
+                RenderMode::Shaded | RenderMode::Shadows => Shading::Lit,
+                RenderMode::Filled | RenderMode::Wireframe => Shading::Unlit,
+            },
+            ..RasterOptions::new(camera)
+        })
+    }
+}
+
 /// The renderer's lights for the view file's (lpfg's default light when
 /// there is none): directional lights in eye coordinates, as lpfg's
 /// stationary lights are. A point light (`O:`) shines from the direction

@@ -339,6 +339,12 @@ fn shade_face(
     let depth = corners.iter().map(|p| p.dot(cam.dir)).sum::<f64>() / corners.len() as f64;
     let color = match shading {
         Shading::Lit => shade(seen, back, cam, base),
+        Shading::Unlit => {
+            let c = face_look(base, back)
+                .diffuse
+                .map(|v| (v * 255.0).round() as u8);
+            Rgba(c[0], c[1], c[2], 255)
+        }
         Shading::Normals => {
             let c = (seen + DVec3::ONE) * 127.5;
             Rgba(c.x.round() as u8, c.y.round() as u8, c.z.round() as u8, 255)

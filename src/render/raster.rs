@@ -407,6 +407,9 @@ pub enum Shading {
     /// Lit by the lights (the default).
     #[default]
     Lit,
+    /// The look's diffuse colour plus its emission, unlit: lpfg's
+    /// `render mode: filled` (its default), where OpenGL's lighting is off.
+    Unlit,
     /// A normal map: the unit normal of the visible side, `(n + 1) / 2` as
     /// red, green and blue.
     Normals,
@@ -1010,6 +1013,10 @@ fn colour(scene: &Scene3, opts: &RasterOptions, k: usize, tri: [u32; 3], w: [f32
             };
             let eye_n = Vec3::new(n.dot(cam.right), n.dot(cam.up), -n.dot(cam.dir));
             lighting(look, eye_n, &opts.lights, opts.global_ambient)
+        }
+        Shading::Unlit => {
+            let look = &scene.looks[k];
+            [0, 1, 2].map(|i| (look.diffuse[i] + look.emission[i]).clamp(0.0, 1.0))
         }
         Shading::Normals => ((n + Vec3::ONE) * 0.5).to_array(),
         Shading::Reflection => reflection(n, cam.dir, cam.up),

@@ -408,6 +408,15 @@ fn shading_modes_colour_by_the_normal() {
     };
     let img = render(&sc, &opts).expect("renders");
     assert_eq!(rgb(&img, 20, 20), [128, 128, 255]);
+    // Unlit (lpfg's `render mode: filled`): the look's own colour.
+    let opts = RasterOptions {
+        shading: Shading::Unlit,
+        ..opts
+    };
+    assert_eq!(
+        rgb(&render(&sc, &opts).expect("renders"), 20, 20),
+        [10, 20, 30]
+    );
 }
 
 #[test]
