@@ -454,7 +454,9 @@ pub struct RasterOptions {
     /// OpenGL's global ambient light (0.2 by default).
     pub global_ambient: [f32; 3],
     pub shading: Shading,
-    /// Samples per pixel side (1 to 4): 2 gives 4 samples a pixel.
+    /// Samples per pixel side (1 to 4): 2 gives 4 samples a pixel. A huge
+    /// image gets fewer, so that its buffers stay within 2^26 samples
+    /// (512 MiB).
     pub samples: u32,
     /// The look of each mesh's back faces (OpenGL's `GL_BACK` material);
     /// `None`: the same look on both sides. Back faces are lit with the
@@ -574,7 +576,13 @@ struct Frame<'a> {
 impl<'a> Frame<'a> {
     fn new(scene: &'a Scene3, opts: &'a RasterOptions) -> Frame<'a> {
         let cam = &opts.camera;
-        let s = opts.samples.clamp(1, 4);
+        // Fewer samples a pixel for a huge image, so that the buffers stay
+        // within MAX_SAMPLES (8 bytes each).
+        let pixels = cam.width as usize * cam.height as usize;
+        let s = (1..=opts.samples.clamp(1, 4))
+            .rev()
+            .find(|s| pixels * (s * s) as usize <= MAX_SAMPLES)
+            .unwrap_or(1);
         let (sw, sh) = ((cam.width * s) as usize, (cam.height * s) as usize);
         let mut tri_start = Vec::with_capacity(scene.meshes.len() + 1);
         let mut vert_start = Vec::with_capacity(scene.meshes.len() + 1);
@@ -681,7 +689,10 @@ impl<'a> Frame<'a> {
         let n = self.sw * self.sh;
         let mut depth = vec![FAR; n];
         let mut ids = vec![NO_TRIANGLE; n];
-        let threads = rayon::current_num_threads().clamp(1, 8);
+        // One more pair of buffers per thread, within 2·MAX_SAMPLES in all.
+        let threads = rayon::current_num_threads()
+            .clamp(1, 8)
+            .min((2 * MAX_SAMPLES / n).max(1));
         if total < 1 << 16 || threads == 1 {
             self.raster_range(0..total, &mut depth, &mut ids);
             return ids;
@@ -720,6 +731,10 @@ impl<'a> Frame<'a> {
         ids
     }
 }
+
+/// The most samples a picture's depth and triangle buffers hold (8 bytes
+/// each): 2×2 samples a pixel up to 4096×4096 pixels, fewer beyond.
+const MAX_SAMPLES: usize = 1 << 26;
 
 /// The depth buffer's value where nothing was drawn: just past the far
 /// plane (1), so that `d < FAR` keeps every depth in 0..=1.
