@@ -1,14 +1,14 @@
 //! The z-buffer renderer (`render::raster`) on a synthetic plant, against
 //! tiny-skia filling the same triangles projected to 2D (issue 17, item 4).
 //! `cargo build --release --example bench_raster`, then
-//! `target/release/examples/bench_raster [SEGMENTS] [--runs N] [--radius R] [--only zbuffer|skia|export] [--skia-max K] [--png FILE] [--export DIR]`
+//! `target/release/examples/bench_raster [SEGMENTS] [--runs N] [--radius R] [--size PIXELS] [--only zbuffer|skia|export] [--skia-max K] [--png FILE] [--export DIR]`
 //!
 //! The plant: SEGMENTS turtle segments (1,000,000 by default) as 8-sided
 //! tubes with smooth normals (8 vertices and 16 triangles a segment,
 //! segments 0.01 long, the trunk's radius 0.02 or `--radius R`), in
 //! branches of 40 segments that wander and start from random points of
 //! earlier branches, generated here from a fixed seed. Timed, best of N
-//! (3 by default): the z-buffer picture at 1000×1000 (2×2 samples a pixel,
+//! (3 by default): the z-buffer picture at 1000×1000 (or `--size`; 2×2 samples a pixel,
 //! one light) as pixels and as PNG bytes; tiny-skia filling each
 //! triangle, projected by the same camera, as an antialiased path of its
 //! look's colour, the way a painter's renderer draws them (all the
@@ -120,6 +120,7 @@ fn main() {
             .and_then(|i| args.get(i + 1).cloned())
     };
     let only = value("--only");
+    let size: u32 = value("--size").and_then(|v| v.parse().ok()).unwrap_or(1000);
     let skia_max: usize = value("--skia-max")
         .and_then(|v| v.parse().ok())
         .unwrap_or(usize::MAX);
@@ -215,7 +216,7 @@ fn main() {
             })
             .collect();
         let (d, _) = best_of(runs, || {
-            let mut pm = tiny_skia::Pixmap::new(1000, 1000).expect("a pixmap");
+            let mut pm = tiny_skia::Pixmap::new(size, size).expect("a pixmap");
             pm.fill(tiny_skia::Color::WHITE);
             for (t, k) in &tris {
                 let mut pb = tiny_skia::PathBuilder::new();
