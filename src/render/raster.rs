@@ -1083,7 +1083,10 @@ impl Image {
     }
 }
 
-/// Draws `scene` with the z-buffer (after [`validate`]).
+/// Draws `scene` with the z-buffer (after [`validate`]). Triangles are not
+/// clipped: one with a corner before the near plane or past the far one
+/// is left out (a camera from [`Camera::from_view`] keeps the whole box
+/// between them, unless a `shift` puts the eye inside it).
 pub fn render(scene: &Scene3, opts: &RasterOptions) -> Result<Image, RenderError> {
     let cam = &opts.camera;
     check_size(cam.width, cam.height)?;
