@@ -167,8 +167,8 @@ fn main() {
             .meshes
             .iter()
             .flat_map(|m| m.positions.iter().copied()),
-        1000,
-        1000,
+        size,
+        size,
     )
     .expect("a camera");
     let opts = RasterOptions::new(camera);
