@@ -968,6 +968,9 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<Ve
             return write_soup_picture(&run.soup, output, &looks, &mut Out::Files)
                 .map(|()| Vec::new());
         }
+        if is_glb(output) {
+            return write_soup_glb(&run.soup, &[], output).map(|()| Vec::new());
+        }
         mesh::io::write(output, &run.soup)?;
         return Ok(Vec::new());
     }
@@ -982,7 +985,28 @@ pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<Ve
     if Picture::from_path(output).is_ok() {
         return write_mesh_picture(&run.mesh, output, &looks, &mut Out::Files).map(|()| Vec::new());
     }
+    if is_glb(output) {
+        return write_soup_glb(&run.mesh.to_quad_soup(), &[], output).map(|()| Vec::new());
+    }
     write_mesh(output, &run.mesh, false)
+}
+
+/// The output is binary glTF (`.glb`), which meshes are exported to as a
+/// 3D scene.
+fn is_glb(output: &Path) -> bool {
+    crate::export::Format::from_path(output) == Some(crate::export::Format::Glb)
+}
+
+/// A polygon mesh as binary glTF: its faces fanned into triangles, one
+/// primitive per face colour (the default blue without colours).
+fn write_soup_glb(soup: &PolygonSoup, colours: &[Rgba], output: &Path) -> Result<(), Error> {
+    let scene = crate::render::mesh::soup_scene3(soup, colours);
+    if scene.triangle_count() == 0 {
+        return Err(Error::Failed(
+            "the mesh has no face of non-zero area to write".into(),
+        ));
+    }
+    crate::export::write_glb(&scene, output)
 }
 
 /// Writes `m` to `output` (basic blocks as quads unless `triangles`) with
@@ -1059,6 +1083,9 @@ fn write_shapes(
         return Err(Error::Failed(
             "the derivation left no terminal shape with faces to write".into(),
         ));
+    }
+    if is_glb(output) {
+        return write_soup_glb(&run.soup, &run.colours, output);
     }
     Ok(mesh::io::write(output, &run.soup)?)
 }

@@ -44,6 +44,7 @@ pub mod vv;
 
 pub mod command;
 pub mod draw;
+pub mod export;
 pub mod infer;
 pub mod mesh;
 pub mod model;

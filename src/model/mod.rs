@@ -85,6 +85,8 @@ pub struct Model {
     pub capped_cylinders: bool,
     /// The view file's lights.
     pub lights: Vec<view::Light>,
+    /// The view file's camera and render mode.
+    pub camera: view::ViewCamera,
     /// The files read, in order.
     pub files: Vec<PathBuf>,
     pub notes: Vec<Note>,
@@ -318,6 +320,7 @@ impl Model {
             m.contour_sides = v.contour_sides;
             m.capped_cylinders = v.capped_cylinders;
             m.lights = v.lights.clone();
+            m.camera = v.camera.clone();
             let dir = p.parent().unwrap_or(Path::new(""));
             for s in &v.surfaces {
                 let sp = dir.join(&s.file);

@@ -4,10 +4,12 @@
 //! (the Bézier surfaces that `Surface(id, s)` draws, numbered from 0 in
 //! the order given, with their scale) and `line style:` (with `polygon`
 //! or `cylinder`, line widths are in the model's units) and `light:`
-//! (materials are lit by the lights, as on a surface facing the viewer);
-//! the others set up lpfg's OpenGL
-//! window (projection, lights, shading, fonts, …) and are reported as
-//! not acted on. The views' names (`window:`) and the turtle's settings
+//! (materials are lit by the lights, as on a surface facing the viewer),
+//! and keeps the camera of the single view (`projection:`, `scale:` /
+//! `scale factor:`, `view: 0 …` in its current and deprecated forms,
+//! `box: 0 …`, `front distance:`, `back distance:`) and the `render
+//! mode:` for the 3D renderer ([`ViewCamera`]); the others set up lpfg's
+//! OpenGL window (shadows, fonts, …) and are reported as not acted on. The views' names (`window:`) and the turtle's settings
 //! (`corrected rotation:`, `tropism:`, `torque:`, `stropism:`) are read by
 //! `load::read_view_file`. The animation file only matters in lpfg's
 //! animate mode, which a still picture is not: it is checked and kept.
@@ -119,6 +121,124 @@ pub struct ViewFile {
     pub capped_cylinders: bool,
     /// `light:` commands, in order.
     pub lights: Vec<Light>,
+    /// The single view's camera and render mode.
+    pub camera: ViewCamera,
+}
+
+/// How lpfg draws 3D geometry (`render mode:`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RenderMode {
+    /// Flat colours, no lighting (lpfg's default).
+    #[default]
+    Filled,
+    Wireframe,
+    /// Lit by the lights.
+    Shaded,
+    /// Lit, with shadows (drawn as `Shaded`: subgram casts no shadows).
+    Shadows,
+}
+
+/// The camera settings of the view file (§8.1.1) for view 0, each as
+/// given (`None`: lpfg's default).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ViewCamera {
+    /// `projection: perspective` (parallel by default).
+    pub perspective: bool,
+    /// The fraction of the window the bounding box fills: `scale:`,
+    /// `scale factor:` or `view:`'s `scale:`, the last given.
+    pub scale: Option<f64>,
+    /// `view:`'s `dir:`, `up:`, `pan:`, `fov:` and `shift:`.
+    pub dir: Option<[f64; 3]>,
+    pub up: Option<[f64; 3]>,
+    pub pan: Option<[f64; 3]>,
+    pub fov: Option<f64>,
+    pub shift: Option<f64>,
+    /// `box:` as xmin xmax ymin ymax zmin zmax.
+    pub bbox: Option<[f64; 6]>,
+    /// `front distance:` and `back distance:` (they act only together).
+    pub front: Option<f64>,
+    pub back: Option<f64>,
+    pub render_mode: RenderMode,
+}
+
+impl ViewCamera {
+    /// The renderer's view: lpfg's defaults where the file says nothing.
+    pub fn spec(&self) -> crate::render::raster::ViewSpec {
+        use crate::render::raster::{Projection, ViewSpec};
+        use glam::Vec3;
+        let v = |a: [f64; 3]| Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32);
+        let d = ViewSpec::default();
+        ViewSpec {
+            dir: self.dir.map(v).unwrap_or(d.dir),
+            up: self.up.map(v).unwrap_or(d.up),
+            projection: if self.perspective {
+                Projection::Perspective
+            } else {
+                Projection::Parallel
+            },
+            fov: self.fov.map_or(d.fov, |f| f as f32),
+            scale: self.scale.map_or(d.scale, |s| s as f32),
+            pan: self.pan.map(v).unwrap_or(d.pan),
+            shift: self.shift.map(|s| s as f32),
+            bounds: self.bbox.map(|b| {
+                (
+                    Vec3::new(b[0] as f32, b[2] as f32, b[4] as f32),
+                    Vec3::new(b[1] as f32, b[3] as f32, b[5] as f32),
+                )
+            }),
+            clip: self.front.zip(self.back).map(|(f, b)| (f as f32, b as f32)),
+            tight: false,
+        }
+    }
+}
+
+impl ViewCamera {
+    /// The renderer's settings for geometry whose vertices are `points`,
+    /// in an image of `width`×`height`: the camera of [`ViewCamera::spec`],
+    /// the view file's `lights` (see [`raster_lights`]), and lit shading
+    /// for `render mode: shaded` or `shadows`, unlit colours for `filled`
+    /// (lpfg's default) and `wireframe`.
+    pub fn raster_options(
+        &self,
+        lights: &[Light],
+        points: &mut dyn Iterator<Item = glam::Vec3>,
+        width: u32,
+        height: u32,
+    ) -> Result<crate::render::raster::RasterOptions, crate::render::RenderError> {
+        use crate::render::raster::{Camera, RasterOptions, Shading};
+        let camera = Camera::from_view(&self.spec(), points, width, height)?;
+        Ok(RasterOptions {
+            lights: raster_lights(lights),
+            shading: match self.render_mode {
+                RenderMode::Shaded | RenderMode::Shadows => Shading::Lit,
+                RenderMode::Filled | RenderMode::Wireframe => Shading::Unlit,
+            },
+            ..RasterOptions::new(camera)
+        })
+    }
+}
+
+/// The renderer's lights for the view file's (lpfg's default light when
+/// there is none): directional lights in eye coordinates, as lpfg's
+/// stationary lights are. A point light (`O:`) shines from the direction
+/// of its position.
+pub fn raster_lights(lights: &[Light]) -> Vec<crate::render::raster::Light> {
+    let f = |a: [f64; 3]| a.map(|x| x as f32);
+    let default = [Light::default()];
+    let lights = if lights.is_empty() {
+        &default[..]
+    } else {
+        lights
+    };
+    lights
+        .iter()
+        .map(|l| crate::render::raster::Light {
+            direction: glam::Vec3::from_array(f(l.direction)),
+            ambient: f(l.ambient),
+            diffuse: f(l.diffuse),
+            specular: f(l.specular),
+        })
+        .collect()
 }
 
 impl Default for ViewFile {
@@ -130,6 +250,7 @@ impl Default for ViewFile {
             contour_sides: DEFAULT_CONTOUR_SIDES,
             capped_cylinders: false,
             lights: Vec::new(),
+            camera: ViewCamera::default(),
         }
     }
 }
@@ -154,12 +275,14 @@ pub enum LineStyle {
 }
 
 /// A light source of the view file: its direction (towards the light),
-/// and its ambient and diffuse colours (each 0 to 1).
+/// and its ambient, diffuse and specular colours (each 0 to 1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
     pub direction: [f64; 3],
     pub ambient: [f64; 3],
     pub diffuse: [f64; 3],
+    /// `S:`, white by default.
+    pub specular: [f64; 3],
 }
 
 impl Default for Light {
@@ -169,6 +292,7 @@ impl Default for Light {
             direction: [0.0, 0.0, 1.0],
             ambient: [1.0; 3],
             diffuse: [1.0; 3],
+            specular: [1.0; 3],
         }
     }
 }
@@ -209,6 +333,7 @@ fn light(lines: &Lines<'_>, line: &str, after: usize) -> Result<Light, Error> {
             "V:" | "O:" => l.direction = [v[0], v[1], v[2]],
             "A:" => l.ambient = [v[0], v[1], v[2]],
             "D:" => l.diffuse = [v[0], v[1], v[2]],
+            "S:" => l.specular = [v[0], v[1], v[2]],
             _ => {}
         }
         i += 1 + n;
@@ -216,9 +341,9 @@ fn light(lines: &Lines<'_>, line: &str, after: usize) -> Result<Light, Error> {
     Ok(l)
 }
 
-/// The words of `text`, which starts at byte `after` of its line.
-fn shifted(text: &str, after: usize) -> Vec<super::text::Word<'_>> {
-    words(text)
+/// The words of `line` after byte `after`, with ranges in the line.
+fn words_after(line: &str, after: usize) -> Vec<super::text::Word<'_>> {
+    words(&line[after..])
         .into_iter()
         .map(|w| super::text::Word {
             text: w.text,
@@ -226,6 +351,170 @@ fn shifted(text: &str, after: usize) -> Vec<super::text::Word<'_>> {
             end: w.end + after,
         })
         .collect()
+}
+
+/// Reads a camera command (`projection:`, `scale:`, `scale factor:`,
+/// `view:`, `box:`, `front distance:`, `back distance:`, `render mode:`)
+/// into `camera`; false for any other command. A value lpfg does not know
+/// is a note (lpfg reports it and keeps its default); a malformed number
+/// is an error at its word. Views other than 0 (multiple views) are left
+/// out with a note.
+fn camera_command(
+    lines: &Lines<'_>,
+    line: &str,
+    (k, after): (&str, usize),
+    camera: &mut ViewCamera,
+    note: &mut dyn FnMut((usize, usize), String),
+) -> Result<bool, Error> {
+    let ws = words_after(line, after);
+    let span = |i: usize| {
+        ws.get(i)
+            .map_or((line.len(), line.len()), |w| (w.start, w.end))
+    };
+    match k {
+        "projection" => match ws.first().map(|w| w.text) {
+            Some("parallel") => camera.perspective = false,
+            Some("perspective") => camera.perspective = true,
+            _ => note(
+                span(0),
+                "not a projection (`parallel` or `perspective`): the projection stays parallel"
+                    .into(),
+            ),
+        },
+        "scale" | "scale factor" => {
+            let s = number(lines, &ws, 0, "the scale")?;
+            if s.abs() < 1e-4 {
+                return Err(lines.error(ws[0], "the scale must not be 0"));
+            }
+            camera.scale = Some(s);
+        }
+        "front distance" => camera.front = Some(number(lines, &ws, 0, "the front distance")?),
+        "back distance" => camera.back = Some(number(lines, &ws, 0, "the back distance")?),
+        "render mode" => match ws.first().map(|w| w.text) {
+            Some("filled") => camera.render_mode = RenderMode::Filled,
+            Some("wireframe") => camera.render_mode = RenderMode::Wireframe,
+            Some("shaded") => camera.render_mode = RenderMode::Shaded,
+            Some("shadows") => {
+                camera.render_mode = RenderMode::Shadows;
+                note(
+                    span(0),
+                    "subgram casts no shadows: the picture is shaded without them".into(),
+                );
+            }
+            _ => note(
+                span(0),
+                "not a render mode (`filled`, `wireframe`, `shaded` or `shadows`): it stays \
+                 `filled`"
+                    .into(),
+            ),
+        },
+        "box" => {
+            let id = number(lines, &ws, 0, "the view's number")?;
+            let mut b = [0.0; 6];
+            for (i, slot) in b.iter_mut().enumerate() {
+                *slot = number(
+                    lines,
+                    &ws,
+                    1 + i,
+                    "a bound of the box (xmin xmax ymin ymax zmin zmax)",
+                )?;
+            }
+            if id != 0.0 {
+                note(span(0), "only view 0 is drawn: this box is left out".into());
+            } else if b[0] > b[1] || b[2] > b[3] || b[4] > b[5] {
+                return Err(lines.error(
+                    ws[1],
+                    "the box's bounds must be xmin xmax ymin ymax zmin zmax, each minimum at most \
+                     its maximum",
+                ));
+            } else {
+                camera.bbox = Some(b);
+            }
+        }
+        "view" => view_command(lines, &ws, camera, note)?,
+        _ => return Ok(false),
+    }
+    Ok(true)
+}
+
+/// `view: id dir: x y z up: x y z pan: x y z fov: f shift: s scale: s`
+/// (each part optional), or the deprecated `view: id rx ry rz scale px py
+/// pz`: rotations in degrees about x, then y, then z of lpfg's default
+/// view (down -z, y up), the scale and the pan.
+fn view_command(
+    lines: &Lines<'_>,
+    ws: &[super::text::Word<'_>],
+    camera: &mut ViewCamera,
+    note: &mut dyn FnMut((usize, usize), String),
+) -> Result<(), Error> {
+    let id = number(lines, ws, 0, "the view's number")?;
+    let mut c = camera.clone();
+    let all_numbers = ws.len() == 8 && ws.iter().all(|w| w.text.parse::<f64>().is_ok());
+    if all_numbers {
+        let v: Vec<f64> = (1..8)
+            .map(|i| number(lines, ws, i, "a value of the view"))
+            .collect::<Result<_, _>>()?;
+        let q = glam::DQuat::from_rotation_x(v[0].to_radians())
+            * glam::DQuat::from_rotation_y(v[1].to_radians())
+            * glam::DQuat::from_rotation_z(v[2].to_radians());
+        c.dir = Some((q * glam::DVec3::NEG_Z).to_array());
+        c.up = Some((q * glam::DVec3::Y).to_array());
+        if v[3].abs() < 1e-4 {
+            return Err(lines.error(ws[4], "the scale must not be 0"));
+        }
+        c.scale = Some(v[3]);
+        c.pan = Some([v[4], v[5], v[6]]);
+    } else {
+        let mut i = 1;
+        while i < ws.len() {
+            let w = ws[i];
+            let three = |i: usize, what: &str| -> Result<[f64; 3], Error> {
+                Ok([
+                    number(lines, ws, i, what)?,
+                    number(lines, ws, i + 1, what)?,
+                    number(lines, ws, i + 2, what)?,
+                ])
+            };
+            match w.text {
+                "dir:" => c.dir = Some(three(i + 1, "a coordinate of the view direction")?),
+                "up:" => c.up = Some(three(i + 1, "a coordinate of the up direction")?),
+                "pan:" => c.pan = Some(three(i + 1, "a coordinate of the pan")?),
+                "fov:" => c.fov = Some(number(lines, ws, i + 1, "the field of view in degrees")?),
+                "shift:" => c.shift = Some(number(lines, ws, i + 1, "the camera's distance")?),
+                "scale:" => {
+                    let s = number(lines, ws, i + 1, "the scale")?;
+                    if s.abs() < 1e-4 {
+                        return Err(lines.error(ws[i + 1], "the scale must not be 0"));
+                    }
+                    c.scale = Some(s);
+                }
+                _ => {
+                    return Err(lines.error(
+                        w,
+                        format!(
+                            "expected a part of the view `dir:`, `up:`, `pan:`, `fov:`, `shift:` \
+                             or `scale:`, found `{}`",
+                            w.text
+                        ),
+                    ))
+                }
+            }
+            i += if matches!(w.text, "dir:" | "up:" | "pan:") {
+                4
+            } else {
+                2
+            };
+        }
+    }
+    if id != 0.0 {
+        note(
+            (ws[0].start, ws[0].end),
+            "only view 0 is drawn: this view is left out".into(),
+        );
+    } else {
+        *camera = c;
+    }
+    Ok(())
 }
 
 /// The text with C and C++ comments blanked out (newlines and byte
@@ -319,6 +608,11 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
             ));
             continue;
         }
+        if camera_command(&lines, line, (&k, after), &mut view.camera, &mut |at, m| {
+            notes.push(Note::at(path, text, base + at.0..base + at.1, m))
+        })? {
+            continue;
+        }
         if k == "light" {
             view.lights.push(light(&lines, line, after)?);
             // Lights shade the materials' colours; their positions and the
@@ -326,14 +620,14 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
             continue;
         }
         if k == "contour sides" {
-            let ws = shifted(&line[after..], after);
+            let ws = words_after(line, after);
             let n = number(&lines, &ws, 0, "the number of sides")?;
             // lpfg clamps the value to its bounds.
             view.contour_sides = n.clamp(MIN_CONTOUR_SIDES as f64, MAX_CONTOUR_SIDES as f64) as u32;
             continue;
         }
         if k == "capped cylinders" {
-            let ws = shifted(&line[after..], after);
+            let ws = words_after(line, after);
             view.capped_cylinders = match ws.first().map(|w| w.text) {
                 Some("on") => true,
                 Some("off") => false,

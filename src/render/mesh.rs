@@ -1,36 +1,42 @@
-//! Pictures of polygon meshes: a flat-shaded orthographic view, as the
-//! shaded polygons of a [`Scene`] that the PNG and SVG backends draw.
+//! Pictures of polygon meshes: a flat-shaded orthographic view.
 //!
-//! The mesh is projected along the view direction, fitted into the image
-//! with a margin (uniform scale, centred), and its faces are painted back
-//! to front (painter's algorithm, by mean depth). Each face gets a flat
-//! Lambert shade of a light grey-blue from a key light and a weak fill
-//! light that are fixed relative to the viewer, so every view is lit the
-//! same way; faces seen from behind (the inside of an open mesh) get a
-//! warmer tint. Thin dark outlines show the polygons.
+//! The mesh is projected along the view direction and fitted into the
+//! image with a margin (uniform scale, centred). The PNG is drawn by the
+//! z-buffer renderer ([`super::raster`]), the one that draws plants: the
+//! polygons are fanned into a [`Scene3`] (one mesh per face colour, each
+//! polygon with its own vertices and its Newell normal, so a polygon is
+//! one flat shade), and the wireframe is drawn where the polygon seen
+//! changes from one sample to the next, so hidden edges stay hidden. The
+//! SVG paints the polygons back to front (painter's algorithm, by mean
+//! depth) in the same colours. Each face gets OpenGL's lighting of a
+//! light grey-blue from a key light and a weak fill light that are fixed
+//! relative to the viewer, so every view is lit the same way; faces seen
+//! from behind (the inside of an open mesh) get a warmer tint.
 
 use glam::{DVec2, DVec3};
 
-use super::{check_size, png, svg, Fit, Item, Outline, RenderError, Rgba, Scene};
+use glam::Vec3;
+
+use super::raster::{self, Light, RasterOptions, ViewSpec, Wireframe};
+use super::{check_size, svg, Fit, Item, Outline, RenderError, Rgba, Scene};
 use crate::mesh::PolygonSoup;
+use crate::scene3::{Look, Scene3, TriMesh};
 
 /// The colour of faces seen from the front (a light grey-blue).
 const FRONT_BASE: DVec3 = DVec3::new(0.70, 0.77, 0.88);
 /// The colour of faces seen from behind (a light warm grey).
 const BACK_BASE: DVec3 = DVec3::new(0.88, 0.76, 0.68);
-/// The light every face gets, whatever its orientation.
-const AMBIENT: f64 = 0.30;
+/// The light every face gets, whatever its orientation (OpenGL's global
+/// ambient light).
+const AMBIENT: f32 = 0.40;
 /// The strength of the key light (upper left, in front of the viewer).
-const KEY: f64 = 0.62;
+const KEY: f32 = 0.62;
 /// The strength of the fill light (lower right, in front of the viewer).
-const FILL: f64 = 0.16;
-/// Lifts the mid tones of the light (below 1: brighter), so that faces
-/// turned from the key light still read clearly.
-const GAMMA: f64 = 0.7;
+const FILL: f32 = 0.22;
 /// The colour of the wireframe edges.
 const EDGE: Rgba = Rgba(38, 46, 60, 255);
 /// The width of the seam-closing outline drawn in the face colour when the
-/// wireframe is off, so antialiased neighbours leave no light cracks.
+/// wireframe is off, so antialiased neighbours leave no light cracks (SVG).
 const SEAM_WIDTH: f64 = 0.7;
 
 /// How a mesh is looked at and how the picture is laid out.
@@ -54,33 +60,7 @@ pub struct MeshView {
     pub shading: Shading,
 }
 
-/// How a face's colour follows from its normal.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Shading {
-    /// Lit by a key and a fill light (the default).
-    #[default]
-    Lit,
-    /// A normal map: the unit normal of the visible side, `(n + 1) / 2` as
-    /// red, green and blue. A crease shows as a jump of colour.
-    Normals,
-    /// Reflection lines: the view direction mirrored in the face and read
-    /// against a room of parallel black and white stripes. On a smooth
-    /// surface the lines run smooth; a kink of a line marks a jump of
-    /// curvature, a break a crease.
-    Reflection,
-}
-
-impl Shading {
-    /// By name: `lit`, `normals` or `reflection`.
-    pub fn from_name(name: &str) -> Option<Shading> {
-        match name {
-            "lit" => Some(Shading::Lit),
-            "normals" => Some(Shading::Normals),
-            "reflection" => Some(Shading::Reflection),
-            _ => None,
-        }
-    }
-}
+pub use super::raster::Shading;
 
 impl Default for MeshView {
     /// 800×800 on white with edges, the "iso" view, 4% margin.
@@ -164,11 +144,6 @@ impl Camera {
     /// The unit vector towards the key light.
     fn key_light(&self) -> DVec3 {
         (-0.45 * self.right + 0.75 * self.up - 0.55 * self.dir).normalize()
-    }
-
-    /// The unit vector towards the fill light.
-    fn fill_light(&self) -> DVec3 {
-        (0.6 * self.right - 0.3 * self.up - 0.7 * self.dir).normalize()
     }
 }
 
@@ -282,9 +257,17 @@ fn unchecked_scene(soup: &PolygonSoup, view: &MeshView) -> Scene {
     }
 }
 
-/// Renders the mesh as a PNG image.
+/// Renders the mesh as a PNG image, with the z-buffer (after [`validate`]).
 pub fn render_png(soup: &PolygonSoup, view: &MeshView) -> Result<Vec<u8>, RenderError> {
-    png::render(&scene(soup, view)?)
+    validate(soup, view)?;
+    let (scene, polygons, back) = scene3(soup, view);
+    if scene.triangle_count() == 0 {
+        return Err(RenderError::new(
+            "nothing to draw: every face of the mesh has zero area",
+        ));
+    }
+    let opts = raster_options(soup, view, polygons, back)?;
+    raster::render_png(&scene, &opts)
 }
 
 /// Renders the mesh as an SVG document that looks like the PNG: one
@@ -356,11 +339,21 @@ fn shade_face(
     let depth = corners.iter().map(|p| p.dot(cam.dir)).sum::<f64>() / corners.len() as f64;
     let color = match shading {
         Shading::Lit => shade(seen, back, cam, base),
+        Shading::Unlit => {
+            let c = face_look(base, back)
+                .diffuse
+                .map(|v| (v * 255.0).round() as u8);
+            Rgba(c[0], c[1], c[2], 255)
+        }
         Shading::Normals => {
             let c = (seen + DVec3::ONE) * 127.5;
             Rgba(c.x.round() as u8, c.y.round() as u8, c.z.round() as u8, 255)
         }
-        Shading::Reflection => reflection(seen, cam),
+        Shading::Reflection => {
+            let c = raster::reflection(seen.as_vec3(), cam.dir.as_vec3(), cam.up.as_vec3());
+            let [r, g, b] = c.map(|v| (v * 255.0).round() as u8);
+            Rgba(r, g, b, 255)
+        }
     };
     let outline = edge.unwrap_or(Outline {
         color,
@@ -397,36 +390,200 @@ fn newell_normal(corners: &[DVec3]) -> DVec3 {
     }
 }
 
-/// The flat colour of a face whose visible side has unit normal `seen`.
+/// The flat colour of a face whose visible side has unit normal `seen`:
+/// the lighting the PNG gives it.
 fn shade(seen: DVec3, back: bool, cam: &Camera, base: Option<DVec3>) -> Rgba {
-    let light = AMBIENT
-        + KEY * seen.dot(cam.key_light()).max(0.0)
-        + FILL * seen.dot(cam.fill_light()).max(0.0);
-    let base = match base {
-        // A face's own colour, darker on its back.
+    let look = face_look(base, back);
+    let n = Vec3::new(
+        seen.dot(cam.right) as f32,
+        seen.dot(cam.up) as f32,
+        -seen.dot(cam.dir) as f32,
+    );
+    let c = raster::lighting(&look, n, &lights(), [AMBIENT; 3]).map(|v| (v * 255.0).round() as u8);
+    Rgba(c[0], c[1], c[2], 255)
+}
+
+/// The key and fill lights, in eye coordinates (fixed to the viewer).
+fn lights() -> Vec<Light> {
+    let light = |d: Vec3, strength: f32| Light {
+        direction: d.normalize(),
+        ambient: [0.0; 3],
+        diffuse: [strength; 3],
+        specular: [0.0; 3],
+    };
+    vec![
+        light(Vec3::new(-0.45, 0.75, 0.55), KEY),
+        light(Vec3::new(0.6, -0.3, 0.7), FILL),
+    ]
+}
+
+/// The look of a face of colour `base` (the default blue when none), on
+/// its back the warm grey, or its colour darkened.
+fn face_look(base: Option<DVec3>, back: bool) -> Look {
+    let c = match base {
         Some(c) if back => c * 0.6,
         Some(c) => c,
         None if back => BACK_BASE,
         None => FRONT_BASE,
     };
-    let c = (base * light.clamp(0.0, 1.0).powf(GAMMA)).clamp(DVec3::ZERO, DVec3::ONE) * 255.0;
-    Rgba(c.x.round() as u8, c.y.round() as u8, c.z.round() as u8, 255)
+    let c = c.as_vec3().to_array();
+    Look {
+        name: String::new(),
+        index: 0,
+        ambient: c,
+        diffuse: c,
+        specular: [0.0; 3],
+        emission: [0.0; 3],
+        shininess: 0.0,
+        opacity: 1.0,
+    }
 }
 
-/// Stripes per unit of the mirrored view direction's height.
-const STRIPES: f64 = 6.0;
-
-/// The colour of the stripe that the view direction, mirrored in a face of
-/// unit normal `seen`, meets: stripes run across the screen's up
-/// direction, so a plane facing the viewer shows one colour.
-fn reflection(seen: DVec3, cam: &Camera) -> Rgba {
-    let r = cam.dir - 2.0 * cam.dir.dot(seen) * seen;
-    let k = ((r.dot(cam.up) + 1.0) * STRIPES).floor() as i64;
-    if k.rem_euclid(2) == 0 {
-        Rgba(250, 250, 250, 255)
-    } else {
-        Rgba(30, 34, 44, 255)
+/// The faces of `soup` as a [`Scene3`] for the z-buffer: one mesh per face
+/// colour (in the order first used), each polygon fanned from its first
+/// corner with its own copies of its vertices and its Newell normal as
+/// their normals, so a polygon (even a warped one) is one flat shade as in
+/// the SVG. Also the polygon of each triangle (for the wireframe) and each
+/// mesh's back look. Faces that cannot be drawn are left out.
+pub fn scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<u32>, Vec<Look>) {
+    let mut scene = Scene3::default();
+    let mut back = Vec::new();
+    let mut keys: Vec<Option<Rgba>> = Vec::new();
+    let mut polygons: Vec<Vec<u32>> = Vec::new();
+    for (f, face) in soup.faces.iter().enumerate() {
+        let Some(corners) = face
+            .iter()
+            .map(|&i| soup.positions.get(i as usize).copied())
+            .collect::<Option<Vec<DVec3>>>()
+        else {
+            continue;
+        };
+        if corners.len() < 3 || corners.iter().any(|p| !p.is_finite()) {
+            continue;
+        }
+        let Some(normal) = newell_normal(&corners).try_normalize() else {
+            continue;
+        };
+        let key = view.face_colours.get(f).copied();
+        let k = match keys.iter().position(|c| *c == key) {
+            Some(k) => k,
+            None => {
+                let base = key.map(|c| DVec3::new(c.0 as f64, c.1 as f64, c.2 as f64) / 255.0);
+                let mut look = face_look(base, false);
+                look.name = format!("face{}", keys.len());
+                let mut b = face_look(base, true);
+                b.name = format!("{}-back", look.name);
+                keys.push(key);
+                scene.looks.push(look);
+                back.push(b);
+                scene.meshes.push(TriMesh::default());
+                polygons.push(Vec::new());
+                keys.len() - 1
+            }
+        };
+        let m = &mut scene.meshes[k];
+        let start = m.positions.len() as u32;
+        m.positions.extend(corners.iter().map(|p| p.as_vec3()));
+        m.normals
+            .extend(std::iter::repeat_n(normal.as_vec3(), corners.len()));
+        for j in 1..corners.len() as u32 - 1 {
+            m.triangles.push([start, start + j, start + j + 1]);
+            polygons[k].push(f as u32);
+        }
     }
+    (scene, polygons.concat(), back)
+}
+
+/// The faces of `soup` as a [`Scene3`] for export: one mesh per face
+/// colour (the default blue without colours), each polygon fanned from its
+/// first corner over the soup's own vertices (renumbered per mesh, shared
+/// between faces), no normals. Faces with fewer than three corners or an
+/// index out of range are left out.
+pub fn soup_scene3(soup: &PolygonSoup, face_colours: &[Rgba]) -> Scene3 {
+    let mut scene = Scene3::default();
+    let mut keys: Vec<Option<Rgba>> = Vec::new();
+    let mut maps: Vec<std::collections::HashMap<u32, u32>> = Vec::new();
+    let n = soup.positions.len();
+    for (f, face) in soup.faces.iter().enumerate() {
+        if face.len() < 3 || face.iter().any(|&i| i as usize >= n) {
+            continue;
+        }
+        let key = face_colours.get(f).copied();
+        let k = match keys.iter().position(|c| *c == key) {
+            Some(k) => k,
+            None => {
+                let base = key.map(|c| DVec3::new(c.0 as f64, c.1 as f64, c.2 as f64) / 255.0);
+                let mut look = face_look(base, false);
+                look.name = match key {
+                    Some(c) => format!("colour-{}", &c.hex()[1..]),
+                    None => "surface".into(),
+                };
+                keys.push(key);
+                scene.looks.push(look);
+                scene.meshes.push(TriMesh::default());
+                maps.push(Default::default());
+                keys.len() - 1
+            }
+        };
+        let m = &mut scene.meshes[k];
+        let map = &mut maps[k];
+        let local: Vec<u32> = face
+            .iter()
+            .map(|&i| {
+                *map.entry(i).or_insert_with(|| {
+                    m.positions.push(soup.positions[i as usize].as_vec3());
+                    m.positions.len() as u32 - 1
+                })
+            })
+            .collect();
+        for j in 1..local.len() - 1 {
+            m.triangles.push([local[0], local[j], local[j + 1]]);
+        }
+    }
+    scene
+}
+
+/// The z-buffer's settings for a picture of `soup` seen with `view`: the
+/// tight fit of the view's direction, the key and fill lights, the back
+/// looks and the wireframe.
+pub fn raster_options(
+    soup: &PolygonSoup,
+    view: &MeshView,
+    polygons: Vec<u32>,
+    back: Vec<Look>,
+) -> Result<RasterOptions, RenderError> {
+    let cam = Camera::or_default(view);
+    let margin = if view.margin.is_finite() {
+        view.margin.clamp(0.0, 0.45)
+    } else {
+        0.04
+    };
+    let spec = ViewSpec {
+        dir: cam.dir.as_vec3(),
+        up: cam.up.as_vec3(),
+        scale: (1.0 - 2.0 * margin) as f32,
+        tight: true,
+        ..ViewSpec::default()
+    };
+    let camera = raster::Camera::from_view(
+        &spec,
+        &mut used_vertices(soup).map(|p| p.as_vec3()),
+        view.width,
+        view.height,
+    )?;
+    Ok(RasterOptions {
+        background: view.background,
+        lights: lights(),
+        global_ambient: [AMBIENT; 3],
+        shading: view.shading,
+        back_looks: Some(back),
+        wireframe: view.wireframe.then_some(Wireframe {
+            color: EDGE,
+            polygons,
+            wide: edge_width(view) >= 0.8,
+        }),
+        ..RasterOptions::new(camera)
+    })
 }
 
 /// The width of edge strokes: thin, growing slowly with the image.

@@ -6,6 +6,7 @@
 mod ink;
 pub mod mesh;
 pub mod png;
+pub mod raster;
 pub mod svg;
 
 pub use crate::atomic::write_atomic;
@@ -182,7 +183,7 @@ pub struct RenderError {
 }
 
 impl RenderError {
-    fn new(m: impl Into<String>) -> RenderError {
+    pub(crate) fn new(m: impl Into<String>) -> RenderError {
         RenderError { message: m.into() }
     }
 }

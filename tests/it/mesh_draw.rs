@@ -565,10 +565,13 @@ fn a_mesh_is_a_scene_of_outlined_polygons_back_to_front() {
         };
         assert_eq!(outline.map(|o| o.color), Some(color));
     }
-    // The PNG is this scene drawn by the shared backend; failures come first.
+    // The PNG is the z-buffer's picture of the same polygons, fanned.
+    let (scene3, polygons, back) = subgram::render::mesh::scene3(&s, &view);
+    assert_eq!(scene3.triangle_count(), s.faces.len());
+    let opts = subgram::render::mesh::raster_options(&s, &view, polygons, back).expect("a camera");
     assert_eq!(
         render_png(&s, &view).expect("renders"),
-        subgram::render::png::render(&sc).expect("renders")
+        subgram::render::raster::render_png(&scene3, &opts).expect("renders")
     );
     let empty = soup(vec![DVec3::ZERO], vec![]);
     assert!(scene(&empty, &view).is_err());

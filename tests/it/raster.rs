@@ -1,0 +1,581 @@
+//! The z-buffer renderer of 3D scenes (`render::raster`): depth order of
+//! crossing surfaces, OpenGL's lighting formula, the camera against
+//! matrices built here with glam's OpenGL-convention constructors, lpfg's
+//! framing, independence from the thread count, SVG order, and refusals.
+
+use glam::{Mat4, Vec3, Vec4};
+use subgram::render::raster::{
+    self, lighting, render, Camera, Light, Projection, RasterOptions, Shading, ViewSpec,
+};
+use subgram::render::Rgba;
+use subgram::scene3::{Look, Scene3, TriMesh};
+
+/// A look that shows exactly its emission (no ambient, diffuse or
+/// specular reflection), so a pixel's colour is known without lighting.
+fn glowing(name: &str, rgb: [u8; 3]) -> Look {
+    let mut l = Look::colour(name, 0, [0, 0, 0]);
+    l.ambient = [0.0; 3];
+    l.diffuse = [0.0; 3];
+    l.emission = rgb.map(|v| v as f32 / 255.0);
+    l
+}
+
+/// A quad of two triangles over the corners in order.
+fn quad(corners: [Vec3; 4]) -> TriMesh {
+    TriMesh {
+        positions: corners.to_vec(),
+        normals: Vec::new(),
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+    }
+}
+
+fn scene(parts: Vec<(Look, TriMesh)>) -> Scene3 {
+    let (looks, meshes) = parts.into_iter().unzip();
+    Scene3 { looks, meshes }
+}
+
+/// A camera on the +z axis looking down -z with y up, at distance 10,
+/// seeing -2..2 in parallel projection (or 45° in perspective).
+fn down_z(projection: Projection, size: u32) -> Camera {
+    let half = match projection {
+        Projection::Parallel => 2.0,
+        Projection::Perspective => (22.5f32).to_radians().tan(),
+    };
+    Camera::look_at(
+        Vec3::new(0.0, 0.0, 10.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        projection,
+        half,
+        (5.0, 15.0),
+        size,
+        size,
+    )
+    .expect("a camera")
+}
+
+/// The un-premultiplied colour of an opaque pixel.
+fn rgb(img: &raster::Image, x: u32, y: u32) -> [u8; 3] {
+    let p = img.pixel(x, y);
+    [p[0], p[1], p[2]]
+}
+
+/// The pixel holding the projection of `p`.
+fn pixel_of(cam: &Camera, p: Vec3) -> (u32, u32) {
+    let q = cam.pixel(p).expect("in front of the eye");
+    (q.x.floor() as u32, q.y.floor() as u32)
+}
+
+#[test]
+fn the_nearer_of_two_crossing_quads_shows_on_each_side_of_their_crossing() {
+    // Quad A lies in the plane z = 0.5·x, quad B in z = -0.5·x (y free):
+    // they cross along the y axis. The camera looks down -z, so the nearer
+    // surface at (x, y) is the one with the larger z: A where x > 0, B
+    // where x < 0, computed here from the plane equations.
+    let za = |x: f32| 0.5 * x;
+    let zb = |x: f32| -0.5 * x;
+    let plane = |z: &dyn Fn(f32) -> f32| {
+        quad([
+            Vec3::new(-1.5, -1.5, z(-1.5)),
+            Vec3::new(1.5, -1.5, z(1.5)),
+            Vec3::new(1.5, 1.5, z(1.5)),
+            Vec3::new(-1.5, 1.5, z(-1.5)),
+        ])
+    };
+    let red = [220, 30, 30];
+    let blue = [30, 30, 220];
+    // Both orders of the meshes: the depth test, not the order, decides.
+    for flip in [false, true] {
+        let mut parts = vec![
+            (glowing("a", red), plane(&za)),
+            (glowing("b", blue), plane(&zb)),
+        ];
+        if flip {
+            parts.reverse();
+        }
+        let sc = scene(parts);
+        for projection in [Projection::Parallel, Projection::Perspective] {
+            let cam = down_z(projection, 120);
+            let img = render(&sc, &RasterOptions::new(cam)).expect("renders");
+            for x in [-1.2f32, -0.6, -0.2, 0.2, 0.6, 1.2] {
+                for y in [-1.0f32, 0.0, 0.7] {
+                    let expect = if za(x) > zb(x) { red } else { blue };
+                    // The point seen is on the nearer plane.
+                    let z = za(x).max(zb(x));
+                    let (px, py) = pixel_of(&cam, Vec3::new(x, y, z));
+                    assert_eq!(
+                        rgb(&img, px, py),
+                        expect,
+                        "{projection:?}, flip {flip}, at x {x}, y {y}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_flat_quad_gets_the_colour_of_opengls_lighting_formula() {
+    // A quad facing +z (towards the viewer), a directional light at 60°
+    // from its normal. OpenGL's fixed-function formula, computed here:
+    // emission + ambient·global + ambient·La + diffuse·Ld·cos θ
+    // + specular·Ls·(n·h)^shininess, h the half-way vector of the light
+    // and the viewer (0, 0, 1), so n·h = cos(θ/2).
+    let theta = 60f32.to_radians();
+    let light = Light {
+        direction: Vec3::new(theta.sin(), 0.0, theta.cos()),
+        ambient: [0.1, 0.2, 0.0],
+        diffuse: [0.9, 0.6, 0.8],
+        specular: [0.5, 0.5, 0.5],
+    };
+    let mut look = Look::colour("leaf", 3, [0, 0, 0]);
+    look.ambient = [0.3, 0.5, 0.2];
+    look.diffuse = [0.4, 0.7, 0.3];
+    look.specular = [0.2, 0.3, 0.1];
+    look.emission = [0.05, 0.0, 0.02];
+    look.shininess = 10.0;
+    let global = 0.2f32;
+    let expect: Vec<u8> = (0..3)
+        .map(|k| {
+            let c = look.emission[k]
+                + look.ambient[k] * global
+                + look.ambient[k] * light.ambient[k]
+                + look.diffuse[k] * light.diffuse[k] * theta.cos()
+                + look.specular[k] * light.specular[k] * (theta / 2.0).cos().powf(10.0);
+            (c.clamp(0.0, 1.0) * 255.0).round() as u8
+        })
+        .collect();
+    let front = quad([
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(-1.0, 1.0, 0.0),
+    ]);
+    // The same quad wound the other way faces away: lit two-sided, with
+    // the flipped normal, it looks the same.
+    let mut back = front.clone();
+    back.triangles = vec![[0, 2, 1], [0, 3, 2]];
+    for mesh in [front, back] {
+        let sc = scene(vec![(look.clone(), mesh)]);
+        let cam = down_z(Projection::Parallel, 40);
+        let opts = RasterOptions {
+            lights: vec![light],
+            ..RasterOptions::new(cam)
+        };
+        let img = render(&sc, &opts).expect("renders");
+        let got = rgb(&img, 20, 20);
+        for k in 0..3 {
+            assert!(
+                (got[k] as i32 - expect[k] as i32).abs() <= 1,
+                "channel {k}: {got:?} against {expect:?}"
+            );
+        }
+    }
+    // The library's formula on its own: a light behind the surface adds
+    // no diffuse and no specular.
+    let away = Light {
+        direction: Vec3::new(0.0, 0.0, -1.0),
+        ..light
+    };
+    let c = lighting(&look, Vec3::Z, &[away], [global; 3]);
+    for (k, ck) in c.iter().enumerate() {
+        let only = look.emission[k] + look.ambient[k] * (global + light.ambient[k]);
+        assert!((ck - only).abs() < 1e-6);
+    }
+}
+
+#[test]
+fn a_point_lands_on_the_pixel_the_opengl_matrices_give() {
+    // gluLookAt then gluPerspective / glOrtho, as glam builds them
+    // (`look_at_rh`, `perspective_rh_gl`, `orthographic_rh_gl`), then the
+    // viewport: pixel = ((x + 1) / 2 · w, (1 - y) / 2 · h), y down.
+    let (w, h) = (160u32, 100u32);
+    let aspect = w as f32 / h as f32;
+    let eye = Vec3::new(3.0, -4.0, 5.0);
+    let target = Vec3::new(0.5, 0.2, -0.3);
+    let up = Vec3::new(0.1, 0.0, 1.0);
+    let (near, far) = (2.0, 20.0);
+    let fovy = 40f32.to_radians();
+    let half = 1.7;
+    let view = Mat4::look_at_rh(eye, target, up);
+    let cases = [
+        (
+            Projection::Perspective,
+            (fovy / 2.0).tan(),
+            Mat4::perspective_rh_gl(fovy, aspect, near, far),
+        ),
+        (
+            Projection::Parallel,
+            half,
+            Mat4::orthographic_rh_gl(-half * aspect, half * aspect, -half, half, near, far),
+        ),
+    ];
+    let points = [
+        Vec3::new(0.5, 0.2, -0.3),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(-0.7, 1.1, 0.4),
+        Vec3::new(0.2, -0.9, -1.0),
+    ];
+    for (projection, half_height, proj) in cases {
+        let cam = Camera::look_at(eye, target, up, projection, half_height, (near, far), w, h)
+            .expect("a camera");
+        for p in points {
+            let clip = proj * view * Vec4::new(p.x, p.y, p.z, 1.0);
+            let ndc = clip.truncate() / clip.w;
+            let want = Vec3::new(
+                (ndc.x + 1.0) * 0.5 * w as f32,
+                (1.0 - ndc.y) * 0.5 * h as f32,
+                (ndc.z + 1.0) * 0.5,
+            );
+            let got = cam.pixel(p).expect("in front");
+            assert!(
+                (got - want).abs().max_element() < 2e-3,
+                "{projection:?} {p}: {got} against {want}"
+            );
+        }
+        // A small square around the first off-centre point, facing the
+        // eye, is drawn where the matrices put the point.
+        let p = points[2];
+        let (r, u) = (cam.right * 0.1, cam.up * 0.1);
+        let sq = quad([p - r - u, p + r - u, p + r + u, p - r + u]);
+        let sc = scene(vec![(glowing("dot", [0, 200, 0]), sq)]);
+        let img = render(&sc, &RasterOptions::new(cam)).expect("renders");
+        let clip = proj * view * p.extend(1.0);
+        let ndc = clip.truncate() / clip.w;
+        let (x, y) = (
+            ((ndc.x + 1.0) * 0.5 * w as f32) as u32,
+            ((1.0 - ndc.y) * 0.5 * h as f32) as u32,
+        );
+        assert_eq!(rgb(&img, x, y), [0, 200, 0], "{projection:?}");
+        assert_eq!(rgb(&img, x + 8, y), [255, 255, 255], "{projection:?}");
+    }
+}
+
+#[test]
+fn lpfgs_default_view_fills_scale_of_the_window_with_the_box() {
+    // lpfg's manual (§8.1.1): the view looks down -z with y up, and
+    // `scale: s` sets the size of the image, 1.0 for full size (0.9 by
+    // default). A box twice as tall as wide in a square window: its
+    // height spans 0.9 of the window, centred.
+    let points = [Vec3::new(-1.0, -2.0, 0.0), Vec3::new(1.0, 2.0, 0.5)];
+    let cam = Camera::from_view(&ViewSpec::default(), &mut points.iter().copied(), 100, 100)
+        .expect("a camera");
+    let top = cam.pixel(Vec3::new(0.0, 2.0, 0.25)).expect("seen");
+    let bottom = cam.pixel(Vec3::new(0.0, -2.0, 0.25)).expect("seen");
+    let right = cam.pixel(Vec3::new(1.0, 0.0, 0.25)).expect("seen");
+    assert!((top.y - 5.0).abs() < 1e-3, "{top}");
+    assert!((bottom.y - 95.0).abs() < 1e-3, "{bottom}");
+    assert!((right.x - (50.0 + 45.0 / 2.0)).abs() < 1e-3, "{right}");
+    // `scale: 1` fills the window; the whole box lies between the
+    // clipping planes.
+    let full = ViewSpec {
+        scale: 1.0,
+        ..ViewSpec::default()
+    };
+    let cam = Camera::from_view(&full, &mut points.iter().copied(), 100, 100).expect("a camera");
+    assert!(cam.pixel(Vec3::new(0.0, 2.0, 0.0)).expect("seen").y.abs() < 1e-3);
+    for z in [0.0, 0.5] {
+        let d = cam.pixel(Vec3::new(0.0, 0.0, z)).expect("seen").z;
+        assert!((0.0..=1.0).contains(&d), "depth {d}");
+    }
+    // Perspective: the box's centre is on the axis, at the image centre.
+    let persp = ViewSpec {
+        projection: Projection::Perspective,
+        ..ViewSpec::default()
+    };
+    let cam = Camera::from_view(&persp, &mut points.iter().copied(), 100, 100).expect("a camera");
+    let c = cam.pixel(Vec3::new(0.0, 0.0, 0.25)).expect("seen");
+    assert!(
+        (c.x - 50.0).abs() < 1e-3 && (c.y - 50.0).abs() < 1e-3,
+        "{c}"
+    );
+}
+
+/// A scene of many small triangles scattered over the view, from a fixed
+/// linear congruential sequence.
+fn confetti(n: usize) -> Scene3 {
+    let mut seed = 12345u64;
+    let mut next = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 33) as f32 / (1u64 << 31) as f32) * 2.0 - 1.0
+    };
+    let mut meshes = vec![TriMesh::default(), TriMesh::default()];
+    for k in 0..n {
+        let m = &mut meshes[k % 2];
+        let c = Vec3::new(next() * 1.8, next() * 1.8, next());
+        let s = 0.02 + 0.05 * next().abs();
+        let start = m.positions.len() as u32;
+        m.positions.push(c);
+        m.positions.push(c + Vec3::new(s, 0.0, next() * s));
+        m.positions.push(c + Vec3::new(0.0, s, next() * s));
+        m.triangles.push([start, start + 1, start + 2]);
+    }
+    let mut a = Look::colour("a", 1, [200, 120, 40]);
+    a.specular = [0.5; 3];
+    a.shininess = 20.0;
+    Scene3 {
+        looks: vec![a, Look::colour("b", 2, [40, 160, 90])],
+        meshes,
+    }
+}
+
+#[test]
+fn the_picture_does_not_depend_on_the_number_of_threads() {
+    // 100,000 triangles: past the size from which triangles are
+    // rasterised in chunks, one key buffer per thread.
+    let sc = confetti(100_000);
+    let cam = down_z(Projection::Parallel, 200);
+    let opts = RasterOptions::new(cam);
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool")
+            .install(|| render(&sc, &opts).expect("renders"))
+    };
+    let one = on(1);
+    assert_eq!(one, on(2));
+    assert_eq!(one, on(5));
+    // And it drew something of both colours.
+    let lit = one
+        .pixels
+        .chunks(4)
+        .filter(|p| p[..3] != [255, 255, 255])
+        .count();
+    assert!(lit > 200 * 200 / 2, "{lit} pixels drawn");
+}
+
+#[test]
+fn svg_paints_triangles_back_to_front() {
+    let near = quad([
+        Vec3::new(-1.0, -1.0, 1.0),
+        Vec3::new(1.0, -1.0, 1.0),
+        Vec3::new(1.0, 1.0, 1.0),
+        Vec3::new(-1.0, 1.0, 1.0),
+    ]);
+    let far = quad([
+        Vec3::new(-1.5, -0.5, -1.0),
+        Vec3::new(0.5, -0.5, -1.0),
+        Vec3::new(0.5, 1.5, -1.0),
+        Vec3::new(-1.5, 1.5, -1.0),
+    ]);
+    // The near quad first in the scene: the SVG must still paint it last.
+    let sc = scene(vec![
+        (glowing("near", [255, 0, 0]), near),
+        (glowing("far", [0, 0, 255]), far),
+    ]);
+    let opts = RasterOptions::new(down_z(Projection::Parallel, 100));
+    let svg = raster::polygons(&sc, &opts).expect("draws");
+    let colours: Vec<Rgba> = svg
+        .items
+        .iter()
+        .map(|i| match i {
+            subgram::render::Item::Polygon { color, .. } => *color,
+            other => panic!("not a polygon: {other:?}"),
+        })
+        .collect();
+    assert_eq!(
+        colours,
+        vec![
+            Rgba(0, 0, 255, 255),
+            Rgba(0, 0, 255, 255),
+            Rgba(255, 0, 0, 255),
+            Rgba(255, 0, 0, 255)
+        ]
+    );
+    let text = raster::render_svg(&sc, &opts).expect("draws");
+    assert_eq!(text.matches("<polygon").count(), 4);
+}
+
+#[test]
+fn shading_modes_colour_by_the_normal() {
+    // A quad facing the viewer (+z): its normal map colour is
+    // (n + 1) / 2 = (0.5, 0.5, 1).
+    let sc = scene(vec![(
+        Look::colour("q", 0, [10, 20, 30]),
+        quad([
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+        ]),
+    )]);
+    let opts = RasterOptions {
+        shading: Shading::Normals,
+        ..RasterOptions::new(down_z(Projection::Parallel, 40))
+    };
+    let img = render(&sc, &opts).expect("renders");
+    assert_eq!(rgb(&img, 20, 20), [128, 128, 255]);
+    // Unlit (lpfg's `render mode: filled`): the look's own colour.
+    let opts = RasterOptions {
+        shading: Shading::Unlit,
+        ..opts
+    };
+    assert_eq!(
+        rgb(&render(&sc, &opts).expect("renders"), 20, 20),
+        [10, 20, 30]
+    );
+}
+
+#[test]
+fn smooth_normals_are_interpolated() {
+    // One triangle whose vertex normals lean left, up and right: lit by a
+    // light from the viewer, the middle is brighter than near a corner
+    // whose normal leans away, and a flat copy (no normals) is uniform.
+    let n = |x: f32, y: f32| Vec3::new(x, y, 1.0).normalize();
+    let tri = TriMesh {
+        positions: vec![
+            Vec3::new(-1.5, -1.5, 0.0),
+            Vec3::new(1.5, -1.5, 0.0),
+            Vec3::new(0.0, 1.5, 0.0),
+        ],
+        normals: vec![n(-2.0, -2.0), n(2.0, -2.0), n(0.0, 2.0)],
+        triangles: vec![[0, 1, 2]],
+    };
+    let mut look = Look::colour("s", 0, [200, 200, 200]);
+    look.ambient = [0.0; 3];
+    let cam = down_z(Projection::Parallel, 80);
+    let opts = RasterOptions {
+        global_ambient: [0.0; 3],
+        ..RasterOptions::new(cam)
+    };
+    let img = render(&scene(vec![(look.clone(), tri.clone())]), &opts).expect("renders");
+    let (cx, cy) = pixel_of(&cam, Vec3::new(0.0, -0.5, 0.0));
+    let (kx, ky) = pixel_of(&cam, Vec3::new(-1.2, -1.35, 0.0));
+    assert!(rgb(&img, cx, cy)[0] > rgb(&img, kx, ky)[0] + 40);
+    // The centroid's normal is the mean of the three: (0, -2/3·…, …)
+    // normalised; its diffuse term under a light from the viewer is its
+    // z, computed here.
+    let mean = (tri.normals[0] + tri.normals[1] + tri.normals[2]).normalize();
+    let (gx, gy) = pixel_of(&cam, Vec3::new(0.0, -0.5, 0.0));
+    let want = (200.0 / 255.0 * mean.z * 255.0).round() as i32;
+    assert!((rgb(&img, gx, gy)[0] as i32 - want).abs() <= 2);
+    let flat = TriMesh {
+        normals: Vec::new(),
+        ..tri
+    };
+    let img = render(&scene(vec![(look, flat)]), &opts).expect("renders");
+    assert_eq!(rgb(&img, cx, cy), rgb(&img, kx, ky));
+}
+
+#[test]
+fn bad_scenes_are_refused_with_a_message() {
+    let cam = down_z(Projection::Parallel, 40);
+    let opts = RasterOptions::new(cam);
+    let err = |sc: &Scene3| render(sc, &opts).expect_err("refused").message;
+    assert!(err(&Scene3::default()).contains("nothing to draw"));
+    let mut nan = quad([Vec3::ZERO, Vec3::X, Vec3::ONE, Vec3::Y]);
+    nan.positions[2].y = f32::NAN;
+    let m = err(&scene(vec![(Look::colour("leaf", 0, [0; 3]), nan)]));
+    assert!(
+        m.contains("vertex 2") && m.contains("non-finite") && m.contains("leaf"),
+        "{m}"
+    );
+    let mut far = quad([Vec3::ZERO, Vec3::X, Vec3::ONE, Vec3::Y]);
+    far.triangles.push([0, 1, 9]);
+    let m = err(&scene(vec![(Look::colour("x", 0, [0; 3]), far)]));
+    assert!(m.contains("refers to vertex 9"), "{m}");
+    let mut normals = quad([Vec3::ZERO, Vec3::X, Vec3::ONE, Vec3::Y]);
+    normals.normals = vec![Vec3::Z];
+    assert!(err(&scene(vec![(Look::colour("x", 0, [0; 3]), normals)])).contains("1 normals"));
+    // A degenerate view is refused too.
+    assert!(Camera::look_at(
+        Vec3::ZERO,
+        Vec3::ZERO,
+        Vec3::Y,
+        Projection::Parallel,
+        1.0,
+        (0.0, 1.0),
+        10,
+        10
+    )
+    .is_none());
+    let bad = ViewSpec {
+        dir: Vec3::ZERO,
+        ..ViewSpec::default()
+    };
+    assert!(Camera::from_view(&bad, &mut [Vec3::ZERO, Vec3::ONE].into_iter(), 10, 10).is_err());
+    assert!(Camera::from_view(&ViewSpec::default(), &mut std::iter::empty(), 10, 10).is_err());
+    assert!(Camera::from_view(&ViewSpec::default(), &mut [Vec3::ONE].into_iter(), 0, 10).is_err());
+}
+
+#[test]
+fn the_view_files_camera_commands_are_kept() {
+    use subgram::model::view::{read_v, RenderMode};
+    let text = "projection: perspective\nscale factor: 0.8\n\
+                view: 0 dir: 1 0 0 up: 0 0 1 fov: 30 shift: 12\n\
+                box: 0 -1 1 -2 2 0 3\nfront distance: -4\nback distance: 5\n\
+                render mode: shaded\nview: 1 dir: 0 1 0\n";
+    let mut notes = Vec::new();
+    let v = read_v("view.v", text, &mut notes).expect("reads");
+    let c = &v.camera;
+    assert!(c.perspective);
+    assert_eq!(c.scale, Some(0.8));
+    assert_eq!(c.dir, Some([1.0, 0.0, 0.0]));
+    assert_eq!(c.up, Some([0.0, 0.0, 1.0]));
+    assert_eq!((c.fov, c.shift), (Some(30.0), Some(12.0)));
+    assert_eq!(c.bbox, Some([-1.0, 1.0, -2.0, 2.0, 0.0, 3.0]));
+    assert_eq!((c.front, c.back), (Some(-4.0), Some(5.0)));
+    assert_eq!(c.render_mode, RenderMode::Shaded);
+    // View 1 (multiple views) is left out with a note at its number.
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(notes[0].message.contains("only view 0"));
+    // The renderer's view: the box framed from +x looking along it.
+    let spec = c.spec();
+    assert_eq!(spec.projection, Projection::Perspective);
+    assert_eq!((spec.scale, spec.fov, spec.shift), (0.8, 30.0, Some(12.0)));
+    assert_eq!(spec.clip, Some((-4.0, 5.0)));
+    let cam = Camera::from_view(&spec, &mut std::iter::empty(), 100, 100).expect("a camera");
+    // The eye stands `shift` before the box's centre (0, 0, 1.5).
+    assert!(
+        (cam.eye - Vec3::new(-12.0, 0.0, 1.5)).length() < 1e-4,
+        "{}",
+        cam.eye
+    );
+    // The deprecated form: rotations about x, y, z in degrees. 90° about
+    // x turns the default direction (0, 0, -1) to (0, 1, 0) and the up
+    // (0, 1, 0) to (0, 0, 1): (x, y cos - z sin, y sin + z cos).
+    let mut notes = Vec::new();
+    let v = read_v("view.v", "view: 0 90 0 0 0.5 1 2 3\n", &mut notes).expect("reads");
+    let d = v.camera.dir.expect("a direction");
+    let u = v.camera.up.expect("an up");
+    for (a, b) in d
+        .iter()
+        .zip([0.0, 1.0, 0.0])
+        .chain(u.iter().zip([0.0, 0.0, 1.0]))
+    {
+        assert!((a - b).abs() < 1e-12, "{d:?} {u:?}");
+    }
+    assert_eq!(
+        (v.camera.scale, v.camera.pan),
+        (Some(0.5), Some([1.0, 2.0, 3.0]))
+    );
+    // Malformed values are errors at their place.
+    for (bad, col) in [
+        ("view: 0 dir: 1 x 0\n", 16),
+        ("box: 0 1 -1 0 1 0 1\n", 8),
+        ("scale: 0\n", 8),
+        ("view: 0 tilt: 3\n", 9),
+    ] {
+        let e = read_v("view.v", bad, &mut Vec::new())
+            .expect_err("refused")
+            .to_string();
+        assert!(e.starts_with(&format!("view.v:1:{col}:")), "{bad}: {e}");
+    }
+    // Lights keep their specular colour; none gives lpfg's default light.
+    let v = read_v(
+        "view.v",
+        "light: V: 0 1 0 S: 0.5 0.4 0.3\n",
+        &mut Vec::new(),
+    )
+    .expect("reads");
+    let l = subgram::model::view::raster_lights(&v.lights);
+    assert_eq!(l[0].specular, [0.5, 0.4, 0.3]);
+    assert_eq!(l[0].direction, Vec3::Y);
+    assert_eq!(
+        subgram::model::view::raster_lights(&[]),
+        vec![Light::default()]
+    );
+}
