@@ -12,7 +12,11 @@ imports the OBJ and the GLB too and the same is checked.
 Usage (from the repository root, after
 `cargo build --release --example bench_raster` and `cargo build --release`):
 
-    /work/venv-xcheck/bin/python benches/export_xcheck.py [SEGMENTS] [--blender /tmp/venv-bpy/bin/python]
+    /work/venv-xcheck/bin/python benches/export_xcheck.py [SEGMENTS] [--blender /tmp/venv-bpy/bin/python] [--models MODEL_DIR...]
+
+With --models, each lpfg model folder is rendered to OBJ, PLY and GLB
+(`subgram render MODEL -o m.EXT`) and every file is held against the
+counts and bounds of the OBJ's own lines.
 
 Exit status 0 when everything agrees. Not part of `cargo test`.
 """
@@ -106,6 +110,11 @@ def main():
         i = args.index("--blender")
         blender = args[i + 1]
         del args[i : i + 2]
+    models = []
+    if "--models" in args:
+        i = args.index("--models")
+        models = args[i + 1 :]
+        del args[i:]
     segments = args[0] if args else "20000"
     ok = True
     with tempfile.TemporaryDirectory() as d:
@@ -126,6 +135,27 @@ def main():
         if blender:
             for name in ["plant.obj", "plant.glb"]:
                 ok &= same(f"blender {name}", counts_blender(blender, os.path.join(d, name)), want)
+        # Real models through `render MODEL -o plant.EXT`: every file against
+        # the counts and bounds of the OBJ's own text.
+        for m in models:
+            name = os.path.basename(os.path.normpath(m))
+            for ext in ["obj", "ply", "glb"]:
+                subprocess.run([SUBGRAM, "render", m, "-o", os.path.join(d, f"{name}.{ext}")],
+                               check=True, stderr=subprocess.DEVNULL)
+            vs, fs = [], 0
+            for line in open(os.path.join(d, f"{name}.obj")):
+                if line.startswith("v "):
+                    vs.append([float(x) for x in line.split()[1:4]])
+                elif line.startswith("f "):
+                    fs += 1
+            vs = np.array(vs)
+            want_m = {"vertices": len(vs), "triangles": fs, "min": list(vs.min(0)), "max": list(vs.max(0))}
+            print(f"{name}: {want_m['vertices']} vertices, {want_m['triangles']} triangles (the OBJ's text)")
+            for ext in ["obj", "ply", "glb"]:
+                ok &= same(f"trimesh {name}.{ext}", counts_trimesh(os.path.join(d, f"{name}.{ext}")), want_m)
+            if blender:
+                for ext in ["obj", "glb"]:
+                    ok &= same(f"blender {name}.{ext}", counts_blender(blender, os.path.join(d, f"{name}.{ext}")), want_m)
     print("all agree" if ok else "DIFFERENCES")
     sys.exit(0 if ok else 1)
 

@@ -297,6 +297,10 @@ pub struct RenderArgs {
     /// The background; `None`: colour 0 of the model's colour map or
     /// material 0's emission when the program comes with one, else white.
     pub background: Option<Rgba>,
+    /// L-systems: draw the turtle's lines in 2D, or its 3D geometry shaded
+    /// (tubes, surfaces, generalized cylinders); by default 3D when the
+    /// model's view file asks for it.
+    pub solid: Solidity,
     /// Curves: xy (the default), xz or yz. Meshes: iso, front, back, left,
     /// right, top or bottom.
     pub view: Option<String>,
@@ -323,6 +327,7 @@ pub struct RenderArgs {
 impl RenderArgs {
     pub fn new(file: impl Into<String>, output: impl Into<String>) -> RenderArgs {
         RenderArgs {
+            solid: Solidity::Auto,
             file: file.into(),
             output: output.into(),
             steps: None,
@@ -342,6 +347,20 @@ impl RenderArgs {
             program_output: ProgramOutput::default(),
         }
     }
+}
+
+/// How `render` draws an L-system.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Solidity {
+    /// 3D when the model's view file asks for tubes (`line style:
+    /// cylinder` or `polygon`) or shading (`render mode: shaded`), or the
+    /// output is a 3D file; else the 2D line drawing.
+    #[default]
+    Auto,
+    /// The 2D line drawing.
+    Lines,
+    /// The shaded 3D geometry.
+    Solid,
 }
 
 /// `subgram render`: a curve's picture, a surface grammar's subdivided
@@ -364,7 +383,11 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<Stri
         write_mesh_picture(&load_mesh(file)?, output, &looks, &mut Out::Files)?;
         return Ok(Vec::new());
     }
-    let format = Picture::from_path(output)?;
+    // A 3D file (.obj, .ply, .glb) is an L-system's geometry exported.
+    let format = match crate::export::Format::from_path(output) {
+        Some(_) => Picture::Png,
+        None => Picture::from_path(output)?,
+    };
     let system = load(file, &load_options(&a.defines, a.double))?;
     let mut warnings = system.warnings();
     warnings.extend(render_system(
@@ -689,6 +712,14 @@ fn render_system(
     let output = Path::new(&a.output);
     let file = Path::new(&a.file);
     let white = Rgba(255, 255, 255, 255);
+    let export = crate::export::Format::from_path(output);
+    if export.is_some() && !matches!(system, System::Curve(_)) {
+        return Err(Error::Usage(format!(
+            "`{}`: render exports an L-system's 3D geometry; write a grammar's mesh with `subgram subdivide … -o {}`",
+            output.display(),
+            output.display()
+        )));
+    }
     match system {
         System::Surface(s) => {
             looks.check()?;
@@ -743,6 +774,9 @@ fn render_system(
             write_soup_picture(&run.soup, output, looks, out)?;
             Ok(Vec::new())
         }
+        System::Curve(c) if wants_solid(a, &c, export.is_some()) => {
+            render_solid(a, &c, (looks, format), deadline, out)
+        }
         System::Curve(c) => {
             let view = match a.view.as_deref().unwrap_or("xy") {
                 "xy" => View::Xy,
@@ -794,6 +828,130 @@ fn render_system(
             write_views(&figures, Path::new(&a.file), output, (format, a.force), out)
         }
     }
+}
+
+/// Whether `render` draws this L-system's 3D geometry (see [`Solidity`]).
+fn wants_solid(a: &RenderArgs, c: &crate::Curve, export: bool) -> bool {
+    use crate::model::view::{LineStyle, RenderMode};
+    let m = &c.program.model;
+    match a.solid {
+        _ if export => true,
+        Solidity::Solid => true,
+        Solidity::Lines => false,
+        Solidity::Auto => {
+            m.line_style != LineStyle::Pixel
+                || matches!(
+                    m.camera.render_mode,
+                    RenderMode::Shaded | RenderMode::Shadows
+                )
+        }
+    }
+}
+
+/// An L-system's 3D geometry: exported (`.obj` with its `.mtl`, `.ply`,
+/// `.glb`) or drawn by the z-buffer with the view file's camera and
+/// lights (`--view` with a mesh view's name turns the camera, y up).
+/// Lines in lpfg's `pixel` style become tubes as wide as their pixels at
+/// the picture's scale.
+fn render_solid(
+    a: &RenderArgs,
+    c: &crate::Curve,
+    (looks, format): (&MeshLooks, Picture),
+    deadline: Option<Deadline>,
+    out: &mut Out,
+) -> Result<Vec<String>, Error> {
+    use crate::draw::solid::SolidOptions;
+    use crate::model::view::LineStyle;
+    let output = Path::new(&a.output);
+    let file = Path::new(&a.file);
+    if a.each {
+        return Err(Error::Usage(
+            "--each draws the 2D steps side by side; add --lines, or draw one step in 3D".into(),
+        ));
+    }
+    check_steps(a.steps)?;
+    let dir = writes_folder(&a.allow_writes, &a.program_output)?;
+    let opts = RunOptions {
+        steps: a.steps,
+        max_modules: a.max_modules,
+        phase: a.phase,
+        seed: a.seed,
+        base_mesh: None,
+        deadline,
+        output: a.program_output.clone(),
+        max_shapes: None,
+    };
+    let model = &c.program.model;
+    let (w, h) = looks.size;
+    let mut run = c.run(opts.derive_options())?;
+    let mut sopts = SolidOptions::default();
+    if model.line_style == LineStyle::Pixel {
+        // The picture's scale from the drawing's extent, as the camera will
+        // frame it (lpfg's 0.9 of the window by default).
+        let mut lo = glam::DVec3::splat(f64::INFINITY);
+        let mut hi = glam::DVec3::splat(f64::NEG_INFINITY);
+        for e in run.events()? {
+            if let crate::draw::Event::Path { points, .. } = &e {
+                for p in points {
+                    lo = lo.min(*p);
+                    hi = hi.max(*p);
+                }
+            }
+        }
+        let extent = (hi - lo).max_element();
+        let units_per_pixel = if extent.is_finite() && extent > 0.0 {
+            extent / (0.9 * w.min(h) as f64)
+        } else {
+            1.0
+        };
+        sopts.pixel_tubes = Some(units_per_pixel);
+    }
+    let scene = run.solid(&sopts)?;
+    write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
+    if crate::export::Format::from_path(output).is_some() {
+        if scene.triangle_count() == 0 {
+            return Err(Error::Failed(
+                "nothing to export: the turtle made no 3D geometry (no lines, surfaces, polygons or spheres)".into(),
+            ));
+        }
+        crate::export::write(&scene, output)?;
+        return Ok(Vec::new());
+    }
+    let mut camera = model.camera.clone();
+    if let Some(name) = a.view.as_deref().filter(|v| *v != "xy") {
+        let Some((d, u)) = crate::render::mesh::view_direction(name) else {
+            return Err(Error::Usage(format!(
+                "`--view {name}` is not a view of a 3D drawing: use xy (the view file's), iso, front, back, left, right, top or bottom"
+            )));
+        };
+        // The mesh views are named for z up; a plant grows along y.
+        let y_up = |v: glam::DVec3| [v.x, v.z, -v.y];
+        camera.dir = Some(y_up(d));
+        camera.up = Some(y_up(u));
+    }
+    let mut ropts = camera.raster_options(
+        &model.lights,
+        &mut scene
+            .meshes
+            .iter()
+            .flat_map(|m| m.positions.iter().copied()),
+        w,
+        h,
+    )?;
+    let model_background = model.colours.as_ref().map(|m| {
+        let [r, g, b] = m.background();
+        Rgba(r, g, b, 255)
+    });
+    ropts.background = a
+        .background
+        .or(model_background)
+        .unwrap_or(Rgba(255, 255, 255, 255));
+    let bytes = match format {
+        Picture::Png => crate::render::raster::render_png(&scene, &ropts)?,
+        Picture::Svg => crate::render::raster::render_svg(&scene, &ropts)?.into_bytes(),
+    };
+    out.put(vec![(output.to_path_buf(), bytes)])?;
+    Ok(Vec::new())
 }
 
 /// The folder of `--allow-writes`, checked to be one, and `output` told

@@ -320,6 +320,13 @@ struct RenderCli {
     /// iso, front, back, left, right, top or bottom for meshes.
     #[arg(long)]
     view: Option<String>,
+    /// L-systems: draw the 3D geometry shaded (tubes, surfaces, generalized
+    /// cylinders) [default: when the model's view file asks for it].
+    #[arg(long, conflicts_with = "lines")]
+    solid: bool,
+    /// L-systems: draw the turtle's lines in 2D.
+    #[arg(long)]
+    lines: bool,
     /// Meshes: draw the faces without their edges.
     #[arg(long)]
     no_wireframe: bool,
@@ -360,6 +367,13 @@ impl RenderCli {
             background: self.background,
             view: self.view,
             wireframe: !self.no_wireframe,
+            solid: if self.solid {
+                command::Solidity::Solid
+            } else if self.lines {
+                command::Solidity::Lines
+            } else {
+                command::Solidity::Auto
+            },
             defines: self.define,
             double: self.double,
             max_modules: self.max_modules,

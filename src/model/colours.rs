@@ -9,9 +9,11 @@
 //! lpfg clears its window to material 0's emission colour, and lights
 //! materials with OpenGL's lighting (a global ambient light of 0.2, then
 //! the view file's lights, by default one white light from the viewer).
-//! subgram draws flat: a material's colour is what that lighting gives a
-//! surface facing the viewer: emission + ambient × (0.2 + Σ light
-//! ambient) + diffuse × Σ light diffuse × cos(light, view direction).
+//! subgram's 2D pictures draw flat: a material's colour is what that
+//! lighting gives a surface facing the viewer: emission + ambient × (0.2 +
+//! Σ light ambient) + diffuse × Σ light diffuse × cos(light, view
+//! direction). Its 3D pictures light each surface by its normal
+//! (`render::raster`), with the same lights.
 
 use crate::error::Error;
 

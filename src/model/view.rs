@@ -8,8 +8,10 @@
 //! and keeps the camera of the single view (`projection:`, `scale:` /
 //! `scale factor:`, `view: 0 …` in its current and deprecated forms,
 //! `box: 0 …`, `front distance:`, `back distance:`) and the `render
-//! mode:` for the 3D renderer ([`ViewCamera`]); the others set up lpfg's
-//! OpenGL window (shadows, fonts, …) and are reported as not acted on. The views' names (`window:`) and the turtle's settings
+//! mode:` for the 3D renderer ([`ViewCamera`]), which always tests depth
+//! and smooths edges (`z buffer:` and `antialiasing:` are taken as on);
+//! the others set up lpfg's OpenGL window (shadows, fonts, …) and are
+//! reported as not acted on. The views' names (`window:`) and the turtle's settings
 //! (`corrected rotation:`, `tropism:`, `torque:`, `stropism:`) are read by
 //! `load::read_view_file`. The animation file only matters in lpfg's
 //! animate mode, which a still picture is not: it is checked and kept.
@@ -717,6 +719,10 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
         if ACTED_ON_BY_THE_TURTLE.contains(&k.as_str()) {
             continue;
         }
+        // subgram's 3D pictures always test depth and smooth their edges.
+        if matches!(k.as_str(), "z buffer" | "antialiasing") {
+            continue;
+        }
         ignored.push((k, n, base + first.start, base + after));
     }
     if !ignored.is_empty() {
@@ -736,7 +742,7 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
             path,
             text,
             s..e,
-            format!("subgram draws flat, in 2D, and does not act on {list}"),
+            format!("subgram does not act on {list}"),
         ));
     }
     Ok(view)

@@ -30,6 +30,7 @@ mod random;
 mod raster;
 mod readme;
 mod render;
+mod render3d;
 mod reverse;
 mod semantics;
 mod serve;

@@ -366,21 +366,23 @@ fn check_warns_about_view_commands_and_environmental_programs() {
     .unwrap();
     std::fs::write(
         tmp.join("view.v"),
-        "// a comment\nz buffer: on\nlight: V: 0 0 1\nzoom: 3\nline style: wireframe\n",
+        "// a comment\nshadow map: on\nlight: V: 0 0 1\nzoom: 3\nline style: wireframe\nz buffer: on\n",
     )
     .unwrap();
     std::fs::write(tmp.join("field.e"), "executable: field -e\n").unwrap();
     let out = subgram::command::check(&tmp.display().to_string(), &[], false).unwrap();
     std::fs::remove_dir_all(&tmp).unwrap();
-    // `light:` is acted on; `z buffer:` is named as not acted on, at its
-    // line; `zoom:` is not a command of the manual.
+    // `light:` is acted on, and `z buffer:` (3D pictures always test
+    // depth); `shadow map:` is named as not acted on, at its line; `zoom:`
+    // is not a command of the manual.
     assert!(
-        out.contains(
-            "view.v:2:1: warning: subgram draws flat, in 2D, and does not act on `z buffer:`"
-        ),
+        out.contains("view.v:2:1: warning: subgram does not act on `shadow map:`"),
         "{out}"
     );
-    assert!(!out.contains("`light:`"), "{out}");
+    assert!(
+        !out.contains("`light:`") && !out.contains("`z buffer:`"),
+        "{out}"
+    );
     assert!(
         out.contains("view.v:4:1: warning: `zoom:` is not a view-file command"),
         "{out}"

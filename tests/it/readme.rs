@@ -205,6 +205,11 @@ fn every_package_the_bench_scripts_import_is_in_the_requirements() {
         "dataclasses",
         "typing",
         "zlib",
+        "warnings",
+        "base64",
+        "select",
+        "csv",
+        "platform",
     ];
     let dir = root().join("benches");
     let req = std::fs::read_to_string(dir.join("requirements.txt")).unwrap();

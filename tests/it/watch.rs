@@ -55,7 +55,7 @@ fn watch_renders_again_on_a_change_to_the_file_or_its_mesh_and_keeps_the_last_pi
     let g = dir.join("smooth.lsys");
     let out = dir.join("smooth.png");
     std::fs::write(dir.join("base.obj"), BIPYRAMID).unwrap();
-    std::fs::write(&g, grammar("0.2")).unwrap();
+    std::fs::write(&g, grammar("0.5")).unwrap();
     // The grammar must run as a plain render first.
     let mut args = RenderArgs::new(g.to_str().unwrap(), out.to_str().unwrap());
     args.size = Some((120, 120));
