@@ -885,7 +885,8 @@ fn render_solid(
     let (w, h) = looks.size;
     let mut run = c.run(opts.derive_options())?;
     let mut sopts = SolidOptions::default();
-    if model.line_style == LineStyle::Pixel {
+    let picture = crate::export::Format::from_path(output).is_none();
+    if model.line_style == LineStyle::Pixel || picture {
         // The picture's scale from the drawing's extent, as the camera will
         // frame it (lpfg's 0.9 of the window by default).
         let mut lo = glam::DVec3::splat(f64::INFINITY);
@@ -904,7 +905,14 @@ fn render_solid(
         } else {
             1.0
         };
-        sopts.pixel_tubes = Some(units_per_pixel);
+        if model.line_style == LineStyle::Pixel {
+            sopts.pixel_tubes = Some(units_per_pixel);
+        }
+        // A picture needs no more sides than its pixels show; an export
+        // keeps them all.
+        if picture {
+            sopts.picture_pixel = Some(units_per_pixel);
+        }
     }
     let scene = run.solid(&sopts)?;
     write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;

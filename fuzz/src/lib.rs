@@ -104,6 +104,7 @@ pub fn lsys_derive(data: &[u8]) {
         max_triangles: 200_000,
         max_vertices: 200_000,
         pixel_tubes: None,
+        picture_pixel: None,
     };
     match run.solid(&sopts) {
         Ok(scene) => {

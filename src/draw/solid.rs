@@ -87,6 +87,11 @@ pub struct SolidOptions {
     /// times this many model units per pixel (the caller knows the
     /// picture's scale). `None`: such lines make no triangles.
     pub pixel_tubes: Option<f64>,
+    /// Geometry for a picture with this many model units per pixel: a tube
+    /// gets fewer sides where it is thin, enough that no side is wider than
+    /// 1.5 pixels (at least 3, at most its own); `None` (exports): every
+    /// tube its own number of sides.
+    pub picture_pixel: Option<f64>,
     /// More triangles than this stop the walk with an error.
     pub max_triangles: usize,
     /// More vertices than this stop the walk with an error.
@@ -98,6 +103,7 @@ impl Default for SolidOptions {
         SolidOptions {
             line_style: None,
             pixel_tubes: None,
+            picture_pixel: None,
             max_triangles: MAX_TRIANGLES,
             max_vertices: MAX_VERTICES,
         }
@@ -255,6 +261,7 @@ struct Builder<'m> {
     model: &'m Model,
     style: LineStyle,
     pixel_tubes: Option<f64>,
+    picture_pixel: Option<f64>,
     sides: u32,
     capped: bool,
     scene: Scene3,
@@ -309,6 +316,7 @@ impl<'m> Builder<'m> {
             model,
             style: sopts.line_style.unwrap_or(model.line_style),
             pixel_tubes: sopts.pixel_tubes.filter(|k| k.is_finite() && *k > 0.0),
+            picture_pixel: sopts.picture_pixel.filter(|k| k.is_finite() && *k > 0.0),
             sides,
             capped: model.capped_cylinders,
             scene: Scene3::default(),
@@ -604,8 +612,16 @@ impl<'m> Builder<'m> {
             return Ok(());
         }
         let dir = d / len;
-        let sides = self.cur.sides.unwrap_or(self.sides);
         let scale = self.cur.scale;
+        let mut sides = self.cur.sides.unwrap_or(self.sides);
+        if let Some(px) = self.picture_pixel {
+            // The circumference in pixels over 1.5 pixels a side.
+            let across = scale.0.abs().max(scale.1.abs()) / px;
+            let need = (std::f64::consts::PI * across / 1.5).ceil();
+            if need.is_finite() && need < sides as f64 {
+                sides = (need as u32).max(MIN_CONTOUR_SIDES);
+            }
+        }
         let mesh = self.mesh(t.pen.color);
         let sec = self.circle(sides);
         let joint = self

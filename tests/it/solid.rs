@@ -797,3 +797,28 @@ fn pixel_lines_become_tubes_only_when_asked_with_the_size_of_a_pixel() {
         }
     }
 }
+
+/// For a picture (`SolidOptions::picture_pixel`), a tube has just enough
+/// sides that none is wider than 1.5 pixels: ⌈π·d/1.5⌉ for a diameter of
+/// d pixels, at least 3 and at most the model's 16. A segment between two
+/// rings of n points is 2n triangles.
+#[test]
+fn a_picture_gives_thin_tubes_fewer_sides() {
+    for (width, sides) in [(0.5, 3), (3.0, 7), (10.0, 16)] {
+        let mut c = load_text(&format!(
+            "derivation length: 0;\nAxiom: SetWidth({width}) F(10);\n"
+        ));
+        c.program.model = Arc::new(cylinders(16, false));
+        let mut run = c.run(Default::default()).unwrap();
+        let picture = run
+            .solid(&SolidOptions {
+                picture_pixel: Some(1.0),
+                ..Default::default()
+            })
+            .unwrap();
+        assert_eq!(picture.triangle_count(), 2 * sides, "width {width} px");
+        // An export keeps the model's sides.
+        let export = run.solid(&SolidOptions::default()).unwrap();
+        assert_eq!(export.triangle_count(), 2 * 16, "width {width}");
+    }
+}
