@@ -25,71 +25,31 @@ pub fn write_word_text(
     alphabet: &Alphabet,
     structs: &[StructDef],
 ) -> std::io::Result<()> {
-    write_ranges(out, word.len(), |range, text| {
-        let mut num = Numbers::default();
-        let mut layouts = Layouts::new(alphabet, structs);
-        for i in range {
-            let sym = word.syms()[i];
-            if i > 0 {
-                text.push(b' ');
-            }
-            text.extend_from_slice(alphabet.name(sym).as_bytes());
-            let data = word.data(i);
-            let tys = layouts.of(sym, data.len());
-            if !tys.is_empty() {
-                text.push(b'(');
-                let mut slots = data;
-                for (j, &ty) in tys.iter().enumerate() {
-                    if j > 0 {
-                        text.extend_from_slice(b", ");
-                    }
-                    slots = num.value(Style::Text, text, ty, slots, structs);
+    let mut buf = Chunks::new(out);
+    let mut num = Numbers::default();
+    let mut layouts = Layouts::new(alphabet, structs);
+    for i in 0..word.len() {
+        let sym = word.syms()[i];
+        if i > 0 {
+            buf.text.push(b' ');
+        }
+        buf.push(alphabet.name(sym).as_bytes());
+        let data = word.data(i);
+        let tys = layouts.of(sym, data.len());
+        if !tys.is_empty() {
+            buf.text.push(b'(');
+            let mut slots = data;
+            for (j, &ty) in tys.iter().enumerate() {
+                if j > 0 {
+                    buf.text.extend_from_slice(b", ");
                 }
-                text.push(b')');
+                slots = num.value(Style::Text, &mut buf.text, ty, slots, structs);
             }
+            buf.text.push(b')');
         }
-    })
-}
-
-/// Modules formatted per task of this many, on rayon's pool when it has
-/// several threads.
-const TASK_MODULES: usize = 1 << 15;
-
-/// Writes the modules `0..len`, formatted by `format` (which appends the
-/// text of a range of modules to a buffer), in order. A long word is cut
-/// into tasks of [`TASK_MODULES`]: a round of one task per thread is
-/// formatted in parallel, then written, so the memory held is a few
-/// tasks' text whatever the word's length, and the bytes are the same for
-/// any number of threads.
-fn write_ranges(
-    out: &mut impl Write,
-    len: usize,
-    format: impl Fn(std::ops::Range<usize>, &mut Vec<u8>) + Sync,
-) -> std::io::Result<()> {
-    use rayon::prelude::*;
-    let threads = rayon::current_num_threads().clamp(1, 16);
-    let mut bufs: Vec<Vec<u8>> = vec![Vec::new(); threads];
-    let round = TASK_MODULES * threads;
-    let mut start = 0;
-    while start < len {
-        let end = (start + round).min(len);
-        let task = |(k, buf): (usize, &mut Vec<u8>)| {
-            buf.clear();
-            let from = (start + k * TASK_MODULES).min(end);
-            let to = (from + TASK_MODULES).min(end);
-            format(from..to, buf);
-        };
-        if threads > 1 && end - start > TASK_MODULES {
-            bufs.par_iter_mut().enumerate().for_each(task);
-        } else {
-            bufs.iter_mut().enumerate().for_each(task);
-        }
-        for b in &bufs {
-            out.write_all(b)?;
-        }
-        start = end;
+        buf.flush_if_full()?;
     }
-    Ok(())
+    buf.finish()
 }
 
 /// Each symbol's parameter types for the number of slots it was last met
@@ -121,6 +81,42 @@ impl<'a> Layouts<'a> {
                 tys
             }
         }
+    }
+}
+
+/// Bytes gathered in memory and written to `out` a large chunk at a time,
+/// so that a word of millions of modules costs a few hundred writes.
+struct Chunks<'a, W: Write> {
+    out: &'a mut W,
+    text: Vec<u8>,
+}
+
+impl<'a, W: Write> Chunks<'a, W> {
+    const SIZE: usize = 1 << 16;
+
+    fn new(out: &'a mut W) -> Self {
+        Chunks {
+            out,
+            text: Vec::with_capacity(Self::SIZE + 256),
+        }
+    }
+
+    fn push(&mut self, bytes: &[u8]) {
+        self.text.extend_from_slice(bytes);
+    }
+
+    fn flush_if_full(&mut self) -> std::io::Result<()> {
+        if self.text.len() >= Self::SIZE {
+            self.out.write_all(&self.text)?;
+            self.text.clear();
+        }
+        Ok(())
+    }
+
+    fn finish(mut self) -> std::io::Result<()> {
+        self.out.write_all(&self.text)?;
+        self.text.clear();
+        Ok(())
     }
 }
 
@@ -406,40 +402,39 @@ pub fn write_word_json(
     alphabet: &Alphabet,
     structs: &[StructDef],
 ) -> std::io::Result<()> {
-    out.write_all(b"{\"modules\":[")?;
-    let names: Vec<Vec<u8>> = (0..alphabet.kinds.len())
-        .map(|k| {
-            serde_json::to_vec(alphabet.name(crate::lang::Sym(k as _))).expect("a string is JSON")
-        })
-        .collect();
-    write_ranges(out, word.len(), |range, text| {
-        let mut num = Numbers::default();
-        let mut layouts = Layouts::new(alphabet, structs);
-        for i in range {
-            if i > 0 {
-                text.push(b',');
-            }
-            let sym = word.syms()[i];
-            text.extend_from_slice(b"{\"params\":[");
-            let data = word.data(i);
-            let mut slots = data;
-            for (j, &ty) in layouts.of(sym, data.len()).iter().enumerate() {
-                if j > 0 {
-                    text.push(b',');
-                }
-                slots = num.value(Style::Json, text, ty, slots, structs);
-            }
-            text.extend_from_slice(b"],\"symbol\":");
-            match names.get(sym.0 as usize) {
-                Some(name) => text.extend_from_slice(name),
-                None => text.extend_from_slice(
-                    &serde_json::to_vec(alphabet.name(sym)).expect("a string is JSON"),
-                ),
-            }
-            text.push(b'}');
+    let mut buf = Chunks::new(out);
+    let mut num = Numbers::default();
+    let mut layouts = Layouts::new(alphabet, structs);
+    buf.push(b"{\"modules\":[");
+    let mut names: Vec<Option<Vec<u8>>> = Vec::new();
+    for i in 0..word.len() {
+        if i > 0 {
+            buf.push(b",");
         }
-    })?;
-    out.write_all(format!("],\"ring\":{ring},\"step\":{step}}}").as_bytes())
+        let sym = word.syms()[i];
+        let k = sym.0 as usize;
+        if names.len() <= k {
+            names.resize(k + 1, None);
+        }
+        let name = names[k].get_or_insert_with(|| {
+            serde_json::to_vec(alphabet.name(sym)).expect("a string is JSON")
+        });
+        buf.push(b"{\"params\":[");
+        let data = word.data(i);
+        let mut slots = data;
+        for (j, &ty) in layouts.of(sym, data.len()).iter().enumerate() {
+            if j > 0 {
+                buf.push(b",");
+            }
+            slots = num.value(Style::Json, &mut buf.text, ty, slots, structs);
+        }
+        buf.push(b"],\"symbol\":");
+        buf.push(name);
+        buf.push(b"}");
+        buf.flush_if_full()?;
+    }
+    buf.push(format!("],\"ring\":{ring},\"step\":{step}}}").as_bytes());
+    buf.finish()
 }
 
 /// [`write_word_json`] into a string.
