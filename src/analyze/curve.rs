@@ -199,7 +199,10 @@ fn measure(probe: &Probe, n: usize) -> Result<DMatrix<f64>, Error> {
     }
     let rows = z.len();
     if rows == 0 {
-        return Err(refuse(&probe.path, format!("the step leaves no points. {NEEDS}")));
+        return Err(refuse(
+            &probe.path,
+            format!("the step leaves no points. {NEEDS}"),
+        ));
     }
     let mut m = DMatrix::zeros(rows, n);
     for j in 0..n {
@@ -414,8 +417,7 @@ pub fn analyze(curve: &Curve, path: &str, deadline: Deadline) -> Result<CurveRep
                 }
             }
         }
-        if a
-            .iter()
+        if a.iter()
             .any(|(k, v)| v.abs() > TOL && k.unsigned_abs() as usize * 3 > rows)
         {
             return Err(refuse(
@@ -427,8 +429,7 @@ pub fn analyze(curve: &Curve, path: &str, deadline: Deadline) -> Result<CurveRep
     } else {
         // The interior: the middle column, and the next one `arity` rows on.
         let c = n / 2;
-        let first_nz =
-            |j: usize| (0..rows).find(|&r| m[(r, j)].abs() > TOL).map(|r| r as i64);
+        let first_nz = |j: usize| (0..rows).find(|&r| m[(r, j)].abs() > TOL).map(|r| r as i64);
         let (Some(f0), Some(f1)) = (first_nz(c), first_nz(c + 1)) else {
             return Err(not_uniform());
         };
@@ -440,9 +441,8 @@ pub fn analyze(curve: &Curve, path: &str, deadline: Deadline) -> Result<CurveRep
             .map(|r| (r as i64 - (arity * c) as i64, m[(r, c)]))
             .collect();
         let at = |k: i64| a.iter().find(|x| x.0 == k).map_or(0.0, |x| x.1);
-        let interior = |r: usize| {
-            (0..n).all(|j| near(m[(r, j)], at(r as i64 - (arity * j) as i64)))
-        };
+        let interior =
+            |r: usize| (0..n).all(|j| near(m[(r, j)], at(r as i64 - (arity * j) as i64)));
         let mut boundary = Vec::new();
         for r in 0..rows {
             if interior(r) {
@@ -457,7 +457,11 @@ pub fn analyze(curve: &Curve, path: &str, deadline: Deadline) -> Result<CurveRep
             let sum = w.iter().map(|w| w.value).sum();
             boundary.push(BoundaryRow {
                 end: if left { "left" } else { "right" }.into(),
-                row: if left { r as i64 } else { r as i64 - rows as i64 },
+                row: if left {
+                    r as i64
+                } else {
+                    r as i64 - rows as i64
+                },
                 weights: w,
                 sum,
             });

@@ -34,6 +34,9 @@ pub const MAX_RINGS: usize = 2;
 /// Eigenvalues listed per valence.
 pub const LISTED: usize = 6;
 const TOL: f64 = 1e-9;
+/// The time the valences of one grammar may take together; valences not
+/// reached in it are skipped with a note.
+pub const BUDGET: std::time::Duration = std::time::Duration::from_secs(20);
 
 /// What `analyze` says about a surface grammar.
 #[derive(Clone, Debug, Serialize)]
@@ -227,7 +230,12 @@ fn local(f: &Fan, full: &DMatrix<f64>, quads: bool) -> Option<(DMatrix<f64>, Vec
             .collect();
         let rows: Option<Vec<usize>> = set
             .iter()
-            .map(|&c| new_at.get(&snap(layout[c])).copied().filter(|&r| r != usize::MAX))
+            .map(|&c| {
+                new_at
+                    .get(&snap(layout[c]))
+                    .copied()
+                    .filter(|&r| r != usize::MAX)
+            })
             .collect();
         let Some(rows) = rows else { continue };
         let inside: Vec<bool> = (0..layout.len()).map(|c| set.contains(&c)).collect();
@@ -249,7 +257,9 @@ fn left_null(s: &DMatrix<f64>, lambda: f64, count: usize) -> Vec<Vec<f64>> {
     let n = s.nrows();
     let a = s.transpose() - DMatrix::identity(n, n) * lambda;
     let svd = a.svd(false, true);
-    let Some(v_t) = svd.v_t else { return Vec::new() };
+    let Some(v_t) = svd.v_t else {
+        return Vec::new();
+    };
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&x, &y| svd.singular_values[x].total_cmp(&svd.singular_values[y]));
     order
@@ -275,7 +285,13 @@ fn label_weights(f: &Fan, set: &[usize], v: &[f64]) -> Vec<LabelWeight> {
         .collect()
 }
 
-fn valence(g: &Grammar, n: usize, quads: bool, deadline: Deadline) -> Result<Valence, Error> {
+fn valence(
+    g: &Grammar,
+    n: usize,
+    quads: bool,
+    deadline: Deadline,
+    budget: Deadline,
+) -> Result<Valence, Error> {
     let f = fan(n, quads, FAN_RINGS);
     let mut v = Valence {
         n,
@@ -292,7 +308,12 @@ fn valence(g: &Grammar, n: usize, quads: bool, deadline: Deadline) -> Result<Val
     let mut why = String::new();
     let mut found = None;
     for steps in 1..=2 {
-        match full_matrix(g, &f, steps, deadline) {
+        let limit = if budget.limit() < deadline.limit() {
+            budget
+        } else {
+            deadline
+        };
+        match full_matrix(g, &f, steps, limit) {
             Ok(full) => {
                 if let Some(l) = local(&f, &full, quads) {
                     found = Some((steps, l));
@@ -306,6 +327,10 @@ fn valence(g: &Grammar, n: usize, quads: bool, deadline: Deadline) -> Result<Val
             Err(e) => {
                 if deadline.passed() {
                     return Err(Error::Failed(deadline.message()));
+                }
+                if budget.passed() {
+                    why = format!("not measured within the budget of {} s", BUDGET.as_secs());
+                    break;
                 }
                 why = format!("the grammar does not run on this fan: {e}");
                 break;
@@ -382,13 +407,11 @@ pub fn analyze(g: &Grammar, path: &str, deadline: Deadline) -> Result<SurfaceRep
         });
     }
     let mut valences = Vec::new();
+    let budget = Deadline::after(BUDGET);
     for n in VALENCES {
-        valences.push(valence(g, n, quads, deadline)?);
+        valences.push(valence(g, n, quads, deadline, budget)?);
     }
-    if let Some(bad) = valences
-        .iter()
-        .find(|v| v.skipped.is_none() && !v.reif)
-    {
+    if let Some(bad) = valences.iter().find(|v| v.skipped.is_none() && !v.reif) {
         notes.push(format!(
             "Reif's check fails at valence {}: the scheme is not shown C1 there",
             bad.n

@@ -91,8 +91,15 @@ pub fn curve(file: &str, r: &CurveReport) -> String {
         _ => {}
     }
     if !r.boundary.is_empty() {
-        let _ = writeln!(s, "\nboundary rows (old points p[0], p[1], … and p[-1], p[-2], … from the ends):");
-        let _ = writeln!(s, "  {:<6} {:<5} {:<44} {:>6}", "end", "row", "weights", "sum");
+        let _ = writeln!(
+            s,
+            "\nboundary rows (old points p[0], p[1], … and p[-1], p[-2], … from the ends):"
+        );
+        let _ = writeln!(
+            s,
+            "  {:<6} {:<5} {:<44} {:>6}",
+            "end", "row", "weights", "sum"
+        );
         for b in &r.boundary {
             let _ = writeln!(
                 s,
@@ -118,7 +125,11 @@ pub fn curve(file: &str, r: &CurveReport) -> String {
     let _ = writeln!(s, "support:            {}", r.support);
     let _ = writeln!(s, "interpolating:      {}", yes(r.interpolating));
     if let Some(m) = &r.mask {
-        let _ = writeln!(s, "mask:               a(z) = {}", poly(m.first, &m.fractions));
+        let _ = writeln!(
+            s,
+            "mask:               a(z) = {}",
+            poly(m.first, &m.fractions)
+        );
         let sigma = match r.arity {
             Some(2) => "(1+z)".to_string(),
             Some(a) => format!("(1+z+…+z^{})", a - 1),
@@ -139,9 +150,7 @@ pub fn curve(file: &str, r: &CurveReport) -> String {
         let _ = writeln!(s, "generates:          polynomials of degree ≤ {d}");
     }
     if let Some(h) = &r.smoothness {
-        let up = h
-            .upper
-            .map_or("?".to_string(), |u| format!("{u:.4}"));
+        let up = h.upper.map_or("?".to_string(), |u| format!("{u:.4}"));
         let _ = writeln!(
             s,
             "Hölder exponent:    {:.4} ≤ α ≤ {up} (Rioul: norms of {} steps, spectral radii of products of {})",
@@ -176,15 +185,14 @@ fn short(ws: &[LabelWeight], n: usize) -> String {
 pub fn surface(file: &str, r: &SurfaceReport) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "{file}: surface grammar, probed on fans of {}", r.faces);
-    if !r.valences.is_empty() {
+    if r.valences.iter().any(|v| v.skipped.is_none()) {
         let _ = writeln!(
             s,
             "\n{:>2} {:>5} {:>5} {:>6} {:>10} {:>10} {:>10} {:>10} {:>5}",
             "n", "steps", "size", "affine", "λ0", "λ1", "λ2", "|λ3|", "Reif"
         );
         for v in &r.valences {
-            if let Some(why) = &v.skipped {
-                let _ = writeln!(s, "{:>2} skipped: {why}", v.n);
+            if v.skipped.is_some() {
                 continue;
             }
             let l = |k: usize| v.eigenvalues.get(k);
@@ -229,6 +237,22 @@ pub fn surface(file: &str, r: &SurfaceReport) -> String {
                 .collect();
             let _ = writeln!(s, "{:>2} {}", v.n, short(&t, 8));
         }
+    }
+    for v in r.valences.iter().filter(|v| v.skipped.is_some()) {
+        let _ = writeln!(
+            s,
+            "valence {:>2} skipped: {}",
+            v.n,
+            v.skipped.as_deref().unwrap_or("")
+        );
+    }
+    for v in r.valences.iter().filter(|v| v.skipped.is_some()) {
+        let _ = writeln!(
+            s,
+            "valence {:>2} skipped: {}",
+            v.n,
+            v.skipped.as_deref().unwrap_or("")
+        );
     }
     for n in &r.notes {
         let _ = writeln!(s, "note: {n}");
