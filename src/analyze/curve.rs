@@ -624,7 +624,10 @@ pub fn holder(b: &[f64], k: usize) -> Smoothness {
                 .flat_map(|p| t.iter().map(move |te| p * te))
                 .collect();
             for p in &products {
-                best = best.max(spectral_radius(p).powf(1.0 / j as f64));
+                // A product whose eigenvalues do not converge bounds nothing.
+                if let Some(r) = spectral_radius(p) {
+                    best = best.max(r.powf(1.0 / j as f64));
+                }
             }
         }
         base - best.log2()

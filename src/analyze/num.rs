@@ -59,16 +59,43 @@ pub fn multiply(a: &[f64], b: &[f64]) -> Vec<f64> {
     out
 }
 
-/// The spectral radius of a square matrix (0 for an empty one).
-pub fn spectral_radius(m: &DMatrix<f64>) -> f64 {
+/// Iterations of the Schur decomposition before it gives up (nalgebra's
+/// default has no bound, and some defective matrices never converge).
+pub const MAX_SCHUR_ITERATIONS: usize = 20_000;
+
+/// The eigenvalues of a square matrix, or `None` where the Schur
+/// decomposition does not converge within [`MAX_SCHUR_ITERATIONS`].
+pub fn eigenvalues(m: &DMatrix<f64>) -> Option<Vec<nalgebra::Complex<f64>>> {
     if m.is_empty() {
-        return 0.0;
+        return Some(Vec::new());
     }
-    m.clone()
-        .complex_eigenvalues()
-        .iter()
-        .map(|c| c.norm())
-        .fold(0.0, f64::max)
+    let try_one = |a: DMatrix<f64>| {
+        nalgebra::linalg::Schur::try_new(a, f64::EPSILON, MAX_SCHUR_ITERATIONS)
+            .map(|s| s.complex_eigenvalues().iter().cloned().collect::<Vec<_>>())
+    };
+    // Where the iteration stalls (matrices with many equal eigenvalues),
+    // the transpose or a similar matrix Q^T m Q, Q orthogonal from a
+    // fixed pseudo-random matrix, has the same eigenvalues.
+    try_one(m.clone())
+        .or_else(|| try_one(m.transpose()))
+        .or_else(|| {
+            let n = m.nrows();
+            let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+            let r = DMatrix::from_fn(n, n, |_, _| {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            });
+            let q = r.qr().q();
+            try_one(q.transpose() * m * &q)
+        })
+}
+
+/// The spectral radius of a square matrix (0 for an empty one), or
+/// `None` where its eigenvalues cannot be computed.
+pub fn spectral_radius(m: &DMatrix<f64>) -> Option<f64> {
+    Some(eigenvalues(m)?.iter().map(|c| c.norm()).fold(0.0, f64::max))
 }
 
 #[cfg(test)]

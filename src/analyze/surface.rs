@@ -20,7 +20,7 @@ use glam::{DVec2, DVec3};
 use nalgebra::DMatrix;
 use serde::Serialize;
 
-use super::num::fraction;
+use super::num::{eigenvalues, fraction};
 use crate::mesh::{Mesh, PolygonSoup};
 use crate::surface::Grammar;
 use crate::{Deadline, Error};
@@ -345,9 +345,14 @@ fn valence(
     v.rings = rings;
     v.size = set.len();
     v.affine = (0..s.nrows()).all(|r| (s.row(r).sum() - 1.0).abs() <= TOL);
-    let mut eig: Vec<Eigenvalue> = s
-        .clone()
-        .complex_eigenvalues()
+    let Some(values) = eigenvalues(&s) else {
+        v.skipped = Some(format!(
+            "the eigenvalues of the {0}×{0} matrix did not converge",
+            s.nrows()
+        ));
+        return Ok(v);
+    };
+    let mut eig: Vec<Eigenvalue> = values
         .iter()
         .map(|c| Eigenvalue {
             re: c.re,

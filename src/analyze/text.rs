@@ -246,14 +246,6 @@ pub fn surface(file: &str, r: &SurfaceReport) -> String {
             v.skipped.as_deref().unwrap_or("")
         );
     }
-    for v in r.valences.iter().filter(|v| v.skipped.is_some()) {
-        let _ = writeln!(
-            s,
-            "valence {:>2} skipped: {}",
-            v.n,
-            v.skipped.as_deref().unwrap_or("")
-        );
-    }
     for n in &r.notes {
         let _ = writeln!(s, "note: {n}");
     }

@@ -341,7 +341,7 @@ fn non_schemes_are_refused() {
     assert!(e.contains("beside the points"), "{e}");
     let e = refused(&format!(
         "{head}Axiom: P(V2f(0,0)) P(V2f(1,0)) P(V2f(1,1));\n\
-         P(v) : v.x > 0.5 -> P(v) P(v)\nP(v) -> P(v)\n"
+         P(v) : {{ if (v.x > 0.5) produce P(v) P(v); else produce P(v); }}\n"
     ));
     assert!(e.contains("analyze needs"), "{e}");
 }
