@@ -359,7 +359,7 @@ pub fn analyze(curve: &Curve, path: &str, deadline: Deadline) -> Result<CurveRep
     let near = |a: f64, b: f64| (a - b).abs() <= TOL;
     if probe.closed && rows < n {
         // A reduction: one new point from `red` old ones.
-        if n % rows != 0 {
+        if !n.is_multiple_of(rows) {
             return Err(not_uniform());
         }
         let red = n / rows;
@@ -396,7 +396,7 @@ pub fn analyze(curve: &Curve, path: &str, deadline: Deadline) -> Result<CurveRep
     }
     // The mask a_k: new point k (relative to `arity`·j) from old point j.
     let (arity, mask, boundary) = if probe.closed {
-        if rows % n != 0 {
+        if !rows.is_multiple_of(n) {
             return Err(not_uniform());
         }
         let arity = rows / n;

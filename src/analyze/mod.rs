@@ -40,7 +40,7 @@ pub struct Report {
 #[derive(Clone, Debug, Serialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Scheme {
-    Curve(CurveReport),
+    Curve(Box<CurveReport>),
     Surface(SurfaceReport),
 }
 
@@ -54,7 +54,7 @@ pub fn analyze(path: &Path, defines: &[String]) -> Result<Report, Error> {
     let name = path.display().to_string();
     let deadline = Deadline::after(TIMEOUT);
     let scheme = match load(path, &opts)? {
-        System::Curve(c) => Scheme::Curve(curve::analyze(&c, &name, deadline)?),
+        System::Curve(c) => Scheme::Curve(Box::new(curve::analyze(&c, &name, deadline)?)),
         System::Surface(s) => Scheme::Surface(surface::analyze(&s.grammar, &name, deadline)?),
         _ => {
             return Err(Error::File {

@@ -14,7 +14,7 @@ fn curve(file: &str) -> CurveReport {
         .unwrap_or_else(|e| panic!("{e}"))
         .scheme
     {
-        Scheme::Curve(c) => c,
+        Scheme::Curve(c) => *c,
         Scheme::Surface(_) => panic!("{file} is a curve"),
     }
 }
@@ -110,7 +110,8 @@ fn four_point_interpolates_and_is_c1() {
             h.lower <= 2.0 + 1e-9 && h.upper.unwrap() >= 2.0 - 1e-9,
             "{f}"
         );
-        assert!(h.lower > 1.0 && h.lower > 2.0 - 1e-6);
+        // Within rounding of 2, so above 1: C^1.
+        assert!(h.lower > 2.0 - 1e-6);
         assert_eq!(h.continuity, Some(1));
     }
 }
@@ -123,7 +124,8 @@ fn open_chaikin_reports_its_boundary_rows() {
         let c = curve(&format!("curves/{f}.lsys"));
         assert!(!c.closed && c.affine);
         assert_eq!(c.mask.as_ref().unwrap().factor_power, 3);
-        let rows: Vec<(String, i64, Vec<(i64, f64)>)> = c
+        type Row = (String, i64, Vec<(i64, f64)>);
+        let rows: Vec<Row> = c
             .boundary
             .iter()
             .map(|b| {
