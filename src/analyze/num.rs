@@ -90,6 +90,14 @@ pub fn eigenvalues(m: &DMatrix<f64>) -> Option<Vec<nalgebra::Complex<f64>>> {
             let q = r.qr().q();
             try_one(q.transpose() * m * &q)
         })
+        .or_else(|| {
+            // Eigenvalues of equal modulus on a circle (a rotation) stall
+            // the shifts; m + c I moves them off it, and c comes back off.
+            let n = m.nrows();
+            let c = 0.375;
+            let e = try_one(m + DMatrix::identity(n, n) * c)?;
+            Some(e.iter().map(|z| z - c).collect())
+        })
 }
 
 /// The spectral radius of a square matrix (0 for an empty one), or
