@@ -69,15 +69,18 @@ pub fn eigenvalues(m: &DMatrix<f64>) -> Option<Vec<nalgebra::Complex<f64>>> {
     if m.is_empty() {
         return Some(Vec::new());
     }
-    let try_one = |a: DMatrix<f64>| {
-        nalgebra::linalg::Schur::try_new(a, f64::EPSILON, MAX_SCHUR_ITERATIONS)
+    // A looser tolerance (1e-13 of the neighbouring diagonal) lets the
+    // deflation of a defective matrix's nearly equal eigenvalues happen.
+    let try_one = |a: DMatrix<f64>, eps: f64| {
+        nalgebra::linalg::Schur::try_new(a, eps, MAX_SCHUR_ITERATIONS)
             .map(|s| s.complex_eigenvalues().iter().cloned().collect::<Vec<_>>())
     };
     // Where the iteration stalls (matrices with many equal eigenvalues),
     // the transpose or a similar matrix Q^T m Q, Q orthogonal from a
     // fixed pseudo-random matrix, has the same eigenvalues.
-    try_one(m.clone())
-        .or_else(|| try_one(m.transpose()))
+    try_one(m.clone(), f64::EPSILON)
+        .or_else(|| try_one(m.clone(), 1e-13))
+        .or_else(|| try_one(m.transpose(), 1e-13))
         .or_else(|| {
             let n = m.nrows();
             let mut seed = 0x9e37_79b9_7f4a_7c15u64;
@@ -88,14 +91,14 @@ pub fn eigenvalues(m: &DMatrix<f64>) -> Option<Vec<nalgebra::Complex<f64>>> {
                 (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
             });
             let q = r.qr().q();
-            try_one(q.transpose() * m * &q)
+            try_one(q.transpose() * m * &q, 1e-13)
         })
         .or_else(|| {
             // Eigenvalues of equal modulus on a circle (a rotation) stall
             // the shifts; m + c I moves them off it, and c comes back off.
             let n = m.nrows();
             let c = 0.375;
-            let e = try_one(m + DMatrix::identity(n, n) * c)?;
+            let e = try_one(m + DMatrix::identity(n, n) * c, 1e-13)?;
             Some(e.iter().map(|z| z - c).collect())
         })
 }
