@@ -1757,3 +1757,23 @@ fn refuse_overwrite(outputs: &[&Path], inputs: &[&Path], force: bool) -> Result<
     }
     Ok(())
 }
+
+/// The arguments of `subgram analyze`.
+#[derive(Clone, Debug, Default)]
+pub struct AnalyzeArgs {
+    pub file: String,
+    /// `--format json` instead of text.
+    pub json: bool,
+    pub defines: Vec<String>,
+}
+
+/// `subgram analyze FILE [--format json] [-D NAME=VALUE]…`: what the
+/// subdivision scheme in FILE is (see [`crate::analyze`]), as text or JSON.
+pub fn analyze(a: &AnalyzeArgs) -> Result<String, Error> {
+    let r = crate::analyze::analyze(Path::new(&a.file), &a.defines)?;
+    let mut s = if a.json { r.json() } else { r.text() };
+    while s.ends_with('\n') {
+        s.pop();
+    }
+    Ok(s)
+}

@@ -42,6 +42,7 @@ mod syntax;
 mod system;
 pub mod vv;
 
+pub mod analyze;
 pub mod command;
 pub mod draw;
 pub mod export;

@@ -259,6 +259,15 @@ enum Command {
         #[arg(long)]
         double: bool,
     },
+    /// Analyse a subdivision scheme (a curve L-system or a surface grammar):
+    /// stencils, mask, degrees, smoothness; eigenvalues around valences 3 to 12.
+    Analyze {
+        file: String,
+        #[arg(long, value_enum, default_value_t = Format::Text)]
+        format: Format,
+        #[arg(short = 'D', value_name = "NAME=VALUE")]
+        define: Vec<String>,
+    },
 }
 
 fn parse_phase(s: &str) -> Result<subgram::reverse::Phase, String> {
@@ -495,6 +504,15 @@ fn run(cli: Cli) -> Result<(), Error> {
             define,
             double,
         } => print_out(&command::check(&file, &define, double)?),
+        Command::Analyze {
+            file,
+            format,
+            define,
+        } => print_out(&command::analyze(&command::AnalyzeArgs {
+            file,
+            json: matches!(format, Format::Json),
+            defines: define,
+        })?),
         Command::Derive {
             file,
             steps,

@@ -2,6 +2,7 @@
 //! against the shared lpfg corpus are a separate target, tests/shared.
 
 mod abop;
+mod analyze;
 mod bad_inputs;
 mod cli;
 mod curves;

@@ -1,0 +1,87 @@
+//! `subgram analyze`: what a subdivision scheme is, measured through the
+//! engine. One step of the scheme is run on impulses (a word or a mesh of
+//! points, one coordinate 1 at one point and 0 elsewhere); the outputs are
+//! the columns of the subdivision matrix. Nothing here re-implements a
+//! scheme: every number comes from the program's own rules.
+//!
+//! Curves ([`curve`]): stencils, affine invariance, support, the mask and
+//! its (1+z) factors, polynomial reproduction and generation, Rioul's
+//! Hölder estimate. Surfaces ([`surface`]): the local subdivision matrix
+//! around a vertex of each valence, its leading eigenvalues, Reif's check
+//! and the limit and tangent stencils.
+
+pub mod curve;
+mod num;
+pub mod surface;
+mod text;
+
+use std::path::Path;
+use std::time::Duration;
+
+use serde::Serialize;
+
+use crate::{load, Deadline, Error, LoadOptions, Precision, System};
+
+pub use curve::CurveReport;
+pub use surface::SurfaceReport;
+
+/// The time an analysis may take.
+pub const TIMEOUT: Duration = Duration::from_secs(120);
+
+/// What `analyze` found.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    pub file: String,
+    #[serde(flatten)]
+    pub scheme: Scheme,
+}
+
+/// A curve scheme's or a surface grammar's analysis.
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Scheme {
+    Curve(Box<CurveReport>),
+    Surface(SurfaceReport),
+}
+
+/// Loads `path` (in double precision, so that the measured weights are the
+/// program's) and analyses it.
+pub fn analyze(path: &Path, defines: &[String]) -> Result<Report, Error> {
+    let opts = LoadOptions {
+        defines: defines.to_vec(),
+        precision: Precision::Double,
+    };
+    let name = path.display().to_string();
+    let deadline = Deadline::after(TIMEOUT);
+    let scheme = match load(path, &opts)? {
+        System::Curve(c) => Scheme::Curve(Box::new(curve::analyze(&c, &name, deadline)?)),
+        System::Surface(s) => Scheme::Surface(surface::analyze(&s.grammar, &name, deadline)?),
+        _ => {
+            return Err(Error::File {
+                path: name,
+                line: None,
+                message: "analyze reads curve L-systems and surface grammars; this file is \
+                          neither"
+                    .into(),
+            })
+        }
+    };
+    Ok(Report { file: name, scheme })
+}
+
+impl Report {
+    /// The report as readable text.
+    pub fn text(&self) -> String {
+        match &self.scheme {
+            Scheme::Curve(c) => text::curve(&self.file, c),
+            Scheme::Surface(s) => text::surface(&self.file, s),
+        }
+    }
+
+    /// The report as JSON.
+    pub fn json(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{e}"));
+        s.push('\n');
+        s
+    }
+}
