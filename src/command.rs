@@ -411,8 +411,8 @@ pub struct Drawn {
     pub warnings: Vec<String>,
 }
 
-/// Renders as [`render`] does, with the program's text replaced by `text`
-/// (see [`crate::load::load_edited`]), and writes nothing: the picture
+/// Renders as [`render()`] does, with the program's text replaced by `text`
+/// (see [`crate::load_edited`]), and writes nothing: the picture
 /// comes back in memory. A program's own files (`fopen`) are refused as
 /// without `--allow-writes`.
 pub fn render_edited(a: &RenderArgs, text: &str) -> Result<Drawn, Error> {

@@ -63,7 +63,8 @@ pub use deadline::{Deadline, DEFAULT_TIMEOUT};
 pub use error::Error;
 pub use lang::{Program, ProgramOutput, Stream, Value};
 pub use load::{
-    load, load_file, load_file_with, load_str, load_str_with, load_text, LoadOptions, Precision,
+    load, load_edited, load_file, load_file_with, load_str, load_str_with, load_text, LoadOptions,
+    Precision,
 };
 pub use rewrite::derive::{DEFAULT_MAX_MODULES, MAX_STEPS};
 pub use rewrite::{derive, Derivation, DeriveError, DeriveOptions, Derived, Word};
