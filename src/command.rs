@@ -788,18 +788,7 @@ fn render_system(
                     )))
                 }
             };
-            check_steps(a.steps)?;
-            let dir = writes_folder(&a.allow_writes, &a.program_output)?;
-            let opts = RunOptions {
-                steps: a.steps,
-                max_modules: a.max_modules,
-                phase: a.phase,
-                seed: a.seed,
-                base_mesh: None,
-                deadline,
-                output: a.program_output.clone(),
-                max_shapes: None,
-            };
+            let (opts, dir) = curve_run(a, deadline)?;
             let model = &c.program.model;
             let palette = model
                 .palette()
@@ -828,6 +817,27 @@ fn render_system(
             write_views(&figures, Path::new(&a.file), output, (format, a.force), out)
         }
     }
+}
+
+/// How `render` runs an L-system: the steps checked, the folder the
+/// program may write in, the run's options.
+fn curve_run(
+    a: &RenderArgs,
+    deadline: Option<Deadline>,
+) -> Result<(RunOptions, Option<PathBuf>), Error> {
+    check_steps(a.steps)?;
+    let dir = writes_folder(&a.allow_writes, &a.program_output)?;
+    let opts = RunOptions {
+        steps: a.steps,
+        max_modules: a.max_modules,
+        phase: a.phase,
+        seed: a.seed,
+        base_mesh: None,
+        deadline,
+        output: a.program_output.clone(),
+        max_shapes: None,
+    };
+    Ok((opts, dir))
 }
 
 /// Whether `render` draws this L-system's 3D geometry (see [`Solidity`]).
@@ -869,18 +879,7 @@ fn render_solid(
             "--each draws the 2D steps side by side; add --lines, or draw one step in 3D".into(),
         ));
     }
-    check_steps(a.steps)?;
-    let dir = writes_folder(&a.allow_writes, &a.program_output)?;
-    let opts = RunOptions {
-        steps: a.steps,
-        max_modules: a.max_modules,
-        phase: a.phase,
-        seed: a.seed,
-        base_mesh: None,
-        deadline,
-        output: a.program_output.clone(),
-        max_shapes: None,
-    };
+    let (opts, dir) = curve_run(a, deadline)?;
     let model = &c.program.model;
     let (w, h) = looks.size;
     let mut run = c.run(opts.derive_options())?;

@@ -605,37 +605,13 @@ pub fn infer_closed(m: &Matrix, shift: Option<i64>) -> Result<Inference, Error> 
             production: group(d),
         })
         .collect();
-    let chosen = match shift {
-        Some(d) => {
-            if d.unsigned_abs() > 64 * reach as u64 {
-                return Err(Error::Usage(format!(
-                    "--shift {d}: a production reaching that far from its old point is not written; the listed shifts run from {} to {}",
-                    -reach, reach
-                )));
-            }
-            d
-        }
-        None => {
-            // The most balanced, then the shortest, then the one whose new
-            // points lie nearest the old point they replace.
-            let p = |g: &Grouping| (g.production.left as i64, g.production.right as i64);
-            groupings
-                .iter()
-                .min_by_key(|g| {
-                    let (l, r) = p(g);
-                    let far = g.production.distance();
-                    ((l - r).abs(), l + r, far, g.shift.abs(), g.shift)
-                })
-                .map_or(0, |g| g.shift)
-        }
-    };
-    let mut groupings = groupings;
-    if !groupings.iter().any(|g| g.shift == chosen) {
-        groupings.push(Grouping {
-            shift: chosen,
-            production: group(chosen),
-        });
+    if let Some(d) = shift.filter(|d| d.unsigned_abs() > 64 * reach as u64) {
+        return Err(Error::Usage(format!(
+            "--shift {d}: a production reaching that far from its old point is not written; the listed shifts run from {} to {}",
+            -reach, reach
+        )));
     }
+    let (groupings, chosen) = choose(groupings, shift, group);
     Ok(Inference {
         arity: a,
         closed: true,
@@ -644,6 +620,33 @@ pub fn infer_closed(m: &Matrix, shift: Option<i64>) -> Result<Inference, Error> 
         chosen,
         open: None,
     })
+}
+
+/// The grouping written: `shift`, else the most balanced, then the
+/// shortest, then the one whose new points lie nearest the old point they
+/// replace; added to the list when it lies outside it.
+fn choose(
+    mut groupings: Vec<Grouping>,
+    shift: Option<i64>,
+    group: impl Fn(i64) -> Production,
+) -> (Vec<Grouping>, i64) {
+    let chosen = shift.unwrap_or_else(|| {
+        groupings
+            .iter()
+            .min_by_key(|g| {
+                let (l, r) = (g.production.left as i64, g.production.right as i64);
+                let far = g.production.distance();
+                ((l - r).abs(), l + r, far, g.shift.abs(), g.shift)
+            })
+            .map_or(0, |g| g.shift)
+    });
+    if !groupings.iter().any(|g| g.shift == chosen) {
+        groupings.push(Grouping {
+            shift: chosen,
+            production: group(chosen),
+        });
+    }
+    (groupings, chosen)
 }
 
 /// Infers the productions of an open scheme (§6): rows for `n` old points
@@ -813,22 +816,7 @@ pub fn infer_reverse(m: &Matrix, shift: Option<i64>) -> Result<Inference, Error>
             production: group(d),
         })
         .collect();
-    let chosen = shift.unwrap_or_else(|| {
-        groupings
-            .iter()
-            .min_by_key(|g| {
-                let p = &g.production;
-                (p.left != p.right, p.left + p.right, g.shift.abs(), g.shift)
-            })
-            .map_or(0, |g| g.shift)
-    });
-    let mut groupings = groupings;
-    if !groupings.iter().any(|g| g.shift == chosen) {
-        groupings.push(Grouping {
-            shift: chosen,
-            production: group(chosen),
-        });
-    }
+    let (groupings, chosen) = choose(groupings, shift, group);
     Ok(Inference {
         arity: a,
         closed: true,
