@@ -63,7 +63,8 @@ enum Command {
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
         timeout: Timeout,
     },
-    /// Render an .lsys file's picture to PNG or SVG.
+    /// Render an .lsys file's picture to PNG or SVG (in 3D when its model
+    /// asks, or with --solid), or export its 3D geometry to OBJ, PLY or GLB.
     Render(RenderCli),
     /// Render, then render again whenever the file or a file it reads
     /// changes (a model's files, a base mesh); an edit with an error keeps
