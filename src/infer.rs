@@ -311,10 +311,12 @@ impl Production {
                 s.push_str(" #");
             }
         }
-        s.push_str(" ->");
         if self.successor.is_empty() {
-            s.push_str(" *");
+            // No new point: the module is erased.
+            s.push_str(" : { produce; }");
+            return s;
         }
+        s.push_str(" ->");
         for point in &self.successor {
             let mut sum = String::new();
             for (k, t) in point.iter().enumerate() {

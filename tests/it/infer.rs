@@ -306,3 +306,19 @@ fn bad_matrices_are_refused_with_their_place_and_reason() {
         "{m}"
     );
 }
+
+/// An open matrix whose first old point keeps no new point (2 rows for 3
+/// points: new 1 = old 1, new 2 = old 2) erases it (`produce;`), and each
+/// other point takes its left neighbour: one step drops the last point.
+/// The program runs.
+#[test]
+fn a_point_that_keeps_no_new_point_is_erased_by_a_program_that_runs() {
+    let text = infer(InferArgs {
+        rows: Some("1 0 0; 0 1 0".into()),
+        open: true,
+        ..Default::default()
+    });
+    assert!(text.contains("# < P(v) : { produce; }"), "{text}");
+    let (before, after) = one_step(&text);
+    assert_eq!(after, before[..before.len() - 1]);
+}
