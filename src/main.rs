@@ -657,7 +657,11 @@ fn run(cli: Cli) -> Result<(), Error> {
                 }
                 command::WatchEvent::Failed { error } => {
                     let _ = print_program_output(&args.program_output, false);
-                    eprintln!("{error}");
+                    if error.has_location() {
+                        eprintln!("{error}");
+                    } else {
+                        eprintln!("error: {error}");
+                    }
                     eprintln!("(the last good picture is kept; waiting for a change)");
                 }
                 command::WatchEvent::Watching { files } => {
