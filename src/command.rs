@@ -370,15 +370,7 @@ pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<Stri
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
     refuse_overwrite(&[output], &[file], a.force)?;
-    let white = Rgba(255, 255, 255, 255);
-    let size = a.size.unwrap_or((800, 800));
-    let looks = MeshLooks {
-        size,
-        background: a.background.unwrap_or(white),
-        view: a.view.as_deref(),
-        wireframe: a.wireframe,
-        shading: crate::render::mesh::Shading::Lit,
-    };
+    let looks = MeshLooks::of_render(a);
     if mesh::io::Format::from_path(file).is_some() {
         write_mesh_picture(&load_mesh(file)?, output, &looks, &mut Out::Files)?;
         return Ok(Vec::new());
@@ -419,14 +411,7 @@ pub fn render_edited(a: &RenderArgs, text: &str) -> Result<Drawn, Error> {
     let deadline = a.timeout.map(Deadline::after);
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
-    let white = Rgba(255, 255, 255, 255);
-    let looks = MeshLooks {
-        size: a.size.unwrap_or((800, 800)),
-        background: a.background.unwrap_or(white),
-        view: a.view.as_deref(),
-        wireframe: a.wireframe,
-        shading: crate::render::mesh::Shading::Lit,
-    };
+    let looks = MeshLooks::of_render(a);
     let format = Picture::from_path(output)?;
     let system = crate::load::load_edited(file, text, &load_options(&a.defines, a.double))?;
     let mut warnings = system.warnings();
@@ -1607,6 +1592,20 @@ struct MeshLooks<'a> {
     view: Option<&'a str>,
     wireframe: bool,
     shading: crate::render::mesh::Shading,
+}
+
+impl<'a> MeshLooks<'a> {
+    /// How `render` draws a mesh: its size (800×800 by default),
+    /// background (white by default), view and wireframe, lit.
+    fn of_render(a: &'a RenderArgs) -> MeshLooks<'a> {
+        MeshLooks {
+            size: a.size.unwrap_or((800, 800)),
+            background: a.background.unwrap_or(Rgba(255, 255, 255, 255)),
+            view: a.view.as_deref(),
+            wireframe: a.wireframe,
+            shading: crate::render::mesh::Shading::Lit,
+        }
+    }
 }
 
 impl MeshLooks<'_> {
