@@ -163,10 +163,7 @@ fn main() {
             dir: Vec3::new(-0.3, -0.2, -1.0),
             ..ViewSpec::default()
         },
-        &mut scene
-            .meshes
-            .iter()
-            .flat_map(|m| m.positions.iter().copied()),
+        &mut scene.points(),
         size,
         size,
     )

@@ -873,17 +873,9 @@ fn render_solid(
     if model.line_style == LineStyle::Pixel || picture {
         // The picture's scale from the drawing's extent, as the camera will
         // frame it (lpfg's 0.9 of the window by default).
-        let mut lo = glam::DVec3::splat(f64::INFINITY);
-        let mut hi = glam::DVec3::splat(f64::NEG_INFINITY);
-        for e in run.events()? {
-            if let crate::draw::Event::Path { points, .. } = &e {
-                for p in points {
-                    lo = lo.min(*p);
-                    hi = hi.max(*p);
-                }
-            }
-        }
-        let extent = (hi - lo).max_element();
+        let extent = run
+            .line_bounds()?
+            .map_or(f64::NAN, |(lo, hi)| (hi - lo).max_element());
         let units_per_pixel = if extent.is_finite() && extent > 0.0 {
             extent / (0.9 * w.min(h) as f64)
         } else {
@@ -921,15 +913,7 @@ fn render_solid(
         camera.dir = Some(y_up(d));
         camera.up = Some(y_up(u));
     }
-    let mut ropts = camera.raster_options(
-        &model.lights,
-        &mut scene
-            .meshes
-            .iter()
-            .flat_map(|m| m.positions.iter().copied()),
-        w,
-        h,
-    )?;
+    let mut ropts = camera.raster_options(&model.lights, &mut scene.points(), w, h)?;
     let model_background = model.colours.as_ref().map(|m| {
         let [r, g, b] = m.background();
         Rgba(r, g, b, 255)

@@ -316,14 +316,14 @@ impl<'c> CurveRun<'c> {
     /// What the turtle draws from the interpreted word: lines, discs,
     /// polygons, in 3D.
     pub fn events(&mut self) -> Result<Vec<Event>, Error> {
-        let curve = self.curve;
-        let opts = self.draw_options()?;
-        let word = self.interpreted()?;
-        let p = &curve.program;
-        draw::draw(&word, &p.alphabet, &p.structs, &opts).map_err(|e| {
-            let maker = (e.module).and_then(|m| self.maker(&word, m));
-            curve.draw_error(e, self.step(), maker)
-        })
+        self.drawing(|word, p, opts| draw::draw(word, &p.alphabet, &p.structs, opts))
+    }
+
+    /// The box around the turtle's lines in the interpreted word, `None`
+    /// when it draws none: the extent of [`CurveRun::events`]' paths,
+    /// without making them.
+    pub fn line_bounds(&mut self) -> Result<Option<(DVec3, DVec3)>, Error> {
+        self.drawing(|word, p, opts| draw::line_bounds(word, &p.alphabet, &p.structs, opts))
     }
 
     /// The 3D geometry the turtle makes from the interpreted word (tubes,
@@ -331,14 +331,29 @@ impl<'c> CurveRun<'c> {
     /// triangle mesh per colour or material of the model: see
     /// [`draw::solid`].
     pub fn solid(&mut self, sopts: &draw::solid::SolidOptions) -> Result<Scene3, Error> {
+        self.drawing(|word, p, opts| draw::solid::solid(word, &p.alphabet, &p.structs, opts, sopts))
+    }
+
+    /// `walk` on the interpreted word, borrowed when no interpretation rule
+    /// applies; a failure names the module and, where the replay finds it,
+    /// the production that made it.
+    fn drawing<T>(
+        &mut self,
+        walk: impl FnOnce(&Word, &Program, &draw::DrawOptions) -> Result<T, draw::DrawError>,
+    ) -> Result<T, Error> {
         let curve = self.curve;
         let opts = self.draw_options()?;
-        let word = self.interpreted()?;
         let p = &curve.program;
-        draw::solid::solid(&word, &p.alphabet, &p.structs, &opts, sopts).map_err(|e| {
-            let maker = (e.module).and_then(|m| self.maker(&word, m));
-            curve.draw_error(e, self.step(), maker)
-        })
+        let step = self.step();
+        let word = self.d.interpreted_view(0).map_err(|e| curve.error(e))?;
+        match walk(&word, p, &opts) {
+            Ok(t) => Ok(t),
+            Err(e) => {
+                let word = word.into_owned();
+                let maker = (e.module).and_then(|m| self.maker(&word, m));
+                Err(curve.draw_error(e, step, maker))
+            }
+        }
     }
 
     /// The turtle's settings for this run: the model, the view file's, the

@@ -58,8 +58,15 @@ pub fn write(scene: &Scene3, path: &Path) -> Result<(), Error> {
 }
 
 /// Refuses a scene that cannot be exported: no triangle, non-finite
-/// coordinates, indices out of range (the renderer's checks).
+/// coordinates, indices out of range (the renderer's checks), or lines,
+/// which only a picture's geometry has.
 fn check(scene: &Scene3) -> Result<(), Error> {
+    let lines = scene.line_count();
+    if lines > 0 {
+        return Err(Error::Failed(format!(
+            "cannot export the scene: it has {lines} lines, the thin tubes of a picture's geometry; make the geometry without `picture_pixel` to export it"
+        )));
+    }
     validate(scene).map_err(|e| Error::Failed(format!("cannot export the scene: {e}")))
 }
 

@@ -49,19 +49,32 @@ impl Look {
 
 /// An indexed triangle mesh of one look. `normals` is empty for flat
 /// shading, or has one unit normal per position for smooth shading.
+///
+/// `lines` are for pictures only: tubes thinner than a pixel, which the
+/// geometry of a picture keeps as their axes (see
+/// [`crate::draw::solid::SolidOptions::picture_pixel`]). The z-buffer draws
+/// each one sample wide, lit as the side of a cylinder that faces the
+/// viewer; the exporters refuse a scene that has any.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriMesh {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
     pub triangles: Vec<[u32; 3]>,
+    pub lines: Vec<[Vec3; 2]>,
 }
 
 impl TriMesh {
-    /// The axis-aligned bounds of its positions, `None` when empty.
+    /// The axis-aligned bounds of its positions and lines, `None` when it
+    /// has neither.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let mut it = self.positions.iter();
-        let first = *it.next()?;
-        Some(it.fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+        let mut it = self.points();
+        let first = it.next()?;
+        Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+    }
+
+    /// Its vertices' positions, then its lines' ends.
+    pub fn points(&self) -> impl Iterator<Item = Vec3> + '_ {
+        (self.positions.iter().copied()).chain(self.lines.iter().flatten().copied())
     }
 }
 
@@ -85,7 +98,17 @@ impl Scene3 {
         self.meshes.iter().map(|m| m.positions.len()).sum()
     }
 
-    /// The bounds of every mesh, `None` when there is no vertex.
+    /// The number of lines over all meshes (see [`TriMesh::lines`]).
+    pub fn line_count(&self) -> usize {
+        self.meshes.iter().map(|m| m.lines.len()).sum()
+    }
+
+    /// Every mesh's points (see [`TriMesh::points`]): what a camera frames.
+    pub fn points(&self) -> impl Iterator<Item = Vec3> + '_ {
+        self.meshes.iter().flat_map(TriMesh::points)
+    }
+
+    /// The bounds of every mesh, `None` when there is no vertex or line.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         self.meshes
             .iter()

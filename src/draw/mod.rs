@@ -565,6 +565,50 @@ impl Sink for Events {
     }
 }
 
+/// The box of the turtle's lines: their end points' least and greatest
+/// coordinates.
+struct LineBounds(DVec3, DVec3);
+
+impl Sink for LineBounds {
+    #[inline]
+    fn line(&mut self, _t: &Turtle, a: DVec3, b: DVec3) -> Result<(), String> {
+        self.0 = self.0.min(a).min(b);
+        self.1 = self.1.max(a).max(b);
+        Ok(())
+    }
+
+    fn round(&mut self, _t: &Turtle, _kind: Round, _r: f64) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn polygon(&mut self, _t: &Turtle, _points: Vec<DVec3>) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn surface(
+        &mut self,
+        _t: &Turtle,
+        _s: &crate::model::Surface,
+        _scale: DVec3,
+    ) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// The box around the turtle's lines in `word` (lines only: discs,
+/// polygons and surfaces are left out), `None` when it draws no line: what
+/// [`draw`]'s paths span, found by the same walk without keeping them.
+pub fn line_bounds(
+    word: &Word,
+    alphabet: &Alphabet,
+    structs: &[StructDef],
+    opts: &DrawOptions,
+) -> Result<Option<(DVec3, DVec3)>, DrawError> {
+    let mut b = LineBounds(DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    walk(word, alphabet, structs, opts, None, &mut b)?;
+    Ok((b.0.x <= b.1.x).then_some((b.0, b.1)))
+}
+
 /// Interprets `word` with the turtle and returns the drawing events.
 pub fn draw(
     word: &Word,

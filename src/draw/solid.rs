@@ -89,8 +89,9 @@ pub struct SolidOptions {
     pub pixel_tubes: Option<f64>,
     /// Geometry for a picture with this many model units per pixel: a tube
     /// gets fewer sides where it is thin, enough that no side is wider than
-    /// 1.5 pixels (at least 3, at most its own); `None` (exports): every
-    /// tube its own number of sides.
+    /// 1.5 pixels (at least 3, at most its own), and a tube less than a
+    /// pixel across is only its axis, a line of [`TriMesh::lines`]; `None`
+    /// (exports): every tube a tube of its own number of sides.
     pub picture_pixel: Option<f64>,
     /// More triangles than this stop the walk with an error.
     pub max_triangles: usize,
@@ -278,6 +279,11 @@ struct Builder<'m> {
     /// Generalized cylinders' sections, the last few used.
     sections: Vec<(SectionKey, Section)>,
 }
+
+/// In a picture, a tube less than this many pixels across is drawn as its
+/// axis, one sample wide (a triangle so thin would cover samples only here
+/// and there, and a plant's twigs would come out dotted).
+const THIN: f64 = 1.0;
 
 /// Directions shorter than this are no direction.
 const TINY: f64 = 1e-12;
@@ -617,6 +623,9 @@ impl<'m> Builder<'m> {
         if let Some(px) = self.picture_pixel {
             // The circumference in pixels over 1.5 pixels a side.
             let across = scale.0.abs().max(scale.1.abs()) / px;
+            if across < THIN {
+                return self.thin(t, a, b);
+            }
             let need = (std::f64::consts::PI * across / 1.5).ceil();
             if need.is_finite() && need < sides as f64 {
                 sides = (need as u32).max(MIN_CONTOUR_SIDES);
@@ -670,6 +679,28 @@ impl<'m> Builder<'m> {
             scale,
             sides,
         });
+        Ok(())
+    }
+
+    /// A tube thinner than a pixel in a picture: its axis, as a line of
+    /// the mesh (see [`TriMesh::lines`]). A tube it follows ends here.
+    fn thin(&mut self, t: &Turtle, a: DVec3, b: DVec3) -> Result<(), String> {
+        self.end_tube()?;
+        if !fits(a, 0.0) || !fits(b, 0.0) {
+            return Err("makes a cylinder that reaches an infinite coordinate".into());
+        }
+        // A line counts as a triangle against the limit.
+        if self.triangles + 1 > self.max_triangles {
+            return Err(format!(
+                "takes the 3D geometry past its limit of {} triangles",
+                self.max_triangles
+            ));
+        }
+        self.triangles += 1;
+        let mesh = self.mesh(t.pen.color);
+        self.scene.meshes[mesh as usize]
+            .lines
+            .push([a.as_vec3(), b.as_vec3()]);
         Ok(())
     }
 

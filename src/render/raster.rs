@@ -498,14 +498,15 @@ pub fn validate(scene: &Scene3) -> Result<(), RenderError> {
         )));
     }
     let triangles = scene.triangle_count();
-    if triangles == 0 {
+    let lines = scene.line_count();
+    if triangles == 0 && lines == 0 {
         return Err(RenderError::new(
             "nothing to draw: the scene has no triangle",
         ));
     }
-    if triangles > MAX_TRIANGLES {
+    if triangles + lines > MAX_TRIANGLES {
         return Err(RenderError::new(format!(
-            "the scene has {triangles} triangles, more than the {MAX_TRIANGLES} one picture takes"
+            "the scene has {triangles} triangles and {lines} lines, more than the {MAX_TRIANGLES} one picture takes"
         )));
     }
     for (k, m) in scene.meshes.iter().enumerate() {
@@ -522,6 +523,15 @@ pub fn validate(scene: &Scene3) -> Result<(), RenderError> {
                 "mesh {k} (`{name}`) has {} normals for {} vertices",
                 m.normals.len(),
                 m.positions.len()
+            )));
+        }
+        if let Some(l) = m
+            .lines
+            .iter()
+            .position(|l| !(l[0].is_finite() && l[1].is_finite()))
+        {
+            return Err(RenderError::new(format!(
+                "line {l} of mesh {k} (`{name}`) has a non-finite end"
             )));
         }
         if let Some(v) = m.normals.iter().position(|n| !n.is_finite()) {
@@ -564,6 +574,9 @@ struct Frame<'a> {
     opts: &'a RasterOptions,
     /// The first global triangle index of each mesh, and the total last.
     tri_start: Vec<u32>,
+    /// The first global index of each mesh's lines, and the total last:
+    /// lines are numbered after every triangle.
+    line_start: Vec<u32>,
     /// The first projected vertex of each mesh.
     vert_start: Vec<usize>,
     screen: Vec<Screen>,
@@ -595,29 +608,14 @@ impl<'a> Frame<'a> {
         }
         tri_start.push(t);
         vert_start.push(v);
+        let mut line_start = Vec::with_capacity(scene.meshes.len() + 1);
+        for m in &scene.meshes {
+            line_start.push(t);
+            t += m.lines.len() as u32;
+        }
+        line_start.push(t);
         let sf = s as f32;
-        let project = |p: &Vec3| match cam.pixel(*p) {
-            Some(q)
-                if (-1e-6..=1.0 + 1e-6).contains(&q.z) && q.x.is_finite() && q.y.is_finite() =>
-            {
-                let inv_w = match cam.projection {
-                    Projection::Parallel => 1.0,
-                    Projection::Perspective => 1.0 / cam.eye_coords(*p).z,
-                };
-                Screen {
-                    x: q.x * sf - 0.5,
-                    y: q.y * sf - 0.5,
-                    z: q.z.clamp(0.0, 1.0) + 0.0,
-                    inv_w,
-                }
-            }
-            _ => Screen {
-                x: f32::NAN,
-                y: f32::NAN,
-                z: f32::NAN,
-                inv_w: f32::NAN,
-            },
-        };
+        let project = |p: &Vec3| project(cam, sf, *p);
         let mut screen = Vec::with_capacity(v);
         for m in &scene.meshes {
             if m.positions.len() >= 1 << 16 {
@@ -647,6 +645,7 @@ impl<'a> Frame<'a> {
             scene,
             opts,
             tri_start,
+            line_start,
             vert_start,
             screen,
             s,
@@ -655,15 +654,40 @@ impl<'a> Frame<'a> {
         }
     }
 
+    /// The mesh of a global line index and the index within it.
+    fn locate_line(&self, id: u32) -> (usize, usize) {
+        let k = self.line_start.partition_point(|&s| s <= id) - 1;
+        (k, (id - self.line_start[k]) as usize)
+    }
+
     /// The mesh of a global triangle index and the index within it.
     fn locate(&self, id: u32) -> (usize, usize) {
         let k = self.tri_start.partition_point(|&s| s <= id) - 1;
         (k, (id - self.tri_start[k]) as usize)
     }
 
-    /// Rasterises the triangles with global indices in `range` into a
-    /// depth and triangle buffer.
+    /// Rasterises the triangles and lines with global indices in `range`
+    /// into a depth and triangle buffer.
     fn raster_range(&self, range: std::ops::Range<usize>, depth: &mut [f32], ids: &mut [u32]) {
+        let triangles = *self.tri_start.last().unwrap_or(&0) as usize;
+        if range.end > triangles {
+            let sf = self.s as f32;
+            let cam = &self.opts.camera;
+            let lines = range.start.max(triangles)..range.end;
+            let mut k = self.locate_line(lines.start as u32).0;
+            for id in lines {
+                while self.line_start[k + 1] as usize <= id {
+                    k += 1;
+                }
+                let [a, b] = self.scene.meshes[k].lines[id - self.line_start[k] as usize];
+                let (a, b) = (project(cam, sf, a), project(cam, sf, b));
+                raster_line(depth, ids, self.sw, self.sh, a, b, id as u32);
+            }
+        }
+        let range = range.start..range.end.min(triangles);
+        if range.is_empty() {
+            return;
+        }
         let mut k = self.locate(range.start as u32).0;
         let mut id = range.start;
         while id < range.end {
@@ -685,7 +709,7 @@ impl<'a> Frame<'a> {
     /// Every sample's nearest triangle (`NO_TRIANGLE` where none), the
     /// smallest (depth, index) over all triangles that cover it.
     fn raster(&self) -> Vec<u32> {
-        let total = *self.tri_start.last().unwrap_or(&0) as usize;
+        let total = *self.line_start.last().unwrap_or(&0) as usize;
         let n = self.sw * self.sh;
         let mut depth = vec![FAR; n];
         let mut ids = vec![NO_TRIANGLE; n];
@@ -763,6 +787,93 @@ fn floor_i(v: f32) -> i32 {
         i - 1
     } else {
         i
+    }
+}
+
+/// Where `p` lands on the sample grid of `sf` samples a pixel side (sample
+/// centres at integers), NaN where it is not in view.
+fn project(cam: &Camera, sf: f32, p: Vec3) -> Screen {
+    match cam.pixel(p) {
+        Some(q) if (-1e-6..=1.0 + 1e-6).contains(&q.z) && q.x.is_finite() && q.y.is_finite() => {
+            let inv_w = match cam.projection {
+                Projection::Parallel => 1.0,
+                Projection::Perspective => 1.0 / cam.eye_coords(p).z,
+            };
+            Screen {
+                x: q.x * sf - 0.5,
+                y: q.y * sf - 0.5,
+                z: q.z.clamp(0.0, 1.0) + 0.0,
+                inv_w,
+            }
+        }
+        _ => Screen {
+            x: f32::NAN,
+            y: f32::NAN,
+            z: f32::NAN,
+            inv_w: f32::NAN,
+        },
+    }
+}
+
+/// One line into the key buffer, one sample wide: the samples nearest to
+/// evenly spaced points of it, one per sample step along its longer axis,
+/// both ends included, with the depth interpolated as a triangle's is. A
+/// NaN end (not in view) drops it; it is clipped to the grid first, so the
+/// steps are at most the grid's width and height.
+fn raster_line(
+    depth: &mut [f32],
+    ids: &mut [u32],
+    sw: usize,
+    sh: usize,
+    a: Screen,
+    b: Screen,
+    id: u32,
+) {
+    if [a.x, a.y, a.z, b.x, b.y, b.z].iter().any(|v| v.is_nan()) {
+        return;
+    }
+    let (dx, dy, dz) = (b.x - a.x, b.y - a.y, b.z - a.z);
+    // Liang–Barsky against the grid, half a sample beyond its centres.
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    for (p, q) in [
+        (-dx, a.x + 0.5),
+        (dx, sw as f32 - 0.5 - a.x),
+        (-dy, a.y + 0.5),
+        (dy, sh as f32 - 0.5 - a.y),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return;
+            }
+        } else {
+            let r = q / p;
+            if !r.is_finite() {
+                return;
+            }
+            if p < 0.0 {
+                t0 = t0.max(r);
+            } else {
+                t1 = t1.min(r);
+            }
+        }
+    }
+    if t0 > t1 {
+        return;
+    }
+    let steps = (dx.abs().max(dy.abs()) * (t1 - t0)).ceil().max(1.0) as usize;
+    let inv = (t1 - t0) / steps as f32;
+    for i in 0..=steps {
+        let t = t0 + i as f32 * inv;
+        let (x, y) = ((a.x + dx * t).round(), (a.y + dy * t).round());
+        if x < 0.0 || y < 0.0 || x >= sw as f32 || y >= sh as f32 {
+            continue;
+        }
+        let d = a.z + dz * t;
+        let k = y as usize * sw + x as usize;
+        if d >= 0.0 && d < depth[k] {
+            depth[k] = d;
+            ids[k] = id;
+        }
     }
 }
 
@@ -866,6 +977,10 @@ impl Frame<'_> {
     /// The colour of triangle `id` at sample position `(x, y)` (sample
     /// units, centres at integers), opaque.
     fn shade(&self, id: u32, x: f32, y: f32) -> [f32; 3] {
+        if id >= *self.tri_start.last().unwrap_or(&0) {
+            let (k, l) = self.locate_line(id);
+            return line_colour(self.scene, self.opts, k, self.scene.meshes[k].lines[l]);
+        }
         let (k, t) = self.locate(id);
         let m = &self.scene.meshes[k];
         let tri = m.triangles[t];
@@ -1020,6 +1135,24 @@ fn colour(scene: &Scene3, opts: &RasterOptions, k: usize, tri: [u32; 3], w: [f32
     if back {
         n = -n;
     }
+    lit(scene, opts, k, n, back)
+}
+
+/// The colour of line `line` of mesh `k` (a tube thinner than a sample):
+/// lit as the side of the tube that faces the viewer, whose normal is the
+/// direction to the viewer made perpendicular to the line.
+fn line_colour(scene: &Scene3, opts: &RasterOptions, k: usize, line: [Vec3; 2]) -> [f32; 3] {
+    let [a, b] = line;
+    let v = opts.camera.towards_viewer((a + b) * 0.5);
+    let t = (b - a).normalize_or_zero();
+    let n = (v - t * t.dot(v)).normalize_or(v);
+    lit(scene, opts, k, n, false)
+}
+
+/// The colour of a point of mesh `k` whose unit normal, turned to the
+/// viewer, is `n`; `back`: the point is on the side that faced away.
+fn lit(scene: &Scene3, opts: &RasterOptions, k: usize, n: Vec3, back: bool) -> [f32; 3] {
+    let cam = &opts.camera;
     match opts.shading {
         Shading::Lit => {
             let look = match (&opts.back_looks, back) {
@@ -1117,7 +1250,8 @@ pub fn render_png(scene: &Scene3, opts: &RasterOptions) -> Result<Vec<u8>, Rende
 
 /// `scene` as flat-shaded triangles for the SVG backend: each triangle
 /// lit at its centroid (with its own normal, or its vertex normals'
-/// mean), painted back to front by the depth of its centroid. Where
+/// mean), painted back to front by the depth of its centroid; a line is
+/// a stroke half a pixel wide, placed by the depth of its middle. Where
 /// triangles cross, or a far triangle's centroid lies before a near
 /// one's, that order is wrong: SVG has no depth test, so the picture is an
 /// approximation that the PNG is not. Each triangle is outlined in its own
@@ -1166,6 +1300,33 @@ pub fn polygons(scene: &Scene3, opts: &RasterOptions) -> Result<Scene, RenderErr
                         .collect(),
                     color,
                     outline: Some(outline),
+                },
+            ));
+        }
+    }
+    for (k, m) in scene.meshes.iter().enumerate() {
+        for &line in &m.lines {
+            let Some(px) = line
+                .iter()
+                .map(|p| {
+                    cam.pixel(*p)
+                        .filter(|q| (-1e-6..=1.0 + 1e-6).contains(&q.z))
+                })
+                .collect::<Option<Vec<Vec3>>>()
+            else {
+                continue;
+            };
+            let [r, g, b] = line_colour(scene, opts, k, line).map(|v| (v * 255.0).round() as u8);
+            let depth = line.iter().map(|p| cam.eye_coords(*p).z).sum::<f32>() * 1.5;
+            faces.push((
+                depth,
+                Item::Polyline {
+                    points: px
+                        .iter()
+                        .map(|q| DVec2::new(q.x as f64, q.y as f64))
+                        .collect(),
+                    color: Rgba(r, g, b, 255),
+                    width: 0.5,
                 },
             ));
         }

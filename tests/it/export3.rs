@@ -29,6 +29,7 @@ fn two_looks() -> Scene3 {
                 positions: tet.to_vec(),
                 normals: tet.iter().map(|p| p.normalize()).collect(),
                 triangles: vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]],
+                lines: Vec::new(),
             },
             TriMesh {
                 positions: vec![
@@ -39,6 +40,7 @@ fn two_looks() -> Scene3 {
                 ],
                 normals: Vec::new(),
                 triangles: vec![[0, 1, 2], [0, 2, 3]],
+                lines: Vec::new(),
             },
         ],
     }

@@ -26,6 +26,7 @@ fn quad(corners: [Vec3; 4]) -> TriMesh {
         positions: corners.to_vec(),
         normals: Vec::new(),
         triangles: vec![[0, 1, 2], [0, 2, 3]],
+        lines: Vec::new(),
     }
 }
 
@@ -433,6 +434,7 @@ fn smooth_normals_are_interpolated() {
         ],
         normals: vec![n(-2.0, -2.0), n(2.0, -2.0), n(0.0, 2.0)],
         triangles: vec![[0, 1, 2]],
+        lines: Vec::new(),
     };
     let mut look = Look::colour("s", 0, [200, 200, 200]);
     look.ambient = [0.0; 3];
@@ -578,4 +580,80 @@ fn the_view_files_camera_commands_are_kept() {
         subgram::model::view::raster_lights(&[]),
         vec![Light::default()]
     );
+}
+
+/// A line (a tube thinner than a pixel) is drawn one sample wide without a
+/// gap: every pixel column it crosses shows it, and the rows around it do
+/// not. It hides behind a nearer quad and shows before a farther one. Lit,
+/// its normal is the direction to the viewer made perpendicular to it: for
+/// a line across the view, the view direction itself, so its colour is
+/// OpenGL's formula for that normal.
+#[test]
+fn a_line_is_drawn_one_sample_wide_lit_as_the_tube_side_facing_the_viewer() {
+    let size = 64;
+    let cam = down_z(Projection::Parallel, size);
+    let red = Look::colour("red", 1, [200, 40, 40]);
+    // A shallow diagonal from (-1.9, -0.3) to (1.9, 0.2), at z = 0.
+    let (a, b) = (Vec3::new(-1.9, -0.3, 0.0), Vec3::new(1.9, 0.2, 0.0));
+    let line = TriMesh {
+        lines: vec![[a, b]],
+        ..Default::default()
+    };
+    let light = Light {
+        direction: Vec3::new(0.3, 0.4, 1.0).normalize(),
+        ambient: [0.0; 3],
+        diffuse: [1.0; 3],
+        specular: [0.0; 3],
+    };
+    let mut opts = RasterOptions::new(cam.clone());
+    opts.lights = vec![light];
+    let img = render(&scene(vec![(red.clone(), line.clone())]), &opts).unwrap();
+    let want = lighting(&red, Vec3::Z, &opts.lights, opts.global_ambient)
+        .map(|v| (v * 255.0).round() as i32);
+    let (x0, _) = pixel_of(&cam, a);
+    let (x1, _) = pixel_of(&cam, b);
+    for x in x0 + 1..x1 {
+        // The line's row at this column's centre.
+        let t = ((x as f32 + 0.5) / size as f32 * 4.0 - 2.0 - a.x) / (b.x - a.x);
+        let p = a + (b - a) * t;
+        let (_, y) = pixel_of(&cam, p);
+        // Two sample columns a pixel, one sample of each on the line: the
+        // column's pixels near the line hold two of their four samples in
+        // all, the line's colour mixed with white in that proportion.
+        let ink: f32 = (y.saturating_sub(2)..=y + 2)
+            .map(|y| {
+                let c = rgb(&img, x, y);
+                (255.0 - c[1] as f32) / (255.0 - want[1] as f32)
+            })
+            .sum();
+        assert!(
+            (ink - 0.5).abs() < 0.02,
+            "column {x}: {ink} pixels of ink near row {y}, not half a pixel"
+        );
+        for far in [y.saturating_sub(3), y + 3] {
+            assert_eq!(rgb(&img, x, far), [255, 255, 255], "column {x}, row {far}");
+        }
+    }
+    // Behind a quad at z = 1 (nearer the eye at z = 10), in front of one at
+    // z = -1: the green quad covers the middle of the picture.
+    let green = glowing("green", [0, 255, 0]);
+    let centre = pixel_of(&cam, Vec3::new(0.0, a.y + (b.y - a.y) * 0.5, 0.0));
+    for (z, line_shows) in [(1.0f32, false), (-1.0, true)] {
+        let q = quad([
+            Vec3::new(-0.5, -1.0, z),
+            Vec3::new(0.5, -1.0, z),
+            Vec3::new(0.5, 1.0, z),
+            Vec3::new(-0.5, 1.0, z),
+        ]);
+        let img = render(
+            &scene(vec![(green.clone(), q), (red.clone(), line.clone())]),
+            &opts,
+        )
+        .unwrap();
+        let near: Vec<[u8; 3]> = (centre.1 - 1..=centre.1 + 1)
+            .map(|y| rgb(&img, centre.0, y))
+            .collect();
+        let red_there = near.iter().any(|c| c[1] < 200);
+        assert_eq!(red_there, line_shows, "quad at z = {z}: {near:?}");
+    }
 }

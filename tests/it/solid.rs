@@ -804,7 +804,7 @@ fn pixel_lines_become_tubes_only_when_asked_with_the_size_of_a_pixel() {
 /// rings of n points is 2n triangles.
 #[test]
 fn a_picture_gives_thin_tubes_fewer_sides() {
-    for (width, sides) in [(0.5, 3), (3.0, 7), (10.0, 16)] {
+    for (width, sides) in [(1.0, 3), (1.2, 3), (3.0, 7), (10.0, 16)] {
         let mut c = load_text(&format!(
             "derivation length: 0;\nAxiom: SetWidth({width}) F(10);\n"
         ));
@@ -821,4 +821,51 @@ fn a_picture_gives_thin_tubes_fewer_sides() {
         let export = run.solid(&SolidOptions::default()).unwrap();
         assert_eq!(export.triangle_count(), 2 * 16, "width {width}");
     }
+}
+
+/// For a picture, a tube less than a pixel across is its axis: one line
+/// from the segment's start to its end, no triangle; an export keeps the
+/// tube, and refuses a picture's geometry.
+#[test]
+fn a_picture_keeps_a_tube_under_a_pixel_as_its_axis() {
+    let mut c = load_text("derivation length: 0;\nAxiom: SetWidth(0.9) F(10) Left(90) F(5);\n");
+    c.program.model = Arc::new(cylinders(16, false));
+    let mut run = c.run(Default::default()).unwrap();
+    let picture = run
+        .solid(&SolidOptions {
+            picture_pixel: Some(1.0),
+            ..Default::default()
+        })
+        .unwrap();
+    assert_eq!(picture.triangle_count(), 0);
+    let lines: Vec<[Vec3; 2]> = picture
+        .meshes
+        .iter()
+        .flat_map(|m| m.lines.clone())
+        .collect();
+    // The turtle starts at the origin heading along +y; Left(90) turns it
+    // towards -x (lpfg's turtle, manual 5.1).
+    let want = [
+        [Vec3::ZERO, Vec3::new(0.0, 10.0, 0.0)],
+        [Vec3::new(0.0, 10.0, 0.0), Vec3::new(-5.0, 10.0, 0.0)],
+    ];
+    assert_eq!(lines.len(), 2);
+    for (got, want) in lines.iter().zip(want) {
+        for (g, w) in got.iter().zip(want) {
+            assert!((*g - w).length() < 1e-5, "{got:?} against {want:?}");
+        }
+    }
+    let export = run.solid(&SolidOptions::default()).unwrap();
+    assert_eq!(export.line_count(), 0);
+    assert_eq!(
+        export.triangle_count(),
+        2 * 2 * 16,
+        "two segments of 16 sides"
+    );
+    let dir = std::env::temp_dir().join(format!("subgram-solid-lines-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let err = subgram::export::write(&picture, &dir.join("p.obj")).unwrap_err();
+    assert!(err.to_string().contains("lines"), "{err}");
+    assert!(!dir.join("p.obj").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }
