@@ -605,7 +605,7 @@ fn a_line_is_drawn_one_sample_wide_lit_as_the_tube_side_facing_the_viewer() {
         diffuse: [1.0; 3],
         specular: [0.0; 3],
     };
-    let mut opts = RasterOptions::new(cam.clone());
+    let mut opts = RasterOptions::new(cam);
     opts.lights = vec![light];
     let img = render(&scene(vec![(red.clone(), line.clone())]), &opts).unwrap();
     let want = lighting(&red, Vec3::Z, &opts.lights, opts.global_ambient)
