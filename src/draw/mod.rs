@@ -152,14 +152,16 @@ pub(crate) struct Turtle {
     up: DVec3,
     pen: Pen,
     /// The elasticity of each of the view file's tropisms, as this turtle
-    /// (and the branch it belongs to) set them.
-    elasticity: Vec<f64>,
+    /// (and the branch it belongs to) set them. Shared with the turtles of
+    /// the stack until it changes (a branch copies the turtle).
+    elasticity: std::rc::Rc<Vec<f64>>,
     /// The simple tropism (`stropism:`), which `Elasticity` and
     /// `SetTropismDirection3f` change for this turtle.
     simple: tropism::SimpleTropism,
     /// The coordinate system of `MoveTo`, `LineTo` and their kin, which
-    /// `SetCoordinateSystem` sets (pushed and popped with the turtle).
-    frame: Cartesian,
+    /// `SetCoordinateSystem` sets (pushed and popped with the turtle;
+    /// shared, as `elasticity` is).
+    frame: std::rc::Rc<Cartesian>,
 }
 
 /// lpfg's coordinate system for the modules that take points: a point
@@ -190,7 +192,7 @@ const EPSILON: f64 = 1e-5;
 impl Turtle {
     fn new(elasticity: Vec<f64>, simple: tropism::SimpleTropism) -> Turtle {
         Turtle {
-            elasticity,
+            elasticity: std::rc::Rc::new(elasticity),
             simple,
             pos: DVec3::ZERO,
             head: DVec3::Y,
@@ -200,13 +202,13 @@ impl Turtle {
                 color: 1,
                 width: 1.0,
             },
-            frame: Cartesian {
+            frame: std::rc::Rc::new(Cartesian {
                 origin: DVec3::ZERO,
                 x_axis: DVec3::NEG_X,
                 y_axis: DVec3::Y,
                 z_axis: DVec3::Z,
                 scale: 1.0,
-            },
+            }),
         }
     }
 
@@ -451,12 +453,12 @@ pub fn is_query(name: &str) -> bool {
     matches!(name, "GetPos" | "GetHead" | "GetLeft" | "GetUp")
 }
 
-/// The sines and cosines of the last two angles turned by: words turn by
-/// a few angles over and over (`+(90) ... -(90)`), and `sin_cos` is most
-/// of a turn's cost.
+/// The sines and cosines of the last four angles turned by: words turn by
+/// a few angles over and over (`+(90) ... -(90)`, or a branching angle
+/// between rolls of 120° and 240°), and `sin_cos` is most of a turn's cost.
 #[derive(Default)]
 struct TurnCache {
-    slots: [Option<(u64, f64, f64)>; 2],
+    slots: [Option<(u64, f64, f64)>; 4],
     next: usize,
 }
 
@@ -470,7 +472,7 @@ impl TurnCache {
         }
         let (s, c) = deg.to_radians().sin_cos();
         self.slots[self.next] = Some((bits, s, c));
-        self.next ^= 1;
+        self.next = (self.next + 1) % self.slots.len();
         (s, c)
     }
 }
@@ -819,7 +821,7 @@ pub(crate) fn walk<S: Sink>(
                 };
                 if let Some(e) = e {
                     if field.set(id, e) {
-                        t.elasticity[id as usize] = e;
+                        std::rc::Rc::make_mut(&mut t.elasticity)[id as usize] = e;
                     }
                 }
             }
@@ -882,13 +884,13 @@ pub(crate) fn walk<S: Sink>(
                 global,
             ),
             Cmd::SetCoordinateSystem => {
-                t.frame = Cartesian {
+                t.frame = std::rc::Rc::new(Cartesian {
                     origin: t.pos,
                     x_axis: t.left,
                     y_axis: t.head,
                     z_axis: t.up,
                     scale: arg(0, 1.0),
-                }
+                })
             }
             Cmd::Rhombus | Cmd::Triangle => {
                 // lpfg's shapes in the HL plane, the turtle at the middle
