@@ -711,8 +711,7 @@ impl<'a> Frame<'a> {
     fn raster(&self) -> Vec<u32> {
         let total = *self.line_start.last().unwrap_or(&0) as usize;
         let n = self.sw * self.sh;
-        let mut depth = vec![FAR; n];
-        let mut ids = vec![NO_TRIANGLE; n];
+        let (mut depth, mut ids) = buffers(n);
         // One more pair of buffers per thread, within 2·MAX_SAMPLES in all.
         let threads = rayon::current_num_threads()
             .clamp(1, 8)
@@ -728,8 +727,7 @@ impl<'a> Frame<'a> {
             for (j, (d, i)) in others.iter_mut().enumerate() {
                 let range = (j + 1) * chunk..((j + 2) * chunk).min(total);
                 scope.spawn(move |_| {
-                    *d = vec![FAR; n];
-                    *i = vec![NO_TRIANGLE; n];
+                    (*d, *i) = buffers(n);
                     self.raster_range(range, d, i);
                 });
             }
@@ -754,6 +752,17 @@ impl<'a> Frame<'a> {
             });
         ids
     }
+}
+
+/// A depth and a triangle buffer of `n` samples, nothing drawn, in huge
+/// pages: a line or a tall triangle steps from row to row, a page apart
+/// with small pages.
+fn buffers(n: usize) -> (Vec<f32>, Vec<u32>) {
+    let mut depth = crate::huge::with_capacity(n);
+    depth.resize(n, FAR);
+    let mut ids = crate::huge::with_capacity(n);
+    ids.resize(n, NO_TRIANGLE);
+    (depth, ids)
 }
 
 /// The most samples a picture's depth and triangle buffers hold (8 bytes
@@ -864,12 +873,15 @@ fn raster_line(
     let inv = (t1 - t0) / steps as f32;
     for i in 0..=steps {
         let t = t0 + i as f32 * inv;
-        let (x, y) = ((a.x + dx * t).round(), (a.y + dy * t).round());
-        if x < 0.0 || y < 0.0 || x >= sw as f32 || y >= sh as f32 {
+        // The nearest sample, halves rounded up; clipping keeps the point
+        // within half a sample of the grid, so the sums are not negative
+        // and truncation rounds.
+        let (x, y) = ((a.x + dx * t + 0.5) as usize, (a.y + dy * t + 0.5) as usize);
+        if x >= sw || y >= sh {
             continue;
         }
         let d = a.z + dz * t;
-        let k = y as usize * sw + x as usize;
+        let k = y * sw + x;
         if d >= 0.0 && d < depth[k] {
             depth[k] = d;
             ids[k] = id;
