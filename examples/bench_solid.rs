@@ -10,8 +10,8 @@
 //! holds are printed with them.
 //!
 //! Then the whole path of `subgram render MODEL -o plant.png --size
-//! 1000x1000` on a model folder (`--model DIR`; by default a ternary plant
-//! of 797,161 segments in `line style: cylinder`, written to the system's
+//! 1000x1000` on a model folder (`--model DIR`; by default a binary plant
+//! of 1,048,575 segments in `line style: cylinder`, written to the system's
 //! temporary folder), phase by phase in-process, beside tiny-skia drawing
 //! the same geometry in 2D, triangles filled and thin tubes' lines stroked
 //! as antialiased paths (`--skia-max K` of them, the time scaled to all), and the binary itself as a user runs it
@@ -34,19 +34,18 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-/// A ternary plant of 797,161 tube segments (13 steps), as a model
+/// A binary plant of 1,048,575 tube segments (20 steps), as a model
 /// folder: its L-system and a view file asking for shaded cylinders.
-const PLANT: &str = "// A ternary plant of 797,161 segments.
+const PLANT: &str = "// A binary plant of 1,048,575 segments.
 #include <lpfgall.h>
 module A(float, float);
-derivation length: 13;
-Axiom: SetColor(2) A(1, 0.06);
+derivation length: 20;
+Axiom: SetColor(2) A(1, 0.05);
 production:
 A(l, w) :
 {
-  produce SetWidth(w) F(l) SB() Left(32) A(l*0.62, w*0.6) EB()
-          SB() RollR(120) Left(32) A(l*0.62, w*0.6) EB()
-          SB() RollR(240) Left(32) A(l*0.62, w*0.6) EB();
+  produce SetWidth(w) F(l) RollR(137.5) SB() Left(32) A(l*0.78, w*0.7) EB()
+          Right(18) A(l*0.86, w*0.8);
 }
 ";
 const PLANT_VIEW: &str = "line style: cylinder

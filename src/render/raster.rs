@@ -670,6 +670,13 @@ impl<'a> Frame<'a> {
     /// into a depth and triangle buffer.
     fn raster_range(&self, range: std::ops::Range<usize>, depth: &mut [f32], ids: &mut [u32]) {
         let triangles = *self.tri_start.last().unwrap_or(&0) as usize;
+        // Triangles first, then lines: each sample keeps the first of equal
+        // depths, so the smallest index, as the merge of threads' buffers
+        // does.
+        let tris = range.start..range.end.min(triangles);
+        if !tris.is_empty() {
+            self.raster_triangles(tris, depth, ids);
+        }
         if range.end > triangles {
             let sf = self.s as f32;
             let cam = &self.opts.camera;
@@ -684,10 +691,10 @@ impl<'a> Frame<'a> {
                 raster_line(depth, ids, self.sw, self.sh, a, b, id as u32);
             }
         }
-        let range = range.start..range.end.min(triangles);
-        if range.is_empty() {
-            return;
-        }
+    }
+
+    /// The triangles of `range` (global indices).
+    fn raster_triangles(&self, range: std::ops::Range<usize>, depth: &mut [f32], ids: &mut [u32]) {
         let mut k = self.locate(range.start as u32).0;
         let mut id = range.start;
         while id < range.end {

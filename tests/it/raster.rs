@@ -348,6 +348,67 @@ fn the_picture_does_not_depend_on_the_number_of_threads() {
     assert!(lit > 200 * 200 / 2, "{lit} pixels drawn");
 }
 
+/// Lines in the plane of a quad tie with it in depth at every sample
+/// they share. The quad, numbered first, keeps those samples, on one
+/// thread as on several (where a thread's lines meet another's triangle
+/// only when the buffers are merged, by the smaller depth and index).
+#[test]
+fn lines_tied_with_a_triangle_give_the_same_picture_on_any_number_of_threads() {
+    let green = glowing("green", [0, 255, 0]);
+    let red = glowing("red", [255, 0, 0]);
+    let plane = quad([
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(-1.0, 1.0, 0.0),
+    ]);
+    // 70,000 short lines at z = 0 over the picture: past the size from
+    // which the work is cut into chunks, one per thread.
+    let mut lines = Vec::new();
+    for k in 0..70_000u32 {
+        let x = -1.9 + 3.8 * ((k as u64 * 7919) % 1000) as f32 / 1000.0;
+        let y = -1.9 + 3.8 * ((k as u64 * 104_729) % 997) as f32 / 997.0;
+        lines.push([Vec3::new(x, y, 0.0), Vec3::new(x + 0.05, y + 0.02, 0.0)]);
+    }
+    let sc = scene(vec![
+        (green, plane),
+        (
+            red,
+            TriMesh {
+                lines,
+                ..Default::default()
+            },
+        ),
+    ]);
+    let opts = RasterOptions::new(down_z(Projection::Parallel, 100));
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool")
+            .install(|| render(&sc, &opts).expect("renders"))
+    };
+    let one = on(1);
+    assert_eq!(one, on(2));
+    assert_eq!(one, on(3));
+    // Inside the quad only its green shows; outside it, the red lines.
+    let (inside, outside) = (rgb(&one, 50, 50), rgb(&one, 3, 3));
+    assert_eq!(inside, [0, 255, 0]);
+    let reds = (0..100)
+        .flat_map(|y| (0..20).map(move |x| (x, y)))
+        .filter(|&(x, y)| rgb(&one, x, y)[1] < 255)
+        .count();
+    assert!(
+        reds > 100,
+        "{reds} pixels of red lines outside the quad ({outside:?})"
+    );
+    for y in 30..70 {
+        for x in 30..70 {
+            assert_eq!(rgb(&one, x, y)[0], 0, "red inside the quad at ({x}, {y})");
+        }
+    }
+}
+
 #[test]
 fn svg_paints_triangles_back_to_front() {
     let near = quad([
