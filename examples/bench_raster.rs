@@ -191,52 +191,13 @@ fn main() {
     if only.as_deref() != Some("zbuffer") {
         // The same triangles projected by the same camera, each filled as
         // an antialiased tiny-skia path in its look's colour.
-        let mut tris: Vec<([f32; 6], usize)> = Vec::new();
-        'all: for (k, m) in scene.meshes.iter().enumerate() {
-            for t in &m.triangles {
-                if tris.len() >= skia_max {
-                    break 'all;
-                }
-                let p = t.map(|i| camera.pixel(m.positions[i as usize]).expect("in front"));
-                tris.push(([p[0].x, p[0].y, p[1].x, p[1].y, p[2].x, p[2].y], k));
-            }
-        }
-        let paints: Vec<tiny_skia::Paint> = scene
-            .looks
-            .iter()
-            .map(|l| {
-                let mut p = tiny_skia::Paint::default();
-                let [r, g, b] = l.diffuse.map(|v| (v * 255.0) as u8);
-                p.set_color_rgba8(r, g, b, 255);
-                p.anti_alias = true;
-                p
-            })
-            .collect();
-        let (d, _) = best_of(runs, || {
-            let mut pm = tiny_skia::Pixmap::new(size, size).expect("a pixmap");
-            pm.fill(tiny_skia::Color::WHITE);
-            for (t, k) in &tris {
-                let mut pb = tiny_skia::PathBuilder::new();
-                pb.move_to(t[0], t[1]);
-                pb.line_to(t[2], t[3]);
-                pb.line_to(t[4], t[5]);
-                pb.close();
-                if let Some(path) = pb.finish() {
-                    pm.fill_path(
-                        &path,
-                        &paints[*k],
-                        tiny_skia::FillRule::Winding,
-                        tiny_skia::Transform::identity(),
-                        None,
-                    );
-                }
-            }
-            pm
+        let (d, filled) = best_of(runs, || {
+            common::skia_fill(&scene, &camera, size, skia_max).1
         });
-        let scale = scene.triangle_count() as f64 / tris.len() as f64;
+        let scale = scene.triangle_count() as f64 / filled.max(1) as f64;
         println!(
             "tiny-skia, {} triangles as paths: {:8.1} ms{}",
-            tris.len(),
+            filled,
             ms(d),
             if scale > 1.0 {
                 format!(

@@ -1284,14 +1284,7 @@ pub fn polygons(scene: &Scene3, opts: &RasterOptions) -> Result<Scene, RenderErr
     for (k, m) in scene.meshes.iter().enumerate() {
         for tri in &m.triangles {
             let corners = tri.map(|i| m.positions[i as usize]);
-            let Some(px) = corners
-                .iter()
-                .map(|p| {
-                    cam.pixel(*p)
-                        .filter(|q| (-1e-6..=1.0 + 1e-6).contains(&q.z))
-                })
-                .collect::<Option<Vec<Vec3>>>()
-            else {
+            let Some(px) = in_view(cam, &corners) else {
                 continue;
             };
             let area = (px[1].x - px[0].x) * (px[2].y - px[0].y)
@@ -1325,14 +1318,7 @@ pub fn polygons(scene: &Scene3, opts: &RasterOptions) -> Result<Scene, RenderErr
     }
     for (k, m) in scene.meshes.iter().enumerate() {
         for &line in &m.lines {
-            let Some(px) = line
-                .iter()
-                .map(|p| {
-                    cam.pixel(*p)
-                        .filter(|q| (-1e-6..=1.0 + 1e-6).contains(&q.z))
-                })
-                .collect::<Option<Vec<Vec3>>>()
-            else {
+            let Some(px) = in_view(cam, &line) else {
                 continue;
             };
             let [r, g, b] = line_colour(scene, opts, k, line).map(|v| (v * 255.0).round() as u8);
@@ -1357,6 +1343,18 @@ pub fn polygons(scene: &Scene3, opts: &RasterOptions) -> Result<Scene, RenderErr
         background: opts.background,
         items: faces.into_iter().map(|(_, i)| i).collect(),
     })
+}
+
+/// The pixels of `points`, `None` unless every one is within the depth
+/// range drawn.
+fn in_view(cam: &Camera, points: &[Vec3]) -> Option<Vec<Vec3>> {
+    points
+        .iter()
+        .map(|p| {
+            cam.pixel(*p)
+                .filter(|q| (-1e-6..=1.0 + 1e-6).contains(&q.z))
+        })
+        .collect()
 }
 
 /// Draws `scene` as an SVG document of depth-sorted shaded triangles (see

@@ -322,6 +322,15 @@ fn confetti(n: usize) -> Scene3 {
     }
 }
 
+/// `sc` drawn by a pool of `threads` threads.
+fn on_threads(threads: usize, sc: &Scene3, opts: &RasterOptions) -> raster::Image {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a pool")
+        .install(|| render(sc, opts).expect("renders"))
+}
+
 #[test]
 fn the_picture_does_not_depend_on_the_number_of_threads() {
     // 100,000 triangles: past the size from which triangles are
@@ -329,13 +338,7 @@ fn the_picture_does_not_depend_on_the_number_of_threads() {
     let sc = confetti(100_000);
     let cam = down_z(Projection::Parallel, 200);
     let opts = RasterOptions::new(cam);
-    let on = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a pool")
-            .install(|| render(&sc, &opts).expect("renders"))
-    };
+    let on = |threads: usize| on_threads(threads, &sc, &opts);
     let one = on(1);
     assert_eq!(one, on(2));
     assert_eq!(one, on(5));
@@ -381,13 +384,7 @@ fn lines_tied_with_a_triangle_give_the_same_picture_on_any_number_of_threads() {
         ),
     ]);
     let opts = RasterOptions::new(down_z(Projection::Parallel, 100));
-    let on = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a pool")
-            .install(|| render(&sc, &opts).expect("renders"))
-    };
+    let on = |threads: usize| on_threads(threads, &sc, &opts);
     let one = on(1);
     assert_eq!(one, on(2));
     assert_eq!(one, on(3));
