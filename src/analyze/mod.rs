@@ -47,6 +47,13 @@ pub enum Scheme {
 /// Loads `path` (in double precision, so that the measured weights are the
 /// program's) and analyses it.
 pub fn analyze(path: &Path, defines: &[String]) -> Result<Report, Error> {
+    let all: Vec<usize> = surface::VALENCES.collect();
+    analyze_at(path, defines, &all)
+}
+
+/// [`analyze`], a surface grammar at the valences `valences` only (each
+/// at least 3; curves ignore them).
+pub fn analyze_at(path: &Path, defines: &[String], valences: &[usize]) -> Result<Report, Error> {
     let opts = LoadOptions {
         defines: defines.to_vec(),
         precision: Precision::Double,
@@ -55,7 +62,9 @@ pub fn analyze(path: &Path, defines: &[String]) -> Result<Report, Error> {
     let deadline = Deadline::after(TIMEOUT);
     let scheme = match load(path, &opts)? {
         System::Curve(c) => Scheme::Curve(Box::new(curve::analyze(&c, &name, deadline)?)),
-        System::Surface(s) => Scheme::Surface(surface::analyze(&s.grammar, &name, deadline)?),
+        System::Surface(s) => {
+            Scheme::Surface(surface::analyze_at(&s.grammar, &name, deadline, valences)?)
+        }
         _ => {
             return Err(Error::File {
                 path: name,

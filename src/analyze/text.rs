@@ -174,9 +174,9 @@ pub fn curve(file: &str, r: &CurveReport) -> String {
 fn short(ws: &[LabelWeight], n: usize) -> String {
     // The centre and the first sector's vertices: the stencil's shape.
     ws.iter()
-        .filter(|w| w.sector == 0 || (w.i, w.j) == (0, 0))
+        .filter(|w| w.sector == 0 || (w.i == 0.0 && w.j == 0.0))
         .take(n)
-        .map(|w| format!("({},{}):{}", w.i, w.j, w.fraction))
+        .map(|w| format!("({},{}):{}", fraction(w.i), fraction(w.j), w.fraction))
         .collect::<Vec<_>>()
         .join(" ")
 }
@@ -184,12 +184,21 @@ fn short(ws: &[LabelWeight], n: usize) -> String {
 /// A surface grammar's report.
 pub fn surface(file: &str, r: &SurfaceReport) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "{file}: surface grammar, probed on fans of {}", r.faces);
+    let _ = writeln!(
+        s,
+        "{file}: surface grammar, probed on fans of {}, around {}",
+        r.faces,
+        if r.around == "face" {
+            "an n-sided face"
+        } else {
+            "a vertex of valence n"
+        }
+    );
     if r.valences.iter().any(|v| v.skipped.is_none()) {
         let _ = writeln!(
             s,
-            "\n{:>2} {:>5} {:>5} {:>6} {:>10} {:>10} {:>10} {:>10} {:>5}",
-            "n", "steps", "size", "affine", "λ0", "λ1", "λ2", "|λ3|", "Reif"
+            "\n{:>2} {:>5} {:>5} {:>5} {:>6} {:>10} {:>10} {:>10} {:>10} {:>5}",
+            "n", "steps", "scale", "size", "affine", "λ0", "λ1", "λ2", "|λ3|", "Reif"
         );
         for v in &r.valences {
             if v.skipped.is_some() {
@@ -207,9 +216,10 @@ pub fn surface(file: &str, r: &SurfaceReport) -> String {
             };
             let _ = writeln!(
                 s,
-                "{:>2} {:>5} {:>5} {:>6} {:>10} {:>10} {:>10} {:>10} {:>5}",
+                "{:>2} {:>5} {:>5} {:>5} {:>6} {:>10} {:>10} {:>10} {:>10} {:>5}",
                 v.n,
                 v.steps,
+                v.scale,
                 v.size,
                 yes(v.affine),
                 show(0),
@@ -219,10 +229,34 @@ pub fn surface(file: &str, r: &SurfaceReport) -> String {
                 yes(v.reif)
             );
         }
-        let _ = writeln!(
-            s,
-            "\nlimit stencils (centre (0,0) and the first sector's vertices (i,j)):"
-        );
+        if r.valences.iter().any(|v| v.wider.is_some()) {
+            let _ = writeln!(
+                s,
+                "\none ring more (what the outer ring adds to the spectrum):\n{:>2} {:>5} {:>5} {:>10} {:>10} {:>10} {:>5}",
+                "n", "rings", "size", "λ1", "λ2", "|λ3|", "Reif"
+            );
+            for v in &r.valences {
+                let Some(w) = &v.wider else { continue };
+                let l = |k: usize| w.eigenvalues.get(k);
+                let _ = writeln!(
+                    s,
+                    "{:>2} {:>5} {:>5} {:>10} {:>10} {:>10} {:>5}",
+                    v.n,
+                    w.rings,
+                    w.size,
+                    l(1).map_or("-".into(), |e| format!("{:.6}", e.re)),
+                    l(2).map_or("-".into(), |e| format!("{:.6}", e.re)),
+                    l(3).map_or("-".into(), |e| format!("{:.6}", e.modulus)),
+                    yes(w.reif)
+                );
+            }
+        }
+        let centre = if r.around == "face" {
+            "the central polygon's corner (1/4,1/4) and the first sector's corners (i,j)"
+        } else {
+            "centre (0,0) and the first sector's vertices (i,j)"
+        };
+        let _ = writeln!(s, "\nlimit stencils ({centre}):");
         for v in r.valences.iter().filter(|v| !v.limit.is_empty()) {
             let _ = writeln!(s, "{:>2} {}", v.n, short(&v.limit, 8));
         }
