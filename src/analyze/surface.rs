@@ -659,12 +659,7 @@ type Hood = (DMatrix<f64>, Vec<usize>, usize);
 /// [`MAX_RINGS`] rings, smallest first, with their columns and ring
 /// counts: the old places within r rings, and the new vertices at the
 /// same places over `scale`.
-fn local(
-    m: &Measured,
-    lattice: Lattice,
-    scale: usize,
-    dual: bool,
-) -> Option<Vec<Hood>> {
+fn local(m: &Measured, lattice: Lattice, scale: usize, dual: bool) -> Option<Vec<Hood>> {
     let mut new_at: HashMap<(usize, i64, i64), usize> = HashMap::new();
     for (r, l) in m.rows.iter().enumerate() {
         let Some(l) = l else { continue };

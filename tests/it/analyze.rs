@@ -316,6 +316,10 @@ fn every_scheme_in_lsystems_is_analysed() {
                 // carries the local matrix.
                 Scheme::Surface(s) if !f.ends_with("four-eight-adaptive.lsys") => {
                     assert_eq!(s.valences.len(), 3, "{}", f.display());
+                    let dual = ["doo-sabin.lsys", "peters.lsys"]
+                        .iter()
+                        .any(|d| f.ends_with(d));
+                    assert_eq!(json["around"], if dual { "face" } else { "vertex" });
                     for (k, v) in s.valences.iter().enumerate() {
                         assert!(v.skipped.is_none() && v.affine, "{} {}", f.display(), v.n);
                         assert_eq!(
