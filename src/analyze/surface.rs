@@ -106,6 +106,21 @@ pub struct Valence {
     /// one within [`MAX_RINGS`]: its spectrum holds the smallest's and
     /// what the outer ring adds, and Reif's check on it.
     pub wider: Option<Wider>,
+    /// The characteristic map's control net on the widest invariant
+    /// neighbourhood, when λ1 = λ2 is real.
+    pub characteristic: Option<CharacteristicNet>,
+}
+
+/// The control net of the characteristic map: every place of the
+/// neighbourhood at its weights in two right eigenvectors of λ1 = λ2
+/// (a basis of that eigenspace, turned and scaled so that the points'
+/// second moment is the identity: a linear image of the map, which keeps
+/// its folds and windings), and the old mesh's edges between the places.
+#[derive(Clone, Debug, Serialize)]
+pub struct CharacteristicNet {
+    pub places: Vec<Place>,
+    pub points: Vec<[f64; 2]>,
+    pub edges: Vec<[usize; 2]>,
 }
 
 /// A place `(sector, i, j)` on the fan (see [`LabelWeight`]).
@@ -462,13 +477,35 @@ struct Measured {
     cols: Vec<Label>,
     rows: Vec<Option<Label>>,
     full: DMatrix<f64>,
+    /// The old mesh's edges between columns.
+    edges: Vec<(usize, usize)>,
 }
 
+/// The edges between the old vertices `cols` (mesh or soup indices) that
+/// `joined` lists, as pairs of positions in `cols`, each once.
+fn edges_among(
+    cols: &[usize],
+    joined: impl Iterator<Item = (usize, usize)>,
+) -> Vec<(usize, usize)> {
+    let at: HashMap<usize, usize> = cols.iter().enumerate().map(|(k, &c)| (c, k)).collect();
+    let mut out: Vec<(usize, usize)> = joined
+        .filter_map(|(a, b)| {
+            let (a, b) = (*at.get(&a)?, *at.get(&b)?);
+            Some((a.min(b), a.max(b)))
+        })
+        .collect();
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// A run's error as the text of a skipped valence.
 fn start_error(e: crate::surface::RunError) -> String {
     e.message
 }
 
-/// The heights of `ids` after `steps` steps of `g` on `soup`.
+/// The positions of the vertices after `steps` steps of `g` on `soup`,
+/// in id order.
 fn run_primal(
     g: &Grammar,
     soup: &PolygonSoup,
@@ -532,6 +569,13 @@ fn measure_primal(
     for (k, out) in outs.iter().enumerate() {
         fill_column(&mut s, k, &base, out)?;
     }
+    let faces = f.soup.faces.to_vecs();
+    let edges = edges_among(
+        &cols,
+        faces.iter().flat_map(|face| {
+            (0..face.len()).map(|a| (face[a] as usize, face[(a + 1) % face.len()] as usize))
+        }),
+    );
     Ok(Measured {
         cols: cols
             .iter()
@@ -539,6 +583,7 @@ fn measure_primal(
             .collect(),
         rows,
         full: s,
+        edges,
     })
 }
 
@@ -569,7 +614,7 @@ fn measure_dual(g: &Grammar, f: &Fan, deadline: Deadline) -> Result<Measured, St
     let mut names: Vec<Option<Label>> = f.labels.clone();
     // The corners after one step, and after two, with their names.
     let mut m = Mesh::from_soup(&f.soup).map_err(|e| e.to_string())?;
-    let (old, new, base, vertex_count) = {
+    let (old, new, base, vertex_count, edges) = {
         let mut run = g.start(&mut m).map_err(start_error)?;
         run.set_deadline(Some(deadline));
         name_generation(run.mesh(), fan_vertices, f.lattice, &mut names, 1);
@@ -582,6 +627,14 @@ fn measure_dual(g: &Grammar, f: &Fan, deadline: Deadline) -> Result<Measured, St
             .filter_map(|v| Some((v, names.get(v.index()).copied().flatten()?)))
             .filter(|&(_, l)| f.lattice.ring(l, true) <= MAX_RINGS + 1)
             .collect();
+        let ids: Vec<usize> = old.iter().map(|(v, _)| v.index()).collect();
+        let edges = edges_among(
+            &ids,
+            m1.edges().map(|e| {
+                let (a, b) = m1.edge_vertices(e);
+                (a.index(), b.index())
+            }),
+        );
         run.steps(1, |_| {}).map_err(start_error)?;
         name_generation(run.mesh(), fan_vertices, f.lattice, &mut names, 3);
         let m2 = run.mesh();
@@ -590,7 +643,7 @@ fn measure_dual(g: &Grammar, f: &Fan, deadline: Deadline) -> Result<Measured, St
             .filter(|&v| generation(m2, fan_vertices, v) == 3 && !m2.is_block_centre(v))
             .collect();
         let base: Vec<DVec3> = new.iter().map(|&v| m2.position(v)).collect();
-        (old, new, base, m2.vertex_count())
+        (old, new, base, m2.vertex_count(), edges)
     };
     if base.iter().any(|p| p.z.abs() > TOL) {
         return Err("a flat mesh does not stay flat: not linear".into());
@@ -610,6 +663,7 @@ fn measure_dual(g: &Grammar, f: &Fan, deadline: Deadline) -> Result<Measured, St
             .map(|v| names.get(v.index()).copied().flatten())
             .collect(),
         full: s,
+        edges,
     })
 }
 
@@ -734,6 +788,60 @@ fn reif(eig: &[Eigenvalue]) -> bool {
         && l3 < l1.re - 1e-7
 }
 
+/// The characteristic net of the local matrix `s` on the columns `set`
+/// of `m` (see [`CharacteristicNet`]), when its λ1 = λ2 is real.
+fn characteristic(s: &DMatrix<f64>, set: &[usize], m: &Measured) -> Option<CharacteristicNet> {
+    let eig = spectrum(s)?;
+    let (l1, l2) = (eig.get(1)?, eig.get(2)?);
+    if !(close(l1.im, 0.0) && close(l2.im, 0.0) && close(l1.re, l2.re)) {
+        return None;
+    }
+    let n = s.nrows();
+    let svd = (s - DMatrix::identity(n, n) * l1.re).svd(false, true);
+    let v_t = svd.v_t?;
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&x, &y| svd.singular_values[x].total_cmp(&svd.singular_values[y]));
+    let (a, b) = (v_t.row(order[0]), v_t.row(order[1]));
+    // Round: the inverse square root of the points' second moment.
+    let mut moment = nalgebra::Matrix2::<f64>::zeros();
+    for k in 0..n {
+        let p = nalgebra::Vector2::new(a[k], b[k]);
+        moment += p * p.transpose();
+    }
+    let e = moment.symmetric_eigen();
+    if e.eigenvalues.min() <= 1e-12 {
+        return None;
+    }
+    let inv = e.eigenvectors
+        * nalgebra::Matrix2::from_diagonal(&e.eigenvalues.map(|x| 1.0 / x.sqrt()))
+        * e.eigenvectors.transpose();
+    let points = (0..n)
+        .map(|k| {
+            let p = inv * nalgebra::Vector2::new(a[k], b[k]);
+            [p.x, p.y]
+        })
+        .collect();
+    let at: HashMap<usize, usize> = set.iter().enumerate().map(|(k, &c)| (c, k)).collect();
+    let edges = m
+        .edges
+        .iter()
+        .filter_map(|&(a, b)| Some([*at.get(&a)?, *at.get(&b)?]))
+        .collect();
+    let places = set
+        .iter()
+        .map(|&c| Place {
+            sector: m.cols[c].t,
+            i: m.cols[c].x,
+            j: m.cols[c].y,
+        })
+        .collect();
+    Some(CharacteristicNet {
+        places,
+        points,
+        edges,
+    })
+}
+
 /// The left null vectors of `s - λ I` (as many as `count`), from the SVD.
 fn left_null(s: &DMatrix<f64>, lambda: f64, count: usize) -> Vec<Vec<f64>> {
     let n = s.nrows();
@@ -791,6 +899,7 @@ fn valence(
         places: Vec::new(),
         matrix: Vec::new(),
         wider: None,
+        characteristic: None,
     };
     let mut why = String::new();
     let mut found = None;
@@ -840,6 +949,10 @@ fn valence(
     };
     let wider = (hoods.len() > 1).then(|| hoods.remove(1));
     let (s, set, rings) = hoods.swap_remove(0);
+    v.characteristic = match &wider {
+        Some((w, wset, _)) => characteristic(w, wset, &measured),
+        None => characteristic(&s, &set, &measured),
+    };
     let cols = &measured.cols;
     v.steps = steps;
     v.scale = scale;

@@ -285,3 +285,74 @@ pub fn surface(file: &str, r: &SurfaceReport) -> String {
     }
     s
 }
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The characteristic maps' control nets as an SVG picture, one panel per
+/// valence that has one (`None` when none has).
+pub fn characteristic_svg(file: &str, r: &SurfaceReport) -> Option<String> {
+    let nets: Vec<_> = r
+        .valences
+        .iter()
+        .filter_map(|v| Some((v, v.characteristic.as_ref()?)))
+        .filter(|(_, c)| !c.points.is_empty())
+        .collect();
+    if nets.is_empty() {
+        return None;
+    }
+    let (cell, cols) = (220.0, 5usize);
+    let rows = nets.len().div_ceil(cols);
+    let (w, h) = (
+        cell * cols.min(nets.len()) as f64,
+        30.0 + cell * rows as f64,
+    );
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">"
+    );
+    let _ = writeln!(s, "<rect width=\"{w}\" height=\"{h}\" fill=\"white\"/>");
+    let _ = writeln!(
+        s,
+        "<text x=\"8\" y=\"20\" font-family=\"sans-serif\" font-size=\"13\">{}: control nets of the characteristic maps (eigenvectors of λ1 = λ2)</text>",
+        xml_escape(file)
+    );
+    for (k, (v, c)) in nets.iter().enumerate() {
+        let (x0, y0) = (cell * (k % cols) as f64, 30.0 + cell * (k / cols) as f64);
+        let reach = c
+            .points
+            .iter()
+            .map(|p| p[0].abs().max(p[1].abs()))
+            .fold(0.0, f64::max)
+            .max(1e-12);
+        let scale = (cell / 2.0 - 22.0) / reach;
+        let (cx, cy) = (x0 + cell / 2.0, y0 + cell / 2.0 + 6.0);
+        let at = |p: [f64; 2]| (cx + scale * p[0], cy - scale * p[1]);
+        let _ = writeln!(s, "<g stroke=\"#1f4e9c\" stroke-width=\"1\">");
+        for e in &c.edges {
+            let (a, b) = (at(c.points[e[0]]), at(c.points[e[1]]));
+            let _ = writeln!(
+                s,
+                "<line x1=\"{:.2}\" y1=\"{:.2}\" x2=\"{:.2}\" y2=\"{:.2}\"/>",
+                a.0, a.1, b.0, b.1
+            );
+        }
+        let _ = writeln!(s, "</g>");
+        let l1 = v.eigenvalues.get(1).map_or(0.0, |e| e.re);
+        let _ = writeln!(
+            s,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-family=\"sans-serif\" font-size=\"12\">n = {}, λ1 = {:.4}</text>",
+            x0 + 8.0,
+            y0 + 14.0,
+            v.n,
+            l1
+        );
+    }
+    s.push_str("</svg>\n");
+    Some(s)
+}

@@ -706,3 +706,55 @@ fn adaptive_grammar_is_not_a_linear_scheme() {
     let r = analyze(&lsys("surfaces/four-eight-adaptive.lsys"), &[]).unwrap();
     assert!(r.text().contains("not one linear map"));
 }
+
+/// The characteristic map's net: λ1's eigenspace is the first rotational
+/// Fourier mode, so (in any basis, made round) the centre of Loop's fan
+/// is at the origin and its first ring, like the corners of Doo-Sabin's
+/// central n-gon, is a regular n-gon turning once around it, 2π/n a
+/// corner, all the same way.
+#[test]
+fn characteristic_nets_turn_once_around_the_centre() {
+    for (file, inner) in [
+        ("surfaces/loop.lsys", (1.0, 0.0)),
+        ("surfaces/doo-sabin.lsys", (0.25, 0.25)),
+    ] {
+        let s = surface_at(file, &[3, 5, 7]);
+        for v in &s.valences {
+            let n = v.n;
+            let c = v.characteristic.as_ref().expect("a characteristic net");
+            assert_eq!(c.places.len(), c.points.len());
+            assert!(!c.edges.is_empty());
+            let mut ring: Vec<(usize, [f64; 2])> = Vec::new();
+            for (p, q) in c.places.iter().zip(&c.points) {
+                if (p.i, p.j) == (0.0, 0.0) {
+                    assert!(
+                        q[0].abs() < 1e-9 && q[1].abs() < 1e-9,
+                        "{file} {n}: centre {q:?}"
+                    );
+                } else if (p.i, p.j) == inner {
+                    ring.push((p.sector, *q));
+                }
+            }
+            ring.sort_by_key(|r| r.0);
+            assert_eq!(ring.len(), n, "{file} {n}");
+            let r0 = (ring[0].1[0].powi(2) + ring[0].1[1].powi(2)).sqrt();
+            let mut turns = Vec::new();
+            for t in 0..n {
+                let (a, b) = (ring[t].1, ring[(t + 1) % n].1);
+                let r = (a[0].powi(2) + a[1].powi(2)).sqrt();
+                assert!(
+                    (r - r0).abs() < 1e-9 * r0.max(1.0),
+                    "{file} {n}: radius {r} and {r0}"
+                );
+                let turn = (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]);
+                turns.push(turn);
+            }
+            let step = TAU / n as f64;
+            assert!(
+                turns.iter().all(|t| (t - step).abs() < 1e-9)
+                    || turns.iter().all(|t| (t + step).abs() < 1e-9),
+                "{file} {n}: {turns:?}"
+            );
+        }
+    }
+}
