@@ -1747,12 +1747,31 @@ pub struct AnalyzeArgs {
     /// `--format json` instead of text.
     pub json: bool,
     pub defines: Vec<String>,
+    /// `--picture OUT.svg`: the characteristic maps' control nets.
+    pub picture: Option<String>,
 }
 
 /// `subgram analyze FILE [--format json] [-D NAME=VALUE]…`: what the
 /// subdivision scheme in FILE is (see [`crate::analyze`]), as text or JSON.
 pub fn analyze(a: &AnalyzeArgs) -> Result<String, Error> {
+    if let Some(out) = &a.picture {
+        let out = Path::new(out);
+        refuse_overwrite(&[out], &[Path::new(&a.file)], false)?;
+        if !out
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("svg"))
+        {
+            return Err(Error::Usage(format!(
+                "--picture writes SVG: name the file `….svg`, not `{}`",
+                out.display()
+            )));
+        }
+    }
     let r = crate::analyze::analyze(Path::new(&a.file), &a.defines)?;
+    if let Some(out) = &a.picture {
+        let svg = r.characteristic_svg().map_err(Error::Usage)?;
+        write_file(Path::new(out), svg.as_bytes())?;
+    }
     let mut s = if a.json { r.json() } else { r.text() };
     while s.ends_with('\n') {
         s.pop();

@@ -268,6 +268,10 @@ enum Command {
         format: Format,
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
+        /// Also draw the control nets of the characteristic maps (surface
+        /// grammars) into this SVG file.
+        #[arg(long, value_name = "OUT.svg")]
+        picture: Option<String>,
     },
 }
 
@@ -509,10 +513,12 @@ fn run(cli: Cli) -> Result<(), Error> {
             file,
             format,
             define,
+            picture,
         } => print_out(&command::analyze(&command::AnalyzeArgs {
             file,
             json: matches!(format, Format::Json),
             defines: define,
+            picture,
         })?),
         Command::Derive {
             file,

@@ -7,8 +7,10 @@
 //! Curves ([`curve`]): stencils, affine invariance, support, the mask and
 //! its (1+z) factors, polynomial reproduction and generation, Rioul's
 //! Hölder estimate. Surfaces ([`surface`]): the local subdivision matrix
-//! around a vertex of each valence, its leading eigenvalues, Reif's check
-//! and the limit and tangent stencils.
+//! around a vertex of each valence (around an n-sided face for dual
+//! schemes), its leading eigenvalues, Reif's check and the limit and
+//! tangent stencils. A dual scheme's centres of blocks, which its rules
+//! may read, are put at their polygons' centroids with each impulse.
 
 pub mod curve;
 mod num;
@@ -47,6 +49,13 @@ pub enum Scheme {
 /// Loads `path` (in double precision, so that the measured weights are the
 /// program's) and analyses it.
 pub fn analyze(path: &Path, defines: &[String]) -> Result<Report, Error> {
+    let all: Vec<usize> = surface::VALENCES.collect();
+    analyze_at(path, defines, &all)
+}
+
+/// [`analyze`], a surface grammar at the valences `valences` only (each
+/// at least 3; curves ignore them).
+pub fn analyze_at(path: &Path, defines: &[String], valences: &[usize]) -> Result<Report, Error> {
     let opts = LoadOptions {
         defines: defines.to_vec(),
         precision: Precision::Double,
@@ -55,7 +64,9 @@ pub fn analyze(path: &Path, defines: &[String]) -> Result<Report, Error> {
     let deadline = Deadline::after(TIMEOUT);
     let scheme = match load(path, &opts)? {
         System::Curve(c) => Scheme::Curve(Box::new(curve::analyze(&c, &name, deadline)?)),
-        System::Surface(s) => Scheme::Surface(surface::analyze(&s.grammar, &name, deadline)?),
+        System::Surface(s) => {
+            Scheme::Surface(surface::analyze_at(&s.grammar, &name, deadline, valences)?)
+        }
         _ => {
             return Err(Error::File {
                 path: name,
@@ -75,6 +86,25 @@ impl Report {
         match &self.scheme {
             Scheme::Curve(c) => text::curve(&self.file, c),
             Scheme::Surface(s) => text::surface(&self.file, s),
+        }
+    }
+
+    /// The control nets of a surface grammar's characteristic maps as an
+    /// SVG picture; an error for a curve scheme or where no valence has
+    /// one.
+    pub fn characteristic_svg(&self) -> Result<String, String> {
+        match &self.scheme {
+            Scheme::Curve(_) => Err(format!(
+                "{}: a curve scheme; --picture draws the characteristic maps of surface \
+                 grammars",
+                self.file
+            )),
+            Scheme::Surface(s) => text::characteristic_svg(&self.file, s).ok_or_else(|| {
+                format!(
+                    "{}: no valence has a characteristic map to draw (λ1 = λ2 real)",
+                    self.file
+                )
+            }),
         }
     }
 

@@ -174,9 +174,9 @@ pub fn curve(file: &str, r: &CurveReport) -> String {
 fn short(ws: &[LabelWeight], n: usize) -> String {
     // The centre and the first sector's vertices: the stencil's shape.
     ws.iter()
-        .filter(|w| w.sector == 0 || (w.i, w.j) == (0, 0))
+        .filter(|w| w.sector == 0 || (w.i == 0.0 && w.j == 0.0))
         .take(n)
-        .map(|w| format!("({},{}):{}", w.i, w.j, w.fraction))
+        .map(|w| format!("({},{}):{}", fraction(w.i), fraction(w.j), w.fraction))
         .collect::<Vec<_>>()
         .join(" ")
 }
@@ -184,12 +184,21 @@ fn short(ws: &[LabelWeight], n: usize) -> String {
 /// A surface grammar's report.
 pub fn surface(file: &str, r: &SurfaceReport) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "{file}: surface grammar, probed on fans of {}", r.faces);
+    let _ = writeln!(
+        s,
+        "{file}: surface grammar, probed on fans of {}, around {}",
+        r.faces,
+        if r.around == "face" {
+            "an n-sided face"
+        } else {
+            "a vertex of valence n"
+        }
+    );
     if r.valences.iter().any(|v| v.skipped.is_none()) {
         let _ = writeln!(
             s,
-            "\n{:>2} {:>5} {:>5} {:>6} {:>10} {:>10} {:>10} {:>10} {:>5}",
-            "n", "steps", "size", "affine", "λ0", "λ1", "λ2", "|λ3|", "Reif"
+            "\n{:>2} {:>5} {:>5} {:>5} {:>6} {:>10} {:>10} {:>10} {:>10} {:>5}",
+            "n", "steps", "scale", "size", "affine", "λ0", "λ1", "λ2", "|λ3|", "Reif"
         );
         for v in &r.valences {
             if v.skipped.is_some() {
@@ -207,9 +216,10 @@ pub fn surface(file: &str, r: &SurfaceReport) -> String {
             };
             let _ = writeln!(
                 s,
-                "{:>2} {:>5} {:>5} {:>6} {:>10} {:>10} {:>10} {:>10} {:>5}",
+                "{:>2} {:>5} {:>5} {:>5} {:>6} {:>10} {:>10} {:>10} {:>10} {:>5}",
                 v.n,
                 v.steps,
+                v.scale,
                 v.size,
                 yes(v.affine),
                 show(0),
@@ -219,10 +229,34 @@ pub fn surface(file: &str, r: &SurfaceReport) -> String {
                 yes(v.reif)
             );
         }
-        let _ = writeln!(
-            s,
-            "\nlimit stencils (centre (0,0) and the first sector's vertices (i,j)):"
-        );
+        if r.valences.iter().any(|v| v.wider.is_some()) {
+            let _ = writeln!(
+                s,
+                "\none ring more (what the outer ring adds to the spectrum):\n{:>2} {:>5} {:>5} {:>10} {:>10} {:>10} {:>5}",
+                "n", "rings", "size", "λ1", "λ2", "|λ3|", "Reif"
+            );
+            for v in &r.valences {
+                let Some(w) = &v.wider else { continue };
+                let l = |k: usize| w.eigenvalues.get(k);
+                let _ = writeln!(
+                    s,
+                    "{:>2} {:>5} {:>5} {:>10} {:>10} {:>10} {:>5}",
+                    v.n,
+                    w.rings,
+                    w.size,
+                    l(1).map_or("-".into(), |e| format!("{:.6}", e.re)),
+                    l(2).map_or("-".into(), |e| format!("{:.6}", e.re)),
+                    l(3).map_or("-".into(), |e| format!("{:.6}", e.modulus)),
+                    yes(w.reif)
+                );
+            }
+        }
+        let centre = if r.around == "face" {
+            "the central polygon's corner (1/4,1/4) and the first sector's corners (i,j)"
+        } else {
+            "centre (0,0) and the first sector's vertices (i,j)"
+        };
+        let _ = writeln!(s, "\nlimit stencils ({centre}):");
         for v in r.valences.iter().filter(|v| !v.limit.is_empty()) {
             let _ = writeln!(s, "{:>2} {}", v.n, short(&v.limit, 8));
         }
@@ -250,4 +284,75 @@ pub fn surface(file: &str, r: &SurfaceReport) -> String {
         let _ = writeln!(s, "note: {n}");
     }
     s
+}
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The characteristic maps' control nets as an SVG picture, one panel per
+/// valence that has one (`None` when none has).
+pub fn characteristic_svg(file: &str, r: &SurfaceReport) -> Option<String> {
+    let nets: Vec<_> = r
+        .valences
+        .iter()
+        .filter_map(|v| Some((v, v.characteristic.as_ref()?)))
+        .filter(|(_, c)| !c.points.is_empty())
+        .collect();
+    if nets.is_empty() {
+        return None;
+    }
+    let (cell, cols) = (220.0, 5usize);
+    let rows = nets.len().div_ceil(cols);
+    let (w, h) = (
+        cell * cols.min(nets.len()) as f64,
+        30.0 + cell * rows as f64,
+    );
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">"
+    );
+    let _ = writeln!(s, "<rect width=\"{w}\" height=\"{h}\" fill=\"white\"/>");
+    let _ = writeln!(
+        s,
+        "<text x=\"8\" y=\"20\" font-family=\"sans-serif\" font-size=\"13\">{}: control nets of the characteristic maps (eigenvectors of λ1 = λ2)</text>",
+        xml_escape(file)
+    );
+    for (k, (v, c)) in nets.iter().enumerate() {
+        let (x0, y0) = (cell * (k % cols) as f64, 30.0 + cell * (k / cols) as f64);
+        let reach = c
+            .points
+            .iter()
+            .map(|p| p[0].abs().max(p[1].abs()))
+            .fold(0.0, f64::max)
+            .max(1e-12);
+        let scale = (cell / 2.0 - 22.0) / reach;
+        let (cx, cy) = (x0 + cell / 2.0, y0 + cell / 2.0 + 6.0);
+        let at = |p: [f64; 2]| (cx + scale * p[0], cy - scale * p[1]);
+        let _ = writeln!(s, "<g stroke=\"#1f4e9c\" stroke-width=\"1\">");
+        for e in &c.edges {
+            let (a, b) = (at(c.points[e[0]]), at(c.points[e[1]]));
+            let _ = writeln!(
+                s,
+                "<line x1=\"{:.2}\" y1=\"{:.2}\" x2=\"{:.2}\" y2=\"{:.2}\"/>",
+                a.0, a.1, b.0, b.1
+            );
+        }
+        let _ = writeln!(s, "</g>");
+        let l1 = v.eigenvalues.get(1).map_or(0.0, |e| e.re);
+        let _ = writeln!(
+            s,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-family=\"sans-serif\" font-size=\"12\">n = {}, λ1 = {:.4}</text>",
+            x0 + 8.0,
+            y0 + 14.0,
+            v.n,
+            l1
+        );
+    }
+    s.push_str("</svg>\n");
+    Some(s)
 }

@@ -1426,6 +1426,12 @@ impl GrammarRun<'_> {
         self.mesh
     }
 
+    /// Moves vertex `v` between steps (the next step reads `p`): how
+    /// `subgram analyze` puts an impulse on a mesh the run has made.
+    pub fn set_position(&mut self, v: VertexId, p: DVec3) {
+        self.mesh.set_position(v, p);
+    }
+
     /// Stops the run with an error once `deadline` passes: it is looked
     /// at before every rule.
     pub fn set_deadline(&mut self, deadline: Option<crate::Deadline>) {

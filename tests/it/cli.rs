@@ -587,3 +587,45 @@ fn render_each_sizes_the_canvas_to_its_panels() {
     let pm = tiny_skia::Pixmap::decode_png(&std::fs::read(&out).unwrap()).unwrap();
     assert_eq!((pm.width(), pm.height()), (800, 800));
 }
+
+/// `analyze --picture OUT.svg` draws one panel per valence of a surface
+/// grammar; a curve scheme, or an output that is the input, is a usage
+/// error (exit code 2) that writes nothing.
+#[test]
+fn analyze_draws_the_characteristic_maps() {
+    let dir = std::env::temp_dir().join(format!("subgram-cli-picture-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("loop.svg");
+    let f = lsys("surfaces/loop.lsys");
+    let o = subgram(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--picture",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(svg.starts_with("<svg"));
+    assert_eq!(svg.matches("n = ").count(), 10, "a panel per valence 3..12");
+    assert!(svg.matches("<line").count() > 10);
+    let curve = dir.join("curve.svg");
+    let c = lsys("curves/cubic-22.lsys");
+    let o = subgram(&[
+        "analyze",
+        c.to_str().unwrap(),
+        "--picture",
+        curve.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("surface grammars") && !curve.exists());
+    let before = std::fs::read(&f).unwrap();
+    let o = subgram(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--picture",
+        f.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&f).unwrap(), before);
+    let _ = std::fs::remove_dir_all(&dir);
+}

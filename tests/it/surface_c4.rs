@@ -20,7 +20,7 @@ fn grammar(file: &str) -> subgram::surface::Grammar {
 /// `k` sectors of `m` × `m` quads around one vertex of `k` quads: the
 /// vertex (sector t, i, j) sits at i u_t + j u_(t+1), u_t the unit vector
 /// at angle 2 pi t / k. (t, 0, j) is (t + 1, j, 0).
-struct Fan {
+pub(crate) struct Fan {
     k: usize,
     soup: PolygonSoup,
     ids: HashMap<(usize, usize, usize), u32>,
@@ -38,7 +38,7 @@ fn canonical(k: usize, t: usize, i: usize, j: usize) -> (usize, usize, usize) {
     }
 }
 
-fn fan(k: usize, m: usize) -> Fan {
+pub(crate) fn fan(k: usize, m: usize) -> Fan {
     let u = |t: usize| {
         let a = TAU * t as f64 / k as f64;
         DVec2::new(a.cos(), a.sin())
@@ -81,7 +81,7 @@ fn fan(k: usize, m: usize) -> Fan {
 
 /// The labels (t, i, j) of the vertices within `r` rings of the centre,
 /// each once, in a fixed order.
-fn labels(k: usize, r: usize) -> Vec<(usize, usize, usize)> {
+pub(crate) fn labels(k: usize, r: usize) -> Vec<(usize, usize, usize)> {
     let mut out = vec![(0, 0, 0)];
     for t in 0..k {
         for i in 0..=r {
@@ -164,7 +164,7 @@ fn grammar_matrix(f: &Fan, r: usize) -> DMatrix<f64> {
 /// puts an edge point at the average of the edge's ends and face points
 /// and moves each face point to 1/2 f + 1/2 the average of its corners,
 /// each old vertex to 1/2 v + 1/2 the average of its face points.
-fn mask_matrix(f: &Fan, r: usize) -> DMatrix<f64> {
+pub(crate) fn mask_matrix(f: &Fan, r: usize) -> DMatrix<f64> {
     let n = f.layout.len();
     let mut nbrs: Vec<Vec<usize>> = vec![Vec::new(); n];
     let mut quads_at: Vec<Vec<usize>> = vec![Vec::new(); n];
@@ -252,7 +252,7 @@ fn mask_matrix(f: &Fan, r: usize) -> DMatrix<f64> {
 /// twelve vectors, then the eigenvalues of the 12 × 12 projection. (The
 /// QR algorithm on the whole matrix stalls: most of its eigenvalues are
 /// zero, in Jordan blocks, for inner rings do not reach the outer ones.)
-fn spectrum(s: &DMatrix<f64>) -> Vec<nalgebra::Complex<f64>> {
+pub(crate) fn spectrum(s: &DMatrix<f64>) -> Vec<nalgebra::Complex<f64>> {
     let (n, p) = (s.nrows(), 12.min(s.nrows()));
     let mut seed = 0x2545_F491_4F6C_DD1Du64;
     let mut x = DMatrix::from_fn(n, p, |_, _| {
