@@ -1756,7 +1756,13 @@ pub struct AnalyzeArgs {
 pub fn analyze(a: &AnalyzeArgs) -> Result<String, Error> {
     if let Some(out) = &a.picture {
         let out = Path::new(out);
-        refuse_overwrite(&[out], &[Path::new(&a.file)], false)?;
+        // analyze has no --force: its one input is never replaced.
+        if same_file(out, Path::new(&a.file)) {
+            return Err(Error::Usage(format!(
+                "the output `{}` is the input: writing it would replace it; name another output",
+                out.display()
+            )));
+        }
         if !out
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("svg"))

@@ -52,15 +52,27 @@ impl Look {
 ///
 /// `lines` are for pictures only: tubes thinner than a pixel, which the
 /// geometry of a picture keeps as their axes (see
-/// [`crate::draw::solid::SolidOptions::picture_pixel`]). The z-buffer draws
-/// each one sample wide, lit as the side of a cylinder that faces the
-/// viewer; the exporters refuse a scene that has any.
+/// [`crate::draw::solid::SolidOptions::picture_pixel`] and [`Line`]); the
+/// exporters refuse a scene that has any.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriMesh {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
     pub triangles: Vec<[u32; 3]>,
-    pub lines: Vec<[Vec3; 2]>,
+    pub lines: Vec<Line>,
+}
+
+/// A tube thinner than a pixel, kept as its axis from `a` to `b` with its
+/// diameter `width`. The z-buffer draws it on its samples along the axis,
+/// one sample wide, each with the chance that the tube covers it (its
+/// width in samples, at most one), so that the ink of many thin twigs is
+/// what their tubes would cover; it is lit as the side of the tube that
+/// faces the viewer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Line {
+    pub a: Vec3,
+    pub b: Vec3,
+    pub width: f32,
 }
 
 impl TriMesh {
@@ -74,7 +86,7 @@ impl TriMesh {
 
     /// Its vertices' positions, then its lines' ends.
     pub fn points(&self) -> impl Iterator<Item = Vec3> + '_ {
-        (self.positions.iter().copied()).chain(self.lines.iter().flatten().copied())
+        (self.positions.iter().copied()).chain(self.lines.iter().flat_map(|l| [l.a, l.b]))
     }
 }
 

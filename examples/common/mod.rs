@@ -93,7 +93,7 @@ pub fn skia_fill(
                 break;
             }
             filled += 1;
-            if let (Some(a), Some(b)) = (camera.pixel(l[0]), camera.pixel(l[1])) {
+            if let (Some(a), Some(b)) = (camera.pixel(l.a), camera.pixel(l.b)) {
                 pb.move_to(a.x, a.y);
                 pb.line_to(b.x, b.y);
             }

@@ -65,7 +65,7 @@ use crate::lang::Alphabet;
 use crate::model::view::{LineStyle, DEFAULT_CONTOUR_SIDES, MAX_CONTOUR_SIDES, MIN_CONTOUR_SIDES};
 use crate::model::{Colours, Contour, Model};
 use crate::rewrite::Word;
-use crate::scene3::{Look, Scene3, TriMesh};
+use crate::scene3::{Line, Look, Scene3, TriMesh};
 
 /// The default limit on the triangles of one scene: 40 million (about a
 /// gigabyte with their vertices).
@@ -624,7 +624,7 @@ impl<'m> Builder<'m> {
             // The circumference in pixels over 1.5 pixels a side.
             let across = scale.0.abs().max(scale.1.abs()) / px;
             if across < THIN {
-                return self.thin(t, a, b);
+                return self.thin(t, a, b, scale.0.abs().max(scale.1.abs()));
             }
             let need = (std::f64::consts::PI * across / 1.5).ceil();
             if need.is_finite() && need < sides as f64 {
@@ -684,7 +684,7 @@ impl<'m> Builder<'m> {
 
     /// A tube thinner than a pixel in a picture: its axis, as a line of
     /// the mesh (see [`TriMesh::lines`]). A tube it follows ends here.
-    fn thin(&mut self, t: &Turtle, a: DVec3, b: DVec3) -> Result<(), String> {
+    fn thin(&mut self, t: &Turtle, a: DVec3, b: DVec3, width: f64) -> Result<(), String> {
         self.end_tube()?;
         if !fits(a, 0.0) || !fits(b, 0.0) {
             return Err("makes a cylinder that reaches an infinite coordinate".into());
@@ -698,9 +698,11 @@ impl<'m> Builder<'m> {
         }
         self.triangles += 1;
         let mesh = self.mesh(t.pen.color);
-        self.scene.meshes[mesh as usize]
-            .lines
-            .push([a.as_vec3(), b.as_vec3()]);
+        self.scene.meshes[mesh as usize].lines.push(Line {
+            a: a.as_vec3(),
+            b: b.as_vec3(),
+            width: width as f32,
+        });
         Ok(())
     }
 

@@ -26,7 +26,7 @@ use glam::{DVec2, Vec3};
 use rayon::prelude::*;
 
 use super::{check_size, Item, Outline, RenderError, Rgba, Scene};
-use crate::scene3::{Look, Scene3};
+use crate::scene3::{Line, Look, Scene3};
 
 /// How the picture is projected.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -528,10 +528,10 @@ pub fn validate(scene: &Scene3) -> Result<(), RenderError> {
         if let Some(l) = m
             .lines
             .iter()
-            .position(|l| !(l[0].is_finite() && l[1].is_finite()))
+            .position(|l| !(l.a.is_finite() && l.b.is_finite() && l.width.is_finite()))
         {
             return Err(RenderError::new(format!(
-                "line {l} of mesh {k} (`{name}`) has a non-finite end"
+                "line {l} of mesh {k} (`{name}`) has a non-finite end or width"
             )));
         }
         if let Some(v) = m.normals.iter().position(|n| !n.is_finite()) {
@@ -686,9 +686,12 @@ impl<'a> Frame<'a> {
                 while self.line_start[k + 1] as usize <= id {
                     k += 1;
                 }
-                let [a, b] = self.scene.meshes[k].lines[id - self.line_start[k] as usize];
-                let (a, b) = (project(cam, sf, a), project(cam, sf, b));
-                raster_line(depth, ids, self.sw, self.sh, a, b, id as u32);
+                let l = self.scene.meshes[k].lines[id - self.line_start[k] as usize];
+                let (a, b) = (project(cam, sf, l.a), project(cam, sf, l.b));
+                // The width in samples where the line starts.
+                let side = project(cam, sf, l.a + cam.up * l.width);
+                let width = (side.x - a.x).hypot(side.y - a.y);
+                raster_line(depth, ids, self.sw, self.sh, [a, b], width, id as u32);
             }
         }
     }
@@ -833,7 +836,9 @@ fn project(cam: &Camera, sf: f32, p: Vec3) -> Screen {
 
 /// One line into the key buffer, one sample wide: the samples nearest to
 /// evenly spaced points of it, one per sample step along its longer axis,
-/// both ends included, with the depth interpolated as a triangle's is. A
+/// both ends included, with the depth interpolated as a triangle's is;
+/// for a tube `width` samples across, under one, each sample with the
+/// chance that the tube covers it. A
 /// NaN end (not in view) drops it; it is clipped to the grid first, so the
 /// steps are at most the grid's width and height.
 fn raster_line(
@@ -841,11 +846,14 @@ fn raster_line(
     ids: &mut [u32],
     sw: usize,
     sh: usize,
-    a: Screen,
-    b: Screen,
+    [a, b]: [Screen; 2],
+    width: f32,
     id: u32,
 ) {
-    if [a.x, a.y, a.z, b.x, b.y, b.z].iter().any(|v| v.is_nan()) {
+    if [a.x, a.y, a.z, b.x, b.y, b.z, width]
+        .iter()
+        .any(|v| v.is_nan())
+    {
         return;
     }
     let (dx, dy, dz) = (b.x - a.x, b.y - a.y, b.z - a.z);
@@ -878,7 +886,17 @@ fn raster_line(
     }
     let steps = (dx.abs().max(dy.abs()) * (t1 - t0)).ceil().max(1.0) as usize;
     let inv = (t1 - t0) / steps as f32;
+    // The chance that the tube covers a sample drawn: its area over the
+    // samples drawn (steps + 1, both ends), at most one; a hash of the
+    // line and the step draws the lot, so the samples taken do not depend
+    // on the order of drawing or the threads.
+    let area = width * dx.hypot(dy) * (t1 - t0);
+    let chance = (area / (steps + 1) as f32).min(1.0);
+    let threshold = (chance as f64 * 4_294_967_296.0) as u64;
     for i in 0..=steps {
+        if threshold < 1 << 32 && (lot(id, i as u32) as u64) >= threshold {
+            continue;
+        }
         let t = t0 + i as f32 * inv;
         // The nearest sample, halves rounded up; clipping keeps the point
         // within half a sample of the grid, so the sums are not negative
@@ -894,6 +912,15 @@ fn raster_line(
             ids[k] = id;
         }
     }
+}
+
+/// A well-mixed number from a line's index and a step along it
+/// (splitmix64's finaliser).
+fn lot(id: u32, step: u32) -> u32 {
+    let mut z = ((id as u64) << 32 | step as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    (z ^ (z >> 31)) as u32
 }
 
 /// One triangle into the key buffer. `v` in sample units (sample centres
@@ -998,7 +1025,7 @@ impl Frame<'_> {
     fn shade(&self, id: u32, x: f32, y: f32) -> [f32; 3] {
         if id >= *self.tri_start.last().unwrap_or(&0) {
             let (k, l) = self.locate_line(id);
-            return line_colour(self.scene, self.opts, k, self.scene.meshes[k].lines[l]);
+            return line_colour(self.scene, self.opts, k, &self.scene.meshes[k].lines[l]);
         }
         let (k, t) = self.locate(id);
         let m = &self.scene.meshes[k];
@@ -1160,8 +1187,8 @@ fn colour(scene: &Scene3, opts: &RasterOptions, k: usize, tri: [u32; 3], w: [f32
 /// The colour of line `line` of mesh `k` (a tube thinner than a sample):
 /// lit as the side of the tube that faces the viewer, whose normal is the
 /// direction to the viewer made perpendicular to the line.
-fn line_colour(scene: &Scene3, opts: &RasterOptions, k: usize, line: [Vec3; 2]) -> [f32; 3] {
-    let [a, b] = line;
+fn line_colour(scene: &Scene3, opts: &RasterOptions, k: usize, line: &Line) -> [f32; 3] {
+    let (a, b) = (line.a, line.b);
     let v = opts.camera.towards_viewer((a + b) * 0.5);
     let t = (b - a).normalize_or_zero();
     let n = (v - t * t.dot(v)).normalize_or(v);
@@ -1270,7 +1297,7 @@ pub fn render_png(scene: &Scene3, opts: &RasterOptions) -> Result<Vec<u8>, Rende
 /// `scene` as flat-shaded triangles for the SVG backend: each triangle
 /// lit at its centroid (with its own normal, or its vertex normals'
 /// mean), painted back to front by the depth of its centroid; a line is
-/// a stroke half a pixel wide, placed by the depth of its middle. Where
+/// a stroke as wide as its tube, placed by the depth of its middle. Where
 /// triangles cross, or a far triangle's centroid lies before a near
 /// one's, that order is wrong: SVG has no depth test, so the picture is an
 /// approximation that the PNG is not. Each triangle is outlined in its own
@@ -1317,21 +1344,24 @@ pub fn polygons(scene: &Scene3, opts: &RasterOptions) -> Result<Scene, RenderErr
         }
     }
     for (k, m) in scene.meshes.iter().enumerate() {
-        for &line in &m.lines {
-            let Some(px) = in_view(cam, &line) else {
+        for line in &m.lines {
+            let Some(px) = in_view(cam, &[line.a, line.b, line.a + cam.up * line.width]) else {
                 continue;
             };
             let [r, g, b] = line_colour(scene, opts, k, line).map(|v| (v * 255.0).round() as u8);
-            let depth = line.iter().map(|p| cam.eye_coords(*p).z).sum::<f32>() * 1.5;
+            let depth = (cam.eye_coords(line.a).z + cam.eye_coords(line.b).z) * 1.5;
+            // As wide as the tube: an antialiased stroke's coverage is its
+            // ink.
+            let width = (px[2] - px[0]).truncate().length() as f64;
             faces.push((
                 depth,
                 Item::Polyline {
-                    points: px
+                    points: px[..2]
                         .iter()
                         .map(|q| DVec2::new(q.x as f64, q.y as f64))
                         .collect(),
                     color: Rgba(r, g, b, 255),
-                    width: 0.5,
+                    width,
                 },
             ));
         }

@@ -626,6 +626,12 @@ fn analyze_draws_the_characteristic_maps() {
         f.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    // analyze has no --force to suggest.
+    assert!(
+        stderr(&o).contains("is the input") && !stderr(&o).contains("--force"),
+        "{}",
+        stderr(&o)
+    );
     assert_eq!(std::fs::read(&f).unwrap(), before);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -8,7 +8,7 @@ use subgram::render::raster::{
     self, lighting, render, Camera, Light, Projection, RasterOptions, Shading, ViewSpec,
 };
 use subgram::render::Rgba;
-use subgram::scene3::{Look, Scene3, TriMesh};
+use subgram::scene3::{Line, Look, Scene3, TriMesh};
 
 /// A look that shows exactly its emission (no ambient, diffuse or
 /// specular reflection), so a pixel's colour is known without lighting.
@@ -371,7 +371,11 @@ fn lines_tied_with_a_triangle_give_the_same_picture_on_any_number_of_threads() {
     for k in 0..70_000u32 {
         let x = -1.9 + 3.8 * ((k as u64 * 7919) % 1000) as f32 / 1000.0;
         let y = -1.9 + 3.8 * ((k as u64 * 104_729) % 997) as f32 / 997.0;
-        lines.push([Vec3::new(x, y, 0.0), Vec3::new(x + 0.05, y + 0.02, 0.0)]);
+        lines.push(Line {
+            a: Vec3::new(x, y, 0.0),
+            b: Vec3::new(x + 0.05, y + 0.02, 0.0),
+            width: 0.1,
+        });
     }
     let sc = scene(vec![
         (green, plane),
@@ -654,7 +658,8 @@ fn a_line_is_drawn_one_sample_wide_lit_as_the_tube_side_facing_the_viewer() {
     // A shallow diagonal from (-1.9, -0.3) to (1.9, 0.2), at z = 0.
     let (a, b) = (Vec3::new(-1.9, -0.3, 0.0), Vec3::new(1.9, 0.2, 0.0));
     let line = TriMesh {
-        lines: vec![[a, b]],
+        // 0.2 wide: 6.4 samples, so it takes every sample on its axis.
+        lines: vec![Line { a, b, width: 0.2 }],
         ..Default::default()
     };
     let light = Light {
@@ -713,5 +718,56 @@ fn a_line_is_drawn_one_sample_wide_lit_as_the_tube_side_facing_the_viewer() {
             .collect();
         let red_there = near.iter().any(|c| c[1] < 200);
         assert_eq!(red_there, line_shows, "quad at z = {z}: {near:?}");
+    }
+}
+
+/// A line thinner than a sample takes each sample on its axis with the
+/// chance that its tube covers it: the ink of many such lines is their
+/// tubes' area. 150 horizontal lines 180 samples long (1.27 samples
+/// apart, so no two share a sample), `w` samples wide, drawn in white on
+/// black: each pixel of 2×2 samples is lit by a quarter per sample taken,
+/// so the picture's light adds up to 180·w·150/4 pixels (within a few
+/// percent; the lots are a hash, the same on every run).
+#[test]
+fn lines_under_a_sample_wide_leave_ink_in_proportion_to_their_width() {
+    let size = 100u32;
+    // 4 world units over 100 pixels: 50 samples a unit.
+    let cam = down_z(Projection::Parallel, size);
+    let white = glowing("white", [255, 255, 255]);
+    let ink = |w_samples: f32| -> f64 {
+        let width = w_samples / 50.0;
+        let lines = (0..150)
+            .map(|k| {
+                let y = -1.9 + 3.8 * (k as f32 + 0.5) / 150.0;
+                Line {
+                    a: Vec3::new(-1.8, y, 0.0),
+                    b: Vec3::new(1.8, y, 0.0),
+                    width,
+                }
+            })
+            .collect();
+        let mut opts = RasterOptions::new(cam);
+        opts.background = Rgba(0, 0, 0, 255);
+        let img = render(
+            &scene(vec![(
+                white.clone(),
+                TriMesh {
+                    lines,
+                    ..Default::default()
+                },
+            )]),
+            &opts,
+        )
+        .unwrap();
+        img.pixels.chunks(4).map(|p| p[1] as f64 / 255.0).sum()
+    };
+    for w in [0.1f32, 0.3, 0.6] {
+        // 3.6 units = 180 samples long.
+        let want = (180.0 * w as f64) * 150.0 / 4.0;
+        let got = ink(w);
+        assert!(
+            (got - want).abs() < 0.06 * want,
+            "{w} samples wide: {got} pixels of ink, expected {want}"
+        );
     }
 }

@@ -838,7 +838,7 @@ fn a_picture_keeps_a_tube_under_a_pixel_as_its_axis() {
         })
         .unwrap();
     assert_eq!(picture.triangle_count(), 0);
-    let lines: Vec<[Vec3; 2]> = picture
+    let lines: Vec<subgram::scene3::Line> = picture
         .meshes
         .iter()
         .flat_map(|m| m.lines.clone())
@@ -851,9 +851,11 @@ fn a_picture_keeps_a_tube_under_a_pixel_as_its_axis() {
     ];
     assert_eq!(lines.len(), 2);
     for (got, want) in lines.iter().zip(want) {
-        for (g, w) in got.iter().zip(want) {
+        for (g, w) in [got.a, got.b].iter().zip(want) {
             assert!((*g - w).length() < 1e-5, "{got:?} against {want:?}");
         }
+        // The tube's diameter, SetWidth's.
+        assert!((got.width - 0.9).abs() < 1e-6, "{got:?}");
     }
     let export = run.solid(&SolidOptions::default()).unwrap();
     assert_eq!(export.line_count(), 0);
