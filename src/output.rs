@@ -226,7 +226,7 @@ impl Numbers {
         } else {
             self.floats.format_finite(x)
         };
-        if may_tie(shortest.as_bytes(), single) {
+        if tie(x, shortest.as_bytes(), single) {
             out.extend_from_slice(float_text(x, single).as_bytes());
         } else {
             display_layout(out, shortest.as_bytes());
@@ -246,7 +246,7 @@ impl Numbers {
             // The `double` nearest the `float`'s shortest decimal, laid out
             // as a `double`.
             let shortest = self.floats.format_finite(x as f32);
-            let decimal = if may_tie(shortest.as_bytes(), true) {
+            let decimal = if tie(x, shortest.as_bytes(), true) {
                 (x as f32).to_string().parse()
             } else {
                 shortest.parse()
@@ -257,6 +257,85 @@ impl Numbers {
             out.extend_from_slice(self.floats.format_finite(x).as_bytes());
         }
     }
+}
+
+/// True when `std` may write `x` otherwise than `shortest`, `zmij`'s
+/// shortest decimal of it: when [`may_tie`] says a tie is possible and,
+/// for a `float`, [`halfway_f32`] finds that `x` really lies halfway
+/// between `shortest` and a neighbour with as many digits.
+fn tie(x: f64, shortest: &[u8], single: bool) -> bool {
+    may_tie(shortest, single) && (!single || halfway_f32(x as f32, shortest))
+}
+
+/// True when the `float` `x` lies exactly halfway between `shortest` (its
+/// shortest decimal, as `zmij` wrote it: `-0.47455198`, `1e-7`,
+/// `1.5e+16`) and the decimal one unit of its last digit above or below:
+/// the one case where two shortest decimals are equally near and `zmij`
+/// (half to even) and `std` may choose differently. Exact, in integers:
+/// `x = m·2^e` with `m` odd, and `x = (2d ± 1)·10^k / 2` for the digits
+/// `d` and exponent `k` of `shortest`; since `2d ± 1` and `5^k` are odd,
+/// that needs `e + 1 = k` and `m = (2d ± 1)·5^k` (`k ≥ 0`) or
+/// `m·5^-k = 2d ± 1` (`k < 0`). A decimal it cannot read counts as a tie
+/// (`std` decides).
+fn halfway_f32(x: f32, shortest: &[u8]) -> bool {
+    let Some((d, k)) = decimal_parts(shortest) else {
+        return true;
+    };
+    let bits = x.abs().to_bits();
+    let (exp, frac) = ((bits >> 23) as i32, (bits & 0x7f_ffff) as u128);
+    let (mut m, mut e) = if exp == 0 {
+        (frac, -149)
+    } else {
+        (frac | 1 << 23, exp - 150)
+    };
+    if m == 0 {
+        return false;
+    }
+    let t = m.trailing_zeros();
+    m >>= t;
+    e += t as i32;
+    if e + 1 != k {
+        return false;
+    }
+    let pow5 = |n: u32| 5u128.checked_pow(n);
+    [2 * d + 1, (2 * d).wrapping_sub(1)]
+        .into_iter()
+        .filter(|&c| c != u128::MAX)
+        .any(|c| {
+            if k >= 0 {
+                pow5(k as u32).and_then(|p| c.checked_mul(p)) == Some(m)
+            } else {
+                pow5(k.unsigned_abs()).and_then(|p| m.checked_mul(p)) == Some(c)
+            }
+        })
+}
+
+/// The digits and decimal exponent of a decimal as `zmij` writes it:
+/// `d·10^k`, the sign left out; `None` for anything else.
+fn decimal_parts(s: &[u8]) -> Option<(u128, i32)> {
+    let s = s.strip_prefix(b"-").unwrap_or(s);
+    let (mantissa, exponent) = match s.iter().position(|&c| c == b'e') {
+        Some(i) => {
+            let e = std::str::from_utf8(&s[i + 1..]).ok()?;
+            (&s[..i], e.trim_start_matches('+').parse::<i32>().ok()?)
+        }
+        None => (s, 0),
+    };
+    let (whole, fraction) = match mantissa.iter().position(|&c| c == b'.') {
+        Some(i) => (&mantissa[..i], &mantissa[i + 1..]),
+        None => (mantissa, &mantissa[..0]),
+    };
+    if whole.len() + fraction.len() > 30 {
+        return None;
+    }
+    let mut d: u128 = 0;
+    for &c in whole.iter().chain(fraction) {
+        if !c.is_ascii_digit() {
+            return None;
+        }
+        d = d * 10 + (c - b'0') as u128;
+    }
+    Some((d, exponent.checked_sub(fraction.len() as i32)?))
 }
 
 /// True when the shortest decimal `zmij` wrote has so many digits that
@@ -644,6 +723,54 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A `float` goes to `std` only when it lies exactly halfway between
+    /// two shortest decimals. 2,097,152.25 (2^21 + 1/4, a quarter apart
+    /// from its neighbours) lies halfway between 2097152.2 and 2097152.3,
+    /// which both read back as it: the exact check must see that, and the
+    /// text must be `std`'s. Around it and in other decades, 140,000
+    /// consecutive floats are written as `std` writes them, and the
+    /// halfway ones counted by the exact check are few.
+    #[test]
+    fn a_float_goes_to_std_only_when_it_lies_halfway() {
+        let mut num = Numbers::default();
+        // 2^21 + 1/4: floats there are a quarter apart.
+        let x = f32::from_bits(2_097_152.0f32.to_bits() + 1);
+        assert_eq!(x as f64, 2_097_152.25);
+        let shortest = num.floats.format_finite(x).to_string();
+        assert!(may_tie(shortest.as_bytes(), true));
+        assert!(halfway_f32(x, shortest.as_bytes()), "{shortest}");
+        // A neighbour a quarter away is not halfway.
+        let y = f32::from_bits(x.to_bits() + 1);
+        let s = num.floats.format_finite(y).to_string();
+        assert!(!halfway_f32(y, s.as_bytes()), "{s}");
+        let (mut out, mut laid) = (Vec::new(), Vec::new());
+        let (mut halfway, mut differ) = (0, 0);
+        for start in [2_097_152.0f32, 0.1, 0.474_552, 3.3, 1e-30, 1e30, 7.0e6] {
+            for i in 0..20_000 {
+                let x = f32::from_bits(start.to_bits() + i);
+                let z = num.floats.format_finite(x).to_string();
+                let half = may_tie(z.as_bytes(), true) && halfway_f32(x, z.as_bytes());
+                halfway += half as usize;
+                // zmij's digits where std's differ: only ever halfway.
+                laid.clear();
+                display_layout(&mut laid, z.as_bytes());
+                if laid != x.to_string().as_bytes() {
+                    differ += 1;
+                    assert!(half, "{x:e}: zmij {z}, std {x}, not seen as halfway");
+                }
+                out.clear();
+                num.float_text(&mut out, x as f64, true);
+                assert_eq!(std::str::from_utf8(&out).unwrap(), x.to_string(), "{x:e}");
+            }
+        }
+        // From 2^21 a float is a quarter from the next: every other one
+        // (x.25, x.75) is halfway, and std and zmij part on some.
+        assert!(
+            halfway >= 10_000 && differ > 0,
+            "{halfway} halfway, {differ} differ"
+        );
     }
 
     #[test]
