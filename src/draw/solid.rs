@@ -573,18 +573,8 @@ impl<'m> Builder<'m> {
         // The centroid of the section's points, as lpfg takes it.
         let centre = pts.iter().copied().sum::<DVec3>() / n as f64;
         let flip = start != s.clockwise;
-        let normal = if start { -h } else { h }.as_vec3();
-        let m = self.room(mesh, n + 1, n)?;
-        let base = m.positions.len() as u32;
-        m.positions.push(centre.as_vec3());
-        m.positions.extend(pts.iter().map(|p| p.as_vec3()));
-        m.normals.extend(std::iter::repeat_n(normal, n + 1));
-        for i in 0..n as u32 {
-            let (p, q) = (base + 1 + i, base + 1 + (i + 1) % n as u32);
-            m.triangles
-                .push(if flip { [base, q, p] } else { [base, p, q] });
-        }
-        Ok(())
+        let normal = if start { -h } else { h };
+        self.fan(mesh, centre, normal, &pts, flip)
     }
 
     /// Ends the pending tube of the current branch: its last ring,
@@ -689,16 +679,9 @@ impl<'m> Builder<'m> {
         if !fits(a, 0.0) || !fits(b, 0.0) {
             return Err("makes a cylinder that reaches an infinite coordinate".into());
         }
-        // A line counts as a triangle against the limit.
-        if self.triangles + 1 > self.max_triangles {
-            return Err(format!(
-                "takes the 3D geometry past its limit of {} triangles",
-                self.max_triangles
-            ));
-        }
-        self.triangles += 1;
         let mesh = self.mesh(t.pen.color);
-        self.scene.meshes[mesh as usize].lines.push(Line {
+        // A line counts as a triangle against the limit.
+        self.room(mesh, 0, 1)?.lines.push(Line {
             a: a.as_vec3(),
             b: b.as_vec3(),
             width: width as f32,
@@ -807,6 +790,32 @@ impl<'m> Builder<'m> {
         Ok(())
     }
 
+    /// A fan of triangles from `centre` over the closed loop `pts`, on
+    /// vertices of its own, all with the normal `normal`; `flip` turns
+    /// every triangle the other way round.
+    fn fan(
+        &mut self,
+        mesh: u32,
+        centre: DVec3,
+        normal: DVec3,
+        pts: &[DVec3],
+        flip: bool,
+    ) -> Result<(), String> {
+        let n = pts.len();
+        let m = self.room(mesh, n + 1, n)?;
+        let base = m.positions.len() as u32;
+        m.positions.push(centre.as_vec3());
+        m.positions.extend(pts.iter().map(|p| p.as_vec3()));
+        m.normals
+            .extend(std::iter::repeat_n(normal.as_vec3(), n + 1));
+        for i in 0..n as u32 {
+            let (p, q) = (base + 1 + i, base + 1 + (i + 1) % n as u32);
+            m.triangles
+                .push(if flip { [base, q, p] } else { [base, p, q] });
+        }
+        Ok(())
+    }
+
     /// A fan of `pts` around `centre`, all facing `normal`, or a ring
     /// between `pts` and `inner` when given.
     fn flat_round(
@@ -820,17 +829,7 @@ impl<'m> Builder<'m> {
         let n = pts.len();
         let nv = normal.as_vec3();
         match inner {
-            None => {
-                let m = self.room(mesh, n + 1, n)?;
-                let base = m.positions.len() as u32;
-                m.positions.push(centre.as_vec3());
-                m.positions.extend(pts.iter().map(|p| p.as_vec3()));
-                m.normals.extend(std::iter::repeat_n(nv, n + 1));
-                for i in 0..n as u32 {
-                    m.triangles
-                        .push([base, base + 1 + i, base + 1 + (i + 1) % n as u32]);
-                }
-            }
+            None => self.fan(mesh, centre, normal, pts, false)?,
             Some(inner) => {
                 let m = self.room(mesh, 2 * n, 2 * n)?;
                 let base = m.positions.len() as u32;
