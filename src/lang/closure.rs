@@ -237,6 +237,9 @@ pub struct Body {
     /// whether it is a `bool`.
     binds: Vec<(usize, usize, usize, bool)>,
     frame_size: usize,
+    /// Neither stores into a global nor draws a random number: what it
+    /// produces depends on the matched modules and the globals alone.
+    pure: bool,
     body: SE,
 }
 
@@ -281,6 +284,7 @@ pub fn compile(rule: &Rule, globals: &[super::ir::GlobalVar]) -> Option<Body> {
             globals,
             unknown: false,
             conflict: false,
+            effects: false,
         };
         let body = c.block(&rule.body);
         if c.conflict {
@@ -293,6 +297,7 @@ pub fn compile(rule: &Rule, globals: &[super::ir::GlobalVar]) -> Option<Body> {
             return Some(Body {
                 binds,
                 frame_size: rule.frame_size,
+                pure: !c.effects,
                 body: body?,
             });
         }
@@ -302,6 +307,13 @@ pub fn compile(rule: &Rule, globals: &[super::ir::GlobalVar]) -> Option<Body> {
 }
 
 impl Body {
+    /// True when the body changes nothing outside its own frame and what
+    /// it produces: no global is stored and no random number drawn. Such
+    /// bodies may run on many modules at once, in any order.
+    pub fn pure(&self) -> bool {
+        self.pure
+    }
+
     /// Runs the body on the parameters of the matched modules (`params(k)`:
     /// the slots of the `k`-th matched module, left context first), as
     /// [`super::eval::Interp::run`] runs it on their decoded values.
@@ -354,6 +366,8 @@ struct Compiler<'g> {
     unknown: bool,
     /// A local would hold two kinds.
     conflict: bool,
+    /// The body stores into a global or draws a random number.
+    effects: bool,
 }
 
 impl Compiler<'_> {
@@ -669,6 +683,7 @@ impl Compiler<'_> {
                     }
                     Func::Random(op) => {
                         use super::random::Op;
+                        self.effects = true;
                         let op = *op;
                         let float = match op {
                             Op::Ran | Op::Drand48 | Op::GillespieTime => true,
@@ -816,6 +831,7 @@ impl Compiler<'_> {
             if kind_of(self.globals.get(slot as usize)?.ty)? != k {
                 return None;
             }
+            self.effects = true;
             slot as usize
         } else {
             self.write(slot, k)?

@@ -113,6 +113,9 @@ pub struct Rewriter<'p> {
     tmp: Word,
     /// The context tables of the word a step rewrites.
     tables: Tables,
+    /// The new words of a parallel step's parts after the first, kept
+    /// from step to step so that their memory is reused.
+    parts: Vec<Word>,
 }
 
 impl<'p> Rewriter<'p> {
@@ -136,6 +139,7 @@ impl<'p> Rewriter<'p> {
             new_matched: Vec::new(),
             tmp: Word::new(),
             tables: Tables::default(),
+            parts: Vec::new(),
         }
     }
 
@@ -191,6 +195,12 @@ impl<'p> Rewriter<'p> {
             }
             // Redo the step on the general path, which names the production.
             dst.clear();
+        }
+        if eligible.is_none() && origin.is_none() {
+            if let Some(rewritten) = self.parallel_step(rules, src, dst, env, opts) {
+                self.growth = dst.len() as f64 / n as f64;
+                return Ok(rewritten);
+            }
         }
         let phase = opts.phase % n;
         let mut rewritten = 0;
@@ -291,6 +301,107 @@ impl<'p> Rewriter<'p> {
             }
         }
         Ok(rewritten)
+    }
+
+    /// A forward step on rayon's pool, when each module's successor
+    /// depends on the old word alone: every rule's strict predecessor is
+    /// one module, it has no new context, and its body is a stencil or a
+    /// compiled body that stores no global and draws no random number; the
+    /// word has `PARALLEL_MODULES` modules or more, and no `Cut` to skip
+    /// (a cut's branch may cross the parts). The word is cut into parts,
+    /// rewritten at once and joined in order: the first part straight into
+    /// `dst`, the others into words kept for the next step. The result is
+    /// the same, to the bit, for any number of threads.
+    ///
+    /// Returns `None` when it does not apply, and also when a part failed:
+    /// the step is then run again on one thread, which stops at the first
+    /// failure in the word's order and names it as it always did.
+    fn parallel_step(
+        &mut self,
+        rules: &[usize],
+        src: &Word,
+        dst: &mut Word,
+        env: &mut Env,
+        opts: &StepOptions,
+    ) -> Option<usize> {
+        use rayon::prelude::*;
+        let n = src.len();
+        let threads = rayon::current_num_threads();
+        if n < PARALLEL_MODULES || threads == 1 || !opts.forward {
+            return None;
+        }
+        let pure = rules.iter().all(|&r| {
+            let rule = &self.program.rules[r];
+            rule.strict.len() == 1
+                && rule.new_left.is_empty()
+                && rule.new_right.is_empty()
+                && (rule.stencil.is_some() || self.bodies[r].as_ref().is_some_and(|b| b.pure()))
+        });
+        if !pure || (opts.cut && src.syms().contains(&self.cut)) {
+            return None;
+        }
+        // The first part, written in place, is a little smaller than an
+        // even share; the rest is cut finer, so that a thread done early
+        // takes some of it.
+        let first = n / threads * 3 / 4;
+        let rest = threads * 3;
+        let bounds: Vec<usize> = std::iter::once(0)
+            .chain((0..=rest).map(|k| first + (n - first) * k / rest))
+            .collect();
+        let g = (self.growth * 1.25).clamp(1.0, 64.0);
+        let per_module = src.slot_count() as f64 / n as f64;
+        self.parts.resize_with(rest, Word::new);
+        for (w, b) in self.parts.iter_mut().zip(bounds[1..].windows(2)) {
+            let want = ((b[1] - b[0]) as f64 * g) as usize;
+            w.clear_with_capacity(want, (want as f64 * per_module) as usize);
+        }
+        let loop_limit = self.interp.loop_limit;
+        self.machine.loop_limit = loop_limit;
+        self.machine.deadline = opts.deadline;
+        let sh = Shared {
+            program: self.program,
+            bodies: &self.bodies,
+            tables: &self.tables,
+            sb: self.sb,
+            eb: self.eb,
+        };
+        let grown = std::sync::atomic::AtomicUsize::new(0);
+        let shared_env = env.clone();
+        let machine = &mut self.machine;
+        let (head, tail) = rayon::join(
+            || rewrite_part(&sh, rules, src, 0..first, dst, env, opts, machine, &grown),
+            || {
+                self.parts
+                    .par_iter_mut()
+                    .zip(bounds[1..].par_windows(2))
+                    .map(|(w, b)| {
+                        let mut env = shared_env.clone();
+                        let mut m = closure::Machine::default();
+                        m.loop_limit = loop_limit;
+                        m.deadline = opts.deadline;
+                        rewrite_part(
+                            &sh,
+                            rules,
+                            src,
+                            b[0]..b[1],
+                            w,
+                            &mut env,
+                            opts,
+                            &mut m,
+                            &grown,
+                        )
+                    })
+                    .collect::<Vec<_>>()
+            },
+        );
+        let total = dst.len() + self.parts.iter().map(Word::len).sum::<usize>();
+        let rewritten = std::iter::once(head).chain(tail).sum::<Result<usize, _>>();
+        let Some(rewritten) = rewritten.ok().filter(|_| total <= opts.max_modules) else {
+            dst.clear();
+            return None;
+        };
+        dst.append_all(&self.parts);
+        Some(rewritten)
     }
 
     /// Where the scan goes on after a `Cut` scanned `k`-th: the matching
@@ -726,8 +837,6 @@ impl<'p> Rewriter<'p> {
         opts: &StepOptions,
         any_flow: bool,
     ) -> Result<bool, StepError> {
-        let n = src.len();
-        let len = rule.strict.len();
         let ctx = Rules {
             sb: self.sb,
             eb: self.eb,
@@ -735,36 +844,12 @@ impl<'p> Rewriter<'p> {
             ring: opts.ring,
             tables: Some(&self.tables),
         };
-        // Cheap test first: the strict predecessor matches exactly.
-        for (j, p) in rule.strict.iter().enumerate() {
-            let idx = if opts.ring {
-                (start + j) % n
-            } else {
-                start + j
-            };
-            if idx >= n || !module_matches(src, idx, p) {
-                return Ok(false);
-            }
-        }
         if (!rule.new_left.is_empty() && !opts.forward)
             || (!rule.new_right.is_empty() && opts.forward)
         {
             return Ok(false);
         }
-        self.matched.clear();
-        let Some(left_end) =
-            match_left(src, start as isize - 1, &rule.left, ctx, &mut self.matched)
-        else {
-            return Ok(false);
-        };
-        for j in 0..len {
-            self.matched.push(if opts.ring {
-                (start + j) % n
-            } else {
-                start + j
-            });
-        }
-        let Some(right_end) = match_right(src, start + len, &rule.right, ctx, &mut self.matched)
+        let Some((left_end, right_end)) = match_old(rule, src, start, ctx, &mut self.matched)
         else {
             return Ok(false);
         };
@@ -805,17 +890,7 @@ impl<'p> Rewriter<'p> {
 
         if let Some(st) = &rule.stencil {
             let before = dst.len();
-            let ok = apply_stencil(st, src, &self.matched, dst);
-            if !ok {
-                dst.truncate(before);
-                return Err(StepError::Runtime {
-                    rule: r,
-                    error: RuntimeError::new(
-                        None,
-                        "a parameter of the successor is NaN or infinite",
-                    ),
-                });
-            }
+            stencil_into(st, r, src, &self.matched, dst)?;
             if !opts.forward {
                 reverse_tail(dst, before, &mut self.tmp);
             }
@@ -826,41 +901,11 @@ impl<'p> Rewriter<'p> {
             // The compiled body reads the matched modules' slots itself.
             self.machine.loop_limit = self.interp.loop_limit;
             self.machine.deadline = self.interp.deadline;
-            let matched = &self.matched;
             if opts.forward {
-                // Straight into the new word, taken back when the body
-                // does not produce: the word is full at the same module.
-                let before = dst.len();
-                let mut successor = Successor {
-                    word: dst,
-                    room: opts.max_modules,
-                };
-                let result = body.run(
-                    &mut self.machine,
-                    |k| src.data(matched[k]),
-                    env,
-                    &mut successor,
-                );
-                let full = successor.full();
-                return match result {
-                    Ok(flow) if flow == Flow::Produced || any_flow => Ok(true),
-                    Ok(_) => {
-                        dst.truncate(before);
-                        Ok(false)
-                    }
-                    Err(error) => {
-                        dst.truncate(before);
-                        Err(if full {
-                            StepError::TooLong {
-                                limit: opts.max_modules,
-                                rule: Some(r),
-                            }
-                        } else {
-                            StepError::Runtime { rule: r, error }
-                        })
-                    }
-                };
+                let (m, matched) = (&mut self.machine, &self.matched[..]);
+                return run_forward(body, r, m, matched, src, dst, env, opts, any_flow);
             }
+            let matched = &self.matched;
             self.tmp.clear();
             let mut successor = Successor {
                 word: &mut self.tmp,
@@ -1281,6 +1326,185 @@ fn combine<const N: usize, const SINGLE: bool>(
     acc
 }
 
+/// Matches `rule`'s strict predecessor at `start` and its left and right
+/// contexts around it in the old word, pushing the matched modules (left
+/// context, strict, right context) onto `matched`. Returns where the left
+/// context's match ended and where the right one's did, or `None` when the
+/// rule does not apply there.
+#[inline]
+fn match_old(
+    rule: &Rule,
+    src: &Word,
+    start: usize,
+    ctx: Rules,
+    matched: &mut Vec<usize>,
+) -> Option<(isize, usize)> {
+    let n = src.len();
+    let len = rule.strict.len();
+    let at = |j: usize| if ctx.ring { (start + j) % n } else { start + j };
+    // Cheap test first: the strict predecessor matches exactly.
+    for (j, p) in rule.strict.iter().enumerate() {
+        let idx = at(j);
+        if idx >= n || !module_matches(src, idx, p) {
+            return None;
+        }
+    }
+    matched.clear();
+    let left_end = match_left(src, start as isize - 1, &rule.left, ctx, matched)?;
+    matched.extend((0..len).map(at));
+    let right_end = match_right(src, start + len, &rule.right, ctx, matched)?;
+    Some((left_end, right_end))
+}
+
+/// Appends the successor `st` computes from the `matched` modules of
+/// `src`; rule `r`'s error, and `dst` as it was, when a value of it is not
+/// finite.
+#[inline(always)]
+fn stencil_into(
+    st: &Stencil,
+    r: usize,
+    src: &Word,
+    matched: &[usize],
+    dst: &mut Word,
+) -> Result<(), StepError> {
+    let before = dst.len();
+    if apply_stencil(st, src, matched, dst) {
+        return Ok(());
+    }
+    dst.truncate(before);
+    Err(StepError::Runtime {
+        rule: r,
+        error: RuntimeError::new(None, "a parameter of the successor is NaN or infinite"),
+    })
+}
+
+/// Runs rule `r`'s compiled body on the `matched` modules of `src`, in a
+/// forward step: straight into `dst`, taken back when the body does not
+/// produce (or fails). Says whether it produced.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn run_forward(
+    body: &closure::Body,
+    r: usize,
+    m: &mut closure::Machine,
+    matched: &[usize],
+    src: &Word,
+    dst: &mut Word,
+    env: &mut Env,
+    opts: &StepOptions,
+    any_flow: bool,
+) -> Result<bool, StepError> {
+    let before = dst.len();
+    let mut successor = Successor {
+        word: dst,
+        room: opts.max_modules,
+    };
+    let result = body.run(m, |k| src.data(matched[k]), env, &mut successor);
+    // The word is full at the same module as on one thread.
+    let full = successor.full();
+    match result {
+        Ok(flow) if flow == Flow::Produced || any_flow => Ok(true),
+        Ok(_) => {
+            dst.truncate(before);
+            Ok(false)
+        }
+        Err(error) => {
+            dst.truncate(before);
+            Err(if full {
+                StepError::TooLong {
+                    limit: opts.max_modules,
+                    rule: Some(r),
+                }
+            } else {
+                StepError::Runtime { rule: r, error }
+            })
+        }
+    }
+}
+
+/// What the parts of a parallel step share: the program, its compiled
+/// bodies and the old word's context tables.
+struct Shared<'a> {
+    program: &'a Program,
+    bodies: &'a [Option<closure::Body>],
+    tables: &'a Tables,
+    sb: Sym,
+    eb: Sym,
+}
+
+/// Rewrites the modules `range` of `src` forward into `dst` (appending),
+/// with rules whose successors depend on the old word alone (see
+/// [`Rewriter::parallel_step`]). `grown` sums, across the parts, the
+/// modules written so far, reported every [`DEADLINE_EVERY`] modules, so
+/// that a runaway step stops near its limit however many parts it has.
+/// Returns how many modules a rule rewrote.
+#[allow(clippy::too_many_arguments)]
+fn rewrite_part(
+    sh: &Shared,
+    rules: &[usize],
+    src: &Word,
+    range: Range<usize>,
+    dst: &mut Word,
+    env: &mut Env,
+    opts: &StepOptions,
+    m: &mut closure::Machine,
+    grown: &std::sync::atomic::AtomicUsize,
+) -> Result<usize, StepError> {
+    use std::sync::atomic::Ordering::Relaxed;
+    let mut matched = Vec::new();
+    let mut rewritten = 0;
+    let mut reported = dst.len();
+    for i in range.clone() {
+        if (i - range.start).is_multiple_of(DEADLINE_EVERY) {
+            crate::deadline::check(opts.deadline).map_err(StepError::Timeout)?;
+            let total = grown.fetch_add(dst.len() - reported, Relaxed) + dst.len() - reported;
+            reported = dst.len();
+            if total > opts.max_modules {
+                return Err(StepError::TooLong {
+                    limit: opts.max_modules,
+                    rule: None,
+                });
+            }
+        }
+        let mut produced = false;
+        for &r in rules {
+            let rule = &sh.program.rules[r];
+            let ctx = Rules {
+                sb: sh.sb,
+                eb: sh.eb,
+                filter: &rule.filter,
+                ring: opts.ring,
+                tables: Some(sh.tables),
+            };
+            if match_old(rule, src, i, ctx, &mut matched).is_none() {
+                continue;
+            }
+            produced = match (&rule.stencil, &sh.bodies[r]) {
+                (Some(st), _) => stencil_into(st, r, src, &matched, dst).map(|()| true)?,
+                (None, Some(body)) => {
+                    run_forward(body, r, m, &matched, src, dst, env, opts, false)?
+                }
+                (None, None) => unreachable!("parallel_step takes no interpreted body"),
+            };
+            if produced {
+                break;
+            }
+        }
+        if produced {
+            rewritten += 1;
+        } else {
+            dst.push_from(src, i);
+        }
+        if dst.len() > opts.max_modules {
+            return Err(StepError::TooLong {
+                limit: opts.max_modules,
+                rule: None,
+            });
+        }
+    }
+    Ok(rewritten)
+}
+
 /// Evaluates a stencil into `dst`. Returns false if a value is not finite.
 #[inline(always)]
 fn apply_stencil(st: &Stencil, src: &Word, matched: &[usize], dst: &mut Word) -> bool {
@@ -1549,6 +1773,89 @@ mod tests {
             vec![(Ty::V3, vec![(0, 1.0)]), three[0].1[0].clone()],
         )];
         assert_eq!(uniform_shape(&mixed), None);
+    }
+
+    /// A word grown to `steps` steps on one thread, then one more step run
+    /// by hand: whether `parallel_step` takes it in a pool of `threads`,
+    /// and the new word (from whichever path ran).
+    fn last_step(src: &str, steps: u64, threads: usize) -> (bool, Word) {
+        let curve = crate::load_str("t.lsys", src, &[]).expect("loads");
+        let program = &curve.program;
+        let opts = crate::DeriveOptions::default().with_steps(steps);
+        let d = crate::derive(program, opts).expect("derives");
+        let mut interp = Interp::for_program(program, None);
+        let mut env = Env::for_program(program, &mut interp, Default::default(), None)
+            .expect("an environment");
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build();
+        // Made here: `closure::set_enabled` holds on this thread.
+        let mut rw = Rewriter::new(program);
+        pool.expect("a pool").install(|| {
+            let rules: Vec<usize> = (0..program.rules.len()).collect();
+            let opts = StepOptions {
+                ring: false,
+                forward: true,
+                phase: 0,
+                max_modules: usize::MAX,
+                deadline: None,
+                cut: true,
+            };
+            let mut dst = Word::new();
+            let parallel = rw
+                .parallel_step(&rules, &d.word, &mut dst, &mut env, &opts)
+                .is_some();
+            let mut again = Word::new();
+            rw.step(&rules, &d.word, &mut again, &mut env, &opts, None, None)
+                .expect("steps");
+            if parallel {
+                assert_eq!(dst, again, "step() takes the same path");
+            }
+            (parallel, again)
+        })
+    }
+
+    /// Guarded, branching, context-sensitive rules with compiled bodies
+    /// that read a global: the general path runs them in parts, and the
+    /// word is the one the interpreter makes on one thread, to the bit.
+    #[test]
+    fn pure_bodies_run_in_parts_as_the_interpreter_runs_them() {
+        let src = "module A(float, int); module B(float);\n\
+             float k = 0.5;\nderivation length: 1;\nAxiom: B(1) F(1) A(1, 0);\n\
+             production:\n\
+             F(x) < A(l, d) : { if (d % 3 == 2 && l < 0.7) produce F(l) A(l * k, d + 1); \
+                else produce F(l) SB() B(x + l) A(l * 0.9, d + 1) EB() A(l * 0.8, d + 2); }\n\
+             A(l, d) -> F(l) A(l * 0.6, d + 1) SB() A(l, d + 2) EB()\n\
+             B(x) > SB() A(l, d) -> B(x * 0.5 + l)\n";
+        let (parallel, two) = last_step(src, 18, 2);
+        assert!(two.len() > 2 * PARALLEL_MODULES, "{} modules", two.len());
+        assert!(parallel, "the general path ran in parts");
+        let (serial, one) = last_step(src, 18, 1);
+        assert!(!serial);
+        assert!(one == two, "the same word on one thread");
+        closure::set_enabled(false);
+        let (interpreted, reference) = last_step(src, 18, 2);
+        closure::set_enabled(true);
+        assert!(!interpreted, "interpreted bodies run on one thread");
+        assert!(reference == two, "the interpreter's word");
+    }
+
+    /// A body that stores a global or draws a random number runs on one
+    /// thread: what it produces depends on the order of the modules.
+    #[test]
+    fn bodies_with_effects_run_on_one_thread() {
+        for body in [
+            "n = n + 1; produce A(l * 0.9) A(l * 0.8);",
+            "produce A(l * ran(1)) A(l);",
+        ] {
+            let src = format!(
+                "module A(float);\nint n = 0;\nderivation length: 1;\nAxiom: A(1);\n\
+                 production:\nA(l) : {{ {body} }}\n"
+            );
+            let (parallel, _) = last_step(&src, 17, 2);
+            assert!(!parallel, "{body}");
+        }
+        let pure = "module A(float);\nint n = 0;\nderivation length: 1;\nAxiom: A(1);\n\
+             production:\nA(l) : { int m = n + 1; produce A(l * 0.9) SB() A(l * m) EB(); }\n";
+        assert!(last_step(pure, 16, 2).0, "reading a global is pure");
     }
 
     /// An overflow in the middle of a long ring, where the kernel computes,

@@ -106,6 +106,51 @@ impl Word {
         self.push_raw(other.syms[i], other.data(i));
     }
 
+    /// Appends all modules of each of `parts`, in order, copying the
+    /// parts at once on rayon's pool: each into its own stretch of the
+    /// word's room, the new memory touched first by the thread that fills
+    /// it.
+    pub fn append_all(&mut self, parts: &[Word]) {
+        use rayon::prelude::*;
+        let modules: usize = parts.iter().map(Word::len).sum();
+        let slots: usize = parts.iter().map(|w| w.data.len()).sum();
+        self.reserve(modules, slots);
+        let mut base = self.data.len();
+        let (mut syms, mut starts, mut data) = (
+            &mut self.syms.spare_capacity_mut()[..modules],
+            &mut self.starts.spare_capacity_mut()[..modules],
+            &mut self.data.spare_capacity_mut()[..slots],
+        );
+        let mut jobs = Vec::with_capacity(parts.len());
+        for w in parts {
+            let (s, rest) = std::mem::take(&mut syms).split_at_mut(w.len());
+            syms = rest;
+            let (o, rest) = std::mem::take(&mut starts).split_at_mut(w.len());
+            starts = rest;
+            let (d, rest) = std::mem::take(&mut data).split_at_mut(w.data.len());
+            data = rest;
+            jobs.push((w, s, o, d, base as u32));
+            base += w.data.len();
+        }
+        jobs.into_par_iter().for_each(|(w, s, o, d, base)| {
+            s.write_copy_of_slice(&w.syms);
+            for (o, &x) in o.iter_mut().zip(&w.starts[1..]) {
+                o.write(x + base);
+            }
+            d.write_copy_of_slice(&w.data);
+        });
+        // SAFETY: the jobs wrote every element of the first `modules`
+        // (`slots`) places of each array's spare capacity: the stretches
+        // they were given cover them, and each was written whole (a
+        // part's `starts` has one entry per module after its leading 0).
+        // A panic would leave before this line, with the word as it was.
+        unsafe {
+            self.syms.set_len(self.syms.len() + modules);
+            self.starts.set_len(self.starts.len() + modules);
+            self.data.set_len(self.data.len() + slots);
+        }
+    }
+
     /// Drops modules from the end until `len` remain.
     pub fn truncate(&mut self, len: usize) {
         if len < self.syms.len() {

@@ -147,3 +147,142 @@ fn chaikin_in_3d_double_is_the_same_word_for_any_number_of_threads() {
     assert!(bits(&word) == want);
     same_error_in_every_pool(&l.program);
 }
+
+/// Steps of the binary plant below: the last one reads 131,066 modules,
+/// past the size from which the general path cuts a step into parts.
+const PLANT_STEPS: u64 = 15;
+
+/// A branching plant whose rule is a stencil (the general path, since the
+/// word has branches), as `bench_solid --whole` draws it.
+const PLANT: &str = "module A(float, float);\nderivation length: 1;\n\
+    Axiom: SetColor(2) A(1, 0.05);\nproduction:\n\
+    A(l, w) -> SetWidth(w) F(l) RollR(137.5) SB() Left(32) A(l*0.78, w*0.7) EB() \
+    Right(18) A(l*0.86, w*0.8)\n";
+
+/// The plant's word after `steps` steps, computed here from the rule: a
+/// module's name and its parameters, each product computed in double and
+/// rounded to single precision, as C computes `l*0.78` for a `float l`.
+fn plant_by_hand(steps: u64) -> Vec<(&'static str, Vec<f64>)> {
+    fn grow(l: f32, w: f32, k: u64, out: &mut Vec<(&'static str, Vec<f64>)>) {
+        if k == 0 {
+            out.push(("A", vec![l as f64, w as f64]));
+            return;
+        }
+        let (l, w) = (l as f64, w as f64);
+        out.push(("SetWidth", vec![w]));
+        out.push(("F", vec![l]));
+        out.push(("RollR", vec![137.5]));
+        out.push(("SB", vec![]));
+        out.push(("Left", vec![32.0]));
+        grow((l * 0.78) as f32, (w * 0.7) as f32, k - 1, out);
+        out.push(("EB", vec![]));
+        out.push(("Right", vec![18.0]));
+        grow((l * 0.86) as f32, (w * 0.8) as f32, k - 1, out);
+    }
+    // An `int` parameter's slot holds the integer's bits.
+    let mut out = vec![("SetColor", vec![f64::from_bits(2)])];
+    grow(1.0, 0.05, steps, &mut out);
+    out
+}
+
+#[test]
+fn a_branching_plant_is_the_same_word_for_any_number_of_threads() {
+    let l = load_text(PLANT);
+    let words: Vec<Word> = [1, 2, 3]
+        .iter()
+        .map(|&k| {
+            pool(k).install(|| {
+                let opts = DeriveOptions::default().with_steps(PLANT_STEPS);
+                subgram::derive(&l.program, opts).expect("derives").word
+            })
+        })
+        .collect();
+    let want = plant_by_hand(PLANT_STEPS);
+    assert_eq!(want.len(), 262_138);
+    for (k, w) in words.iter().enumerate() {
+        assert_eq!(w.len(), want.len(), "{} threads", k + 1);
+        for (i, (name, slots)) in want.iter().enumerate() {
+            let got: Vec<u64> = w.data(i).iter().map(|x| x.to_bits()).collect();
+            let exp: Vec<u64> = slots.iter().map(|x| x.to_bits()).collect();
+            assert!(
+                l.program.alphabet.name(w.sym(i)) == *name && got == exp,
+                "module {i} with {} threads: {} {:?}, want {name} {slots:?}",
+                k + 1,
+                l.program.alphabet.name(w.sym(i)),
+                w.data(i)
+            );
+        }
+    }
+}
+
+/// The error of a step run in parts is the one the step run on one thread
+/// gives: the first failing module in the word's order, named with its
+/// production, whichever part it falls in and whatever fails after it.
+#[test]
+fn a_branching_step_fails_alike_for_any_number_of_threads() {
+    // A NaN in an `A` of the plant's word: the first (in the first part),
+    // one a third of the way, the last (in the last part), and two at once.
+    let l = load_text(PLANT);
+    let fail = |nth: &[usize], threads: usize| {
+        pool(threads).install(|| {
+            let opts = DeriveOptions::default().with_steps(PLANT_STEPS);
+            let mut d = Derivation::new(&l.program, opts).expect("starts");
+            while d.step + 1 < PLANT_STEPS {
+                d.next_step().expect("steps");
+            }
+            let n = d.word.len();
+            assert!(n > 131_000, "{n} modules");
+            let a = l.program.alphabet.lookup("A").expect("A");
+            let mut w = Word::new();
+            let mut seen = 0;
+            for i in 0..n {
+                let mut slots = d.word.data(i).to_vec();
+                if d.word.sym(i) == a {
+                    if nth.contains(&seen) {
+                        slots[1] = f64::NAN;
+                    }
+                    seen += 1;
+                }
+                w.push_raw(d.word.sym(i), &slots);
+            }
+            assert_eq!(seen, 1 << (PLANT_STEPS - 1));
+            d.word = w;
+            d.next_step().expect_err("a NaN spreads").message
+        })
+    };
+    let last = (1 << (PLANT_STEPS - 1)) - 1;
+    for nth in [&[0][..], &[last / 3], &[last], &[1, last]] {
+        let one = fail(nth, 1);
+        assert!(one.contains("NaN or infinite"), "{one}");
+        for k in [2, 3] {
+            assert_eq!(fail(nth, k), one, "NaN in the A numbered {nth:?}");
+        }
+    }
+    // An integer division by zero in a compiled body, late in the word,
+    // and a word that grows past its limit.
+    let div = "module A(int);\nderivation length: 18;\nAxiom: A(0);\nproduction:\n\
+        A(i) : { if (i == 100000) produce A(1 / (i - i)); \
+        else produce A(2 * i) SB() A(2 * i + 1) EB(); }\n";
+    let l = load_text(div);
+    let fail = |threads: usize, max: usize| {
+        pool(threads).install(|| {
+            let opts = DeriveOptions {
+                max_modules: max,
+                ..DeriveOptions::default()
+            };
+            let e = subgram::derive(&l.program, opts).expect_err("fails");
+            l.error(e).to_string()
+        })
+    };
+    for max in [10_000_000, 200_000] {
+        let one = fail(1, max);
+        for k in [2, 3] {
+            assert_eq!(fail(k, max), one);
+        }
+        if max == 200_000 {
+            assert!(one.contains("200000"), "{one}");
+        } else {
+            assert!(one.contains("integer division by zero"), "{one}");
+        }
+    }
+}
