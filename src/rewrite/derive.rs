@@ -484,6 +484,13 @@ impl<'p> Derivation<'p> {
         self.step = step;
         self.decompose()?;
         self.control(ControlKind::EndEach)?;
+        if !self.has_next() {
+            // The last step is done: the old word and the rewriter's
+            // scratch words would only hold memory while the word is
+            // drawn or written.
+            self.spare = Word::new();
+            self.rewriter.release();
+        }
         Ok(())
     }
 

@@ -404,6 +404,13 @@ impl<'p> Rewriter<'p> {
         Some(rewritten)
     }
 
+    /// Frees the words kept from step to step.
+    pub fn release(&mut self) {
+        self.parts = Vec::new();
+        self.tmp = Word::new();
+        self.tables.clear();
+    }
+
     /// Where the scan goes on after a `Cut` scanned `k`-th: the matching
     /// `EB` of its branch, or the end of the word when there is none. On a
     /// ring scanned from a phase, the end of the word is where the scan
