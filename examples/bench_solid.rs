@@ -85,8 +85,8 @@ fn whole_path(args: &[String], runs: usize) {
     let names = [
         "load",
         "derive",
-        "line bounds (picture scale)",
-        "turtle -> Scene3",
+        "(no second walk for the picture's scale)",
+        "turtle -> Scene3, scale found on the way",
         "camera fit",
         "z-buffer to pixels",
         "PNG encoding",
@@ -106,12 +106,12 @@ fn whole_path(args: &[String], runs: usize) {
         };
         let mut run = c.run(DeriveOptions::default()).expect("derives");
         lap(1, &mut best);
-        let (lo, hi) = run.line_bounds().expect("walks").expect("draws lines");
-        let per_pixel = (hi - lo).max_element() / (0.9 * size as f64);
         lap(2, &mut best);
+        // The picture's scale found by the walk that makes the geometry,
+        // as `render` does.
         let scene = run
             .solid(&SolidOptions {
-                picture_pixel: Some(per_pixel),
+                fit_pixels: Some(0.9 * size as f64),
                 ..Default::default()
             })
             .expect("makes the geometry");

@@ -870,25 +870,24 @@ fn render_solid(
     let mut run = c.run(opts.derive_options())?;
     let mut sopts = SolidOptions::default();
     let picture = crate::export::Format::from_path(output).is_none();
-    if model.line_style == LineStyle::Pixel || picture {
-        // The picture's scale from the drawing's extent, as the camera will
-        // frame it (lpfg's 0.9 of the window by default).
+    // The picture's scale from the drawing's extent, as the camera will
+    // frame it (lpfg's 0.9 of the window by default).
+    let fit = 0.9 * w.min(h) as f64;
+    if model.line_style == LineStyle::Pixel {
+        // Pixel-wide lines are tubes of that many units: the scale first.
         let extent = run
             .line_bounds()?
             .map_or(f64::NAN, |(lo, hi)| (hi - lo).max_element());
-        let units_per_pixel = if extent.is_finite() && extent > 0.0 {
-            extent / (0.9 * w.min(h) as f64)
-        } else {
-            1.0
-        };
-        if model.line_style == LineStyle::Pixel {
-            sopts.pixel_tubes = Some(units_per_pixel);
-        }
+        let units_per_pixel = crate::draw::solid::pixel_of(extent, fit);
+        sopts.pixel_tubes = Some(units_per_pixel);
         // A picture needs no more sides than its pixels show; an export
         // keeps them all.
         if picture {
             sopts.picture_pixel = Some(units_per_pixel);
         }
+    } else if picture {
+        // The same scale, found by the walk that makes the geometry.
+        sopts.fit_pixels = Some(fit);
     }
     let scene = run.solid(&sopts)?;
     write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;

@@ -105,6 +105,7 @@ pub fn lsys_derive(data: &[u8]) {
         max_vertices: 200_000,
         pixel_tubes: None,
         picture_pixel: None,
+        fit_pixels: None,
     };
     match run.solid(&sopts) {
         Ok(scene) => {
@@ -118,6 +119,38 @@ pub fn lsys_derive(data: &[u8]) {
         Err(e) => {
             std::hint::black_box(e.to_string());
         }
+    }
+    // A picture's geometry, its scale found by the walk that makes it, is
+    // the geometry made knowing the scale beforehand: the same meshes in
+    // the same order, the same lines, as many triangles and vertices; or
+    // the same error.
+    let fit = 90.0;
+    let found = run.solid(&subgram::draw::solid::SolidOptions {
+        fit_pixels: Some(fit),
+        ..sopts.clone()
+    });
+    let px = match run.line_bounds() {
+        Ok(Some((lo, hi))) => subgram::draw::solid::pixel_of((hi - lo).max_element(), fit),
+        _ => 1.0,
+    };
+    let known = run.solid(&subgram::draw::solid::SolidOptions {
+        picture_pixel: Some(px),
+        ..sopts
+    });
+    match (found, known) {
+        (Ok(a), Ok(b)) => {
+            assert_eq!(a.looks.len(), b.looks.len());
+            for (x, y) in a.looks.iter().zip(&b.looks) {
+                assert_eq!(x.name, y.name);
+            }
+            for (m, n) in a.meshes.iter().zip(&b.meshes) {
+                assert_eq!(m.positions.len(), n.positions.len());
+                assert_eq!(m.triangles.len(), n.triangles.len());
+                assert!(m.lines == n.lines);
+            }
+        }
+        (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+        (a, b) => panic!("{:?} against {:?}", a.err(), b.err()),
     }
     let events = match run.events() {
         Ok(ev) => ev,

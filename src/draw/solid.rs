@@ -93,6 +93,13 @@ pub struct SolidOptions {
     /// pixel across is only its axis, a line of [`TriMesh::lines`]; `None`
     /// (exports): every tube a tube of its own number of sides.
     pub picture_pixel: Option<f64>,
+    /// Geometry for a picture whose scale the walk finds: `picture_pixel`
+    /// is the extent of the turtle's lines (what [`super::line_bounds`]
+    /// spans) over this many pixels, or 1 when they have no extent. The
+    /// tubes are logged as the turtle goes and made once the extent is
+    /// known, so the word is walked once instead of twice. Ignored when
+    /// `picture_pixel` or `pixel_tubes` is given.
+    pub fit_pixels: Option<f64>,
     /// More triangles than this stop the walk with an error.
     pub max_triangles: usize,
     /// More vertices than this stop the walk with an error.
@@ -105,6 +112,7 @@ impl Default for SolidOptions {
             line_style: None,
             pixel_tubes: None,
             picture_pixel: None,
+            fit_pixels: None,
             max_triangles: MAX_TRIANGLES,
             max_vertices: MAX_VERTICES,
         }
@@ -120,6 +128,31 @@ pub fn solid(
     opts: &DrawOptions,
     sopts: &SolidOptions,
 ) -> Result<Scene3, DrawError> {
+    let fit = sopts
+        .fit_pixels
+        .filter(|f| f.is_finite() && *f > 0.0 && sopts.picture_pixel.is_none());
+    let fit = fit.filter(|_| sopts.pixel_tubes.is_none());
+    if let Some(fit) = fit {
+        let mut b = Builder::new(&opts.model, sopts);
+        b.log = Some(Log::new(fit));
+        let walked = walk(word, alphabet, structs, opts, None, &mut b).is_ok();
+        if walked && b.finish().is_ok() && b.replay().is_ok() {
+            return Ok(b.scene);
+        }
+        // A failure names its module only on a walk that makes the tubes
+        // as it goes: find the scale as before and walk again, which fails
+        // where it always did.
+        let px = match super::line_bounds(word, alphabet, structs, opts)? {
+            Some((lo, hi)) => pixel_of((hi - lo).max_element(), fit),
+            None => 1.0,
+        };
+        let sopts = SolidOptions {
+            picture_pixel: Some(px),
+            fit_pixels: None,
+            ..sopts.clone()
+        };
+        return solid(word, alphabet, structs, opts, &sopts);
+    }
     let mut b = Builder::new(&opts.model, sopts);
     walk(word, alphabet, structs, opts, None, &mut b)?;
     b.finish().map_err(|message| DrawError {
@@ -127,6 +160,89 @@ pub fn solid(
         module: None,
     })?;
     Ok(b.scene)
+}
+
+/// Model units a pixel, for lines spanning `extent` drawn `fit` pixels
+/// across: 1 where they span nothing.
+pub fn pixel_of(extent: f64, fit: f64) -> f64 {
+    if extent.is_finite() && extent > 0.0 {
+        extent / fit
+    } else {
+        1.0
+    }
+}
+
+/// A tube less than a pixel across whatever the picture's final scale:
+/// what [`Builder::thin`] makes of it, decided while the walk logs.
+#[derive(Clone, Copy, Debug)]
+struct LoggedThin {
+    a: Vec3,
+    b: Vec3,
+    width: f32,
+    color: i64,
+}
+
+/// A tube segment as [`Builder::tube`] reads it from the turtle and the
+/// branch.
+#[derive(Clone, Copy, Debug)]
+struct Seg {
+    a: DVec3,
+    b: DVec3,
+    left: DVec3,
+    up: DVec3,
+    color: i64,
+    scale: (f64, f64),
+    sides: Option<u32>,
+}
+
+/// What a walk for a picture of unknown scale logs of its tubes, in order
+/// ([`SolidOptions::fit_pixels`]): each tube, and each branch and each end
+/// of a branch's tube, since they decide which tubes join.
+struct Log {
+    fit: f64,
+    /// The box around the lines so far.
+    lo: DVec3,
+    hi: DVec3,
+    /// The largest scale a tube was found thin at: the final scale must
+    /// be at least this (it is, as the box only grows).
+    px_used: f64,
+    ops: Vec<Op>,
+    thin: Vec<LoggedThin>,
+    segs: Vec<Seg>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Op {
+    Thin,
+    Tube,
+    Push,
+    Pop,
+    End,
+}
+
+impl Log {
+    fn new(fit: f64) -> Log {
+        Log {
+            fit,
+            lo: DVec3::splat(f64::INFINITY),
+            hi: DVec3::splat(f64::NEG_INFINITY),
+            px_used: 0.0,
+            ops: Vec::new(),
+            thin: Vec::new(),
+            segs: Vec::new(),
+        }
+    }
+
+    /// The scale so far: at most the final one, 0 while the lines span
+    /// nothing.
+    fn pixel_so_far(&self) -> f64 {
+        let extent = (self.hi - self.lo).max_element();
+        if extent.is_finite() && extent > 0.0 {
+            extent / self.fit
+        } else {
+            0.0
+        }
+    }
 }
 
 /// A cross-section: its distinct points and unit normals in the plane
@@ -278,6 +394,9 @@ struct Builder<'m> {
     circles: Vec<Section>,
     /// Generalized cylinders' sections, the last few used.
     sections: Vec<(SectionKey, Section)>,
+    /// Tubes logged for a scale found by the walk, `None` when they are
+    /// made as it goes.
+    log: Option<Log>,
 }
 
 /// In a picture, a tube less than this many pixels across is drawn as its
@@ -345,7 +464,45 @@ impl<'m> Builder<'m> {
             stack: Vec::new(),
             circles: Vec::new(),
             sections: Vec::new(),
+            log: None,
         }
+    }
+
+    /// Makes the logged tubes at the scale of the whole walk's lines, on
+    /// a branch state of their own (the walk's holds no tube), as the
+    /// walk would have made them knowing the scale.
+    fn replay(&mut self) -> Result<(), String> {
+        let Some(log) = self.log.take() else {
+            return Ok(());
+        };
+        let px = pixel_of((log.hi - log.lo).max_element(), log.fit);
+        if px < log.px_used {
+            return Err("the scale shrank".into());
+        }
+        self.picture_pixel = Some(px);
+        self.stack.clear();
+        self.cur.tube = None;
+        self.cur.gc = None;
+        let (mut thin, mut segs) = (log.thin.iter(), log.segs.iter());
+        for op in &log.ops {
+            match op {
+                Op::Thin => {
+                    let t = thin.next().ok_or("a short log")?;
+                    self.end_tube()?;
+                    let mesh = self.mesh(t.color);
+                    self.room(mesh, 0, 1)?.lines.push(Line {
+                        a: t.a,
+                        b: t.b,
+                        width: t.width,
+                    });
+                }
+                Op::Tube => self.tube_at(segs.next().ok_or("a short log")?)?,
+                Op::Push => self.push(),
+                Op::Pop => self.pop()?,
+                Op::End => self.end_tube()?,
+            }
+        }
+        self.finish()
     }
 
     /// The look of colour index `k` (0 to 255).
@@ -580,6 +737,10 @@ impl<'m> Builder<'m> {
     /// Ends the pending tube of the current branch: its last ring,
     /// perpendicular to its direction, and the cap.
     fn end_tube(&mut self) -> Result<(), String> {
+        if let Some(log) = &mut self.log {
+            log.ops.push(Op::End);
+            return Ok(());
+        }
         let Some(p) = self.cur.tube.take() else {
             return Ok(());
         };
@@ -602,26 +763,82 @@ impl<'m> Builder<'m> {
 
     /// A tube segment from `a` to `b`.
     fn tube(&mut self, t: &Turtle, a: DVec3, b: DVec3) -> Result<(), String> {
+        let seg = Seg {
+            a,
+            b,
+            left: t.left,
+            up: t.up,
+            color: t.pen.color,
+            scale: self.cur.scale,
+            sides: self.cur.sides,
+        };
+        if self.log.is_some() {
+            return self.log_tube(seg);
+        }
+        self.tube_at(&seg)
+    }
+
+    /// Logs a tube segment: as a line when it is thinner than a pixel at
+    /// the scale so far (the final scale is at least that), else whole.
+    fn log_tube(&mut self, seg: Seg) -> Result<(), String> {
+        let Some(log) = &mut self.log else {
+            return Ok(());
+        };
+        let (a, b) = (seg.a, seg.b);
+        if (b - a).length() < TINY * (1.0 + a.abs().max_element()) {
+            return Ok(());
+        }
+        let width = seg.scale.0.abs().max(seg.scale.1.abs());
+        let px = log.pixel_so_far();
+        // The tube's mesh is made now, where a walk that made the tube
+        // would make it, so that the meshes come in the same order.
+        let mesh_of = &self.mesh_of;
+        let k = seg.color.rem_euclid(256) as usize;
+        if mesh_of[k] == u32::MAX {
+            self.mesh(seg.color);
+        }
+        let Some(log) = &mut self.log else {
+            return Ok(());
+        };
+        if px > 0.0 && width / px < THIN && fits(a, 0.0) && fits(b, 0.0) {
+            log.px_used = log.px_used.max(px);
+            log.ops.push(Op::Thin);
+            log.thin.push(LoggedThin {
+                a: a.as_vec3(),
+                b: b.as_vec3(),
+                width: width as f32,
+                color: seg.color,
+            });
+        } else {
+            log.ops.push(Op::Tube);
+            log.segs.push(seg);
+        }
+        Ok(())
+    }
+
+    /// A tube segment as `seg` gives it.
+    fn tube_at(&mut self, seg: &Seg) -> Result<(), String> {
+        let (a, b) = (seg.a, seg.b);
         let d = b - a;
         let len = d.length();
         if len < TINY * (1.0 + a.abs().max_element()) {
             return Ok(());
         }
         let dir = d / len;
-        let scale = self.cur.scale;
-        let mut sides = self.cur.sides.unwrap_or(self.sides);
+        let scale = seg.scale;
+        let mut sides = seg.sides.unwrap_or(self.sides);
         if let Some(px) = self.picture_pixel {
             // The circumference in pixels over 1.5 pixels a side.
             let across = scale.0.abs().max(scale.1.abs()) / px;
             if across < THIN {
-                return self.thin(t, a, b, scale.0.abs().max(scale.1.abs()));
+                return self.thin(seg.color, a, b, scale.0.abs().max(scale.1.abs()));
             }
             let need = (std::f64::consts::PI * across / 1.5).ceil();
             if need.is_finite() && need < sides as f64 {
                 sides = (need as u32).max(MIN_CONTOUR_SIDES);
             }
         }
-        let mesh = self.mesh(t.pen.color);
+        let mesh = self.mesh(seg.color);
         let sec = self.circle(sides);
         let joint = self
             .cur
@@ -651,7 +868,7 @@ impl<'m> Builder<'m> {
             }
             None => {
                 self.end_tube()?;
-                let (l, u) = axes(dir, t.left, t.up);
+                let (l, u) = axes(dir, seg.left, seg.up);
                 let r = self.ring(mesh, true, sec, a, l, u, scale)?;
                 if self.capped {
                     self.cap(mesh, true, sec, a, (l, u, dir), scale, true)?;
@@ -674,12 +891,12 @@ impl<'m> Builder<'m> {
 
     /// A tube thinner than a pixel in a picture: its axis, as a line of
     /// the mesh (see [`TriMesh::lines`]). A tube it follows ends here.
-    fn thin(&mut self, t: &Turtle, a: DVec3, b: DVec3, width: f64) -> Result<(), String> {
+    fn thin(&mut self, color: i64, a: DVec3, b: DVec3, width: f64) -> Result<(), String> {
         self.end_tube()?;
         if !fits(a, 0.0) || !fits(b, 0.0) {
             return Err("makes a cylinder that reaches an infinite coordinate".into());
         }
-        let mesh = self.mesh(t.pen.color);
+        let mesh = self.mesh(color);
         // A line counts as a triangle against the limit.
         self.room(mesh, 0, 1)?.lines.push(Line {
             a: a.as_vec3(),
@@ -949,6 +1166,10 @@ fn triangulate(pts: &[DVec3], normal: DVec3) -> Vec<[u32; 3]> {
 
 impl Sink for Builder<'_> {
     fn line(&mut self, t: &Turtle, a: DVec3, b: DVec3) -> Result<(), String> {
+        if let Some(log) = &mut self.log {
+            log.lo = log.lo.min(a).min(b);
+            log.hi = log.hi.max(a).max(b);
+        }
         match self.style {
             LineStyle::Pixel => match self.pixel_tubes {
                 Some(k) => {
@@ -1117,6 +1338,9 @@ impl Sink for Builder<'_> {
     }
 
     fn push(&mut self) {
+        if let Some(log) = &mut self.log {
+            log.ops.push(Op::Push);
+        }
         let mut child = self.cur;
         // The parent's tube waits on the stack for the parent; the branch
         // starts its own.
@@ -1128,6 +1352,9 @@ impl Sink for Builder<'_> {
 
     fn pop(&mut self) -> Result<(), String> {
         self.end_tube()?;
+        if let Some(log) = &mut self.log {
+            log.ops.push(Op::Pop);
+        }
         if let Some(b) = self.stack.pop() {
             self.cur = b;
         }

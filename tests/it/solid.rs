@@ -871,3 +871,89 @@ fn a_picture_keeps_a_tube_under_a_pixel_as_its_axis() {
     assert!(!dir.join("p.obj").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A mesh's triangles as their corners' coordinates, sorted: the same
+/// set of triangles whatever their order and numbering.
+fn triangle_set(m: &TriMesh) -> Vec<[[u32; 3]; 3]> {
+    let mut t: Vec<[[u32; 3]; 3]> = m
+        .triangles
+        .iter()
+        .map(|tri| tri.map(|i| m.positions[i as usize].to_array().map(f32::to_bits)))
+        .collect();
+    t.sort_unstable();
+    t
+}
+
+/// The geometry of a picture whose scale the walk finds
+/// (`SolidOptions::fit_pixels`, one walk, tubes logged and made at the
+/// end) is the geometry made knowing the scale beforehand (the extent of
+/// the lines from a first walk): the same meshes in the same order, the
+/// same lines, the same triangles; and a failure names the same module.
+#[test]
+fn a_picture_found_in_one_walk_is_the_one_made_knowing_its_scale() {
+    // A plant whose trunk is thick and whose twigs are thin, with a
+    // generalized cylinder, a polygon and a sphere among its tubes, in
+    // three colours: the first segments are logged whole (the lines span
+    // little yet), later ones as lines.
+    let plant = "module A(float, float);\nderivation length: 9;\n\
+        Axiom: SetColor(2) SetWidth(3) F(20) StartGC F(5) Left(10) F(5) EndGC \
+        SetColor(3) SP() f(2) PP() Left(90) f(2) PP() Left(90) f(2) PP() EP() \
+        SetColor(2) A(10, 2);\n\
+        production:\n\
+        A(l, w) -> SetWidth(w) F(l) RollR(137.5) SB() Left(32) A(l*0.78, w*0.55) EB() \
+        Right(18) SetColor(4) A(l*0.86, w*0.7) Sphere(w)\n";
+    let fit = 0.9 * 300.0;
+    for (src, capped) in [(plant, true), (plant, false)] {
+        let mut c = load_text(src);
+        c.program.model = Arc::new(cylinders(8, capped));
+        let mut run = c.run(Default::default()).unwrap();
+        let found = run
+            .solid(&SolidOptions {
+                fit_pixels: Some(fit),
+                ..Default::default()
+            })
+            .unwrap();
+        let (lo, hi) = run.line_bounds().unwrap().unwrap();
+        let px = (hi - lo).max_element() / fit;
+        let known = run
+            .solid(&SolidOptions {
+                picture_pixel: Some(px),
+                ..Default::default()
+            })
+            .unwrap();
+        assert!(found.line_count() > 100, "{} lines", found.line_count());
+        assert!(
+            found.triangle_count() > 100,
+            "{} triangles",
+            found.triangle_count()
+        );
+        assert_eq!(found.looks, known.looks);
+        assert_eq!(found.meshes.len(), known.meshes.len());
+        for (m, n) in found.meshes.iter().zip(&known.meshes) {
+            assert!(m.lines == n.lines);
+            assert_eq!(m.positions.len(), n.positions.len());
+            assert!(triangle_set(m) == triangle_set(n));
+        }
+        // Past the triangle limit: the one-walk run gives up its log and
+        // fails as the walk that knows its scale does, at the same module.
+        let limit = known.triangle_count() / 2;
+        let mut err = |sopts: SolidOptions| {
+            run.solid(&SolidOptions {
+                max_triangles: limit,
+                ..sopts
+            })
+            .unwrap_err()
+            .to_string()
+        };
+        let one = err(SolidOptions {
+            fit_pixels: Some(fit),
+            ..Default::default()
+        });
+        assert!(one.contains("limit of"), "{one}");
+        let two = err(SolidOptions {
+            picture_pixel: Some(px),
+            ..Default::default()
+        });
+        assert_eq!(one, two);
+    }
+}
