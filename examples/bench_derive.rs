@@ -13,8 +13,11 @@
 //! 2. Threads (issue 16, item 6): the last step of the same run (512,000 ->
 //!    1,024,000 points) and the whole run, in a pool of one rayon thread and
 //!    one of two, alternating, with the speedup; the words are checked to
-//!    be the same to the bit. `--threads-only` runs this section only; run
-//!    it with `MALLOC_ARENA_MAX=1` (benches/README.md says why).
+//!    be the same to the bit; then the same for two branching systems on
+//!    the general path (a plant whose rule is a stencil, and a guarded
+//!    body compiled to closures), about a million modules at the end.
+//!    `--threads-only` runs this section only; run it with
+//!    `MALLOC_ARENA_MAX=1` (benches/README.md says why).
 //! 3. A context-sensitive rewrite without geometry: a signal moving through
 //!    a word of a million modules, in million modules per second.
 //! 4. The interpreter on a branching word: 50,000 modules, each with a
@@ -263,7 +266,6 @@ fn main() {
 /// Section 2: the Chaikin run `src` in a pool of 1 and of 2 threads,
 /// alternating run by run so that both see the same load; best of `runs`.
 fn threads(src: &str, runs: usize) {
-    use std::time::{Duration, Instant};
     let pools: Vec<rayon::ThreadPool> = [1, 2]
         .iter()
         .map(|&k| {
@@ -275,51 +277,79 @@ fn threads(src: &str, runs: usize) {
         .collect();
     for precision in [subgram::Precision::Single, subgram::Precision::Double] {
         let loaded = subgram::load_str_with("bench.lsys", src, &[], precision).expect("loads");
-        let program = &loaded.program;
-        let (mut last, mut whole) = ([Duration::MAX; 2], [Duration::MAX; 2]);
-        let mut words: Vec<subgram::Word> = Vec::new();
-        for _ in 0..runs {
-            for (k, pool) in pools.iter().enumerate() {
-                pool.install(|| {
-                    // The last step alone: the steps before it untimed.
-                    let mut d = subgram::Derivation::new(program, DeriveOptions::default())
-                        .expect("starts");
-                    while d.step + 1 < d.length {
-                        d.next_step().expect("steps");
-                    }
-                    let t = Instant::now();
-                    d.next_step().expect("steps");
-                    last[k] = last[k].min(t.elapsed());
-                    let t = Instant::now();
-                    let all = subgram::derive(program, DeriveOptions::default()).expect("derives");
-                    whole[k] = whole[k].min(t.elapsed());
-                    assert_eq!(d.word.len(), all.word.len());
-                    if words.len() < 2 {
-                        words.push(all.word);
-                    }
-                });
-            }
-        }
-        // The same word, to the bit, from either pool.
-        let bits =
-            |w: &subgram::Word| -> Vec<u64> { w.all_slots().iter().map(|x| x.to_bits()).collect() };
-        assert_eq!(words[0].syms(), words[1].syms());
-        assert_eq!(bits(&words[0]), bits(&words[1]));
-        let n = words[0].len();
-        let ms = |t: Duration| t.as_secs_f64() * 1e3;
-        println!("chaikin threads, {precision:?} precision, best of {runs}, 1 vs 2 threads");
-        println!(
-            "  last step {} -> {n} points  {:>8.2} ms  {:>8.2} ms  speedup {:.2}",
-            n / 2,
-            ms(last[0]),
-            ms(last[1]),
-            last[0].as_secs_f64() / last[1].as_secs_f64()
-        );
-        println!(
-            "  whole run 1000 -> {n}      {:>8.2} ms  {:>8.2} ms  speedup {:.2}",
-            ms(whole[0]),
-            ms(whole[1]),
-            whole[0].as_secs_f64() / whole[1].as_secs_f64()
-        );
+        let label = format!("chaikin, {precision:?} precision");
+        on_pools(&label, &loaded.program, &pools, runs);
     }
+    // The general path (issue 16, item 6): branching words, which the
+    // stencil fast path does not take. A plant whose rule is a stencil
+    // (bench_solid's), and the guarded branching system of bench_body,
+    // whose body is compiled to closures; 17 and 11 steps, about a
+    // million modules at the end.
+    let plant = "module A(float, float);\nderivation length: 17;\n\
+        Axiom: SetColor(2) A(1, 0.05);\nproduction:\n\
+        A(l, w) -> SetWidth(w) F(l) RollR(137.5) SB() Left(32) A(l*0.78, w*0.7) EB() \
+        Right(18) A(l*0.86, w*0.8)\n";
+    let guarded = "module A(float, float);\nderivation length: 11;\nAxiom: A(1, 1);\n\
+        production:\nA(l, w) : { if (l > 0.01) produce F(l) SB() Left(30) A(l * 0.7, w * 0.7) EB() \
+        SB() Right(25) A(l * 0.6, w * 0.7) EB() A(l * 0.9, w * 0.9); }\n";
+    for (label, src) in [
+        ("branching plant (stencil)", plant),
+        ("guarded branching (compiled body)", guarded),
+    ] {
+        let loaded = subgram::load_str("bench.lsys", src, &[]).expect("loads");
+        on_pools(label, &loaded.program, &pools, runs);
+    }
+}
+
+/// The last step and the whole derivation of `program` in each pool (one
+/// thread, two), alternating, best of `runs`, with the speedup; the words
+/// are checked to be the same to the bit.
+fn on_pools(label: &str, program: &subgram::Program, pools: &[rayon::ThreadPool], runs: usize) {
+    use std::time::{Duration, Instant};
+    let (mut last, mut whole) = ([Duration::MAX; 2], [Duration::MAX; 2]);
+    let mut words: Vec<subgram::Word> = Vec::new();
+    let mut before = 0;
+    for _ in 0..runs {
+        for (k, pool) in pools.iter().enumerate() {
+            pool.install(|| {
+                // The last step alone: the steps before it untimed.
+                let mut d =
+                    subgram::Derivation::new(program, DeriveOptions::default()).expect("starts");
+                while d.step + 1 < d.length {
+                    d.next_step().expect("steps");
+                }
+                before = d.word.len();
+                let t = Instant::now();
+                d.next_step().expect("steps");
+                last[k] = last[k].min(t.elapsed());
+                let t = Instant::now();
+                let all = subgram::derive(program, DeriveOptions::default()).expect("derives");
+                whole[k] = whole[k].min(t.elapsed());
+                assert_eq!(d.word.len(), all.word.len());
+                if words.len() < 2 {
+                    words.push(all.word);
+                }
+            });
+        }
+    }
+    // The same word, to the bit, from either pool.
+    let bits =
+        |w: &subgram::Word| -> Vec<u64> { w.all_slots().iter().map(|x| x.to_bits()).collect() };
+    assert_eq!(words[0].syms(), words[1].syms());
+    assert_eq!(bits(&words[0]), bits(&words[1]));
+    let n = words[0].len();
+    let ms = |t: Duration| t.as_secs_f64() * 1e3;
+    println!("{label}, best of {runs}, 1 vs 2 threads");
+    println!(
+        "  last step {before} -> {n} modules  {:>8.2} ms  {:>8.2} ms  speedup {:.2}",
+        ms(last[0]),
+        ms(last[1]),
+        last[0].as_secs_f64() / last[1].as_secs_f64()
+    );
+    println!(
+        "  whole run                   {:>8.2} ms  {:>8.2} ms  speedup {:.2}",
+        ms(whole[0]),
+        ms(whole[1]),
+        whole[0].as_secs_f64() / whole[1].as_secs_f64()
+    );
 }
