@@ -337,7 +337,16 @@ impl<'p> Rewriter<'p> {
                 && rule.new_right.is_empty()
                 && (rule.stencil.is_some() || self.bodies[r].as_ref().is_some_and(|b| b.pure()))
         });
-        if !pure || (opts.cut && src.syms().contains(&self.cut)) {
+        // Each part runs on its own copy of the environment: not worth it
+        // when the globals hold large arrays.
+        fn held(v: &Value) -> usize {
+            match v {
+                Value::Struct(fields) => fields.iter().map(held).sum::<usize>() + 1,
+                _ => 1,
+            }
+        }
+        let small = env.globals.iter().map(held).sum::<usize>() <= MAX_COPIED_GLOBALS;
+        if !pure || !small || (opts.cut && src.syms().contains(&self.cut)) {
             return None;
         }
         // The first part, written in place, is a little smaller than an
@@ -1155,6 +1164,10 @@ fn uniform_shape(fixed: &[FixedOutput]) -> Option<(usize, usize, bool)> {
 /// saves).
 pub(crate) const PARALLEL_MODULES: usize = 1 << 16;
 
+/// The most values the globals may hold for a step to run in parts, each
+/// part on its own copy of them.
+const MAX_COPIED_GLOBALS: usize = 1 << 12;
+
 /// The modules one parallel task computes: many blocks, so that a task
 /// outweighs its scheduling, and few enough that two threads share a step
 /// evenly.
@@ -1863,6 +1876,12 @@ mod tests {
         let pure = "module A(float);\nint n = 0;\nderivation length: 1;\nAxiom: A(1);\n\
              production:\nA(l) : { int m = n + 1; produce A(l * 0.9) SB() A(l * m) EB(); }\n";
         assert!(last_step(pure, 16, 2).0, "reading a global is pure");
+        // Each part would copy a large array the body does not even read.
+        let big = pure.replace("int n = 0;", "int n = 0;\nfloat big[10000];");
+        assert!(
+            !last_step(&big, 16, 2).0,
+            "large globals stay on one thread"
+        );
     }
 
     /// An overflow in the middle of a long ring, where the kernel computes,
