@@ -292,9 +292,13 @@ fn threads(src: &str, runs: usize) {
     let guarded = "module A(float, float);\nderivation length: 11;\nAxiom: A(1, 1);\n\
         production:\nA(l, w) : { if (l > 0.01) produce F(l) SB() Left(30) A(l * 0.7, w * 0.7) EB() \
         SB() Right(25) A(l * 0.6, w * 0.7) EB() A(l * 0.9, w * 0.9); }\n";
+    // A bracketed plant without parameters (lpfg's ABOP bush), 9 steps.
+    let bush = "angle: 22.5;\nderivation length: 9;\nAxiom: X;\n\
+        X -> F-[[X]+X]+F[+FX]-X\nF -> FF\n";
     for (label, src) in [
         ("branching plant (stencil)", plant),
         ("guarded branching (compiled body)", guarded),
+        ("bush, no parameters", bush),
     ] {
         let loaded = subgram::load_str("bench.lsys", src, &[]).expect("loads");
         on_pools(label, &loaded.program, &pools, runs);
