@@ -361,8 +361,12 @@ impl<'p> Rewriter<'p> {
         let per_module = src.slot_count() as f64 / n as f64;
         self.parts.resize_with(rest, Word::new);
         for (w, b) in self.parts.iter_mut().zip(bounds[1..].windows(2)) {
-            let want = ((b[1] - b[0]) as f64 * g) as usize;
-            w.clear_with_capacity(want, (want as f64 * per_module) as usize);
+            // As the new word's room is sized in `step`, within the limit.
+            let want =
+                (((b[1] - b[0]) as f64 * g) as usize).min(opts.max_modules.saturating_add(1));
+            let slots =
+                ((want as f64 * per_module) as usize).min(opts.max_modules.saturating_mul(4));
+            w.clear_with_capacity(want, slots);
         }
         let loop_limit = self.interp.loop_limit;
         self.machine.loop_limit = loop_limit;
