@@ -809,15 +809,7 @@ impl<'p> Rewriter<'p> {
                 last_rule = Some(r);
                 break;
             }
-            if !done {
-                dst.push_from(src, i);
-            }
-            if dst.len() > opts.max_modules {
-                return Err(StepError::TooLong {
-                    limit: opts.max_modules,
-                    rule: last_rule,
-                });
-            }
+            settle(done, src, i, dst, opts, last_rule)?;
         }
         Ok(rewritten)
     }
@@ -1514,19 +1506,34 @@ fn rewrite_part(
                 break;
             }
         }
-        if produced {
-            rewritten += 1;
-        } else {
-            dst.push_from(src, i);
-        }
-        if dst.len() > opts.max_modules {
-            return Err(StepError::TooLong {
-                limit: opts.max_modules,
-                rule: None,
-            });
-        }
+        rewritten += produced as usize;
+        settle(produced, src, i, dst, opts, None)?;
     }
     Ok(rewritten)
+}
+
+/// After module `i` of `src` was tried: copies it when no rule produced,
+/// and fails once `dst` holds more modules than the limit (blaming `rule`,
+/// the rule that produced last, when known).
+#[inline(always)]
+fn settle(
+    produced: bool,
+    src: &Word,
+    i: usize,
+    dst: &mut Word,
+    opts: &StepOptions,
+    rule: Option<usize>,
+) -> Result<(), StepError> {
+    if !produced {
+        dst.push_from(src, i);
+    }
+    if dst.len() > opts.max_modules {
+        return Err(StepError::TooLong {
+            limit: opts.max_modules,
+            rule,
+        });
+    }
+    Ok(())
 }
 
 /// Evaluates a stencil into `dst`. Returns false if a value is not finite.
