@@ -413,6 +413,11 @@ fn fits(c: DVec3, r: f64) -> bool {
     (c.abs().max_element() + r.abs()) < f32::MAX as f64
 }
 
+/// A segment too short to have a direction: it makes no tube.
+fn too_short(a: DVec3, b: DVec3) -> bool {
+    (b - a).length() < TINY * (1.0 + a.abs().max_element())
+}
+
 /// Left and up axes perpendicular to the unit `dir`, as close to the
 /// turtle's left as can be, with up = dir × left.
 fn axes(dir: DVec3, left: DVec3, up: DVec3) -> (DVec3, DVec3) {
@@ -781,25 +786,18 @@ impl<'m> Builder<'m> {
     /// Logs a tube segment: as a line when it is thinner than a pixel at
     /// the scale so far (the final scale is at least that), else whole.
     fn log_tube(&mut self, seg: Seg) -> Result<(), String> {
-        let Some(log) = &mut self.log else {
-            return Ok(());
-        };
         let (a, b) = (seg.a, seg.b);
-        if (b - a).length() < TINY * (1.0 + a.abs().max_element()) {
+        if self.log.is_none() || too_short(a, b) {
             return Ok(());
         }
-        let width = seg.scale.0.abs().max(seg.scale.1.abs());
-        let px = log.pixel_so_far();
         // The tube's mesh is made now, where a walk that made the tube
         // would make it, so that the meshes come in the same order.
-        let mesh_of = &self.mesh_of;
-        let k = seg.color.rem_euclid(256) as usize;
-        if mesh_of[k] == u32::MAX {
-            self.mesh(seg.color);
-        }
+        self.mesh(seg.color);
         let Some(log) = &mut self.log else {
             return Ok(());
         };
+        let width = seg.scale.0.abs().max(seg.scale.1.abs());
+        let px = log.pixel_so_far();
         if px > 0.0 && width / px < THIN && fits(a, 0.0) && fits(b, 0.0) {
             log.px_used = log.px_used.max(px);
             log.ops.push(Op::Thin);
@@ -819,12 +817,11 @@ impl<'m> Builder<'m> {
     /// A tube segment as `seg` gives it.
     fn tube_at(&mut self, seg: &Seg) -> Result<(), String> {
         let (a, b) = (seg.a, seg.b);
-        let d = b - a;
-        let len = d.length();
-        if len < TINY * (1.0 + a.abs().max_element()) {
+        if too_short(a, b) {
             return Ok(());
         }
-        let dir = d / len;
+        let d = b - a;
+        let dir = d / d.length();
         let scale = seg.scale;
         let mut sides = seg.sides.unwrap_or(self.sides);
         if let Some(px) = self.picture_pixel {
