@@ -453,10 +453,10 @@ impl<'p> Rewriter<'p> {
 
     /// True when the step can take the compiled fast path: every rule is a
     /// stencil with a one-module strict predecessor, plain contexts (no
-    /// filter, no overloaded modules) and the word has no branches and no
-    /// `Cut`.
+    /// filter; an overloaded module's pattern matches by its width, as on
+    /// the general path) and the word has no branches and no `Cut`.
     fn stencils_only(&self, rules: &[usize], src: &Word) -> bool {
-        let simple = |p: &Pattern| p.width.is_none() && p.sym != self.sb && p.sym != self.eb;
+        let simple = |p: &Pattern| p.sym != self.sb && p.sym != self.eb;
         let rules_ok = rules.iter().all(|&r| {
             let rule = &self.program.rules[r];
             rule.stencil.is_some()
@@ -507,7 +507,7 @@ impl<'p> Rewriter<'p> {
                 .iter()
                 .chain(&rule.strict)
                 .chain(&rule.right)
-                .all(|p| p.sym == s);
+                .all(|p| p.sym == s && p.width.is_none_or(|pw| pw == w));
             if rule.strict.len() == 1 && all_s && rule.left.len() <= n && rule.right.len() <= n {
                 return rule.stencil.is_some().then_some((r, w));
             }
@@ -752,7 +752,6 @@ impl<'p> Rewriter<'p> {
     ) -> Result<usize, StepError> {
         let program = self.program;
         let n = src.len();
-        let syms = src.syms();
         // Contexts reach at most n modules either way (as in the general
         // path), so one addition or subtraction wraps a position.
         let at = |pos: isize| -> Option<usize> {
@@ -778,7 +777,7 @@ impl<'p> Rewriter<'p> {
             let mut done = false;
             'rules: for &r in rules {
                 let rule = &program.rules[r];
-                if syms[i] != rule.strict[0].sym {
+                if !module_matches(src, i, &rule.strict[0]) {
                     continue;
                 }
                 let nl = rule.left.len();
@@ -791,14 +790,14 @@ impl<'p> Rewriter<'p> {
                 }
                 for (t, p) in rule.left.iter().enumerate() {
                     match at(i as isize - (nl - t) as isize) {
-                        Some(j) if syms[j] == p.sym => matched[t] = j,
+                        Some(j) if module_matches(src, j, p) => matched[t] = j,
                         _ => continue 'rules,
                     }
                 }
                 matched[nl] = i;
                 for (t, p) in rule.right.iter().enumerate() {
                     match at(i as isize + 1 + t as isize) {
-                        Some(j) if syms[j] == p.sym => matched[nl + 1 + t] = j,
+                        Some(j) if module_matches(src, j, p) => matched[nl + 1 + t] = j,
                         _ => continue 'rules,
                     }
                 }

@@ -274,6 +274,46 @@ fn function_like_macros_expand_with_their_arguments() {
     assert_eq!(run(src), "A(1) A(3)");
 }
 
+/// `F` is overloaded (`F` and `F(l)`): a stencil whose pattern is `F(x)`
+/// rewrites only the `F`s with one parameter, on the fast paths as on the
+/// general one: in an open word, in contexts (an `F` without parameters
+/// is no `F(a)` context), and on rings of one module kind with and without
+/// the pattern's parameters. The expected words are worked out by hand.
+#[test]
+fn stencils_on_overloaded_modules_match_by_width() {
+    let cases = [
+        (
+            "derivation length: 1;\nAxiom: F F(1) f F F(3);\nF(x) -> F(x/2) F(x/2)\n",
+            "F F(0.5) F(0.5) f F F(1.5) F(1.5)",
+        ),
+        (
+            "derivation length: 1;\nAxiom: F(1) F F(2) F(4);\nF(a) < F(x) -> F(a + x)\n",
+            "F(1) F F(2) F(6)",
+        ),
+        (
+            "ring L-system: 1;\nderivation length: 2;\nAxiom: F(1) F(2) F(4);\n\
+             F(a) < F(x) > F(b) -> F(a + b) F(x)\n",
+            "F(5) F(6) F(11) F(1) F(3) F(5) F(8) F(2) F(6) F(3) F(9) F(4)",
+        ),
+        (
+            "ring L-system: 1;\nderivation length: 2;\nAxiom: F F F;\nF(x) -> F(x) F(x)\n",
+            "F F F",
+        ),
+    ];
+    for (src, want) in cases {
+        let slow = src
+            .replace("-> F", ": { if (1) produce F")
+            .replace(")\n", "); }\n");
+        assert!(load_text(src).program.rules[0].stencil.is_some(), "{src}");
+        assert!(
+            load_text(&slow).program.rules[0].stencil.is_none(),
+            "{slow}"
+        );
+        assert_eq!(run(src), want, "{src}");
+        assert_eq!(run(&slow), want, "{slow}");
+    }
+}
+
 /// The fast path replays the interpreter's operations: results agree to
 /// the last bit, whatever the shape of the affine expression.
 #[test]
