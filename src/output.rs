@@ -25,31 +25,106 @@ pub fn write_word_text(
     alphabet: &Alphabet,
     structs: &[StructDef],
 ) -> std::io::Result<()> {
-    let mut buf = Chunks::new(out);
-    let mut num = Numbers::default();
-    let mut layouts = Layouts::new(alphabet, structs);
-    for i in 0..word.len() {
+    let text = |f: &mut Formatter<'_>, buf: &mut Vec<u8>, i: usize| {
         let sym = word.syms()[i];
         if i > 0 {
-            buf.text.push(b' ');
+            buf.push(b' ');
         }
-        buf.push(alphabet.name(sym).as_bytes());
+        buf.extend_from_slice(alphabet.name(sym).as_bytes());
         let data = word.data(i);
-        let tys = layouts.of(sym, data.len());
+        let tys = f.layouts.of(sym, data.len());
         if !tys.is_empty() {
-            buf.text.push(b'(');
+            buf.push(b'(');
             let mut slots = data;
             for (j, &ty) in tys.iter().enumerate() {
                 if j > 0 {
-                    buf.text.extend_from_slice(b", ");
+                    buf.extend_from_slice(b", ");
                 }
-                slots = num.value(Style::Text, &mut buf.text, ty, slots, structs);
+                slots = f.num.value(Style::Text, buf, ty, slots, structs);
             }
-            buf.text.push(b')');
+            buf.push(b')');
         }
-        buf.flush_if_full()?;
+    };
+    write_modules(out, word.len(), || Formatter::new(alphabet, structs), text)
+}
+
+/// What one thread needs to format modules: its number buffers and its
+/// cache of parameter layouts.
+struct Formatter<'a> {
+    num: Numbers,
+    layouts: Layouts<'a>,
+    /// Each symbol's name as a JSON string, once met.
+    names: Vec<Option<Vec<u8>>>,
+}
+
+impl<'a> Formatter<'a> {
+    fn new(alphabet: &'a Alphabet, structs: &'a [StructDef]) -> Self {
+        Formatter {
+            num: Numbers::default(),
+            layouts: Layouts::new(alphabet, structs),
+            names: Vec::new(),
+        }
     }
-    buf.finish()
+}
+
+/// Modules in a block formatted by one task.
+const BLOCK: usize = 8192;
+/// Blocks formatted at once, while the ones before them are written.
+const WINDOW: usize = 16;
+
+/// Writes the text `module(f, buf, i)` appends for each module `i` of
+/// `0..n`, in order. A small word is formatted on this thread, a large
+/// one in blocks on rayon's pool: a window of blocks is formatted while
+/// the window before it is written, so that memory beyond the word stays
+/// two windows of text whatever the word's length. The bytes are the same
+/// either way: each module's text depends on the module alone.
+fn write_modules<'a, W: Write + ?Sized>(
+    out: &mut W,
+    n: usize,
+    init: impl Fn() -> Formatter<'a> + Sync,
+    module: impl Fn(&mut Formatter<'a>, &mut Vec<u8>, usize) + Sync,
+) -> std::io::Result<()> {
+    use rayon::prelude::*;
+    if n < 2 * BLOCK || rayon::current_num_threads() == 1 {
+        let mut f = init();
+        let mut buf = Chunks::new(out);
+        for i in 0..n {
+            module(&mut f, &mut buf.text, i);
+            buf.flush_if_full()?;
+        }
+        return buf.finish();
+    }
+    let format = |window: usize, bufs: &mut Vec<Vec<u8>>| {
+        let first = window * WINDOW * BLOCK;
+        bufs.par_iter_mut()
+            .enumerate()
+            .for_each_init(&init, |f, (b, buf)| {
+                buf.clear();
+                let from = (first + b * BLOCK).min(n);
+                let to = (from + BLOCK).min(n);
+                for i in from..to {
+                    module(f, buf, i);
+                }
+            });
+    };
+    let windows = n.div_ceil(WINDOW * BLOCK);
+    let mut ready: Vec<Vec<u8>> = vec![Vec::new(); WINDOW];
+    let mut next: Vec<Vec<u8>> = vec![Vec::new(); WINDOW];
+    format(0, &mut ready);
+    for w in 0..windows {
+        let mut written = Ok(());
+        rayon::in_place_scope(|s| {
+            if w + 1 < windows {
+                let next = &mut next;
+                let format = &format;
+                s.spawn(move |_| format(w + 1, next));
+            }
+            written = ready.iter().try_for_each(|b| out.write_all(b));
+        });
+        written?;
+        std::mem::swap(&mut ready, &mut next);
+    }
+    Ok(())
 }
 
 /// Each symbol's parameter types for the number of slots it was last met
@@ -86,12 +161,12 @@ impl<'a> Layouts<'a> {
 
 /// Bytes gathered in memory and written to `out` a large chunk at a time,
 /// so that a word of millions of modules costs a few hundred writes.
-struct Chunks<'a, W: Write> {
+struct Chunks<'a, W: Write + ?Sized> {
     out: &'a mut W,
     text: Vec<u8>,
 }
 
-impl<'a, W: Write> Chunks<'a, W> {
+impl<'a, W: Write + ?Sized> Chunks<'a, W> {
     const SIZE: usize = 1 << 16;
 
     fn new(out: &'a mut W) -> Self {
@@ -99,10 +174,6 @@ impl<'a, W: Write> Chunks<'a, W> {
             out,
             text: Vec::with_capacity(Self::SIZE + 256),
         }
-    }
-
-    fn push(&mut self, bytes: &[u8]) {
-        self.text.extend_from_slice(bytes);
     }
 
     fn flush_if_full(&mut self) -> std::io::Result<()> {
@@ -481,39 +552,34 @@ pub fn write_word_json(
     alphabet: &Alphabet,
     structs: &[StructDef],
 ) -> std::io::Result<()> {
-    let mut buf = Chunks::new(out);
-    let mut num = Numbers::default();
-    let mut layouts = Layouts::new(alphabet, structs);
-    buf.push(b"{\"modules\":[");
-    let mut names: Vec<Option<Vec<u8>>> = Vec::new();
-    for i in 0..word.len() {
+    out.write_all(b"{\"modules\":[")?;
+    let json = |f: &mut Formatter<'_>, buf: &mut Vec<u8>, i: usize| {
         if i > 0 {
-            buf.push(b",");
+            buf.push(b',');
         }
         let sym = word.syms()[i];
         let k = sym.0 as usize;
-        if names.len() <= k {
-            names.resize(k + 1, None);
+        if f.names.len() <= k {
+            f.names.resize(k + 1, None);
         }
-        let name = names[k].get_or_insert_with(|| {
-            serde_json::to_vec(alphabet.name(sym)).expect("a string is JSON")
-        });
-        buf.push(b"{\"params\":[");
+        buf.extend_from_slice(b"{\"params\":[");
         let data = word.data(i);
         let mut slots = data;
-        for (j, &ty) in layouts.of(sym, data.len()).iter().enumerate() {
+        for (j, &ty) in f.layouts.of(sym, data.len()).iter().enumerate() {
             if j > 0 {
-                buf.push(b",");
+                buf.push(b',');
             }
-            slots = num.value(Style::Json, &mut buf.text, ty, slots, structs);
+            slots = f.num.value(Style::Json, buf, ty, slots, structs);
         }
-        buf.push(b"],\"symbol\":");
-        buf.push(name);
-        buf.push(b"}");
-        buf.flush_if_full()?;
-    }
-    buf.push(format!("],\"ring\":{ring},\"step\":{step}}}").as_bytes());
-    buf.finish()
+        buf.extend_from_slice(b"],\"symbol\":");
+        let name = f.names[k].get_or_insert_with(|| {
+            serde_json::to_vec(alphabet.name(sym)).expect("a string is JSON")
+        });
+        buf.extend_from_slice(name);
+        buf.push(b'}');
+    };
+    write_modules(out, word.len(), || Formatter::new(alphabet, structs), json)?;
+    write!(out, "],\"ring\":{ring},\"step\":{step}}}")
 }
 
 /// [`write_word_json`] into a string.
@@ -839,6 +905,45 @@ mod tests {
             word_text(word, alphabet, structs),
             text_by_values(word, alphabet, structs)
         );
+    }
+
+    /// A word of several windows of blocks is written in parallel blocks,
+    /// in pools of one and of three threads: the text is the values' text
+    /// and the JSON the tree's, byte for byte.
+    #[test]
+    fn a_long_word_in_blocks_is_the_same_text_for_any_number_of_threads() {
+        let text = r#"
+            struct S { int k; float w; V2f v; };
+            module A(float, double, int, bool);
+            module C(S);
+            module T(float);
+            Axiom: A(0.1, 1e-7, -3, true) C(S(7, 0.3f, V2f(0, 1e-30))) F T(1);
+            derivation length: 17;
+            T(x) : { produce T(x / 3) C(S(2, x, V2f(x, -x))) T(x * 1.7) F(x + 0.1); }
+        "#;
+        let curve = crate::load_str("t.lsys", text, &[]).unwrap_or_else(|e| panic!("{e}"));
+        let run = curve.run(Default::default()).unwrap();
+        let (alphabet, structs) = (&curve.program.alphabet, &curve.program.structs);
+        let word = run.word();
+        // Past two windows, and not a whole number of blocks.
+        assert!(word.len() > 2 * WINDOW * BLOCK, "{}", word.len());
+        assert_ne!(word.len() % BLOCK, 0);
+        let text_ref = text_by_values(word, alphabet, structs);
+        let json_ref = tree(word, false, 17, alphabet, structs).to_string();
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (text, json) = pool.install(|| {
+                (
+                    word_text(word, alphabet, structs),
+                    word_json(word, false, 17, alphabet, structs),
+                )
+            });
+            assert!(text == text_ref, "text differs on {threads} threads");
+            assert!(json == json_ref, "JSON differs on {threads} threads");
+        }
     }
 
     /// Every kind of parameter, streamed, prints as the tree prints.
