@@ -27,9 +27,6 @@ pub fn write_word_text(
 ) -> std::io::Result<()> {
     let text = |f: &mut Formatter<'_>, buf: &mut Vec<u8>, i: usize| {
         let sym = word.syms()[i];
-        if i > 0 {
-            buf.push(b' ');
-        }
         buf.extend_from_slice(alphabet.name(sym).as_bytes());
         let data = word.data(i);
         let tys = f.layouts.of(sym, data.len());
@@ -45,16 +42,17 @@ pub fn write_word_text(
             buf.push(b')');
         }
     };
-    write_modules(out, word.len(), || Formatter::new(alphabet, structs), text)
+    write_modules(out, word, b' ', || Formatter::new(alphabet, structs), text)
 }
 
-/// What one thread needs to format modules: its number buffers and its
-/// cache of parameter layouts.
+/// What one thread needs to format modules: its number buffers, its
+/// cache of parameter layouts, and each symbol's last text.
 struct Formatter<'a> {
     num: Numbers,
     layouts: Layouts<'a>,
     /// Each symbol's name as a JSON string, once met.
     names: Vec<Option<Vec<u8>>>,
+    memo: Memo,
 }
 
 impl<'a> Formatter<'a> {
@@ -63,7 +61,58 @@ impl<'a> Formatter<'a> {
             num: Numbers::default(),
             layouts: Layouts::new(alphabet, structs),
             names: Vec::new(),
+            memo: Memo::default(),
         }
+    }
+}
+
+/// The text of the last module of each symbol, with the bits of its
+/// parameters: turtle modules repeat their parameters (`F(1)`, `+(90)`)
+/// through the whole word, and a repeat is copied instead of formatted.
+/// The text depends on the symbol and those bits alone.
+#[derive(Default)]
+struct Memo {
+    last: Vec<Remembered>,
+}
+
+#[derive(Default)]
+struct Remembered {
+    known: bool,
+    bits: Vec<u64>,
+    text: Vec<u8>,
+}
+
+impl Memo {
+    /// Modules with more slots than this, or a longer text, are not kept.
+    const SLOTS: usize = 8;
+    const TEXT: usize = 256;
+
+    #[inline]
+    fn get(&self, sym: crate::lang::Sym, data: &[f64]) -> Option<&[u8]> {
+        let r = self.last.get(sym.0 as usize)?;
+        let same = r.known
+            && r.bits.len() == data.len()
+            && r.bits.iter().zip(data).all(|(&b, x)| b == x.to_bits());
+        same.then_some(&r.text[..])
+    }
+
+    fn put(&mut self, sym: crate::lang::Sym, data: &[f64], text: &[u8]) {
+        let k = sym.0 as usize;
+        if data.len() > Self::SLOTS || text.len() > Self::TEXT {
+            if let Some(r) = self.last.get_mut(k) {
+                r.known = false;
+            }
+            return;
+        }
+        if self.last.len() <= k {
+            self.last.resize_with(k + 1, Remembered::default);
+        }
+        let r = &mut self.last[k];
+        r.known = true;
+        r.bits.clear();
+        r.bits.extend(data.iter().map(|x| x.to_bits()));
+        r.text.clear();
+        r.text.extend_from_slice(text);
     }
 }
 
@@ -73,18 +122,34 @@ const BLOCK: usize = 8192;
 const WINDOW: usize = 16;
 
 /// Writes the text `module(f, buf, i)` appends for each module `i` of
-/// `0..n`, in order. A small word is formatted on this thread, a large
-/// one in blocks on rayon's pool: a window of blocks is formatted while
-/// the window before it is written, so that memory beyond the word stays
-/// two windows of text whatever the word's length. The bytes are the same
-/// either way: each module's text depends on the module alone.
+/// `word`, in order, `sep` between two modules. A small word is formatted
+/// on this thread, a large one in blocks on rayon's pool: a window of
+/// blocks is formatted while the window before it is written, so that
+/// memory beyond the word stays two windows of text whatever the word's
+/// length. The bytes are the same either way: each module's text depends
+/// on the module alone.
 fn write_modules<'a, W: Write + ?Sized>(
     out: &mut W,
-    n: usize,
+    word: &Word,
+    sep: u8,
     init: impl Fn() -> Formatter<'a> + Sync,
     module: impl Fn(&mut Formatter<'a>, &mut Vec<u8>, usize) + Sync,
 ) -> std::io::Result<()> {
     use rayon::prelude::*;
+    let n = word.len();
+    let module = |f: &mut Formatter<'a>, buf: &mut Vec<u8>, i: usize| {
+        if i > 0 {
+            buf.push(sep);
+        }
+        let (sym, data) = (word.syms()[i], word.data(i));
+        if let Some(text) = f.memo.get(sym, data) {
+            buf.extend_from_slice(text);
+            return;
+        }
+        let start = buf.len();
+        module(f, buf, i);
+        f.memo.put(sym, data, &buf[start..]);
+    };
     if n < 2 * BLOCK || rayon::current_num_threads() == 1 {
         let mut f = init();
         let mut buf = Chunks::new(out);
@@ -554,9 +619,6 @@ pub fn write_word_json(
 ) -> std::io::Result<()> {
     out.write_all(b"{\"modules\":[")?;
     let json = |f: &mut Formatter<'_>, buf: &mut Vec<u8>, i: usize| {
-        if i > 0 {
-            buf.push(b',');
-        }
         let sym = word.syms()[i];
         let k = sym.0 as usize;
         if f.names.len() <= k {
@@ -578,7 +640,7 @@ pub fn write_word_json(
         buf.extend_from_slice(name);
         buf.push(b'}');
     };
-    write_modules(out, word.len(), || Formatter::new(alphabet, structs), json)?;
+    write_modules(out, word, b',', || Formatter::new(alphabet, structs), json)?;
     write!(out, "],\"ring\":{ring},\"step\":{step}}}")
 }
 
@@ -909,7 +971,9 @@ mod tests {
 
     /// A word of several windows of blocks is written in parallel blocks,
     /// in pools of one and of three threads: the text is the values' text
-    /// and the JSON the tree's, byte for byte.
+    /// and the JSON the tree's, byte for byte. Modules repeat (the memo's
+    /// copies), and `F` comes with and without parameters and with 0 and
+    /// -0 between others.
     #[test]
     fn a_long_word_in_blocks_is_the_same_text_for_any_number_of_threads() {
         let text = r#"
@@ -918,8 +982,8 @@ mod tests {
             module C(S);
             module T(float);
             Axiom: A(0.1, 1e-7, -3, true) C(S(7, 0.3f, V2f(0, 1e-30))) F T(1);
-            derivation length: 17;
-            T(x) : { produce T(x / 3) C(S(2, x, V2f(x, -x))) T(x * 1.7) F(x + 0.1); }
+            derivation length: 15;
+            T(x) : { produce T(x / 3) C(S(2, x, V2f(x, -x))) T(x * 1.7) F(x + 0.1) F Left(30) F(1) F(0 * x) F(-0.0 * x) Right(30); }
         "#;
         let curve = crate::load_str("t.lsys", text, &[]).unwrap_or_else(|e| panic!("{e}"));
         let run = curve.run(Default::default()).unwrap();
@@ -929,7 +993,7 @@ mod tests {
         assert!(word.len() > 2 * WINDOW * BLOCK, "{}", word.len());
         assert_ne!(word.len() % BLOCK, 0);
         let text_ref = text_by_values(word, alphabet, structs);
-        let json_ref = tree(word, false, 17, alphabet, structs).to_string();
+        let json_ref = tree(word, false, 15, alphabet, structs).to_string();
         for threads in [1, 3] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -938,7 +1002,7 @@ mod tests {
             let (text, json) = pool.install(|| {
                 (
                     word_text(word, alphabet, structs),
-                    word_json(word, false, 17, alphabet, structs),
+                    word_json(word, false, 15, alphabet, structs),
                 )
             });
             assert!(text == text_ref, "text differs on {threads} threads");
