@@ -22,14 +22,18 @@ use super::Rgba;
 /// The longest piece a segment is cut into, in pixels.
 const PIECE: f64 = 0.5;
 
+/// Polylines of this many points or more are inked in bands of rows, one
+/// per thread of rayon's pool.
+const PARALLEL_POINTS: usize = 1 << 16;
+
 /// The ink of one path at a time, over a picture of a given size.
 pub(crate) struct Ink {
     width: usize,
     height: usize,
     /// The ink on each pixel, row by row.
     ink: Vec<f32>,
-    /// The pixels with ink, each once.
-    touched: Vec<u32>,
+    /// The pixels with ink, each once: a list for each band of rows.
+    touched: Vec<Vec<u32>>,
 }
 
 impl Ink {
@@ -38,17 +42,106 @@ impl Ink {
             width: width as usize,
             height: height as usize,
             ink: vec![0.0; width as usize * height as usize],
-            touched: Vec::new(),
+            touched: vec![Vec::new()],
         }
     }
 
     /// Lays down the ink of `points`, joined in order, with a pen `pen`
     /// pixels wide (at most one).
+    ///
+    /// A long polyline is inked in bands of rows at once: each band walks
+    /// every segment and keeps the ink that falls on its rows, so that
+    /// every pixel gathers its ink in the order of the segments, as on one
+    /// thread, and the picture is the same to the bit.
     pub(crate) fn polyline(&mut self, points: &[DVec2], pen: f64) {
+        use rayon::prelude::*;
+        let (width, height) = (self.width, self.height);
+        let bands = if points.len() >= PARALLEL_POINTS && width > 0 {
+            rayon::current_num_threads().min(height / 16).max(1)
+        } else {
+            1
+        };
+        let rows = height.div_ceil(bands).max(1);
+        if self.touched.len() < bands {
+            self.touched.resize_with(bands, Vec::new);
+        }
+        let lay = |b: usize, ink: &mut [f32], touched: &mut Vec<u32>| {
+            Band {
+                width,
+                height,
+                row0: b * rows,
+                rows: ink.len() / width.max(1),
+                ink,
+                touched,
+            }
+            .lay(points, pen)
+        };
+        if bands == 1 {
+            lay(0, &mut self.ink, &mut self.touched[0]);
+        } else {
+            self.ink
+                .par_chunks_mut(rows * width)
+                .zip(self.touched.par_iter_mut())
+                .enumerate()
+                .for_each(|(b, (ink, touched))| lay(b, ink, touched));
+        }
+    }
+    /// Blends `color` over `pm` where the ink lies, by the ink's coverage,
+    /// and clears the ink for the next path.
+    pub(crate) fn blend(&mut self, pm: &mut Pixmap, color: Rgba) {
+        let alpha = color.3 as f32 / 255.0;
+        let src = [color.0 as f32, color.1 as f32, color.2 as f32, 255.0];
+        let pixels = pm.pixels_mut();
+        for &i in self.touched.iter().flatten() {
+            let i = i as usize;
+            let a = self.ink[i].min(1.0) * alpha;
+            self.ink[i] = 0.0;
+            let p = pixels[i];
+            let dst = [p.red(), p.green(), p.blue(), p.alpha()].map(f32::from);
+            let mix = |k: usize| (src[k] * a + dst[k] * (1.0 - a)).round().clamp(0.0, 255.0) as u8;
+            let out_a = mix(3);
+            let out = PremultipliedColorU8::from_rgba(
+                mix(0).min(out_a),
+                mix(1).min(out_a),
+                mix(2).min(out_a),
+                out_a,
+            );
+            if let Some(out) = out {
+                pixels[i] = out;
+            }
+        }
+        for t in &mut self.touched {
+            t.clear();
+        }
+    }
+}
+
+/// The rows `row0..row0 + rows` of the ink, and the pixels among them
+/// that have ink.
+struct Band<'a> {
+    width: usize,
+    height: usize,
+    row0: usize,
+    rows: usize,
+    /// The band's rows of [`Ink::ink`].
+    ink: &'a mut [f32],
+    touched: &'a mut Vec<u32>,
+}
+
+impl Band<'_> {
+    /// The ink of `points` on the band's rows (see [`Ink::polyline`]).
+    fn lay(&mut self, points: &[DVec2], pen: f64) {
         let (w, h) = (self.width as f64, self.height as f64);
         let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= w && p.y <= h;
+        // A piece's middle at y inks rows floor(y - 0.5) and the one below:
+        // a segment wholly above `top` or below `bottom` inks none of the
+        // band's rows (nor does a piece clipping keeps of it).
+        let (top, bottom) = (self.row0 as f64 - 2.0, (self.row0 + self.rows) as f64 + 2.0);
         for pair in points.windows(2) {
             let (a, b) = (pair[0], pair[1]);
+            if (a.y < top && b.y < top) || (a.y > bottom && b.y > bottom) {
+                continue;
+            }
             let Some((a, b)) = (if inside(a) && inside(b) {
                 Some((a, b))
             } else {
@@ -75,7 +168,8 @@ impl Ink {
         }
     }
 
-    /// Adds `area` to the four pixels whose centres surround `c`.
+    /// Adds `area` to those of the four pixels whose centres surround `c`
+    /// that lie in the band.
     #[inline]
     fn splat(&mut self, c: DVec2, area: f32) {
         // Clipped points lie above -1, so that truncating after adding 2
@@ -90,7 +184,8 @@ impl Ink {
             (1.0 - tx) * ty,
             tx * ty,
         ];
-        if x0 >= 0 && y0 >= 0 && x0 + 1 < self.width as i64 && y0 + 1 < self.height as i64 {
+        let (first, end) = (self.row0 as i64, (self.row0 + self.rows) as i64);
+        if x0 >= 0 && y0 >= first && x0 + 1 < self.width as i64 && y0 + 1 < end {
             // All four inside: no bounds to check.
             let i = y0 as usize * self.width + x0 as usize;
             for (k, weight) in weights.into_iter().enumerate() {
@@ -99,58 +194,26 @@ impl Ink {
             }
             return;
         }
-        for (dx, dy, weight) in [
-            (0, 0, (1.0 - tx) * (1.0 - ty)),
-            (1, 0, tx * (1.0 - ty)),
-            (0, 1, (1.0 - tx) * ty),
-            (1, 1, tx * ty),
-        ] {
-            let (x, y) = (x0 + dx, y0 + dy);
-            if x < 0 || y < 0 || x >= self.width as i64 || y >= self.height as i64 {
+        for (k, weight) in weights.into_iter().enumerate() {
+            let (x, y) = (x0 + (k & 1) as i64, y0 + (k >> 1) as i64);
+            if x < 0 || y < first || x >= self.width as i64 || y >= end {
                 continue;
             }
             self.add(y as usize * self.width + x as usize, area * weight);
         }
     }
 
-    /// Adds `ink` to pixel `i`, noting the pixel when it gets its first
-    /// ink: a piece whose ink is zero (a pen or a piece so thin that its
-    /// area rounds to nothing) notes nothing, so that a pixel is noted once
-    /// however many of them fall on it.
+    /// Adds `ink` to pixel `i` (of the whole picture), noting the pixel
+    /// when it gets its first ink: a piece whose ink is zero (a pen or a
+    /// piece so thin that its area rounds to nothing) notes nothing, so
+    /// that a pixel is noted once however many of them fall on it.
     #[inline(always)]
     fn add(&mut self, i: usize, ink: f32) {
-        let cell = &mut self.ink[i];
+        let cell = &mut self.ink[i - self.row0 * self.width];
         if *cell == 0.0 && ink > 0.0 {
             self.touched.push(i as u32);
         }
         *cell += ink;
-    }
-
-    /// Blends `color` over `pm` where the ink lies, by the ink's coverage,
-    /// and clears the ink for the next path.
-    pub(crate) fn blend(&mut self, pm: &mut Pixmap, color: Rgba) {
-        let alpha = color.3 as f32 / 255.0;
-        let src = [color.0 as f32, color.1 as f32, color.2 as f32, 255.0];
-        let pixels = pm.pixels_mut();
-        for &i in &self.touched {
-            let i = i as usize;
-            let a = self.ink[i].min(1.0) * alpha;
-            self.ink[i] = 0.0;
-            let p = pixels[i];
-            let dst = [p.red(), p.green(), p.blue(), p.alpha()].map(f32::from);
-            let mix = |k: usize| (src[k] * a + dst[k] * (1.0 - a)).round().clamp(0.0, 255.0) as u8;
-            let out_a = mix(3);
-            let out = PremultipliedColorU8::from_rgba(
-                mix(0).min(out_a),
-                mix(1).min(out_a),
-                mix(2).min(out_a),
-                out_a,
-            );
-            if let Some(out) = out {
-                pixels[i] = out;
-            }
-        }
-        self.touched.clear();
     }
 }
 
@@ -216,6 +279,64 @@ fn clip(a: DVec2, b: DVec2, w: f64, h: f64) -> Option<(DVec2, DVec2)> {
 mod tests {
     use super::*;
 
+    impl Ink {
+        /// The pixels noted, band after band.
+        fn noted(&self) -> Vec<u32> {
+            self.touched.iter().flatten().copied().collect()
+        }
+    }
+
+    /// A polyline long enough to be inked in bands, in pools of one to
+    /// four threads: the same ink on every pixel, to the bit, and the same
+    /// pixels noted. Its points wander in and out of the picture (a
+    /// spiral, jitter from a generator written here, and long jumps
+    /// across it), and the picture's height is not a multiple of the
+    /// bands'.
+    #[test]
+    fn a_long_polyline_inks_the_same_in_bands() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let n = 3 * PARALLEL_POINTS;
+        let points: Vec<DVec2> = (0..n)
+            .map(|i| {
+                let t = i as f64 / n as f64;
+                let r = 10.0 + 60.0 * t;
+                let a = t * 300.0;
+                let jitter = DVec2::new(next() - 0.5, next() - 0.5) * 3.0;
+                let jump = if i % 997 == 0 {
+                    DVec2::new(0.0, 150.0)
+                } else {
+                    DVec2::ZERO
+                };
+                DVec2::new(50.0 + r * a.cos(), 45.0 + r * a.sin()) + jitter + jump
+            })
+            .collect();
+        let inked = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut ink = Ink::new(101, 91);
+            pool.install(|| ink.polyline(&points, 0.7));
+            let mut noted = ink.noted();
+            noted.sort_unstable();
+            let bits: Vec<u32> = ink.ink.iter().map(|x| x.to_bits()).collect();
+            (bits, noted)
+        };
+        let (one, noted) = inked(1);
+        assert!(noted.len() > 5000, "{}", noted.len());
+        for threads in 2..=4 {
+            let (bits, seen) = inked(threads);
+            assert!(bits == one, "the ink differs on {threads} threads");
+            assert_eq!(seen, noted, "{threads} threads");
+        }
+    }
+
     fn ink_of(points: &[DVec2], pen: f64) -> Ink {
         let mut ink = Ink::new(20, 20);
         ink.polyline(points, pen);
@@ -253,7 +374,7 @@ mod tests {
         let total: f32 = far.ink.iter().sum();
         assert!((total - 20.0).abs() < 0.6, "{total}");
         let none = ink_of(&[DVec2::new(-50.0, -50.0), DVec2::new(-10.0, 80.0)], 1.0);
-        assert!(none.touched.is_empty());
+        assert!(none.noted().is_empty());
     }
 
     #[test]
@@ -269,7 +390,7 @@ mod tests {
         assert_eq!((p.red(), p.green(), p.blue(), p.alpha()), (10, 20, 30, 255));
         let q = pm.pixel(2, 2).unwrap();
         assert_eq!((q.red(), q.alpha()), (255, 255));
-        assert!(ink.touched.is_empty() && ink.ink.iter().all(|&x| x == 0.0));
+        assert!(ink.noted().is_empty() && ink.ink.iter().all(|&x| x == 0.0));
     }
 
     #[test]
@@ -279,15 +400,15 @@ mod tests {
         // again (their ink stayed zero), so that a long path noted a pixel
         // over and over; now no pixel is noted, and none is blended.
         let ink = ink_of(&[DVec2::new(2.0, 2.0), DVec2::new(18.0, 18.0)], 1e-50);
-        assert!(ink.touched.is_empty(), "{} pixels noted", ink.touched.len());
+        assert!(ink.noted().is_empty(), "{} pixels noted", ink.noted().len());
         // A normal pen notes each pixel once: the diagonal's pieces fall
         // on at most the pixels of the 3-pixel-wide band around it.
         let ink = ink_of(&[DVec2::new(2.0, 2.0), DVec2::new(18.0, 18.0)], 1.0);
-        let mut seen = ink.touched.clone();
+        let mut seen = ink.noted();
         seen.sort_unstable();
         seen.dedup();
-        assert_eq!(seen.len(), ink.touched.len());
-        assert!(!ink.touched.is_empty());
+        assert_eq!(seen.len(), ink.noted().len());
+        assert!(!seen.is_empty());
     }
 
     #[test]
@@ -311,7 +432,7 @@ mod tests {
                     let mut theirs = ours.clone();
                     let mut ink = Ink::new(1, 1);
                     ink.ink[0] = coverage;
-                    ink.touched.push(0);
+                    ink.touched[0].push(0);
                     ink.blend(&mut ours, color);
                     let mut paint = tiny_skia::Paint::default();
                     paint.set_color(
