@@ -116,7 +116,14 @@ pub struct Rewriter<'p> {
     /// The new words of a parallel step's parts after the first, kept
     /// from step to step so that their memory is reused.
     parts: Vec<Word>,
+    /// For each module of the old word, the rule (its place in the step's
+    /// list) that rewrites it in a step of stencils in parts, or
+    /// `KEEP`.
+    choice: Vec<u16>,
 }
+
+/// `Rewriter::choice` of a module that no rule rewrites.
+const KEEP: u16 = u16::MAX;
 
 impl<'p> Rewriter<'p> {
     pub fn new(program: &'p Program) -> Rewriter<'p> {
@@ -140,6 +147,7 @@ impl<'p> Rewriter<'p> {
             tmp: Word::new(),
             tables: Tables::default(),
             parts: Vec::new(),
+            choice: Vec::new(),
         }
     }
 
@@ -187,7 +195,10 @@ impl<'p> Rewriter<'p> {
             self.checked_finite = false;
             let rewritten = match self.uniform_rule(rules, src, opts) {
                 Some((r, w)) => self.uniform_step(r, w, src, dst, opts)?,
-                None => self.stencil_step(rules, src, dst, opts)?,
+                None => match self.stencil_parts(rules, src, dst, opts) {
+                    Some(rewritten) => rewritten,
+                    None => self.stencil_step(rules, src, dst, opts)?,
+                },
             };
             if self.checked_finite || Self::all_finite(dst) {
                 self.growth = dst.len() as f64 / n as f64;
@@ -349,6 +360,12 @@ impl<'p> Rewriter<'p> {
         if !pure || !small || (opts.cut && src.syms().contains(&self.cut)) {
             return None;
         }
+        if rules
+            .iter()
+            .all(|&r| self.program.rules[r].stencil.is_some())
+        {
+            return self.stencil_parts(rules, src, dst, opts);
+        }
         // The first part, written in place, is a little smaller than an
         // even share; the rest is cut finer, so that a thread done early
         // takes some of it.
@@ -417,9 +434,153 @@ impl<'p> Rewriter<'p> {
         Some(rewritten)
     }
 
+    /// A forward step of stencils in parts on rayon's pool, written
+    /// straight into `dst`: every rule is a stencil with a one-module
+    /// strict predecessor and no new context, so each module's successor
+    /// depends on the old word alone and its size on the rule alone. A
+    /// first pass matches every module and counts each part's modules and
+    /// slots; the second writes each part into its place in the new word
+    /// ([`Word::fill_parts`]), with no words on the side to join. The
+    /// result is the same, to the bit, for any number of threads, and the
+    /// new slots are checked finite.
+    ///
+    /// Returns `None` when it does not apply, and when a value is not
+    /// finite, the word would pass its limit or the deadline passed: the
+    /// step then runs on one thread, which names the module and the rule.
+    fn stencil_parts(
+        &mut self,
+        rules: &[usize],
+        src: &Word,
+        dst: &mut Word,
+        opts: &StepOptions,
+    ) -> Option<usize> {
+        use rayon::prelude::*;
+        let n = src.len();
+        let threads = rayon::current_num_threads();
+        let program = self.program;
+        let applies = n >= PARALLEL_MODULES
+            && threads > 1
+            && opts.forward
+            && rules.len() < KEEP as usize
+            && rules.iter().all(|&r| {
+                let rule = &program.rules[r];
+                rule.stencil.is_some()
+                    && rule.strict.len() == 1
+                    && rule.new_left.is_empty()
+                    && rule.new_right.is_empty()
+            })
+            && !(opts.cut && src.syms().contains(&self.cut));
+        if !applies {
+            return None;
+        }
+        // Each rule's successor: its modules and slots.
+        let sizes: Vec<(usize, usize)> = rules
+            .iter()
+            .map(|&r| {
+                let st = program.rules[r].stencil.as_ref().expect("checked above");
+                let slots = st
+                    .outputs
+                    .iter()
+                    .flat_map(|(_, cs)| cs.iter().map(|c| c.ty.dim().max(1)))
+                    .sum();
+                (st.outputs.len(), slots)
+            })
+            .collect();
+        // Parts of `chunk` modules, a few per thread, so that a thread done
+        // early takes another.
+        let chunk = n.div_ceil(threads * 4);
+        let (sb, eb, tables) = (self.sb, self.eb, &self.tables);
+        let ctx = |r: usize| Rules {
+            sb,
+            eb,
+            filter: &program.rules[r].filter,
+            ring: opts.ring,
+            tables: Some(tables),
+        };
+        // The first pass: which rule rewrites each module, and each part's
+        // size.
+        self.choice.resize(n, KEEP);
+        let counts: Option<Vec<(usize, usize, usize)>> = self
+            .choice
+            .par_chunks_mut(chunk)
+            .enumerate()
+            .map(|(k, choice)| {
+                let from = k * chunk;
+                let mut matched = Vec::new();
+                let (mut modules, mut slots, mut rewritten) = (0, 0, 0);
+                for (j, c) in choice.iter_mut().enumerate() {
+                    let i = from + j;
+                    if j.is_multiple_of(DEADLINE_EVERY) {
+                        crate::deadline::check(opts.deadline).ok()?;
+                    }
+                    *c = KEEP;
+                    for (t, &r) in rules.iter().enumerate() {
+                        let rule = &program.rules[r];
+                        if match_old(rule, src, i, ctx(r), &mut matched).is_some() {
+                            *c = t as u16;
+                            break;
+                        }
+                    }
+                    let (m, s) = match *c {
+                        KEEP => (1, src.data(i).len()),
+                        t => {
+                            rewritten += 1;
+                            sizes[t as usize]
+                        }
+                    };
+                    modules += m;
+                    slots += s;
+                }
+                Some((modules, slots, rewritten))
+            })
+            .collect();
+        let counts = counts?;
+        let total: usize = counts.iter().map(|c| c.0).sum();
+        if total > opts.max_modules {
+            return None;
+        }
+        let sizes_of: Vec<(usize, usize)> = counts.iter().map(|c| (c.0, c.1)).collect();
+        let choice = &self.choice;
+        dst.clear();
+        let written = dst.fill_parts(&sizes_of, |k, out| {
+            let mut matched = Vec::new();
+            let mut scratch = Word::new();
+            for i in k * chunk..((k + 1) * chunk).min(n) {
+                if (i - k * chunk).is_multiple_of(DEADLINE_EVERY)
+                    && crate::deadline::check(opts.deadline).is_err()
+                {
+                    return false;
+                }
+                let ok = match choice[i] {
+                    KEEP => out.push(src.sym(i), src.data(i)),
+                    t => {
+                        let r = rules[t as usize];
+                        let rule = &program.rules[r];
+                        let st = rule.stencil.as_ref().expect("checked above");
+                        scratch.clear();
+                        match_old(rule, src, i, ctx(r), &mut matched).is_some()
+                            && apply_stencil(st, src, &matched, &mut scratch)
+                            && (0..scratch.len()).all(|j| out.push(scratch.sym(j), scratch.data(j)))
+                    }
+                };
+                if !ok {
+                    return false;
+                }
+            }
+            true
+        });
+        if !written {
+            dst.clear();
+            return None;
+        }
+        self.checked_finite = true;
+        Some(counts.iter().map(|c| c.2).sum())
+    }
+
     /// Frees the words kept from step to step.
     pub fn release(&mut self) {
         self.parts = Vec::new();
+        self.choice = Vec::new();
         self.tmp = Word::new();
         self.tables.clear();
     }

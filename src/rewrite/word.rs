@@ -151,6 +151,70 @@ impl Word {
         }
     }
 
+    /// Appends parts whose sizes are known beforehand, written at once on
+    /// rayon's pool straight into place: part `k` gets `counts[k]`
+    /// (modules, slots) and `fill(k, writer)` writes them in order. When
+    /// every part's `fill` returns true having written exactly its share,
+    /// the word holds them all and this returns true; otherwise the word
+    /// is left as it was and this returns false.
+    pub(crate) fn fill_parts(
+        &mut self,
+        counts: &[(usize, usize)],
+        fill: impl Fn(usize, &mut PartWriter<'_>) -> bool + Sync,
+    ) -> bool {
+        use rayon::prelude::*;
+        let modules: usize = counts.iter().map(|c| c.0).sum();
+        let slots: usize = counts.iter().map(|c| c.1).sum();
+        if self.data.len() + slots > u32::MAX as usize {
+            return false;
+        }
+        self.reserve(modules, slots);
+        let mut base = self.data.len();
+        let (mut syms, mut starts, mut data) = (
+            &mut self.syms.spare_capacity_mut()[..modules],
+            &mut self.starts.spare_capacity_mut()[..modules],
+            &mut self.data.spare_capacity_mut()[..slots],
+        );
+        let mut writers = Vec::with_capacity(counts.len());
+        for &(m, n) in counts {
+            let (s, rest) = std::mem::take(&mut syms).split_at_mut(m);
+            syms = rest;
+            let (o, rest) = std::mem::take(&mut starts).split_at_mut(m);
+            starts = rest;
+            let (d, rest) = std::mem::take(&mut data).split_at_mut(n);
+            data = rest;
+            writers.push(PartWriter {
+                syms: s,
+                starts: o,
+                data: d,
+                base: base as u32,
+                modules: 0,
+                slots: 0,
+            });
+            base += n;
+        }
+        let whole = writers
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, mut w)| {
+                fill(k, &mut w) && w.modules == w.syms.len() && w.slots == w.data.len()
+            })
+            .reduce(|| true, |a, b| a & b);
+        if whole {
+            // SAFETY: every writer wrote each element of its stretch of the
+            // spare capacity (it counts what it wrote, never past the
+            // stretch's end, and `whole` says each count reached its
+            // stretch's length); the stretches cover the first `modules`
+            // (`slots`) places of each array.
+            unsafe {
+                self.syms.set_len(self.syms.len() + modules);
+                self.starts.set_len(self.starts.len() + modules);
+                self.data.set_len(self.data.len() + slots);
+            }
+        }
+        whole
+    }
+
     /// Drops modules from the end until `len` remain.
     pub fn truncate(&mut self, len: usize) {
         if len < self.syms.len() {
@@ -261,5 +325,86 @@ impl Seq for Reversed<'_> {
 
     fn data(&self, i: usize) -> &[f64] {
         self.0.data(self.0.len() - 1 - i)
+    }
+}
+
+/// Writes one part of [`Word::fill_parts`] into its stretch of the new
+/// word's arrays, module after module.
+pub(crate) struct PartWriter<'a> {
+    syms: &'a mut [std::mem::MaybeUninit<Sym>],
+    starts: &'a mut [std::mem::MaybeUninit<u32>],
+    data: &'a mut [std::mem::MaybeUninit<f64>],
+    /// The word's slot count before this part.
+    base: u32,
+    modules: usize,
+    slots: usize,
+}
+
+impl PartWriter<'_> {
+    /// Writes the next module; false (and nothing written) when it would
+    /// pass the part's share.
+    #[inline]
+    pub(crate) fn push(&mut self, sym: Sym, slots: &[f64]) -> bool {
+        let end = self.slots + slots.len();
+        if self.modules == self.syms.len() || end > self.data.len() {
+            return false;
+        }
+        self.syms[self.modules].write(sym);
+        self.data[self.slots..end].write_copy_of_slice(slots);
+        self.starts[self.modules].write(self.base + end as u32);
+        self.modules += 1;
+        self.slots = end;
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Parts written in place make the word that pushing the same modules
+    /// one by one makes; a part that writes less or more than its share
+    /// leaves the word as it was.
+    #[test]
+    fn parts_filled_in_place_are_the_pushed_word() {
+        let (a, b, c) = (Sym(3), Sym(5), Sym(7));
+        let parts: Vec<Vec<(Sym, Vec<f64>)>> = vec![
+            vec![(a, vec![1.0, 2.0]), (b, vec![])],
+            vec![],
+            vec![(c, vec![-0.0]), (a, vec![3.5, f64::MAX]), (b, vec![4.0])],
+        ];
+        let mut want = Word::new();
+        want.push_raw(b, &[9.0]);
+        for m in parts.iter().flatten() {
+            want.push_raw(m.0, &m.1);
+        }
+        let counts: Vec<(usize, usize)> = parts
+            .iter()
+            .map(|p| (p.len(), p.iter().map(|m| m.1.len()).sum()))
+            .collect();
+        let mut w = Word::new();
+        w.push_raw(b, &[9.0]);
+        let before = w.clone();
+        assert!(w.fill_parts(&counts, |k, out| parts[k]
+            .iter()
+            .all(|m| out.push(m.0, &m.1))));
+        assert_eq!(w, want);
+        for i in 0..w.len() {
+            assert_eq!(w.data(i), want.data(i));
+        }
+        // One module short in the last part, then one too many in the first.
+        let mut short = before.clone();
+        let fill_short = |k: usize, out: &mut PartWriter<'_>| {
+            let n = if k == 2 { 2 } else { parts[k].len() };
+            parts[k][..n].iter().all(|m| out.push(m.0, &m.1))
+        };
+        assert!(!short.fill_parts(&counts, fill_short));
+        assert_eq!(short, before);
+        let mut long = before.clone();
+        let fill_long = |k: usize, out: &mut PartWriter<'_>| {
+            parts[k].iter().all(|m| out.push(m.0, &m.1)) && (k != 0 || out.push(c, &[]))
+        };
+        assert!(!long.fill_parts(&counts, fill_long));
+        assert_eq!(long, before);
     }
 }
