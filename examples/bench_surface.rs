@@ -89,11 +89,13 @@ fn faces_to_faces(
 }
 
 fn main() {
-    let out = PathBuf::from(
-        std::env::args()
-            .nth(1)
-            .unwrap_or_else(|| "/tmp/subgram-bench".into()),
-    );
+    let arg = std::env::args().nth(1);
+    if arg.as_deref().is_some_and(|a| a.starts_with('-')) {
+        // Not a folder to fill: `--help` once became one.
+        println!("usage: bench_surface [OUT_DIR] (default /tmp/subgram-bench)");
+        return;
+    }
+    let out = PathBuf::from(arg.unwrap_or_else(|| "/tmp/subgram-bench".into()));
     std::fs::create_dir_all(&out).expect("output folder");
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let runs = 7;
