@@ -545,13 +545,15 @@ impl<'p> Rewriter<'p> {
         let written = dst.fill_parts(&sizes_of, |k, out| {
             let mut matched = Vec::new();
             let mut scratch = Word::new();
-            for i in k * chunk..((k + 1) * chunk).min(n) {
-                if (i - k * chunk).is_multiple_of(DEADLINE_EVERY)
+            let from = k * chunk;
+            for (j, &c) in choice[from..(from + chunk).min(n)].iter().enumerate() {
+                let i = from + j;
+                if j.is_multiple_of(DEADLINE_EVERY)
                     && crate::deadline::check(opts.deadline).is_err()
                 {
                     return false;
                 }
-                let ok = match choice[i] {
+                let ok = match c {
                     KEEP => out.push(src.sym(i), src.data(i)),
                     t => {
                         let r = rules[t as usize];
