@@ -1021,6 +1021,9 @@ enum Kind {
 /// or derives a shape grammar, and writes the mesh or its picture. The
 /// file is read and lexed once.
 pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<Vec<String>, Error> {
+    // One large mesh: freed working memory goes back at once, not kept
+    // under the next step's peak.
+    crate::huge::return_freed_memory();
     let deadline = a.timeout.map(Deadline::after);
     let grammar = Path::new(&a.grammar);
     let output = Path::new(&a.output);

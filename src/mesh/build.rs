@@ -11,7 +11,7 @@
 //! vertices.
 
 use super::halfedge::{
-    Column, EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId,
+    Bits, Column, EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, Narrow, VertexId,
 };
 use super::soup::{Faces, PolygonSoup};
 
@@ -337,24 +337,23 @@ impl Mesh {
         let ne = ne as usize;
         let mut m = Mesh {
             fanned,
-            v_out: vec![None; nv],
+            v_out: vec![super::halfedge::NO_HALFEDGE; nv],
             pos: soup.positions.clone(),
-            v_level: vec![0; nv],
-            v_step: vec![0; nv],
-            v_alive: vec![true; nv],
+            v_level: Narrow::filled(nv, 0),
+            v_step: Narrow::filled(nv, 0),
+            v_alive: Bits::filled(nv, true),
             v_sharp: Column::defaults(nv),
             he_to: vec![VertexId(0); 2 * ne],
             he_next: vec![HalfEdgeId(0); 2 * ne],
-            he_prev: vec![HalfEdgeId(0); 2 * ne],
             he_face: vec![super::halfedge::NO_FACE; 2 * ne],
-            e_level: vec![0; ne],
-            e_alive: vec![true; ne],
-            e_block: vec![false; ne],
-            e_transversal: vec![false; ne],
+            e_level: Narrow::filled(ne, 0),
+            e_alive: Bits::filled(ne, true),
+            e_block: Bits::filled(ne, false),
+            e_transversal: Bits::filled(ne, false),
             e_sharp: Column::defaults(ne),
             f_he: Vec::with_capacity(nt),
-            f_level: vec![1; nt],
-            f_alive: vec![true; nt],
+            f_level: Narrow::filled(nt, 1),
+            f_alive: Bits::filled(nt, true),
             f_tag: match tags {
                 Some(t) => Column::from_vec(source.iter().map(|&fi| t[fi as usize]).collect()),
                 None => Column::defaults(nt),
@@ -370,8 +369,8 @@ impl Mesh {
                 let diag = diagonal[t][k];
                 m.he_to[h as usize] = VertexId(head(c));
                 m.he_to[h as usize + 1] = VertexId(corner[c]);
-                m.e_level[e] = if diag { 0 } else { outer_level };
-                m.e_block[e] = diag && soup.faces[src(t)].len() == 4;
+                m.e_level.set(e, if diag { 0 } else { outer_level });
+                m.e_block.set(e, diag && soup.faces[src(t)].len() == 4);
             }
             m.he_face[h as usize] = (c / 3) as u32;
         }
@@ -382,7 +381,7 @@ impl Mesh {
             m.link(hs[2], hs[0]);
             m.f_he.push(hs[0]);
             for (k, h) in hs.iter().enumerate() {
-                m.v_out[corner[3 * t + k] as usize] = Some(*h);
+                m.v_out[corner[3 * t + k] as usize] = h.0;
             }
         }
         drop(he);
@@ -413,7 +412,7 @@ impl Mesh {
         }
         for (v, b) in boundary_out.iter().enumerate() {
             if let Some(b) = b {
-                m.v_out[v] = Some(*b);
+                m.v_out[v] = b.0;
             }
         }
         // An interior vertex whose faces form two or more cycles.
@@ -480,9 +479,9 @@ impl Mesh {
         let base = self.vertices().all(|v| self.vertex_level(v) == 0);
         let edges: Vec<EdgeId> = self.edges().collect();
         for e in edges {
-            self.e_block[e.index()] = false;
+            self.e_block.set(e.index(), false);
             if base {
-                self.e_level[e.index()] = 0;
+                self.e_level.set(e.index(), 0);
             }
         }
     }
@@ -991,7 +990,8 @@ mod tests {
                         None => {
                             let level = if diag[k] { 0 } else { outer_level };
                             let h = m.new_edge(VertexId(a), VertexId(b), level);
-                            m.e_block[h.edge().index()] = diag[k] && soup.faces[*fi].len() == 4;
+                            m.e_block
+                                .set(h.edge().index(), diag[k] && soup.faces[*fi].len() == 4);
                             edges.insert(key, h);
                             h
                         }
@@ -1030,7 +1030,7 @@ mod tests {
                 face_of_source.push(*fi);
                 m.set_triangle(f, hs[0], hs[1], hs[2]);
                 for (k, h) in hs.iter().enumerate() {
-                    m.v_out[tri[k] as usize] = Some(*h);
+                    m.v_out[tri[k] as usize] = h.0;
                 }
             }
             // Link the boundary: each boundary half-edge continues with the
@@ -1060,7 +1060,7 @@ mod tests {
             }
             for (v, b) in boundary_out.iter().enumerate() {
                 if let Some(b) = b {
-                    m.v_out[v] = Some(*b);
+                    m.v_out[v] = b.0;
                 }
             }
             // An interior vertex whose faces form two or more cycles.
@@ -1081,7 +1081,7 @@ mod tests {
             }
             for f in 0..m.f_alive.len() {
                 let vs = m.face_vertices(FaceId(f as u32));
-                m.f_level[f] = m.face_level_from_vertices(vs);
+                m.f_level.set(f, m.face_level_from_vertices(vs));
             }
             Ok(m)
         }

@@ -16,6 +16,11 @@ use glam::DVec3;
 /// `he_face` of a boundary half-edge.
 pub(crate) const NO_FACE: u32 = u32::MAX;
 
+/// `v_out` of a vertex without edges.
+pub(crate) const NO_HALFEDGE: u32 = u32::MAX;
+
+pub(crate) use super::packed::{Bits, Narrow};
+
 macro_rules! id {
     ($(#[$m:meta])* $name:ident) => {
         $(#[$m])*
@@ -117,31 +122,35 @@ impl std::error::Error for MeshError {}
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     // Vertices.
-    pub(crate) v_out: Vec<Option<HalfEdgeId>>,
+    /// One outgoing half-edge of each vertex, [`NO_HALFEDGE`] for none.
+    pub(crate) v_out: Vec<u32>,
     pub(crate) pos: Vec<DVec3>,
-    pub(crate) v_level: Vec<u32>,
+    pub(crate) v_level: Narrow,
     /// The step of the grammar run that made the vertex (0: the base mesh
     /// and `init:` rules).
-    pub(crate) v_step: Vec<u32>,
-    pub(crate) v_alive: Vec<bool>,
+    pub(crate) v_step: Narrow,
+    pub(crate) v_alive: Bits,
     /// The sharpness of each vertex, as OpenSubdiv has it: 0 smooth, a
     /// positive number a corner for that many more levels, infinite a
     /// corner for ever. New vertices get 0.
     pub(crate) v_sharp: Column<f64>,
     // Half-edges, in twin pairs.
     pub(crate) he_to: Vec<VertexId>,
+    /// The next half-edge of each one's face, or of its boundary loop.
+    /// The previous one is not stored: all faces are triangles, so it is
+    /// the next one's next, and a boundary half-edge's is found by turning
+    /// around its tail ([`Mesh::prev`]).
     pub(crate) he_next: Vec<HalfEdgeId>,
-    pub(crate) he_prev: Vec<HalfEdgeId>,
     /// The face of each half-edge, `NO_FACE` on the boundary.
     pub(crate) he_face: Vec<u32>,
     // Edges.
-    pub(crate) e_level: Vec<u32>,
-    pub(crate) e_alive: Vec<bool>,
+    pub(crate) e_level: Narrow,
+    pub(crate) e_alive: Bits,
     /// The internal edge of a basic block of a tri-quad mesh.
-    pub(crate) e_block: Vec<bool>,
+    pub(crate) e_block: Bits,
     /// Made by an edge split, joining the new vertex to a vertex opposite
     /// the split edge, and not flipped since.
-    pub(crate) e_transversal: Vec<bool>,
+    pub(crate) e_transversal: Bits,
     /// The sharpness of each edge (OpenSubdiv's): 0 smooth, a positive
     /// number a crease for that many more levels (semi-sharp below 1),
     /// infinite a crease for ever. The halves of a split edge inherit it;
@@ -153,8 +162,8 @@ pub struct Mesh {
     pub(crate) creased: bool,
     // Faces.
     pub(crate) f_he: Vec<HalfEdgeId>,
-    pub(crate) f_level: Vec<u32>,
-    pub(crate) f_alive: Vec<bool>,
+    pub(crate) f_level: Narrow,
+    pub(crate) f_alive: Bits,
     /// A number the caller gives each face of the soup
     /// ([`Mesh::from_soup_tagged`]; 0 otherwise), handed down by the
     /// stellar operators to the faces cut from it: which part of a welded
@@ -200,31 +209,31 @@ impl Mesh {
     pub fn vertices(&self) -> impl Iterator<Item = VertexId> + '_ {
         (0..self.v_alive.len() as u32)
             .map(VertexId)
-            .filter(|v| self.v_alive[v.index()])
+            .filter(|v| self.v_alive.get(v.index()))
     }
 
     pub fn edges(&self) -> impl Iterator<Item = EdgeId> + '_ {
         (0..self.e_alive.len() as u32)
             .map(EdgeId)
-            .filter(|e| self.e_alive[e.index()])
+            .filter(|e| self.e_alive.get(e.index()))
     }
 
     pub fn faces(&self) -> impl Iterator<Item = FaceId> + '_ {
         (0..self.f_alive.len() as u32)
             .map(FaceId)
-            .filter(|f| self.f_alive[f.index()])
+            .filter(|f| self.f_alive.get(f.index()))
     }
 
     pub fn is_vertex(&self, v: VertexId) -> bool {
-        self.v_alive.get(v.index()).copied().unwrap_or(false)
+        self.v_alive.get_or_false(v.index())
     }
 
     pub fn is_edge(&self, e: EdgeId) -> bool {
-        self.e_alive.get(e.index()).copied().unwrap_or(false)
+        self.e_alive.get_or_false(e.index())
     }
 
     pub fn is_face(&self, f: FaceId) -> bool {
-        self.f_alive.get(f.index()).copied().unwrap_or(false)
+        self.f_alive.get_or_false(f.index())
     }
 
     /// Bytes of storage per face, for the benchmark's report: the arrays'
@@ -241,19 +250,19 @@ impl Mesh {
         }
         let v = size(&self.v_out)
             + size(&self.pos)
-            + size(&self.v_level)
-            + size(&self.v_step)
-            + size(&self.v_alive)
+            + self.v_level.bytes()
+            + self.v_step.bytes()
+            + self.v_alive.bytes()
             + self.v_sharp.stored_bytes();
-        let h = size(&self.he_to) + size(&self.he_next) + size(&self.he_prev) + size(&self.he_face);
-        let e = size(&self.e_level)
-            + size(&self.e_alive)
-            + size(&self.e_block)
-            + size(&self.e_transversal)
+        let h = size(&self.he_to) + size(&self.he_next) + size(&self.he_face);
+        let e = self.e_level.bytes()
+            + self.e_alive.bytes()
+            + self.e_block.bytes()
+            + self.e_transversal.bytes()
             + self.e_sharp.stored_bytes();
         let f = size(&self.f_he)
-            + size(&self.f_level)
-            + size(&self.f_alive)
+            + self.f_level.bytes()
+            + self.f_alive.bytes()
             + self.f_tag.stored_bytes();
         v + h + e + f
     }
@@ -270,15 +279,15 @@ impl Mesh {
     }
 
     pub fn vertex_level(&self, v: VertexId) -> u32 {
-        self.v_level[v.index()]
+        self.v_level.get(v.index())
     }
 
     pub fn edge_level(&self, e: EdgeId) -> u32 {
-        self.e_level[e.index()]
+        self.e_level.get(e.index())
     }
 
     pub fn face_level(&self, f: FaceId) -> u32 {
-        self.f_level[f.index()]
+        self.f_level.get(f.index())
     }
 
     /// The face's tag: that of the soup face it was cut from
@@ -288,16 +297,16 @@ impl Mesh {
     }
 
     pub fn set_vertex_level(&mut self, v: VertexId, l: u32) {
-        self.v_level[v.index()] = l;
+        self.v_level.set(v.index(), l);
     }
 
     pub fn set_edge_level(&mut self, e: EdgeId, l: u32) {
-        self.e_level[e.index()] = l;
+        self.e_level.set(e.index(), l);
     }
 
     /// True for the internal edge of a basic block (tri-quad meshes).
     pub fn is_block_edge(&self, e: EdgeId) -> bool {
-        self.e_block[e.index()]
+        self.e_block.get(e.index())
     }
 
     /// The edge's sharpness: 0 smooth, positive creased (see
@@ -394,7 +403,7 @@ impl Mesh {
 
     /// The step of a grammar run that made the vertex (0: the base mesh).
     pub fn vertex_step(&self, v: VertexId) -> u32 {
-        self.v_step[v.index()]
+        self.v_step.get(v.index())
     }
 
     /// The first polygon of more than four sides in the soup the mesh was
@@ -413,7 +422,7 @@ impl Mesh {
     pub fn is_block_centre(&self, v: VertexId) -> bool {
         let mut any = false;
         for h in self.outgoing_halfedges(v) {
-            if !self.e_block[h.edge().index()] {
+            if !self.e_block.get(h.edge().index()) {
                 return false;
             }
             any = true;
@@ -424,7 +433,7 @@ impl Mesh {
     /// True for an edge that an edge split drew from the new vertex to a
     /// vertex opposite the split edge, and that no flip has touched since.
     pub fn is_transversal_edge(&self, e: EdgeId) -> bool {
-        self.e_transversal[e.index()]
+        self.e_transversal.get(e.index())
     }
 
     // ----- half-edge navigation ------------------------------------
@@ -444,9 +453,34 @@ impl Mesh {
         self.he_next[h.index()]
     }
 
+    /// The half-edge before `h` in its face, or in its boundary loop. A
+    /// face's is its next one's next (all faces are triangles); a boundary
+    /// half-edge's is the boundary half-edge into its tail, found by
+    /// turning around the tail through its faces.
     #[inline]
     pub fn prev(&self, h: HalfEdgeId) -> HalfEdgeId {
-        self.he_prev[h.index()]
+        if self.he_face[h.index()] != NO_FACE {
+            self.next(self.next(h))
+        } else {
+            self.after_gap(h).twin()
+        }
+    }
+
+    /// For a boundary half-edge `b` leaving `v`: the first half-edge
+    /// leaving `v` counter-clockwise after the boundary gap, the one whose
+    /// twin is the boundary half-edge into `v`. Found by turning clockwise
+    /// from `b` (`next(twin(g))` is the half-edge leaving `v` before `g`)
+    /// until the face side ends; a manifold vertex has one gap.
+    /// On a broken mesh (`validate`'s input) the turn stops after as many
+    /// steps as there are half-edges.
+    fn after_gap(&self, b: HalfEdgeId) -> HalfEdgeId {
+        let mut g = self.next(b.twin());
+        let mut steps = self.he_to.len();
+        while self.he_face[g.twin().index()] != NO_FACE && steps > 0 {
+            g = self.next(g.twin());
+            steps -= 1;
+        }
+        g
     }
 
     #[inline]
@@ -461,7 +495,14 @@ impl Mesh {
 
     /// An outgoing half-edge of `v` (the boundary one for boundary vertices).
     pub fn outgoing(&self, v: VertexId) -> Option<HalfEdgeId> {
-        self.v_out[v.index()]
+        let h = self.v_out[v.index()];
+        (h != NO_HALFEDGE).then_some(HalfEdgeId(h))
+    }
+
+    /// Sets `v`'s outgoing half-edge.
+    #[inline]
+    pub(crate) fn set_outgoing(&mut self, v: VertexId, h: Option<HalfEdgeId>) {
+        self.v_out[v.index()] = h.map_or(NO_HALFEDGE, |h| h.0);
     }
 
     pub fn is_boundary_halfedge(&self, h: HalfEdgeId) -> bool {
@@ -474,7 +515,8 @@ impl Mesh {
     }
 
     pub fn is_boundary_vertex(&self, v: VertexId) -> bool {
-        self.v_out[v.index()].is_some_and(|h| self.is_boundary_halfedge(h))
+        self.outgoing(v)
+            .is_some_and(|h| self.is_boundary_halfedge(h))
     }
 
     /// The next (`forward`) or previous vertex along the boundary through
@@ -482,7 +524,7 @@ impl Mesh {
     /// `v -> bnext(v)` and `bprev(v) -> v` run along a face. None off the
     /// boundary.
     pub fn boundary_neighbour(&self, v: VertexId, forward: bool) -> Option<VertexId> {
-        let out = self.v_out[v.index()].filter(|&h| self.is_boundary_halfedge(h))?;
+        let out = self.outgoing(v).filter(|&h| self.is_boundary_halfedge(h))?;
         // `out` runs v -> w with no face, so its twin w -> v runs along a
         // face: w is the previous vertex. The boundary half-edge before
         // `out` in the loop runs u -> v; its twin v -> u is along a face.
@@ -501,7 +543,7 @@ impl Mesh {
 
     /// The half-edge from `a` to `b`, if they are joined.
     pub fn find_halfedge(&self, a: VertexId, b: VertexId) -> Option<HalfEdgeId> {
-        self.outgoing_halfedges(a).find(|&h| self.to(h) == b)
+        self.outgoing_any_order(a).find(|&h| self.to(h) == b)
     }
 
     /// The face `vs` (its corners counter-clockwise, from any of them),
@@ -509,7 +551,7 @@ impl Mesh {
     /// the cost is three times the smallest of their valences: a triangle
     /// at a vertex of huge valence is found from its other corners.
     pub fn find_face(&self, vs: [VertexId; 3]) -> Option<FaceId> {
-        let mut walks = vs.map(|v| self.outgoing_halfedges(v));
+        let mut walks = vs.map(|v| self.outgoing_any_order(v));
         loop {
             for (k, walk) in walks.iter_mut().enumerate() {
                 // A face at `vs` is met around each of its corners, so a
@@ -543,18 +585,48 @@ impl Mesh {
     /// boundary vertex the walk crosses faces only: it starts at the edge
     /// after the boundary gap and ends with the outgoing boundary half-edge.
     pub fn outgoing_halfedges(&self, v: VertexId) -> OutgoingIter<'_> {
-        let start = self.v_out.get(v.index()).copied().flatten().map(|h| {
-            if self.is_boundary_halfedge(h) {
-                self.prev(h).twin()
-            } else {
-                h
-            }
-        });
+        let out = self
+            .v_out
+            .get(v.index())
+            .filter(|&&h| h != NO_HALFEDGE)
+            .map(|&h| HalfEdgeId(h));
+        let (start, last) = match out {
+            Some(h) if self.is_boundary_halfedge(h) => (Some(self.after_gap(h)), Some(h)),
+            _ => (out, None),
+        };
         OutgoingIter {
             mesh: self,
             start,
+            last,
             cur: start,
         }
+    }
+
+    /// The half-edges leaving `v`, clockwise from its outgoing one: all of
+    /// them, as [`Mesh::outgoing_halfedges`] gives them, in another order,
+    /// with no walk to a boundary vertex's gap first (which the
+    /// counter-clockwise order needs), for searches that stop at what
+    /// they look for. From a half-edge `h` leaving `v`, the next one
+    /// clockwise is `next(twin(h))`; a boundary vertex's walk starts at
+    /// its outgoing boundary half-edge and ends at the one whose twin is
+    /// on the boundary.
+    pub(crate) fn outgoing_any_order(&self, v: VertexId) -> impl Iterator<Item = HalfEdgeId> + '_ {
+        let start = self
+            .v_out
+            .get(v.index())
+            .filter(|&&h| h != NO_HALFEDGE)
+            .map(|&h| HalfEdgeId(h));
+        let mut cur = start;
+        std::iter::from_fn(move || {
+            let h = cur?;
+            let t = h.twin();
+            cur = if self.is_boundary_halfedge(t) {
+                None
+            } else {
+                Some(self.next(t)).filter(|&n| Some(n) != start)
+            };
+            Some(h)
+        })
     }
 
     /// The one-ring of `v`: its neighbours in counter-clockwise order.
@@ -608,22 +680,21 @@ impl Mesh {
     pub fn reserve(&mut self, vertices: usize, edges: usize, faces: usize) {
         crate::huge::grow(&mut self.v_out, vertices);
         crate::huge::grow(&mut self.pos, vertices);
-        crate::huge::grow(&mut self.v_level, vertices);
-        crate::huge::grow(&mut self.v_step, vertices);
-        crate::huge::grow(&mut self.v_alive, vertices);
+        self.v_level.reserve(vertices);
+        self.v_step.reserve(vertices);
+        self.v_alive.reserve(vertices);
         self.v_sharp.reserve(vertices);
         crate::huge::grow(&mut self.he_next, 2 * edges);
-        crate::huge::grow(&mut self.he_prev, 2 * edges);
         crate::huge::grow(&mut self.he_to, 2 * edges);
         crate::huge::grow(&mut self.he_face, 2 * edges);
-        crate::huge::grow(&mut self.e_level, edges);
-        crate::huge::grow(&mut self.e_alive, edges);
-        crate::huge::grow(&mut self.e_block, edges);
-        crate::huge::grow(&mut self.e_transversal, edges);
+        self.e_level.reserve(edges);
+        self.e_alive.reserve(edges);
+        self.e_block.reserve(edges);
+        self.e_transversal.reserve(edges);
         self.e_sharp.reserve(edges);
         crate::huge::grow(&mut self.f_he, faces);
-        crate::huge::grow(&mut self.f_level, faces);
-        crate::huge::grow(&mut self.f_alive, faces);
+        self.f_level.reserve(faces);
+        self.f_alive.reserve(faces);
         self.f_tag.reserve(faces);
     }
 
@@ -631,15 +702,15 @@ impl Mesh {
     pub(crate) fn new_vertex(&mut self, p: DVec3, level: u32, step: u32) -> VertexId {
         if let Some(i) = self.free_v.pop() {
             let k = i as usize;
-            self.v_out[k] = None;
+            self.v_out[k] = NO_HALFEDGE;
             self.pos[k] = p;
-            self.v_level[k] = level;
-            self.v_step[k] = step;
-            self.v_alive[k] = true;
+            self.v_level.set(k, level);
+            self.v_step.set(k, step);
+            self.v_alive.set(k, true);
             self.v_sharp.set(k, 0.0);
             return VertexId(i);
         }
-        self.v_out.push(None);
+        self.v_out.push(NO_HALFEDGE);
         self.pos.push(p);
         self.v_level.push(level);
         self.v_step.push(step);
@@ -653,10 +724,10 @@ impl Mesh {
     pub(crate) fn new_edge(&mut self, a: VertexId, b: VertexId, level: u32) -> HalfEdgeId {
         let e = if let Some(i) = self.free_e.pop() {
             let k = i as usize;
-            self.e_level[k] = level;
-            self.e_alive[k] = true;
-            self.e_block[k] = false;
-            self.e_transversal[k] = false;
+            self.e_level.set(k, level);
+            self.e_alive.set(k, true);
+            self.e_block.set(k, false);
+            self.e_transversal.set(k, false);
             self.e_sharp.set(k, 0.0);
             EdgeId(i)
         } else {
@@ -670,7 +741,6 @@ impl Mesh {
             for _ in 0..2 {
                 self.he_to.push(VertexId(0));
                 self.he_next.push(dummy);
-                self.he_prev.push(dummy);
                 self.he_face.push(NO_FACE);
             }
             e
@@ -687,8 +757,8 @@ impl Mesh {
     pub(crate) fn new_face(&mut self, h: HalfEdgeId, level: u32, tag: u32) -> FaceId {
         if let Some(i) = self.free_f.pop() {
             self.f_he[i as usize] = h;
-            self.f_level[i as usize] = level;
-            self.f_alive[i as usize] = true;
+            self.f_level.set(i as usize, level);
+            self.f_alive.set(i as usize, true);
             self.f_tag.set(i as usize, tag);
             return FaceId(i);
         }
@@ -700,25 +770,25 @@ impl Mesh {
     }
 
     pub(crate) fn delete_vertex(&mut self, v: VertexId) {
-        self.v_alive[v.index()] = false;
-        self.v_out[v.index()] = None;
+        self.v_alive.set(v.index(), false);
+        self.v_out[v.index()] = NO_HALFEDGE;
         self.free_v.push(v.0);
     }
 
     pub(crate) fn delete_edge(&mut self, e: EdgeId) {
-        self.e_alive[e.index()] = false;
+        self.e_alive.set(e.index(), false);
         self.free_e.push(e.0);
     }
 
     pub(crate) fn delete_face(&mut self, f: FaceId) {
-        self.f_alive[f.index()] = false;
+        self.f_alive.set(f.index(), false);
         self.free_f.push(f.0);
     }
 
+    /// Makes `b` the half-edge after `a`.
     #[inline]
     pub(crate) fn link(&mut self, a: HalfEdgeId, b: HalfEdgeId) {
         self.he_next[a.index()] = b;
-        self.he_prev[b.index()] = a;
     }
 
     /// Makes `h0 -> h1 -> h2` a face cycle of face `f`.
@@ -741,7 +811,7 @@ impl Mesh {
     /// The level of a face: one more than its highest vertex (paper 000, §6).
     pub(crate) fn face_level_from_vertices(&self, vs: [VertexId; 3]) -> u32 {
         vs.iter()
-            .map(|v| self.v_level[v.index()])
+            .map(|v| self.v_level.get(v.index()))
             .max()
             .unwrap_or(0)
             + 1
@@ -749,13 +819,13 @@ impl Mesh {
 
     /// Points `v`'s outgoing half-edge at its boundary one, if it has one.
     pub(crate) fn fix_outgoing(&mut self, v: VertexId) {
-        let Some(start) = self.v_out[v.index()] else {
+        let Some(start) = self.outgoing(v) else {
             return;
         };
         let mut h = start;
         loop {
             if self.is_boundary_halfedge(h) {
-                self.v_out[v.index()] = Some(h);
+                self.set_outgoing(v, Some(h));
                 return;
             }
             h = self.prev(h).twin();
@@ -770,17 +840,31 @@ impl Mesh {
 pub struct OutgoingIter<'m> {
     mesh: &'m Mesh,
     start: Option<HalfEdgeId>,
+    /// A boundary vertex's outgoing boundary half-edge, where the walk
+    /// ends; none for an interior vertex, whose walk ends back at `start`.
+    last: Option<HalfEdgeId>,
     cur: Option<HalfEdgeId>,
 }
 
 impl Iterator for OutgoingIter<'_> {
     type Item = HalfEdgeId;
 
+    #[inline]
     fn next(&mut self) -> Option<HalfEdgeId> {
         let h = self.cur?;
+        if Some(h) == self.last {
+            self.cur = None;
+            return Some(h);
+        }
         // Counter-clockwise around the origin: the previous half-edge of
-        // h's face comes into the vertex; its twin leaves it.
-        let n = self.mesh.prev(h).twin();
+        // h's face (a triangle: its next one's next) comes into the
+        // vertex; its twin leaves it.
+        let m = self.mesh;
+        debug_assert!(
+            !m.is_boundary_halfedge(h),
+            "a boundary vertex keeps its boundary half-edge as its outgoing one"
+        );
+        let n = m.next(m.next(h)).twin();
         self.cur = if Some(n) == self.start { None } else { Some(n) };
         Some(h)
     }
@@ -881,7 +965,129 @@ impl<T: Copy + Default + PartialEq> PartialEq for Column<T> {
 
 #[cfg(test)]
 mod tests {
-    use super::Column;
+    use super::{Column, EdgeId, HalfEdgeId, Mesh, VertexId};
+    use crate::mesh::shapes;
+    use glam::DVec3;
+
+    /// The live half-edges of `m`.
+    fn live(m: &Mesh) -> Vec<HalfEdgeId> {
+        m.edges()
+            .flat_map(|e| [e.halfedge(), e.halfedge().twin()])
+            .collect()
+    }
+
+    /// `prev` and the ring walk against what the test builds from `next`
+    /// alone: the half-edge whose next is `h`, found by searching them
+    /// all, and each vertex's outgoing half-edges in counter-clockwise
+    /// order, found by following that inverse (the walk turns with the
+    /// twin of the half-edge before), from the one after the boundary gap.
+    fn check_prev_and_rings(m: &Mesh) {
+        let hs = live(m);
+        let before = |h: HalfEdgeId| -> HalfEdgeId {
+            let found: Vec<HalfEdgeId> = hs.iter().copied().filter(|&g| m.next(g) == h).collect();
+            assert_eq!(found.len(), 1, "one half-edge before {h:?}");
+            found[0]
+        };
+        for &h in &hs {
+            assert_eq!(m.prev(h), before(h), "prev of {h:?}");
+        }
+        for v in m.vertices() {
+            let leaving: Vec<HalfEdgeId> = hs.iter().copied().filter(|&h| m.from(h) == v).collect();
+            let walked: Vec<HalfEdgeId> = m.outgoing_halfedges(v).collect();
+            assert_eq!(walked.len(), leaving.len(), "valence of {v:?}");
+            // The first after the gap: the one whose twin is a boundary
+            // half-edge; any one for an interior vertex, so start where
+            // the walk starts.
+            let first = leaving
+                .iter()
+                .copied()
+                .find(|&h| m.is_boundary_halfedge(h.twin()))
+                .unwrap_or(walked[0]);
+            let mut expect = vec![first];
+            while expect.len() < leaving.len() {
+                let h = *expect.last().expect("one");
+                expect.push(before(h).twin());
+            }
+            assert_eq!(walked, expect, "ring of {v:?}");
+            let mut any: Vec<HalfEdgeId> = m.outgoing_any_order(v).collect();
+            any.sort_unstable();
+            let mut sorted = leaving.clone();
+            sorted.sort_unstable();
+            assert_eq!(any, sorted, "the same half-edges in any order at {v:?}");
+            if let Some(&out) = walked.last() {
+                if m.is_boundary_vertex(v) {
+                    assert!(m.is_boundary_halfedge(out), "ends at the boundary");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn prev_and_the_ring_walk_agree_with_the_next_links_through_splits_flips_and_welds() {
+        // A grid has boundary vertices of valence 2 to 4 and corners.
+        let mut m = Mesh::from_soup(&shapes::triangle_grid(4, 3)).expect("a grid");
+        m.validate().expect("valid");
+        check_prev_and_rings(&m);
+        // Split every boundary edge and some interior ones, flip, weld.
+        let boundary: Vec<EdgeId> = m.edges().filter(|&e| m.is_boundary_edge(e)).collect();
+        let mut made = Vec::new();
+        for e in boundary.into_iter().step_by(2) {
+            let (a, b) = m.edge_vertices(e);
+            let p = (m.position(a) + m.position(b)) * 0.5;
+            made.push(m.edge_split(e, p).expect("split"));
+            check_prev_and_rings(&m);
+        }
+        let interior: Vec<EdgeId> = m.edges().filter(|&e| !m.is_boundary_edge(e)).collect();
+        for &e in interior.iter().take(5) {
+            let (a, b) = m.edge_vertices(e);
+            made.push(
+                m.edge_split(e, (m.position(a) + m.position(b)) * 0.5)
+                    .expect("split"),
+            );
+        }
+        let f = m.faces().next().expect("a face");
+        let centre = m.face_split(f, m.face_centroid(f)).expect("face split");
+        check_prev_and_rings(&m);
+        m.face_weld(centre).expect("a face split welds back");
+        check_prev_and_rings(&m);
+        let centre = m.face_split(f, m.face_centroid(f)).expect("face split");
+        let flips: Vec<EdgeId> = m.edges().filter(|&e| m.is_transversal_edge(e)).collect();
+        let mut flipped = 0;
+        for e in flips {
+            if m.edge_flip(e).is_ok() {
+                flipped += 1;
+            }
+        }
+        assert!(flipped > 0);
+        check_prev_and_rings(&m);
+        m.validate().expect("valid");
+        assert!(m.is_vertex(centre));
+        // Weld boundary midpoints back where they still have valence 3.
+        let mut welded = 0;
+        for v in made {
+            if m.is_vertex(v) && m.is_boundary_vertex(v) {
+                let keep = m.boundary_neighbour(v, true).expect("on the boundary");
+                if m.edge_weld(v, keep).is_ok() {
+                    welded += 1;
+                    check_prev_and_rings(&m);
+                }
+            }
+        }
+        assert!(welded > 0);
+        m.validate().expect("valid");
+        // A closed mesh: every half-edge has a face.
+        let s = Mesh::from_soup(&shapes::icosahedron()).expect("closed");
+        check_prev_and_rings(&s);
+        // A lone triangle: a boundary loop of three.
+        let mut soup = crate::mesh::PolygonSoup {
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            ..Default::default()
+        };
+        soup.faces.push([0u32, 1, 2]);
+        let t = Mesh::from_soup(&soup).expect("a triangle");
+        check_prev_and_rings(&t);
+        assert_eq!(t.valence(VertexId(0)), 2);
+    }
 
     #[test]
     fn a_column_is_stored_only_once_an_element_differs_from_0() {

@@ -5,6 +5,7 @@ pub mod build;
 pub mod halfedge;
 pub mod info;
 pub mod io;
+mod packed;
 pub mod pairing;
 pub mod shapes;
 pub mod soup;

@@ -523,12 +523,13 @@ impl Mesh {
         }
         let base = self.vertices().all(|v| self.vertex_level(v) == 0);
         for &e in &pairs {
-            self.e_block[e.index()] = true;
+            self.e_block.set(e.index(), true);
         }
         if base {
             let edges: Vec<EdgeId> = self.edges().collect();
             for e in edges {
-                self.e_level[e.index()] = if self.e_block[e.index()] { 0 } else { 1 };
+                self.e_level
+                    .set(e.index(), if self.e_block.get(e.index()) { 0 } else { 1 });
             }
         }
         Ok(Pairing {

@@ -64,7 +64,7 @@ impl Mesh {
     /// adaptive runs check ([`Mesh::reuses_vertex_slots`]).
     pub fn refinement_edge(&self, f: FaceId) -> EdgeId {
         let hs = self.face_halfedges(f);
-        if let Some(h) = hs.iter().find(|h| self.e_block[h.edge().index()]) {
+        if let Some(h) = hs.iter().find(|h| self.e_block.get(h.edge().index())) {
             return h.edge();
         }
         // The edge opposite the corner `from(h)` is `next(h)`.
@@ -151,14 +151,15 @@ impl Mesh {
         self.set_triangle(f, h0, vb.twin(), va);
         self.set_triangle(f1, h1, vc.twin(), vb);
         self.set_triangle(f2, h2, va.twin(), vc);
-        self.v_out[v.index()] = Some(va);
+        self.set_outgoing(v, Some(va));
         for g in [f, f1, f2] {
             let vs = self.face_vertices(g);
-            self.f_level[g.index()] = self.face_level_from_vertices(vs);
+            self.f_level
+                .set(g.index(), self.face_level_from_vertices(vs));
         }
         if policy.lone_triangles_join_blocks {
             for s in [va, vb, vc] {
-                self.e_block[s.edge().index()] = true;
+                self.e_block.set(s.edge().index(), true);
             }
         }
         Ok(v)
@@ -217,11 +218,12 @@ impl Mesh {
         self.set_triangle(keep, outer[0], outer[1], outer[2]);
         for &o in &outer {
             let a = self.from(o);
-            self.v_out[a.index()] = Some(o);
+            self.set_outgoing(a, Some(o));
             self.fix_outgoing(a);
         }
         let vs = self.face_vertices(keep);
-        self.f_level[keep.index()] = self.face_level_from_vertices(vs);
+        self.f_level
+            .set(keep.index(), self.face_level_from_vertices(vs));
         Ok(keep)
     }
 
@@ -275,10 +277,13 @@ impl Mesh {
         }
         let t = h.twin();
         let (a, b) = (self.from(h), self.to(h));
-        let le = self.e_level[e.index()];
-        let was_block = self.e_block[e.index()];
-        let lv = self.v_level[a.index()].max(self.v_level[b.index()]) + 1;
+        let le = self.e_level.get(e.index());
+        let was_block = self.e_block.get(e.index());
+        let lv = self.v_level.get(a.index()).max(self.v_level.get(b.index())) + 1;
         let (h_bc, h_ca) = (self.next(h), self.prev(h));
+        // Read before anything changes: on the boundary, `prev` turns
+        // around b through its faces.
+        let (t_next, t_prev) = (self.next(t), self.prev(t));
         let c = self.to(h_bc);
         let f1 = self.face(h).expect("h has a face");
         let boundary = self.face(t).is_none();
@@ -296,18 +301,18 @@ impl Mesh {
         // h becomes a -> v, t becomes v -> a.
         self.he_to[h.index()] = v;
         self.he_to[t.index()] = a;
-        self.e_level[e.index()] = le + 2;
-        self.e_block[e.index()] = false;
-        self.e_transversal[e.index()] = false;
+        self.e_level.set(e.index(), le + 2);
+        self.e_block.set(e.index(), false);
+        self.e_transversal.set(e.index(), false);
         let g = self.new_edge(v, b, le + 2); // v -> b
                                              // Both halves keep the edge's sharpness (OpenSubdiv's child edges);
                                              // the transversals below are drawn across faces and stay smooth.
         self.e_sharp
             .set(g.edge().index(), self.e_sharp.get(e.index()));
-        let k = self.new_edge(v, c, self.v_level[c.index()] + 1); // v -> c
-        self.e_transversal[k.edge().index()] = true;
+        let k = self.new_edge(v, c, self.v_level.get(c.index()) + 1); // v -> c
+        self.e_transversal.set(k.edge().index(), true);
         if lone {
-            self.e_block[k.edge().index()] = true;
+            self.e_block.set(k.edge().index(), true);
         }
         let f2 = self.new_face(g, 0, self.f_tag.get(f1.index()));
         self.set_triangle(f1, h, k, h_ca);
@@ -315,39 +320,39 @@ impl Mesh {
         if boundary {
             // The boundary loop ... -> (b -> a) -> ... becomes
             // ... -> (b -> v) -> (v -> a) -> ...
-            let (tp, tn) = (self.prev(t), self.next(t));
+            let (tp, tn) = (t_prev, t_next);
             let gt = g.twin();
             self.he_face[gt.index()] = NO_FACE;
             self.he_face[t.index()] = NO_FACE;
             self.link(tp, gt);
             self.link(gt, t);
             self.link(t, tn);
-            self.v_out[v.index()] = Some(t);
-            if self.v_out[b.index()] == Some(t) {
-                self.v_out[b.index()] = Some(gt);
+            self.set_outgoing(v, Some(t));
+            if self.outgoing(b) == Some(t) {
+                self.set_outgoing(b, Some(gt));
             }
         } else {
             let f3 = self.face(t).expect("interior edge");
-            let (t_ad, t_db) = (self.next(t), self.prev(t));
+            let (t_ad, t_db) = (t_next, t_prev);
             let d = self.to(t_ad);
-            let m = self.new_edge(v, d, self.v_level[d.index()] + 1); // v -> d
-            self.e_transversal[m.edge().index()] = true;
+            let m = self.new_edge(v, d, self.v_level.get(d.index()) + 1); // v -> d
+            self.e_transversal.set(m.edge().index(), true);
             let f4 = self.new_face(g.twin(), 0, self.f_tag.get(f3.index()));
             self.set_triangle(f3, t, t_ad, m.twin());
             self.set_triangle(f4, g.twin(), m, t_db);
-            self.v_out[v.index()] = Some(g);
-            if self.v_out[b.index()] == Some(t) {
-                self.v_out[b.index()] = Some(g.twin());
+            self.set_outgoing(v, Some(g));
+            if self.outgoing(b) == Some(t) {
+                self.set_outgoing(b, Some(g.twin()));
             }
             // Faces a-d-v and v-d-b: l(v) is above l(a) and l(b).
-            let l = lv.max(self.v_level[d.index()]) + 1;
-            self.f_level[f3.index()] = l;
-            self.f_level[f4.index()] = l;
+            let l = lv.max(self.v_level.get(d.index())) + 1;
+            self.f_level.set(f3.index(), l);
+            self.f_level.set(f4.index(), l);
         }
         // Faces a-v-c and v-b-c.
-        let l = lv.max(self.v_level[c.index()]) + 1;
-        self.f_level[f1.index()] = l;
-        self.f_level[f2.index()] = l;
+        let l = lv.max(self.v_level.get(c.index())) + 1;
+        self.f_level.set(f1.index(), l);
+        self.f_level.set(f2.index(), l);
         if was_block {
             match policy.blocks {
                 BlockSplit::Quadrisection | BlockSplit::Dual => {
@@ -361,7 +366,7 @@ impl Mesh {
                         *slot = Some(h.edge());
                     }
                     for s in spokes.into_iter().flatten() {
-                        self.e_block[s.index()] = true;
+                        self.e_block.set(s.index(), true);
                     }
                 }
                 BlockSplit::Bisection => {
@@ -383,7 +388,7 @@ impl Mesh {
                                         .face(h.twin())
                                         .is_none_or(|g| self.refinement_edge(g) == h.edge());
                                 if complete {
-                                    self.e_block[h.edge().index()] = true;
+                                    self.e_block.set(h.edge().index(), true);
                                 }
                             }
                         }
@@ -461,7 +466,7 @@ impl Mesh {
             let bin = x.twin(); // n0 -> v, boundary
             let bout = out[2]; // v -> n2, boundary
             let (bp, bn) = (self.prev(bin), self.next(bout));
-            let le = self.e_level[x.edge().index()].saturating_sub(2);
+            let le = self.e_level.get(x.edge().index()).saturating_sub(2);
             // The restored edge is as sharp as the sharper of its halves.
             let sharp = self
                 .e_sharp
@@ -474,8 +479,8 @@ impl Mesh {
             self.delete_vertex(v);
             self.he_to[x.index()] = n0;
             self.he_to[bin.index()] = n2;
-            self.e_level[x.edge().index()] = le;
-            self.e_transversal[x.edge().index()] = false;
+            self.e_level.set(x.edge().index(), le);
+            self.e_transversal.set(x.edge().index(), false);
             self.set_triangle(f, o1, o2, x);
             self.he_face[bin.index()] = NO_FACE;
             self.link(bp, bin);
@@ -488,11 +493,12 @@ impl Mesh {
                 } else {
                     x
                 };
-                self.v_out[w.index()] = Some(any);
+                self.set_outgoing(w, Some(any));
                 self.fix_outgoing(w);
             }
             let vs = self.face_vertices(f);
-            self.f_level[f.index()] = self.face_level_from_vertices(vs);
+            self.f_level
+                .set(f.index(), self.face_level_from_vertices(vs));
             return Ok(x.edge());
         }
         // Interior: rotate so that out = [v->a, v->c, v->b, v->d].
@@ -512,7 +518,7 @@ impl Mesh {
             self.next(o[3]),
         );
         let faces: Vec<FaceId> = o.iter().map(|&h| self.face(h).expect("interior")).collect();
-        let le = self.e_level[o[0].edge().index()].saturating_sub(2);
+        let le = self.e_level.get(o[0].edge().index()).saturating_sub(2);
         // Reuse edge v-a: x = a -> b, x' = b -> a.
         let x = o[0].twin(); // was a -> v
                              // The restored edge is as sharp as the sharper of its halves.
@@ -529,8 +535,8 @@ impl Mesh {
         self.delete_vertex(v);
         self.he_to[x.index()] = b;
         self.he_to[x.twin().index()] = a;
-        self.e_level[x.edge().index()] = le;
-        self.e_transversal[x.edge().index()] = false;
+        self.e_level.set(x.edge().index(), le);
+        self.e_transversal.set(x.edge().index(), false);
         self.set_triangle(faces[0], o_ac, o_cb, x.twin());
         self.set_triangle(faces[1], o_bd, o_da, x);
         // faces[1] was v-c-b; it is now b-d-a, whose half on a's side was
@@ -538,12 +544,13 @@ impl Mesh {
         self.f_tag
             .set(faces[1].index(), self.f_tag.get(faces[3].index()));
         for (w, h) in [(a, x), (b, x.twin()), (c, o_cb), (d, o_da)] {
-            self.v_out[w.index()] = Some(h);
+            self.set_outgoing(w, Some(h));
             self.fix_outgoing(w);
         }
         for f in [faces[0], faces[1]] {
             let vs = self.face_vertices(f);
-            self.f_level[f.index()] = self.face_level_from_vertices(vs);
+            self.f_level
+                .set(f.index(), self.face_level_from_vertices(vs));
         }
         Ok(x.edge())
     }
@@ -614,19 +621,21 @@ impl Mesh {
         self.he_to[t.index()] = d; // c -> d
         self.set_triangle(f1, t_ad, h, h_ca);
         self.set_triangle(f2, t_db, h_bc, t);
-        if self.v_out[a.index()] == Some(h) {
-            self.v_out[a.index()] = Some(t_ad);
+        if self.outgoing(a) == Some(h) {
+            self.set_outgoing(a, Some(t_ad));
         }
-        if self.v_out[b.index()] == Some(t) {
-            self.v_out[b.index()] = Some(h_bc);
+        if self.outgoing(b) == Some(t) {
+            self.set_outgoing(b, Some(h_bc));
         }
-        self.e_level[e.index()] += 1;
-        self.e_block[e.index()] = false;
-        self.e_transversal[e.index()] = false;
+        self.e_level.set(e.index(), self.e_level.get(e.index()) + 1);
+        self.e_block.set(e.index(), false);
+        self.e_transversal.set(e.index(), false);
         // The faces are now d-c-a and c-d-b.
-        let lcd = self.v_level[c.index()].max(self.v_level[d.index()]);
-        self.f_level[f1.index()] = lcd.max(self.v_level[a.index()]) + 1;
-        self.f_level[f2.index()] = lcd.max(self.v_level[b.index()]) + 1;
+        let lcd = self.v_level.get(c.index()).max(self.v_level.get(d.index()));
+        self.f_level
+            .set(f1.index(), lcd.max(self.v_level.get(a.index())) + 1);
+        self.f_level
+            .set(f2.index(), lcd.max(self.v_level.get(b.index())) + 1);
         Ok(())
     }
 }

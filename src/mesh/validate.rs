@@ -2,7 +2,7 @@
 
 use std::collections::HashSet;
 
-use super::halfedge::{Mesh, MeshError};
+use super::halfedge::{HalfEdgeId, Mesh, MeshError};
 
 impl Mesh {
     /// Checks the invariants: twins, next/prev cycles, faces of three
@@ -109,16 +109,16 @@ impl Mesh {
                             v.0
                         ));
                     }
-                    let boundary = self
-                        .outgoing_halfedges(v)
-                        .any(|h| self.is_boundary_halfedge(h));
+                    // Walked here with `prev`, which takes any half-edge,
+                    // and at most one step past the vertex's degree: the
+                    // walkers assume what is checked here.
+                    let (walked, boundary) = self.walk_checked(h, degree[v.index()] + 1);
                     if boundary && !self.is_boundary_halfedge(h) {
                         return bad(format!(
                             "vertex {} is on the boundary but does not point at its boundary half-edge",
                             v.0
                         ));
                     }
-                    let walked = self.outgoing_halfedges(v).count();
                     if walked != degree[v.index()] {
                         return bad(format!(
                             "vertex {} is non-manifold: a walk around it meets {walked} of its {} edges",
@@ -130,6 +130,27 @@ impl Mesh {
             }
         }
         Ok(())
+    }
+
+    /// Walks counter-clockwise around the tail of `out` (from the first
+    /// half-edge after the boundary gap when `out` is a boundary one), at
+    /// most `limit` steps: how many half-edges it meets, and whether one
+    /// is on the boundary.
+    fn walk_checked(&self, out: HalfEdgeId, limit: usize) -> (usize, bool) {
+        let start = if self.is_boundary_halfedge(out) {
+            self.prev(out).twin()
+        } else {
+            out
+        };
+        let (mut h, mut n, mut boundary) = (start, 0, false);
+        loop {
+            n += 1;
+            boundary |= self.is_boundary_halfedge(h);
+            h = self.prev(h).twin();
+            if h == start || n >= limit {
+                return (n, boundary);
+            }
+        }
     }
 
     /// A description of the mesh that ignores how elements are numbered:

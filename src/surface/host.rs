@@ -137,6 +137,11 @@ pub fn face_vertices(e: &Elem) -> Option<[VertexId; 3]> {
     (e.kind == FACE).then_some([VertexId(e.ids[0]), VertexId(e.ids[1]), VertexId(e.ids[2])])
 }
 
+/// The id of an edge value.
+pub fn edge_id(e: &Elem) -> Option<EdgeId> {
+    (e.kind == EDGE).then_some(EdgeId(e.ids[3]))
+}
+
 /// The end vertices of an edge value.
 pub fn edge_vertices(e: &Elem) -> Option<(VertexId, VertexId)> {
     (e.kind == EDGE).then_some((VertexId(e.ids[0]), VertexId(e.ids[1])))

@@ -22,6 +22,7 @@ use crate::lang::compile::RuleCompiler;
 use crate::lang::eval::{Env, Interp, RuntimeError};
 use crate::lang::ir::{Ex, Func};
 use crate::lang::value::{Elem, Ty, Value};
+use crate::mesh::halfedge::Bits;
 use crate::mesh::{BlockSplit, EdgeId, FaceId, Mesh, Split, VertexId};
 use crate::syntax::span::{Diagnostic, SourceMap, Span};
 
@@ -50,6 +51,11 @@ pub struct Rule {
     /// A vertex rule whose condition is `refined(v) && ...`: only corners
     /// of faces with a vertex made in this step can match.
     needs_refined: bool,
+    /// A split rule whose assignment reads positions only through `pos`
+    /// and `avg` of the matched element ([`reads_only_matched_positions`]):
+    /// its new vertices' points read none of theirs, so each can be
+    /// written as soon as it is computed.
+    points_in_place: bool,
 }
 
 /// A checked grammar, ready to run.
@@ -79,7 +85,8 @@ pub struct Grammar {
     /// maximum matching before the `init:` rules.
     pub match_blocks_at: Option<Span>,
     /// A rule that would make more faces than this stops the run with an
-    /// error instead of exhausting memory (about 110 bytes a face).
+    /// error instead of exhausting memory (about 70 bytes a face at the
+    /// peak of a Loop step).
     pub max_faces: usize,
     /// A rule after which a vertex has a higher valence than this (or
     /// than twice the base mesh's highest, where that is more) stops the
@@ -92,7 +99,7 @@ pub struct Grammar {
     pub warnings: Vec<Diagnostic>,
 }
 
-/// The default face limit: about 5.5 GB of mesh.
+/// The default face limit: about 3.5 GB at the peak of a step.
 pub const MAX_FACES: usize = 50_000_000;
 
 /// The default valence limit ([`Grammar::max_valence`]): far above what
@@ -213,6 +220,10 @@ pub(crate) fn compile_with(
         let needs_refined = cond
             .as_ref()
             .is_some_and(|c| requires_refined(c, elem_slot));
+        let points_in_place = r.op != Op::Vertex
+            && assign
+                .as_ref()
+                .is_some_and(|a| reads_only_matched_positions(a, elem_slot));
         rules.push(Rule {
             guard,
             affine,
@@ -227,6 +238,7 @@ pub(crate) fn compile_with(
             text: r.text.clone(),
             init: r.init,
             needs_refined,
+            points_in_place,
         });
     }
     let length = match &file.length {
@@ -476,7 +488,10 @@ impl Protected {
 /// The elements a rule matched when it started.
 struct Matches {
     current: u32,
+    /// The matched elements as values (none for a flip rule, which needs
+    /// only their ids; an edge's value holds its id).
     vals: Vec<Elem>,
+    /// A flip rule's matched edges (empty for other rules).
     edge_ids: Vec<crate::mesh::EdgeId>,
 }
 
@@ -903,8 +918,13 @@ impl Grammar {
                             };
                             let val = edge_value(mesh, e, block);
                             if ev.test(r, &val).map_err(|e| (!std::ptr::eq(r, rule), e))? {
-                                out.0.push(val);
-                                out.1.push(e);
+                                // A flip needs the edge alone; a split's
+                                // value holds the id.
+                                if r.op == Op::Flip {
+                                    out.1.push(e);
+                                } else {
+                                    out.0.push(val);
+                                }
                             }
                         }
                     }
@@ -948,7 +968,7 @@ impl Grammar {
         Ok((join(&|p| &p.0), join(&|p| &p.1)))
     }
 
-    /// Evaluates `assign` for elements `0..n` in parallel, `bind` setting
+    /// Evaluates `assign` for elements `range` in parallel, `bind` setting
     /// each one's frame slots, giving the points in order; or the first
     /// element whose point is not finite, with what it gave: a point, a
     /// value that is not one, or an error.
@@ -960,14 +980,15 @@ impl Grammar {
         current: u32,
         step: u32,
         assign: &Ex,
-        n: usize,
+        range: std::ops::Range<usize>,
         bind: impl Fn(&mut [Value], usize) + Sync,
     ) -> Result<Vec<DVec3>, (usize, Result<Value, RuntimeError>)> {
+        let lo = range.start;
         let one = |ev: &mut Evaluator, k: usize| {
             bind(&mut ev.frame, k);
             ev.assign(rule, assign)
         };
-        let points: Vec<DVec3> = (0..n)
+        let points: Vec<DVec3> = range
             .into_par_iter()
             .with_min_len(CHUNK)
             .map_init(
@@ -982,8 +1003,8 @@ impl Grammar {
             None => Ok(points),
             // Evaluate the first bad one again, to say what it gave.
             Some(k) => Err((
-                k,
-                one(&mut Evaluator::new(mesh, current, step, rule.frame), k),
+                lo + k,
+                one(&mut Evaluator::new(mesh, current, step, rule.frame), lo + k),
             )),
         }
     }
@@ -1049,6 +1070,10 @@ impl Grammar {
                     self.apply_matched(next, mesh, state, b)?;
                     i += 2;
                 }
+                None if rule.op == Op::Vertex => {
+                    self.apply_vertex_rule(rule, mesh, state)?;
+                    i += 1;
+                }
                 None => {
                     let m = self
                         .find_matches(rule, mesh, state)
@@ -1099,13 +1124,12 @@ impl Grammar {
         };
         // The values the selected edges had when the rule started.
         let mut selected: std::collections::HashMap<EdgeId, Elem> = a
-            .edge_ids
+            .vals
             .iter()
-            .zip(&a.vals)
-            .chain(b.edge_ids.iter().zip(&b.vals))
-            .map(|(&e, &v)| (e, v))
+            .chain(&b.vals)
+            .map(|v| (edge_id(v), *v))
             .collect();
-        let mut todo: Vec<EdgeId> = a.edge_ids.iter().chain(&b.edge_ids).copied().collect();
+        let mut todo: Vec<EdgeId> = a.vals.iter().chain(&b.vals).map(edge_id).collect();
         todo.sort_unstable();
         while !todo.is_empty() {
             if let Err(m) = crate::deadline::check(state.deadline) {
@@ -1189,7 +1213,7 @@ impl Grammar {
                     Matches {
                         current,
                         vals,
-                        edge_ids: edges,
+                        edge_ids: Vec::new(),
                     },
                 )?;
             }
@@ -1211,6 +1235,154 @@ impl Grammar {
         }
     }
 
+    /// A vertex rule, matched and evaluated in one pass: the vertices (or
+    /// the work list) in chunks on rayon's threads, each chunk testing the
+    /// condition and evaluating the assignment of its vertices and writing
+    /// their points to the next-position buffer at their slots. The same
+    /// as matching every vertex first and evaluating the matches after:
+    /// a vertex rule changes neither the topology nor the current
+    /// positions, so every match and every point reads what it read when
+    /// the rule started. The errors are those of the two passes: the
+    /// first condition that fails to evaluate, in id order; else the
+    /// first match, in id order, whose point is not a finite point.
+    fn apply_vertex_rule(
+        &self,
+        rule: &Rule,
+        mesh: &Mesh,
+        state: &mut RunState,
+    ) -> Result<(), RunError> {
+        let step = state.step as usize;
+        let current = state.current_level;
+        // A crease rule on a mesh without creases matches nothing.
+        if !mesh.has_sharpness_flag()
+            && rule
+                .guard
+                .as_ref()
+                .is_some_and(|g| g.never_without_creases())
+        {
+            return Ok(());
+        }
+        let list = state.work_list(rule, mesh);
+        let slots = list.as_ref().map_or(mesh.v_alive.len(), |l| l.len());
+        let id_at = |i: usize| VertexId(list.as_ref().map_or(i as u32, |l| l[i]));
+        let protect = state.protect.as_ref();
+        let assign = rule.assign.as_ref();
+        let slot = rule.elem_slot as usize;
+        // Tests and evaluates the ids at places `lo..hi`, handing each
+        // point to `emit` with its place.
+        let task = |lo: usize, hi: usize, emit: &mut dyn FnMut(usize, VertexId, DVec3)| {
+            let mut ev = Evaluator::new(mesh, current, state.step, rule.frame);
+            let mut end = VertexTask::default();
+            for i in lo..hi {
+                let v = id_at(i);
+                if !mesh.is_vertex(v)
+                    || mesh.outgoing(v).is_none()
+                    || protect.is_some_and(|p| !p.vertex_free(v))
+                {
+                    continue;
+                }
+                let ok = match rule.context {
+                    VertexContext::Any => true,
+                    VertexContext::Boundary => mesh.is_boundary_vertex(v),
+                    VertexContext::Interior => !mesh.is_boundary_vertex(v),
+                };
+                let val = host::vertex(v);
+                match ok.then(|| ev.test(rule, &val)) {
+                    Some(Err(e)) => {
+                        end.error = Some(e);
+                        return end;
+                    }
+                    Some(Ok(true)) => {}
+                    _ => continue,
+                }
+                // After a bad point only the conditions matter: one that
+                // fails later in the chunk is the error to report.
+                let Some(assign) = assign.filter(|_| end.bad.is_none()) else {
+                    continue;
+                };
+                ev.frame[slot] = Value::Elem(val);
+                match ev.assign(rule, assign) {
+                    Ok(Value::V3(p)) if p.is_finite() => emit(i, v, p),
+                    _ => end.bad = Some(i),
+                }
+            }
+            end
+        };
+        let ranges =
+            |n: usize| (0..n.div_ceil(CHUNK)).map(move |k| (k * CHUNK, ((k + 1) * CHUNK).min(n)));
+        let ends: Vec<VertexTask> = match (&list, assign) {
+            // Every slot: each chunk writes its own part of the buffer.
+            (None, Some(_)) => {
+                state.next.cover(mesh);
+                let NextPositions { pos, written } = &mut state.next;
+                pos[..slots]
+                    .par_chunks_mut(CHUNK)
+                    .zip(written.words_mut().par_chunks_mut(CHUNK / 64))
+                    .enumerate()
+                    .map(|(k, (pos, words))| {
+                        let lo = k * CHUNK;
+                        task(lo, lo + pos.len(), &mut |i, _, p| {
+                            let j = i - lo;
+                            pos[j] = p;
+                            words[j / 64] |= 1 << (j % 64);
+                        })
+                    })
+                    .collect()
+            }
+            // A work list: each chunk's points, then written in order.
+            (Some(_), Some(_)) => {
+                let parts: Vec<(VertexTask, Vec<(VertexId, DVec3)>)> = ranges(slots)
+                    .collect::<Vec<_>>()
+                    .into_par_iter()
+                    .map(|(lo, hi)| {
+                        let mut out = Vec::new();
+                        let end = task(lo, hi, &mut |_, v, p| out.push((v, p)));
+                        (end, out)
+                    })
+                    .collect();
+                state.next.cover(mesh);
+                parts
+                    .into_iter()
+                    .map(|(end, out)| {
+                        for (v, p) in out {
+                            state.next.set(v, p);
+                        }
+                        end
+                    })
+                    .collect()
+            }
+            // No assignment: the conditions are still tested.
+            (_, None) => ranges(slots)
+                .collect::<Vec<_>>()
+                .into_par_iter()
+                .map(|(lo, hi)| task(lo, hi, &mut |_, _, _| {}))
+                .collect(),
+        };
+        let mut bad = None;
+        for end in ends {
+            if let Some(e) = end.error {
+                return Err(self.runtime_error(rule, step, e));
+            }
+            bad = bad.or(end.bad);
+        }
+        let (Some(i), Some(assign)) = (bad, assign) else {
+            return Ok(());
+        };
+        // Evaluate the first bad one again, to say what it gave.
+        let v = id_at(i);
+        let mut ev = Evaluator::new(mesh, current, state.step, rule.frame);
+        ev.frame[slot] = Value::Elem(host::vertex(v));
+        Err(match ev.assign(rule, assign) {
+            Ok(Value::V3(p)) => rule_error(
+                rule,
+                step,
+                format!("vertex {v} would move to {p}, which is not finite"),
+            ),
+            Ok(_) => rule_error(rule, step, "the assignment did not give a point".into()),
+            Err(e) => self.runtime_error(rule, step, e),
+        })
+    }
+
     fn apply_matched(
         &self,
         rule: &Rule,
@@ -1224,46 +1396,11 @@ impl Grammar {
             vals: matched,
             edge_ids,
         } = m;
-        let fail = |m: String| RunError {
-            span: Some(rule.span),
-            message: if step == 0 {
-                format!("at initialization, rule `{}`: {m}", rule.text)
-            } else {
-                format!("at step {step}, rule `{}`: {m}", rule.text)
-            },
-        };
+        debug_assert!(rule.op == Op::Flip || edge_ids.is_empty());
+        let fail = |m: String| rule_error(rule, step, m);
 
         match rule.op {
-            Op::Vertex => {
-                let Some(assign) = &rule.assign else {
-                    return Ok(());
-                };
-                let slot = rule.elem_slot as usize;
-                let out = self
-                    .eval_points(
-                        rule,
-                        mesh,
-                        current,
-                        state.step,
-                        assign,
-                        matched.len(),
-                        |frame, k| {
-                            frame[slot] = Value::Elem(matched[k]);
-                        },
-                    )
-                    .map_err(|(k, p)| match p {
-                        Ok(Value::V3(p)) => fail(format!(
-                            "vertex {} would move to {p}, which is not finite",
-                            vertex_of(&matched[k])
-                        )),
-                        Ok(_) => fail("the assignment did not give a point".into()),
-                        Err(e) => self.runtime_error(rule, step, e),
-                    })?;
-                state
-                    .next_pos
-                    .extend(matched.iter().zip(out).map(|(val, p)| (vertex_of(val), p)));
-                Ok(())
-            }
+            Op::Vertex => unreachable!("vertex rules run in apply_vertex_rule"),
             Op::Flip => {
                 for &e in &edge_ids {
                     mesh.edge_flip(e).map_err(|e| fail(e.message))?;
@@ -1281,14 +1418,15 @@ impl Grammar {
                     )));
                 }
                 let split = state.split();
-                let mut made: Vec<(VertexId, &Elem)> = Vec::with_capacity(matched.len());
+                // The vertex made from each matched element, in order.
+                let mut made: Vec<VertexId> = Vec::with_capacity(matched.len());
                 match rule.op {
                     Op::FaceSplit => {
                         mesh.reserve(matched.len(), 3 * matched.len(), 2 * matched.len())
                     }
                     _ => mesh.reserve(matched.len(), 3 * matched.len(), 2 * matched.len()),
                 }
-                for (k, val) in matched.iter().enumerate() {
+                for val in &matched {
                     let v = if let Some(vs) = host::face_vertices(val) {
                         {
                             let Some(f) = face_of(mesh, vs) else {
@@ -1300,7 +1438,7 @@ impl Grammar {
                         }
                     } else if let Some((p, q)) = host::edge_vertices(val) {
                         {
-                            let e = edge_ids[k];
+                            let e = edge_id(val);
                             debug_assert!({
                                 let (a, b) = mesh.edge_vertices(e);
                                 (a, b) == (p, q) || (a, b) == (q, p)
@@ -1310,48 +1448,53 @@ impl Grammar {
                                 .map_err(|e| fail(e.message))?
                         }
                     } else {
-                        continue;
+                        unreachable!("a split rule matches faces and edges")
                     };
-                    made.push((v, val));
+                    made.push(v);
                 }
                 if state.adaptive {
-                    state.made_now.extend(made.iter().map(|(v, _)| *v));
+                    state.made_now.extend(&made);
                 }
                 state.check_valence(mesh).map_err(fail)?;
                 state.current_level = made
                     .iter()
-                    .map(|(v, _)| mesh.vertex_level(*v))
+                    .map(|v| mesh.vertex_level(*v))
                     .fold(state.current_level, u32::max);
                 let Some(assign) = &rule.assign else {
                     return Ok(());
                 };
                 let vslot = rule.vertex_slot.expect("an assignment names its vertex");
                 let slot = rule.elem_slot as usize;
-                let out = self
-                    .eval_points(
-                        rule,
-                        mesh,
-                        current,
-                        state.step,
-                        assign,
-                        made.len(),
-                        |frame, k| {
-                            frame[slot] = Value::Elem(*made[k].1);
-                            frame[vslot as usize] = Value::Elem(host::vertex(made[k].0));
-                        },
-                    )
-                    .map_err(|(k, p)| match p {
-                        Ok(Value::V3(p)) => fail(format!(
-                            "new vertex {} would be at {p}, which is not finite",
-                            made[k].0
-                        )),
-                        Ok(_) => fail("the assignment did not give a point".into()),
-                        Err(e) => self.runtime_error(rule, step, e),
-                    })?;
-                for ((v, _), p) in made.iter().zip(out) {
-                    mesh.set_position(*v, p);
+                let bind = |frame: &mut [Value], k: usize| {
+                    frame[slot] = Value::Elem(matched[k]);
+                    frame[vslot as usize] = Value::Elem(host::vertex(made[k]));
+                };
+                let bad = |(k, p): (usize, Result<Value, RuntimeError>)| match p {
+                    Ok(Value::V3(p)) => fail(format!(
+                        "new vertex {} would be at {p}, which is not finite",
+                        made[k]
+                    )),
+                    Ok(_) => fail("the assignment did not give a point".into()),
+                    Err(e) => self.runtime_error(rule, step, e),
+                };
+                // Where no point reads another, a batch's points are
+                // written before the next batch is computed, and only a
+                // batch is held; else all are computed first. A bad point
+                // stops the rule before its batch is written.
+                let batch = if rule.points_in_place {
+                    POINT_BATCH
+                } else {
+                    made.len().max(1)
+                };
+                for lo in (0..made.len()).step_by(batch) {
+                    let range = lo..(lo + batch).min(made.len());
+                    let out = self
+                        .eval_points(rule, mesh, current, state.step, assign, range, bind)
+                        .map_err(bad)?;
+                    for (v, p) in made[lo..].iter().zip(out) {
+                        mesh.set_position(*v, p);
+                    }
                 }
-
                 Ok(())
             }
         }
@@ -1448,9 +1591,8 @@ struct RunState {
     /// The step running (0 for `init:` rules); new vertices record it.
     step: u32,
     /// Positions written for the next step (the second buffer of paper
-    /// 000, §7), kept as a list: only smoothed vertices have one. They
-    /// become current, in the order written, at the end of the step.
-    next_pos: Vec<(VertexId, DVec3)>,
+    /// 000, §7): they become current at the end of the step.
+    next: NextPositions,
     /// What splitting a basic block's internal edge makes of the block.
     blocks: BlockSplit,
     /// Set for grammars that read blocks: a face split then makes blocks.
@@ -1547,14 +1689,117 @@ impl RunState {
     /// Makes the next positions current (paper 000, §7: the buffer is
     /// swapped after each step), in the order they were written.
     fn swap_positions(&mut self, mesh: &mut Mesh) {
-        for (v, p) in self.next_pos.drain(..) {
-            mesh.set_position(v, p);
+        std::mem::take(&mut self.next).make_current(mesh);
+    }
+}
+
+/// The points of a split rule whose points read no other new vertex
+/// (`Rule::points_in_place`) are computed and written this many at a
+/// time.
+const POINT_BATCH: usize = 16 * CHUNK;
+
+/// Elements per parallel task: small jobs stay on one thread. A multiple
+/// of 64, so that a task's flags in [`NextPositions`] are whole words.
+const CHUNK: usize = 16384;
+
+/// The positions vertex rules write for the next step, by vertex slot,
+/// and which slots were written: a dense buffer, 24 bytes and a bit a
+/// vertex, filled while the rules run and made current when the step
+/// ends. A later rule's point for a vertex replaces an earlier one's.
+#[derive(Debug, Default)]
+struct NextPositions {
+    pos: Vec<DVec3>,
+    written: Bits,
+}
+
+impl NextPositions {
+    /// Room for every vertex slot of `mesh`, none written.
+    fn cover(&mut self, mesh: &Mesh) {
+        let n = mesh.v_alive.len();
+        if self.pos.len() < n {
+            if self.pos.is_empty() {
+                self.pos = crate::huge::with_capacity(n);
+            }
+            self.pos.resize(n, DVec3::ZERO);
+        }
+        while self.written.len() < n {
+            self.written.push(false);
+        }
+    }
+
+    /// Records `p` for vertex `v`.
+    fn set(&mut self, v: VertexId, p: DVec3) {
+        self.pos[v.index()] = p;
+        self.written.set(v.index(), true);
+    }
+
+    /// Gives the written vertices their points.
+    fn make_current(self, mesh: &mut Mesh) {
+        for (i, p) in self.pos.iter().enumerate() {
+            if self.written.get(i) {
+                mesh.set_position(VertexId(i as u32), *p);
+            }
         }
     }
 }
 
-/// Elements per parallel task: small jobs stay on one thread.
-const CHUNK: usize = 16384;
+/// How one task of a vertex rule ended (see `Grammar::apply_vertex_rule`).
+#[derive(Default)]
+struct VertexTask {
+    /// The first condition that failed to evaluate, which stopped it.
+    error: Option<RuntimeError>,
+    /// The first matched vertex, by its place among the ids tested, whose
+    /// point was not finite or not a point.
+    bad: Option<usize>,
+}
+
+/// An error of `rule` at `step` (0: the `init:` rules).
+fn rule_error(rule: &Rule, step: usize, m: String) -> RunError {
+    RunError {
+        span: Some(rule.span),
+        message: if step == 0 {
+            format!("at initialization, rule `{}`: {m}", rule.text)
+        } else {
+            format!("at step {step}, rule `{}`: {m}", rule.text)
+        },
+    }
+}
+
+/// True when `e`, a split rule's assignment, reads positions only through
+/// `pos` or `avg` of the matched element in slot `elem`: the split face's
+/// or edge's own corners, which are there before the rule and keep their
+/// positions until the step ends. Everything else it may read is a
+/// number that no position changes (levels, valences, `c`, the step) or
+/// arithmetic. Conservative: anything else says no.
+fn reads_only_matched_positions(e: &Ex, elem: u16) -> bool {
+    let mut ok = true;
+    e.walk(&mut |x| match x {
+        Ex::Call(Func::Host(id::POS | id::AVG_OF), args, _) => {
+            ok &= matches!(args.as_slice(), [Ex::Local(s)] if *s == elem);
+        }
+        Ex::Call(
+            Func::Host(id::VALENCE | id::LEVEL | id::CURRENT | id::STEP | id::CREASES),
+            ..,
+        ) => {}
+        Ex::Let(s, ..) => ok &= *s != elem,
+        Ex::Const(_)
+        | Ex::Local(_)
+        | Ex::Bin(..)
+        | Ex::Neg(_)
+        | Ex::Not(_)
+        | Ex::Logic(..)
+        | Ex::Cond(..)
+        | Ex::Convert(..)
+        | Ex::MakeV3(..) => {}
+        _ => ok = false,
+    });
+    ok
+}
+
+/// The id of a matched edge's value.
+fn edge_id(val: &Elem) -> EdgeId {
+    host::edge_id(val).expect("an edge value")
+}
 
 /// An edge as a rule's value: its ends (a boundary edge runs the way its
 /// face does), level and marks, `block` the block mark it shows.
@@ -1601,10 +1846,6 @@ fn check_adaptive_start(mesh: &Mesh) -> Result<(), String> {
         );
     }
     Ok(())
-}
-
-fn vertex_of(val: &Elem) -> VertexId {
-    host::vertex_of(val).unwrap_or(VertexId(u32::MAX))
 }
 
 fn face_of(mesh: &Mesh, vs: [VertexId; 3]) -> Option<crate::mesh::FaceId> {
