@@ -430,7 +430,10 @@ impl<'p> Rewriter<'p> {
             dst.clear();
             return None;
         };
-        dst.append_all(&self.parts);
+        if !dst.append_all(&self.parts) {
+            dst.clear();
+            return None;
+        }
         Some(rewritten)
     }
 

@@ -107,48 +107,13 @@ impl Word {
     }
 
     /// Appends all modules of each of `parts`, in order, copying the
-    /// parts at once on rayon's pool: each into its own stretch of the
-    /// word's room, the new memory touched first by the thread that fills
-    /// it.
-    pub fn append_all(&mut self, parts: &[Word]) {
-        use rayon::prelude::*;
-        let modules: usize = parts.iter().map(Word::len).sum();
-        let slots: usize = parts.iter().map(|w| w.data.len()).sum();
-        self.reserve(modules, slots);
-        let mut base = self.data.len();
-        let (mut syms, mut starts, mut data) = (
-            &mut self.syms.spare_capacity_mut()[..modules],
-            &mut self.starts.spare_capacity_mut()[..modules],
-            &mut self.data.spare_capacity_mut()[..slots],
-        );
-        let mut jobs = Vec::with_capacity(parts.len());
-        for w in parts {
-            let (s, rest) = std::mem::take(&mut syms).split_at_mut(w.len());
-            syms = rest;
-            let (o, rest) = std::mem::take(&mut starts).split_at_mut(w.len());
-            starts = rest;
-            let (d, rest) = std::mem::take(&mut data).split_at_mut(w.data.len());
-            data = rest;
-            jobs.push((w, s, o, d, base as u32));
-            base += w.data.len();
-        }
-        jobs.into_par_iter().for_each(|(w, s, o, d, base)| {
-            s.write_copy_of_slice(&w.syms);
-            for (o, &x) in o.iter_mut().zip(&w.starts[1..]) {
-                o.write(x + base);
-            }
-            d.write_copy_of_slice(&w.data);
-        });
-        // SAFETY: the jobs wrote every element of the first `modules`
-        // (`slots`) places of each array's spare capacity: the stretches
-        // they were given cover them, and each was written whole (a
-        // part's `starts` has one entry per module after its leading 0).
-        // A panic would leave before this line, with the word as it was.
-        unsafe {
-            self.syms.set_len(self.syms.len() + modules);
-            self.starts.set_len(self.starts.len() + modules);
-            self.data.set_len(self.data.len() + slots);
-        }
+    /// parts at once on rayon's pool ([`Word::fill_parts`]): each into
+    /// its own stretch of the word's room, the new memory touched first by
+    /// the thread that fills it. False, and the word as it was, when the
+    /// slots would pass the offsets' `u32` range.
+    pub fn append_all(&mut self, parts: &[Word]) -> bool {
+        let counts: Vec<(usize, usize)> = parts.iter().map(|w| (w.len(), w.data.len())).collect();
+        self.fill_parts(&counts, |k, out| out.push_word(&parts[k]))
     }
 
     /// Appends parts whose sizes are known beforehand, written at once on
@@ -341,6 +306,24 @@ pub(crate) struct PartWriter<'a> {
 }
 
 impl PartWriter<'_> {
+    /// Writes the modules of `w`, slots and all; false (and nothing
+    /// written) when they would pass the part's share.
+    pub(crate) fn push_word(&mut self, w: &Word) -> bool {
+        let (m, s) = (self.modules + w.len(), self.slots + w.data.len());
+        if m > self.syms.len() || s > self.data.len() {
+            return false;
+        }
+        self.syms[self.modules..m].write_copy_of_slice(&w.syms);
+        let base = self.base + self.slots as u32;
+        for (o, &x) in self.starts[self.modules..m].iter_mut().zip(&w.starts[1..]) {
+            o.write(x + base);
+        }
+        self.data[self.slots..s].write_copy_of_slice(&w.data);
+        self.modules = m;
+        self.slots = s;
+        true
+    }
+
     /// Writes the next module; false (and nothing written) when it would
     /// pass the part's share.
     #[inline]

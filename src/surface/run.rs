@@ -930,16 +930,8 @@ impl Grammar {
                     }
                     Op::Vertex => {
                         for v in (lo..hi).map(|i| VertexId(id_at(i))) {
-                            if !mesh.is_vertex(v)
-                                || mesh.outgoing(v).is_none()
-                                || protect.is_some_and(|p| !p.vertex_free(v))
-                            {
+                            let Some(ok) = vertex_candidate(mesh, v, protect, rule) else {
                                 continue;
-                            }
-                            let ok = match rule.context {
-                                VertexContext::Any => true,
-                                VertexContext::Boundary => mesh.is_boundary_vertex(v),
-                                VertexContext::Interior => !mesh.is_boundary_vertex(v),
                             };
                             let val = host::vertex(v);
                             if ok && ev.test(rule, &val).map_err(|e| (false, e))? {
@@ -1275,16 +1267,8 @@ impl Grammar {
             let mut end = VertexTask::default();
             for i in lo..hi {
                 let v = id_at(i);
-                if !mesh.is_vertex(v)
-                    || mesh.outgoing(v).is_none()
-                    || protect.is_some_and(|p| !p.vertex_free(v))
-                {
+                let Some(ok) = vertex_candidate(mesh, v, protect, rule) else {
                     continue;
-                }
-                let ok = match rule.context {
-                    VertexContext::Any => true,
-                    VertexContext::Boundary => mesh.is_boundary_vertex(v),
-                    VertexContext::Interior => !mesh.is_boundary_vertex(v),
                 };
                 let val = host::vertex(v);
                 match ok.then(|| ev.test(rule, &val)) {
@@ -1797,6 +1781,28 @@ fn reads_only_matched_positions(e: &Ex, elem: u16) -> bool {
 }
 
 /// The id of a matched edge's value.
+/// Whether vertex `v` is one a vertex rule looks at (alive, on an edge,
+/// not protected): `None` when it is not, else whether the rule's context
+/// (`| boundary`, `| interior`) holds there; the guard is tested after.
+fn vertex_candidate(
+    mesh: &Mesh,
+    v: VertexId,
+    protect: Option<&Protected>,
+    rule: &Rule,
+) -> Option<bool> {
+    if !mesh.is_vertex(v)
+        || mesh.outgoing(v).is_none()
+        || protect.is_some_and(|p| !p.vertex_free(v))
+    {
+        return None;
+    }
+    Some(match rule.context {
+        VertexContext::Any => true,
+        VertexContext::Boundary => mesh.is_boundary_vertex(v),
+        VertexContext::Interior => !mesh.is_boundary_vertex(v),
+    })
+}
+
 fn edge_id(val: &Elem) -> EdgeId {
     host::edge_id(val).expect("an edge value")
 }
