@@ -107,7 +107,7 @@ impl Word {
     }
 
     /// Appends all modules of each of `parts`, in order, copying the
-    /// parts at once on rayon's pool ([`Word::fill_parts`]): each into
+    /// parts at once on rayon's pool (as `fill_parts` writes): each into
     /// its own stretch of the word's room, the new memory touched first by
     /// the thread that fills it. False, and the word as it was, when the
     /// slots would pass the offsets' `u32` range.
