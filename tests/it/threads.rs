@@ -290,19 +290,50 @@ fn a_branching_step_fails_alike_for_any_number_of_threads() {
 /// A Koch curve whose rules rewrite the overloaded `F(x)`, one of them
 /// with a right context, in a word without branches: the stencil fast
 /// path's steps from 65,536 modules on run in parts (the last one reads
-/// 98,303 modules and writes 393,215). In pools of 1, 2 and 3 threads the
+/// 98,304 modules and writes 393,216). In pools of 1, 2 and 3 threads the
 /// word is the one computed here from the rules: an `F` followed by
 /// `Right(a)` takes the first rule, every other `F` the second; `x/3` and
-/// `a + 1` are single-precision operations.
+/// `a + 1` are single-precision operations. As a ring, the last `F`'s
+/// right context is the first module.
 #[test]
 fn a_koch_curve_with_contexts_is_the_same_word_for_any_number_of_threads() {
-    let src = "derivation length: 8;\nAxiom: F(1) Right(120) F(1) Right(120) F(1);\n\
-               F(x) > Right(a) -> F(x/3) Left(60) F(x/3) Right(a + 1) F(x/3) Left(60) F(x/3)\n\
-               F(x) -> F(x/3) Left(60) F(x/3) Right(120) F(x/3) Left(60) F(x/3)\n";
-    let l = load_text(src);
-    assert!(l.program.rules.iter().all(|r| r.stencil.is_some()));
-    let mut want: Vec<(&str, f32)> = vec![("F", 1.0), ("Right", 120.0), ("F", 1.0)];
-    want.extend([("Right", 120.0), ("F", 1.0)]);
+    let rules = "F(x) > Right(a) -> F(x/3) Left(60) F(x/3) Right(a + 1) F(x/3) Left(60) F(x/3)\n\
+                 F(x) -> F(x/3) Left(60) F(x/3) Right(120) F(x/3) Left(60) F(x/3)\n";
+    for ring in [false, true] {
+        let src = format!(
+            "{}derivation length: 8;\nAxiom: Right(120) F(1) Right(120) F(1) Right(120) F(1);\n{rules}",
+            if ring { "ring L-system: 1;\n" } else { "" }
+        );
+        let l = load_text(&src);
+        assert!(l.program.rules.iter().all(|r| r.stencil.is_some()));
+        let want = koch_by_hand(ring);
+        assert_eq!(want.len(), 393_216);
+        // The wrap matters: the ring's word is not the open one's.
+        assert!(want != koch_by_hand(!ring));
+        for threads in [1, 2, 3] {
+            let w = pool(threads).install(|| {
+                subgram::derive(&l.program, DeriveOptions::default())
+                    .expect("derives")
+                    .word
+            });
+            assert_eq!(w.len(), want.len(), "{threads} threads, ring {ring}");
+            for (i, &(name, x)) in want.iter().enumerate() {
+                assert!(
+                    l.program.alphabet.name(w.sym(i)) == name
+                        && w.data(i).len() == 1
+                        && w.data(i)[0].to_bits() == (x as f64).to_bits(),
+                    "module {i} with {threads} threads, ring {ring}: {} {:?}, want {name}({x})",
+                    l.program.alphabet.name(w.sym(i)),
+                    w.data(i)
+                );
+            }
+        }
+    }
+}
+
+/// The Koch curve of the test above after 8 steps, computed from its rules.
+fn koch_by_hand(ring: bool) -> Vec<(&'static str, f32)> {
+    let mut want: Vec<(&str, f32)> = [("Right", 120.0), ("F", 1.0)].repeat(3);
     for _ in 0..8 {
         let mut next = Vec::with_capacity(want.len() * 4);
         for (i, &(name, x)) in want.iter().enumerate() {
@@ -311,7 +342,12 @@ fn a_koch_curve_with_contexts_is_the_same_word_for_any_number_of_threads() {
                 continue;
             }
             let third = (x as f64 / 3.0) as f32;
-            let turn = match want.get(i + 1) {
+            let right = if ring {
+                want.get((i + 1) % want.len())
+            } else {
+                want.get(i + 1)
+            };
+            let turn = match right {
                 Some(&("Right", a)) => a + 1.0,
                 _ => 120.0,
             };
@@ -327,23 +363,5 @@ fn a_koch_curve_with_contexts_is_the_same_word_for_any_number_of_threads() {
         }
         want = next;
     }
-    assert_eq!(want.len(), 393_215);
-    for threads in [1, 2, 3] {
-        let w = pool(threads).install(|| {
-            subgram::derive(&l.program, DeriveOptions::default())
-                .expect("derives")
-                .word
-        });
-        assert_eq!(w.len(), want.len(), "{threads} threads");
-        for (i, &(name, x)) in want.iter().enumerate() {
-            assert!(
-                l.program.alphabet.name(w.sym(i)) == name
-                    && w.data(i).len() == 1
-                    && w.data(i)[0].to_bits() == (x as f64).to_bits(),
-                "module {i} with {threads} threads: {} {:?}, want {name}({x})",
-                l.program.alphabet.name(w.sym(i)),
-                w.data(i)
-            );
-        }
-    }
+    want
 }
