@@ -187,7 +187,34 @@ fn sum(e: &Ex, slot_ty: &[Ty], out: &mut Vec<(Option<u16>, f64, bool, bool, bool
     Some(())
 }
 
+/// The slots an output of type `ty` fills: its components.
+fn slots_of(ty: Ty) -> usize {
+    ty.dim().max(1)
+}
+
+impl Combination {
+    /// The slots this output fills.
+    pub fn slots(&self) -> usize {
+        slots_of(self.ty)
+    }
+}
+
+impl PlainCombination {
+    /// The slots this output fills.
+    pub fn slots(&self) -> usize {
+        slots_of(self.ty)
+    }
+}
+
 impl Stencil {
+    /// The slots of the whole successor: every output's components.
+    pub fn slot_count(&self) -> usize {
+        self.outputs
+            .iter()
+            .flat_map(|(_, cs)| cs.iter().map(Combination::slots))
+            .sum()
+    }
+
     /// Compiles `rule` to a stencil when its body allows it.
     pub fn compile(rule: &Rule) -> Option<Stencil> {
         if !rule.new_left.is_empty() || !rule.new_right.is_empty() {

@@ -341,6 +341,13 @@ impl<'p> Rewriter<'p> {
         if n < PARALLEL_MODULES || threads == 1 || !opts.forward {
             return None;
         }
+        // Stencils read no environment: their parts are written in place.
+        if rules
+            .iter()
+            .all(|&r| self.program.rules[r].stencil.is_some())
+        {
+            return self.stencil_parts(rules, src, dst, opts);
+        }
         let pure = rules.iter().all(|&r| {
             let rule = &self.program.rules[r];
             rule.strict.len() == 1
@@ -359,12 +366,6 @@ impl<'p> Rewriter<'p> {
         let small = env.globals.iter().map(held).sum::<usize>() <= MAX_COPIED_GLOBALS;
         if !pure || !small || (opts.cut && src.syms().contains(&self.cut)) {
             return None;
-        }
-        if rules
-            .iter()
-            .all(|&r| self.program.rules[r].stencil.is_some())
-        {
-            return self.stencil_parts(rules, src, dst, opts);
         }
         // The first part, written in place, is a little smaller than an
         // even share; the rest is cut finer, so that a thread done early
@@ -481,12 +482,7 @@ impl<'p> Rewriter<'p> {
             .iter()
             .map(|&r| {
                 let st = program.rules[r].stencil.as_ref().expect("checked above");
-                let slots = st
-                    .outputs
-                    .iter()
-                    .flat_map(|(_, cs)| cs.iter().map(|c| c.ty.dim().max(1)))
-                    .sum();
-                (st.outputs.len(), slots)
+                (st.outputs.len(), st.slot_count())
             })
             .collect();
         // Parts of `chunk` modules, a few per thread, so that a thread done
@@ -705,11 +701,7 @@ impl<'p> Rewriter<'p> {
         }
         let data = src.all_slots();
         // The new word's exact size is known: allocate it once.
-        let slots_per_module: usize = st
-            .outputs
-            .iter()
-            .flat_map(|(_, cs)| cs.iter().map(|c| c.ty.dim().max(1)))
-            .sum();
+        let slots_per_module = st.slot_count();
         dst.clear_with_capacity(n * out_per_module, n * slots_per_module);
         let (syms, starts, out) = dst.raw_parts_mut();
         // The common case: every term a weighted parameter.
@@ -754,7 +746,7 @@ impl<'p> Rewriter<'p> {
             // them in bulk, and only the parameters in the loops below.
             let widths: Vec<usize> = plain
                 .iter()
-                .map(|(_, cs)| cs.iter().map(|c| c.ty.dim().max(1)).sum())
+                .map(|(_, cs)| cs.iter().map(|c| c.slots()).sum())
                 .collect();
             let pattern: Vec<Sym> = plain.iter().map(|(s, _)| *s).collect();
             // On a long word they are written on rayon's pool, which also
