@@ -120,7 +120,7 @@ fn whole_path(args: &[String], runs: usize) {
         let model = &c.program.model;
         let opts = model
             .camera
-            .raster_options(&model.lights, &mut scene.points(), size, size)
+            .raster_options(&model.lights, scene.bounds(), size, size)
             .expect("a camera");
         lap(4, &mut best);
         let img = raster::render(&scene, &opts).expect("renders");

@@ -912,7 +912,7 @@ fn render_solid(
         camera.dir = Some(y_up(d));
         camera.up = Some(y_up(u));
     }
-    let mut ropts = camera.raster_options(&model.lights, &mut scene.points(), w, h)?;
+    let mut ropts = camera.raster_options(&model.lights, scene.bounds(), w, h)?;
     let model_background = model.colours.as_ref().map(|m| {
         let [r, g, b] = m.background();
         Rgba(r, g, b, 255)

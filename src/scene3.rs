@@ -79,9 +79,16 @@ impl TriMesh {
     /// The axis-aligned bounds of its positions and lines, `None` when it
     /// has neither.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let mut it = self.points();
-        let first = it.next()?;
-        Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+        let first =
+            (self.positions.first().copied()).or_else(|| self.lines.first().map(|l| l.a))?;
+        let (mut lo, mut hi) = (first, first);
+        for &p in &self.positions {
+            (lo, hi) = (lo.min(p), hi.max(p));
+        }
+        for l in &self.lines {
+            (lo, hi) = (lo.min(l.a).min(l.b), hi.max(l.a).max(l.b));
+        }
+        Some((lo, hi))
     }
 
     /// Its vertices' positions, then its lines' ends.

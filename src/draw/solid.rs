@@ -172,16 +172,6 @@ pub fn pixel_of(extent: f64, fit: f64) -> f64 {
     }
 }
 
-/// A tube less than a pixel across whatever the picture's final scale:
-/// what [`Builder::thin`] makes of it, decided while the walk logs.
-#[derive(Clone, Copy, Debug)]
-struct LoggedThin {
-    a: Vec3,
-    b: Vec3,
-    width: f32,
-    color: i64,
-}
-
 /// A tube segment as [`Builder::tube`] reads it from the turtle and the
 /// branch.
 #[derive(Clone, Copy, Debug)]
@@ -193,6 +183,9 @@ struct Seg {
     color: i64,
     scale: (f64, f64),
     sides: Option<u32>,
+    /// The lines its mesh had when it was logged: where its line goes if
+    /// it turns out thin at the final scale.
+    lines: usize,
 }
 
 /// What a walk for a picture of unknown scale logs of its tubes, in order
@@ -207,13 +200,11 @@ struct Log {
     /// be at least this (it is, as the box only grows).
     px_used: f64,
     ops: Vec<Op>,
-    thin: Vec<LoggedThin>,
     segs: Vec<Seg>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Op {
-    Thin,
     Tube,
     Push,
     Pop,
@@ -228,7 +219,6 @@ impl Log {
             hi: DVec3::splat(f64::NEG_INFINITY),
             px_used: 0.0,
             ops: Vec::new(),
-            thin: Vec::new(),
             segs: Vec::new(),
         }
     }
@@ -397,6 +387,12 @@ struct Builder<'m> {
     /// Tubes logged for a scale found by the walk, `None` when they are
     /// made as it goes.
     log: Option<Log>,
+    /// While a logged tube is made: the place of its line, should it be
+    /// thin, among the lines its mesh had then.
+    replaying: Option<usize>,
+    /// The lines of logged tubes found thin at the final scale, with
+    /// their meshes and places, to be put among the walk's.
+    late: Vec<(u32, usize, Line)>,
 }
 
 /// In a picture, a tube less than this many pixels across is drawn as its
@@ -470,6 +466,8 @@ impl<'m> Builder<'m> {
             circles: Vec::new(),
             sections: Vec::new(),
             log: None,
+            replaying: None,
+            late: Vec::new(),
         }
     }
 
@@ -488,26 +486,57 @@ impl<'m> Builder<'m> {
         self.stack.clear();
         self.cur.tube = None;
         self.cur.gc = None;
-        let (mut thin, mut segs) = (log.thin.iter(), log.segs.iter());
+        // Thin tubes went into the meshes as lines on the walk; the ops
+        // only say where the logged tubes join.
+        if log.segs.is_empty() {
+            return self.finish();
+        }
+        let mut segs = log.segs.iter();
         for op in &log.ops {
             match op {
-                Op::Thin => {
-                    let t = thin.next().ok_or("a short log")?;
-                    self.end_tube()?;
-                    let mesh = self.mesh(t.color);
-                    self.room(mesh, 0, 1)?.lines.push(Line {
-                        a: t.a,
-                        b: t.b,
-                        width: t.width,
-                    });
+                Op::Tube => {
+                    let seg = segs.next().ok_or("a short log")?;
+                    self.replaying = Some(seg.lines);
+                    let made = self.tube_at(seg);
+                    self.replaying = None;
+                    made?
                 }
-                Op::Tube => self.tube_at(segs.next().ok_or("a short log")?)?,
                 Op::Push => self.push(),
                 Op::Pop => self.pop()?,
                 Op::End => self.end_tube()?,
             }
         }
-        self.finish()
+        self.finish()?;
+        self.place_late_lines();
+        Ok(())
+    }
+
+    /// Puts the lines of logged tubes found thin at the final scale among
+    /// the lines the walk made, each where a walk knowing the scale would
+    /// have made it.
+    fn place_late_lines(&mut self) {
+        let late = std::mem::take(&mut self.late);
+        for (k, mesh) in self.scene.meshes.iter_mut().enumerate() {
+            let mine: Vec<(usize, Line)> = (late.iter())
+                .filter(|(m, _, _)| *m as usize == k)
+                .map(|&(_, at, line)| (at, line))
+                .collect();
+            let Some(&(_, filler)) = mine.first() else {
+                continue;
+            };
+            // In place, from the back: the walk's lines from each place on
+            // move up by the late lines at or before it.
+            let lines = &mut mesh.lines;
+            let mut end = lines.len();
+            lines.resize(end + mine.len(), filler);
+            for (j, &(at, line)) in mine.iter().enumerate().rev() {
+                // Places only grow along the log; clamped all the same.
+                let at = at.min(end);
+                lines.copy_within(at..end, at + j + 1);
+                lines[at + j] = line;
+                end = at;
+            }
+        }
     }
 
     /// The look of colour index `k` (0 to 255).
@@ -776,15 +805,17 @@ impl<'m> Builder<'m> {
             color: t.pen.color,
             scale: self.cur.scale,
             sides: self.cur.sides,
+            lines: 0,
         };
-        if self.log.is_some() {
-            return self.log_tube(seg);
+        if self.log.is_none() {
+            return self.tube_at(&seg);
         }
-        self.tube_at(&seg)
+        self.log_tube(seg)
     }
 
     /// Logs a tube segment: as a line when it is thinner than a pixel at
     /// the scale so far (the final scale is at least that), else whole.
+    #[inline]
     fn log_tube(&mut self, seg: Seg) -> Result<(), String> {
         let (a, b) = (seg.a, seg.b);
         if self.log.is_none() || too_short(a, b) {
@@ -792,7 +823,7 @@ impl<'m> Builder<'m> {
         }
         // The tube's mesh is made now, where a walk that made the tube
         // would make it, so that the meshes come in the same order.
-        self.mesh(seg.color);
+        let mesh = self.mesh(seg.color);
         let Some(log) = &mut self.log else {
             return Ok(());
         };
@@ -800,16 +831,21 @@ impl<'m> Builder<'m> {
         let px = log.pixel_so_far();
         if px > 0.0 && width / px < THIN && fits(a, 0.0) && fits(b, 0.0) {
             log.px_used = log.px_used.max(px);
-            log.ops.push(Op::Thin);
-            log.thin.push(LoggedThin {
+            // A line at any scale from here on: made now, in the order a
+            // walk knowing the scale makes the lines, and the tube it
+            // follows ends here (logged).
+            log.ops.push(Op::End);
+            let line = Line {
                 a: a.as_vec3(),
                 b: b.as_vec3(),
                 width: width as f32,
-                color: seg.color,
-            });
+            };
+            // A line counts as a triangle against the limit.
+            self.room(mesh, 0, 1)?.lines.push(line);
         } else {
             log.ops.push(Op::Tube);
-            log.segs.push(seg);
+            let lines = self.scene.meshes[mesh as usize].lines.len();
+            log.segs.push(Seg { lines, ..seg });
         }
         Ok(())
     }
@@ -894,12 +930,18 @@ impl<'m> Builder<'m> {
             return Err("makes a cylinder that reaches an infinite coordinate".into());
         }
         let mesh = self.mesh(color);
-        // A line counts as a triangle against the limit.
-        self.room(mesh, 0, 1)?.lines.push(Line {
+        let line = Line {
             a: a.as_vec3(),
             b: b.as_vec3(),
             width: width as f32,
-        });
+        };
+        // A line counts as a triangle against the limit.
+        let replaying = self.replaying;
+        let m = self.room(mesh, 0, 1)?;
+        match replaying {
+            Some(at) => self.late.push((mesh, at, line)),
+            None => m.lines.push(line),
+        }
         Ok(())
     }
 
@@ -1338,13 +1380,11 @@ impl Sink for Builder<'_> {
         if let Some(log) = &mut self.log {
             log.ops.push(Op::Push);
         }
-        let mut child = self.cur;
         // The parent's tube waits on the stack for the parent; the branch
-        // starts its own.
-        child.tube = None;
-        child.gc_branch = self.cur.gc.is_some();
+        // starts its own. (One copy of the branch state: it is large.)
         self.stack.push(self.cur);
-        self.cur = child;
+        self.cur.tube = None;
+        self.cur.gc_branch = self.cur.gc.is_some();
     }
 
     fn pop(&mut self) -> Result<(), String> {

@@ -195,20 +195,25 @@ impl ViewCamera {
 }
 
 impl ViewCamera {
-    /// The renderer's settings for geometry whose vertices are `points`,
-    /// in an image of `width`×`height`: the camera of [`ViewCamera::spec`],
-    /// the view file's `lights` (see [`raster_lights`]), and lit shading
-    /// for `render mode: shaded` or `shadows`, unlit colours for `filled`
-    /// (lpfg's default) and `wireframe`.
+    /// The renderer's settings for geometry within the box `bounds` (the
+    /// lowest and highest corners; `None` for no geometry), in an image of
+    /// `width`×`height`: the camera of [`ViewCamera::spec`], the view
+    /// file's `lights` (see [`raster_lights`]), and lit shading for
+    /// `render mode: shaded` or `shadows`, unlit colours for `filled`
+    /// (lpfg's default) and `wireframe`. (The camera frames the box: a
+    /// view file's camera is never fitted to the outline on screen.)
     pub fn raster_options(
         &self,
         lights: &[Light],
-        points: &mut dyn Iterator<Item = glam::Vec3>,
+        bounds: Option<(glam::Vec3, glam::Vec3)>,
         width: u32,
         height: u32,
     ) -> Result<crate::render::raster::RasterOptions, crate::render::RenderError> {
         use crate::render::raster::{Camera, RasterOptions, Shading};
-        let camera = Camera::from_view(&self.spec(), points, width, height)?;
+        let spec = self.spec();
+        debug_assert!(!spec.tight, "the box's corners stand for the points");
+        let mut corners = bounds.into_iter().flat_map(|(lo, hi)| [lo, hi]);
+        let camera = Camera::from_view(&spec, &mut corners, width, height)?;
         Ok(RasterOptions {
             lights: raster_lights(lights),
             shading: match self.render_mode {

@@ -1067,14 +1067,39 @@ impl Frame<'_> {
             (wf, [c.0, c.1, c.2].map(|v| v as f32 / 255.0))
         });
         let inv = 1.0 / (s * s) as f32;
+        // The bytes of a pixel whose samples all show the background, summed
+        // as any pixel's samples are.
+        let bg_bytes = {
+            let mut sum = [0.0f32; 4];
+            for _ in 0..s * s {
+                for (a, b) in sum.iter_mut().zip(bgp) {
+                    *a += b;
+                }
+            }
+            sum.map(|v| to_byte(v * inv * 255.0))
+        };
+        let triangles = *self.tri_start.last().unwrap_or(&0);
         let mut out = vec![0u8; w * h * 4];
         out.par_chunks_mut(w * 4).enumerate().for_each(|(py, row)| {
             // Shading once per pixel and triangle, at the pixel's centre
             // (as multisampling does): the distinct triangles of a pixel's
             // samples, at most s² of them.
             let mut seen: Vec<(u32, [f32; 3])> = Vec::with_capacity(s * s);
+            // A line's colour is the same wherever it is seen (it does not
+            // depend on the pixel): the last few of a row are kept.
+            let mut lines = [(NO_TRIANGLE, [0.0f32; 3]); LINE_CACHE];
             let centre = (s as f32 - 1.0) * 0.5;
             for px in 0..w {
+                // A pixel of background only: the background's bytes.
+                if edge.is_none()
+                    && (0..s).all(|j| {
+                        let at = (py * s + j) * self.sw + px * s;
+                        keys[at..at + s].iter().all(|&k| k == NO_TRIANGLE)
+                    })
+                {
+                    row[px * 4..px * 4 + 4].copy_from_slice(&bg_bytes);
+                    continue;
+                }
                 seen.clear();
                 let mut sum = [0.0f32; 4];
                 let (cx, cy) = ((px * s) as f32 + centre, (py * s) as f32 + centre);
@@ -1113,12 +1138,20 @@ impl Frame<'_> {
                             continue;
                         }
                         let id = key;
-                        let c = match seen.iter().find(|(t, _)| *t == id) {
-                            Some((_, c)) => *c,
-                            None => {
-                                let c = self.shade(id, cx, cy);
-                                seen.push((id, c));
-                                c
+                        let c = if id >= triangles {
+                            let slot = &mut lines[id as usize % LINE_CACHE];
+                            if slot.0 != id {
+                                *slot = (id, self.shade(id, cx, cy));
+                            }
+                            slot.1
+                        } else {
+                            match seen.iter().find(|(t, _)| *t == id) {
+                                Some((_, c)) => *c,
+                                None => {
+                                    let c = self.shade(id, cx, cy);
+                                    seen.push((id, c));
+                                    c
+                                }
                             }
                         };
                         sum[0] += c[0];
@@ -1128,7 +1161,7 @@ impl Frame<'_> {
                     }
                 }
                 for (k, v) in sum.iter().enumerate() {
-                    row[px * 4 + k] = (v * inv * 255.0).round().clamp(0.0, 255.0) as u8;
+                    row[px * 4 + k] = to_byte(v * inv * 255.0);
                 }
             }
         });
@@ -1194,6 +1227,20 @@ fn line_colour(scene: &Scene3, opts: &RasterOptions, k: usize, line: &Line) -> [
     let n = (v - t * t.dot(v)).normalize_or(v);
     lit(scene, opts, k, n, false)
 }
+
+/// `v` rounded to the nearest integer (halves away from zero) and clamped
+/// to 0..=255, as `v.round().clamp(0.0, 255.0) as u8` (0 for NaN), without
+/// a call to `roundf` on targets without SSE4.1.
+#[inline(always)]
+fn to_byte(v: f32) -> u8 {
+    let v = v.clamp(0.0, 255.0);
+    // Exact: the integer part and the fraction of a number below 2^23.
+    let t = v as u32;
+    (t + u32::from(v - t as f32 >= 0.5)) as u8
+}
+
+/// The lines' colours a row of [`Frame::resolve`] keeps, by line index.
+const LINE_CACHE: usize = 32;
 
 /// The colour of a point of mesh `k` whose unit normal, turned to the
 /// viewer, is `n`; `back`: the point is on the side that faced away.
@@ -1391,4 +1438,39 @@ fn in_view(cam: &Camera, points: &[Vec3]) -> Option<Vec<Vec3>> {
 /// [`polygons`]).
 pub fn render_svg(scene: &Scene3, opts: &RasterOptions) -> Result<String, RenderError> {
     Ok(super::svg::render(&polygons(scene, opts)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::to_byte;
+
+    /// `to_byte` is the standard library's rounding and clamping, on every
+    /// `f32` from -2 to 258 in steps of 1/4096 (every half among them),
+    /// around each half by one unit in the last place, and on the
+    /// specials.
+    #[test]
+    fn bytes_round_as_the_standard_library_rounds() {
+        let std = |v: f32| v.round().clamp(0.0, 255.0) as u8;
+        let mut values = vec![
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -0.0,
+            0.0,
+            f32::MAX,
+            f32::MIN,
+            f32::MIN_POSITIVE,
+            0.5f32.next_down(),
+            254.5,
+            255.49998,
+            255.5,
+        ];
+        for k in -8192..=(258 * 4096) {
+            let v = k as f32 / 4096.0;
+            values.extend([v, v.next_up(), v.next_down()]);
+        }
+        for v in values {
+            assert_eq!(to_byte(v), std(v), "{v:e}");
+        }
+    }
 }

@@ -496,6 +496,16 @@ impl<'p> Rewriter<'p> {
             ring: opts.ring,
             tables: Some(tables),
         };
+        // The symbols some rule's predecessor starts with: a module of any
+        // other symbol is kept without trying the rules.
+        let mut wanted = Vec::new();
+        for &r in rules {
+            let s = program.rules[r].strict[0].sym.0 as usize;
+            if s >= wanted.len() {
+                wanted.resize(s + 1, false);
+            }
+            wanted[s] = true;
+        }
         // The first pass: which rule rewrites each module, and each part's
         // size.
         self.choice.resize(n, KEEP);
@@ -513,11 +523,13 @@ impl<'p> Rewriter<'p> {
                         crate::deadline::check(opts.deadline).ok()?;
                     }
                     *c = KEEP;
-                    for (t, &r) in rules.iter().enumerate() {
-                        let rule = &program.rules[r];
-                        if match_old(rule, src, i, ctx(r), &mut matched).is_some() {
-                            *c = t as u16;
-                            break;
+                    if wanted.get(src.sym(i).0 as usize) == Some(&true) {
+                        for (t, &r) in rules.iter().enumerate() {
+                            let rule = &program.rules[r];
+                            if match_old(rule, src, i, ctx(r), &mut matched).is_some() {
+                                *c = t as u16;
+                                break;
+                            }
                         }
                     }
                     let (m, s) = match *c {
@@ -545,23 +557,33 @@ impl<'p> Rewriter<'p> {
             let mut matched = Vec::new();
             let mut scratch = Word::new();
             let from = k * chunk;
-            for (j, &c) in choice[from..(from + chunk).min(n)].iter().enumerate() {
-                let i = from + j;
-                if j.is_multiple_of(DEADLINE_EVERY)
-                    && crate::deadline::check(opts.deadline).is_err()
-                {
-                    return false;
+            let part = &choice[from..(from + chunk).min(n)];
+            let mut j = 0;
+            let mut checked = 0;
+            while j < part.len() {
+                if j >= checked {
+                    if crate::deadline::check(opts.deadline).is_err() {
+                        return false;
+                    }
+                    checked = j + DEADLINE_EVERY;
                 }
-                let ok = match c {
-                    KEEP => out.push(src.sym(i), src.data(i)),
+                let i = from + j;
+                let ok = match part[j] {
+                    KEEP => {
+                        // The modules no rule rewrites, copied as a run.
+                        let run = part[j..].iter().take_while(|&&c| c == KEEP).count();
+                        j += run;
+                        out.push_run(src, i..i + run)
+                    }
                     t => {
                         let r = rules[t as usize];
                         let rule = &program.rules[r];
                         let st = rule.stencil.as_ref().expect("checked above");
                         scratch.clear();
+                        j += 1;
                         match_old(rule, src, i, ctx(r), &mut matched).is_some()
                             && apply_stencil(st, src, &matched, &mut scratch)
-                            && (0..scratch.len()).all(|j| out.push(scratch.sym(j), scratch.data(j)))
+                            && out.push_word(&scratch)
                     }
                 };
                 if !ok {

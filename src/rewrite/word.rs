@@ -309,34 +309,29 @@ impl PartWriter<'_> {
     /// Writes the modules of `w`, slots and all; false (and nothing
     /// written) when they would pass the part's share.
     pub(crate) fn push_word(&mut self, w: &Word) -> bool {
-        let (m, s) = (self.modules + w.len(), self.slots + w.data.len());
+        self.push_run(w, 0..w.len())
+    }
+
+    /// Writes the modules `run` of `w`, slots and all; false (and nothing
+    /// written) when they would pass the part's share.
+    pub(crate) fn push_run(&mut self, w: &Word, run: std::ops::Range<usize>) -> bool {
+        let (lo, hi) = (w.starts[run.start], w.starts[run.end]);
+        let (m, s) = (self.modules + run.len(), self.slots + (hi - lo) as usize);
         if m > self.syms.len() || s > self.data.len() {
             return false;
         }
-        self.syms[self.modules..m].write_copy_of_slice(&w.syms);
+        self.syms[self.modules..m].write_copy_of_slice(&w.syms[run.clone()]);
+        // Offsets in this part's share, which `fill_parts` checked to fit.
         let base = self.base + self.slots as u32;
-        for (o, &x) in self.starts[self.modules..m].iter_mut().zip(&w.starts[1..]) {
-            o.write(x + base);
+        for (o, &x) in self.starts[self.modules..m]
+            .iter_mut()
+            .zip(&w.starts[run.start + 1..=run.end])
+        {
+            o.write(x - lo + base);
         }
-        self.data[self.slots..s].write_copy_of_slice(&w.data);
+        self.data[self.slots..s].write_copy_of_slice(&w.data[lo as usize..hi as usize]);
         self.modules = m;
         self.slots = s;
-        true
-    }
-
-    /// Writes the next module; false (and nothing written) when it would
-    /// pass the part's share.
-    #[inline]
-    pub(crate) fn push(&mut self, sym: Sym, slots: &[f64]) -> bool {
-        let end = self.slots + slots.len();
-        if self.modules == self.syms.len() || end > self.data.len() {
-            return false;
-        }
-        self.syms[self.modules].write(sym);
-        self.data[self.slots..end].write_copy_of_slice(slots);
-        self.starts[self.modules].write(self.base + end as u32);
-        self.modules += 1;
-        self.slots = end;
         true
     }
 }
@@ -345,9 +340,9 @@ impl PartWriter<'_> {
 mod tests {
     use super::*;
 
-    /// Parts written in place make the word that pushing the same modules
-    /// one by one makes; a part that writes less or more than its share
-    /// leaves the word as it was.
+    /// Parts written in place, as runs of another word's modules, make the
+    /// word that pushing the same modules one by one makes; a part that
+    /// writes less or more than its share leaves the word as it was.
     #[test]
     fn parts_filled_in_place_are_the_pushed_word() {
         let (a, b, c) = (Sym(3), Sym(5), Sym(7));
@@ -361,6 +356,18 @@ mod tests {
         for m in parts.iter().flatten() {
             want.push_raw(m.0, &m.1);
         }
+        // The modules to copy from: the parts' after one of slots of its
+        // own, so that no run starts at slot 0.
+        let mut src = Word::new();
+        src.push_raw(c, &[7.0, 8.0]);
+        let mut runs = Vec::new();
+        for p in &parts {
+            let from = src.len();
+            for m in p {
+                src.push_raw(m.0, &m.1);
+            }
+            runs.push(from..src.len());
+        }
         let counts: Vec<(usize, usize)> = parts
             .iter()
             .map(|p| (p.len(), p.iter().map(|m| m.1.len()).sum()))
@@ -368,9 +375,11 @@ mod tests {
         let mut w = Word::new();
         w.push_raw(b, &[9.0]);
         let before = w.clone();
-        assert!(w.fill_parts(&counts, |k, out| parts[k]
-            .iter()
-            .all(|m| out.push(m.0, &m.1))));
+        // The last part a module at a time, the others as whole runs.
+        assert!(w.fill_parts(&counts, |k, out| match k {
+            2 => runs[k].clone().all(|i| out.push_run(&src, i..i + 1)),
+            _ => out.push_run(&src, runs[k].clone()),
+        }));
         assert_eq!(w, want);
         for i in 0..w.len() {
             assert_eq!(w.data(i), want.data(i));
@@ -378,14 +387,15 @@ mod tests {
         // One module short in the last part, then one too many in the first.
         let mut short = before.clone();
         let fill_short = |k: usize, out: &mut PartWriter<'_>| {
-            let n = if k == 2 { 2 } else { parts[k].len() };
-            parts[k][..n].iter().all(|m| out.push(m.0, &m.1))
+            let r = runs[k].clone();
+            let end = if k == 2 { r.end - 1 } else { r.end };
+            out.push_run(&src, r.start..end)
         };
         assert!(!short.fill_parts(&counts, fill_short));
         assert_eq!(short, before);
         let mut long = before.clone();
         let fill_long = |k: usize, out: &mut PartWriter<'_>| {
-            parts[k].iter().all(|m| out.push(m.0, &m.1)) && (k != 0 || out.push(c, &[]))
+            out.push_run(&src, runs[k].clone()) && (k != 0 || out.push_run(&src, 0..1))
         };
         assert!(!long.fill_parts(&counts, fill_long));
         assert_eq!(long, before);
