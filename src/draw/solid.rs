@@ -491,7 +491,12 @@ impl<'m> Builder<'m> {
         if log.segs.is_empty() {
             return self.finish();
         }
+        // Of a branch's state, making the tubes reads only its pending
+        // tube: the branches keep that alone, where the walk kept all
+        // (`push`, `pop`, `finish`, a tube at a time).
         let mut segs = log.segs.iter();
+        let mut waiting: Vec<Pending> = Vec::new();
+        let mut had: Vec<bool> = Vec::new();
         for op in &log.ops {
             match op {
                 Op::Tube => {
@@ -501,12 +506,29 @@ impl<'m> Builder<'m> {
                     self.replaying = None;
                     made?
                 }
-                Op::Push => self.push(),
-                Op::Pop => self.pop()?,
+                Op::Push => had.push(match self.cur.tube.take() {
+                    Some(p) => {
+                        waiting.push(p);
+                        true
+                    }
+                    None => false,
+                }),
+                Op::Pop => {
+                    self.end_tube()?;
+                    if had.pop() == Some(true) {
+                        self.cur.tube = waiting.pop();
+                    }
+                }
                 Op::End => self.end_tube()?,
             }
         }
-        self.finish()?;
+        self.end_tube()?;
+        while let Some(h) = had.pop() {
+            if h {
+                self.cur.tube = waiting.pop();
+                self.end_tube()?;
+            }
+        }
         self.place_late_lines();
         Ok(())
     }
