@@ -746,28 +746,39 @@ impl Compiler<'_> {
             }
             St::Block(b) => self.block(b)?,
             St::Produce { modules, last } => {
-                let mut ms = Vec::new();
-                for m in modules {
-                    let args = m
-                        .args
-                        .iter()
-                        .map(|a| self.arg(a))
-                        .collect::<Option<Vec<_>>>()?;
-                    ms.push((m.sym, args, m.span));
+                // Every parameter of every module in one list, in order,
+                // each with its module and its place in it.
+                let mut args = Vec::new();
+                for (k, m) in modules.iter().enumerate() {
+                    for (j, a) in m.args.iter().enumerate() {
+                        args.push((self.arg(a)?, k, j));
+                    }
                 }
                 let first = modules.first().map(|m| m.span);
                 let flow = if *last { Flow::Produced } else { Flow::Normal };
-                let syms: Vec<Sym> = ms.iter().map(|m| m.0).collect();
-                let widths: Vec<usize> = ms.iter().map(|m| m.1.len()).collect();
+                let syms: Vec<Sym> = modules.iter().map(|m| m.sym).collect();
+                let widths: Vec<usize> = modules.iter().map(|m| m.args.len()).collect();
+                let spans: Vec<Span> = modules.iter().map(|m| m.span).collect();
+                // Where each module's slots start among the statement's.
+                let starts: Vec<usize> = widths
+                    .iter()
+                    .scan(0, |at, &w| {
+                        let s = *at;
+                        *at += w;
+                        Some(s)
+                    })
+                    .collect();
                 Box::new(move |cx| {
                     // Every module's slots first, then all modules at once;
                     // when one fails, the sink gets those before it, as
                     // module by module.
                     let base = cx.m.slots.len();
-                    for (k, (_, args, span)) in ms.iter().enumerate() {
-                        if let Err(e) = produce(cx, args, *span) {
+                    cx.m.slots.reserve(args.len());
+                    for (a, k, j) in &args {
+                        if let Err(e) = parameter(cx, a, *j, spans[*k]) {
+                            cx.m.slots.truncate(base + starts[*k]);
                             cx.sink
-                                .emit_run(&syms[..k], &widths[..k], &cx.m.slots[base..]);
+                                .emit_run(&syms[..*k], &widths[..*k], &cx.m.slots[base..]);
                             cx.m.slots.truncate(base);
                             return Err(e);
                         }
@@ -1102,52 +1113,31 @@ enum Arg {
     C(C),
 }
 
-/// One successor module's parameters, checked finite, appended to the
-/// machine's slots (none of them when one fails).
-#[inline]
-fn produce(cx: &mut Cx, args: &[Arg], span: Span) -> R<()> {
-    let base = cx.m.slots.len();
-    for (k, a) in args.iter().enumerate() {
-        // `value::encode`: an int's bits, a float, a bool as 0 or 1.
-        let (x, float) = match a {
-            Arg::Slot(x) => {
-                cx.m.slots.push(*x);
-                continue;
-            }
-            Arg::Local(Kind::F, s) => (Ok(f64::from_bits(cx.m.frame[*s])), true),
-            Arg::Local(Kind::I, s) => (Ok(f64::from_bits(cx.m.frame[*s])), false),
-            Arg::Local(Kind::B, s) => (Ok((cx.m.frame[*s] != 0) as u8 as f64), false),
-            Arg::C(C::F(a)) => (a(cx), true),
-            Arg::C(C::I(a)) => (a(cx).map(|i| f64::from_bits(i as u64)), false),
-            Arg::C(C::B(a)) => (a(cx).map(|b| b as u8 as f64), false),
-        };
-        let x = match x {
-            Ok(x) => x,
-            Err(e) => {
-                cx.m.slots.truncate(base);
-                return Err(e);
-            }
-        };
-        let slot = match float {
-            true => {
-                let f = x;
-                if !f.is_finite() {
-                    cx.m.slots.truncate(base);
-                    return Err(rt(
-                        Some(span),
-                        format!(
-                            "parameter {} of this successor module is {}; NaN and infinity are not allowed in a word",
-                            k + 1,
-                            Value::Float(f)
-                        ),
-                    ));
-                }
-                f
-            }
-            false => x,
-        };
-        cx.m.slots.push(slot);
+/// Parameter `j` (from 0) of a successor module at `span`, checked
+/// finite, appended to the machine's slots.
+#[inline(always)]
+fn parameter(cx: &mut Cx, a: &Arg, j: usize, span: Span) -> R<()> {
+    // `value::encode`: an int's bits, a float, a bool as 0 or 1.
+    let (x, float) = match a {
+        Arg::Slot(x) => (*x, false),
+        Arg::Local(Kind::F, s) => (f64::from_bits(cx.m.frame[*s]), true),
+        Arg::Local(Kind::I, s) => (f64::from_bits(cx.m.frame[*s]), false),
+        Arg::Local(Kind::B, s) => ((cx.m.frame[*s] != 0) as u8 as f64, false),
+        Arg::C(C::F(a)) => (a(cx)?, true),
+        Arg::C(C::I(a)) => (f64::from_bits(a(cx)? as u64), false),
+        Arg::C(C::B(a)) => (a(cx)? as u8 as f64, false),
+    };
+    if float && !x.is_finite() {
+        return Err(rt(
+            Some(span),
+            format!(
+                "parameter {} of this successor module is {}; NaN and infinity are not allowed in a word",
+                j + 1,
+                Value::Float(x)
+            ),
+        ));
     }
+    cx.m.slots.push(x);
     Ok(())
 }
 

@@ -1722,6 +1722,8 @@ struct Dispatch {
     /// the one before it (which ran on the same modules and did not
     /// produce).
     cands: Vec<(usize, bool, bool)>,
+    /// Per symbol, whether it has rules.
+    has: Vec<bool>,
 }
 
 impl Dispatch {
@@ -1767,8 +1769,15 @@ impl Dispatch {
             }
         }
         self.rules = rules.to_vec();
+        self.has = first.windows(2).map(|w| w[0] < w[1]).collect();
         self.first = first;
         self.cands = cands;
+    }
+
+    /// True when some rule's strict predecessor is a module of symbol `s`.
+    #[inline(always)]
+    fn rewrites(&self, s: Sym) -> bool {
+        self.has.get(s.0 as usize).copied().unwrap_or(false)
     }
 
     /// The rules whose strict predecessor is a module of symbol `s`.
@@ -1838,11 +1847,11 @@ fn rewrite_part(
         let to = range.end.min(from + DEADLINE_EVERY);
         let mut i = from;
         while i < to {
-            let cands = sh.dispatch.of(src.sym(i));
-            if cands.is_empty() {
+            let d = sh.dispatch;
+            if !d.rewrites(src.sym(i)) {
                 // A run of modules that no rule rewrites, copied at once.
                 let mut j = i + 1;
-                while j < to && sh.dispatch.of(src.sym(j)).is_empty() {
+                while j < to && !d.rewrites(src.sym(j)) {
                     j += 1;
                 }
                 dst.push_range(src, i..j);
@@ -1855,6 +1864,7 @@ fn rewrite_part(
                 i = j;
                 continue;
             }
+            let cands = d.of(src.sym(i));
             let mut produced = false;
             // Whether the last rule tried matched (`matched` holds its
             // match when it did).

@@ -96,9 +96,9 @@ impl Word {
     /// `slots`, as `push_raw` on each in turn.
     #[inline]
     pub fn push_run(&mut self, syms: &[Sym], widths: &[usize], slots: &[f64]) {
-        self.syms.extend_from_slice(syms);
         let mut at = self.data.len();
-        self.data.extend_from_slice(slots);
+        self.syms.extend(syms.iter().copied());
+        self.data.extend(slots.iter().copied());
         self.starts.extend(widths.iter().map(|&w| {
             at += w;
             at as u32
