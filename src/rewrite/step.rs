@@ -2446,4 +2446,25 @@ mod tests {
         assert_eq!(derived_within(long, false, 1000), Err(e.clone()));
         assert!(e.contains("1000") && e.contains("A(x)"), "{e}");
     }
+
+    /// The second of two rules with one predecessor runs on the
+    /// parameters its body binds, not on what the first body left in the
+    /// frame: a first body that stores into a parameter makes the second
+    /// bind again (worked out by hand: 1 and 2, the first rule producing
+    /// only where ten times the parameter passes 15); one that stores
+    /// only into a local of its own leaves the parameters to the next.
+    #[test]
+    fn a_body_that_writes_its_parameter_leaves_the_next_rule_the_modules_values() {
+        let writes = "module A(double);\nderivation length: 1;\nAxiom: A(1) A(2);\n\
+             A(x) : { x = x * 10; if (x > 15) produce A(x); }\n\
+             A(x) : { produce A(x + 0.5); }\n";
+        let locals = "module A(double);\nderivation length: 1;\nAxiom: A(1) A(2);\n\
+             A(x) : { double t = x * 10; if (t > 15) produce A(t); }\n\
+             A(y) : { double u = y + 0.5; produce A(u); }\n";
+        let a = |x: f64| ("A".to_string(), vec![x.to_bits()]);
+        for src in [writes, locals] {
+            assert_eq!(derived(src, true), Ok(vec![a(1.5), a(20.0)]), "{src}");
+            assert_eq!(derived(src, false), Ok(vec![a(1.5), a(20.0)]), "{src}");
+        }
+    }
 }
