@@ -237,6 +237,12 @@ pub struct Body {
     /// whether it is a `bool`.
     binds: Vec<(usize, usize, usize, bool)>,
     frame_size: usize,
+    /// The slots before this one are all bound to parameters: a run
+    /// clears the frame from here on only.
+    bound: usize,
+    /// No statement stores into a parameter's slot: after a run, the
+    /// frame still holds the parameters as bound.
+    keeps_params: bool,
     /// Neither stores into a global nor draws a random number: what it
     /// produces depends on the matched modules and the globals alone.
     pure: bool,
@@ -285,6 +291,7 @@ pub fn compile(rule: &Rule, globals: &[super::ir::GlobalVar]) -> Option<Body> {
             unknown: false,
             conflict: false,
             effects: false,
+            stored: vec![false; rule.frame_size],
         };
         let body = c.block(&rule.body);
         if c.conflict {
@@ -294,9 +301,17 @@ pub fn compile(rule: &Rule, globals: &[super::ir::GlobalVar]) -> Option<Body> {
             if c.unknown {
                 return None;
             }
+            let mut is_bound = vec![false; rule.frame_size];
+            for &(_, _, slot, _) in &binds {
+                is_bound[slot] = true;
+            }
+            let bound = is_bound.iter().take_while(|&&b| b).count();
+            let keeps_params = binds.iter().all(|b| !c.stored[b.2]);
             return Some(Body {
+                keeps_params,
                 binds,
                 frame_size: rule.frame_size,
+                bound,
                 pure: !c.effects,
                 body: body?,
             });
@@ -314,9 +329,37 @@ impl Body {
         self.pure
     }
 
+    /// True when, right after `self` ran on some modules without
+    /// producing, `next` may run on the same modules with
+    /// [`Body::run_bound`]: both bind the same parameters to the same
+    /// slots, and `self` stores into none of them.
+    pub fn leaves_params_for(&self, next: &Body) -> bool {
+        self.keeps_params && self.binds == next.binds
+    }
+
+    /// [`Body::run`] on parameters already in the machine's frame: those
+    /// the last body run on it bound, when that body
+    /// [left them](Body::leaves_params_for) for this one.
+    #[inline]
+    pub fn run_bound(
+        &self,
+        m: &mut Machine,
+        env: &mut Env,
+        sink: &mut dyn Emit,
+    ) -> Result<Flow, RuntimeError> {
+        if m.frame.len() < self.frame_size {
+            m.frame.resize(self.frame_size, 0);
+        }
+        if self.bound < self.frame_size {
+            m.frame[self.bound..self.frame_size].fill(0);
+        }
+        self.go(m, env, sink)
+    }
+
     /// Runs the body on the parameters of the matched modules (`params(k)`:
     /// the slots of the `k`-th matched module, left context first), as
     /// [`super::eval::Interp::run`] runs it on their decoded values.
+    #[inline]
     pub fn run<'s>(
         &self,
         m: &mut Machine,
@@ -330,7 +373,10 @@ impl Body {
         if m.frame.len() < self.frame_size {
             m.frame.resize(self.frame_size, 0);
         }
-        m.frame[..self.frame_size].fill(0);
+        // The bound slots are written below.
+        if self.bound < self.frame_size {
+            m.frame[self.bound..self.frame_size].fill(0);
+        }
         let mut data: &[f64] = &[];
         let mut at = usize::MAX;
         for &(k, j, slot, boolean) in &self.binds {
@@ -346,6 +392,17 @@ impl Body {
                 x.to_bits()
             };
         }
+        self.go(m, env, sink)
+    }
+
+    /// Runs the body on its frame as bound.
+    #[inline(always)]
+    fn go(
+        &self,
+        m: &mut Machine,
+        env: &mut Env,
+        sink: &mut dyn Emit,
+    ) -> Result<Flow, RuntimeError> {
         m.fuel = m.loop_limit;
         let mut cx = Cx { m, env, sink };
         match (self.body)(&mut cx) {
@@ -368,11 +425,16 @@ struct Compiler<'g> {
     conflict: bool,
     /// The body stores into a global or draws a random number.
     effects: bool,
+    /// The locals the body stores into.
+    stored: Vec<bool>,
 }
 
 impl Compiler<'_> {
     fn write(&mut self, slot: u16, k: Kind) -> Option<usize> {
         let s = slot as usize;
+        if let Some(st) = self.stored.get_mut(s) {
+            *st = true;
+        }
         let w = self.writes.get_mut(s)?;
         match w {
             Some(o) if *o != k => self.conflict = true,
@@ -449,6 +511,135 @@ impl Compiler<'_> {
         })
     }
 
+    /// `a op b` where one operand is a leaf and the other compiles to a
+    /// floating expression, in one closure that calls that expression and
+    /// reads the leaf itself (rounded to single precision with `round`):
+    /// the floating branch of [`bin`] with one call fewer. The left operand
+    /// is evaluated first, as in `bin`.
+    fn half_fused(&mut self, op: BinOp, a: &Ex, b: &Ex, round: bool) -> Option<Result<C, C>> {
+        use BinOp::*;
+        if !matches!(op, Add | Sub | Mul | Div) {
+            return None;
+        }
+        let (la, lb) = (self.leaf(a), self.leaf(b));
+        macro_rules! f {
+            ($op:tt, $e:expr, $l:expr, $left:expr) => {{
+                let (e, l) = ($e, $l);
+                if $left {
+                    C::F(Box::new(move |cx| {
+                        let v = e(cx)? $op l.get(&cx.m.frame);
+                        Ok(if round { round32(v) } else { v })
+                    }))
+                } else {
+                    C::F(Box::new(move |cx| {
+                        let x = l.get(&cx.m.frame);
+                        let v = x $op e(cx)?;
+                        Ok(if round { round32(v) } else { v })
+                    }))
+                }
+            }};
+        }
+        let (e, l, left) = match (la, lb) {
+            (None, Some(l)) => (self.expr(a)?, l, true),
+            (Some(l), None) => (self.expr(b)?, l, false),
+            _ => return None,
+        };
+        let C::F(e) = e else {
+            return Some(Err(e));
+        };
+        Some(Ok(match op {
+            Add => f!(+, e, l, left),
+            Sub => f!(-, e, l, left),
+            Mul => f!(*, e, l, left),
+            _ => f!(/, e, l, left),
+        }))
+    }
+
+    /// A binary operator on two expressions: [`Compiler::fused`] or
+    /// [`Compiler::half_fused`] where they apply, otherwise [`bin`] (after
+    /// a conversion to `ty`, when given).
+    fn binary(&mut self, op: BinOp, a: &Ex, b: &Ex, span: Span, ty: Option<Ty>) -> Option<C> {
+        let round = ty == Some(Ty::Float);
+        if ty.is_none() || round {
+            if let Some(c) = self.fused(op, a, b, round) {
+                return Some(c);
+            }
+            match self.half_fused(op, a, b, round) {
+                Some(Ok(c)) => return Some(c),
+                // The expression side was compiled but is not floating.
+                Some(Err(e)) => {
+                    let (ca, cb) = if self.leaf(a).is_some() {
+                        (self.expr(a)?, e)
+                    } else {
+                        (e, self.expr(b)?)
+                    };
+                    let c = bin(op, ca, cb, Some(span))?;
+                    return match ty {
+                        Some(ty) => convert(ty, c),
+                        None => Some(c),
+                    };
+                }
+                None => {}
+            }
+        }
+        let (ca, cb) = (self.expr(a)?, self.expr(b)?);
+        let c = bin(op, ca, cb, Some(span))?;
+        match ty {
+            Some(ty) => convert(ty, c),
+            None => Some(c),
+        }
+    }
+
+    /// `if (a OP b) t else e` where `a OP b` compares two leaves of which
+    /// one at least is floating ([`Compiler::fused`]'s comparisons): the
+    /// test made in the statement's closure, with no call for it.
+    fn if_compare(&mut self, c: &Ex, t: &St, e: Option<&St>) -> Option<SE> {
+        use BinOp::*;
+        let Ex::Bin(op, a, b, _) = c else {
+            return None;
+        };
+        let (x, y) = (self.leaf(a)?, self.leaf(b)?);
+        let floating = |l: Leaf, e: &Ex| {
+            matches!(l, Leaf::Float(_)) || matches!(e, Ex::Const(Value::Float(_)))
+        };
+        if !matches!(op, Lt | Le | Gt | Ge | Eq | Ne) || (!floating(x, a) && !floating(y, b)) {
+            return None;
+        }
+        let t = self.stmt(t)?;
+        let e = match e {
+            Some(e) => Some(self.stmt(e)?),
+            None => None,
+        };
+        macro_rules! iff {
+            ($f:expr) => {
+                match e {
+                    Some(e) => Box::new(move |cx: &mut Cx| {
+                        if $f(x.get(&cx.m.frame), y.get(&cx.m.frame)) {
+                            t(cx)
+                        } else {
+                            e(cx)
+                        }
+                    }) as SE,
+                    None => Box::new(move |cx: &mut Cx| {
+                        if $f(x.get(&cx.m.frame), y.get(&cx.m.frame)) {
+                            t(cx)
+                        } else {
+                            Ok(Flow::Normal)
+                        }
+                    }),
+                }
+            };
+        }
+        Some(match op {
+            Lt => iff!(|p: f64, q: f64| p < q),
+            Le => iff!(|p: f64, q: f64| p <= q),
+            Gt => iff!(|p: f64, q: f64| p > q),
+            Ge => iff!(|p: f64, q: f64| p >= q),
+            Eq => iff!(|p: f64, q: f64| p == q),
+            _ => iff!(|p: f64, q: f64| p != q),
+        })
+    }
+
     fn block(&mut self, body: &[St]) -> Option<SE> {
         let mut sts = body
             .iter()
@@ -487,6 +678,9 @@ impl Compiler<'_> {
                 })
             }
             St::If(c, t, e) => {
+                if let Some(s) = self.if_compare(c, t, e.as_deref()) {
+                    return Some(s);
+                }
                 let c = self.expr(c)?.b();
                 let t = self.stmt(t)?;
                 match e {
@@ -552,21 +746,45 @@ impl Compiler<'_> {
             }
             St::Block(b) => self.block(b)?,
             St::Produce { modules, last } => {
-                let mut ms = Vec::new();
-                for m in modules {
-                    let args = m
-                        .args
-                        .iter()
-                        .map(|a| self.expr(a))
-                        .collect::<Option<Vec<_>>>()?;
-                    ms.push((m.sym, args, m.span));
+                // Every parameter of every module in one list, in order,
+                // each with its module and its place in it.
+                let mut args = Vec::new();
+                for (k, m) in modules.iter().enumerate() {
+                    for (j, a) in m.args.iter().enumerate() {
+                        args.push((self.arg(a)?, k, j));
+                    }
                 }
                 let first = modules.first().map(|m| m.span);
                 let flow = if *last { Flow::Produced } else { Flow::Normal };
+                let syms: Vec<Sym> = modules.iter().map(|m| m.sym).collect();
+                let widths: Vec<usize> = modules.iter().map(|m| m.args.len()).collect();
+                let spans: Vec<Span> = modules.iter().map(|m| m.span).collect();
+                // Where each module's slots start among the statement's.
+                let starts: Vec<usize> = widths
+                    .iter()
+                    .scan(0, |at, &w| {
+                        let s = *at;
+                        *at += w;
+                        Some(s)
+                    })
+                    .collect();
                 Box::new(move |cx| {
-                    for (sym, args, span) in &ms {
-                        produce(cx, *sym, args, *span)?;
+                    // Every module's slots first, then all modules at once;
+                    // when one fails, the sink gets those before it, as
+                    // module by module.
+                    let base = cx.m.slots.len();
+                    cx.m.slots.reserve(args.len());
+                    for (a, k, j) in &args {
+                        if let Err(e) = parameter(cx, a, *j, spans[*k]) {
+                            cx.m.slots.truncate(base + starts[*k]);
+                            cx.sink
+                                .emit_run(&syms[..*k], &widths[..*k], &cx.m.slots[base..]);
+                            cx.m.slots.truncate(base);
+                            return Err(e);
+                        }
                     }
+                    cx.sink.emit_run(&syms, &widths, &cx.m.slots[base..]);
+                    cx.m.slots.truncate(base);
                     if cx.sink.full() {
                         return Err(rt(first, "this successor takes the word past its limit"));
                     }
@@ -578,6 +796,32 @@ impl Compiler<'_> {
             St::Continue => Box::new(|_| Ok(Flow::Continue)),
             _ => return None,
         })
+    }
+
+    /// A successor parameter: a constant's slot (a finite `float`, an
+    /// `int`, a `bool`, possibly converted) or a local of known kind read
+    /// where it is written, otherwise the compiled expression.
+    fn arg(&mut self, e: &Ex) -> Option<Arg> {
+        let constant = match e {
+            Ex::Const(v) => Some(v.clone()),
+            Ex::Convert(ty, c) => match &**c {
+                Ex::Const(v) if kind_of(*ty).is_some() => Some(v.clone().convert(*ty)),
+                _ => None,
+            },
+            _ => None,
+        };
+        match constant {
+            Some(Value::Float(f)) if f.is_finite() => return Some(Arg::Slot(f)),
+            Some(Value::Int(i)) => return Some(Arg::Slot(f64::from_bits(i as u64))),
+            Some(Value::Bool(b)) => return Some(Arg::Slot(b as u8 as f64)),
+            _ => {}
+        }
+        if let Ex::Local(s) = e {
+            if let Some(Some(k)) = self.kinds.get(*s as usize) {
+                return Some(Arg::Local(*k, *s as usize));
+            }
+        }
+        Some(Arg::C(self.expr(e)?))
     }
 
     fn expr(&mut self, e: &Ex) -> Option<C> {
@@ -605,13 +849,7 @@ impl Compiler<'_> {
                 let a = self.expr(a)?.b();
                 C::B(Box::new(move |cx| Ok(!a(cx)?)))
             }
-            Ex::Bin(op, a, b, span) => {
-                if let Some(c) = self.fused(*op, a, b, false) {
-                    return Some(c);
-                }
-                let (a, b) = (self.expr(a)?, self.expr(b)?);
-                bin(*op, a, b, Some(*span))?
-            }
+            Ex::Bin(op, a, b, span) => self.binary(*op, a, b, *span, None)?,
             Ex::Logic(and, a, b) => {
                 let (a, b) = (self.expr(a)?.b(), self.expr(b)?.b());
                 if *and {
@@ -636,10 +874,8 @@ impl Compiler<'_> {
                 }
             }
             Ex::Convert(ty, a) => {
-                if let (Ty::Float, Ex::Bin(op, x, y, _)) = (ty, &**a) {
-                    if let Some(c) = self.fused(*op, x, y, true) {
-                        return Some(c);
-                    }
+                if let (Ty::Float, Ex::Bin(op, x, y, span)) = (ty, &**a) {
+                    return self.binary(*op, x, y, *span, Some(Ty::Float));
                 }
                 let a = self.expr(a)?;
                 convert(*ty, a)?
@@ -868,45 +1104,40 @@ fn pure(e: &Ex) -> bool {
     ok
 }
 
-/// One successor module: its parameters, checked finite, as slots.
-fn produce(cx: &mut Cx, sym: Sym, args: &[C], span: Span) -> R<()> {
-    let base = cx.m.slots.len();
-    for (k, a) in args.iter().enumerate() {
-        // `value::encode`: an int's bits, a float, a bool as 0 or 1.
-        let x = match a {
-            C::F(a) => a(cx),
-            C::I(a) => a(cx).map(|i| f64::from_bits(i as u64)),
-            C::B(a) => a(cx).map(|b| b as u8 as f64),
-        };
-        let x = match x {
-            Ok(x) => x,
-            Err(e) => {
-                cx.m.slots.truncate(base);
-                return Err(e);
-            }
-        };
-        let slot = match a {
-            C::F(_) => {
-                let f = x;
-                if !f.is_finite() {
-                    cx.m.slots.truncate(base);
-                    return Err(rt(
-                        Some(span),
-                        format!(
-                            "parameter {} of this successor module is {}; NaN and infinity are not allowed in a word",
-                            k + 1,
-                            Value::Float(f)
-                        ),
-                    ));
-                }
-                f
-            }
-            _ => x,
-        };
-        cx.m.slots.push(slot);
+/// A successor module's parameter as [`Compiler::arg`] compiles it.
+enum Arg {
+    /// The slot of a constant.
+    Slot(f64),
+    /// A local of this kind.
+    Local(Kind, usize),
+    C(C),
+}
+
+/// Parameter `j` (from 0) of a successor module at `span`, checked
+/// finite, appended to the machine's slots.
+#[inline(always)]
+fn parameter(cx: &mut Cx, a: &Arg, j: usize, span: Span) -> R<()> {
+    // `value::encode`: an int's bits, a float, a bool as 0 or 1.
+    let (x, float) = match a {
+        Arg::Slot(x) => (*x, false),
+        Arg::Local(Kind::F, s) => (f64::from_bits(cx.m.frame[*s]), true),
+        Arg::Local(Kind::I, s) => (f64::from_bits(cx.m.frame[*s]), false),
+        Arg::Local(Kind::B, s) => ((cx.m.frame[*s] != 0) as u8 as f64, false),
+        Arg::C(C::F(a)) => (a(cx)?, true),
+        Arg::C(C::I(a)) => (f64::from_bits(a(cx)? as u64), false),
+        Arg::C(C::B(a)) => (a(cx)? as u8 as f64, false),
+    };
+    if float && !x.is_finite() {
+        return Err(rt(
+            Some(span),
+            format!(
+                "parameter {} of this successor module is {}; NaN and infinity are not allowed in a word",
+                j + 1,
+                Value::Float(x)
+            ),
+        ));
     }
-    cx.sink.emit_slots(sym, &cx.m.slots[base..]);
-    cx.m.slots.truncate(base);
+    cx.m.slots.push(x);
     Ok(())
 }
 

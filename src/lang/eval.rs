@@ -125,6 +125,18 @@ pub trait Emit {
         self.emit(sym, &args);
     }
 
+    /// Modules one after another whose parameters are given as one run of
+    /// slots: module `k` has symbol `syms[k]` and the next `widths[k]`
+    /// slots. The same as [`Emit::emit_slots`] on each in turn (the
+    /// default), at once.
+    fn emit_run(&mut self, syms: &[Sym], widths: &[usize], slots: &[f64]) {
+        let mut at = 0;
+        for (&sym, &w) in syms.iter().zip(widths) {
+            self.emit_slots(sym, &slots[at..at + w]);
+            at += w;
+        }
+    }
+
     /// True when the sink holds more than it may: the interpreter stops
     /// the body after the `produce` that filled it.
     fn full(&self) -> bool {

@@ -92,6 +92,19 @@ impl Word {
         self.starts.push(self.data.len() as u32);
     }
 
+    /// Appends modules `syms`, module `k` with the next `widths[k]` of
+    /// `slots`, as `push_raw` on each in turn.
+    #[inline]
+    pub fn push_run(&mut self, syms: &[Sym], widths: &[usize], slots: &[f64]) {
+        let mut at = self.data.len();
+        self.syms.extend(syms.iter().copied());
+        self.data.extend(slots.iter().copied());
+        self.starts.extend(widths.iter().map(|&w| {
+            at += w;
+            at as u32
+        }));
+    }
+
     /// Appends a module whose slots `fill` writes.
     #[inline(always)]
     pub fn push_with(&mut self, sym: Sym, fill: impl FnOnce(&mut Vec<f64>)) {
@@ -104,6 +117,22 @@ impl Word {
     #[inline]
     pub fn push_from(&mut self, other: &Word, i: usize) {
         self.push_raw(other.syms[i], other.data(i));
+    }
+
+    /// Appends modules `range` of `other`, at once.
+    #[inline]
+    pub fn push_range(&mut self, other: &Word, range: std::ops::Range<usize>) {
+        self.syms.extend_from_slice(&other.syms[range.clone()]);
+        let (a, b) = (other.starts[range.start], other.starts[range.end]);
+        // As `push_raw` computes each offset: the slot count after it.
+        let shift = (self.data.len() as u32).wrapping_sub(a);
+        self.data
+            .extend_from_slice(&other.data[a as usize..b as usize]);
+        self.starts.extend(
+            other.starts[range.start + 1..=range.end]
+                .iter()
+                .map(|&s| s.wrapping_add(shift)),
+        );
     }
 
     /// Appends all modules of each of `parts`, in order, copying the
