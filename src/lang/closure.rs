@@ -347,13 +347,20 @@ impl Body {
         env: &mut Env,
         sink: &mut dyn Emit,
     ) -> Result<Flow, RuntimeError> {
+        self.clear_locals(m);
+        self.go(m, env, sink)
+    }
+
+    /// Makes the frame the body's size, the slots past its bound
+    /// parameters zero.
+    #[inline]
+    fn clear_locals(&self, m: &mut Machine) {
         if m.frame.len() < self.frame_size {
             m.frame.resize(self.frame_size, 0);
         }
         if self.bound < self.frame_size {
             m.frame[self.bound..self.frame_size].fill(0);
         }
-        self.go(m, env, sink)
     }
 
     /// Runs the body on the parameters of the matched modules (`params(k)`:
@@ -369,14 +376,8 @@ impl Body {
     ) -> Result<Flow, RuntimeError> {
         // Cleared, though a body reads a local only after its declaration
         // stored into it or a pattern bound it: nothing of the last body
-        // can show.
-        if m.frame.len() < self.frame_size {
-            m.frame.resize(self.frame_size, 0);
-        }
-        // The bound slots are written below.
-        if self.bound < self.frame_size {
-            m.frame[self.bound..self.frame_size].fill(0);
-        }
+        // can show. The bound slots are written below.
+        self.clear_locals(m);
         let mut data: &[f64] = &[];
         let mut at = usize::MAX;
         for &(k, j, slot, boolean) in &self.binds {

@@ -399,10 +399,8 @@ impl<'p> Rewriter<'p> {
                 ((want as f64 * per_module) as usize).min(opts.max_modules.saturating_mul(4));
             w.clear_with_capacity(want, slots);
         }
+        self.prepare_parts(rules, opts);
         let loop_limit = self.interp.loop_limit;
-        self.machine.loop_limit = loop_limit;
-        self.machine.deadline = opts.deadline;
-        self.dispatch.prepare(self.program, &self.bodies, rules);
         let sh = Shared {
             program: self.program,
             bodies: &self.bodies,
@@ -456,6 +454,14 @@ impl<'p> Rewriter<'p> {
     /// Returns `None` when it does not apply, and when a value is not
     /// finite, the word would pass its limit or the deadline passed: the
     /// step then runs on one thread, which names the module and the rule.
+    /// Sets up what `rewrite_part` reads beside the word: the rules by
+    /// symbol, and the compiled bodies' loop limit and deadline.
+    fn prepare_parts(&mut self, rules: &[usize], opts: &StepOptions) {
+        self.dispatch.prepare(self.program, &self.bodies, rules);
+        self.machine.loop_limit = self.interp.loop_limit;
+        self.machine.deadline = opts.deadline;
+    }
+
     fn stencil_parts(
         &mut self,
         rules: &[usize],
@@ -578,7 +584,7 @@ impl<'p> Rewriter<'p> {
                         // The modules no rule rewrites, copied as a run.
                         let run = part[j..].iter().take_while(|&&c| c == KEEP).count();
                         j += run;
-                        out.push_run(src, i..i + run)
+                        out.push_range(src, i..i + run)
                     }
                     t => {
                         let r = rules[t as usize];
@@ -640,9 +646,7 @@ impl<'p> Rewriter<'p> {
         env: &mut Env,
         opts: &StepOptions,
     ) -> Result<usize, StepError> {
-        self.dispatch.prepare(self.program, &self.bodies, rules);
-        self.machine.loop_limit = self.interp.loop_limit;
-        self.machine.deadline = opts.deadline;
+        self.prepare_parts(rules, opts);
         let sh = Shared {
             program: self.program,
             bodies: &self.bodies,

@@ -338,12 +338,12 @@ impl PartWriter<'_> {
     /// Writes the modules of `w`, slots and all; false (and nothing
     /// written) when they would pass the part's share.
     pub(crate) fn push_word(&mut self, w: &Word) -> bool {
-        self.push_run(w, 0..w.len())
+        self.push_range(w, 0..w.len())
     }
 
     /// Writes the modules `run` of `w`, slots and all; false (and nothing
     /// written) when they would pass the part's share.
-    pub(crate) fn push_run(&mut self, w: &Word, run: std::ops::Range<usize>) -> bool {
+    pub(crate) fn push_range(&mut self, w: &Word, run: std::ops::Range<usize>) -> bool {
         let (lo, hi) = (w.starts[run.start], w.starts[run.end]);
         let (m, s) = (self.modules + run.len(), self.slots + (hi - lo) as usize);
         if m > self.syms.len() || s > self.data.len() {
@@ -406,8 +406,8 @@ mod tests {
         let before = w.clone();
         // The last part a module at a time, the others as whole runs.
         assert!(w.fill_parts(&counts, |k, out| match k {
-            2 => runs[k].clone().all(|i| out.push_run(&src, i..i + 1)),
-            _ => out.push_run(&src, runs[k].clone()),
+            2 => runs[k].clone().all(|i| out.push_range(&src, i..i + 1)),
+            _ => out.push_range(&src, runs[k].clone()),
         }));
         assert_eq!(w, want);
         for i in 0..w.len() {
@@ -418,13 +418,13 @@ mod tests {
         let fill_short = |k: usize, out: &mut PartWriter<'_>| {
             let r = runs[k].clone();
             let end = if k == 2 { r.end - 1 } else { r.end };
-            out.push_run(&src, r.start..end)
+            out.push_range(&src, r.start..end)
         };
         assert!(!short.fill_parts(&counts, fill_short));
         assert_eq!(short, before);
         let mut long = before.clone();
         let fill_long = |k: usize, out: &mut PartWriter<'_>| {
-            out.push_run(&src, runs[k].clone()) && (k != 0 || out.push_run(&src, 0..1))
+            out.push_range(&src, runs[k].clone()) && (k != 0 || out.push_range(&src, 0..1))
         };
         assert!(!long.fill_parts(&counts, fill_long));
         assert_eq!(long, before);
