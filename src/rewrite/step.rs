@@ -399,23 +399,14 @@ impl<'p> Rewriter<'p> {
                 ((want as f64 * per_module) as usize).min(opts.max_modules.saturating_mul(4));
             w.clear_with_capacity(want, slots);
         }
-        self.prepare_parts(rules, opts);
         let loop_limit = self.interp.loop_limit;
-        let sh = Shared {
-            program: self.program,
-            bodies: &self.bodies,
-            tables: &self.tables,
-            dispatch: &self.dispatch,
-            sb: self.sb,
-            eb: self.eb,
-        };
+        let (sh, machine, parts) = self.prepare_parts(rules, opts);
         let grown = std::sync::atomic::AtomicUsize::new(0);
         let shared_env = env.clone();
-        let machine = &mut self.machine;
         let (head, tail) = rayon::join(
             || rewrite_part(&sh, src, 0..first, dst, env, opts, machine, &grown),
             || {
-                self.parts
+                parts
                     .par_iter_mut()
                     .zip(bounds[1..].par_windows(2))
                     .map(|(w, b)| {
@@ -428,17 +419,39 @@ impl<'p> Rewriter<'p> {
                     .collect::<Vec<_>>()
             },
         );
-        let total = dst.len() + self.parts.iter().map(Word::len).sum::<usize>();
+        let total = dst.len() + parts.iter().map(Word::len).sum::<usize>();
         let rewritten = std::iter::once(head).chain(tail).sum::<Result<usize, _>>();
         let Some(rewritten) = rewritten.ok().filter(|_| total <= opts.max_modules) else {
             dst.clear();
             return None;
         };
-        if !dst.append_all(&self.parts) {
+        if !dst.append_all(parts) {
             dst.clear();
             return None;
         }
         Some(rewritten)
+    }
+
+    /// Sets up what `rewrite_part` reads beside the word (the rules by
+    /// symbol, the compiled bodies' loop limit and deadline) and lends it,
+    /// with the machine of the first part and the words of the others.
+    fn prepare_parts(
+        &mut self,
+        rules: &[usize],
+        opts: &StepOptions,
+    ) -> (Shared<'_>, &mut closure::Machine, &mut Vec<Word>) {
+        self.dispatch.prepare(self.program, &self.bodies, rules);
+        self.machine.loop_limit = self.interp.loop_limit;
+        self.machine.deadline = opts.deadline;
+        let sh = Shared {
+            program: self.program,
+            bodies: &self.bodies,
+            tables: &self.tables,
+            dispatch: &self.dispatch,
+            sb: self.sb,
+            eb: self.eb,
+        };
+        (sh, &mut self.machine, &mut self.parts)
     }
 
     /// A forward step of stencils in parts on rayon's pool, written
@@ -454,14 +467,6 @@ impl<'p> Rewriter<'p> {
     /// Returns `None` when it does not apply, and when a value is not
     /// finite, the word would pass its limit or the deadline passed: the
     /// step then runs on one thread, which names the module and the rule.
-    /// Sets up what `rewrite_part` reads beside the word: the rules by
-    /// symbol, and the compiled bodies' loop limit and deadline.
-    fn prepare_parts(&mut self, rules: &[usize], opts: &StepOptions) {
-        self.dispatch.prepare(self.program, &self.bodies, rules);
-        self.machine.loop_limit = self.interp.loop_limit;
-        self.machine.deadline = opts.deadline;
-    }
-
     fn stencil_parts(
         &mut self,
         rules: &[usize],
@@ -646,26 +651,9 @@ impl<'p> Rewriter<'p> {
         env: &mut Env,
         opts: &StepOptions,
     ) -> Result<usize, StepError> {
-        self.prepare_parts(rules, opts);
-        let sh = Shared {
-            program: self.program,
-            bodies: &self.bodies,
-            tables: &self.tables,
-            dispatch: &self.dispatch,
-            sb: self.sb,
-            eb: self.eb,
-        };
+        let (sh, machine, _) = self.prepare_parts(rules, opts);
         let grown = std::sync::atomic::AtomicUsize::new(0);
-        rewrite_part(
-            &sh,
-            src,
-            0..src.len(),
-            dst,
-            env,
-            opts,
-            &mut self.machine,
-            &grown,
-        )
+        rewrite_part(&sh, src, 0..src.len(), dst, env, opts, machine, &grown)
     }
 
     /// Frees the words kept from step to step.
