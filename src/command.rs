@@ -797,9 +797,19 @@ fn render_system(
                     ..Default::default()
                 },
             };
-            let figures = c.figures(&figure)?;
+            let figures = match format {
+                Picture::Png => c.png_figures(&figure)?,
+                Picture::Svg => {
+                    let f = c.figures(&figure)?;
+                    let svg = |s: &Scene| render::svg::render(s).into_bytes();
+                    crate::Figures {
+                        main: svg(&f.main),
+                        views: f.views.iter().map(|(v, s)| (*v, svg(s))).collect(),
+                    }
+                }
+            };
             write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
-            write_views(&figures, Path::new(&a.file), output, (format, a.force), out)
+            write_views(figures, Path::new(&a.file), output, a.force, out)
         }
     }
 }
@@ -1497,18 +1507,17 @@ pub fn write_picture(scene: &Scene, path: &Path, format: Picture) -> Result<(), 
 /// warning for each view that `UseView` activated and the view file does
 /// not define (lpfg ignores those too).
 fn write_views(
-    figures: &crate::Figures,
+    figures: crate::Figures<Vec<u8>>,
     program: &Path,
     output: &Path,
-    (format, force): (Picture, bool),
+    force: bool,
     out: &mut Out,
 ) -> Result<Vec<String>, Error> {
     let names = crate::load::window_names(program);
-    let mut files: Vec<(PathBuf, Vec<u8>)> =
-        vec![(output.to_path_buf(), picture_bytes(&figures.main, format)?)];
+    let mut files: Vec<(PathBuf, Vec<u8>)> = vec![(output.to_path_buf(), figures.main)];
     let mut warnings = Vec::new();
-    for (view, scene) in &figures.views {
-        let name = usize::try_from(*view)
+    for (view, picture) in figures.views {
+        let name = usize::try_from(view)
             .ok()
             .and_then(|v| names.get(v))
             .filter(|n| crate::load::is_identifier(n));
@@ -1519,7 +1528,7 @@ fn write_views(
             ));
             continue;
         };
-        files.push((view_path(output, name), picture_bytes(scene, format)?));
+        files.push((view_path(output, name), picture));
     }
     let outputs: Vec<&Path> = files.iter().map(|(p, _)| p.as_path()).collect();
     refuse_overwrite(&outputs, &[program], force)?;

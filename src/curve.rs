@@ -193,6 +193,71 @@ impl Curve {
     /// their first `UseView`. With `each`, a view activated after the first
     /// step has panels from that step on.
     pub fn figures(&self, opts: &FigureOptions) -> Result<Figures, Error> {
+        let p = &self.program;
+        let panels = self.each_view(opts, |word, draw_opts| {
+            draw::draw(word, &p.alphabet, &p.structs, draw_opts)
+        })?;
+        // The words are drawn and freed: each view's events are freed once
+        // its picture is laid out.
+        let mut scenes = Vec::with_capacity(panels.len());
+        for (view, list) in panels {
+            scenes.push((view, render::scene(&list, &opts.render)?));
+        }
+        let (_, main) = scenes.remove(0);
+        Ok(Figures {
+            main,
+            views: scenes,
+        })
+    }
+
+    /// [`Curve::figures`] as PNG files' bytes, the same to the bit; each
+    /// view's picture (without `each`) painted as the turtle walks its
+    /// word (`render::png::word`), with no events or items in memory.
+    pub fn png_figures(&self, opts: &FigureOptions) -> Result<Figures<Vec<u8>>, Error> {
+        if opts.each {
+            let f = self.figures(opts)?;
+            let png = |s: &render::Scene| render::png::render(s).map_err(Error::from);
+            return Ok(Figures {
+                main: png(&f.main)?,
+                views: f
+                    .views
+                    .iter()
+                    .map(|(v, s)| Ok((*v, png(s)?)))
+                    .collect::<Result<_, Error>>()?,
+            });
+        }
+        let p = &self.program;
+        // A drawing that cannot be pictured is told after every view is
+        // drawn, as `figures` tells it.
+        let painted = self.each_view(opts, |word, draw_opts| {
+            match render::png::word(word, &p.alphabet, &p.structs, draw_opts, &opts.render) {
+                Ok(png) => Ok(Ok(png)),
+                Err(render::png::WordError::Draw(e)) => Err(e),
+                Err(render::png::WordError::Render(e)) => Ok(Err(e)),
+            }
+        })?;
+        let mut pictures = Vec::with_capacity(painted.len());
+        for (view, mut list) in painted {
+            let png = list.pop().expect("one picture a view without `each`")?;
+            pictures.push((view, png));
+        }
+        let (_, main) = pictures.remove(0);
+        Ok(Figures {
+            main,
+            views: pictures,
+        })
+    }
+
+    /// Derives once and draws the interpreted word of every view with
+    /// `draw`: the main view's drawings first, then each view's in the
+    /// order of its first `UseView`; a drawing of each step with `each`
+    /// (a view activated after the first step from that step on), else of
+    /// the last.
+    fn each_view<T>(
+        &self,
+        opts: &FigureOptions,
+        mut draw: impl FnMut(&Word, &draw::DrawOptions) -> Result<T, draw::DrawError>,
+    ) -> Result<Vec<(i64, Vec<T>)>, Error> {
         check_steps(opts.derive.steps)?;
         let p = &self.program;
         let fail = |e| self.error(e);
@@ -203,23 +268,21 @@ impl Curve {
         if let Some(a) = d.angle().map_err(fail)? {
             draw_opts.angle = a;
         }
-        // Each view's panels, the main view's first.
-        let mut panels: Vec<(i64, Vec<Vec<Event>>)> = vec![(0, Vec::new())];
+        let mut drawn: Vec<(i64, Vec<T>)> = vec![(0, Vec::new())];
         let mut panel = |d: &mut Derivation| -> Result<(), Error> {
             let others: Vec<i64> = d.views().iter().copied().filter(|v| *v != 0).collect();
             for view in std::iter::once(0).chain(others) {
                 let step = d.step;
                 let word = d.interpreted_view(view).map_err(fail)?;
-                let events =
-                    draw::draw(&word, &p.alphabet, &p.structs, &draw_opts).map_err(|e| {
-                        let maker = (e.module)
-                            .filter(|_| view == 0)
-                            .and_then(|m| self.maker_in_figure(opts, step, &word, m));
-                        self.draw_error(e, step, maker)
-                    })?;
-                match panels.iter_mut().find(|(v, _)| *v == view) {
-                    Some((_, list)) => list.push(events),
-                    None => panels.push((view, vec![events])),
+                let made = draw(&word, &draw_opts).map_err(|e| {
+                    let maker = (e.module)
+                        .filter(|_| view == 0)
+                        .and_then(|m| self.maker_in_figure(opts, step, &word, m));
+                    self.draw_error(e, step, maker)
+                })?;
+                match drawn.iter_mut().find(|(v, _)| *v == view) {
+                    Some((_, list)) => list.push(made),
+                    None => drawn.push((view, vec![made])),
                 }
             }
             Ok(())
@@ -237,27 +300,16 @@ impl Curve {
         if !opts.each {
             panel(&mut d)?;
         }
-        // The word is drawn: free it before the pictures are laid out, and
-        // each view's events once its picture is.
-        drop(d);
-        let mut scenes = Vec::with_capacity(panels.len());
-        for (view, list) in panels {
-            scenes.push((view, render::scene(&list, &opts.render)?));
-        }
-        let (_, main) = scenes.remove(0);
-        Ok(Figures {
-            main,
-            views: scenes,
-        })
+        Ok(drawn)
     }
 }
 
 /// The pictures of a program's views (manual 7.3): the main one, and one
 /// per view that `UseView` activated, by view number.
 #[derive(Clone, Debug)]
-pub struct Figures {
-    pub main: render::Scene,
-    pub views: Vec<(i64, render::Scene)>,
+pub struct Figures<P = render::Scene> {
+    pub main: P,
+    pub views: Vec<(i64, P)>,
 }
 
 /// More steps than this are refused before a derivation starts.

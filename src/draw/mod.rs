@@ -512,31 +512,59 @@ pub(crate) trait Sink {
     }
 }
 
-/// The 2D drawing: renderer-neutral events.
-struct Events(Vec<Event>);
+/// Where the turtle's 2D drawing goes, one event at a time: a list of
+/// events ([`draw`]), or a picture laid out and painted as the turtle
+/// walks (`render::png::word`). [`Events`] decides which lines continue a
+/// path.
+pub(crate) trait EventSink {
+    /// A new path: the segment `a`..`b` drawn with `pen`.
+    fn path(&mut self, pen: Pen, a: DVec3, b: DVec3) -> Result<(), String>;
+    /// The last event, a path, continued to `b`.
+    fn continue_to(&mut self, b: DVec3) -> Result<(), String>;
+    /// An event that is not a path.
+    fn event(&mut self, e: Event) -> Result<(), String>;
+}
 
-impl Sink for Events {
-    /// Appends the segment `a`..`b` to the last event when that is a path
-    /// with the same pen ending at `a`, or else starts a path.
+/// The 2D drawing as renderer-neutral events: a line continues the last
+/// event when that is a path with the same pen that ends where the line
+/// starts, and starts a path otherwise.
+pub(crate) struct Events<E> {
+    out: E,
+    /// The pen and the end of the last event, when that is a path.
+    last: Option<(Pen, DVec3)>,
+}
+
+impl<E: EventSink> Events<E> {
+    pub(crate) fn new(out: E) -> Self {
+        Events { out, last: None }
+    }
+
+    pub(crate) fn into_inner(self) -> E {
+        self.out
+    }
+
+    fn event(&mut self, e: Event) -> Result<(), String> {
+        self.last = None;
+        self.out.event(e)
+    }
+}
+
+impl<E: EventSink> Sink for Events<E> {
     #[inline]
     fn line(&mut self, t: &Turtle, a: DVec3, b: DVec3) -> Result<(), String> {
         let pen = t.pen;
-        if let Some(Event::Path { points, pen: p }) = self.0.last_mut() {
-            if *p == pen && points.last() == Some(&a) {
-                points.push(b);
-                return Ok(());
-            }
+        let joined = self.last == Some((pen, a));
+        self.last = Some((pen, b));
+        if joined {
+            self.out.continue_to(b)
+        } else {
+            self.out.path(pen, a, b)
         }
-        self.0.push(Event::Path {
-            points: vec![a, b],
-            pen,
-        });
-        Ok(())
     }
 
     fn round(&mut self, t: &Turtle, kind: Round, r: f64) -> Result<(), String> {
         let c = t.pos;
-        self.0.push(match kind {
+        self.event(match kind {
             Round::Circle | Round::CircleFront | Round::Sphere => Event::Disc {
                 c,
                 r,
@@ -544,16 +572,14 @@ impl Sink for Events {
             },
             Round::Circle0 | Round::CircleFront0 | Round::Sphere0 => Event::Dot { c, pen: t.pen },
             Round::CircleB | Round::CircleFrontB => Event::Ring { c, r, pen: t.pen },
-        });
-        Ok(())
+        })
     }
 
     fn polygon(&mut self, t: &Turtle, points: Vec<DVec3>) -> Result<(), String> {
-        self.0.push(Event::Polygon {
+        self.event(Event::Polygon {
             points,
             color: t.pen.color,
-        });
-        Ok(())
+        })
     }
 
     fn surface(
@@ -562,7 +588,32 @@ impl Sink for Events {
         s: &crate::model::Surface,
         scale: DVec3,
     ) -> Result<(), String> {
-        surface_events(s, t, scale, &mut self.0);
+        let mut polygons = Vec::new();
+        surface_events(s, t, scale, &mut polygons);
+        polygons.into_iter().try_for_each(|e| self.event(e))
+    }
+}
+
+/// The events themselves, in order.
+impl EventSink for Vec<Event> {
+    fn path(&mut self, pen: Pen, a: DVec3, b: DVec3) -> Result<(), String> {
+        self.push(Event::Path {
+            points: vec![a, b],
+            pen,
+        });
+        Ok(())
+    }
+
+    #[inline]
+    fn continue_to(&mut self, b: DVec3) -> Result<(), String> {
+        if let Some(Event::Path { points, .. }) = self.last_mut() {
+            points.push(b);
+        }
+        Ok(())
+    }
+
+    fn event(&mut self, e: Event) -> Result<(), String> {
+        self.push(e);
         Ok(())
     }
 }
@@ -631,9 +682,9 @@ pub fn draw_with_queries(
     opts: &DrawOptions,
     queries: Option<&mut Vec<(usize, [f64; 3])>>,
 ) -> Result<Vec<Event>, DrawError> {
-    let mut events = Events(Vec::new());
+    let mut events = Events::new(Vec::new());
     walk(word, alphabet, structs, opts, queries, &mut events)?;
-    Ok(events.0)
+    Ok(events.into_inner())
 }
 
 /// The turtle's walk over `word`, drawing into `sink`.

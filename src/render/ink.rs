@@ -86,6 +86,22 @@ impl Ink {
                 .for_each(|(b, (ink, touched))| lay(b, ink, touched));
         }
     }
+    /// Lays down the ink of the segment `a`..`b` with a pen `pen` pixels
+    /// wide (at most one), on this thread: segment after segment, this is
+    /// [`Ink::polyline`] of their points to the bit.
+    #[inline]
+    pub(crate) fn segment(&mut self, a: DVec2, b: DVec2, pen: f64) {
+        Band {
+            width: self.width,
+            height: self.height,
+            row0: 0,
+            rows: self.height,
+            ink: &mut self.ink,
+            touched: &mut self.touched[0],
+        }
+        .segment(a, b, pen)
+    }
+
     /// Blends `color` over `pm` where the ink lies, by the ink's coverage,
     /// and clears the ink for the next path.
     pub(crate) fn blend(&mut self, pm: &mut Pixmap, color: Rgba) {
@@ -131,40 +147,45 @@ struct Band<'a> {
 impl Band<'_> {
     /// The ink of `points` on the band's rows (see [`Ink::polyline`]).
     fn lay(&mut self, points: &[DVec2], pen: f64) {
+        for pair in points.windows(2) {
+            self.segment(pair[0], pair[1], pen);
+        }
+    }
+
+    /// The ink of the segment `a`..`b` on the band's rows.
+    #[inline]
+    fn segment(&mut self, a: DVec2, b: DVec2, pen: f64) {
         let (w, h) = (self.width as f64, self.height as f64);
         let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= w && p.y <= h;
         // A piece's middle at y inks rows floor(y - 0.5) and the one below:
         // a segment wholly above `top` or below `bottom` inks none of the
         // band's rows (nor does a piece clipping keeps of it).
         let (top, bottom) = (self.row0 as f64 - 2.0, (self.row0 + self.rows) as f64 + 2.0);
-        for pair in points.windows(2) {
-            let (a, b) = (pair[0], pair[1]);
-            if (a.y < top && b.y < top) || (a.y > bottom && b.y > bottom) {
-                continue;
-            }
-            let Some((a, b)) = (if inside(a) && inside(b) {
-                Some((a, b))
-            } else {
-                clip(a, b, w, h)
-            }) else {
-                continue;
-            };
-            let d = b - a;
-            let length = d.length();
-            if length == 0.0 {
-                continue;
-            }
-            // As many pieces as `PIECE` needs (`ceil` without the call;
-            // clipped lengths are a few times the picture's side at most).
-            let whole = (length / PIECE) as usize;
-            let pieces = whole + usize::from((whole as f64) * PIECE < length);
-            let step = d / pieces as f64;
-            let area = (length / pieces as f64 * pen) as f32;
-            let mut c = a + step * 0.5;
-            for _ in 0..pieces {
-                self.splat(c, area);
-                c += step;
-            }
+        if (a.y < top && b.y < top) || (a.y > bottom && b.y > bottom) {
+            return;
+        }
+        let Some((a, b)) = (if inside(a) && inside(b) {
+            Some((a, b))
+        } else {
+            clip(a, b, w, h)
+        }) else {
+            return;
+        };
+        let d = b - a;
+        let length = d.length();
+        if length == 0.0 {
+            return;
+        }
+        // As many pieces as `PIECE` needs (`ceil` without the call;
+        // clipped lengths are a few times the picture's side at most).
+        let whole = (length / PIECE) as usize;
+        let pieces = whole + usize::from((whole as f64) * PIECE < length);
+        let step = d / pieces as f64;
+        let area = (length / pieces as f64 * pen) as f32;
+        let mut c = a + step * 0.5;
+        for _ in 0..pieces {
+            self.splat(c, area);
+            c += step;
         }
     }
 
@@ -335,6 +356,17 @@ mod tests {
             assert!(bits == one, "the ink differs on {threads} threads");
             assert_eq!(seen, noted, "{threads} threads");
         }
+        // Segment after segment, as a picture painted while the turtle
+        // walks inks it.
+        let mut ink = Ink::new(101, 91);
+        for pair in points.windows(2) {
+            ink.segment(pair[0], pair[1], 0.7);
+        }
+        let mut seen = ink.noted();
+        seen.sort_unstable();
+        let bits: Vec<u32> = ink.ink.iter().map(|x| x.to_bits()).collect();
+        assert!(bits == one, "the ink differs segment by segment");
+        assert_eq!(seen, noted, "segment by segment");
     }
 
     fn ink_of(points: &[DVec2], pen: f64) -> Ink {

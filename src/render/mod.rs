@@ -13,7 +13,7 @@ pub use crate::atomic::write_atomic;
 
 use glam::{DVec2, DVec3};
 
-use crate::draw::Event;
+use crate::draw::{Event, Pen};
 
 /// The plane the 3D drawing is projected onto, orthographically.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -237,24 +237,16 @@ impl Fit {
 pub fn scene(panels: &[Vec<Event>], opts: &RenderOptions) -> Result<Scene, RenderError> {
     check_size(opts.width, opts.height)?;
     if panels.iter().all(|p| p.is_empty()) {
-        return Err(RenderError::new(
-            "nothing to draw: after interpretation the word has no drawing modules (F, LineTo2f, Circle, ...)",
-        ));
+        return Err(nothing_to_draw());
     }
     let cell_w = opts.width as f64 / panels.len() as f64;
     let mut opts = std::borrow::Cow::Borrowed(opts);
     if opts.fit_height {
-        // The tallest drawing as the panels are fitted, plus the margins.
-        let h = opts.height as f64;
-        let mut needed: f64 = 0.0;
+        let mut boxes = Vec::new();
         for events in panels {
-            if let Some((lo, hi)) = panel_bounds(events, opts.view)? {
-                let fit = Fit::new(lo, hi, 0.0, cell_w, h, opts.margin);
-                needed = needed.max((hi.y - lo.y) * fit.scale);
-            }
+            boxes.extend(panel_bounds(events, opts.view)?);
         }
-        let m = opts.margin * cell_w.min(h);
-        let height = (needed + 2.0 * m).ceil().clamp(1.0, h) as u32;
+        let height = fitted_height(&opts, cell_w, boxes);
         opts.to_mut().height = height;
     }
     let mut items = Vec::new();
@@ -270,35 +262,292 @@ pub fn scene(panels: &[Vec<Event>], opts: &RenderOptions) -> Result<Scene, Rende
     })
 }
 
+fn nothing_to_draw() -> RenderError {
+    RenderError::new(
+        "nothing to draw: after interpretation the word has no drawing modules (F, LineTo2f, Circle, ...)",
+    )
+}
+
+/// The height that panels `cell_w` pixels wide with drawings in `boxes`
+/// need: the tallest drawing as the panels are fitted, plus the margins,
+/// at most the height asked.
+fn fitted_height(
+    opts: &RenderOptions,
+    cell_w: f64,
+    boxes: impl IntoIterator<Item = (DVec2, DVec2)>,
+) -> u32 {
+    let h = opts.height as f64;
+    let mut needed: f64 = 0.0;
+    for (lo, hi) in boxes {
+        let fit = Fit::new(lo, hi, 0.0, cell_w, h, opts.margin);
+        needed = needed.max((hi.y - lo.y) * fit.scale);
+    }
+    let m = opts.margin * cell_w.min(h);
+    (needed + 2.0 * m).ceil().clamp(1.0, h) as u32
+}
+
 /// The bounds of a panel's events in the drawing plane (discs and rings
 /// with their radius); `None` for no events, an error for a coordinate that
 /// is not finite.
 fn panel_bounds(events: &[Event], v: View) -> Result<Option<(DVec2, DVec2)>, RenderError> {
-    if events.is_empty() {
-        return Ok(None);
-    }
-    let mut lo = DVec2::splat(f64::INFINITY);
-    let mut hi = DVec2::splat(f64::NEG_INFINITY);
-    let mut finite = true;
-    let mut grow = |p: DVec2, r: f64| {
-        finite &= p.is_finite() && r.is_finite();
-        lo = lo.min(p - r);
-        hi = hi.max(p + r);
-    };
-    for e in events {
-        match e {
-            Event::Path { points, .. } => points.iter().for_each(|p| grow(v.project(*p), 0.0)),
-            Event::Disc { c, r, .. } | Event::Ring { c, r, .. } => grow(v.project(*c), r.abs()),
-            Event::Dot { c, .. } => grow(v.project(*c), 0.0),
-            Event::Polygon { points, .. } => points.iter().for_each(|p| grow(v.project(*p), 0.0)),
+    let mut b = Bounds::new(v);
+    events.iter().for_each(|e| b.event(e));
+    b.get()
+}
+
+/// The box around events as they come, in the drawing plane.
+pub(crate) struct Bounds {
+    view: View,
+    lo: DVec2,
+    hi: DVec2,
+    finite: bool,
+    /// Whether any event came.
+    any: bool,
+}
+
+impl Bounds {
+    pub(crate) fn new(view: View) -> Bounds {
+        Bounds {
+            view,
+            lo: DVec2::splat(f64::INFINITY),
+            hi: DVec2::splat(f64::NEG_INFINITY),
+            finite: true,
+            any: false,
         }
     }
-    if !(finite && lo.is_finite() && hi.is_finite()) {
-        return Err(RenderError::new(
-            "the drawing has a NaN or infinite coordinate and cannot be fitted",
-        ));
+
+    #[inline]
+    fn grow(&mut self, p: DVec3, r: f64) {
+        let p = self.view.project(p);
+        self.finite &= p.is_finite() && r.is_finite();
+        self.lo = self.lo.min(p - r);
+        self.hi = self.hi.max(p + r);
     }
-    Ok(Some((lo, hi)))
+
+    fn event(&mut self, e: &Event) {
+        self.any = true;
+        match e {
+            Event::Path { points, .. } | Event::Polygon { points, .. } => {
+                points.iter().for_each(|p| self.grow(*p, 0.0))
+            }
+            Event::Disc { c, r, .. } | Event::Ring { c, r, .. } => self.grow(*c, r.abs()),
+            Event::Dot { c, .. } => self.grow(*c, 0.0),
+        }
+    }
+
+    /// The box, `None` when no event came, or an error for a coordinate
+    /// that is not finite.
+    pub(crate) fn get(&self) -> Result<Option<(DVec2, DVec2)>, RenderError> {
+        if !self.any {
+            return Ok(None);
+        }
+        if !(self.finite && self.lo.is_finite() && self.hi.is_finite()) {
+            return Err(RenderError::new(
+                "the drawing has a NaN or infinite coordinate and cannot be fitted",
+            ));
+        }
+        Ok(Some((self.lo, self.hi)))
+    }
+}
+
+impl crate::draw::EventSink for Bounds {
+    #[inline]
+    fn path(&mut self, _pen: Pen, a: DVec3, b: DVec3) -> Result<(), String> {
+        self.any = true;
+        self.grow(a, 0.0);
+        self.grow(b, 0.0);
+        Ok(())
+    }
+
+    #[inline]
+    fn continue_to(&mut self, b: DVec3) -> Result<(), String> {
+        self.grow(b, 0.0);
+        Ok(())
+    }
+
+    fn event(&mut self, e: Event) -> Result<(), String> {
+        Bounds::event(self, &e);
+        Ok(())
+    }
+}
+
+/// Where laid-out items go: a [`Scene`]'s list, or a picture painted at
+/// once. A polyline comes a point at a time, between `begin` and `end`.
+pub(crate) trait Canvas {
+    /// A polyline of colour `color` and width `width` (pixels) starts at
+    /// `first`.
+    fn begin(&mut self, color: Rgba, width: f64, first: DVec2);
+    /// The open polyline goes on to `p`.
+    fn point(&mut self, p: DVec2);
+    /// The open polyline is complete.
+    fn end(&mut self);
+    /// Any other item (never a polyline).
+    fn item(&mut self, item: Item);
+}
+
+/// The items of a [`Scene`].
+impl Canvas for Vec<Item> {
+    fn begin(&mut self, color: Rgba, width: f64, first: DVec2) {
+        self.push(Item::Polyline {
+            points: vec![first],
+            color,
+            width,
+        });
+    }
+
+    #[inline]
+    fn point(&mut self, p: DVec2) {
+        if let Some(Item::Polyline { points, .. }) = self.last_mut() {
+            points.push(p);
+        }
+    }
+
+    fn end(&mut self) {}
+
+    fn item(&mut self, item: Item) {
+        self.push(item);
+    }
+}
+
+/// Events laid out in pixels in one cell of the picture, handed to a
+/// [`Canvas`] as they come: consecutive paths of one colour and width that
+/// meet (within 1e-9 pixels) make one polyline, the later path's first
+/// point left out.
+pub(crate) struct Layout<'o, C> {
+    fit: Fit,
+    opts: &'o RenderOptions,
+    canvas: C,
+    /// The open polyline's colour, width and last point.
+    run: Option<(Rgba, f64, DVec2)>,
+}
+
+impl<'o, C: Canvas> Layout<'o, C> {
+    /// The layout of events within the box `lo..hi` into the cell of width
+    /// `cell_w` that starts at column `x0`.
+    pub(crate) fn new(
+        (lo, hi): (DVec2, DVec2),
+        x0: f64,
+        cell_w: f64,
+        opts: &'o RenderOptions,
+        canvas: C,
+    ) -> Self {
+        Layout {
+            fit: Fit::new(lo, hi, x0, cell_w, opts.height as f64, opts.margin),
+            opts,
+            canvas,
+            run: None,
+        }
+    }
+
+    fn color(&self, i: i64) -> Rgba {
+        match &self.opts.palette {
+            Some(p) => p[i.rem_euclid(256) as usize],
+            None => palette(i),
+        }
+    }
+
+    fn width(&self, w: f64) -> f64 {
+        if self.opts.widths_in_units {
+            w * self.fit.scale
+        } else {
+            w
+        }
+    }
+
+    #[inline]
+    fn px(&self, p: DVec3) -> DVec2 {
+        self.fit.pixel(self.opts.view.project(p))
+    }
+
+    /// A path with `pen` starts at `a`: it continues the open polyline, or
+    /// begins one.
+    fn path_from(&mut self, pen: Pen, a: DVec3) {
+        let (color, width, first) = (self.color(pen.color), self.width(pen.width), self.px(a));
+        let joined = matches!(self.run, Some((c, w, last))
+            if c == color && w == width && last.distance(first) < 1e-9);
+        if !joined {
+            self.end_run();
+            self.canvas.begin(color, width, first);
+            self.run = Some((color, width, first));
+        }
+    }
+
+    #[inline]
+    fn point(&mut self, p: DVec3) {
+        let q = self.px(p);
+        self.canvas.point(q);
+        if let Some(run) = &mut self.run {
+            run.2 = q;
+        }
+    }
+
+    fn end_run(&mut self) {
+        if self.run.take().is_some() {
+            self.canvas.end();
+        }
+    }
+
+    fn lay(&mut self, e: &Event) {
+        let scale = self.fit.scale;
+        let item = match e {
+            Event::Path { points, pen } => {
+                if let [first, rest @ ..] = points.as_slice() {
+                    self.path_from(*pen, *first);
+                    rest.iter().for_each(|p| self.point(*p));
+                }
+                return;
+            }
+            Event::Disc { c, r, color } => Item::Disc {
+                c: self.px(*c),
+                r: r.abs() * scale,
+                color: self.color(*color),
+            },
+            Event::Dot { c, pen } => Item::Disc {
+                c: self.px(*c),
+                r: self.width(pen.width) * 0.5,
+                color: self.color(pen.color),
+            },
+            Event::Ring { c, r, pen } => Item::Ring {
+                c: self.px(*c),
+                r: r.abs() * scale,
+                color: self.color(pen.color),
+                width: self.width(pen.width),
+            },
+            Event::Polygon { points, color } => Item::Polygon {
+                points: points.iter().map(|p| self.px(*p)).collect(),
+                color: self.color(*color),
+                outline: None,
+            },
+        };
+        self.end_run();
+        self.canvas.item(item);
+    }
+
+    /// The canvas, the last polyline ended.
+    pub(crate) fn finish(mut self) -> C {
+        self.end_run();
+        self.canvas
+    }
+}
+
+impl<C: Canvas> crate::draw::EventSink for Layout<'_, C> {
+    #[inline]
+    fn path(&mut self, pen: Pen, a: DVec3, b: DVec3) -> Result<(), String> {
+        self.path_from(pen, a);
+        self.point(b);
+        Ok(())
+    }
+
+    #[inline]
+    fn continue_to(&mut self, b: DVec3) -> Result<(), String> {
+        self.point(b);
+        Ok(())
+    }
+
+    fn event(&mut self, e: Event) -> Result<(), String> {
+        self.lay(&e);
+        Ok(())
+    }
 }
 
 fn fit_panel(
@@ -308,79 +557,12 @@ fn fit_panel(
     cell_w: f64,
     items: &mut Vec<Item>,
 ) -> Result<(), RenderError> {
-    let v = opts.view;
-    let Some((lo, hi)) = panel_bounds(events, v)? else {
+    let Some(bounds) = panel_bounds(events, opts.view)? else {
         return Ok(());
     };
-    let fit = Fit::new(lo, hi, x0, cell_w, opts.height as f64, opts.margin);
-    let width = |w: f64| {
-        if opts.widths_in_units {
-            w * fit.scale
-        } else {
-            w
-        }
-    };
-    let palette = |i: i64| match &opts.palette {
-        Some(p) => p[i.rem_euclid(256) as usize],
-        None => palette(i),
-    };
-    let scale = fit.scale;
-    let px = |p: DVec3| fit.pixel(v.project(p));
-    let mut run: Option<(Vec<DVec2>, Rgba, f64)> = None;
-    let flush = |run: &mut Option<(Vec<DVec2>, Rgba, f64)>, items: &mut Vec<Item>| {
-        if let Some((points, color, width)) = run.take() {
-            items.push(Item::Polyline {
-                points,
-                color,
-                width,
-            });
-        }
-    };
-    for e in events {
-        if let Event::Path { points, pen } = e {
-            let color = palette(pen.color);
-            let w = width(pen.width);
-            let Some(first) = points.first().map(|p| px(*p)) else {
-                continue;
-            };
-            let joined = matches!(&run, Some((pts, c, rw))
-                if *c == color && *rw == w && pts.last().is_some_and(|l| l.distance(first) < 1e-9));
-            if !joined {
-                flush(&mut run, items);
-                run = Some((vec![first], color, w));
-            }
-            if let Some((pts, _, _)) = run.as_mut() {
-                pts.extend(points[1..].iter().map(|p| px(*p)));
-            }
-            continue;
-        }
-        flush(&mut run, items);
-        items.push(match e {
-            Event::Disc { c, r, color } => Item::Disc {
-                c: px(*c),
-                r: r.abs() * scale,
-                color: palette(*color),
-            },
-            Event::Dot { c, pen } => Item::Disc {
-                c: px(*c),
-                r: width(pen.width) * 0.5,
-                color: palette(pen.color),
-            },
-            Event::Ring { c, r, pen } => Item::Ring {
-                c: px(*c),
-                r: r.abs() * scale,
-                color: palette(pen.color),
-                width: width(pen.width),
-            },
-            Event::Polygon { points, color } => Item::Polygon {
-                points: points.iter().map(|p| px(*p)).collect(),
-                color: palette(*color),
-                outline: None,
-            },
-            Event::Path { .. } => unreachable!("handled above"),
-        });
-    }
-    flush(&mut run, items);
+    let mut layout = Layout::new(bounds, x0, cell_w, opts, std::mem::take(items));
+    events.iter().for_each(|e| layout.lay(e));
+    *items = layout.finish();
     Ok(())
 }
 

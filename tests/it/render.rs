@@ -160,6 +160,86 @@ fn png_matches_the_stored_kolam() {
     );
 }
 
+/// A Koch curve (a thin pen, 4^8 segments: the scene's polyline is inked
+/// in bands), then lines (`G`) that join it and lines that do not, colour
+/// and width changes and back, a pen wider than a pixel, discs, dots,
+/// rings, a polygon and a Rhombus, moves without drawing, and branches.
+const MANY_EVENTS: &str = "derivation length: 8;\n\
+    Axiom: SetWidth(0.5) F(1) Right(90) G(1) SetColor(3) G(1) SetColor(1) G(1) \
+    SetWidth(4) G(2) Left(45) G(2) SetWidth(0.5) G(1) Circle(3) G(1) Circle0 \
+    f(2) G(1) CircleB(2) SB Left(30) SetColor(5) G(3) EB G(1) \
+    SP PP G(2) Left(120) PP G(2) Left(120) PP EP MoveTo(-5, -3, 2) G(2) Rhombus(2, 1) \
+    SetWidth(0) G(1) Up(40) G(2);\n\
+    F(x) -> F(x/3) Left(60) F(x/3) Right(120) F(x/3) Left(60) F(x/3);\n";
+
+#[test]
+fn a_picture_painted_as_the_turtle_walks_is_the_scenes_to_the_bit() {
+    let l = load_text(MANY_EVENTS);
+    let views = [
+        (render::View::Xy, false),
+        (render::View::Xz, true),
+        (render::View::Yz, false),
+    ];
+    for (k, (view, units)) in views.into_iter().enumerate() {
+        {
+            let mut opts = sized(700 - 100 * k as u32, 500);
+            opts.render.view = view;
+            opts.render.widths_in_units = units;
+            let scene = l.figure(&opts).unwrap();
+            let lines: usize = scene
+                .items
+                .iter()
+                .map(|i| match i {
+                    Item::Polyline { points, .. } => points.len() - 1,
+                    _ => 0,
+                })
+                .sum();
+            assert!(lines > 65_536 && scene.items.len() > 10, "{lines}");
+            let expected = png::render(&scene).unwrap();
+            // Painted on this thread, and on a thread beside the walk.
+            for threads in [1, 2] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let painted = pool.install(|| l.png_figures(&opts)).unwrap();
+                assert!(
+                    painted.main == expected,
+                    "{view:?}, widths in units {units}, {threads} threads: the pictures differ"
+                );
+            }
+        }
+    }
+    // With `each`, one panel a step, and a height fitted to them.
+    let opts = FigureOptions {
+        each: true,
+        derive: DeriveOptions::default().with_steps(2),
+        render: RenderOptions {
+            fit_height: true,
+            ..RenderOptions::default()
+        },
+        ..FigureOptions::default()
+    };
+    let scene = l.figure(&opts).unwrap();
+    assert!(scene.height < 800, "{}", scene.height);
+    assert!(l.png_figures(&opts).unwrap().main == png::render(&scene).unwrap());
+}
+
+#[test]
+fn a_picture_painted_as_the_turtle_walks_fails_as_the_scene_does() {
+    for src in [
+        "module A;\nderivation length: 1;\nAxiom: A;\n",
+        "derivation length: 0;\nAxiom: F(1) MoveTo(1e308, 0, 0) F(1) Left(90) MoveTo(-1e308, 0, 0) F(1);\n",
+        "derivation length: 0;\nAxiom: F(1) F(0/0);\n",
+    ] {
+        let l = load_text(src);
+        let (a, b) = (FigureOptions::default(), FigureOptions::default());
+        let scene = l.figure(&a).map(|_| ()).unwrap_err().to_string();
+        let painted = l.png_figures(&b).map(|_| ()).unwrap_err().to_string();
+        assert_eq!(painted, scene, "{src}");
+    }
+}
+
 #[test]
 fn an_empty_drawing_is_an_error() {
     let l = load_text("module A;\nderivation length: 1;\nAxiom: A;\n");
