@@ -730,6 +730,9 @@ pub(crate) fn walk<S: Sink>(
         ),
         module: Some(i),
     };
+    // Parameters are checked a module at a time only when some number of
+    // the word is not finite (one pass over the slots, most words).
+    let all_finite = word.all_slots().iter().all(|x| x.is_finite());
     while i < n {
         let sym: Sym = word.sym(i);
         let cmd = cmds[sym.0 as usize];
@@ -744,7 +747,8 @@ pub(crate) fn walk<S: Sink>(
         };
         // An integer parameter is held as its bits, which may read as a
         // NaN (`SetColor(-1)`): only the decoded numbers are checked then.
-        if d.iter().any(|x| !x.is_finite())
+        if !all_finite
+            && d.iter().any(|x| !x.is_finite())
             && cmd != Cmd::None
             && !matches!(cmd, Cmd::Query(_))
             && !word.values(i, alphabet, structs).iter().all(finite)
@@ -984,8 +988,18 @@ pub(crate) fn walk<S: Sink>(
                 }
             }
         }
-        // Finite parameters can still add up past the largest number.
-        if !t.pos.is_finite() {
+        // Finite parameters can still add up past the largest number (only
+        // the moves move the turtle; a popped one was checked before).
+        let moved = matches!(
+            cmd,
+            Cmd::Forward { .. }
+                | Cmd::MoveTo
+                | Cmd::MoveRel
+                | Cmd::LineTo
+                | Cmd::LineRel
+                | Cmd::Line
+        );
+        if moved && !t.pos.is_finite() {
             return Err(beyond(word, i, alphabet, structs, "moves the turtle to"));
         }
         i += 1;

@@ -211,10 +211,14 @@ impl<'t> Field<'t> {
 
     /// Before a step forward: the heading turns towards the tropisms'
     /// sum, and the torques turn the up vector.
+    #[inline]
     pub(super) fn adjust(&self, head: &mut DVec3, left: &mut DVec3, up: &mut DVec3) {
-        if self.tropisms.is_empty() {
-            return;
+        if !self.tropisms.is_empty() {
+            self.adjust_by_all(head, left, up)
         }
+    }
+
+    fn adjust_by_all(&self, head: &mut DVec3, left: &mut DVec3, up: &mut DVec3) {
         let mut desired = self.global;
         let mut found = false;
         for (i, t) in self.tropisms.iter().enumerate() {

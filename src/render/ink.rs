@@ -176,6 +176,12 @@ impl Band<'_> {
         if length == 0.0 {
             return;
         }
+        if length <= PIECE {
+            // One piece (the general case's step is `d / 1.0`, its area
+            // `length / 1.0 * pen`: the same numbers without dividing).
+            self.splat(a + d * 0.5, (length * pen) as f32);
+            return;
+        }
         // As many pieces as `PIECE` needs (`ceil` without the call;
         // clipped lengths are a few times the picture's side at most).
         let whole = (length / PIECE) as usize;
