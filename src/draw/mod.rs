@@ -732,11 +732,13 @@ pub(crate) fn walk<S: Sink>(
     };
     // Parameters are checked a module at a time only when some number of
     // the word is not finite (one pass over the slots, most words).
-    let all_finite = word.all_slots().iter().all(|x| x.is_finite());
+    let (syms, offsets, slots) = (word.syms(), word.offsets(), word.all_slots());
+    let all_finite = slots.iter().all(|x| x.is_finite());
     while i < n {
-        let sym: Sym = word.sym(i);
-        let cmd = cmds[sym.0 as usize];
-        let d = word.data(i);
+        let sym: Sym = syms[i];
+        let cmd = cmds.get(sym.0 as usize).copied().unwrap_or(Cmd::None);
+        let (lo, hi) = (offsets[i] as usize, offsets[i + 1] as usize);
+        let d = slots.get(lo..hi).unwrap_or_default();
         let arg = |k: usize, default: f64| d.get(k).copied().unwrap_or(default);
         let point = || -> DVec3 {
             match d.len() {

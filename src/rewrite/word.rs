@@ -267,6 +267,12 @@ impl Word {
         &self.data
     }
 
+    /// Where each module's slots start in [`Word::all_slots`], and after
+    /// the last one the slot count: one more than the modules.
+    pub(crate) fn offsets(&self) -> &[u32] {
+        &self.starts
+    }
+
     /// The parameters of module `i` as values.
     pub fn values(&self, i: usize, alphabet: &Alphabet, structs: &[StructDef]) -> Vec<Value> {
         let d = self.data(i);
