@@ -1767,7 +1767,8 @@ const CHUNK: usize = 16384;
 /// current position: per coordinate, the new bits minus the current bits,
 /// as integers (wrapping), which gives back the same bits whatever the
 /// numbers. A vertex moves little against its coordinates (at three levels
-/// of Loop on a sphere, about 2^33 units in the last place), so the
+/// of Loop on a sphere, almost every one by less than 2^39 units in the
+/// last place), so the
 /// differences fit in fewer bytes than a coordinate: each block stores
 /// them in the width ([`Block::width`], 1 to 8 bytes) that makes it
 /// smallest, and the points whose differences do not fit (a coordinate
@@ -1789,7 +1790,8 @@ struct Block {
     /// Bytes per coordinate's difference in `diffs`; 0 while nothing is
     /// written.
     width: usize,
-    /// Three differences a slot, `width` bytes each, little-endian.
+    /// Three differences a slot, `width` bytes each, little-endian, and
+    /// [`Block::PAD`] bytes after them.
     diffs: Vec<u8>,
     /// The slots written.
     written: Vec<u64>,
@@ -1847,6 +1849,18 @@ impl Block {
     /// Bytes a wide point takes in `wide`.
     const WIDE_BYTES: usize = std::mem::size_of::<(u32, DVec3)>();
 
+    /// Bytes after the last difference, so that each is read and written
+    /// as the 8 bytes from where it starts.
+    const PAD: usize = 8;
+
+    /// The 8 bytes of `diffs` from `at`, as a number.
+    #[inline]
+    fn word(&self, at: usize) -> u64 {
+        let mut b = [0u8; 8];
+        b.copy_from_slice(&self.diffs[at..at + 8]);
+        u64::from_le_bytes(b)
+    }
+
     /// Grows the block to `len` slots, none of the new ones written.
     fn grow(&mut self, len: usize) {
         if len <= self.len {
@@ -1856,7 +1870,7 @@ impl Block {
         self.written.resize(len.div_ceil(64), 0);
         self.is_wide.resize(len.div_ceil(64), 0);
         if self.width > 0 {
-            self.diffs.resize(3 * self.width * len, 0);
+            self.diffs.resize(3 * self.width * len + Self::PAD, 0);
         }
     }
 
@@ -1865,13 +1879,9 @@ impl Block {
     fn stored(&self, i: usize) -> [i64; 3] {
         let w = self.width;
         let at = 3 * w * i;
-        std::array::from_fn(|k| {
-            let mut b = [0u8; 8];
-            b[..w].copy_from_slice(&self.diffs[at + k * w..at + (k + 1) * w]);
-            // Sign-extend from the width.
-            let shift = 64 - 8 * w as u32;
-            (i64::from_le_bytes(b) << shift) >> shift
-        })
+        // The lowest `w` bytes, sign-extended.
+        let shift = 64 - 8 * w as u32;
+        std::array::from_fn(|k| ((self.word(at + k * w) << shift) as i64) >> shift)
     }
 
     /// Stores `d`, which fits `width` bytes, for slot `i`.
@@ -1879,8 +1889,12 @@ impl Block {
     fn store(&mut self, i: usize, d: [i64; 3]) {
         let w = self.width;
         let at = 3 * w * i;
-        for (k, x) in d.iter().enumerate() {
-            self.diffs[at + k * w..at + (k + 1) * w].copy_from_slice(&x.to_le_bytes()[..w]);
+        // The lowest `w` bytes of each; the bytes after them are kept.
+        let mask = u64::MAX >> (64 - 8 * w as u32);
+        for (k, &x) in d.iter().enumerate() {
+            let o = at + k * w;
+            let word = (self.word(o) & !mask) | (x as u64 & mask);
+            self.diffs[o..o + 8].copy_from_slice(&word.to_le_bytes());
         }
     }
 
@@ -1945,7 +1959,7 @@ impl Block {
         let fresh = Block {
             len: self.len,
             width,
-            diffs: vec![0; 3 * width * self.len],
+            diffs: vec![0; 3 * width * self.len + Self::PAD],
             written: std::mem::take(&mut self.written),
             is_wide: std::mem::take(&mut self.is_wide),
             wide: Vec::new(),
