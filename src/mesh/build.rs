@@ -352,7 +352,7 @@ impl Mesh {
             e_transversal: Bits::filled(ne, false),
             e_sharp: Column::defaults(ne),
             f_he: Vec::with_capacity(nt),
-            f_level: Narrow::filled(nt, 1),
+            f_level_kept: Default::default(),
             f_alive: Bits::filled(nt, true),
             f_tag: match tags {
                 Some(t) => Column::from_vec(source.iter().map(|&fi| t[fi as usize]).collect()),
@@ -1025,8 +1025,7 @@ mod tests {
                     };
                     hs[k] = h;
                 }
-                let level = 1;
-                let f = m.new_face(hs[0], level, tags.map_or(0, |t| t[*fi]));
+                let f = m.new_face(hs[0], tags.map_or(0, |t| t[*fi]));
                 face_of_source.push(*fi);
                 m.set_triangle(f, hs[0], hs[1], hs[2]);
                 for (k, h) in hs.iter().enumerate() {
@@ -1078,10 +1077,6 @@ mod tests {
                     ))
                     .at(soup.vertex_line(v)));
                 }
-            }
-            for f in 0..m.f_alive.len() {
-                let vs = m.face_vertices(FaceId(f as u32));
-                m.f_level.set(f, m.face_level_from_vertices(vs));
             }
             Ok(m)
         }

@@ -1,6 +1,7 @@
 //! The half-edge mesh: typed ids, flat arrays of indices, and per-element
-//! attributes (a refinement level on every vertex, edge and face, the step
-//! that made each vertex, block and transversal marks). The state of a
+//! attributes (a refinement level on every vertex and edge, and on every
+//! face through its corners, the step that made each vertex, block and
+//! transversal marks). The state of a
 //! grammar's run (its step, its current level, the positions written for
 //! the next step) lives with the run, in `surface::run`.
 //!
@@ -9,6 +10,7 @@
 //! one outgoing half-edge; a boundary vertex keeps its outgoing boundary
 //! half-edge, so that walks around it start at the boundary.
 
+use std::collections::BTreeMap;
 use std::fmt;
 
 use glam::DVec3;
@@ -162,7 +164,12 @@ pub struct Mesh {
     pub(crate) creased: bool,
     // Faces.
     pub(crate) f_he: Vec<HalfEdgeId>,
-    pub(crate) f_level: Narrow,
+    /// A face's level is one more than its highest corner's (paper 000,
+    /// §6), so it is not stored, except here: the faces around a vertex
+    /// whose level [`Mesh::set_vertex_level`] changed keep the level they
+    /// had until an operator remakes them, and those levels, where they
+    /// differ from the derived one, are kept by face slot.
+    pub(crate) f_level_kept: BTreeMap<u32, u32>,
     pub(crate) f_alive: Bits,
     /// A number the caller gives each face of the soup
     /// ([`Mesh::from_soup_tagged`]; 0 otherwise), handed down by the
@@ -261,7 +268,7 @@ impl Mesh {
             + self.e_transversal.bytes()
             + self.e_sharp.stored_bytes();
         let f = size(&self.f_he)
-            + self.f_level.bytes()
+            + self.f_level_kept.len() * 2 * std::mem::size_of::<u32>()
             + self.f_alive.bytes()
             + self.f_tag.stored_bytes();
         v + h + e + f
@@ -286,8 +293,14 @@ impl Mesh {
         self.e_level.get(e.index())
     }
 
+    /// One more than the level of the face's highest corner, unless
+    /// [`Mesh::set_vertex_level`] changed a corner's level since an
+    /// operator last made the face: then the level it had.
     pub fn face_level(&self, f: FaceId) -> u32 {
-        self.f_level.get(f.index())
+        if let Some(&l) = self.f_level_kept.get(&f.0) {
+            return l;
+        }
+        self.face_level_from_vertices(self.face_vertices(f))
     }
 
     /// The face's tag: that of the soup face it was cut from
@@ -296,8 +309,22 @@ impl Mesh {
         self.f_tag.get(f.index())
     }
 
+    /// Sets a vertex's level. The faces around it keep their levels (and
+    /// edges theirs): the next operator that remakes a face gives it one
+    /// more than its highest corner's.
     pub fn set_vertex_level(&mut self, v: VertexId, l: u32) {
+        let faces: Vec<(FaceId, u32)> = self
+            .vertex_faces(v)
+            .map(|f| (f, self.face_level(f)))
+            .collect();
         self.v_level.set(v.index(), l);
+        for (f, old) in faces {
+            if self.face_level_from_vertices(self.face_vertices(f)) == old {
+                self.f_level_kept.remove(&f.0);
+            } else {
+                self.f_level_kept.insert(f.0, old);
+            }
+        }
     }
 
     pub fn set_edge_level(&mut self, e: EdgeId, l: u32) {
@@ -693,7 +720,6 @@ impl Mesh {
         self.e_transversal.reserve(edges);
         self.e_sharp.reserve(edges);
         crate::huge::grow(&mut self.f_he, faces);
-        self.f_level.reserve(faces);
         self.f_alive.reserve(faces);
         self.f_tag.reserve(faces);
     }
@@ -753,17 +779,17 @@ impl Mesh {
         h
     }
 
-    /// A new face with tag `tag`: that of the face it is cut from.
-    pub(crate) fn new_face(&mut self, h: HalfEdgeId, level: u32, tag: u32) -> FaceId {
+    /// A new face with tag `tag`: that of the face it is cut from. Its
+    /// level is one more than its highest corner's.
+    pub(crate) fn new_face(&mut self, h: HalfEdgeId, tag: u32) -> FaceId {
         if let Some(i) = self.free_f.pop() {
             self.f_he[i as usize] = h;
-            self.f_level.set(i as usize, level);
+            self.face_remade(FaceId(i));
             self.f_alive.set(i as usize, true);
             self.f_tag.set(i as usize, tag);
             return FaceId(i);
         }
         self.f_he.push(h);
-        self.f_level.push(level);
         self.f_alive.push(true);
         self.f_tag.push(tag);
         FaceId(self.f_alive.len() as u32 - 1)
@@ -781,6 +807,7 @@ impl Mesh {
     }
 
     pub(crate) fn delete_face(&mut self, f: FaceId) {
+        self.face_remade(f);
         self.f_alive.set(f.index(), false);
         self.free_f.push(f.0);
     }
@@ -806,6 +833,15 @@ impl Mesh {
             self.he_face[h.index()] = f.0;
         }
         self.f_he[f.index()] = h0;
+    }
+
+    /// An operator made face `f` anew: its level is one more than its
+    /// highest corner's again.
+    #[inline]
+    pub(crate) fn face_remade(&mut self, f: FaceId) {
+        if !self.f_level_kept.is_empty() {
+            self.f_level_kept.remove(&f.0);
+        }
     }
 
     /// The level of a face: one more than its highest vertex (paper 000, §6).
@@ -965,9 +1001,10 @@ impl<T: Copy + Default + PartialEq> PartialEq for Column<T> {
 
 #[cfg(test)]
 mod tests {
-    use super::{Column, EdgeId, HalfEdgeId, Mesh, VertexId};
+    use super::{Column, EdgeId, FaceId, HalfEdgeId, Mesh, VertexId};
     use crate::mesh::shapes;
     use glam::DVec3;
+    use std::collections::HashMap;
 
     /// The live half-edges of `m`.
     fn live(m: &Mesh) -> Vec<HalfEdgeId> {
@@ -1087,6 +1124,120 @@ mod tests {
         let t = Mesh::from_soup(&soup).expect("a triangle");
         check_prev_and_rings(&t);
         assert_eq!(t.valence(VertexId(0)), 2);
+    }
+
+    /// The test's own record of face levels, as a mesh stored them when
+    /// every face had its level in an array: by face slot, the corners
+    /// the face had (from its smallest vertex id on) and its level, set
+    /// to one more than its highest corner's when an operator made it
+    /// (a slot that is new, or whose corners changed), and kept
+    /// otherwise, whatever the corners' levels do later.
+    type Stored = HashMap<FaceId, ([VertexId; 3], u32)>;
+
+    /// Brings `stored` up to date after one operation on `m` and compares
+    /// every face's level with it.
+    fn follow_face_levels(m: &Mesh, stored: &mut Stored) {
+        let mut now = Stored::new();
+        for f in m.faces() {
+            let mut vs = m.face_vertices(f);
+            let first = (0..3).min_by_key(|&i| vs[i]).expect("three corners");
+            vs.rotate_left(first);
+            let level = match stored.get(&f) {
+                Some(&(was, l)) if was == vs => l,
+                _ => vs.iter().map(|&v| m.vertex_level(v)).max().expect("three") + 1,
+            };
+            now.insert(f, (vs, level));
+        }
+        *stored = now;
+        for f in m.faces() {
+            assert_eq!(m.face_level(f), stored[&f].1, "level of face {f:?}");
+        }
+    }
+
+    #[test]
+    fn face_levels_are_what_an_array_set_by_the_operators_holds_through_splits_flips_welds_and_set_vertex_level(
+    ) {
+        let mut m = Mesh::from_soup(&shapes::triangle_grid(5, 4)).expect("a grid");
+        let mut stored = Stored::new();
+        follow_face_levels(&m, &mut stored);
+        assert!(m.faces().all(|f| m.face_level(f) == 1));
+        let original = m.clone();
+        // Raised corners: their faces keep level 1 until an operator
+        // makes them again.
+        let (a, b) = (VertexId(7), VertexId(12));
+        m.set_vertex_level(a, 5);
+        follow_face_levels(&m, &mut stored);
+        m.set_vertex_level(b, 300);
+        follow_face_levels(&m, &mut stored);
+        assert!(m.vertex_faces(a).all(|f| m.face_level(f) == 1));
+        // Setting them back leaves nothing kept: the mesh is the one it
+        // was.
+        m.set_vertex_level(b, 0);
+        m.set_vertex_level(a, 0);
+        follow_face_levels(&m, &mut stored);
+        assert_eq!(m, original);
+        m.set_vertex_level(a, 5);
+        m.set_vertex_level(b, 2);
+        follow_face_levels(&m, &mut stored);
+        // Operators around them and elsewhere.
+        let at_a: Vec<EdgeId> = m.outgoing_halfedges(a).map(|h| h.edge()).collect();
+        for &e in at_a.iter().take(2) {
+            let (p, q) = m.edge_vertices(e);
+            m.edge_split(e, (m.position(p) + m.position(q)) * 0.5)
+                .expect("split");
+            follow_face_levels(&m, &mut stored);
+        }
+        // A split vertex's level moves after its faces were made.
+        let made = VertexId(m.v_alive.len() as u32 - 1);
+        m.set_vertex_level(made, 9);
+        follow_face_levels(&m, &mut stored);
+        let transversals: Vec<EdgeId> = m.edges().filter(|&e| m.is_transversal_edge(e)).collect();
+        let mut flipped = 0;
+        for e in transversals {
+            if m.edge_flip(e).is_ok() {
+                flipped += 1;
+                follow_face_levels(&m, &mut stored);
+            }
+        }
+        assert!(flipped > 0);
+        let f = m.vertex_faces(b).next().expect("a face at b");
+        let centre = m.face_split(f, m.face_centroid(f)).expect("face split");
+        follow_face_levels(&m, &mut stored);
+        m.set_vertex_level(b, 1);
+        follow_face_levels(&m, &mut stored);
+        m.face_weld(centre).expect("welds back");
+        follow_face_levels(&m, &mut stored);
+        // A weld frees slots that later operators reuse.
+        let boundary: Vec<EdgeId> = m.edges().filter(|&e| m.is_boundary_edge(e)).collect();
+        let e = boundary[1];
+        let (p, q) = m.edge_vertices(e);
+        let v = m
+            .edge_split(e, (m.position(p) + m.position(q)) * 0.5)
+            .expect("split");
+        follow_face_levels(&m, &mut stored);
+        m.set_vertex_level(q, 4);
+        follow_face_levels(&m, &mut stored);
+        let keep = m.boundary_neighbour(v, true).expect("on the boundary");
+        m.edge_weld(v, keep).expect("weld");
+        follow_face_levels(&m, &mut stored);
+        let f = m.faces().nth(3).expect("a face");
+        m.face_split(f, m.face_centroid(f)).expect("reuses slots");
+        follow_face_levels(&m, &mut stored);
+        m.validate().expect("valid");
+        // Some face kept a level its corners no longer give, and some
+        // has the level its corners give.
+        let derived = |f: FaceId| {
+            m.face_vertices(f)
+                .iter()
+                .map(|&v| m.vertex_level(v))
+                .max()
+                .expect("three")
+                + 1
+        };
+        assert!(m.faces().any(|f| m.face_level(f) != derived(f)));
+        assert!(m
+            .faces()
+            .any(|f| m.face_level(f) == derived(f) && derived(f) > 1));
     }
 
     #[test]

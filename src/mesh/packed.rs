@@ -73,12 +73,6 @@ impl Bits {
         }
     }
 
-    /// The words, flag `i` at bit `i % 64` of word `i / 64`; the bits
-    /// past `len` must stay 0.
-    pub(crate) fn words_mut(&mut self) -> &mut [u64] {
-        &mut self.words
-    }
-
     /// Room for `additional` more flags.
     pub(crate) fn reserve(&mut self, additional: usize) {
         let words = (self.len + additional).div_ceil(64) - self.words.len();

@@ -146,17 +146,13 @@ impl Mesh {
         let vb = self.new_edge(v, b, lv);
         let vc = self.new_edge(v, c, lv);
         let tag = self.f_tag.get(f.index());
-        let f1 = self.new_face(h1, 0, tag);
-        let f2 = self.new_face(h2, 0, tag);
+        let f1 = self.new_face(h1, tag);
+        let f2 = self.new_face(h2, tag);
         self.set_triangle(f, h0, vb.twin(), va);
         self.set_triangle(f1, h1, vc.twin(), vb);
         self.set_triangle(f2, h2, va.twin(), vc);
         self.set_outgoing(v, Some(va));
-        for g in [f, f1, f2] {
-            let vs = self.face_vertices(g);
-            self.f_level
-                .set(g.index(), self.face_level_from_vertices(vs));
-        }
+        self.face_remade(f);
         if policy.lone_triangles_join_blocks {
             for s in [va, vb, vc] {
                 self.e_block.set(s.edge().index(), true);
@@ -221,9 +217,7 @@ impl Mesh {
             self.set_outgoing(a, Some(o));
             self.fix_outgoing(a);
         }
-        let vs = self.face_vertices(keep);
-        self.f_level
-            .set(keep.index(), self.face_level_from_vertices(vs));
+        self.face_remade(keep);
         Ok(keep)
     }
 
@@ -314,7 +308,7 @@ impl Mesh {
         if lone {
             self.e_block.set(k.edge().index(), true);
         }
-        let f2 = self.new_face(g, 0, self.f_tag.get(f1.index()));
+        let f2 = self.new_face(g, self.f_tag.get(f1.index()));
         self.set_triangle(f1, h, k, h_ca);
         self.set_triangle(f2, g, h_bc, k.twin());
         if boundary {
@@ -337,22 +331,18 @@ impl Mesh {
             let d = self.to(t_ad);
             let m = self.new_edge(v, d, self.v_level.get(d.index()) + 1); // v -> d
             self.e_transversal.set(m.edge().index(), true);
-            let f4 = self.new_face(g.twin(), 0, self.f_tag.get(f3.index()));
+            let f4 = self.new_face(g.twin(), self.f_tag.get(f3.index()));
             self.set_triangle(f3, t, t_ad, m.twin());
             self.set_triangle(f4, g.twin(), m, t_db);
             self.set_outgoing(v, Some(g));
             if self.outgoing(b) == Some(t) {
                 self.set_outgoing(b, Some(g.twin()));
             }
-            // Faces a-d-v and v-d-b: l(v) is above l(a) and l(b).
-            let l = lv.max(self.v_level.get(d.index())) + 1;
-            self.f_level.set(f3.index(), l);
-            self.f_level.set(f4.index(), l);
+            // Faces a-d-v and v-d-b (f4 is new).
+            self.face_remade(f3);
         }
-        // Faces a-v-c and v-b-c.
-        let l = lv.max(self.v_level.get(c.index())) + 1;
-        self.f_level.set(f1.index(), l);
-        self.f_level.set(f2.index(), l);
+        // Faces a-v-c and v-b-c (f2 is new).
+        self.face_remade(f1);
         if was_block {
             match policy.blocks {
                 BlockSplit::Quadrisection | BlockSplit::Dual => {
@@ -496,9 +486,7 @@ impl Mesh {
                 self.set_outgoing(w, Some(any));
                 self.fix_outgoing(w);
             }
-            let vs = self.face_vertices(f);
-            self.f_level
-                .set(f.index(), self.face_level_from_vertices(vs));
+            self.face_remade(f);
             return Ok(x.edge());
         }
         // Interior: rotate so that out = [v->a, v->c, v->b, v->d].
@@ -548,9 +536,7 @@ impl Mesh {
             self.fix_outgoing(w);
         }
         for f in [faces[0], faces[1]] {
-            let vs = self.face_vertices(f);
-            self.f_level
-                .set(f.index(), self.face_level_from_vertices(vs));
+            self.face_remade(f);
         }
         Ok(x.edge())
     }
@@ -631,11 +617,8 @@ impl Mesh {
         self.e_block.set(e.index(), false);
         self.e_transversal.set(e.index(), false);
         // The faces are now d-c-a and c-d-b.
-        let lcd = self.v_level.get(c.index()).max(self.v_level.get(d.index()));
-        self.f_level
-            .set(f1.index(), lcd.max(self.v_level.get(a.index())) + 1);
-        self.f_level
-            .set(f2.index(), lcd.max(self.v_level.get(b.index())) + 1);
+        self.face_remade(f1);
+        self.face_remade(f2);
         Ok(())
     }
 }

@@ -22,7 +22,6 @@ use crate::lang::compile::RuleCompiler;
 use crate::lang::eval::{Env, Interp, RuntimeError};
 use crate::lang::ir::{Ex, Func};
 use crate::lang::value::{Elem, Ty, Value};
-use crate::mesh::halfedge::Bits;
 use crate::mesh::{BlockSplit, EdgeId, FaceId, Mesh, Split, VertexId};
 use crate::syntax::span::{Diagnostic, SourceMap, Span};
 
@@ -56,6 +55,11 @@ pub struct Rule {
     /// its new vertices' points read none of theirs, so each can be
     /// written as soon as it is computed.
     points_in_place: bool,
+    /// A split rule whose points read, besides the matched element's
+    /// positions, no number that a split of another element changes (no
+    /// valence, no count of creases; [`reads_counts`]): each part of the
+    /// matches gets its points right after its splits, and is let go.
+    points_between_splits: bool,
 }
 
 /// A checked grammar, ready to run.
@@ -224,6 +228,7 @@ pub(crate) fn compile_with(
             && assign
                 .as_ref()
                 .is_some_and(|a| reads_only_matched_positions(a, elem_slot));
+        let points_between_splits = points_in_place && !assign.as_ref().is_some_and(reads_counts);
         rules.push(Rule {
             guard,
             affine,
@@ -239,6 +244,7 @@ pub(crate) fn compile_with(
             init: r.init,
             needs_refined,
             points_in_place,
+            points_between_splits,
         });
     }
     let length = match &file.length {
@@ -488,11 +494,25 @@ impl Protected {
 /// The elements a rule matched when it started.
 struct Matches {
     current: u32,
-    /// The matched elements as values (none for a flip rule, which needs
-    /// only their ids; an edge's value holds its id).
-    vals: Vec<Elem>,
+    /// The matched elements as values, in order, in parts (one for each
+    /// range of ids tested), so that a split rule can let each part go
+    /// once it is applied; none for a flip rule, which needs only their
+    /// ids; an edge's value holds its id.
+    parts: Vec<Vec<Elem>>,
     /// A flip rule's matched edges (empty for other rules).
     edge_ids: Vec<crate::mesh::EdgeId>,
+}
+
+impl Matches {
+    /// The number of matched elements.
+    fn len(&self) -> usize {
+        self.parts.iter().map(Vec::len).sum()
+    }
+
+    /// The matched elements, in order.
+    fn vals(&self) -> impl Iterator<Item = &Elem> + '_ {
+        self.parts.iter().flatten()
+    }
 }
 
 /// A failed run: the rule, the step, and what went wrong.
@@ -843,7 +863,7 @@ impl Grammar {
         {
             let none = || Matches {
                 current,
-                vals: Vec::new(),
+                parts: Vec::new(),
                 edge_ids: Vec::new(),
             };
             return Ok((none(), none()));
@@ -944,20 +964,20 @@ impl Grammar {
             })
             .collect();
         let parts = parts.into_iter().collect::<Result<Vec<_>, _>>()?;
-        let join = |pick: &dyn Fn(&(Part, Part)) -> &Part| {
-            let mut vals = Vec::with_capacity(parts.iter().map(|p| pick(p).0.len()).sum());
-            let mut edge_ids = Vec::with_capacity(parts.iter().map(|p| pick(p).1.len()).sum());
-            for p in &parts {
-                vals.extend_from_slice(&pick(p).0);
-                edge_ids.extend_from_slice(&pick(p).1);
-            }
-            Matches {
-                current,
-                vals,
-                edge_ids,
-            }
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        let (mut a_ids, mut b_ids) = (Vec::new(), Vec::new());
+        for ((av, ai), (bv, bi)) in parts {
+            a.push(av);
+            b.push(bv);
+            a_ids.push(ai);
+            b_ids.push(bi);
+        }
+        let join = |parts: Vec<Vec<Elem>>, ids: Vec<Vec<EdgeId>>| Matches {
+            current,
+            parts: parts.into_iter().filter(|p| !p.is_empty()).collect(),
+            edge_ids: ids.concat(),
         };
-        Ok((join(&|p| &p.0), join(&|p| &p.1)))
+        Ok((join(a, a_ids), join(b, b_ids)))
     }
 
     /// Evaluates `assign` for elements `range` in parallel, `bind` setting
@@ -1115,13 +1135,9 @@ impl Grammar {
             rules.iter().position(|r| r.op == want)
         };
         // The values the selected edges had when the rule started.
-        let mut selected: std::collections::HashMap<EdgeId, Elem> = a
-            .vals
-            .iter()
-            .chain(&b.vals)
-            .map(|v| (edge_id(v), *v))
-            .collect();
-        let mut todo: Vec<EdgeId> = a.vals.iter().chain(&b.vals).map(edge_id).collect();
+        let mut selected: std::collections::HashMap<EdgeId, Elem> =
+            a.vals().chain(b.vals()).map(|v| (edge_id(v), *v)).collect();
+        let mut todo: Vec<EdgeId> = a.vals().chain(b.vals()).map(edge_id).collect();
         todo.sort_unstable();
         while !todo.is_empty() {
             if let Err(m) = crate::deadline::check(state.deadline) {
@@ -1204,7 +1220,7 @@ impl Grammar {
                     state,
                     Matches {
                         current,
-                        vals,
+                        parts: vec![vals],
                         edge_ids: Vec::new(),
                     },
                 )?;
@@ -1295,21 +1311,24 @@ impl Grammar {
         let ranges =
             |n: usize| (0..n.div_ceil(CHUNK)).map(move |k| (k * CHUNK, ((k + 1) * CHUNK).min(n)));
         let ends: Vec<VertexTask> = match (&list, assign) {
-            // Every slot: each chunk writes its own part of the buffer.
+            // Every slot: each chunk writes its own block of the buffer.
             (None, Some(_)) => {
                 state.next.cover(mesh);
-                let NextPositions { pos, written } = &mut state.next;
-                pos[..slots]
-                    .par_chunks_mut(CHUNK)
-                    .zip(written.words_mut().par_chunks_mut(CHUNK / 64))
+                let pos = &mesh.pos;
+                state
+                    .next
+                    .blocks
+                    .par_iter_mut()
+                    .take(slots.div_ceil(CHUNK))
                     .enumerate()
-                    .map(|(k, (pos, words))| {
+                    .map(|(k, block)| {
                         let lo = k * CHUNK;
-                        task(lo, lo + pos.len(), &mut |i, _, p| {
-                            let j = i - lo;
-                            pos[j] = p;
-                            words[j / 64] |= 1 << (j % 64);
-                        })
+                        let mut out = Vec::with_capacity(block.len);
+                        let end = task(lo, lo + block.len, &mut |i, _, p| {
+                            out.push(((i - lo) as u32, p))
+                        });
+                        block.write(&pos[lo..lo + block.len], &out);
+                        end
                     })
                     .collect()
             }
@@ -1328,9 +1347,7 @@ impl Grammar {
                 parts
                     .into_iter()
                     .map(|(end, out)| {
-                        for (v, p) in out {
-                            state.next.set(v, p);
-                        }
+                        state.next.write(&mesh.pos, &out);
                         end
                     })
                     .collect()
@@ -1375,9 +1392,10 @@ impl Grammar {
         m: Matches,
     ) -> Result<(), RunError> {
         let step = state.step as usize;
+        let count = m.len();
         let Matches {
             current,
-            vals: matched,
+            parts,
             edge_ids,
         } = m;
         debug_assert!(rule.op == Op::Flip || edge_ids.is_empty());
@@ -1393,7 +1411,7 @@ impl Grammar {
             }
             Op::FaceSplit | Op::EdgeSplit | Op::BoundarySplit => {
                 let per = if rule.op == Op::BoundarySplit { 1 } else { 2 };
-                let after = mesh.face_count() + per * matched.len();
+                let after = mesh.face_count() + per * count;
                 if after > self.max_faces {
                     return Err(fail(format!(
                         "this rule would make {after} faces, past the limit of {}; \
@@ -1402,26 +1420,24 @@ impl Grammar {
                     )));
                 }
                 let split = state.split();
-                // The vertex made from each matched element, in order.
-                let mut made: Vec<VertexId> = Vec::with_capacity(matched.len());
-                match rule.op {
-                    Op::FaceSplit => {
-                        mesh.reserve(matched.len(), 3 * matched.len(), 2 * matched.len())
-                    }
-                    _ => mesh.reserve(matched.len(), 3 * matched.len(), 2 * matched.len()),
-                }
-                for val in &matched {
-                    let v = if let Some(vs) = host::face_vertices(val) {
-                        {
+                mesh.reserve(count, 3 * count, 2 * count);
+                // Splits the elements of `part`, in order, adding the
+                // vertex made from each to `made`.
+                let split_all = |mesh: &mut Mesh,
+                                 state: &mut RunState,
+                                 part: &[Elem],
+                                 made: &mut Vec<VertexId>|
+                 -> Result<(), RunError> {
+                    let first = made.len();
+                    for val in part {
+                        let v = if let Some(vs) = host::face_vertices(val) {
                             let Some(f) = face_of(mesh, vs) else {
                                 return Err(fail("a face to split is gone".into()));
                             };
                             let p = vs.iter().map(|v| mesh.position(*v)).sum::<DVec3>() / 3.0;
                             mesh.face_split_with(f, p, &split)
                                 .map_err(|e| fail(e.message))?
-                        }
-                    } else if let Some((p, q)) = host::edge_vertices(val) {
-                        {
+                        } else if let Some((p, q)) = host::edge_vertices(val) {
                             let e = edge_id(val);
                             debug_assert!({
                                 let (a, b) = mesh.edge_vertices(e);
@@ -1430,56 +1446,107 @@ impl Grammar {
                             let at = (mesh.position(p) + mesh.position(q)) * 0.5;
                             mesh.edge_split_with(e, at, &split)
                                 .map_err(|e| fail(e.message))?
-                        }
-                    } else {
-                        unreachable!("a split rule matches faces and edges")
-                    };
-                    made.push(v);
-                }
-                if state.adaptive {
-                    state.made_now.extend(&made);
-                }
-                state.check_valence(mesh).map_err(fail)?;
-                state.current_level = made
-                    .iter()
-                    .map(|v| mesh.vertex_level(*v))
-                    .fold(state.current_level, u32::max);
-                let Some(assign) = &rule.assign else {
-                    return Ok(());
+                        } else {
+                            unreachable!("a split rule matches faces and edges")
+                        };
+                        made.push(v);
+                    }
+                    if state.adaptive {
+                        state.made_now.extend(&made[first..]);
+                    }
+                    state.current_level = made[first..]
+                        .iter()
+                        .map(|v| mesh.vertex_level(*v))
+                        .fold(state.current_level, u32::max);
+                    Ok(())
                 };
-                let vslot = rule.vertex_slot.expect("an assignment names its vertex");
+                let run_step = state.step;
                 let slot = rule.elem_slot as usize;
-                let bind = |frame: &mut [Value], k: usize| {
-                    frame[slot] = Value::Elem(matched[k]);
-                    frame[vslot as usize] = Value::Elem(host::vertex(made[k]));
+                // Evaluates the points of `matched`, whose new vertices
+                // are `made`, `batch` at a time, writing each batch before
+                // the next is computed; the error of the first bad one.
+                let points = |mesh: &mut Mesh,
+                              assign: &Ex,
+                              matched: &[Elem],
+                              made: &[VertexId],
+                              batch: usize|
+                 -> Result<(), RunError> {
+                    let vslot = rule.vertex_slot.expect("an assignment names its vertex") as usize;
+                    let bind = |frame: &mut [Value], k: usize| {
+                        frame[slot] = Value::Elem(matched[k]);
+                        frame[vslot] = Value::Elem(host::vertex(made[k]));
+                    };
+                    let bad = |(k, p): (usize, Result<Value, RuntimeError>)| match p {
+                        Ok(Value::V3(p)) => fail(format!(
+                            "new vertex {} would be at {p}, which is not finite",
+                            made[k]
+                        )),
+                        Ok(_) => fail("the assignment did not give a point".into()),
+                        Err(e) => self.runtime_error(rule, step, e),
+                    };
+                    for lo in (0..made.len()).step_by(batch.max(1)) {
+                        let range = lo..(lo + batch).min(made.len());
+                        let out = self
+                            .eval_points(rule, mesh, current, run_step, assign, range, bind)
+                            .map_err(bad)?;
+                        for (v, p) in made[lo..].iter().zip(out) {
+                            mesh.set_position(*v, p);
+                        }
+                    }
+                    Ok(())
                 };
-                let bad = |(k, p): (usize, Result<Value, RuntimeError>)| match p {
-                    Ok(Value::V3(p)) => fail(format!(
-                        "new vertex {} would be at {p}, which is not finite",
-                        made[k]
-                    )),
-                    Ok(_) => fail("the assignment did not give a point".into()),
-                    Err(e) => self.runtime_error(rule, step, e),
-                };
-                // Where no point reads another, a batch's points are
-                // written before the next batch is computed, and only a
-                // batch is held; else all are computed first. A bad point
-                // stops the rule before its batch is written.
-                let batch = if rule.points_in_place {
-                    POINT_BATCH
-                } else {
-                    made.len().max(1)
-                };
-                for lo in (0..made.len()).step_by(batch) {
-                    let range = lo..(lo + batch).min(made.len());
-                    let out = self
-                        .eval_points(rule, mesh, current, state.step, assign, range, bind)
-                        .map_err(bad)?;
-                    for (v, p) in made[lo..].iter().zip(out) {
-                        mesh.set_position(*v, p);
+                match &rule.assign {
+                    // Each part's points right after its splits (they read
+                    // nothing the later splits change), a batch at a
+                    // time, and the part let go: the matches are never
+                    // held whole while the mesh grows. The errors are
+                    // those of splitting everything first: a bad point
+                    // waits until the other splits and the valence check
+                    // have passed.
+                    Some(assign) if rule.points_between_splits => {
+                        let mut bad = None;
+                        let (mut matched, mut made) = (Vec::new(), Vec::new());
+                        let mut parts = parts.into_iter().peekable();
+                        while let Some(part) = parts.next() {
+                            split_all(mesh, state, &part, &mut made)?;
+                            matched.extend_from_slice(&part);
+                            drop(part);
+                            if matched.len() >= BETWEEN_SPLITS_BATCH || parts.peek().is_none() {
+                                if bad.is_none() {
+                                    bad =
+                                        points(mesh, assign, &matched, &made, matched.len()).err();
+                                }
+                                matched.clear();
+                                made.clear();
+                            }
+                        }
+                        state.check_valence(mesh).map_err(fail)?;
+                        bad.map_or(Ok(()), Err)
+                    }
+                    assign => {
+                        let matched = parts.concat();
+                        drop(parts);
+                        // The vertex made from each matched element, in
+                        // order.
+                        let mut made: Vec<VertexId> = Vec::with_capacity(matched.len());
+                        split_all(mesh, state, &matched, &mut made)?;
+                        state.check_valence(mesh).map_err(fail)?;
+                        let Some(assign) = assign else {
+                            return Ok(());
+                        };
+                        // Where no point reads another, a batch's points
+                        // are written before the next batch is computed,
+                        // and only a batch is held; else all are computed
+                        // first. A bad point stops the rule before its
+                        // batch is written.
+                        let batch = if rule.points_in_place {
+                            POINT_BATCH
+                        } else {
+                            made.len()
+                        };
+                        points(mesh, assign, &matched, &made, batch)
                     }
                 }
-                Ok(())
             }
         }
     }
@@ -1682,48 +1749,318 @@ impl RunState {
 /// time.
 const POINT_BATCH: usize = 16 * CHUNK;
 
+/// The points of a split rule that are computed between its splits
+/// (`Rule::points_between_splits`) are computed this many at a time (at
+/// least: whole parts of the matches).
+const BETWEEN_SPLITS_BATCH: usize = 4 * CHUNK;
+
 /// Elements per parallel task: small jobs stay on one thread. A multiple
-/// of 64, so that a task's flags in [`NextPositions`] are whole words.
+/// of 64, so that a block's flags in [`NextPositions`] are whole words.
 const CHUNK: usize = 16384;
 
 /// The positions vertex rules write for the next step, by vertex slot,
-/// and which slots were written: a dense buffer, 24 bytes and a bit a
-/// vertex, filled while the rules run and made current when the step
-/// ends. A later rule's point for a vertex replaces an earlier one's.
+/// in blocks of [`CHUNK`] slots, filled while the rules run and made
+/// current when the step ends. A later rule's point for a vertex replaces
+/// an earlier one's.
+///
+/// A block keeps each written point as its difference from the vertex's
+/// current position: per coordinate, the new bits minus the current bits,
+/// as integers (wrapping), which gives back the same bits whatever the
+/// numbers. A vertex moves little against its coordinates (at three levels
+/// of Loop on a sphere, almost every one by less than 2^39 units in the
+/// last place), so the
+/// differences fit in fewer bytes than a coordinate: each block stores
+/// them in the width ([`Block::width`], 1 to 8 bytes) that makes it
+/// smallest, and the points whose differences do not fit (a coordinate
+/// near 0, which moves by many of its units in the last place) in a list
+/// of their own. Vertex rules never move a vertex otherwise, and splits
+/// place only the vertices they make, so a written slot's current
+/// position is the same when it is written and when the step ends.
 #[derive(Debug, Default)]
 struct NextPositions {
-    pos: Vec<DVec3>,
-    written: Bits,
+    blocks: Vec<Block>,
 }
 
-impl NextPositions {
-    /// Room for every vertex slot of `mesh`, none written.
-    fn cover(&mut self, mesh: &Mesh) {
-        let n = mesh.v_alive.len();
-        if self.pos.len() < n {
-            if self.pos.is_empty() {
-                self.pos = crate::huge::with_capacity(n);
-            }
-            self.pos.resize(n, DVec3::ZERO);
+/// The next positions of [`CHUNK`] vertex slots (fewer in the last
+/// block): see [`NextPositions`].
+#[derive(Debug, Default)]
+struct Block {
+    /// The slots of the block.
+    len: usize,
+    /// Bytes per coordinate's difference in `diffs`; 0 while nothing is
+    /// written.
+    width: usize,
+    /// Three differences a slot, `width` bytes each, little-endian, and
+    /// [`Block::PAD`] bytes after them.
+    diffs: Vec<u8>,
+    /// The slots written.
+    written: Vec<u64>,
+    /// The written slots whose last point is in `wide`.
+    is_wide: Vec<u64>,
+    /// Points whose differences do not fit `width` bytes, with their
+    /// places in the block, in the order written: a later one for a slot
+    /// replaces an earlier one.
+    wide: Vec<(u32, DVec3)>,
+}
+
+/// The difference of `next`'s coordinates from `cur`'s, as integers: the
+/// bits of `next` are `cur`'s plus it, wrapping.
+#[inline]
+fn bit_difference(cur: DVec3, next: DVec3) -> [i64; 3] {
+    let d = |c: f64, n: f64| (n.to_bits() as i64).wrapping_sub(c.to_bits() as i64);
+    [d(cur.x, next.x), d(cur.y, next.y), d(cur.z, next.z)]
+}
+
+/// `cur` moved by a [`bit_difference`].
+#[inline]
+fn add_bit_difference(cur: DVec3, d: [i64; 3]) -> DVec3 {
+    let a = |c: f64, d: i64| f64::from_bits((c.to_bits() as i64).wrapping_add(d) as u64);
+    DVec3::new(a(cur.x, d[0]), a(cur.y, d[1]), a(cur.z, d[2]))
+}
+
+/// The fewest bytes that hold each of `d` as a signed number (1 to 8).
+#[inline]
+fn bytes_needed(d: [i64; 3]) -> usize {
+    // A number fits in b bytes when its bits above the lowest 8b - 1 are
+    // copies of its sign.
+    let bits = d
+        .iter()
+        .map(|&x| 64 - (x ^ (x >> 63)).leading_zeros() as usize + 1)
+        .max()
+        .unwrap_or(1);
+    bits.div_ceil(8).max(1)
+}
+
+#[inline]
+fn bit(words: &[u64], i: usize) -> bool {
+    (words[i >> 6] >> (i & 63)) & 1 != 0
+}
+
+#[inline]
+fn set_bit(words: &mut [u64], i: usize, value: bool) {
+    if value {
+        words[i >> 6] |= 1 << (i & 63);
+    } else {
+        words[i >> 6] &= !(1 << (i & 63));
+    }
+}
+
+impl Block {
+    /// Bytes a wide point takes in `wide`.
+    const WIDE_BYTES: usize = std::mem::size_of::<(u32, DVec3)>();
+
+    /// Bytes after the last difference, so that each is read and written
+    /// as the 8 bytes from where it starts.
+    const PAD: usize = 8;
+
+    /// The 8 bytes of `diffs` from `at`, as a number.
+    #[inline]
+    fn word(&self, at: usize) -> u64 {
+        let mut b = [0u8; 8];
+        b.copy_from_slice(&self.diffs[at..at + 8]);
+        u64::from_le_bytes(b)
+    }
+
+    /// Grows the block to `len` slots, none of the new ones written.
+    fn grow(&mut self, len: usize) {
+        if len <= self.len {
+            return;
         }
-        while self.written.len() < n {
-            self.written.push(false);
+        self.len = len;
+        self.written.resize(len.div_ceil(64), 0);
+        self.is_wide.resize(len.div_ceil(64), 0);
+        if self.width > 0 {
+            self.diffs.resize(3 * self.width * len + Self::PAD, 0);
         }
     }
 
-    /// Records `p` for vertex `v`.
-    fn set(&mut self, v: VertexId, p: DVec3) {
-        self.pos[v.index()] = p;
-        self.written.set(v.index(), true);
+    /// The difference stored for slot `i` (written, not wide).
+    #[inline]
+    fn stored(&self, i: usize) -> [i64; 3] {
+        let w = self.width;
+        let at = 3 * w * i;
+        // The lowest `w` bytes, sign-extended.
+        let shift = 64 - 8 * w as u32;
+        std::array::from_fn(|k| ((self.word(at + k * w) << shift) as i64) >> shift)
+    }
+
+    /// Stores `d`, which fits `width` bytes, for slot `i`.
+    #[inline]
+    fn store(&mut self, i: usize, d: [i64; 3]) {
+        let w = self.width;
+        let at = 3 * w * i;
+        // The lowest `w` bytes of each; the bytes after them are kept.
+        let mask = u64::MAX >> (64 - 8 * w as u32);
+        for (k, &x) in d.iter().enumerate() {
+            let o = at + k * w;
+            let word = (self.word(o) & !mask) | (x as u64 & mask);
+            self.diffs[o..o + 8].copy_from_slice(&word.to_le_bytes());
+        }
+    }
+
+    /// Records `p` for slot `i`, whose current position is `cur`.
+    #[inline]
+    fn put(&mut self, i: usize, cur: DVec3, p: DVec3) {
+        let d = bit_difference(cur, p);
+        set_bit(&mut self.written, i, true);
+        let wide = bytes_needed(d) > self.width;
+        set_bit(&mut self.is_wide, i, wide);
+        if wide {
+            self.wide.push((i as u32, p));
+        } else {
+            self.store(i, d);
+        }
+    }
+
+    /// Records `points` (places in the block, in increasing order, and
+    /// points) given the current positions `cur` of the block's slots,
+    /// first widening the block where the points and those written
+    /// before take less room that way.
+    fn write(&mut self, cur: &[DVec3], points: &[(u32, DVec3)]) {
+        debug_assert_eq!(cur.len(), self.len);
+        if points.is_empty() {
+            return;
+        }
+        // How many points need each width: the new ones and the last
+        // of each slot before.
+        let mut need = [0usize; 9];
+        for &(i, p) in points {
+            need[bytes_needed(bit_difference(cur[i as usize], p))] += 1;
+        }
+        if self.width > 0 {
+            for i in 0..self.len {
+                if bit(&self.written, i) && !bit(&self.is_wide, i) {
+                    need[self.width] += 1;
+                }
+            }
+            for &(i, p) in &self.wide {
+                need[bytes_needed(bit_difference(cur[i as usize], p))] += 1;
+            }
+        }
+        // The width that takes the least room from the current one up
+        // (the widest that does, where several do).
+        let cost =
+            |w: usize| 3 * w * self.len + Self::WIDE_BYTES * need[w + 1..].iter().sum::<usize>();
+        let best = (self.width.max(1)..=8)
+            .rev()
+            .min_by_key(|&w| cost(w))
+            .unwrap_or(8);
+        if best > self.width {
+            self.widen(best, cur);
+        }
+        for &(i, p) in points {
+            self.put(i as usize, cur[i as usize], p);
+        }
+    }
+
+    /// Stores every difference in `width` bytes, more than now, and takes
+    /// the wide points that then fit out of `wide`.
+    fn widen(&mut self, width: usize, cur: &[DVec3]) {
+        let fresh = Block {
+            len: self.len,
+            width,
+            diffs: vec![0; 3 * width * self.len + Self::PAD],
+            written: std::mem::take(&mut self.written),
+            is_wide: std::mem::take(&mut self.is_wide),
+            wide: Vec::new(),
+        };
+        let old = std::mem::replace(self, fresh);
+        if old.width > 0 {
+            for i in 0..self.len {
+                if bit(&self.written, i) && !bit(&self.is_wide, i) {
+                    self.store(i, old.stored(i));
+                }
+            }
+        }
+        // The last point of each wide slot, from the end.
+        let mut seen = vec![0u64; self.len.div_ceil(64)];
+        let mut still = Vec::new();
+        for &(i, p) in old.wide.iter().rev() {
+            let k = i as usize;
+            if bit(&seen, k) || !bit(&self.is_wide, k) {
+                continue;
+            }
+            set_bit(&mut seen, k, true);
+            let d = bit_difference(cur[k], p);
+            if bytes_needed(d) <= width {
+                self.store(k, d);
+                set_bit(&mut self.is_wide, k, false);
+            } else {
+                still.push((i, p));
+            }
+        }
+        still.reverse();
+        self.wide = still;
+    }
+
+    /// Gives the written slots their points; `pos` holds the block's
+    /// current positions.
+    fn make_current(&self, pos: &mut [DVec3]) {
+        for (i, p) in pos.iter_mut().enumerate().take(self.len) {
+            if bit(&self.written, i) && !bit(&self.is_wide, i) {
+                *p = add_bit_difference(*p, self.stored(i));
+            }
+        }
+        for &(i, p) in &self.wide {
+            if bit(&self.is_wide, i as usize) {
+                pos[i as usize] = p;
+            }
+        }
+    }
+
+    /// The bytes the block holds.
+    #[cfg(test)]
+    fn bytes(&self) -> usize {
+        self.diffs.len()
+            + 8 * (self.written.len() + self.is_wide.len())
+            + Self::WIDE_BYTES * self.wide.len()
+    }
+}
+
+impl NextPositions {
+    /// Room for every vertex slot of `mesh`, none of the new ones written.
+    fn cover(&mut self, mesh: &Mesh) {
+        let n = mesh.v_alive.len();
+        let blocks = n.div_ceil(CHUNK);
+        let k = self.blocks.len().saturating_sub(1);
+        if let Some(last) = self.blocks.last_mut() {
+            last.grow((n - k * CHUNK).min(CHUNK));
+        }
+        while self.blocks.len() < blocks {
+            let k = self.blocks.len();
+            let mut b = Block::default();
+            b.grow((n - k * CHUNK).min(CHUNK));
+            self.blocks.push(b);
+        }
+    }
+
+    /// Records `points` (vertices in increasing order of id, and their
+    /// points) given the current positions `pos`.
+    fn write(&mut self, pos: &[DVec3], points: &[(VertexId, DVec3)]) {
+        let mut rest = points;
+        while let Some(&(v, _)) = rest.first() {
+            let k = v.index() / CHUNK;
+            let n = rest
+                .iter()
+                .position(|(w, _)| w.index() / CHUNK != k)
+                .unwrap_or(rest.len());
+            let lo = k * CHUNK;
+            let block: Vec<(u32, DVec3)> = rest[..n]
+                .iter()
+                .map(|&(w, p)| ((w.index() - lo) as u32, p))
+                .collect();
+            let b = &mut self.blocks[k];
+            b.write(&pos[lo..lo + b.len], &block);
+            rest = &rest[n..];
+        }
     }
 
     /// Gives the written vertices their points.
     fn make_current(self, mesh: &mut Mesh) {
-        for (i, p) in self.pos.iter().enumerate() {
-            if self.written.get(i) {
-                mesh.set_position(VertexId(i as u32), *p);
-            }
-        }
+        self.blocks
+            .par_iter()
+            .zip(mesh.pos.par_chunks_mut(CHUNK))
+            .for_each(|(b, pos)| b.make_current(pos));
     }
 }
 
@@ -1778,6 +2115,16 @@ fn reads_only_matched_positions(e: &Ex, elem: u16) -> bool {
         _ => ok = false,
     });
     ok
+}
+
+/// True when `e` calls `valence` or `creases`, which the splits of other
+/// elements may change while a split rule runs.
+fn reads_counts(e: &Ex) -> bool {
+    let mut found = false;
+    e.walk(&mut |x| {
+        found |= matches!(x, Ex::Call(Func::Host(id::VALENCE | id::CREASES), ..));
+    });
+    found
 }
 
 /// The id of a matched edge's value.
@@ -1892,5 +2239,274 @@ impl crate::production::Topology for GrammarRun<'_> {
 
     fn step(&mut self) -> Result<(), RunError> {
         self.one_step()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use glam::DVec3;
+
+    use super::{bytes_needed, Grammar, NextPositions, CHUNK};
+    use crate::mesh::{io, shapes, Mesh, VertexId};
+
+    /// A small deterministic sequence (xorshift).
+    fn rng(seed: u64) -> impl FnMut() -> u64 {
+        let mut s = seed;
+        move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        }
+    }
+
+    #[test]
+    fn bytes_needed_is_the_narrowest_signed_width() {
+        let mut next = rng(77);
+        let mut xs = vec![
+            0i64,
+            1,
+            -1,
+            127,
+            128,
+            -128,
+            -129,
+            255,
+            256,
+            i64::MAX,
+            i64::MIN,
+        ];
+        for b in 1..8 {
+            let edge = 1i64 << (8 * b - 1);
+            xs.extend([edge - 1, edge, -edge, -edge - 1]);
+        }
+        xs.extend((0..1000).map(|_| (next() as i64) >> (next() % 64)));
+        for x in xs {
+            // The smallest b with -2^(8b-1) <= x < 2^(8b-1), in i128.
+            let want = (1..=8)
+                .find(|&b| {
+                    let half = 1i128 << (8 * b - 1);
+                    (-half..half).contains(&(x as i128))
+                })
+                .expect("8 bytes hold any i64");
+            assert_eq!(bytes_needed([x, 0, 0]), want, "{x}");
+            assert_eq!(bytes_needed([0, x, -1]), want, "{x}");
+        }
+    }
+
+    /// The next positions against a plain list of the last point written
+    /// for each slot: rounds of writes (a round is a vertex rule: some
+    /// slots, in id order), with small moves, none, sign changes, zeros
+    /// of either sign, huge moves and subnormal numbers, on a mesh that
+    /// grows between rounds; every coordinate must come back to the bit.
+    #[test]
+    fn next_positions_give_back_the_last_point_of_every_slot_to_the_bit() {
+        let mut next = rng(0x51_7cc1_b727_220a);
+        let mut unit = move || (next() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut m = Mesh::from_soup(&shapes::triangle_grid(150, 120)).expect("a grid");
+        let n0 = m.v_alive.len();
+        assert!(n0 > CHUNK, "more than one block");
+        let magnitudes = [1e-300, 1e-9, 0.5, 3.0, 1e6, 1e300];
+        for i in 0..n0 {
+            let c = |u: f64, k: f64| (u - 0.5) * magnitudes[(k * 6.0) as usize % 6];
+            let p = DVec3::new(c(unit(), unit()), c(unit(), unit()), c(unit(), unit()));
+            m.set_position(VertexId(i as u32), p);
+        }
+        m.set_position(VertexId(3), DVec3::new(0.0, -0.0, f64::MIN_POSITIVE / 8.0));
+        let mut buf = NextPositions::default();
+        let mut plain: Vec<Option<DVec3>> = vec![None; n0];
+        for round in 0..5 {
+            if round == 2 {
+                // New vertices between rules (a split rule's).
+                for k in 0..CHUNK + 100 {
+                    m.new_vertex(DVec3::splat(k as f64 * 0.25 - 7.0), 1, 1);
+                }
+                plain.resize(m.v_alive.len(), None);
+            }
+            buf.cover(&m);
+            let share = [0.9, 0.8, 0.5, 0.05, 0.6][round];
+            let mut points = Vec::new();
+            for (i, last) in plain.iter_mut().enumerate() {
+                if unit() >= share {
+                    continue;
+                }
+                let cur = m.position(VertexId(i as u32));
+                // The kinds of point: a tiny move, a move as a smoothing
+                // step makes, none, a sign change, zeros, a huge move, a
+                // subnormal point. The first rounds are mostly tiny
+                // moves, then mostly larger ones, so that blocks widen
+                // over points that were wide before.
+                let weights: [f64; 7] = match round {
+                    0 | 3 => [0.93, 0.03, 0.01, 0.01, 0.005, 0.01, 0.005],
+                    1 => [0.02, 0.9, 0.02, 0.02, 0.01, 0.02, 0.01],
+                    _ => [0.3, 0.3, 0.1, 0.1, 0.05, 0.1, 0.05],
+                };
+                let mut r = unit();
+                let kind = weights
+                    .iter()
+                    .position(|&w| {
+                        r -= w;
+                        r < 0.0
+                    })
+                    .unwrap_or(6);
+                let t = unit() - 0.5;
+                let p = match kind {
+                    0 => cur + cur * t * 1e-12,
+                    1 => cur + cur * t * 1e-7,
+                    2 => cur,
+                    3 => -cur,
+                    4 => DVec3::new(0.0, -0.0, cur.z),
+                    5 => cur * 1e200 + DVec3::splat(t),
+                    _ => DVec3::splat(f64::MIN_POSITIVE * t),
+                };
+                *last = Some(p);
+                points.push((VertexId(i as u32), p));
+            }
+            buf.write(&m.pos, &points);
+        }
+        let before = m.pos.clone();
+        // Small moves everywhere take fewer bytes than the points.
+        buf.make_current(&mut m);
+        for (i, (&got, (&was, want))) in m.pos.iter().zip(before.iter().zip(&plain)).enumerate() {
+            let want = want.unwrap_or(was);
+            assert_eq!(
+                got.to_array().map(f64::to_bits),
+                want.to_array().map(f64::to_bits),
+                "slot {i}"
+            );
+        }
+    }
+
+    /// Writes that move every vertex a little take fewer bytes than the
+    /// points would (24 a slot), and one far move among them goes to the
+    /// block's list of wide points instead of widening the block.
+    #[test]
+    fn small_moves_take_fewer_bytes_than_points() {
+        let mut m = Mesh::from_soup(&shapes::triangle_grid(150, 120)).expect("a grid");
+        let n = m.v_alive.len();
+        let mut next = rng(9);
+        let mut points: Vec<(VertexId, DVec3)> = (0..n)
+            .map(|i| {
+                let v = VertexId(i as u32);
+                let p = m.position(v) + DVec3::splat(1.0);
+                m.set_position(v, p);
+                let t = (next() >> 11) as f64 / (1u64 << 53) as f64;
+                (v, p * (1.0 + 1e-10 * (t - 0.5)))
+            })
+            .collect();
+        points[5].1 = DVec3::splat(-1e100);
+        let mut buf = NextPositions::default();
+        buf.cover(&m);
+        buf.write(&m.pos, &points);
+        let bytes: usize = buf.blocks.iter().map(|b| b.bytes()).sum();
+        assert!(bytes < 12 * n, "{bytes} bytes for {n} slots");
+        assert_eq!(buf.blocks[0].wide.len(), 1);
+        buf.make_current(&mut m);
+        for (v, p) in points {
+            assert_eq!(
+                m.position(v).to_array().map(f64::to_bits),
+                p.to_array().map(f64::to_bits)
+            );
+        }
+    }
+
+    fn grammar(name: &str, text: &str) -> Grammar {
+        let front = crate::load::front(name, text.to_string(), &[]).expect("reads");
+        crate::surface::from_front_with(front, true).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// A mesh of `lsystems/meshes`.
+    fn mesh_file(name: &str) -> Mesh {
+        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("lsystems/meshes");
+        io::read_mesh(&dir.join(name)).expect("a mesh")
+    }
+
+    /// Runs `g` `steps` steps on `mesh`, with the points of split rules
+    /// computed between their splits where `between` allows it, and after
+    /// all of them otherwise.
+    fn run_with(g: &mut Grammar, mesh: &Mesh, steps: usize, between: bool) -> Result<Mesh, String> {
+        for r in &mut g.rules {
+            r.points_between_splits &= between;
+        }
+        let mut m = mesh.clone();
+        g.run(&mut m, steps, |_| {})
+            .map(|()| m)
+            .map_err(|e| g.render_error(&e))
+    }
+
+    fn same_bits(a: &Mesh, b: &Mesh) -> bool {
+        a == b
+            && a.pos
+                .iter()
+                .zip(&b.pos)
+                .all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits))
+    }
+
+    /// A split rule's points computed right after each part of its splits
+    /// give the mesh that computing them after all splits gives, to the
+    /// bit: Loop, Catmull-Clark, √3, c4 and 4-8 (their `avg(e)` and
+    /// `avg(f)` split rules compute points between splits) on their own
+    /// meshes, the bunny and a sphere of two batches. A point that reads a
+    /// valence, which later splits change, is computed after all of them,
+    /// and a bad point gives the error it gives after all splits.
+    #[test]
+    fn points_between_splits_are_the_points_after_all_splits() {
+        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("lsystems/surfaces");
+        let mut between = 0;
+        let sphere = Mesh::from_soup(&shapes::icosphere(6)).expect("a sphere");
+        for file in [
+            "loop.lsys",
+            "catmull-clark.lsys",
+            "sqrt3.lsys",
+            "c4.lsys",
+            "four-eight.lsys",
+        ] {
+            let text = std::fs::read_to_string(dir.join(file)).expect("reads");
+            let mut g = grammar(file, &text);
+            between += g.rules.iter().filter(|r| r.points_between_splits).count();
+            let own = g.mesh.clone().expect("names its mesh").0;
+            let own = mesh_file(own.trim_start_matches("../meshes/"));
+            // The icosphere's 122,880 edges are eight parts of matches and
+            // two batches of points.
+            for (mesh, steps) in [(&own, 3), (&mesh_file("bunny.obj"), 1), (&sphere, 1)] {
+                let a = run_with(&mut grammar(file, &text), mesh, steps, true);
+                let b = run_with(&mut g, mesh, steps, false);
+                match (a, b) {
+                    (Ok(a), Ok(b)) => assert!(same_bits(&a, &b), "{file}"),
+                    (Err(a), Err(b)) => assert_eq!(a, b, "{file}"),
+                    (a, b) => panic!("{file}: {:?} and {:?}", a.err(), b.err()),
+                }
+            }
+        }
+        assert!(
+            between >= 3,
+            "{between} rules compute points between splits"
+        );
+        // A point that reads the new vertex's valence: the splits of the
+        // edges after its own raise it, so it waits for all of them (on
+        // the sphere, whose edges make two batches).
+        let valence = "mesh: \"../meshes/octahedron.obj\";\n\
+            E(e) | F^2 -> V(v = avg(e) * (1 + 0.01 * valence(v))) || E^4 F^4;\n";
+        let mut g = grammar("valence.lsys", valence);
+        assert!(!g.rules[0].points_between_splits && g.rules[0].points_in_place);
+        let after = run_with(&mut g, &sphere, 1, true).expect("runs");
+        let mut wrong = grammar("valence.lsys", valence);
+        wrong.rules[0].points_between_splits = true;
+        let early = run_with(&mut wrong, &sphere, 1, true).expect("runs");
+        assert!(
+            !same_bits(&after, &early),
+            "the valences differ between splits"
+        );
+        // A bad point is the error it is after all splits.
+        let bad = "mesh: \"../meshes/bunny.obj\";\n\
+            E(e) | F^2 -> V(v = avg(e) / (l(e) - l(e))) || E^4 F^4;\n\
+            E(e) | F -> V(v = avg(e)) || E^3 F^2;\n";
+        let bunny = mesh_file("bunny.obj");
+        let a = run_with(&mut grammar("bad.lsys", bad), &bunny, 1, true);
+        let b = run_with(&mut grammar("bad.lsys", bad), &bunny, 1, false);
+        assert!(a.is_err());
+        assert_eq!(a.err(), b.err());
     }
 }
