@@ -40,6 +40,8 @@ mod production;
 mod rewrite;
 mod syntax;
 mod system;
+#[cfg(test)]
+mod testing;
 pub mod vv;
 
 pub mod analyze;

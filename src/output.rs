@@ -787,13 +787,7 @@ mod tests {
     /// random bit patterns of both widths, numbers as programs make them,
     /// and the edges of the integer and exponent ranges.
     fn numbers() -> Vec<f64> {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = crate::testing::xorshift(0x2545_f491_4f6c_dd1d);
         let mut xs = vec![
             0.0,
             -0.0,

@@ -202,16 +202,7 @@ impl PartialEq for Narrow {
 mod tests {
     use super::{Bits, Narrow};
 
-    /// A small deterministic sequence (xorshift) for the tests.
-    fn rng(seed: u64) -> impl FnMut() -> u64 {
-        let mut s = seed;
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        }
-    }
+    use crate::testing::xorshift as rng;
 
     #[test]
     fn bits_hold_what_a_vec_of_bools_holds() {

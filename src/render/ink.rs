@@ -321,13 +321,8 @@ mod tests {
     /// bands'.
     #[test]
     fn a_long_polyline_inks_the_same_in_bands() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut bits = crate::testing::xorshift(0x2545_f491_4f6c_dd1d);
+        let mut next = || (bits() >> 11) as f64 / (1u64 << 53) as f64;
         let n = 3 * PARALLEL_POINTS;
         let points: Vec<DVec2> = (0..n)
             .map(|i| {

@@ -426,13 +426,8 @@ mod tests {
     /// polyline's first point, at its last, or at an item in between.
     #[test]
     fn relayed_calls_arrive_in_order() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = |n: u64| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state % n
-        };
+        let mut bits = crate::testing::xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut next = |n: u64| bits() % n;
         let calls: Vec<(u64, f64)> = (0..600).map(|i| (next(10), i as f64)).collect();
         let make = |canvas: &mut dyn Canvas| {
             let mut open = false;

@@ -2251,16 +2251,7 @@ mod tests {
     use super::{bytes_needed, Grammar, NextPositions, CHUNK};
     use crate::mesh::{io, shapes, Mesh, VertexId};
 
-    /// A small deterministic sequence (xorshift).
-    fn rng(seed: u64) -> impl FnMut() -> u64 {
-        let mut s = seed;
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        }
-    }
+    use crate::testing::xorshift as rng;
 
     #[test]
     fn bytes_needed_is_the_narrowest_signed_width() {
