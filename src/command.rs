@@ -799,14 +799,7 @@ fn render_system(
             };
             let figures = match format {
                 Picture::Png => c.png_figures(&figure)?,
-                Picture::Svg => {
-                    let f = c.figures(&figure)?;
-                    let svg = |s: &Scene| render::svg::render(s).into_bytes();
-                    crate::Figures {
-                        main: svg(&f.main),
-                        views: f.views.iter().map(|(v, s)| (*v, svg(s))).collect(),
-                    }
-                }
+                Picture::Svg => c.figures(&figure)?.try_map(|s| picture_bytes(s, format))?,
             };
             write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
             write_views(figures, Path::new(&a.file), output, a.force, out)

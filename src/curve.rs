@@ -203,11 +203,7 @@ impl Curve {
         for (view, list) in panels {
             scenes.push((view, render::scene(&list, &opts.render)?));
         }
-        let (_, main) = scenes.remove(0);
-        Ok(Figures {
-            main,
-            views: scenes,
-        })
+        Ok(Figures::from_views(scenes))
     }
 
     /// [`Curve::figures`] as PNG files' bytes, the same to the bit; each
@@ -215,16 +211,9 @@ impl Curve {
     /// word (`render::png::word`), with no events or items in memory.
     pub fn png_figures(&self, opts: &FigureOptions) -> Result<Figures<Vec<u8>>, Error> {
         if opts.each {
-            let f = self.figures(opts)?;
-            let png = |s: &render::Scene| render::png::render(s).map_err(Error::from);
-            return Ok(Figures {
-                main: png(&f.main)?,
-                views: f
-                    .views
-                    .iter()
-                    .map(|(v, s)| Ok((*v, png(s)?)))
-                    .collect::<Result<_, Error>>()?,
-            });
+            return self
+                .figures(opts)?
+                .try_map(|s| render::png::render(s).map_err(Error::from));
         }
         let p = &self.program;
         // A drawing that cannot be pictured is told after every view is
@@ -241,11 +230,7 @@ impl Curve {
             let png = list.pop().expect("one picture a view without `each`")?;
             pictures.push((view, png));
         }
-        let (_, main) = pictures.remove(0);
-        Ok(Figures {
-            main,
-            views: pictures,
-        })
+        Ok(Figures::from_views(pictures))
     }
 
     /// Derives once and draws the interpreted word of every view with
@@ -310,6 +295,27 @@ impl Curve {
 pub struct Figures<P = render::Scene> {
     pub main: P,
     pub views: Vec<(i64, P)>,
+}
+
+impl<P> Figures<P> {
+    /// The pictures of views in order, the main view's first.
+    fn from_views(mut views: Vec<(i64, P)>) -> Self {
+        let (_, main) = views.remove(0);
+        Figures { main, views }
+    }
+
+    /// Each picture made into another by `f`, the main one first; the
+    /// first failure.
+    pub fn try_map<Q, E>(&self, mut f: impl FnMut(&P) -> Result<Q, E>) -> Result<Figures<Q>, E> {
+        Ok(Figures {
+            main: f(&self.main)?,
+            views: self
+                .views
+                .iter()
+                .map(|(v, p)| Ok((*v, f(p)?)))
+                .collect::<Result<_, E>>()?,
+        })
+    }
 }
 
 /// More steps than this are refused before a derivation starts.

@@ -8,6 +8,8 @@ use tiny_skia::{
 
 use glam::DVec2;
 
+use crate::draw::{walk, Events};
+
 use super::{Item, RenderError, Rgba, Scene};
 
 /// An anti-aliased solid paint.
@@ -41,8 +43,9 @@ pub fn render(scene: &Scene) -> Result<Vec<u8>, RenderError> {
 /// [`crate::draw::draw`]'s events, to the bit; but painted as the turtle
 /// walks, with no list of events or items. The turtle walks twice: once
 /// to find the drawing's box, once to lay out and paint each event as it
-/// comes. Memory beyond the word is the picture's, and the points of the
-/// widest pen's open polyline.
+/// comes. Memory beyond the word is the picture's, the points of the
+/// widest pen's open polyline, and a few batches of points on their way
+/// to the painting thread.
 pub fn word(
     word: &crate::rewrite::Word,
     alphabet: &crate::lang::Alphabet,
@@ -50,7 +53,6 @@ pub fn word(
     draw: &crate::draw::DrawOptions,
     opts: &super::RenderOptions,
 ) -> Result<Vec<u8>, WordError> {
-    use crate::draw::{walk, Events};
     super::check_size(opts.width, opts.height)?;
     let mut bounds = Events::new(super::Bounds::new(opts.view));
     walk(word, alphabet, structs, draw, None, &mut bounds)?;
@@ -63,11 +65,9 @@ pub fn word(
         opts.to_mut().height = height;
     }
     let painter = Painter::new(opts.width, opts.height, opts.background)?;
-    let cell = opts.width as f64;
+    let drawn = (word, alphabet, structs, draw);
     if rayon::current_num_threads() == 1 {
-        let mut events = Events::new(super::Layout::new(bounds, 0.0, cell, &opts, painter));
-        walk(word, alphabet, structs, draw, None, &mut events)?;
-        return Ok(events.into_inner().finish().encode()?);
+        return Ok(lay_out(drawn, bounds, &opts, painter)?.encode()?);
     }
     // Two threads: this one walks and lays out, the other paints what
     // was laid out, in order.
@@ -90,13 +90,8 @@ pub fn word(
             out: batches,
             spare,
         };
-        let mut events = Events::new(super::Layout::new(bounds, 0.0, cell, &opts, relay));
-        let walked = walk(word, alphabet, structs, draw, None, &mut events);
-        if walked.is_ok() {
-            events.into_inner().finish().send();
-        } else {
-            drop(events);
-        }
+        // A failed walk drops the relay, which ends the painting.
+        let walked = lay_out(drawn, bounds, &opts, relay).map(|mut relay| relay.send());
         let painter = paint
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
@@ -206,6 +201,28 @@ impl super::Canvas for Relay {
         self.mark(Mark::Item(item));
     }
 }
+
+/// The turtle's walk over a word, laying its drawing out within `bounds`
+/// on `canvas`.
+fn lay_out<C: super::Canvas>(
+    (word, alphabet, structs, draw): Drawn<'_>,
+    bounds: (DVec2, DVec2),
+    opts: &super::RenderOptions,
+    canvas: C,
+) -> Result<C, crate::draw::DrawError> {
+    let layout = super::Layout::new(bounds, 0.0, opts.width as f64, opts, canvas);
+    let mut events = Events::new(layout);
+    walk(word, alphabet, structs, draw, None, &mut events)?;
+    Ok(events.into_inner().finish())
+}
+
+/// A word and what the turtle needs to draw it.
+type Drawn<'a> = (
+    &'a crate::rewrite::Word,
+    &'a crate::lang::Alphabet,
+    &'a [crate::lang::value::StructDef],
+    &'a crate::draw::DrawOptions,
+);
 
 /// Why [`word`] made no picture: the turtle's walk failed, or the drawing
 /// cannot be pictured.
