@@ -162,6 +162,11 @@ fn island(runs: usize) {
         .unwrap()
     });
 
+    // The first of the two walks alone: the turtle finding the box.
+    let (t_box, _) = best_of(runs, || {
+        subgram::draw::line_bounds(word, &p.alphabet, &p.structs, &Default::default()).unwrap()
+    });
+
     let exe = std::env::current_exe().unwrap();
     let bin = exe
         .parent()
@@ -232,6 +237,10 @@ fn island(runs: usize) {
         "  in this process: the PNG painted as the turtle walks the word {:.1} ms ({:.2}x the derivation's first run)",
         ms(t_walked),
         t_walked.as_secs_f64() / t_first.as_secs_f64()
+    );
+    println!(
+        "    of which the walk that finds the drawing's box alone {:.1} ms",
+        ms(t_box)
     );
     println!(
         "  in this process: PNG of the laid-out scene {:.1} ms; tiny-skia stroking its segments as one path {:.1} ms ({:.2}x)",

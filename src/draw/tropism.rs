@@ -213,9 +213,26 @@ impl<'t> Field<'t> {
     /// sum, and the torques turn the up vector.
     #[inline]
     pub(super) fn adjust(&self, head: &mut DVec3, left: &mut DVec3, up: &mut DVec3) {
-        if !self.tropisms.is_empty() {
+        if self.acts() {
             self.adjust_by_all(head, left, up)
         }
+    }
+
+    /// Whether [`Field::adjust`] turns anything: there are tropisms.
+    #[inline]
+    pub(super) fn acts(&self) -> bool {
+        !self.tropisms.is_empty()
+    }
+
+    /// The frame as [`Field::adjust`] leaves it.
+    pub(super) fn adjusted(
+        &self,
+        mut head: DVec3,
+        mut left: DVec3,
+        mut up: DVec3,
+    ) -> (DVec3, DVec3, DVec3) {
+        self.adjust(&mut head, &mut left, &mut up);
+        (head, left, up)
     }
 
     fn adjust_by_all(&self, head: &mut DVec3, left: &mut DVec3, up: &mut DVec3) {
@@ -260,6 +277,17 @@ impl<'t> Field<'t> {
             }
         }
     }
+}
+
+/// The frame as [`bend`] leaves it.
+pub(super) fn bent(
+    s: &SimpleTropism,
+    mut head: DVec3,
+    mut left: DVec3,
+    mut up: DVec3,
+) -> (DVec3, DVec3, DVec3) {
+    bend(s, &mut head, &mut left, &mut up);
+    (head, left, up)
 }
 
 /// After a step forward: the simple tropism bends the heading, once

@@ -320,8 +320,13 @@ impl Bounds {
     fn grow(&mut self, p: DVec3, r: f64) {
         let p = self.view.project(p);
         self.finite &= p.is_finite() && r.is_finite();
-        self.lo = self.lo.min(p - r);
-        self.hi = self.hi.max(p + r);
+        // Plain comparisons: a coordinate that is not finite fails `get`
+        // whatever the box.
+        let (a, b) = (p - r, p + r);
+        let less = |a: f64, b: f64| if a < b { a } else { b };
+        let more = |a: f64, b: f64| if a > b { a } else { b };
+        self.lo = DVec2::new(less(a.x, self.lo.x), less(a.y, self.lo.y));
+        self.hi = DVec2::new(more(b.x, self.hi.x), more(b.y, self.hi.y));
     }
 
     fn event(&mut self, e: &Event) {
@@ -359,7 +364,7 @@ impl crate::draw::EventSink for Bounds {
         Ok(())
     }
 
-    #[inline]
+    #[inline(always)]
     fn continue_to(&mut self, b: DVec3) -> Result<(), String> {
         self.grow(b, 0.0);
         Ok(())
@@ -538,7 +543,7 @@ impl<C: Canvas> crate::draw::EventSink for Layout<'_, C> {
         Ok(())
     }
 
-    #[inline]
+    #[inline(always)]
     fn continue_to(&mut self, b: DVec3) -> Result<(), String> {
         self.point(b);
         Ok(())

@@ -157,6 +157,7 @@ struct Relay {
 
 impl Relay {
     /// Sends the batch on (a full one, or the last).
+    #[inline(never)]
     fn send(&mut self) {
         let next = self.spare.try_recv().unwrap_or_default();
         let full = std::mem::replace(&mut self.batch, next);
