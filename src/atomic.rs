@@ -109,9 +109,12 @@ mod tests {
 
     #[test]
     fn all_or_none() {
-        let dir = std::env::temp_dir().join(format!("subgram-atomic-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(dir.join("taken")).unwrap();
+        let tmp = tempfile::Builder::new()
+            .prefix("subgram-atomic-")
+            .tempdir()
+            .unwrap();
+        let dir = tmp.path();
+        std::fs::create_dir(dir.join("taken")).unwrap();
         let (a, b) = (dir.join("a.txt"), dir.join("b.txt"));
         // The second cannot be written (its folder is missing): neither is.
         let missing = dir.join("no/such/c.txt");
@@ -120,13 +123,12 @@ mod tests {
         // The second is renamed onto a folder and fails: the first goes.
         let e = write_all_atomic(&[(&a, b"a"), (&dir.join("taken"), b"t")]).unwrap_err();
         assert_eq!(e.0, dir.join("taken"));
-        let left: Vec<_> = std::fs::read_dir(&dir)
+        let left: Vec<_> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().file_name())
             .collect();
         assert_eq!(left, vec![std::ffi::OsString::from("taken")]);
         write_all_atomic(&[(&a, b"a"), (&b, b"b")]).unwrap();
         assert_eq!(std::fs::read(&b).unwrap(), b"b");
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -350,8 +350,8 @@ fn json_has_the_stencils() {
 }
 
 fn refused(text: &str) -> String {
-    let dir = std::env::temp_dir().join(format!("subgram-analyze-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("analyze");
+    let dir = tmp.path();
     let f = dir.join(format!("t{}.lsys", text.len()));
     std::fs::write(&f, text).unwrap();
     let e = analyze(&f, &[]).expect_err("must be refused").to_string();

@@ -84,8 +84,8 @@ fn steps_and_defines_override_the_file() {
 
 #[test]
 fn check_reports_diagnostics_with_exit_code_1() {
-    let dir = std::env::temp_dir().join(format!("subgram-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("cli");
+    let dir = tmp.path();
     let bad = dir.join("bad.lsys");
     std::fs::write(
         &bad,
@@ -123,8 +123,8 @@ fn usage_errors_exit_with_2() {
 
 #[test]
 fn picture_options_with_a_mesh_output_are_usage_errors() {
-    let dir = std::env::temp_dir().join(format!("subgram-cli-shading-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("cli-shading");
+    let dir = tmp.path();
     let out = dir.join("out.obj");
     let g = lsys("surfaces/c4.lsys");
     for flags in [&["--shading", "normals"][..], &["--no-wireframe"][..]] {
@@ -151,7 +151,6 @@ fn picture_options_with_a_mesh_output_are_usage_errors() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("use lit, normals or reflection"));
     assert!(!png.exists());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -163,8 +162,8 @@ fn a_missing_file_is_an_input_error() {
 
 #[test]
 fn runaway_derivation_stops_with_a_message() {
-    let dir = std::env::temp_dir().join(format!("subgram-cli-grow-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("cli-grow");
+    let dir = tmp.path();
     let f = dir.join("grow.lsys");
     std::fs::write(
         &f,
@@ -186,8 +185,9 @@ fn runaway_derivation_stops_with_a_message() {
 /// replaces it.
 #[test]
 fn an_output_that_is_an_input_is_refused_unless_forced() {
-    use crate::reverse::{files_in, run_in, scratch};
-    let dir = scratch("overwrite");
+    use crate::reverse::{files_in, run_in};
+    let tmp = scratch("overwrite");
+    let dir = tmp.path();
     let cube = std::fs::read(lsys("meshes/cube.obj")).unwrap();
     // Texture coordinates and normals that a conversion would drop.
     let mut a = cube.clone();
@@ -221,20 +221,20 @@ fn an_output_that_is_an_input_is_refused_unless_forced() {
         (&["reconstruct", "p.txt", "--details", "d.json", "-o", "p.txt"], "the output `p.txt` is an input of this command"),
         (&["render", "a.obj", "-o", "soft.obj"], "the output `soft.obj` is the same file as the input `a.obj`"),
     ];
-    let before = files_in(&dir);
+    let before = files_in(dir);
     for (args, message) in refusals {
-        let r = run_in(&dir, args);
+        let r = run_in(dir, args);
         assert_eq!(r.code, Some(2), "{args:?}: {}", r.stderr);
         let want = format!(
             "error: {message}: writing it would replace the input; name another output, or add --force to replace it\n"
         );
         assert_eq!(r.stderr, want, "{args:?}");
         assert_eq!(std::fs::read(dir.join("a.obj")).unwrap(), a, "{args:?}");
-        assert_eq!(files_in(&dir), before, "{args:?}");
+        assert_eq!(files_in(dir), before, "{args:?}");
     }
     // Two outputs that are one file are refused even with --force.
     let r = run_in(
-        &dir,
+        dir,
         &[
             "reverse",
             "p.txt",
@@ -255,7 +255,7 @@ fn an_output_that_is_an_input_is_refused_unless_forced() {
         r.stderr
     );
     // --force replaces the input.
-    let r = run_in(&dir, &["mesh", "convert", "a.obj", "a.obj", "--force"]);
+    let r = run_in(dir, &["mesh", "convert", "a.obj", "a.obj", "--force"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     let converted = std::fs::read_to_string(dir.join("a.obj")).unwrap();
     assert!(
@@ -263,7 +263,7 @@ fn an_output_that_is_an_input_is_refused_unless_forced() {
         "the conversion drops what it cannot hold"
     );
     let r = run_in(
-        &dir,
+        dir,
         &[
             "subdivide",
             "a.obj",
@@ -278,7 +278,7 @@ fn an_output_that_is_an_input_is_refused_unless_forced() {
     );
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     let r = run_in(
-        &dir,
+        dir,
         &["reverse", "p.txt", "-n", "1", "-o", "p.txt", "--force"],
     );
     assert_eq!(r.code, Some(0), "{}", r.stderr);
@@ -289,7 +289,6 @@ fn an_output_that_is_an_input_is_refused_unless_forced() {
             .count(),
         8
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Nothing silent (issue 12): a predefined module that subgram does not
@@ -298,8 +297,8 @@ fn an_output_that_is_an_input_is_refused_unless_forced() {
 /// succeed. Modules the turtle draws are not warned about.
 #[test]
 fn modules_subgram_does_not_draw_are_warned_about_at_their_first_place() {
-    let dir = std::env::temp_dir().join(format!("subgram-cli-unsupported-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("cli-unsupported");
+    let dir = tmp.path();
     let file = dir.join("leaf.lsys");
     std::fs::write(
         &file,
@@ -340,7 +339,6 @@ fn modules_subgram_does_not_draw_are_warned_about_at_their_first_place() {
     let render = subgram(&["render", f, "-o", png.to_str().unwrap()]);
     assert!(render.status.success(), "{}", stderr(&render));
     assert_eq!(stderr(&render).matches(": warning:").count(), 3);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Views (manual 7.3): `UseView` activates the views that the view file's
@@ -351,8 +349,8 @@ fn modules_subgram_does_not_draw_are_warned_about_at_their_first_place() {
 /// is a warning and no file.
 #[test]
 fn every_view_is_drawn_to_its_own_file() {
-    let dir = std::env::temp_dir().join(format!("subgram-cli-views-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("cli-views");
+    let dir = tmp.path();
     std::fs::write(
         dir.join("view.v"),
         "window: Top 0.0 0.0 1.0 0.5\nwindow: Side 0.0 0.5 0.5 0.5\n",
@@ -384,7 +382,7 @@ fn every_view_is_drawn_to_its_own_file() {
     // are circles in Side only.
     assert_eq!(svg_counts(&main), (3, 0, 0));
     assert_eq!(svg_counts(&side), (3, 4, 0));
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
+    let mut names: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
@@ -402,7 +400,6 @@ fn every_view_is_drawn_to_its_own_file() {
     ]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(!again.exists());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// A tropism of the view file that cannot be read (a null direction, or a
@@ -411,8 +408,8 @@ fn every_view_is_drawn_to_its_own_file() {
 /// runs, as lpfg runs it.
 #[test]
 fn a_bad_tropism_in_the_view_file_is_a_warning_at_its_line() {
-    let dir = std::env::temp_dir().join(format!("subgram-cli-bad-view-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("cli-bad-view");
+    let dir = tmp.path();
     let view = dir.join("view.v");
     std::fs::write(
         &view,
@@ -451,7 +448,6 @@ Axiom: F(1);
     let o = subgram(&["derive", file.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0));
     assert_eq!(stdout(&o).trim(), "F(1)");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Writing a creased mesh keeps its sharp edges in PLY (an `edge` element
@@ -463,9 +459,10 @@ Axiom: F(1);
 /// 2 = 16 edges, while the finite ones (2 and 0.5) have dropped to 0.
 #[test]
 fn writing_a_creased_mesh_keeps_or_reports_its_sharpness() {
-    use crate::reverse::{run_in, scratch};
+    use crate::reverse::run_in;
     use subgram::mesh::io::read_mesh;
-    let dir = scratch("write-creases");
+    let tmp = scratch("write-creases");
+    let dir = tmp.path();
     let cube = lsys("meshes/creased-cube.ply");
     let octa = lsys("meshes/creased-octahedron.obj");
     let (cube, octa) = (cube.to_str().unwrap(), octa.to_str().unwrap());
@@ -493,7 +490,7 @@ fn writing_a_creased_mesh_keeps_or_reports_its_sharpness() {
         if triangles {
             args.push("--triangles");
         }
-        let r = run_in(&dir, &args);
+        let r = run_in(dir, &args);
         assert_eq!(r.code, Some(0), "{}", r.stderr);
         assert_eq!(r.stderr, "", "a PLY keeps every sharp edge");
         let back = read_mesh(&dir.join("c.ply")).unwrap();
@@ -503,7 +500,7 @@ fn writing_a_creased_mesh_keeps_or_reports_its_sharpness() {
             "--triangles {triangles}"
         );
     }
-    let r = run_in(&dir, &["mesh", "convert", cube, "c.obj"]);
+    let r = run_in(dir, &["mesh", "convert", cube, "c.obj"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(
         r.stderr
@@ -511,7 +508,7 @@ fn writing_a_creased_mesh_keeps_or_reports_its_sharpness() {
         "{}",
         r.stderr
     );
-    let r = run_in(&dir, &["mesh", "convert", octa, "o.ply"]);
+    let r = run_in(dir, &["mesh", "convert", octa, "o.ply"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(
         r.stderr
@@ -534,7 +531,7 @@ fn writing_a_creased_mesh_keeps_or_reports_its_sharpness() {
         "-o",
         "s.ply",
     ];
-    let r = run_in(&dir, &args);
+    let r = run_in(dir, &args);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     let s = sharp_edges(&read_mesh(&dir.join("s.ply")).unwrap());
     assert_eq!(s.len(), 16);
@@ -542,7 +539,7 @@ fn writing_a_creased_mesh_keeps_or_reports_its_sharpness() {
     // A file of creases left beside the output is named: it will be read
     // with the new mesh.
     std::fs::write(dir.join("s.creases"), "e 1 2 inf\n").unwrap();
-    let r = run_in(&dir, &args);
+    let r = run_in(dir, &args);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(
         r.stderr.contains("s.ply: warning: `s.creases` beside it"),
@@ -558,8 +555,8 @@ fn writing_a_creased_mesh_keeps_or_reports_its_sharpness() {
 /// quarters empty. `--size` is kept as given.
 #[test]
 fn render_each_sizes_the_canvas_to_its_panels() {
-    let dir = std::env::temp_dir().join(format!("subgram-each-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("each");
+    let dir = tmp.path();
     let f = lsys("figures/fig01-chaikin-square.lsys");
     let size = |extra: &[&str], name: &str| {
         let out = dir.join(name);
@@ -593,8 +590,8 @@ fn render_each_sizes_the_canvas_to_its_panels() {
 /// error (exit code 2) that writes nothing.
 #[test]
 fn analyze_draws_the_characteristic_maps() {
-    let dir = std::env::temp_dir().join(format!("subgram-cli-picture-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("cli-picture");
+    let dir = tmp.path();
     let out = dir.join("loop.svg");
     let f = lsys("surfaces/loop.lsys");
     let o = subgram(&[
@@ -633,5 +630,4 @@ fn analyze_draws_the_characteristic_maps() {
         stderr(&o)
     );
     assert_eq!(std::fs::read(&f).unwrap(), before);
-    let _ = std::fs::remove_dir_all(&dir);
 }

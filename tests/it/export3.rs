@@ -10,6 +10,8 @@ use serde_json::Value;
 use subgram::export::{glb_bytes, obj_text, write, write_glb, write_obj, write_ply};
 use subgram::scene3::{Look, Scene3, TriMesh};
 
+use crate::support::scratch;
+
 /// A tetrahedron with unit vertex normals (look 0) and a quad without
 /// normals (look 1, with a specular part and a name with a space).
 fn two_looks() -> Scene3 {
@@ -59,17 +61,12 @@ fn flat(scene: &Scene3) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     (ps, ts)
 }
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("subgram-export3-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("a folder");
-    dir.join(name)
-}
-
 #[test]
 fn obj_and_mtl_hold_the_geometry_and_the_looks() {
     let sc = two_looks();
     let (ps, ts) = flat(&sc);
-    let path = tmp("two.obj");
+    let tmp = scratch("export3-two-obj");
+    let path = tmp.path().join("two.obj");
     write_obj(&sc, &path).expect("writes");
     // subgram's own reader: the same vertices and triangles.
     let soup = subgram::mesh::io::read(&path).expect("reads back");
@@ -111,7 +108,8 @@ fn obj_and_mtl_hold_the_geometry_and_the_looks() {
 fn ply_holds_positions_and_a_colour_per_vertex() {
     let sc = two_looks();
     let (ps, ts) = flat(&sc);
-    let path = tmp("two.ply");
+    let tmp = scratch("export3-two-ply");
+    let path = tmp.path().join("two.ply");
     write_ply(&sc, &path).expect("writes");
     let soup = subgram::mesh::io::read(&path).expect("reads back");
     assert_eq!(soup.positions.len(), ps.len());
@@ -272,15 +270,16 @@ fn glb_follows_the_gltf_layout_and_holds_the_scene() {
     }
     assert_eq!(pink["doubleSided"], true);
     // Written atomically to the named file.
-    let path = tmp("two.glb");
+    let tmp = scratch("export3-two-glb");
+    let path = tmp.path().join("two.glb");
     write_glb(&sc, &path).expect("writes");
     assert_eq!(std::fs::read(&path).expect("bytes"), bytes);
 }
 
 #[test]
 fn exports_refuse_bad_scenes_and_leave_no_file() {
-    let dir = tmp("refusals");
-    std::fs::create_dir_all(&dir).expect("a folder");
+    let tmp = scratch("export3-refusals");
+    let dir = tmp.path();
     let mut nan = two_looks();
     nan.meshes[1].positions[2].z = f32::NAN;
     for (scene, what) in [(Scene3::default(), "no triangle"), (nan, "non-finite")] {
@@ -302,16 +301,14 @@ fn exports_refuse_bad_scenes_and_leave_no_file() {
         .expect_err("refused")
         .to_string();
     assert!(e.contains("x."), "{e}");
-    assert!(std::fs::read_dir(&dir)
-        .expect("the folder")
-        .next()
-        .is_none());
+    assert!(std::fs::read_dir(dir).expect("the folder").next().is_none());
     assert!(write(&two_looks(), Path::new("x.stl")).is_err());
 }
 
 #[test]
 fn subdivide_writes_a_glb() {
-    let out = tmp("cube.glb");
+    let tmp = scratch("export3-cube-glb");
+    let out = tmp.path().join("cube.glb");
     let root = crate::support::root();
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
         .args(["subdivide", "--grammar"])

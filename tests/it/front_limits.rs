@@ -13,13 +13,7 @@ use std::time::{Duration, Instant};
 use subgram::mesh::{shapes, Mesh};
 use subgram::{DeriveOptions, LoadOptions, System};
 
-/// A folder of this test's own, emptied first.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("subgram-front-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::support::scratch;
 
 /// Runs the binary with `env` set, and says how long it took.
 fn run_with(args: &[&str], env: &[(&str, &str)]) -> (Output, Duration) {
@@ -54,7 +48,8 @@ fn refused(file: &Path, want: &str, limit: Duration) -> String {
 /// level of nesting and stops at the limit, pointing at the link.
 #[test]
 fn megabyte_chains_stop_at_the_nesting_limit() {
-    let dir = scratch("chains");
+    let tmp = scratch("front-chains");
+    let dir = tmp.path();
     let n = 400_000;
     let cases = [
         (
@@ -96,7 +91,8 @@ fn megabyte_chains_stop_at_the_nesting_limit() {
 /// nesting and the tokens that arguments carry are bounded now.
 #[test]
 fn deeply_nested_macro_arguments_are_refused() {
-    let dir = scratch("macro");
+    let tmp = scratch("front-macro");
+    let dir = tmp.path();
     let n = 200_000;
     let f = dir.join("macro.lsys");
     let text = format!(
@@ -117,7 +113,8 @@ fn deeply_nested_macro_arguments_are_refused() {
 /// minute to check: expansion is linear now.
 #[test]
 fn a_chain_of_30000_defines_checks_quickly() {
-    let dir = scratch("defines");
+    let tmp = scratch("front-defines");
+    let dir = tmp.path();
     let n = 30_000;
     let mut text = String::from("#define D0 1\n");
     for i in 1..n {
@@ -150,7 +147,8 @@ fn inputs_have_a_size_limit() {
         );
         assert!(took < Duration::from_secs(10), "{took:?}");
     }
-    let dir = scratch("size");
+    let tmp = scratch("front-size");
+    let dir = tmp.path();
     let f = dir.join("big.lsys");
     // 2 MiB and a bit of comment after a valid program.
     let mut text = String::from("module A;\nAxiom: A;\n");
@@ -185,7 +183,8 @@ fn a_define_without_a_value_is_a_usage_error_everywhere() {
     let curve = root.join("lsystems/curves/chaikin-13.lsys");
     let surface = root.join("lsystems/surfaces/loop.lsys");
     let (curve, surface) = (curve.to_str().unwrap(), surface.to_str().unwrap());
-    let dir = scratch("define");
+    let tmp = scratch("front-define");
+    let dir = tmp.path();
     let png = dir.join("out.png");
     let obj = dir.join("out.obj");
     let (png, obj) = (png.to_str().unwrap(), obj.to_str().unwrap());
@@ -307,7 +306,8 @@ fn inlined_functions_close_to_the_limit_run() {
 /// is 65,535 kinds less the predefined ones (98 of them).
 #[test]
 fn declarations_past_what_16_bits_number_are_refused() {
-    let dir = scratch("counts");
+    let tmp = scratch("front-counts");
+    let dir = tmp.path();
     let n = 70_000;
     let mut globals = String::new();
     for i in 0..n {
@@ -366,7 +366,8 @@ fn declarations_past_what_16_bits_number_are_refused() {
 /// first 100 and counts the rest.
 #[test]
 fn many_errors_on_one_long_line_are_reported_quickly_and_counted() {
-    let dir = scratch("errors");
+    let tmp = scratch("front-errors");
+    let dir = tmp.path();
     let f = dir.join("many.lsys");
     let n = 1_000_000;
     std::fs::write(&f, format!("module A;\nAxiom: {};\n", "Q ".repeat(n))).unwrap();

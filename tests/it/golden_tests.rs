@@ -2,6 +2,7 @@
 //! would let every golden test pass.
 
 use crate::golden::*;
+use crate::support::scratch;
 
 /// The comparison itself: these would pass if it were too lenient.
 #[test]
@@ -52,7 +53,8 @@ fn json_lines_is_json_with_one_module_per_line() {
 /// written; a differing one is reported with the line that differs.
 #[test]
 fn a_missing_or_differing_expectation_fails() {
-    let dir = std::env::temp_dir().join(format!("subgram-golden-{}", std::process::id()));
+    let tmp = scratch("golden");
+    let dir = tmp.path();
     let missing = dir.join("missing.txt");
     let result = compare(&missing, b"x\n", Kind::Exact);
     if updating() {
@@ -64,7 +66,6 @@ fn a_missing_or_differing_expectation_fails() {
         assert!(e.contains("cannot read the expectation"), "{e}");
         assert!(!missing.exists());
     }
-    std::fs::create_dir_all(&dir).unwrap();
     let present = dir.join("present.txt");
     std::fs::write(&present, "a\nb\n").unwrap();
     assert!(compare(&present, b"a\nb\n", Kind::Exact).is_ok());
@@ -91,8 +92,8 @@ fn png_comparison_has_its_documented_tolerance() {
         pm.encode_png().unwrap()
     };
     let white = picture(&|_, _| 255);
-    let dir = std::env::temp_dir().join(format!("subgram-golden-png-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("golden-png");
+    let dir = tmp.path();
     let path = dir.join("white.png");
     std::fs::write(&path, &white).unwrap();
     assert!(compare(&path, &picture(&|_, _| 254), Kind::Png).is_ok());

@@ -293,8 +293,8 @@ fn bad_matrices_are_refused_with_their_place_and_reason() {
         ..Default::default()
     });
     assert!(m.contains("give the scheme once"), "{m}");
-    let dir = std::env::temp_dir().join(format!("subgram-infer-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("infer");
+    let dir = tmp.path();
     let f = dir.join("m.txt");
     std::fs::write(&f, "# Chaikin\n1/4 3/4 0\n0 3/4 1/4x\n").unwrap();
     let m = e(InferArgs {

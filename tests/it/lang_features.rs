@@ -268,12 +268,12 @@ fn fopen_needs_allow_writes_and_a_path_inside_the_folder() {
     assert!(e.contains("test.lsys:5:13"), "{e}");
     assert!(e.contains("--allow-writes"), "{e}");
 
-    let dir = std::env::temp_dir().join(format!("subgram-fopen-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("fopen");
+    let dir = tmp.path();
     let file = dir.join("prog.lsys");
     std::fs::write(&file, src.replace("NAME", "sub/out.txt")).unwrap();
     let mut args = subgram::command::DeriveArgs::new(file.to_str().unwrap());
-    args.allow_writes = Some(dir.clone());
+    args.allow_writes = Some(dir.to_path_buf());
     assert_eq!(
         subgram::command::derive(&args, |_| {}).unwrap().text,
         "A(1)"
@@ -289,7 +289,6 @@ fn fopen_needs_allow_writes_and_a_path_inside_the_folder() {
         .to_string();
     assert!(e.contains("only inside the --allow-writes folder"), "{e}");
     assert!(!dir.join("../escape.txt").exists());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -423,8 +422,8 @@ fn a_long_recursion_stops_at_the_deadline() {
 /// text mode.
 #[test]
 fn printed_text_and_the_json_word_do_not_mix() {
-    let dir = std::env::temp_dir().join(format!("subgram-printf-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("printf");
+    let dir = tmp.path();
     let file = dir.join("p.lsys");
     std::fs::write(
         &file,
@@ -452,7 +451,6 @@ fn printed_text_and_the_json_word_do_not_mix() {
     let word: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(word["modules"][0]["params"][0], 2);
     assert_eq!(err, "n is 1\nto stderr\n");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `End` runs after the final derivation step (manual §4.1) on every path
@@ -460,8 +458,8 @@ fn printed_text_and_the_json_word_do_not_mix() {
 /// prints `end after 2 steps` for this program.
 #[test]
 fn end_runs_after_the_final_step_for_derive_and_render() {
-    let dir = std::env::temp_dir().join(format!("subgram-end-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("end");
+    let dir = tmp.path();
     let file = dir.join("end.l");
     std::fs::write(
         &file,
@@ -473,7 +471,7 @@ fn end_runs_after_the_final_step_for_derive_and_render() {
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
             .args(args)
             .arg(&file)
-            .current_dir(&dir)
+            .current_dir(dir)
             .output()
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -481,7 +479,6 @@ fn end_runs_after_the_final_step_for_derive_and_render() {
     };
     assert_eq!(run(&["derive"]), "end after 2 steps\nA F F\n");
     assert_eq!(run(&["render", "-o", "end.png"]), "end after 2 steps\n");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 // ----- switch, character constants, C++ structs (issue 12, C++ forms) -----

@@ -10,40 +10,30 @@ use std::time::{Duration, Instant};
 
 use subgram::DeriveOptions;
 
-use crate::support::{load_text, lsys};
+use crate::support::{load_text, lsys, scratch};
 
 /// A folder of its own for one test, removed afterwards.
-struct Scratch(PathBuf);
+struct Scratch(tempfile::TempDir);
 
 impl Scratch {
     fn new(name: &str) -> Scratch {
-        let dir =
-            std::env::temp_dir().join(format!("subgram-limits-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
+        Scratch(scratch(&format!("limits-{name}")))
     }
 
     fn write(&self, name: &str, text: &str) -> PathBuf {
-        let p = self.0.join(name);
+        let p = self.0.path().join(name);
         std::fs::write(&p, text).unwrap();
         p
     }
 
     /// The names of the files in the folder, sorted.
     fn files(&self) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(&self.0)
+        let mut v: Vec<String> = std::fs::read_dir(self.0.path())
             .unwrap()
             .map(|e| e.unwrap().file_name().into_string().unwrap())
             .collect();
         v.sort();
         v
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
     }
 }
 
@@ -93,7 +83,7 @@ A(x) : { int i = 0; while (i < 9000000) i = i + 1; produce A(x + 1); }
 fn long_loops_in_every_body_stop_at_the_time_limit() {
     let s = Scratch::new("endless");
     s.write("endless.lsys", ENDLESS);
-    let r = subgram(&s.0, &["derive", "endless.lsys", "--timeout", "1"]);
+    let r = subgram(s.0.path(), &["derive", "endless.lsys", "--timeout", "1"]);
     fails_with(
         &r,
         "production `A(x)`: the run went past its time limit of 1 s; \
@@ -105,7 +95,7 @@ fn long_loops_in_every_body_stop_at_the_time_limit() {
     assert!(r.took < Duration::from_secs(10), "{:?}", r.took);
 
     let r = subgram(
-        &s.0,
+        s.0.path(),
         &["render", "endless.lsys", "-o", "out.png", "--timeout", "1"],
     );
     fails_with(&r, "the run went past its time limit of 1 s");
@@ -120,11 +110,11 @@ fn the_time_limit_is_a_number_of_seconds() {
         "a.lsys",
         "module A;\nderivation length: 2;\nAxiom: A;\nA -> A A\n",
     );
-    let r = subgram(&s.0, &["derive", "a.lsys", "--timeout", "soon"]);
+    let r = subgram(s.0.path(), &["derive", "a.lsys", "--timeout", "soon"]);
     assert_eq!(r.code, Some(2), "{}", r.stderr);
     assert!(r.stderr.contains("`soon` is not a number of seconds"));
     for ok in ["0", "0.5", "600"] {
-        let r = subgram(&s.0, &["derive", "a.lsys", "--timeout", ok]);
+        let r = subgram(s.0.path(), &["derive", "a.lsys", "--timeout", ok]);
         assert_eq!(r.code, Some(0), "{}", r.stderr);
         assert_eq!(r.stdout.trim(), "A A A A");
     }
@@ -136,7 +126,7 @@ fn subdivide_reverse_and_reconstruct_stop_at_the_time_limit() {
     let grammar = lsys("surfaces/loop.lsys");
     let mesh = lsys("meshes/octahedron.obj");
     let r = subgram(
-        &s.0,
+        s.0.path(),
         &[
             "subdivide",
             mesh.to_str().unwrap(),
@@ -169,7 +159,7 @@ fn subdivide_reverse_and_reconstruct_stop_at_the_time_limit() {
     s.write("in.txt", &points);
     let reverse = |timeout: &str| {
         subgram(
-            &s.0,
+            s.0.path(),
             &[
                 "reverse",
                 "in.txt",
@@ -193,7 +183,7 @@ fn subdivide_reverse_and_reconstruct_stop_at_the_time_limit() {
     let r = reverse("600");
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     let r = subgram(
-        &s.0,
+        s.0.path(),
         &[
             "reconstruct",
             "coarse.txt",
@@ -220,7 +210,7 @@ fn right_contexts_skip_deep_branches_in_linear_time() {
     text.push_str(&" EB()".repeat(depth));
     text.push_str(" C;\nA > C -> B\n");
     s.write("deep.lsys", &text);
-    let r = subgram(&s.0, &["derive", "deep.lsys", "--timeout", "20"]);
+    let r = subgram(s.0.path(), &["derive", "deep.lsys", "--timeout", "20"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     // Only the outermost A sees C, past the whole branch.
     assert!(
@@ -243,7 +233,7 @@ fn contexts_skip_long_runs_of_ignored_modules_in_linear_time() {
         " A".repeat(n)
     );
     s.write("runs.lsys", &text);
-    let r = subgram(&s.0, &["derive", "runs.lsys", "--timeout", "20"]);
+    let r = subgram(s.0.path(), &["derive", "runs.lsys", "--timeout", "20"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert_eq!(r.stdout.trim(), format!("B{} B", " C".repeat(n)));
     assert!(r.took < Duration::from_secs(20), "{:?}", r.took);
@@ -260,7 +250,7 @@ fn a_context_after_a_predecessor_that_wraps_stays_on_the_ring() {
         "module A; module B;\nring L-system: 1;\nignore: A;\nderivation length: 1;\n\
          Axiom: A A A;\nA() A() > B() -> B\n",
     );
-    let r = subgram(&s.0, &["derive", "wrap.lsys", "--phase", "2"]);
+    let r = subgram(s.0.path(), &["derive", "wrap.lsys", "--phase", "2"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert_eq!(r.stdout.trim(), "A A A");
 }
@@ -273,7 +263,7 @@ fn the_axiom_counts_against_the_module_limit() {
         " A(1)".repeat(3000)
     );
     s.write("big.lsys", &text);
-    let r = subgram(&s.0, &["derive", "big.lsys", "--max-modules", "2000"]);
+    let r = subgram(s.0.path(), &["derive", "big.lsys", "--max-modules", "2000"]);
     // The caret is under the first module past the limit.
     fails_with(
         &r,
@@ -281,7 +271,7 @@ fn the_axiom_counts_against_the_module_limit() {
          raise the limit with --max-modules",
     );
     assert!(r.stderr.contains("\n  |"), "{}", r.stderr);
-    let r = subgram(&s.0, &["derive", "big.lsys", "--max-modules", "3000"]);
+    let r = subgram(s.0.path(), &["derive", "big.lsys", "--max-modules", "3000"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
 }
 
@@ -295,7 +285,10 @@ fn a_successor_built_in_a_loop_counts_against_the_module_limit() {
         "module A; module B;\nderivation length: 1;\nAxiom: A;\n\
          A : { int i = 0; while (i < 9000000) { nproduce B B B B B B B B B B; i = i + 1; } produce A; }\n",
     );
-    let r = subgram(&s.0, &["derive", "loop.lsys", "--max-modules", "1000"]);
+    let r = subgram(
+        s.0.path(),
+        &["derive", "loop.lsys", "--max-modules", "1000"],
+    );
     fails_with(
         &r,
         "loop.lsys:4:1: error: at step 1, production `A()`: the word grew past 1000 modules; \
@@ -313,7 +306,10 @@ fn decomposition_and_interpretation_count_against_the_module_limit() {
         "module A;\nderivation length: 1;\nAxiom: A;\n\
          decomposition:\nmaximum depth: 100;\nA -> A A\n",
     );
-    let r = subgram(&s.0, &["derive", "decompose.lsys", "--max-modules", "1000"]);
+    let r = subgram(
+        s.0.path(),
+        &["derive", "decompose.lsys", "--max-modules", "1000"],
+    );
     fails_with(
         &r,
         "decompose.lsys:6:1: error: at step 0, decomposition rule `A()`: the word grew past 1000 modules",
@@ -324,7 +320,7 @@ fn decomposition_and_interpretation_count_against_the_module_limit() {
          interpretation:\nmaximum depth: 100;\nA -> A A\n",
     );
     let r = subgram(
-        &s.0,
+        s.0.path(),
         &[
             "derive",
             "interpret.lsys",
@@ -379,13 +375,16 @@ fn a_drawing_that_overflows_names_its_module_step_and_maker() {
     );
     // In lpfg's single precision, 1e308 is no float at all: the axiom
     // already holds an infinity.
-    let r = subgram(&s.0, &["render", "far.lsys", "-o", "far.png"]);
+    let r = subgram(s.0.path(), &["render", "far.lsys", "-o", "far.png"]);
     fails_with(
         &r,
         "far.lsys:3:8: error: parameter 1 of this successor module is inf",
     );
     // In double precision it is a number, and the turtle overflows.
-    let r = subgram(&s.0, &["render", "far.lsys", "-o", "far.png", "--double"]);
+    let r = subgram(
+        s.0.path(),
+        &["render", "far.lsys", "-o", "far.png", "--double"],
+    );
     fails_with(
         &r,
         "far.lsys:4:1: error: at step 2, module 2 of the interpreted word, `F(1e308)`, \
@@ -394,7 +393,7 @@ fn a_drawing_that_overflows_names_its_module_step_and_maker() {
     );
     // Each step drawn: step 1 draws, step 2 overflows.
     let r = subgram(
-        &s.0,
+        s.0.path(),
         &["render", "far.lsys", "-o", "far.png", "--each", "--double"],
     );
     fails_with(&r, "far.lsys:4:1: error: at step 2, module 2 ");
@@ -402,7 +401,10 @@ fn a_drawing_that_overflows_names_its_module_step_and_maker() {
         "disc.lsys",
         "module A;\nderivation length: 0;\nAxiom: MoveTo2f(V2f(1e308, 0)) Circle(1e308);\n",
     );
-    let r = subgram(&s.0, &["render", "disc.lsys", "-o", "disc.svg", "--double"]);
+    let r = subgram(
+        s.0.path(),
+        &["render", "disc.lsys", "-o", "disc.svg", "--double"],
+    );
     fails_with(
         &r,
         "disc.lsys:3:32: error: at step 0, module 2 of the interpreted word, `Circle(1e308)`, \

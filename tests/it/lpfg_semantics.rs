@@ -372,15 +372,14 @@ fn rhombus_and_triangle_are_polygons_in_the_hl_plane() {
 
 /// The query vectors of `program` derived beside a view file `view`.
 fn queries_with_view(name: &str, view: &str, program: &str) -> Vec<[f64; 3]> {
-    let dir = std::env::temp_dir().join(format!("subgram-lpfg-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch(&format!("lpfg-{name}"));
+    let dir = tmp.path();
     std::fs::write(dir.join("view.v"), view).unwrap();
     let file = dir.join("lsystem.l");
     std::fs::write(&file, program).unwrap();
     let l = load(&file);
     // The curve's own derive: it brings the view file's settings.
     let d = l.derive(DeriveOptions::default()).unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
     d.word
         .modules(&l.program.alphabet, &l.program.structs)
         .filter(|(s, _)| l.program.alphabet.name(*s).starts_with("Get"))

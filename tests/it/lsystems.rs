@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::golden::{self, Kind};
-use crate::support::root;
+use crate::support::{root, scratch};
 
 /// The folders of `lsystems/`, each checked by its own test below.
 const FOLDERS: &[&str] = &[
@@ -172,8 +172,8 @@ fn outputs(rel: &Path) -> Result<Vec<Vec<u8>>, String> {
     }
     if folder == "shapes" {
         let stem = rel.file_stem().unwrap().to_str().unwrap();
-        let dir = std::env::temp_dir().join(format!("subgram-shapes-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let tmp = scratch("shapes");
+        let dir = tmp.path();
         let out = dir.join(format!("{stem}.obj"));
         let o = out.to_str().unwrap();
         subgram(&["subdivide", "--grammar", f, "-o", o])?;
@@ -187,8 +187,8 @@ fn outputs(rel: &Path) -> Result<Vec<Vec<u8>>, String> {
         return Ok(vec![golden::json_lines(&json).into_bytes()]);
     }
     let stem = rel.file_stem().unwrap().to_str().unwrap();
-    let dir = std::env::temp_dir().join(format!("subgram-lsystems-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("lsystems");
+    let dir = tmp.path();
     let subdivide = |mesh: Option<&str>, out: &str| -> Result<Vec<u8>, String> {
         let out = dir.join(out);
         let o = out.to_str().unwrap();

@@ -5,6 +5,8 @@ use glam::DVec3;
 use subgram::mesh::shapes;
 use subgram::mesh::{EdgeId, FaceId, Mesh, PolygonSoup, VertexId};
 
+use crate::support::scratch;
+
 fn soup(positions: &[[f64; 3]], faces: &[&[u32]]) -> PolygonSoup {
     PolygonSoup {
         positions: positions.iter().map(|p| DVec3::from_array(*p)).collect(),
@@ -544,8 +546,8 @@ fn mesh_commands_info_convert_and_render() {
     assert_eq!(v["quads"], 96);
     let o = bin(&["mesh", "info", torus.to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("Euler characteristic 0, genus 1"));
-    let dir = std::env::temp_dir().join(format!("subgram-mesh-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("mesh-cli");
+    let dir = tmp.path();
     for ext in ["off", "ply", "obj"] {
         let out = dir.join(format!("t.{ext}"));
         let o = bin(&[

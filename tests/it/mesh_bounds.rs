@@ -10,6 +10,8 @@ use std::time::{Duration, Instant};
 use subgram::mesh::io::{self, Format};
 use subgram::mesh::{Mesh, PolygonSoup, VertexId};
 
+use crate::support::scratch;
+
 /// Runs the binary in `dir` with `env` set, timing it.
 fn bin(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> (Output, Duration) {
     let t = Instant::now();
@@ -22,14 +24,6 @@ fn bin(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> (Output, Duration) {
         .output()
         .unwrap();
     (o, t.elapsed())
-}
-
-/// A fresh empty folder for the test `name`.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("subgram-bounds-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 /// The folder's entries, by name.
@@ -131,13 +125,14 @@ end_header
 fn bounds_ply_element_without_properties_and_a_huge_count() {
     // Once a hang in every command that reads a mesh: nothing is read per
     // instance, so the count alone drove the loop.
-    let dir = scratch("no-properties");
+    let tmp = scratch("bounds-no-properties");
+    let dir = tmp.path();
     let element = "element e 18446744073709551615\n";
     let ascii = TET_PLY.replace(
         "element vertex 4\n",
         &format!("{element}element vertex 4\n"),
     );
-    let err = refused(&dir, "ascii.ply", ascii.as_bytes(), &[], 10);
+    let err = refused(dir, "ascii.ply", ascii.as_bytes(), &[], 10);
     assert_mentions(
         &err,
         &[
@@ -150,13 +145,12 @@ fn bounds_ply_element_without_properties_and_a_huge_count() {
         .replace("end_header\n", &format!("{element}end_header\n"))
         .into_bytes();
     binary.extend(tet_binary_data());
-    let err = refused(&dir, "binary.ply", &binary, &[], 10);
+    let err = refused(dir, "binary.ply", &binary, &[], 10);
     assert_mentions(&err, &["binary.ply:9:11: error: the `e` element declares"]);
     // With no instances it is harmless.
     let empty = TET_PLY.replace("element vertex 4\n", "element e 0\nelement vertex 4\n");
     let soup = io::read_str("t.ply", Format::Ply, empty.as_bytes()).unwrap();
     assert_eq!(soup.faces.len(), 4);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -244,9 +238,10 @@ fn bounds_ascii_counts_past_the_data() {
 
 #[test]
 fn bounds_mesh_errors_show_the_line_and_a_caret() {
-    let dir = scratch("located");
+    let tmp = scratch("bounds-located");
+    let dir = tmp.path();
     let err = refused(
-        &dir,
+        dir,
         "m.obj",
         b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n",
         &[],
@@ -258,7 +253,7 @@ fn bounds_mesh_errors_show_the_line_and_a_caret() {
          |\n4 | f 1 2 7\n  |       ^\n"
     );
     let err = refused(
-        &dir,
+        dir,
         "m.off",
         b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2x\n",
         &[],
@@ -269,7 +264,7 @@ fn bounds_mesh_errors_show_the_line_and_a_caret() {
         "m.off:6:7: error: expected a vertex index, found `2x`\n  |\n6 | 3 0 1 2x\n  |       ^^\n"
     );
     let err = refused(
-        &dir,
+        dir,
         "m.ply",
         TET_PLY.replace("1 0 0\n", "1 0 zero\n").as_bytes(),
         &[],
@@ -281,7 +276,7 @@ fn bounds_mesh_errors_show_the_line_and_a_caret() {
     );
     let mut bytes = TET_BIN_HEADER.replace("float z", "float z w").into_bytes();
     bytes.extend(tet_binary_data());
-    let err = refused(&dir, "b.ply", &bytes, &[], 10);
+    let err = refused(dir, "b.ply", &bytes, &[], 10);
     assert_eq!(
         err,
         "b.ply:6:1: error: expected `property TYPE NAME` or `property list COUNT_TYPE ITEM_TYPE NAME`\n  \
@@ -289,14 +284,14 @@ fn bounds_mesh_errors_show_the_line_and_a_caret() {
     );
     // What the half-edge mesh refuses, at the line of the element.
     let bowtie = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n";
-    let err = refused(&dir, "bowtie.obj", bowtie, &[], 10);
+    let err = refused(dir, "bowtie.obj", bowtie, &[], 10);
     assert_eq!(
         err,
         "bowtie.obj:1:1: error: vertex 1 (line 1) is a bow-tie: two separate fans of faces meet \
          there (non-manifold)\n  |\n1 | v 0 0 0\n  | ^^^^^^^\n"
     );
     // Invalid UTF-8, at its byte, the line shown with U+FFFD.
-    let err = refused(&dir, "u.obj", b"v 0 0 0\nv 1 \xff\xfe 0\n", &[], 10);
+    let err = refused(dir, "u.obj", b"v 0 0 0\nv 1 \xff\xfe 0\n", &[], 10);
     assert_eq!(
         err,
         "u.obj:2:5: error: the file is not UTF-8 text (an invalid byte on this line)\n  \
@@ -307,9 +302,8 @@ fn bounds_mesh_errors_show_the_line_and_a_caret() {
         .into_bytes();
     let at = bytes.iter().position(|&b| b == b'@').unwrap();
     bytes[at] = 0xff;
-    let err = refused(&dir, "h.ply", &bytes, &[], 10);
+    let err = refused(dir, "h.ply", &bytes, &[], 10);
     assert_mentions(&err, &["h.ply:7:10: error: the PLY header is not text"]);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 // ---------------------------------------------------------------------------
@@ -317,9 +311,10 @@ fn bounds_mesh_errors_show_the_line_and_a_caret() {
 
 #[test]
 fn bounds_files_larger_than_the_limit_are_refused_before_reading() {
-    let dir = scratch("size");
+    let tmp = scratch("bounds-size");
+    let dir = tmp.path();
     let limit = [("SUBGRAM_MAX_MESH_BYTES", "100")];
-    let err = refused(&dir, "big.ply", TET_PLY.as_bytes(), &limit, 10);
+    let err = refused(dir, "big.ply", TET_PLY.as_bytes(), &limit, 10);
     assert_mentions(
         &err,
         &[
@@ -328,7 +323,7 @@ fn bounds_files_larger_than_the_limit_are_refused_before_reading() {
         ],
     );
     let bad = [("SUBGRAM_MAX_MESH_BYTES", "2G")];
-    let err = refused(&dir, "tet.ply", TET_PLY.as_bytes(), &bad, 10);
+    let err = refused(dir, "tet.ply", TET_PLY.as_bytes(), &bad, 10);
     assert_mentions(
         &err,
         &["SUBGRAM_MAX_MESH_BYTES must be a whole number of bytes, found `2G`"],
@@ -336,7 +331,7 @@ fn bounds_files_larger_than_the_limit_are_refused_before_reading() {
     // A device that cannot hold a mesh of the format is refused at its
     // first bytes: `/dev/zero` gives NUL bytes, and OBJ files are text.
     std::os::unix::fs::symlink("/dev/zero", dir.join("zero.obj")).unwrap();
-    let (o, took) = bin(&dir, &["mesh", "convert", "zero.obj", "out.obj"], &[]);
+    let (o, took) = bin(dir, &["mesh", "convert", "zero.obj", "out.obj"], &[]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(took < Duration::from_secs(10), "{took:?}");
@@ -351,7 +346,7 @@ fn bounds_files_larger_than_the_limit_are_refused_before_reading() {
     std::os::unix::fs::symlink("/dev/stdin", dir.join("stream.obj")).unwrap();
     let t = Instant::now();
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
-        .current_dir(&dir)
+        .current_dir(dir)
         .args(["mesh", "convert", "stream.obj", "out.obj"])
         .env_remove("SUBGRAM_MAX_MESH_BYTES")
         .env("SUBGRAM_MAX_MESH_BYTES", "1048576")
@@ -377,9 +372,8 @@ fn bounds_files_larger_than_the_limit_are_refused_before_reading() {
         &["stream.obj: error: the file goes on, more than the limit of 1048576 bytes (1 MiB) for a \
            mesh file; set SUBGRAM_MAX_MESH_BYTES"],
     );
-    assert_eq!(entries(&dir), vec!["stream.obj".to_string()]);
+    assert_eq!(entries(dir), vec!["stream.obj".to_string()]);
     assert_eq!(io::MAX_FILE_BYTES, 2 << 30);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 // ---------------------------------------------------------------------------
@@ -504,7 +498,8 @@ fn bounds_valence_limit_allows_twice_the_base_mesh() {
 
 #[test]
 fn bounds_valence_limit_from_the_command_line() {
-    let dir = scratch("valence");
+    let tmp = scratch("bounds-valence");
+    let dir = tmp.path();
     let octahedron =
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("lsystems/meshes/octahedron.obj");
     std::fs::write(dir.join("two.lsys"), TWO_SPLITS).unwrap();
@@ -516,7 +511,7 @@ fn bounds_valence_limit_from_the_command_line() {
         "-o",
         "out.obj",
     ];
-    let (o, took) = bin(&dir, &args, &[]);
+    let (o, took) = bin(dir, &args, &[]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(took < Duration::from_secs(20), "{took:?}");
@@ -528,7 +523,7 @@ fn bounds_valence_limit_from_the_command_line() {
             "(set SUBGRAM_MAX_VALENCE to a larger number to allow more)",
         ],
     );
-    let (o, _) = bin(&dir, &args, &[("SUBGRAM_MAX_VALENCE", "100")]);
+    let (o, _) = bin(dir, &args, &[("SUBGRAM_MAX_VALENCE", "100")]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert_mentions(
@@ -538,15 +533,14 @@ fn bounds_valence_limit_from_the_command_line() {
             "valence 128 after this rule, more than the limit of 100",
         ],
     );
-    let (o, _) = bin(&dir, &args, &[("SUBGRAM_MAX_VALENCE", "many")]);
+    let (o, _) = bin(dir, &args, &[("SUBGRAM_MAX_VALENCE", "many")]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert_mentions(
         &err,
         &["SUBGRAM_MAX_VALENCE must be a whole number, found `many`"],
     );
-    assert_eq!(entries(&dir), vec!["two.lsys".to_string()]);
-    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(entries(dir), vec!["two.lsys".to_string()]);
 }
 
 #[test]

@@ -1,11 +1,13 @@
 //! Mesh files: reading OBJ, OFF and PLY (ASCII and binary), writing them
 //! back exactly, and refusing bad files with located messages.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::DVec3;
 use subgram::mesh::io::{self, Format};
 use subgram::mesh::PolygonSoup;
+
+use crate::support::scratch;
 
 // ---------------------------------------------------------------------------
 // Helpers
@@ -52,14 +54,6 @@ fn assert_mentions(msg: &str, parts: &[&str]) {
     for part in parts {
         assert!(msg.contains(part), "`{part}` is not in the message:\n{msg}");
     }
-}
-
-/// A fresh empty directory for files of the test `name`.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("subgram-mesh-io-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("cannot create a scratch directory");
-    dir
 }
 
 fn faces(soup: &PolygonSoup) -> Vec<Vec<u32>> {
@@ -526,7 +520,8 @@ fn mesh_io_round_trip_of_read_meshes() {
 
 #[test]
 fn mesh_io_writes_files_atomically_and_reads_them_back() {
-    let dir = scratch("atomic");
+    let tmp = scratch("mesh-io-atomic");
+    let dir = tmp.path();
     let soup = mixed_soup();
     let names = ["m.obj", "m.OFF", "m.Ply"];
     for name in names {
@@ -538,7 +533,7 @@ fn mesh_io_writes_files_atomically_and_reads_them_back() {
         assert_eq!(bits(&back), bits(&soup), "{name}");
         assert_eq!(back.faces, soup.faces, "{name}");
     }
-    let mut left: Vec<String> = std::fs::read_dir(&dir)
+    let mut left: Vec<String> = std::fs::read_dir(dir)
         .expect("cannot list the scratch directory")
         .map(|e| {
             e.expect("a directory entry")
@@ -553,7 +548,6 @@ fn mesh_io_writes_files_atomically_and_reads_them_back() {
         vec!["m.OFF", "m.Ply", "m.obj"],
         "temporary files left"
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -570,14 +564,14 @@ fn mesh_io_format_from_path() {
 
 #[test]
 fn mesh_io_error_unreadable_file() {
-    let dir = scratch("unreadable");
+    let tmp = scratch("mesh-io-unreadable");
+    let dir = tmp.path();
     let path = dir.join("missing.obj");
     let msg = io::read(&path).expect_err("a missing file").to_string();
     assert_mentions(
         &msg,
         &[&format!("{}: error: cannot read the file", path.display())],
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -613,7 +607,8 @@ fn mesh_io_error_unknown_extension() {
 
 #[test]
 fn mesh_io_error_unwritable_file() {
-    let dir = scratch("unwritable");
+    let tmp = scratch("mesh-io-unwritable");
+    let dir = tmp.path();
     let path = dir.join("no/such/dir/m.obj");
     let msg = io::write(&path, &mixed_soup())
         .expect_err("no directory")
@@ -622,7 +617,6 @@ fn mesh_io_error_unwritable_file() {
         &msg,
         &[&format!("{}: error: cannot write the file", path.display())],
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

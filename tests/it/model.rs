@@ -4,18 +4,18 @@
 //! and from hand computations written out here, independent of the
 //! implementation.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use subgram::model::{self, Colours, Model};
 use subgram::{LoadOptions, System, Value};
 
-use crate::support::root;
+use crate::support::{root, scratch};
 
 fn models(name: &str) -> PathBuf {
     root().join("tests/data/models").join(name)
 }
 
-fn curve(path: &PathBuf) -> subgram::Curve {
+fn curve(path: &Path) -> subgram::Curve {
     match subgram::load(path, &LoadOptions::default()) {
         Ok(System::Curve(c)) => c,
         Ok(_) => panic!("{} is not a curve", path.display()),
@@ -303,20 +303,19 @@ fn surfaces_are_placed_on_the_turtle() {
 fn a_surface_the_model_lacks_is_an_error() {
     let dir = models("surface");
     let text = "#include <lpfgall.h>\nderivation length: 0;\nAxiom: Surface(1, 1);\n";
-    let tmp = std::env::temp_dir().join(format!("subgram-model-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
+    let folder = scratch("model");
+    let tmp = folder.path();
     for f in ["square.s", "view.v"] {
         std::fs::copy(dir.join(f), tmp.join(f)).unwrap();
     }
     std::fs::write(tmp.join("lsystem.l"), text).unwrap();
-    let c = curve(&tmp);
+    let c = curve(tmp);
     let e = c
         .run(Default::default())
         .unwrap()
         .events()
         .unwrap_err()
         .to_string();
-    std::fs::remove_dir_all(&tmp).unwrap();
     assert!(
         e.contains("draws surface 1, but the model has surfaces 0 to 0"),
         "{e}"
@@ -325,8 +324,8 @@ fn a_surface_the_model_lacks_is_an_error() {
 
 #[test]
 fn specifications_name_the_files_and_a_missing_one_is_an_error() {
-    let tmp = std::env::temp_dir().join(format!("subgram-spec-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
+    let folder = scratch("spec");
+    let tmp = folder.path();
     let src = models("accessors");
     for f in ["lsystem.l", "functions.fset"] {
         std::fs::copy(src.join(f), tmp.join(f)).unwrap();
@@ -336,10 +335,9 @@ fn specifications_name_the_files_and_a_missing_one_is_an_error() {
         "lsystem.l\n*\nmodel:\n\tgenerate:\n\t\tlpfg -rmode cont lsystem.l functions.fset params.vset\n",
     )
     .unwrap();
-    let e = subgram::load(&tmp, &LoadOptions::default())
+    let e = subgram::load(tmp, &LoadOptions::default())
         .unwrap_err()
         .to_string();
-    std::fs::remove_dir_all(&tmp).unwrap();
     // The caret is under the missing file's name on the lpfg line.
     assert!(e.contains("specifications:5:"), "{e}");
     assert!(e.contains("names `params.vset`, but"), "{e}");
@@ -357,8 +355,8 @@ fn specifications_name_the_files_and_a_missing_one_is_an_error() {
 
 #[test]
 fn check_warns_about_view_commands_and_environmental_programs() {
-    let tmp = std::env::temp_dir().join(format!("subgram-notes-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
+    let folder = scratch("notes");
+    let tmp = folder.path();
     std::fs::copy(
         root().join("tests/data/bad/common/model.l"),
         tmp.join("lsystem.l"),
@@ -371,7 +369,6 @@ fn check_warns_about_view_commands_and_environmental_programs() {
     .unwrap();
     std::fs::write(tmp.join("field.e"), "executable: field -e\n").unwrap();
     let out = subgram::command::check(&tmp.display().to_string(), &[], false).unwrap();
-    std::fs::remove_dir_all(&tmp).unwrap();
     // `light:` is acted on, and `z buffer:` (3D pictures always test
     // depth); `shadow map:` is named as not acted on, at its line; `zoom:`
     // is not a command of the manual.
@@ -515,8 +512,8 @@ fn ea20_arrays_are_modules_with_a_warning() {
 /// first by name.
 #[test]
 fn the_turtle_reads_the_view_file_the_specifications_name() {
-    let tmp = std::env::temp_dir().join(format!("subgram-two-views-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
+    let folder = scratch("two-views");
+    let tmp = folder.path();
     std::fs::write(
         tmp.join("lsystem.l"),
         "derivation length: 1;\nmodule A;\nAxiom: A;\nA : { produce F(1) A; }\n",
@@ -527,7 +524,6 @@ fn the_turtle_reads_the_view_file_the_specifications_name() {
     std::fs::write(tmp.join("a.v"), "tropism: T: 0 0 0\n").unwrap();
     std::fs::write(tmp.join("b.v"), "corrected rotation: on\n").unwrap();
     let out = subgram::command::check(&tmp.display().to_string(), &[], false).unwrap();
-    std::fs::remove_dir_all(&tmp).unwrap();
     assert!(!out.contains("a.v"), "{out}");
     assert!(out.lines().last().unwrap().contains(": ok ("), "{out}");
 }

@@ -5,8 +5,12 @@
 //! floating-point absolute value, and integer division by zero is an
 //! error.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
+
+use tempfile::TempDir;
+
+use crate::support::scratch;
 
 fn subgram(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_subgram"))
@@ -19,14 +23,15 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
-/// A fresh folder holding one triangle, for surface grammars to run on.
-fn folder(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "subgram-one-language-{name}-{}",
-        std::process::id()
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+/// A fresh folder holding one triangle, for surface grammars to run on;
+/// removed when the returned `TempDir` is dropped.
+fn folder(name: &str) -> TempDir {
+    let dir = scratch(&format!("one-language-{name}"));
+    std::fs::write(
+        dir.path().join("tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
     dir
 }
 
@@ -41,9 +46,10 @@ fn write(dir: &Path, name: &str, body: &str) -> String {
 /// a vertex rule moves every vertex.
 #[test]
 fn the_same_expressions_give_the_same_values() {
-    let dir = folder("values");
+    let tmp = folder("values");
+    let dir = tmp.path();
     let curve = write(
-        &dir,
+        dir,
         "c.lsys",
         "module A(float, float, float, float);\nderivation length: 0;\n\
          Axiom: A(-1 % 3, 7/2, fabs(-2.5), abs(-3));\n",
@@ -57,7 +63,7 @@ fn the_same_expressions_give_the_same_values() {
     );
 
     let surface = write(
-        &dir,
+        dir,
         "s.lsys",
         "mesh: \"tri.obj\";\nderivation length: 1;\n\
          V(v) -> V(v = v + V3f(-1 % 3, 7/2, fabs(-2.5)) * abs(-3));\n",
@@ -106,16 +112,17 @@ fn message_and_caret(stderr: &str) -> (String, String) {
 
 #[test]
 fn integer_division_by_zero_is_the_same_error() {
-    let dir = folder("zero");
+    let tmp = folder("zero");
+    let dir = tmp.path();
     let curve = write(
-        &dir,
+        dir,
         "c.lsys",
         "module A(float);\nderivation length: 1;\nAxiom: A(1);\nA(x) -> A(x * (1/0));\n",
     );
     let c = subgram(&["derive", &curve]);
     assert_eq!(c.status.code(), Some(1), "{}", text(&c.stderr));
     let surface = write(
-        &dir,
+        dir,
         "s.lsys",
         "mesh: \"tri.obj\";\nderivation length: 1;\nV(v) -> V(v = v * (1/0));\n",
     );
@@ -149,14 +156,15 @@ fn integer_division_by_zero_is_the_same_error() {
 
 #[test]
 fn a_truncating_constant_division_is_the_same_warning() {
-    let dir = folder("truncation");
+    let tmp = folder("truncation");
+    let dir = tmp.path();
     let curve = write(
-        &dir,
+        dir,
         "c.lsys",
         "module A(float);\nderivation length: 1;\nAxiom: A(1);\nA(x) -> A(1/16 * x);\n",
     );
     let surface = write(
-        &dir,
+        dir,
         "s.lsys",
         "mesh: \"tri.obj\";\nV(v) -> V(v = 1/16 * v);\n",
     );
@@ -178,7 +186,7 @@ fn a_truncating_constant_division_is_the_same_warning() {
     // warned about too: a surface grammar written before the one language
     // meant `(n - 2)/n` as a fraction.
     let vars = write(
-        &dir,
+        dir,
         "v.lsys",
         "mesh: \"tri.obj\";\ndefine f(v, n) = (n - 2)/n*v;\nV(v) -> V(v = f(v, valence(v)));\n",
     );
@@ -194,7 +202,7 @@ fn a_truncating_constant_division_is_the_same_warning() {
     // A division that does not truncate, or one meant as an integer, is
     // not warned about.
     let quiet = write(
-        &dir,
+        dir,
         "q.lsys",
         "module A(float, int);\nderivation length: 1;\nAxiom: A(8/2 * 1.5, 7/2);\n",
     );
@@ -209,17 +217,14 @@ fn a_truncating_constant_division_is_the_same_warning() {
 
 #[test]
 fn the_same_type_errors_read_the_same() {
-    let dir = folder("types");
+    let tmp = folder("types");
+    let dir = tmp.path();
     let curve = write(
-        &dir,
+        dir,
         "c.lsys",
         "module A(V3d);\nderivation length: 1;\nAxiom: A(V3d(0, 0, 0));\nA(p) -> A(p + 1);\n",
     );
-    let surface = write(
-        &dir,
-        "s.lsys",
-        "mesh: \"tri.obj\";\nV(v) -> V(v = v + 1);\n",
-    );
+    let surface = write(dir, "s.lsys", "mesh: \"tri.obj\";\nV(v) -> V(v = v + 1);\n");
     let c = subgram(&["check", &curve]);
     let s = subgram(&["check", &surface]);
     let (cm, _) = message_and_caret(&text(&c.stderr));
@@ -234,10 +239,11 @@ fn the_same_type_errors_read_the_same() {
 /// panic on it (it divides exactly, so there is nothing to warn about).
 #[test]
 fn the_most_negative_integer_divided_by_minus_one_is_checked_without_a_panic() {
-    let dir = folder("overflow");
+    let tmp = folder("overflow");
+    let dir = tmp.path();
     let min = "(-9223372036854775807 - 1)";
     let curve = write(
-        &dir,
+        dir,
         "c.lsys",
         &format!(
             "module A(double);\nderivation length: 1;\nAxiom: A(1);\n\
@@ -245,7 +251,7 @@ fn the_most_negative_integer_divided_by_minus_one_is_checked_without_a_panic() {
         ),
     );
     let surface = write(
-        &dir,
+        dir,
         "s.lsys",
         &format!("mesh: \"tri.obj\";\nV(v) -> V(v = v * ({min} / -1));\n"),
     );
@@ -271,9 +277,10 @@ fn the_most_negative_integer_divided_by_minus_one_is_checked_without_a_panic() {
 /// Positions counted by hand in the line.
 #[test]
 fn truncation_is_warned_through_parameters_branches_comparisons_and_negations() {
-    let dir = folder("truncation-paths");
+    let tmp = folder("truncation-paths");
+    let dir = tmp.path();
     let surface = write(
-        &dir,
+        dir,
         "s.lsys",
         "mesh: \"tri.obj\";\ndefine f(v, k) = k * v;\n\
          V(v; 1/2 > 0.25) -> V(v = f(v, 1/16) + (new(v) ? 1/4 : 0.5) * v - -(1/8) * v);\n",
@@ -294,7 +301,7 @@ fn truncation_is_warned_through_parameters_branches_comparisons_and_negations() 
     }
     // A parameter read as an integer is not warned about.
     let quiet = write(
-        &dir,
+        dir,
         "q.lsys",
         "mesh: \"tri.obj\";\ndefine f(v, n) = valence(v) > n;\n\
          V(v; f(v, 7/2)) -> V(v = v);\n",

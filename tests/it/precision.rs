@@ -125,8 +125,8 @@ fn stencils_agree_with_the_interpreter_in_every_precision() {
 /// `--double` on the command line.
 #[test]
 fn the_double_option_computes_floats_in_double() {
-    let dir = std::env::temp_dir().join(format!("subgram-precision-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("precision");
+    let dir = tmp.path();
     let file = dir.join("t.l");
     std::fs::write(&file, THRESHOLD).unwrap();
     let run = |extra: &[&str]| {
@@ -141,7 +141,6 @@ fn the_double_option_computes_floats_in_double() {
     };
     assert_eq!(run(&[]), "A(2.0199988)");
     assert!(run(&["--double"]).starts_with("B(2.0000000000000"));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A literal with an `f` suffix is a `float`, as in C: `x * 3.3f` is a

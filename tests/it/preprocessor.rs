@@ -70,8 +70,8 @@ fn conditionals_choose_the_program() {
 /// is not L+C at all.
 #[test]
 fn the_binary_passes_defines_to_conditionals() {
-    let dir = std::env::temp_dir().join(format!("subgram-pre-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("pre");
+    let dir = tmp.path();
     let f = dir.join("p.lsys");
     std::fs::write(
         &f,
@@ -93,7 +93,6 @@ fn the_binary_passes_defines_to_conditionals() {
     assert_eq!(run(&[]), "B");
     assert_eq!(run(&["-D", "LONG=1"]), "A A A");
     assert_eq!(run(&["-D", "LONG=0"]), "B");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// C's literal forms in a program: hexadecimal, octal, integer suffixes,

@@ -99,8 +99,8 @@ fn a_seed_makes_runs_reproducible() {
 
 #[test]
 fn the_binary_takes_a_seed() {
-    let dir = std::env::temp_dir().join(format!("subgram-seed-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("seed");
+    let dir = tmp.path();
     let f = dir.join("stochastic.lsys");
     std::fs::write(&f, STOCHASTIC).unwrap();
     let run = |args: &[&str]| {
@@ -136,7 +136,6 @@ fn the_binary_takes_a_seed() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2), "a negative seed is a usage error");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// lpfg (vlab 9bf820d, built headless by ../shared/tools/lpfg) prints these

@@ -276,8 +276,8 @@ fn subgram_bin(args: &[&str]) -> std::process::Output {
 
 #[test]
 fn render_writes_png_and_svg_files() {
-    let dir = std::env::temp_dir().join(format!("subgram-render-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("render");
+    let dir = tmp.path();
     let f = lsys("curves/chaikin-13.lsys");
     for ext in ["png", "svg"] {
         let out = dir.join(format!("c.{ext}"));
@@ -299,13 +299,13 @@ fn render_writes_png_and_svg_files() {
         }
     }
     // Only the two outputs: no temporary files left behind.
-    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2);
+    assert_eq!(std::fs::read_dir(dir).unwrap().count(), 2);
 }
 
 #[test]
 fn a_failed_render_leaves_no_file() {
-    let dir = std::env::temp_dir().join(format!("subgram-render-fail-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("render-fail");
+    let dir = tmp.path();
     let bad = dir.join("empty.lsys");
     std::fs::write(&bad, "module A;\nAxiom: A;\n").unwrap();
     let out = dir.join("x.png");
@@ -321,7 +321,7 @@ fn a_failed_render_leaves_no_file() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(
-        std::fs::read_dir(&dir).unwrap().count(),
+        std::fs::read_dir(dir).unwrap().count(),
         1,
         "only the input remains"
     );

@@ -6,17 +6,10 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-use crate::support::root;
+use crate::support::{root, scratch};
 
 fn model(name: &str) -> PathBuf {
     root().join("tests/data/models/solid").join(name)
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("subgram-r3d-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn subgram(args: &[&str]) -> std::process::Output {
@@ -42,7 +35,8 @@ fn luminance(p: tiny_skia::PremultipliedColorU8) -> f64 {
 /// colour.
 #[test]
 fn a_model_that_asks_for_tubes_is_drawn_in_3d_shaded_as_its_render_mode_says() {
-    let dir = scratch("shaded");
+    let tmp = scratch("r3d-shaded");
+    let dir = tmp.path();
     for f in ["looks.l", "material.mat"] {
         std::fs::copy(model(f), dir.join(f)).unwrap();
     }
@@ -59,7 +53,7 @@ fn a_model_that_asks_for_tubes_is_drawn_in_3d_shaded_as_its_render_mode_says() {
         ];
         args.extend_from_slice(extra);
         let o = Command::new(env!("CARGO_BIN_EXE_subgram"))
-            .current_dir(&dir)
+            .current_dir(dir)
             .args(&args)
             .output()
             .unwrap();
@@ -104,7 +98,8 @@ fn a_model_that_asks_for_tubes_is_drawn_in_3d_shaded_as_its_render_mode_says() {
 /// same numbers of vertices and triangles, read back from each file.
 #[test]
 fn render_exports_the_geometry_the_library_builds() {
-    let dir = scratch("export");
+    let tmp = scratch("r3d-export");
+    let dir = tmp.path();
     let f = model("leaf.l");
     let curve = match subgram::load(&f, &Default::default()).unwrap() {
         subgram::System::Curve(c) => c,
@@ -160,7 +155,8 @@ fn render_exports_the_geometry_the_library_builds() {
 
 #[test]
 fn what_3d_drawing_refuses() {
-    let dir = scratch("refuse");
+    let tmp = scratch("r3d-refuse");
+    let dir = tmp.path();
     let looks = model("looks.l");
     let o = subgram(&[
         "render",
@@ -195,7 +191,7 @@ fn what_3d_drawing_refuses() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(
-        std::fs::read_dir(&dir).unwrap().count(),
+        std::fs::read_dir(dir).unwrap().count(),
         0,
         "nothing written"
     );

@@ -250,8 +250,8 @@ fn svg_shapes_are_read() {
 
 #[test]
 fn bad_inputs_get_clear_errors_naming_the_file_and_line() {
-    let dir = std::env::temp_dir().join(format!("subgram-rev-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("rev");
+    let dir = tmp.path();
     let cases: &[(&str, &[u8], &str)] = &[
         ("empty.txt", b"", "empty.txt: error: the file has no points"),
         (
@@ -301,8 +301,8 @@ fn bad_inputs_get_clear_errors_naming_the_file_and_line() {
 
 #[test]
 fn the_command_writes_coarse_points_report_figure_and_details() {
-    let dir = std::env::temp_dir().join(format!("subgram-rev-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("rev-cli");
+    let dir = tmp.path();
     let out = dir.join("coarse.csv");
     let fig = dir.join("fig.svg");
     let det = dir.join("d.json");
@@ -353,14 +353,6 @@ fn the_command_writes_coarse_points_report_figure_and_details() {
 // ---------------------------------------------------------------------
 // Bad inputs through the binary (issue 11): each finishes fast, exits
 // with 1 (or 2 for usage errors), says where, and leaves no file behind.
-
-/// A fresh, empty folder for one test.
-pub fn scratch(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("subgram-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// What a run of the binary gave.
 pub struct Ran {
@@ -430,11 +422,12 @@ pub fn files_in(dir: &std::path::Path) -> Vec<String> {
 /// a message that begins with `message` (and has the line and caret when
 /// `caret`), and checks that only the inputs are left.
 fn refused(name: &str, inputs: &[(&str, &[u8])], args: &[&str], code: i32, message: &str) -> Ran {
-    let dir = scratch(name);
+    let tmp = scratch(name);
+    let dir = tmp.path();
     for (f, bytes) in inputs {
         std::fs::write(dir.join(f), bytes).unwrap();
     }
-    let r = run_in(&dir, args);
+    let r = run_in(dir, args);
     assert_eq!(r.code, Some(code), "{name}: {}", r.stderr);
     assert!(
         r.stderr.starts_with(message),
@@ -443,9 +436,8 @@ fn refused(name: &str, inputs: &[(&str, &[u8])], args: &[&str], code: i32, messa
     );
     let mut want: Vec<String> = inputs.iter().map(|(f, _)| f.to_string()).collect();
     want.sort();
-    assert_eq!(files_in(&dir), want, "{name}: a file was left behind");
+    assert_eq!(files_in(dir), want, "{name}: a file was left behind");
     assert!(r.seconds < 30.0, "{name}: {} s", r.seconds);
-    std::fs::remove_dir_all(&dir).unwrap();
     r
 }
 
@@ -462,14 +454,15 @@ const CIRCLE_64: fn() -> String = || {
 fn a_closed_contour_with_one_far_spike_reverses_at_once() {
     // The flattest-point search measured the spike against a tiny grid and
     // searched rings of cells out to it: it never finished.
-    let dir = scratch("spike");
+    let tmp = scratch("spike");
+    let dir = tmp.path();
     std::fs::write(
         dir.join("spike.txt"),
         "0 0\n1 0\n1 1\n0.5 1.0000001\n0 1\n0 0.5\n1e9 1e9\n",
     )
     .unwrap();
     let r = run_in(
-        &dir,
+        dir,
         &[
             "reverse",
             "spike.txt",
@@ -483,19 +476,19 @@ fn a_closed_contour_with_one_far_spike_reverses_at_once() {
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(r.stdout.contains("step 1: 6 -> 3 points"), "{}", r.stdout);
     assert!(r.seconds < 10.0, "{} s", r.seconds);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn segments_longer_than_1e154_are_measured_without_nan() {
     // Their squared lengths overflow: the report gave NaN after searching
     // the whole grid. Now distances are scaled, and finite.
-    let dir = scratch("huge");
+    let tmp = scratch("huge");
+    let dir = tmp.path();
     let pts =
         "0 0\n1e155 0\n1e155 1e155\n0 1e155\n-1e155 1e155\n-1e155 0\n-1e155 -1e155\n0 -1e155\n";
     std::fs::write(dir.join("huge.txt"), pts).unwrap();
     let r = run_in(
-        &dir,
+        dir,
         &[
             "reverse", "huge.txt", "-n", "1", "-o", "out.csv", "--report", "--format", "json",
         ],
@@ -508,7 +501,6 @@ fn segments_longer_than_1e154_are_measured_without_nan() {
             assert!(x.is_finite() && x > 1e153, "{k} {m}: {}", v[k][m]);
         }
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -516,11 +508,12 @@ fn a_scheme_that_sends_every_point_to_the_origin_finishes() {
     let scheme = "module P(V2f);\nring L-system: 1;\nderivation length: 1;\nAxiom: P(V2f(0,0));\n\
                   group 1:\nP(vl) < P(va) P(vb) > P(vr) -> P(V2f(0,0))\n\
                   group 2:\nP(v) -> P(V2f(0,0)) P(V2f(0,0))\n";
-    let dir = scratch("origin");
+    let tmp = scratch("origin");
+    let dir = tmp.path();
     std::fs::write(dir.join("origin.lsys"), scheme).unwrap();
     std::fs::write(dir.join("c.txt"), CIRCLE_64()).unwrap();
     let r = run_in(
-        &dir,
+        dir,
         &[
             "reverse",
             "c.txt",
@@ -535,7 +528,6 @@ fn a_scheme_that_sends_every_point_to_the_origin_finishes() {
     );
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(r.stdout.contains("rms 1000.000000"), "{}", r.stdout);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -603,10 +595,11 @@ fn invalid_utf8_and_unreadable_pictures_are_reported_with_the_file() {
 
 #[test]
 fn details_with_a_huge_shift_or_values_near_the_limit_are_refused_at_their_place() {
-    let dir = scratch("details-src");
+    let tmp = scratch("details-src");
+    let dir = tmp.path();
     std::fs::write(dir.join("c.txt"), CIRCLE_64()).unwrap();
     let r = run_in(
-        &dir,
+        dir,
         &[
             "reverse",
             "c.txt",
@@ -622,7 +615,6 @@ fn details_with_a_huge_shift_or_values_near_the_limit_are_refused_at_their_place
     let coarse = std::fs::read(dir.join("coarse.txt")).unwrap();
     let good: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("d.json")).unwrap()).unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
     let pretty = |v: &serde_json::Value| serde_json::to_string_pretty(v).unwrap();
 
     // `file:line:col` of the first `needle` in `text`, and its line.
@@ -784,11 +776,12 @@ fn reverse_writes_all_of_its_outputs_or_none() {
     );
     // The figure's name is a folder: renamed last, it fails, and the two
     // files renamed before it are removed again.
-    let dir = scratch("all-or-none-dir");
+    let tmp = scratch("all-or-none-dir");
+    let dir = tmp.path();
     std::fs::write(dir.join("c.txt"), &circle).unwrap();
     std::fs::create_dir(dir.join("f.svg")).unwrap();
     let r = run_in(
-        &dir,
+        dir,
         &[
             "reverse",
             "c.txt",
@@ -808,11 +801,11 @@ fn reverse_writes_all_of_its_outputs_or_none() {
         "{}",
         r.stderr
     );
-    assert_eq!(files_in(&dir), vec!["c.txt", "f.svg"]);
+    assert_eq!(files_in(dir), vec!["c.txt", "f.svg"]);
     // And with everything in order, all three are there.
     std::fs::remove_dir(dir.join("f.svg")).unwrap();
     let r = run_in(
-        &dir,
+        dir,
         &[
             "reverse",
             "c.txt",
@@ -827,24 +820,24 @@ fn reverse_writes_all_of_its_outputs_or_none() {
         ],
     );
     assert_eq!(r.code, Some(0), "{}", r.stderr);
-    assert_eq!(files_in(&dir), vec!["c.txt", "d.json", "f.svg", "out.csv"]);
-    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(files_in(dir), vec!["c.txt", "d.json", "f.svg", "out.csv"]);
 }
 
 #[test]
 fn inputs_larger_than_the_limit_are_refused_before_they_are_read() {
     // /dev/zero never ends: the read stops one byte past the limit.
-    let dir = scratch("dev-zero");
-    let r = run_in(&dir, &["reverse", "/dev/zero", "-n", "1", "-o", "out.csv"]);
+    let tmp = scratch("dev-zero");
+    let dir = tmp.path();
+    let r = run_in(dir, &["reverse", "/dev/zero", "-n", "1", "-o", "out.csv"]);
     assert_eq!(r.code, Some(1));
     assert_eq!(
         r.stderr.trim_end(),
         "/dev/zero: error: the file is larger than the input size limit of 64 MiB (67108864 bytes): \
          it holds more than that; raise the limit with --max-input-size (e.g. --max-input-size 256M)"
     );
-    assert!(files_in(&dir).is_empty());
+    assert!(files_in(dir).is_empty());
     let r = run_in(
-        &dir,
+        dir,
         &[
             "reconstruct",
             "/dev/zero",
@@ -860,7 +853,6 @@ fn inputs_larger_than_the_limit_are_refused_before_they_are_read() {
         "{}",
         r.stderr
     );
-    std::fs::remove_dir_all(&dir).unwrap();
     // A regular file is measured before it is opened for reading.
     let circle = CIRCLE_64();
     refused(
@@ -874,10 +866,11 @@ fn inputs_larger_than_the_limit_are_refused_before_they_are_read() {
             reverse::input::human_bytes(circle.len() as u64)
         ),
     );
-    let dir = scratch("limit-raised");
+    let tmp = scratch("limit-raised");
+    let dir = tmp.path();
     std::fs::write(dir.join("c.txt"), &circle).unwrap();
     let r = run_in(
-        &dir,
+        dir,
         &[
             "reverse",
             "c.txt",
@@ -890,7 +883,6 @@ fn inputs_larger_than_the_limit_are_refused_before_they_are_read() {
         ],
     );
     assert_eq!(r.code, Some(0), "{}", r.stderr);
-    std::fs::remove_dir_all(&dir).unwrap();
     let r = run_in(
         &std::env::temp_dir(),
         &[
@@ -974,10 +966,11 @@ fn noise_stops_at_the_measurement_budget_and_fixed_phases_still_run() {
         "{}",
         r.stderr
     );
-    let dir = scratch("noise-fixed");
+    let tmp = scratch("noise-fixed");
+    let dir = tmp.path();
     std::fs::write(dir.join("noise.txt"), &noise).unwrap();
     let r = run_in(
-        &dir,
+        dir,
         &[
             "reverse",
             "noise.txt",
@@ -990,7 +983,6 @@ fn noise_stops_at_the_measurement_budget_and_fixed_phases_still_run() {
         ],
     );
     assert_eq!(r.code, Some(0), "{}", r.stderr);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// tests/data/horse.png with every pixel inverted (over white first, as
@@ -1017,7 +1009,8 @@ fn inverted_horse() -> tiny_skia::Pixmap {
 /// the side found by itself or given by `--invert`, at `--threshold`.
 #[test]
 fn reverse_reads_a_light_silhouette_through_the_binary() {
-    let dir = scratch("rev-light");
+    let tmp = scratch("rev-light");
+    let dir = tmp.path();
     let light = dir.join("light.png");
     std::fs::write(&light, inverted_horse().encode_png().unwrap()).unwrap();
     let horse = root().join("tests/data/horse.png");

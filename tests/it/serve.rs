@@ -6,18 +6,20 @@
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
-use std::path::PathBuf;
+use std::path::Path;
 use std::time::Duration;
 
 use subgram::serve::{Limits, ServeOptions, Server};
+use tempfile::TempDir;
+
+use crate::support::scratch;
 
 /// A server on a free port in a thread of its own, serving a copy of
-/// `program` in a fresh folder; its address and the folder.
-fn start(name: &str, program: &str, save: bool, limits: Limits) -> (String, PathBuf) {
-    let dir = std::env::temp_dir().join(format!("subgram-serve-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("prog.lsys");
+/// `program` in a fresh folder; its address and the folder, removed when
+/// the caller drops it.
+fn start(name: &str, program: &str, save: bool, limits: Limits) -> (String, TempDir) {
+    let dir = scratch(&format!("serve-{name}"));
+    let file = dir.path().join("prog.lsys");
     std::fs::write(&file, program).unwrap();
     let server = Server::bind(ServeOptions {
         path: file,
@@ -77,7 +79,7 @@ fn render(addr: &str, text: &str, extra: &str) -> serde_json::Value {
 
 const KOCH: &str = "angle: 60;\nderivation length: 3;\nAxiom: F--F--F;\nF -> F+F--F+F\n";
 
-fn files(dir: &PathBuf) -> Vec<(String, Vec<u8>)> {
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| {
@@ -94,8 +96,9 @@ fn files(dir: &PathBuf) -> Vec<(String, Vec<u8>)> {
 
 #[test]
 fn the_page_and_the_api_draw_an_edited_text_and_place_its_errors() {
-    let (addr, dir) = start("draw", KOCH, false, Limits::default());
-    let before = files(&dir);
+    let (addr, tmp) = start("draw", KOCH, false, Limits::default());
+    let dir = tmp.path();
+    let before = files(dir);
     let (status, page) = request(&addr, "GET", "/", "");
     assert_eq!(status, 200);
     assert!(page.contains("/app.js") && page.contains("<textarea"));
@@ -140,7 +143,7 @@ fn the_page_and_the_api_draw_an_edited_text_and_place_its_errors() {
     assert_eq!(m["program"], true);
     assert!(m["message"].as_str().unwrap().contains("`@`"), "{r}");
     // Nothing written, the program untouched.
-    assert_eq!(files(&dir), before);
+    assert_eq!(files(dir), before);
 }
 
 #[test]
@@ -178,7 +181,8 @@ fn runaway_rules_stop_at_the_page_limits_and_the_server_goes_on() {
 
 #[test]
 fn malformed_requests_get_errors_and_nothing_from_the_disk_is_served() {
-    let (addr, dir) = start("bad", KOCH, false, Limits::default());
+    let (addr, tmp) = start("bad", KOCH, false, Limits::default());
+    let dir = tmp.path();
     std::fs::write(dir.join("secret.txt"), "not for the page").unwrap();
     for path in [
         "/secret.txt",
@@ -223,7 +227,8 @@ fn malformed_requests_get_errors_and_nothing_from_the_disk_is_served() {
 
 #[test]
 fn with_save_the_page_writes_the_program_back_and_nothing_else() {
-    let (addr, dir) = start("save", KOCH, true, Limits::default());
+    let (addr, tmp) = start("save", KOCH, true, Limits::default());
+    let dir = tmp.path();
     let edited = KOCH.replace("derivation length: 3", "derivation length: 2");
     let body = format!("{{\"text\": {}}}", serde_json::to_string(&edited).unwrap());
     let (status, reply) = request(&addr, "POST", "/api/save", &body);
@@ -232,7 +237,7 @@ fn with_save_the_page_writes_the_program_back_and_nothing_else() {
         std::fs::read_to_string(dir.join("prog.lsys")).unwrap(),
         edited
     );
-    let names: Vec<String> = files(&dir).into_iter().map(|(n, _)| n).collect();
+    let names: Vec<String> = files(dir).into_iter().map(|(n, _)| n).collect();
     assert_eq!(names, ["prog.lsys"], "no temporary file left");
     let (_, source) = request(&addr, "GET", "/api/source", "");
     assert!(source.contains("derivation length: 2"));

@@ -7,6 +7,8 @@ use std::collections::{HashMap, HashSet};
 
 use subgram::{LoadOptions, RunOptions, ShapeRun, Shapes, System};
 
+use crate::support::scratch;
+
 fn load(text: &str) -> Shapes {
     match subgram::load_text("t.lsys", text, &LoadOptions::default()) {
         Ok(System::Shapes(s)) => s,
@@ -444,8 +446,8 @@ fn a_named_group_waits_for_its_members_and_takes_terminal_ones() {
 /// A derivation that fails writes nothing: no OBJ, no MTL.
 #[test]
 fn a_failed_derivation_writes_no_file() {
-    let dir = std::env::temp_dir().join(format!("subgram-shapes-nowrite-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("shapes-nowrite");
+    let dir = tmp.path();
     let grammar = dir.join("bad.lsys");
     std::fs::write(
         &grammar,
@@ -463,7 +465,6 @@ fn a_failed_derivation_writes_no_file() {
         .unwrap();
     assert_eq!(status.code(), Some(1));
     assert!(!out.exists() && !dir.join("out.mtl").exists());
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// CityEngine's relative coordinates in `s` and `t`: `'0.5` is half the
@@ -581,7 +582,8 @@ fn deep_trees_are_written_in_bounded_lines() {
 /// string.
 #[test]
 fn inserting_a_non_file_is_refused() {
-    let dir = std::env::temp_dir().join(format!("subgram-adv14-{}", std::process::id()));
+    let tmp = scratch("adv14");
+    let dir = tmp.path();
     std::fs::create_dir_all(dir.join("folder.obj")).unwrap();
     let fifo = dir.join("pipe.obj");
     let made_fifo = std::process::Command::new("mkfifo")
@@ -602,7 +604,6 @@ fn inserting_a_non_file_is_refused() {
         assert!(e.contains("is not a regular file"), "{e}");
         assert!(e.contains("t.lsys:1:21"), "{e}");
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `set` converts to the attribute's type as C's assignment does: 2.5 in

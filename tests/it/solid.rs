@@ -19,7 +19,7 @@ use subgram::model::Model;
 use subgram::scene3::{Scene3, TriMesh};
 use subgram::{LoadOptions, System};
 
-use crate::support::{load_text, root};
+use crate::support::{load_text, root, scratch};
 
 /// The turtle as the manual moves it, written out for the tests.
 #[derive(Clone, Copy, Debug)]
@@ -864,12 +864,11 @@ fn a_picture_keeps_a_tube_under_a_pixel_as_its_axis() {
         2 * 2 * 16,
         "two segments of 16 sides"
     );
-    let dir = std::env::temp_dir().join(format!("subgram-solid-lines-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("solid-lines");
+    let dir = tmp.path();
     let err = subgram::export::write(&picture, &dir.join("p.obj")).unwrap_err();
     assert!(err.to_string().contains("lines"), "{err}");
     assert!(!dir.join("p.obj").exists());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// A mesh's triangles as their corners' coordinates, sorted: the same

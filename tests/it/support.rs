@@ -14,6 +14,18 @@ pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// A fresh, empty scratch folder in the system's temp dir, named
+/// `subgram-NAME-` and a random tail. The folder and all in it are removed
+/// when the returned `TempDir` is dropped, even when the test panics: bind
+/// it to a variable that lives as long as the test (or a program the test
+/// runs, or a watcher it starts) uses the folder, and do not `keep()` it.
+pub fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("subgram-{name}-"))
+        .tempdir()
+        .unwrap_or_else(|e| panic!("cannot create a scratch folder for {name}: {e}"))
+}
+
 /// `lsystems/NAME` inside the project.
 pub fn lsys(name: &str) -> PathBuf {
     root().join("lsystems").join(name)

@@ -414,8 +414,8 @@ fn surface_grammars_run_under_every_command() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["faces"], 512);
     assert_eq!(v["valences"]["4"], 6);
-    let dir = std::env::temp_dir().join(format!("subgram-surface-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("surface-cli");
+    let dir = tmp.path();
     let png = dir.join("loop.png");
     let o = bin(&[
         "render",

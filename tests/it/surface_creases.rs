@@ -317,12 +317,6 @@ fn write(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
     p
 }
 
-fn temp(tag: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("subgram-creases-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
 #[test]
 fn sharpness_is_read_from_ply_edges_and_creases_files() {
     let m = io::read_mesh(&lsys("meshes/creased-cube.ply")).unwrap();
@@ -346,31 +340,32 @@ fn sharpness_is_read_from_ply_edges_and_creases_files() {
     assert_eq!(m.edges().filter(|&e| m.is_sharp_edge(e)).count(), 5);
     // Without the file, nothing is sharp; an OFF mesh reads one too, and
     // counts its vertices from 1 there as well.
-    let dir = temp("read");
+    let tmp = scratch("creases-read");
+    let dir = tmp.path();
     let off = write(
-        &dir,
+        dir,
         "t.off",
         "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
     );
     assert!(!io::read_mesh(&off).unwrap().has_sharpness());
     write(
-        &dir,
+        dir,
         "t.creases",
         "# comment\ne 1 2 3 # the first edge\n\nv 4 0.25\n",
     );
     let m = io::read_mesh(&off).unwrap();
     assert_eq!(m.edge_sharpness(edge(&m, 0, 1)), 3.0);
     assert_eq!(m.vertex_sharpness(VertexId(3)), 0.25);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn grammar_functions_read_sharpness() {
     // A grammar that moves each vertex by what the functions give, so the
     // positions say what they read.
-    let dir = temp("fns");
+    let tmp = scratch("creases-fns");
+    let dir = tmp.path();
     let g = write(
-        &dir,
+        dir,
         "g.lsys",
         "mesh: \"m.obj\";\nderivation length: 1;\n\
          V(v; creases(v) == 2) -> V(v = v + point(sharpness(v), creases(v), \
@@ -394,7 +389,6 @@ fn grammar_functions_read_sharpness() {
     // The top and bottom vertices have no sharp edge.
     let d = out.position(VertexId(5)) - base.position(VertexId(5));
     assert_eq!(d, DVec3::ZERO);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -402,9 +396,10 @@ fn crease_weight_follows_opensubdiv() {
     // OpenSubdiv's fractional weight (Sdc::Crease, uniform creasing): 1
     // while the vertex's rule holds one level down, else the mean of the
     // sharpnesses in (0, 1] at it, at most 1.
-    let dir = temp("weight");
+    let tmp = scratch("creases-weight");
+    let dir = tmp.path();
     write(
-        &dir,
+        dir,
         "g.lsys",
         "mesh: \"m.obj\";\nderivation length: 1;\n\
          V(v) -> V(v = point(crease_weight(v), 0, 0));\n",
@@ -432,7 +427,6 @@ fn crease_weight_follows_opensubdiv() {
     assert_eq!(weight(&[], 0.25), 0.25);
     // And of sharpness 2: still a corner one level down.
     assert_eq!(weight(&[], 2.0), 1.0);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `k` steps of cubic B-spline subdivision of an open polygon whose ends

@@ -9,29 +9,7 @@ use glam::DVec3;
 use subgram::mesh::{io, shapes, PolygonSoup};
 use subgram::{LoadOptions, Run, RunOptions, System};
 
-/// A folder of its own for a test, removed at the end.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new() -> TempDir {
-        use std::sync::atomic::{AtomicUsize, Ordering};
-        static N: AtomicUsize = AtomicUsize::new(0);
-        let n = N.fetch_add(1, Ordering::Relaxed);
-        let p = std::env::temp_dir().join(format!("subgram-vv-{}-{n}", std::process::id()));
-        std::fs::create_dir_all(&p).unwrap();
-        TempDir(p)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+use crate::support::scratch;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -162,7 +140,7 @@ fn bumpy_grid(dir: &Path) -> (PathBuf, PolygonSoup) {
 
 #[test]
 fn vv_butterfly_is_the_eight_point_mask_on_a_regular_region() {
-    let dir = TempDir::new();
+    let dir = scratch("vv");
     let (path, base) = bumpy_grid(dir.path());
     let out = run(&vv("butterfly.lsys"), &path, 1, &[]);
     // The scheme interpolates: the old vertices come first, unmoved.
@@ -286,7 +264,7 @@ Step: {
 
 #[test]
 fn synchronize_makes_the_order_of_iteration_irrelevant_to_the_bit() {
-    let dir = TempDir::new();
+    let dir = scratch("vv");
     let file = dir.path().join("order.lsys");
     std::fs::write(&file, LOOP_IN_ANY_ORDER).unwrap();
     for m in ["octahedron.obj", "pentagon-patch.obj", "torus.obj"] {
@@ -302,7 +280,7 @@ fn synchronize_makes_the_order_of_iteration_irrelevant_to_the_bit() {
 
 /// Runs a vv program from text; the first error, as the binary shows it.
 fn error_of(text: &str) -> String {
-    let dir = TempDir::new();
+    let dir = scratch("vv");
     let file = dir.path().join("t.lsys");
     std::fs::write(&file, text).unwrap();
     let system = subgram::load(&file, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
@@ -389,7 +367,7 @@ fn table_2_error_cases_are_located_errors() {
 
 #[test]
 fn table_2_null_and_no_effect_cases() {
-    let dir = TempDir::new();
+    let dir = scratch("vv");
     // Notes 1, 2 and 4, and 5's "no effect": printed by the program.
     let body = r#"
   vertex a = any in v;
@@ -427,7 +405,7 @@ fn the_readme_program_runs_as_printed() {
     let section = &readme[readme.find("## Vertex-vertex programs").unwrap()..];
     let start = section.find("```c\n").unwrap() + 5;
     let text = &section[start..start + section[start..].find("```").unwrap()];
-    let dir = TempDir::new();
+    let dir = scratch("vv");
     let file = dir.path().join("readme.lsys");
     std::fs::write(&file, text).unwrap();
     let a = run(&file, &mesh("octahedron.obj"), 2, &[]);
@@ -522,7 +500,7 @@ fn a_base_mesh_written_as_neighbour_lists() {
 /// `subdivide` prints what a vv program prints, as `derive` and `render` do.
 #[test]
 fn subdivide_prints_what_a_vv_program_prints() {
-    let dir = TempDir::new();
+    let dir = scratch("vv");
     let file = dir.path().join("p.lsys");
     std::fs::write(
         &file,
@@ -557,7 +535,7 @@ fn subdivide_prints_what_a_vv_program_prints() {
 /// on that side.
 #[test]
 fn vv_butterfly_boundary_rules_keep_planes_and_boundary_cubics() {
-    let dir = TempDir::new();
+    let dir = scratch("vv");
     let plane = |p: DVec3| 0.2 * p.x + 0.3 * p.y + 0.1;
     let mut soup = shapes::triangle_grid(8, 4);
     for p in &mut soup.positions {

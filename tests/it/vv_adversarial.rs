@@ -10,7 +10,7 @@ use std::process::Command;
 
 use subgram::{LoadOptions, ProgramOutput, RunOptions, System};
 
-use crate::support::root;
+use crate::support::{root, scratch};
 
 fn mesh(name: &str) -> PathBuf {
     root().join("lsystems/meshes").join(name)
@@ -169,8 +169,8 @@ Step: {
 /// allowed.
 #[test]
 fn the_valence_limit_makes_room_for_the_base_mesh() {
-    let dir = std::env::temp_dir().join(format!("subgram-vv-adv-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("vv-adv");
+    let dir = tmp.path();
     let n = 1500;
     let mut obj = String::from("v 0 0 0\n");
     for k in 0..n {
@@ -206,7 +206,6 @@ Step: {
         ..RunOptions::default()
     };
     let r = vv.run(&opts, |_| {});
-    let _ = std::fs::remove_dir_all(&dir);
     if let Err(e) = r {
         panic!("{e}");
     }
@@ -219,9 +218,10 @@ Step: {
 /// `--allow-writes` (they were dropped without a word).
 #[test]
 fn vv_programs_write_their_files_under_allow_writes() {
-    let dir = std::env::temp_dir().join(format!("subgram-vv-adv-w-{}", std::process::id()));
+    let tmp = scratch("vv-adv-w");
+    let dir = tmp.path();
     let out = dir.join("out");
-    std::fs::create_dir_all(&out).unwrap();
+    std::fs::create_dir(&out).unwrap();
     let program = dir.join("count.lsys");
     std::fs::copy(mesh("tetrahedron.obj"), dir.join("tetrahedron.obj")).unwrap();
     std::fs::write(
@@ -249,7 +249,6 @@ fn vv_programs_write_their_files_under_allow_writes() {
         p,
     ]);
     let rendered = std::fs::read_to_string(out.join("count.txt"));
-    let _ = std::fs::remove_dir_all(&dir);
     // The tetrahedron has 4 vertices.
     assert_eq!(derived.ok().as_deref(), Some("4\n"));
     assert_eq!(rendered.ok().as_deref(), Some("4\n"));
@@ -288,8 +287,8 @@ Step: {
 /// curve's (it was ignored: every seed gave lpfg's starting state).
 #[test]
 fn seed_seeds_a_vv_program_as_it_seeds_a_curve() {
-    let dir = std::env::temp_dir().join(format!("subgram-vv-adv-s-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("vv-adv-s");
+    let dir = tmp.path();
     std::fs::copy(mesh("tetrahedron.obj"), dir.join("tetrahedron.obj")).unwrap();
     let draw = r#"printf("%g %d %g\n", ran(1.0), rand(), drand48());"#;
     let vv = dir.join("vv.lsys");
@@ -319,7 +318,6 @@ fn seed_seeds_a_vv_program_as_it_seeds_a_curve() {
     let (v7, c7) = (first_line(&vv, "7"), first_line(&curve, "7"));
     let (v8, v_none) = (first_line(&vv, "8"), first_line(&vv, ""));
     let c_none = first_line(&curve, "");
-    let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(v7, c7);
     assert_eq!(v_none, c_none);
     assert_ne!(v7, v8);

@@ -8,12 +8,7 @@ use std::time::Duration;
 
 use subgram::command::{self, RenderArgs, WatchEvent, WatchOptions};
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("subgram-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::support::scratch;
 
 /// A triangular bipyramid: apexes of valence 3, an equator of valence 4.
 /// Moving each vertex towards its neighbours' centre changes the ratio of
@@ -51,7 +46,8 @@ fn write(path: &Path, text: &str) {
 
 #[test]
 fn watch_renders_again_on_a_change_to_the_file_or_its_mesh_and_keeps_the_last_picture_on_error() {
-    let dir = scratch("watch");
+    let tmp = scratch("watch");
+    let dir = tmp.path();
     let g = dir.join("smooth.lsys");
     let out = dir.join("smooth.png");
     std::fs::write(dir.join("base.obj"), BIPYRAMID).unwrap();
@@ -126,7 +122,8 @@ fn watch_renders_again_on_a_change_to_the_file_or_its_mesh_and_keeps_the_last_pi
 /// with exit code 2, through the binary.
 #[test]
 fn watch_stops_at_a_usage_error_and_runs_once_through_the_binary() {
-    let dir = scratch("watch-cli");
+    let tmp = scratch("watch-cli");
+    let dir = tmp.path();
     let f = dir.join("c.lsys");
     std::fs::copy(crate::support::lsys("curves/chaikin-13.lsys"), &f).unwrap();
     let run = |extra: &[&str]| {

@@ -54,16 +54,13 @@ fn monopodial_renders_with_lpfgs_background_and_leaf_colour() {
     let m = &c.program.model;
     assert_eq!(m.functions.len(), 2);
     assert_eq!(m.defines()[..2], ["internode_length=1", "leaf_length=2"]);
+    let tmp = crate::support::scratch("mono");
     let a = subgram::command::RenderArgs::new(
         folder("monopodial").display().to_string(),
-        std::env::temp_dir()
-            .join(format!("subgram-mono-{}.png", std::process::id()))
-            .display()
-            .to_string(),
+        tmp.path().join("mono.png").display().to_string(),
     );
     subgram::command::render(&a, |_| {}).unwrap();
     let ours = std::fs::read(&a.output).unwrap();
-    std::fs::remove_file(&a.output).unwrap();
     let (_, ours) = colours(&ours);
     let theirs = lpfg_picture("monopodial");
     // The background is lpfg's, to the byte: material 0's emission.
