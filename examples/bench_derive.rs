@@ -12,10 +12,11 @@
 //!    single precision) with the ring's seam handled outside the loop.
 //! 2. Threads (issue 16, item 6): the last step of the same run (512,000 ->
 //!    1,024,000 points) and the whole run, in a pool of one rayon thread and
-//!    one of two, alternating, with the speedup; the words are checked to
-//!    be the same to the bit; then the same for two branching systems on
-//!    the general path (a plant whose rule is a stencil, and a guarded
-//!    body compiled to closures), about a million modules at the end.
+//!    one of two, alternating, with the best and the median of each and
+//!    their speedups; the words are checked to be the same to the bit;
+//!    then the same for three branching systems on the general path (a
+//!    plant whose rule is a stencil, a guarded body compiled to closures,
+//!    and a bush without parameters), about a million modules at the end.
 //!    `--threads-only` runs this section only; run it with
 //!    `MALLOC_ARENA_MAX=1` (benches/README.md says why).
 //! 3. A context-sensitive rewrite without geometry: a signal moving through
@@ -310,7 +311,11 @@ fn threads(src: &str, runs: usize) {
 /// are checked to be the same to the bit.
 fn on_pools(label: &str, program: &subgram::Program, pools: &[rayon::ThreadPool], runs: usize) {
     use std::time::{Duration, Instant};
-    let (mut last, mut whole) = ([Duration::MAX; 2], [Duration::MAX; 2]);
+    // Every run's time, per pool: the best and the median are printed (on
+    // a shared machine the best of one pool and the best of the other may
+    // come from minutes of different speed; the median of interleaved
+    // runs is steadier).
+    let (mut last, mut whole): ([Vec<Duration>; 2], [Vec<Duration>; 2]) = Default::default();
     let mut words: Vec<subgram::Word> = Vec::new();
     let mut before = 0;
     for _ in 0..runs {
@@ -325,10 +330,10 @@ fn on_pools(label: &str, program: &subgram::Program, pools: &[rayon::ThreadPool]
                 before = d.word.len();
                 let t = Instant::now();
                 d.next_step().expect("steps");
-                last[k] = last[k].min(t.elapsed());
+                last[k].push(t.elapsed());
                 let t = Instant::now();
                 let all = subgram::derive(program, DeriveOptions::default()).expect("derives");
-                whole[k] = whole[k].min(t.elapsed());
+                whole[k].push(t.elapsed());
                 assert_eq!(d.word.len(), all.word.len());
                 if words.len() < 2 {
                     words.push(all.word);
@@ -343,17 +348,25 @@ fn on_pools(label: &str, program: &subgram::Program, pools: &[rayon::ThreadPool]
     assert_eq!(bits(&words[0]), bits(&words[1]));
     let n = words[0].len();
     let ms = |t: Duration| t.as_secs_f64() * 1e3;
-    println!("{label}, best of {runs}, 1 vs 2 threads");
-    println!(
-        "  last step {before} -> {n} modules  {:>8.2} ms  {:>8.2} ms  speedup {:.2}",
-        ms(last[0]),
-        ms(last[1]),
-        last[0].as_secs_f64() / last[1].as_secs_f64()
-    );
-    println!(
-        "  whole run                   {:>8.2} ms  {:>8.2} ms  speedup {:.2}",
-        ms(whole[0]),
-        ms(whole[1]),
-        whole[0].as_secs_f64() / whole[1].as_secs_f64()
-    );
+    // (best, median) of a pool's runs.
+    let stats = |times: &mut Vec<Duration>| {
+        times.sort();
+        (times[0], times[times.len() / 2])
+    };
+    println!("{label}, {runs} runs alternating, 1 vs 2 threads: best, then median");
+    for (name, times) in [
+        (format!("last step {before} -> {n} modules"), &mut last),
+        ("whole run".to_string(), &mut whole),
+    ] {
+        let [(b1, m1), (b2, m2)] = [stats(&mut times[0]), stats(&mut times[1])];
+        println!(
+            "  {name:<36} best {:>7.2} / {:>7.2} ms (speedup {:.2}), median {:>7.2} / {:>7.2} ms (speedup {:.2})",
+            ms(b1),
+            ms(b2),
+            b1.as_secs_f64() / b2.as_secs_f64(),
+            ms(m1),
+            ms(m2),
+            m1.as_secs_f64() / m2.as_secs_f64()
+        );
+    }
 }
