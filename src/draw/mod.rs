@@ -285,11 +285,6 @@ impl Turtle {
     /// Rotates by `deg` degrees about one of the turtle's own axes.
     fn turn(&mut self, axis: DVec3Axis, deg: f64) {
         let (s, c) = deg.to_radians().sin_cos();
-        self.turn_by(axis, s, c);
-    }
-
-    /// [`Turtle::turn`] by the angle whose sine and cosine are `s`, `c`.
-    fn turn_by(&mut self, axis: DVec3Axis, s: f64, c: f64) {
         (self.head, self.left, self.up) = turned(axis, s, c, (self.head, self.left, self.up));
     }
 }
@@ -1328,24 +1323,23 @@ fn finite(v: &Value) -> bool {
     }
 }
 
-/// The box `lo..hi` grown to take in the point `p`, by plain comparisons:
-/// `f64::min` and `max` give the same for finite numbers, but compile to a
-/// sequence that also handles a NaN operand (a quarter of a box walk's
-/// instructions). A NaN coordinate leaves the box as it is, as with them.
+/// The box `lo..hi` grown to take in the point `p`, by plain comparisons
+/// (glam's `select`): `f64::min` and `max` give the same for finite
+/// numbers, but compile to a sequence that also handles a NaN operand (a
+/// quarter of a box walk's instructions). A NaN coordinate leaves the box
+/// as it is, as with them.
 #[inline(always)]
-pub(crate) fn grown((lo, hi): (DVec3, DVec3), p: DVec3) -> (DVec3, DVec3) {
-    let less = |a: f64, b: f64| if a < b { a } else { b };
-    let more = |a: f64, b: f64| if a > b { a } else { b };
+fn grown((lo, hi): (DVec3, DVec3), p: DVec3) -> (DVec3, DVec3) {
     (
-        DVec3::new(less(p.x, lo.x), less(p.y, lo.y), less(p.z, lo.z)),
-        DVec3::new(more(p.x, hi.x), more(p.y, hi.y), more(p.z, hi.z)),
+        DVec3::select(p.cmplt(lo), p, lo),
+        DVec3::select(p.cmpgt(hi), p, hi),
     )
 }
 
 /// Whether every coordinate of `p` is finite, without a branch per
 /// coordinate: `x * 0` is (signed) 0 for a finite `x` and NaN otherwise.
 #[inline(always)]
-pub(crate) fn finite3(p: DVec3) -> bool {
+fn finite3(p: DVec3) -> bool {
     let z = p * 0.0;
     z.x + z.y + z.z == 0.0
 }

@@ -209,29 +209,23 @@ impl<'t> Field<'t> {
         }
     }
 
-    /// Before a step forward: the heading turns towards the tropisms'
-    /// sum, and the torques turn the up vector.
-    #[inline]
-    pub(super) fn adjust(&self, head: &mut DVec3, left: &mut DVec3, up: &mut DVec3) {
-        if self.acts() {
-            self.adjust_by_all(head, left, up)
-        }
-    }
-
-    /// Whether [`Field::adjust`] turns anything: there are tropisms.
+    /// Whether [`Field::adjusted`] turns anything: there are tropisms.
     #[inline]
     pub(super) fn acts(&self) -> bool {
         !self.tropisms.is_empty()
     }
 
-    /// The frame as [`Field::adjust`] leaves it.
+    /// Before a step forward: the frame with the heading turned towards
+    /// the tropisms' sum, and the up vector by the torques.
     pub(super) fn adjusted(
         &self,
         mut head: DVec3,
         mut left: DVec3,
         mut up: DVec3,
     ) -> (DVec3, DVec3, DVec3) {
-        self.adjust(&mut head, &mut left, &mut up);
+        if self.acts() {
+            self.adjust_by_all(&mut head, &mut left, &mut up);
+        }
         (head, left, up)
     }
 
@@ -279,30 +273,25 @@ impl<'t> Field<'t> {
     }
 }
 
-/// The frame as [`bend`] leaves it.
+/// After a step forward: the frame with the heading bent by the simple
+/// tropism, once towards up and once towards left.
 pub(super) fn bent(
     s: &SimpleTropism,
     mut head: DVec3,
     mut left: DVec3,
     mut up: DVec3,
 ) -> (DVec3, DVec3, DVec3) {
-    bend(s, &mut head, &mut left, &mut up);
-    (head, left, up)
-}
-
-/// After a step forward: the simple tropism bends the heading, once
-/// towards up and once towards left.
-pub(super) fn bend(s: &SimpleTropism, head: &mut DVec3, left: &mut DVec3, up: &mut DVec3) {
     if s.elasticity == 0.0 {
-        return;
+        return (head, left, up);
     }
-    for other in [up, left] {
+    for other in [&mut up, &mut left] {
         let c = s.elasticity * s.direction.dot(*other);
         let r = (1.0 - c * c).sqrt();
-        let h = *head * r + *other * c;
-        *other = *other * r - *head * c;
-        *head = h;
+        let h = head * r + *other * c;
+        *other = *other * r - head * c;
+        head = h;
     }
+    (head, left, up)
 }
 
 /// The quaternion `(cos a, sin a * axis)`.

@@ -320,13 +320,11 @@ impl Bounds {
     fn grow(&mut self, p: DVec3, r: f64) {
         let p = self.view.project(p);
         self.finite &= p.is_finite() && r.is_finite();
-        // Plain comparisons: a coordinate that is not finite fails `get`
-        // whatever the box.
+        // Plain comparisons (as `draw::grown`): a coordinate that is not
+        // finite fails `get` whatever the box.
         let (a, b) = (p - r, p + r);
-        let less = |a: f64, b: f64| if a < b { a } else { b };
-        let more = |a: f64, b: f64| if a > b { a } else { b };
-        self.lo = DVec2::new(less(a.x, self.lo.x), less(a.y, self.lo.y));
-        self.hi = DVec2::new(more(b.x, self.hi.x), more(b.y, self.hi.y));
+        self.lo = DVec2::select(a.cmplt(self.lo), a, self.lo);
+        self.hi = DVec2::select(b.cmpgt(self.hi), b, self.hi);
     }
 
     fn event(&mut self, e: &Event) {
