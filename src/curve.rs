@@ -207,8 +207,9 @@ impl Curve {
     }
 
     /// [`Curve::figures`] as PNG files' bytes, the same to the bit; each
-    /// view's picture (without `each`) painted as the turtle walks its
-    /// word (`render::png::word`), with no events or items in memory.
+    /// view's picture (without `each`) painted from the points the turtle
+    /// keeps as it walks its word (`render::png::word`), with no events or
+    /// items in memory.
     pub fn png_figures(&self, opts: &FigureOptions) -> Result<Figures<Vec<u8>>, Error> {
         if opts.each {
             return self

@@ -549,9 +549,9 @@ pub(crate) trait Sink {
 }
 
 /// Where the turtle's 2D drawing goes, one event at a time: a list of
-/// events ([`draw`]), or a picture laid out and painted as the turtle
-/// walks (`render::png::word`). [`Events`] decides which lines continue a
-/// path.
+/// events ([`draw`]), or the compact drawing that `render::png::word`
+/// keeps (its paths' points in one list). [`Events`] decides which lines
+/// continue a path.
 pub(crate) trait EventSink {
     /// A new path: the segment `a`..`b` drawn with `pen`.
     fn path(&mut self, pen: Pen, a: DVec3, b: DVec3) -> Result<(), String>;

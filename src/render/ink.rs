@@ -22,9 +22,17 @@ use super::Rgba;
 /// The longest piece a segment is cut into, in pixels.
 const PIECE: f64 = 0.5;
 
-/// Polylines of this many points or more are inked in bands of rows, one
-/// per thread of rayon's pool.
+/// Runs of thin lines with this many points or more in all are inked in
+/// bands of rows, one per thread of rayon's pool.
 const PARALLEL_POINTS: usize = 1 << 16;
+
+/// A thin polyline to ink: its points, joined in order, with a pen `pen`
+/// pixels wide (at most one), in `color`.
+pub(crate) struct Line<'a> {
+    pub(crate) points: &'a [DVec2],
+    pub(crate) pen: f64,
+    pub(crate) color: Rgba,
+}
 
 /// The ink of one path at a time, over a picture of a given size.
 pub(crate) struct Ink {
@@ -46,17 +54,20 @@ impl Ink {
         }
     }
 
-    /// Lays down the ink of `points`, joined in order, with a pen `pen`
-    /// pixels wide (at most one).
+    /// Paints `lines` on `pm` one after another: the ink of a line is laid
+    /// down, then its colour blended over the pixels it inked.
     ///
-    /// A long polyline is inked in bands of rows at once: each band walks
-    /// every segment and keeps the ink that falls on its rows, so that
-    /// every pixel gathers its ink in the order of the segments, as on one
-    /// thread, and the picture is the same to the bit.
-    pub(crate) fn polyline(&mut self, points: &[DVec2], pen: f64) {
+    /// Lines with many points in all are painted in bands of rows at once:
+    /// each band walks every segment of every line and keeps the ink that
+    /// falls on its rows, then blends its own pixels, line after line.
+    /// Every pixel gathers its ink in the order of the segments and takes
+    /// the lines' colours in their order, as on one thread, so the picture
+    /// is the same to the bit.
+    pub(crate) fn paint(&mut self, pm: &mut Pixmap, lines: &[Line]) {
         use rayon::prelude::*;
         let (width, height) = (self.width, self.height);
-        let bands = if points.len() >= PARALLEL_POINTS && width > 0 {
+        let points: usize = lines.iter().map(|l| l.points.len()).sum();
+        let bands = if points >= PARALLEL_POINTS && width > 0 {
             rayon::current_num_threads().min(height / 16).max(1)
         } else {
             1
@@ -65,69 +76,33 @@ impl Ink {
         if self.touched.len() < bands {
             self.touched.resize_with(bands, Vec::new);
         }
-        let lay = |b: usize, ink: &mut [f32], touched: &mut Vec<u32>| {
-            Band {
+        let paint = |b: usize,
+                     ink: &mut [f32],
+                     touched: &mut Vec<u32>,
+                     pixels: &mut [PremultipliedColorU8]| {
+            let mut band = Band {
                 width,
                 height,
                 row0: b * rows,
                 rows: ink.len() / width.max(1),
                 ink,
                 touched,
+            };
+            for line in lines {
+                band.lay(line.points, line.pen);
+                band.blend(pixels, line.color);
             }
-            .lay(points, pen)
         };
+        let pixels = pm.pixels_mut();
         if bands == 1 {
-            lay(0, &mut self.ink, &mut self.touched[0]);
+            paint(0, &mut self.ink, &mut self.touched[0], pixels);
         } else {
             self.ink
                 .par_chunks_mut(rows * width)
                 .zip(self.touched.par_iter_mut())
+                .zip(pixels.par_chunks_mut(rows * width))
                 .enumerate()
-                .for_each(|(b, (ink, touched))| lay(b, ink, touched));
-        }
-    }
-    /// Lays down the ink of the segment `a`..`b` with a pen `pen` pixels
-    /// wide (at most one), on this thread: segment after segment, this is
-    /// [`Ink::polyline`] of their points to the bit.
-    #[inline]
-    pub(crate) fn segment(&mut self, a: DVec2, b: DVec2, pen: f64) {
-        Band {
-            width: self.width,
-            height: self.height,
-            row0: 0,
-            rows: self.height,
-            ink: &mut self.ink,
-            touched: &mut self.touched[0],
-        }
-        .segment(a, b, pen)
-    }
-
-    /// Blends `color` over `pm` where the ink lies, by the ink's coverage,
-    /// and clears the ink for the next path.
-    pub(crate) fn blend(&mut self, pm: &mut Pixmap, color: Rgba) {
-        let alpha = color.3 as f32 / 255.0;
-        let src = [color.0 as f32, color.1 as f32, color.2 as f32, 255.0];
-        let pixels = pm.pixels_mut();
-        for &i in self.touched.iter().flatten() {
-            let i = i as usize;
-            let a = self.ink[i].min(1.0) * alpha;
-            self.ink[i] = 0.0;
-            let p = pixels[i];
-            let dst = [p.red(), p.green(), p.blue(), p.alpha()].map(f32::from);
-            let mix = |k: usize| (src[k] * a + dst[k] * (1.0 - a)).round().clamp(0.0, 255.0) as u8;
-            let out_a = mix(3);
-            let out = PremultipliedColorU8::from_rgba(
-                mix(0).min(out_a),
-                mix(1).min(out_a),
-                mix(2).min(out_a),
-                out_a,
-            );
-            if let Some(out) = out {
-                pixels[i] = out;
-            }
-        }
-        for t in &mut self.touched {
-            t.clear();
+                .for_each(|(b, ((ink, touched), pixels))| paint(b, ink, touched, pixels));
         }
     }
 }
@@ -145,11 +120,38 @@ struct Band<'a> {
 }
 
 impl Band<'_> {
-    /// The ink of `points` on the band's rows (see [`Ink::polyline`]).
+    /// The ink of `points`, joined in order, on the band's rows.
     fn lay(&mut self, points: &[DVec2], pen: f64) {
         for pair in points.windows(2) {
             self.segment(pair[0], pair[1], pen);
         }
+    }
+
+    /// Blends `color` by the ink's coverage over the band's rows of the
+    /// picture, `pixels`, where the ink lies, and clears the ink.
+    fn blend(&mut self, pixels: &mut [PremultipliedColorU8], color: Rgba) {
+        let alpha = color.3 as f32 / 255.0;
+        let src = [color.0 as f32, color.1 as f32, color.2 as f32, 255.0];
+        let first = self.row0 * self.width;
+        for &i in self.touched.iter() {
+            let i = i as usize - first;
+            let a = self.ink[i].min(1.0) * alpha;
+            self.ink[i] = 0.0;
+            let p = pixels[i];
+            let dst = [p.red(), p.green(), p.blue(), p.alpha()].map(f32::from);
+            let mix = |k: usize| (src[k] * a + dst[k] * (1.0 - a)).round().clamp(0.0, 255.0) as u8;
+            let out_a = mix(3);
+            let out = PremultipliedColorU8::from_rgba(
+                mix(0).min(out_a),
+                mix(1).min(out_a),
+                mix(2).min(out_a),
+                out_a,
+            );
+            if let Some(out) = out {
+                pixels[i] = out;
+            }
+        }
+        self.touched.clear();
     }
 
     /// The ink of the segment `a`..`b` on the band's rows.
@@ -311,20 +313,43 @@ mod tests {
         fn noted(&self) -> Vec<u32> {
             self.touched.iter().flatten().copied().collect()
         }
+
+        /// The whole picture as one band.
+        fn whole(&mut self) -> Band<'_> {
+            Band {
+                width: self.width,
+                height: self.height,
+                row0: 0,
+                rows: self.height,
+                ink: &mut self.ink,
+                touched: &mut self.touched[0],
+            }
+        }
+
+        /// Lays down the ink of `points` on this thread, blending nothing.
+        fn polyline(&mut self, points: &[DVec2], pen: f64) {
+            self.whole().lay(points, pen);
+        }
+
+        fn blend(&mut self, pm: &mut Pixmap, color: Rgba) {
+            self.whole().blend(pm.pixels_mut(), color);
+        }
     }
 
-    /// A polyline long enough to be inked in bands, in pools of one to
-    /// four threads: the same ink on every pixel, to the bit, and the same
-    /// pixels noted. Its points wander in and out of the picture (a
-    /// spiral, jitter from a generator written here, and long jumps
-    /// across it), and the picture's height is not a multiple of the
-    /// bands'.
+    /// Lines long enough in all to be painted in bands, in pools of one to
+    /// four threads: the same picture to the bit, and the ink left clear.
+    /// The lines overlap in colours with alpha, so that the order in which
+    /// a pixel takes them shows; the longest wanders in and out of the
+    /// picture (a spiral, jitter from a generator written here, and long
+    /// jumps across it), and the picture's height is not a multiple of the
+    /// bands'. One line at a time, laid segment by segment and blended on
+    /// this thread, is the reference.
     #[test]
-    fn a_long_polyline_inks_the_same_in_bands() {
+    fn lines_paint_the_same_in_bands() {
         let mut bits = crate::testing::xorshift(0x2545_f491_4f6c_dd1d);
         let mut next = || (bits() >> 11) as f64 / (1u64 << 53) as f64;
         let n = 3 * PARALLEL_POINTS;
-        let points: Vec<DVec2> = (0..n)
+        let spiral: Vec<DVec2> = (0..n)
             .map(|i| {
                 let t = i as f64 / n as f64;
                 let r = 10.0 + 60.0 * t;
@@ -338,36 +363,54 @@ mod tests {
                 DVec2::new(50.0 + r * a.cos(), 45.0 + r * a.sin()) + jitter + jump
             })
             .collect();
-        let inked = |threads: usize| {
+        let short: Vec<Vec<DVec2>> = (0..300)
+            .map(|_| {
+                let a = DVec2::new(next() * 110.0 - 5.0, next() * 100.0 - 5.0);
+                (0..1 + (next() * 6.0) as usize)
+                    .map(|k| a + DVec2::new(next() - 0.5, next() - 0.5) * 8.0 * k as f64)
+                    .collect()
+            })
+            .collect();
+        let mut lines = vec![Line {
+            points: &spiral,
+            pen: 0.7,
+            color: Rgba(200, 30, 60, 180),
+        }];
+        for (k, points) in short.iter().enumerate() {
+            lines.push(Line {
+                points,
+                pen: [1.0, 0.4, 0.05][k % 3],
+                color: Rgba(k as u8, 255 - k as u8, 90, [255, 128, 7][k % 3]),
+            });
+        }
+        let background = tiny_skia::Color::from_rgba8(240, 240, 200, 255);
+        let mut reference = Pixmap::new(101, 91).unwrap();
+        reference.fill(background);
+        let mut ink = Ink::new(101, 91);
+        for line in &lines {
+            for pair in line.points.windows(2) {
+                ink.whole().segment(pair[0], pair[1], line.pen);
+            }
+            ink.blend(&mut reference, line.color);
+        }
+        for threads in 1..=4 {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
                 .unwrap();
+            let mut pm = Pixmap::new(101, 91).unwrap();
+            pm.fill(background);
             let mut ink = Ink::new(101, 91);
-            pool.install(|| ink.polyline(&points, 0.7));
-            let mut noted = ink.noted();
-            noted.sort_unstable();
-            let bits: Vec<u32> = ink.ink.iter().map(|x| x.to_bits()).collect();
-            (bits, noted)
-        };
-        let (one, noted) = inked(1);
-        assert!(noted.len() > 5000, "{}", noted.len());
-        for threads in 2..=4 {
-            let (bits, seen) = inked(threads);
-            assert!(bits == one, "the ink differs on {threads} threads");
-            assert_eq!(seen, noted, "{threads} threads");
+            pool.install(|| ink.paint(&mut pm, &lines));
+            assert!(pm == reference, "the picture differs on {threads} threads");
+            assert!(ink.noted().is_empty() && ink.ink.iter().all(|&x| x == 0.0));
         }
-        // Segment after segment, as a picture painted while the turtle
-        // walks inks it.
-        let mut ink = Ink::new(101, 91);
-        for pair in points.windows(2) {
-            ink.segment(pair[0], pair[1], 0.7);
-        }
-        let mut seen = ink.noted();
-        seen.sort_unstable();
-        let bits: Vec<u32> = ink.ink.iter().map(|x| x.to_bits()).collect();
-        assert!(bits == one, "the ink differs segment by segment");
-        assert_eq!(seen, noted, "segment by segment");
+        // The lines changed the picture, and the later ones show over the
+        // spiral.
+        let changed = (reference.pixels().iter())
+            .filter(|p| (p.red(), p.green(), p.blue()) != (240, 240, 200))
+            .count();
+        assert!(changed > 3000, "{changed}");
     }
 
     fn ink_of(points: &[DVec2], pen: f64) -> Ink {

@@ -318,7 +318,12 @@ impl Bounds {
 
     #[inline]
     fn grow(&mut self, p: DVec3, r: f64) {
-        let p = self.view.project(p);
+        self.grow_projected(self.view.project(p), r);
+    }
+
+    /// [`Bounds::grow`] by a point already projected onto the view's plane.
+    #[inline]
+    fn grow_projected(&mut self, p: DVec2, r: f64) {
         self.finite &= p.is_finite() && r.is_finite();
         // Plain comparisons (as `draw::grown`): a coordinate that is not
         // finite fails `get` whatever the box.
@@ -350,27 +355,6 @@ impl Bounds {
             ));
         }
         Ok(Some((self.lo, self.hi)))
-    }
-}
-
-impl crate::draw::EventSink for Bounds {
-    #[inline]
-    fn path(&mut self, _pen: Pen, a: DVec3, b: DVec3) -> Result<(), String> {
-        self.any = true;
-        self.grow(a, 0.0);
-        self.grow(b, 0.0);
-        Ok(())
-    }
-
-    #[inline(always)]
-    fn continue_to(&mut self, b: DVec3) -> Result<(), String> {
-        self.grow(b, 0.0);
-        Ok(())
-    }
-
-    fn event(&mut self, e: Event) -> Result<(), String> {
-        Bounds::event(self, &e);
-        Ok(())
     }
 }
 
@@ -462,10 +446,11 @@ impl<'o, C: Canvas> Layout<'o, C> {
         self.fit.pixel(self.opts.view.project(p))
     }
 
-    /// A path with `pen` starts at `a`: it continues the open polyline, or
-    /// begins one.
-    fn path_from(&mut self, pen: Pen, a: DVec3) {
-        let (color, width, first) = (self.color(pen.color), self.width(pen.width), self.px(a));
+    /// A path with `pen` starts at `a` (projected onto the view's plane):
+    /// it continues the open polyline, or begins one.
+    fn path_from(&mut self, pen: Pen, a: DVec2) {
+        let first = self.fit.pixel(a);
+        let (color, width) = (self.color(pen.color), self.width(pen.width));
         let joined = matches!(self.run, Some((c, w, last))
             if c == color && w == width && last.distance(first) < 1e-9);
         if !joined {
@@ -475,9 +460,10 @@ impl<'o, C: Canvas> Layout<'o, C> {
         }
     }
 
+    /// The open polyline goes on to `p` (projected onto the view's plane).
     #[inline]
-    fn point(&mut self, p: DVec3) {
-        let q = self.px(p);
+    fn point(&mut self, p: DVec2) {
+        let q = self.fit.pixel(p);
         self.canvas.point(q);
         if let Some(run) = &mut self.run {
             run.2 = q;
@@ -494,9 +480,10 @@ impl<'o, C: Canvas> Layout<'o, C> {
         let scale = self.fit.scale;
         let item = match e {
             Event::Path { points, pen } => {
+                let view = self.opts.view;
                 if let [first, rest @ ..] = points.as_slice() {
-                    self.path_from(*pen, *first);
-                    rest.iter().for_each(|p| self.point(*p));
+                    self.path_from(*pen, view.project(*first));
+                    rest.iter().for_each(|p| self.point(view.project(*p)));
                 }
                 return;
             }
@@ -530,26 +517,6 @@ impl<'o, C: Canvas> Layout<'o, C> {
     pub(crate) fn finish(mut self) -> C {
         self.end_run();
         self.canvas
-    }
-}
-
-impl<C: Canvas> crate::draw::EventSink for Layout<'_, C> {
-    #[inline]
-    fn path(&mut self, pen: Pen, a: DVec3, b: DVec3) -> Result<(), String> {
-        self.path_from(pen, a);
-        self.point(b);
-        Ok(())
-    }
-
-    #[inline(always)]
-    fn continue_to(&mut self, b: DVec3) -> Result<(), String> {
-        self.point(b);
-        Ok(())
-    }
-
-    fn event(&mut self, e: Event) -> Result<(), String> {
-        self.lay(&e);
-        Ok(())
     }
 }
 

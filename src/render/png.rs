@@ -6,9 +6,9 @@ use tiny_skia::{
     Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, Transform,
 };
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
-use crate::draw::{walk, Events};
+use crate::draw::{walk, Event, Events, Pen};
 
 use super::{Item, RenderError, Rgba, Scene};
 
@@ -32,20 +32,28 @@ fn stroke(width: f64) -> Stroke {
 /// Rasterises a scene and encodes it as PNG.
 pub fn render(scene: &Scene) -> Result<Vec<u8>, RenderError> {
     let mut painter = Painter::new(scene.width, scene.height, scene.background)?;
-    for item in &scene.items {
-        painter.paint(item);
-    }
+    painter.paint(scene.items.iter().map(|item| match item {
+        Item::Polyline {
+            points,
+            color,
+            width,
+        } => Piece::Line(points, *color, *width),
+        item => Piece::Item(item),
+    }));
     painter.encode()
 }
 
 /// The PNG of the turtle's 2D drawing of `word` in one cell the size of
 /// the picture, as [`render`] makes it from the [`super::scene`] of
-/// [`crate::draw::draw`]'s events, to the bit; but painted as the turtle
-/// walks, with no list of events or items. The turtle walks twice: once
-/// to find the drawing's box, once to lay out and paint each event as it
-/// comes. Memory beyond the word is the picture's, the points of the
-/// widest pen's open polyline, and a few batches of points on their way
-/// to the painting thread.
+/// [`crate::draw::draw`]'s events, to the bit; but with no list of events
+/// or items. The turtle walks once, keeping its lines' points (projected
+/// onto the view's plane) in one list and finding the drawing's box; the
+/// points are then laid out in pixels where they lie, and painted.
+///
+/// Memory beyond the word and the picture is those points, 16 bytes each
+/// (at most two a line drawn, one a line that continues a path, as every
+/// line of a curve does), a mark where each path or other event starts,
+/// and the events that are not paths.
 pub fn word(
     word: &crate::rewrite::Word,
     alphabet: &crate::lang::Alphabet,
@@ -54,9 +62,10 @@ pub fn word(
     opts: &super::RenderOptions,
 ) -> Result<Vec<u8>, WordError> {
     super::check_size(opts.width, opts.height)?;
-    let mut bounds = Events::new(super::Bounds::new(opts.view));
-    walk(word, alphabet, structs, draw, None, &mut bounds)?;
-    let Some(bounds) = bounds.into_inner().get()? else {
+    let mut drawing = Events::new(Drawing::new(opts.view, word.len()));
+    walk(word, alphabet, structs, draw, None, &mut drawing)?;
+    let drawing = drawing.into_inner();
+    let Some(bounds) = drawing.bounds.get()? else {
         return Err(super::nothing_to_draw().into());
     };
     let mut opts = std::borrow::Cow::Borrowed(opts);
@@ -64,166 +73,153 @@ pub fn word(
         let height = super::fitted_height(&opts, opts.width as f64, [bounds]);
         opts.to_mut().height = height;
     }
-    let painter = Painter::new(opts.width, opts.height, opts.background)?;
-    let drawn = (word, alphabet, structs, draw);
-    if rayon::current_num_threads() == 1 {
-        return Ok(lay_out(drawn, bounds, &opts, painter)?.encode()?);
-    }
-    // Two threads: this one walks and lays out, the other paints what
-    // was laid out, in order.
-    let (batches, painted) = std::sync::mpsc::sync_channel::<Batch>(IN_FLIGHT);
-    let (spent, spare) = std::sync::mpsc::channel::<Batch>();
-    let painter = std::thread::scope(|scope| {
-        let paint = scope.spawn(move || {
-            let mut painter = painter;
-            for mut batch in painted {
-                batch.replay(&mut painter);
-                // The painting is over when the walk stops taking batches
-                // back.
-                let _ = spent.send(batch);
-            }
-            painter
-        });
-        let relay = Relay {
-            batch: Batch::default(),
-            limit: BATCH,
-            out: batches,
-            spare,
-        };
-        // A failed walk drops the relay, which ends the painting.
-        let walked = lay_out(drawn, bounds, &opts, relay).map(|mut relay| relay.send());
-        let painter = paint
-            .join()
-            .unwrap_or_else(|e| std::panic::resume_unwind(e));
-        walked.map(|()| painter)
-    })?;
+    let mut painter = Painter::new(opts.width, opts.height, opts.background)?;
+    let laid = drawing.lay_out(bounds, &opts);
+    painter.paint(laid.parts.iter().map(|piece| match piece {
+        Part::Line(range, color, width) => Piece::Line(&laid.points[range.clone()], *color, *width),
+        Part::Item(item) => Piece::Item(item),
+    }));
     Ok(painter.encode()?)
 }
 
-/// Points in a batch handed from the walk to the painting thread.
-const BATCH: usize = 1 << 14;
-/// Batches on their way to the painting thread at most.
-const IN_FLIGHT: usize = 4;
-
-/// Calls of a [`Canvas`](super::Canvas) in order, with the points of
-/// their polylines in one list: a mark at `k` comes after `points[..k]`
-/// (a polyline's first point is the one at its `Begin`).
-#[derive(Default)]
-struct Batch {
+/// The turtle's 2D drawing as it walks, compactly: the points of its
+/// paths, one path after another, projected onto the view's plane; where
+/// each path, and each other event, starts among them; and the box of it
+/// all.
+struct Drawing {
+    view: super::View,
+    bounds: super::Bounds,
     points: Vec<DVec2>,
-    marks: Vec<(usize, Mark)>,
+    /// What starts before the point at each index.
+    starts: Vec<(usize, Start)>,
 }
 
-enum Mark {
-    Begin(Rgba, f64),
-    End,
+enum Start {
+    /// A path drawn with this pen: its first point is the one at the index.
+    Path(Pen),
+    /// An event that is not a path.
+    Event(Event),
+}
+
+impl Drawing {
+    /// A drawing of a word of `modules` modules: room for a point each is
+    /// set aside (and taken from the system only as the points come).
+    fn new(view: super::View, modules: usize) -> Drawing {
+        Drawing {
+            view,
+            bounds: super::Bounds::new(view),
+            points: Vec::with_capacity(modules.saturating_add(1)),
+            starts: Vec::new(),
+        }
+    }
+
+    /// The drawing laid out in pixels within `bounds`, as
+    /// [`super::scene`] lays out the events: each point becomes its pixel
+    /// in place, and consecutive paths that [`super::Layout`] joins become
+    /// one line (the later path's first point left out).
+    fn lay_out(self, bounds: (DVec2, DVec2), opts: &super::RenderOptions) -> Laid {
+        let Drawing { points, starts, .. } = self;
+        let n = points.len();
+        let canvas = Laid {
+            points,
+            len: 0,
+            parts: Vec::new(),
+        };
+        let mut layout = super::Layout::new(bounds, 0.0, opts.width as f64, opts, canvas);
+        // Point `read` is read before any pixel is written over it: each
+        // point read writes at most one pixel, at `len <= read`.
+        let mut read = 0;
+        fn to(layout: &mut super::Layout<'_, Laid>, read: &mut usize, end: usize) {
+            while *read < end {
+                let p = layout.canvas.points[*read];
+                layout.point(p);
+                *read += 1;
+            }
+        }
+        for (at, start) in starts {
+            to(&mut layout, &mut read, at);
+            match start {
+                Start::Path(pen) => {
+                    let a = layout.canvas.points[read];
+                    layout.path_from(pen, a);
+                    read += 1;
+                }
+                Start::Event(e) => layout.lay(&e),
+            }
+        }
+        to(&mut layout, &mut read, n);
+        let mut laid = layout.finish();
+        laid.points.truncate(laid.len);
+        laid
+    }
+}
+
+impl crate::draw::EventSink for Drawing {
+    fn path(&mut self, pen: Pen, a: DVec3, b: DVec3) -> Result<(), String> {
+        let (a, b) = (self.view.project(a), self.view.project(b));
+        self.bounds.any = true;
+        self.bounds.grow_projected(a, 0.0);
+        self.bounds.grow_projected(b, 0.0);
+        self.starts.push((self.points.len(), Start::Path(pen)));
+        self.points.extend([a, b]);
+        Ok(())
+    }
+
+    #[inline(always)]
+    fn continue_to(&mut self, b: DVec3) -> Result<(), String> {
+        let b = self.view.project(b);
+        self.bounds.grow_projected(b, 0.0);
+        self.points.push(b);
+        Ok(())
+    }
+
+    fn event(&mut self, e: Event) -> Result<(), String> {
+        self.bounds.event(&e);
+        self.starts.push((self.points.len(), Start::Event(e)));
+        Ok(())
+    }
+}
+
+/// A drawing laid out in pixels: the points of its lines, one line after
+/// another, and its lines and other items in order.
+struct Laid {
+    points: Vec<DVec2>,
+    /// The points laid out so far: `points[..len]`.
+    len: usize,
+    parts: Vec<Part>,
+}
+
+/// A part of a [`Laid`] drawing.
+enum Part {
+    /// A polyline through the points in the range, with its colour and
+    /// width in pixels.
+    Line(std::ops::Range<usize>, Rgba, f64),
     Item(Item),
 }
 
-impl Batch {
-    /// Makes the calls on `canvas`, in order, and empties the batch.
-    fn replay(&mut self, canvas: &mut impl super::Canvas) {
-        let mut next = 0;
-        for (at, mark) in self.marks.drain(..) {
-            for p in &self.points[next..at] {
-                canvas.point(*p);
-            }
-            next = at;
-            match mark {
-                Mark::Begin(color, width) => {
-                    canvas.begin(color, width, self.points[at]);
-                    next = at + 1;
-                }
-                Mark::End => canvas.end(),
-                Mark::Item(item) => canvas.item(item),
-            }
-        }
-        for p in &self.points[next..] {
-            canvas.point(*p);
-        }
-        self.points.clear();
-    }
-}
-
-/// The canvas of the walking thread: batches of calls sent to the
-/// painting thread, and batches it painted taken back for reuse.
-struct Relay {
-    batch: Batch,
-    /// The points, or marks, of a full batch.
-    limit: usize,
-    out: std::sync::mpsc::SyncSender<Batch>,
-    spare: std::sync::mpsc::Receiver<Batch>,
-}
-
-impl Relay {
-    /// Sends the batch on (a full one, or the last).
-    #[inline(never)]
-    fn send(&mut self) {
-        let next = self.spare.try_recv().unwrap_or_default();
-        let full = std::mem::replace(&mut self.batch, next);
-        // The painting thread takes batches until this one stops; it
-        // cannot have stopped before.
-        let _ = self.out.send(full);
-    }
-
-    /// Sends the batch on when it is full.
-    #[inline]
-    fn sent_if_full(&mut self) {
-        if self.batch.points.len() >= self.limit || self.batch.marks.len() >= self.limit {
-            self.send();
-        }
-    }
-
-    fn mark(&mut self, mark: Mark) {
-        self.batch.marks.push((self.batch.points.len(), mark));
-        self.sent_if_full();
-    }
-}
-
-impl super::Canvas for Relay {
+impl super::Canvas for Laid {
     fn begin(&mut self, color: Rgba, width: f64, first: DVec2) {
-        let at = self.batch.points.len();
-        self.batch.marks.push((at, Mark::Begin(color, width)));
-        self.batch.points.push(first);
-        self.sent_if_full();
+        self.parts
+            .push(Part::Line(self.len..self.len, color, width));
+        self.point(first);
     }
 
     #[inline]
     fn point(&mut self, p: DVec2) {
-        self.batch.points.push(p);
-        self.sent_if_full();
+        self.points[self.len] = p;
+        self.len += 1;
     }
 
     fn end(&mut self) {
-        self.mark(Mark::End);
+        if let Some(Part::Line(range, ..)) = self.parts.last_mut() {
+            range.end = self.len;
+        }
     }
 
     fn item(&mut self, item: Item) {
-        self.mark(Mark::Item(item));
+        self.parts.push(Part::Item(item));
     }
 }
-
-/// The turtle's walk over a word, laying its drawing out within `bounds`
-/// on `canvas`.
-fn lay_out<C: super::Canvas>(
-    (word, alphabet, structs, draw): Drawn<'_>,
-    bounds: (DVec2, DVec2),
-    opts: &super::RenderOptions,
-    canvas: C,
-) -> Result<C, crate::draw::DrawError> {
-    let layout = super::Layout::new(bounds, 0.0, opts.width as f64, opts, canvas);
-    let mut events = Events::new(layout);
-    walk(word, alphabet, structs, draw, None, &mut events)?;
-    Ok(events.into_inner().finish())
-}
-
-/// A word and what the turtle needs to draw it.
-type Drawn<'a> = (
-    &'a crate::rewrite::Word,
-    &'a crate::lang::Alphabet,
-    &'a [crate::lang::value::StructDef],
-    &'a crate::draw::DrawOptions,
-);
 
 /// Why [`word`] made no picture: the turtle's walk failed, or the drawing
 /// cannot be pictured.
@@ -245,27 +241,17 @@ impl From<RenderError> for WordError {
     }
 }
 
-/// A picture being painted: items one after another, and a polyline a
-/// point at a time.
+/// What a picture is painted from, in order: a polyline (its points,
+/// colour and width in pixels), or another item.
+enum Piece<'a> {
+    Line(&'a [DVec2], Rgba, f64),
+    Item(&'a Item),
+}
+
+/// A picture being painted.
 pub(crate) struct Painter {
     pm: Pixmap,
     ink: super::ink::Ink,
-    open: Option<Open>,
-}
-
-/// The polyline being painted: a thin pen's inks each segment as it
-/// comes; a wider pen's points wait for tiny-skia to stroke them whole.
-enum Open {
-    Thin {
-        color: Rgba,
-        pen: f64,
-        last: DVec2,
-    },
-    Wide {
-        color: Rgba,
-        width: f64,
-        points: Vec<DVec2>,
-    },
 }
 
 impl Painter {
@@ -277,7 +263,6 @@ impl Painter {
         Ok(Painter {
             pm,
             ink: super::ink::Ink::new(width, height),
-            open: None,
         })
     }
 
@@ -287,20 +272,37 @@ impl Painter {
         (width <= 1.0).then_some(if width > 0.0 { width } else { 1.0 })
     }
 
-    /// Paints `item` (a long thin polyline in bands on rayon's pool).
-    fn paint(&mut self, item: &Item) {
+    /// Paints `pieces` one after another. Each run of thin polylines
+    /// between other pieces is inked at once (in bands of rows on rayon's
+    /// pool when it is long); wider polylines and other items are painted
+    /// by tiny-skia.
+    fn paint<'a>(&mut self, pieces: impl Iterator<Item = Piece<'a>>) {
+        let mut run = Vec::new();
+        for piece in pieces {
+            if let Piece::Line(points, color, width) = piece {
+                if let Some(pen) = Self::thin(width) {
+                    run.push(super::ink::Line { points, pen, color });
+                    continue;
+                }
+            }
+            self.ink.paint(&mut self.pm, &run);
+            run.clear();
+            match piece {
+                Piece::Line(points, color, width) => self.stroke(points, color, width),
+                Piece::Item(item) => self.item(item),
+            }
+        }
+        self.ink.paint(&mut self.pm, &run);
+    }
+
+    /// Paints an item that is not a polyline.
+    fn item(&mut self, item: &Item) {
         match item {
             Item::Polyline {
                 points,
                 color,
                 width,
-            } => match Self::thin(*width) {
-                Some(pen) => {
-                    self.ink.polyline(points, pen);
-                    self.ink.blend(&mut self.pm, *color);
-                }
-                None => self.stroke(points, *color, *width),
-            },
+            } => self.paint(std::iter::once(Piece::Line(points, *color, *width))),
             Item::Disc { c, r, color } => {
                 if let Some(path) =
                     PathBuilder::from_circle(c.x as f32, c.y as f32, (*r as f32).max(0.25))
@@ -368,138 +370,4 @@ fn path_through(points: &[DVec2]) -> Option<PathBuilder> {
         pb.line_to(p.x as f32, p.y as f32);
     }
     Some(pb)
-}
-
-impl super::Canvas for Painter {
-    fn begin(&mut self, color: Rgba, width: f64, first: DVec2) {
-        self.open = Some(match Self::thin(width) {
-            Some(pen) => Open::Thin {
-                color,
-                pen,
-                last: first,
-            },
-            None => Open::Wide {
-                color,
-                width,
-                points: vec![first],
-            },
-        });
-    }
-
-    #[inline]
-    fn point(&mut self, p: DVec2) {
-        match &mut self.open {
-            Some(Open::Thin { pen, last, .. }) => {
-                self.ink.segment(*last, p, *pen);
-                *last = p;
-            }
-            Some(Open::Wide { points, .. }) => points.push(p),
-            None => {}
-        }
-    }
-
-    fn end(&mut self) {
-        match self.open.take() {
-            Some(Open::Thin { color, .. }) => self.ink.blend(&mut self.pm, color),
-            Some(Open::Wide {
-                color,
-                width,
-                points,
-            }) => self.stroke(&points, color, width),
-            None => {}
-        }
-    }
-
-    fn item(&mut self, item: Item) {
-        self.paint(&item);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::super::Canvas;
-    use super::*;
-
-    /// The calls a canvas got, as text.
-    #[derive(Default)]
-    struct Log(Vec<String>);
-
-    impl Canvas for Log {
-        fn begin(&mut self, color: Rgba, width: f64, first: DVec2) {
-            self.0.push(format!("begin {color:?} {width} {first}"));
-        }
-        fn point(&mut self, p: DVec2) {
-            self.0.push(format!("point {p}"));
-        }
-        fn end(&mut self) {
-            self.0.push("end".into());
-        }
-        fn item(&mut self, item: Item) {
-            self.0.push(format!("item {item:?}"));
-        }
-    }
-
-    /// Calls relayed in batches of every small size reach the painting
-    /// thread's canvas as they were made: a batch that fills at a
-    /// polyline's first point, at its last, or at an item in between.
-    #[test]
-    fn relayed_calls_arrive_in_order() {
-        let mut bits = crate::testing::xorshift(0x9e37_79b9_7f4a_7c15);
-        let mut next = |n: u64| bits() % n;
-        let calls: Vec<(u64, f64)> = (0..600).map(|i| (next(10), i as f64)).collect();
-        let make = |canvas: &mut dyn Canvas| {
-            let mut open = false;
-            for &(kind, x) in &calls {
-                let p = DVec2::new(x, -x);
-                match kind {
-                    0 | 1 if !open => {
-                        canvas.begin(Rgba(kind as u8, 0, 0, 255), x, p);
-                        open = true;
-                    }
-                    0 => {
-                        canvas.end();
-                        open = false;
-                    }
-                    1 => canvas.item(Item::Disc {
-                        c: p,
-                        r: x,
-                        color: Rgba(1, 2, 3, 4),
-                    }),
-                    _ if open => canvas.point(p),
-                    _ => {}
-                }
-            }
-            if open {
-                canvas.end();
-            }
-        };
-        let mut direct = Log::default();
-        make(&mut direct);
-        assert!(direct.0.len() > 400, "{}", direct.0.len());
-        for limit in 1..=7 {
-            let (out, painted) = std::sync::mpsc::sync_channel::<Batch>(IN_FLIGHT);
-            let (spent, spare) = std::sync::mpsc::channel::<Batch>();
-            let got = std::thread::scope(|scope| {
-                let paint = scope.spawn(move || {
-                    let mut log = Log::default();
-                    for mut batch in painted {
-                        batch.replay(&mut log);
-                        let _ = spent.send(batch);
-                    }
-                    log
-                });
-                let mut relay = Relay {
-                    batch: Batch::default(),
-                    limit,
-                    out,
-                    spare,
-                };
-                make(&mut relay);
-                relay.send();
-                drop(relay);
-                paint.join().unwrap()
-            });
-            assert_eq!(got.0, direct.0, "batches of {limit}");
-        }
-    }
 }

@@ -197,7 +197,7 @@ fn a_picture_painted_as_the_turtle_walks_is_the_scenes_to_the_bit() {
             assert!(lines > 65_536 && scene.items.len() > 10, "{lines}");
             let expected = png::render(&scene).unwrap();
             // Painted on this thread, and on a thread beside the walk.
-            for threads in [1, 2] {
+            for threads in [1, 2, 3] {
                 let pool = rayon::ThreadPoolBuilder::new()
                     .num_threads(threads)
                     .build()
@@ -223,6 +223,59 @@ fn a_picture_painted_as_the_turtle_walks_is_the_scenes_to_the_bit() {
     let scene = l.figure(&opts).unwrap();
     assert!(scene.height < 800, "{}", scene.height);
     assert!(l.png_figures(&opts).unwrap().main == png::render(&scene).unwrap());
+}
+
+/// Paths that the turtle keeps apart and the layout joins into one line
+/// (the later path's first point left out, so that the laid-out points
+/// fall behind the drawn ones): colours 12 apart are one colour of the
+/// default palette, and a move of 1e-13 is no distance in pixels. Between
+/// them, paths that stay apart (another colour, a move of half a unit),
+/// and a disc; the Koch curves make the lines long enough to be painted in
+/// bands.
+#[test]
+fn paths_the_layout_joins_are_painted_as_the_scene_paints_them() {
+    let l = load_text(
+        "derivation length: 6;\n\
+         Axiom: SetColor(1) F(1) SetColor(13) F(1) f(1e-13) Right(60) F(1) SetColor(25) \
+         G(1) SetColor(2) G(1) f(0.5) G(1) Circle(0.2) F(1) SetColor(14) F(1) Left(90) \
+         SetColor(2) SetWidth(0.3) F(1) f(1e-14) F(1);\n\
+         F(x) -> F(x/3) Left(60) F(x/3) Right(120) F(x/3) Left(60) F(x/3);\n",
+    );
+    let opts = sized(300, 260);
+    let scene = l.figure(&opts).unwrap();
+    let lines: Vec<usize> = (scene.items.iter())
+        .filter_map(|i| match i {
+            Item::Polyline { points, .. } => Some(points.len()),
+            _ => None,
+        })
+        .collect();
+    // The turtle draws ten paths; the layout joins them into five lines:
+    // three Koch curves (4^6 segments each) and a `G`; two lines of a `G`
+    // each; two Koch curves after the disc; and two in another width.
+    let p = &l.program;
+    let mut d = subgram::Derivation::new(p, DeriveOptions::default()).unwrap();
+    while d.has_next() {
+        d.next_step().unwrap();
+    }
+    let word = d.interpret().unwrap();
+    let events = subgram::draw::draw(&word, &p.alphabet, &p.structs, &Default::default()).unwrap();
+    let paths = (events.iter())
+        .filter(|e| matches!(e, subgram::draw::Event::Path { .. }))
+        .count();
+    assert_eq!(paths, 10);
+    assert_eq!(lines, [3 * 4096 + 2, 2, 2, 2 * 4096 + 1, 2 * 4096 + 1]);
+    let expected = png::render(&scene).unwrap();
+    for threads in [1, 2, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let painted = pool.install(|| l.png_figures(&opts)).unwrap();
+        assert!(
+            painted.main == expected,
+            "{threads} threads: the pictures differ"
+        );
+    }
 }
 
 #[test]
