@@ -30,9 +30,26 @@ fn ms(d: Duration) -> f64 {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--derive-only") {
+        derive_only(&args[i + 1]);
+        return;
+    }
     let runs = common::runs_arg(&args, 3);
     snowflake(runs);
     island(runs);
+}
+
+/// The reference process for `render`'s: reads the file, derives it, and
+/// exits (the same start, file reading and fresh memory as a command's
+/// derivation, and nothing after it).
+fn derive_only(file: &str) {
+    let src = std::fs::read_to_string(file).unwrap();
+    let loaded = subgram::load_str(file, &src, &[]).expect("loads");
+    let mut d = Derivation::new(&loaded.program, DeriveOptions::default()).unwrap();
+    while d.has_next() {
+        d.next_step().unwrap();
+    }
+    assert!(!d.word.is_empty());
 }
 
 fn snowflake(runs: usize) {
@@ -184,14 +201,14 @@ fn island(runs: usize) {
     // Each run writes a new file: the last run's output is removed before
     // the clock starts (freeing 119 MB of page cache is not the command's
     // work, nor the derivation's it is compared with).
-    let cli = |args: &[&str], out: &str| {
+    let process = |program: &std::path::Path, args: &[&str], out: &str| {
         let target = dir.join(out);
         let mut best = std::time::Duration::MAX;
         for _ in 0..runs {
             let _ = std::fs::remove_file(&target);
             let started = std::time::Instant::now();
             let stdout = std::fs::File::create(&target).unwrap();
-            let mut cmd = std::process::Command::new(&bin);
+            let mut cmd = std::process::Command::new(program);
             cmd.args(args).arg(&file);
             if out.ends_with(".png") {
                 cmd.arg("-o").arg(&target);
@@ -200,10 +217,12 @@ fn island(runs: usize) {
             }
             let ok = cmd.status().unwrap().success();
             best = best.min(started.elapsed());
-            assert!(ok, "subgram {args:?} failed");
+            assert!(ok, "{} {args:?} failed", program.display());
         }
         (best, std::fs::metadata(&target).unwrap().len())
     };
+    let cli = |args: &[&str], out: &str| process(&bin, args, out);
+    let (t_process, _) = process(&exe, &["--derive-only"], "derived.txt");
     let (t_text, text_len) = cli(&["derive", "--format", "text"], "island.txt");
     let (t_json, json_len) = cli(&["derive", "--format", "json"], "island.json");
     let (t_render, _) = cli(&["render"], "island.png");
@@ -234,6 +253,13 @@ fn island(runs: usize) {
         format!("({} MB)", json_len >> 20),
     );
     row("subgram render -o PNG", t_render, String::new());
+    println!(
+        "  a process that only reads the file and derives {:.1} ms: render {:.2}x, derive --format text {:.2}x, --format json {:.2}x",
+        ms(t_process),
+        t_render.as_secs_f64() / t_process.as_secs_f64(),
+        t_text.as_secs_f64() / t_process.as_secs_f64(),
+        t_json.as_secs_f64() / t_process.as_secs_f64(),
+    );
     println!(
         "  in this process: the PNG of the derived word (what `render` does after deriving) {:.1} ms ({:.2}x the derivation's first run, {:.2}x the best)",
         ms(t_walked),
