@@ -26,12 +26,36 @@ const PIECE: f64 = 0.5;
 /// bands of rows, one per thread of rayon's pool.
 const PARALLEL_POINTS: usize = 1 << 16;
 
+/// Thin lines painted one after another (see [`Ink::paint`]).
+pub(crate) trait Run: Sync {
+    /// How many points the lines have in all.
+    fn points(&self) -> usize;
+    /// Paints the lines on `band`, in order: a line's ink laid down by
+    /// [`Band::lay`], then its colour blended by [`Band::blend`].
+    fn paint(&self, band: &mut Band<'_>, pixels: &mut [PremultipliedColorU8]);
+}
+
 /// A thin polyline to ink: its points, joined in order, with a pen `pen`
 /// pixels wide (at most one), in `color`.
 pub(crate) struct Line<'a> {
     pub(crate) points: &'a [DVec2],
     pub(crate) pen: f64,
     pub(crate) color: Rgba,
+}
+
+impl Run for [Line<'_>] {
+    fn points(&self) -> usize {
+        self.iter().map(|l| l.points.len()).sum()
+    }
+
+    fn paint(&self, band: &mut Band<'_>, pixels: &mut [PremultipliedColorU8]) {
+        for line in self {
+            if let [first, rest @ ..] = line.points {
+                band.lay(*first, rest.iter().copied(), line.pen);
+            }
+            band.blend(pixels, line.color);
+        }
+    }
 }
 
 /// The ink of one path at a time, over a picture of a given size.
@@ -54,8 +78,9 @@ impl Ink {
         }
     }
 
-    /// Paints `lines` on `pm` one after another: the ink of a line is laid
-    /// down, then its colour blended over the pixels it inked.
+    /// Paints the lines of `run` on `pm` one after another: the ink of a
+    /// line is laid down, then its colour blended over the pixels it
+    /// inked.
     ///
     /// Lines with many points in all are painted in bands of rows at once:
     /// each band walks every segment of every line and keeps the ink that
@@ -63,11 +88,10 @@ impl Ink {
     /// Every pixel gathers its ink in the order of the segments and takes
     /// the lines' colours in their order, as on one thread, so the picture
     /// is the same to the bit.
-    pub(crate) fn paint(&mut self, pm: &mut Pixmap, lines: &[Line]) {
+    pub(crate) fn paint<R: Run + ?Sized>(&mut self, pm: &mut Pixmap, run: &R) {
         use rayon::prelude::*;
         let (width, height) = (self.width, self.height);
-        let points: usize = lines.iter().map(|l| l.points.len()).sum();
-        let bands = if points >= PARALLEL_POINTS && width > 0 {
+        let bands = if run.points() >= PARALLEL_POINTS && width > 0 {
             rayon::current_num_threads().min(height / 16).max(1)
         } else {
             1
@@ -88,10 +112,7 @@ impl Ink {
                 ink,
                 touched,
             };
-            for line in lines {
-                band.lay(line.points, line.pen);
-                band.blend(pixels, line.color);
-            }
+            run.paint(&mut band, pixels);
         };
         let pixels = pm.pixels_mut();
         if bands == 1 {
@@ -109,7 +130,7 @@ impl Ink {
 
 /// The rows `row0..row0 + rows` of the ink, and the pixels among them
 /// that have ink.
-struct Band<'a> {
+pub(crate) struct Band<'a> {
     width: usize,
     height: usize,
     row0: usize,
@@ -120,16 +141,24 @@ struct Band<'a> {
 }
 
 impl Band<'_> {
-    /// The ink of `points`, joined in order, on the band's rows.
-    fn lay(&mut self, points: &[DVec2], pen: f64) {
-        for pair in points.windows(2) {
-            self.segment(pair[0], pair[1], pen);
-        }
+    /// The ink, on the band's rows, of the polyline from `from` through
+    /// `points` in order, with a pen `pen` pixels wide; its last point.
+    #[inline]
+    pub(crate) fn lay(
+        &mut self,
+        from: DVec2,
+        points: impl Iterator<Item = DVec2>,
+        pen: f64,
+    ) -> DVec2 {
+        points.fold(from, |a, b| {
+            self.segment(a, b, pen);
+            b
+        })
     }
 
     /// Blends `color` by the ink's coverage over the band's rows of the
     /// picture, `pixels`, where the ink lies, and clears the ink.
-    fn blend(&mut self, pixels: &mut [PremultipliedColorU8], color: Rgba) {
+    pub(crate) fn blend(&mut self, pixels: &mut [PremultipliedColorU8], color: Rgba) {
         let alpha = color.3 as f32 / 255.0;
         let src = [color.0 as f32, color.1 as f32, color.2 as f32, 255.0];
         let first = self.row0 * self.width;
@@ -328,7 +357,9 @@ mod tests {
 
         /// Lays down the ink of `points` on this thread, blending nothing.
         fn polyline(&mut self, points: &[DVec2], pen: f64) {
-            self.whole().lay(points, pen);
+            if let [first, rest @ ..] = points {
+                self.whole().lay(*first, rest.iter().copied(), pen);
+            }
         }
 
         fn blend(&mut self, pm: &mut Pixmap, color: Rgba) {
@@ -401,7 +432,7 @@ mod tests {
             let mut pm = Pixmap::new(101, 91).unwrap();
             pm.fill(background);
             let mut ink = Ink::new(101, 91);
-            pool.install(|| ink.paint(&mut pm, &lines));
+            pool.install(|| ink.paint(&mut pm, &lines[..]));
             assert!(pm == reference, "the picture differs on {threads} threads");
             assert!(ink.noted().is_empty() && ink.ink.iter().all(|&x| x == 0.0));
         }

@@ -396,13 +396,47 @@ impl Canvas for Vec<Item> {
     }
 }
 
+/// How a cell of the picture draws: the map to its pixels, and the
+/// colours and widths of pens.
+#[derive(Clone, Copy)]
+pub(crate) struct Style<'o> {
+    fit: Fit,
+    opts: &'o RenderOptions,
+}
+
+impl Style<'_> {
+    /// The colour of index `i`: the model's colour map, or the default
+    /// palette.
+    fn color(&self, i: i64) -> Rgba {
+        match &self.opts.palette {
+            Some(p) => p[i.rem_euclid(256) as usize],
+            None => palette(i),
+        }
+    }
+
+    /// A pen's width in pixels.
+    fn width(&self, w: f64) -> f64 {
+        if self.opts.widths_in_units {
+            w * self.fit.scale
+        } else {
+            w
+        }
+    }
+}
+
+/// Whether a path of colour, width and first point `next` continues the
+/// open polyline of colour, width and last point `open`: the same colour
+/// and width, and within 1e-9 pixels.
+fn joins((c, w, last): (Rgba, f64, DVec2), (color, width, first): (Rgba, f64, DVec2)) -> bool {
+    c == color && w == width && last.distance(first) < 1e-9
+}
+
 /// Events laid out in pixels in one cell of the picture, handed to a
 /// [`Canvas`] as they come: consecutive paths of one colour and width that
 /// meet (within 1e-9 pixels) make one polyline, the later path's first
 /// point left out.
 pub(crate) struct Layout<'o, C> {
-    fit: Fit,
-    opts: &'o RenderOptions,
+    style: Style<'o>,
     canvas: C,
     /// The open polyline's colour, width and last point.
     run: Option<(Rgba, f64, DVec2)>,
@@ -419,40 +453,36 @@ impl<'o, C: Canvas> Layout<'o, C> {
         canvas: C,
     ) -> Self {
         Layout {
-            fit: Fit::new(lo, hi, x0, cell_w, opts.height as f64, opts.margin),
-            opts,
+            style: Style {
+                fit: Fit::new(lo, hi, x0, cell_w, opts.height as f64, opts.margin),
+                opts,
+            },
             canvas,
             run: None,
         }
     }
 
     fn color(&self, i: i64) -> Rgba {
-        match &self.opts.palette {
-            Some(p) => p[i.rem_euclid(256) as usize],
-            None => palette(i),
-        }
+        self.style.color(i)
     }
 
     fn width(&self, w: f64) -> f64 {
-        if self.opts.widths_in_units {
-            w * self.fit.scale
-        } else {
-            w
-        }
+        self.style.width(w)
     }
 
     #[inline]
     fn px(&self, p: DVec3) -> DVec2 {
-        self.fit.pixel(self.opts.view.project(p))
+        self.style.fit.pixel(self.style.opts.view.project(p))
     }
 
     /// A path with `pen` starts at `a` (projected onto the view's plane):
     /// it continues the open polyline, or begins one.
     fn path_from(&mut self, pen: Pen, a: DVec2) {
-        let first = self.fit.pixel(a);
+        let first = self.style.fit.pixel(a);
         let (color, width) = (self.color(pen.color), self.width(pen.width));
-        let joined = matches!(self.run, Some((c, w, last))
-            if c == color && w == width && last.distance(first) < 1e-9);
+        let joined = self
+            .run
+            .is_some_and(|open| joins(open, (color, width, first)));
         if !joined {
             self.end_run();
             self.canvas.begin(color, width, first);
@@ -463,7 +493,7 @@ impl<'o, C: Canvas> Layout<'o, C> {
     /// The open polyline goes on to `p` (projected onto the view's plane).
     #[inline]
     fn point(&mut self, p: DVec2) {
-        let q = self.fit.pixel(p);
+        let q = self.style.fit.pixel(p);
         self.canvas.point(q);
         if let Some(run) = &mut self.run {
             run.2 = q;
@@ -477,10 +507,10 @@ impl<'o, C: Canvas> Layout<'o, C> {
     }
 
     fn lay(&mut self, e: &Event) {
-        let scale = self.fit.scale;
+        let scale = self.style.fit.scale;
         let item = match e {
             Event::Path { points, pen } => {
-                let view = self.opts.view;
+                let view = self.style.opts.view;
                 if let [first, rest @ ..] = points.as_slice() {
                     self.path_from(*pen, view.project(*first));
                     rest.iter().for_each(|p| self.point(view.project(*p)));

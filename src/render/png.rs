@@ -3,7 +3,8 @@
 //! (`render::ink`, a private module).
 
 use tiny_skia::{
-    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, Transform,
+    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, PremultipliedColorU8, Stroke,
+    Transform,
 };
 
 use glam::{DVec2, DVec3};
@@ -46,14 +47,14 @@ pub fn render(scene: &Scene) -> Result<Vec<u8>, RenderError> {
 /// The PNG of the turtle's 2D drawing of `word` in one cell the size of
 /// the picture, as [`render`] makes it from the [`super::scene`] of
 /// [`crate::draw::draw`]'s events, to the bit; but with no list of events
-/// or items. The turtle walks once, keeping its lines' points (projected
+/// or items. The turtle walks once, keeping its paths' points (projected
 /// onto the view's plane) in one list and finding the drawing's box; the
-/// points are then laid out in pixels where they lie, and painted.
+/// painting then takes each point to its pixel as it inks it.
 ///
 /// Memory beyond the word and the picture is those points, 16 bytes each
-/// (at most two a line drawn, one a line that continues a path, as every
-/// line of a curve does), a mark where each path or other event starts,
-/// and the events that are not paths.
+/// (two for a line that starts a path, one for a line that continues one,
+/// as every line of a curve does), the start and pen of each path (24
+/// bytes), and the events that are not paths.
 pub fn word(
     word: &crate::rewrite::Word,
     alphabet: &crate::lang::Alphabet,
@@ -73,32 +74,24 @@ pub fn word(
         let height = super::fitted_height(&opts, opts.width as f64, [bounds]);
         opts.to_mut().height = height;
     }
-    let mut painter = Painter::new(opts.width, opts.height, opts.background)?;
-    let laid = drawing.lay_out(bounds, &opts);
-    painter.paint(laid.parts.iter().map(|piece| match piece {
-        Part::Line(range, color, width) => Piece::Line(&laid.points[range.clone()], *color, *width),
-        Part::Item(item) => Piece::Item(item),
-    }));
-    Ok(painter.encode()?)
+    let painter = Painter::new(opts.width, opts.height, opts.background)?;
+    let layout = super::Layout::new(bounds, 0.0, opts.width as f64, &opts, painter);
+    Ok(drawing.paint(layout).encode()?)
 }
 
 /// The turtle's 2D drawing as it walks, compactly: the points of its
 /// paths, one path after another, projected onto the view's plane; where
-/// each path, and each other event, starts among them; and the box of it
-/// all.
+/// each path starts among them, and its pen; the other events; and the box
+/// of it all.
 struct Drawing {
     view: super::View,
     bounds: super::Bounds,
     points: Vec<DVec2>,
-    /// What starts before the point at each index.
-    starts: Vec<(usize, Start)>,
-}
-
-enum Start {
-    /// A path drawn with this pen: its first point is the one at the index.
-    Path(Pen),
-    /// An event that is not a path.
-    Event(Event),
+    /// The index of each path's first point, and its pen.
+    paths: Vec<(usize, Pen)>,
+    /// The events that are not paths, each after the points drawn before
+    /// it (and before a path that starts at the same index).
+    events: Vec<(usize, Event)>,
 }
 
 impl Drawing {
@@ -109,48 +102,109 @@ impl Drawing {
             view,
             bounds: super::Bounds::new(view),
             points: Vec::with_capacity(modules.saturating_add(1)),
-            starts: Vec::new(),
+            paths: Vec::new(),
+            events: Vec::new(),
         }
     }
 
-    /// The drawing laid out in pixels within `bounds`, as
-    /// [`super::scene`] lays out the events: each point becomes its pixel
-    /// in place, and consecutive paths that [`super::Layout`] joins become
-    /// one line (the later path's first point left out).
-    fn lay_out(self, bounds: (DVec2, DVec2), opts: &super::RenderOptions) -> Laid {
-        let Drawing { points, starts, .. } = self;
-        let n = points.len();
-        let canvas = Laid {
-            points,
-            len: 0,
-            parts: Vec::new(),
+    /// Where path `k` ends: the start of the next one, or of none.
+    fn end(&self, k: usize) -> usize {
+        self.paths.get(k + 1).map_or(self.points.len(), |p| p.0)
+    }
+
+    /// Paints the drawing as `layout` lays out the events: each run of
+    /// thin paths with no event between them is inked at once
+    /// ([`PathRun`]), and wider paths and the other events go through the
+    /// layout to the painter.
+    fn paint(self, mut layout: super::Layout<'_, Painter>) -> Painter {
+        let thin = |layout: &super::Layout<'_, Painter>, pen: Pen| {
+            Painter::thin(layout.width(pen.width)).is_some()
         };
-        let mut layout = super::Layout::new(bounds, 0.0, opts.width as f64, opts, canvas);
-        // Point `read` is read before any pixel is written over it: each
-        // point read writes at most one pixel, at `len <= read`.
-        let mut read = 0;
-        fn to(layout: &mut super::Layout<'_, Laid>, read: &mut usize, end: usize) {
-            while *read < end {
-                let p = layout.canvas.points[*read];
-                layout.point(p);
-                *read += 1;
+        let mut events = self.events.iter().peekable();
+        let mut k = 0;
+        loop {
+            let next_path = self.paths.get(k).map(|p| p.0);
+            if let Some((at, e)) = events.next_if(|(at, _)| next_path.is_none_or(|s| *at <= s)) {
+                debug_assert!(*at <= self.points.len());
+                layout.lay(e);
+                continue;
             }
-        }
-        for (at, start) in starts {
-            to(&mut layout, &mut read, at);
-            match start {
-                Start::Path(pen) => {
-                    let a = layout.canvas.points[read];
-                    layout.path_from(pen, a);
-                    read += 1;
+            let Some(&(start, pen)) = self.paths.get(k) else {
+                break;
+            };
+            if !thin(&layout, pen) {
+                layout.path_from(pen, self.points[start]);
+                for &p in &self.points[start + 1..self.end(k)] {
+                    layout.point(p);
                 }
-                Start::Event(e) => layout.lay(&e),
+                k += 1;
+                continue;
             }
+            // The run: the thin paths from `k` on, up to the next event
+            // or wider path.
+            let event = events.peek().map(|(at, _)| *at);
+            let mut last = k + 1;
+            while let Some(&(s, pen)) = self.paths.get(last) {
+                if event.is_some_and(|at| at <= s) || !thin(&layout, pen) {
+                    break;
+                }
+                last += 1;
+            }
+            layout.end_run();
+            let run = PathRun {
+                drawing: &self,
+                paths: k..last,
+                style: layout.style,
+            };
+            let painter = &mut layout.canvas;
+            painter.ink.paint(&mut painter.pm, &run);
+            k = last;
         }
-        to(&mut layout, &mut read, n);
-        let mut laid = layout.finish();
-        laid.points.truncate(laid.len);
-        laid
+        layout.finish()
+    }
+}
+
+/// Consecutive thin paths of a [`Drawing`], painted as the layout joins
+/// them into lines ([`super::Layout::path_from`]): a path continues the
+/// line before it when it has the same colour and width and starts within
+/// 1e-9 pixels of the line's end, and then its first point is left out.
+struct PathRun<'a> {
+    drawing: &'a Drawing,
+    paths: std::ops::Range<usize>,
+    style: super::Style<'a>,
+}
+
+impl super::ink::Run for PathRun<'_> {
+    fn points(&self) -> usize {
+        let d = self.drawing;
+        d.end(self.paths.end - 1) - d.paths[self.paths.start].0
+    }
+
+    fn paint(&self, band: &mut super::ink::Band<'_>, pixels: &mut [PremultipliedColorU8]) {
+        let (d, style) = (self.drawing, self.style);
+        // The open line's colour, width and last point.
+        let mut open: Option<(Rgba, f64, DVec2)> = None;
+        for k in self.paths.clone() {
+            let (start, pen) = d.paths[k];
+            let (color, width) = (style.color(pen.color), style.width(pen.width));
+            let first = style.fit.pixel(d.points[start]);
+            let from = match open {
+                Some((c, w, last)) if super::joins((c, w, last), (color, width, first)) => last,
+                _ => {
+                    if let Some((c, ..)) = open {
+                        band.blend(pixels, c);
+                    }
+                    first
+                }
+            };
+            let rest = d.points[start + 1..d.end(k)].iter();
+            let pen = Painter::thin(width).unwrap_or(1.0);
+            let last = band.lay(from, rest.map(|q| style.fit.pixel(*q)), pen);
+            open = Some((color, width, last));
+        }
+        if let Some((c, ..)) = open {
+            band.blend(pixels, c);
+        }
     }
 }
 
@@ -160,7 +214,7 @@ impl crate::draw::EventSink for Drawing {
         self.bounds.any = true;
         self.bounds.grow_projected(a, 0.0);
         self.bounds.grow_projected(b, 0.0);
-        self.starts.push((self.points.len(), Start::Path(pen)));
+        self.paths.push((self.points.len(), pen));
         self.points.extend([a, b]);
         Ok(())
     }
@@ -175,49 +229,8 @@ impl crate::draw::EventSink for Drawing {
 
     fn event(&mut self, e: Event) -> Result<(), String> {
         self.bounds.event(&e);
-        self.starts.push((self.points.len(), Start::Event(e)));
+        self.events.push((self.points.len(), e));
         Ok(())
-    }
-}
-
-/// A drawing laid out in pixels: the points of its lines, one line after
-/// another, and its lines and other items in order.
-struct Laid {
-    points: Vec<DVec2>,
-    /// The points laid out so far: `points[..len]`.
-    len: usize,
-    parts: Vec<Part>,
-}
-
-/// A part of a [`Laid`] drawing.
-enum Part {
-    /// A polyline through the points in the range, with its colour and
-    /// width in pixels.
-    Line(std::ops::Range<usize>, Rgba, f64),
-    Item(Item),
-}
-
-impl super::Canvas for Laid {
-    fn begin(&mut self, color: Rgba, width: f64, first: DVec2) {
-        self.parts
-            .push(Part::Line(self.len..self.len, color, width));
-        self.point(first);
-    }
-
-    #[inline]
-    fn point(&mut self, p: DVec2) {
-        self.points[self.len] = p;
-        self.len += 1;
-    }
-
-    fn end(&mut self) {
-        if let Some(Part::Line(range, ..)) = self.parts.last_mut() {
-            range.end = self.len;
-        }
-    }
-
-    fn item(&mut self, item: Item) {
-        self.parts.push(Part::Item(item));
     }
 }
 
@@ -252,6 +265,9 @@ enum Piece<'a> {
 pub(crate) struct Painter {
     pm: Pixmap,
     ink: super::ink::Ink,
+    /// The polyline coming through [`super::Canvas`]: its colour, width
+    /// and points so far.
+    open: Option<(Rgba, f64, Vec<DVec2>)>,
 }
 
 impl Painter {
@@ -263,6 +279,7 @@ impl Painter {
         Ok(Painter {
             pm,
             ink: super::ink::Ink::new(width, height),
+            open: None,
         })
     }
 
@@ -285,14 +302,14 @@ impl Painter {
                     continue;
                 }
             }
-            self.ink.paint(&mut self.pm, &run);
+            self.ink.paint(&mut self.pm, &run[..]);
             run.clear();
             match piece {
                 Piece::Line(points, color, width) => self.stroke(points, color, width),
                 Piece::Item(item) => self.item(item),
             }
         }
-        self.ink.paint(&mut self.pm, &run);
+        self.ink.paint(&mut self.pm, &run[..]);
     }
 
     /// Paints an item that is not a polyline.
@@ -370,4 +387,28 @@ fn path_through(points: &[DVec2]) -> Option<PathBuilder> {
         pb.line_to(p.x as f32, p.y as f32);
     }
     Some(pb)
+}
+
+/// Polylines a point at a time, painted whole at their end, and items as
+/// they come.
+impl super::Canvas for Painter {
+    fn begin(&mut self, color: Rgba, width: f64, first: DVec2) {
+        self.open = Some((color, width, vec![first]));
+    }
+
+    fn point(&mut self, p: DVec2) {
+        if let Some((.., points)) = &mut self.open {
+            points.push(p);
+        }
+    }
+
+    fn end(&mut self) {
+        if let Some((color, width, points)) = self.open.take() {
+            self.paint(std::iter::once(Piece::Line(&points, color, width)));
+        }
+    }
+
+    fn item(&mut self, item: Item) {
+        self.item(&item);
+    }
 }

@@ -238,7 +238,8 @@ fn paths_the_layout_joins_are_painted_as_the_scene_paints_them() {
         "derivation length: 6;\n\
          Axiom: SetColor(1) F(1) SetColor(13) F(1) f(1e-13) Right(60) F(1) SetColor(25) \
          G(1) SetColor(2) G(1) f(0.5) G(1) Circle(0.2) F(1) SetColor(14) F(1) Left(90) \
-         SetColor(2) SetWidth(0.3) F(1) f(1e-14) F(1);\n\
+         SetColor(2) SetWidth(0.3) F(1) f(1e-14) F(1) SetWidth(3) F(1) f(1e-13) F(1) \
+         SetColor(3) F(1);\n\
          F(x) -> F(x/3) Left(60) F(x/3) Right(120) F(x/3) Left(60) F(x/3);\n",
     );
     let opts = sized(300, 260);
@@ -249,9 +250,11 @@ fn paths_the_layout_joins_are_painted_as_the_scene_paints_them() {
             _ => None,
         })
         .collect();
-    // The turtle draws ten paths; the layout joins them into five lines:
-    // three Koch curves (4^6 segments each) and a `G`; two lines of a `G`
-    // each; two Koch curves after the disc; and two in another width.
+    // The turtle draws thirteen paths; the layout joins them into seven
+    // lines: three Koch curves (4^6 segments each) and a `G`; two lines of
+    // a `G` each; two Koch curves after the disc; two in another width;
+    // two with a pen wider than a pixel (stroked by tiny-skia); one in
+    // another colour.
     let p = &l.program;
     let mut d = subgram::Derivation::new(p, DeriveOptions::default()).unwrap();
     while d.has_next() {
@@ -262,8 +265,12 @@ fn paths_the_layout_joins_are_painted_as_the_scene_paints_them() {
     let paths = (events.iter())
         .filter(|e| matches!(e, subgram::draw::Event::Path { .. }))
         .count();
-    assert_eq!(paths, 10);
-    assert_eq!(lines, [3 * 4096 + 2, 2, 2, 2 * 4096 + 1, 2 * 4096 + 1]);
+    assert_eq!(paths, 13);
+    let koch = |n: usize| n * 4096 + 1;
+    assert_eq!(
+        lines,
+        [koch(3) + 1, 2, 2, koch(2), koch(2), koch(2), koch(1)]
+    );
     let expected = png::render(&scene).unwrap();
     for threads in [1, 2, 3] {
         let pool = rayon::ThreadPoolBuilder::new()
