@@ -184,7 +184,7 @@ impl Band<'_> {
     }
 
     /// The ink of the segment `a`..`b` on the band's rows.
-    #[inline]
+    #[inline(always)]
     fn segment(&mut self, a: DVec2, b: DVec2, pen: f64) {
         let (w, h) = (self.width as f64, self.height as f64);
         let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= w && p.y <= h;
