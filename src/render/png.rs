@@ -96,12 +96,13 @@ struct Drawing {
 
 impl Drawing {
     /// A drawing of a word of `modules` modules: room for a point each is
-    /// set aside (and taken from the system only as the points come).
+    /// set aside (taken from the system only as the points come, in huge
+    /// pages where the system has them, as the word's own arrays are).
     fn new(view: super::View, modules: usize) -> Drawing {
         Drawing {
             view,
             bounds: super::Bounds::new(view),
-            points: Vec::with_capacity(modules.saturating_add(1)),
+            points: crate::huge::with_capacity(modules.saturating_add(1)),
             paths: Vec::new(),
             events: Vec::new(),
         }
