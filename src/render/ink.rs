@@ -168,7 +168,7 @@ impl Band<'_> {
             self.ink[i] = 0.0;
             let p = pixels[i];
             let dst = [p.red(), p.green(), p.blue(), p.alpha()].map(f32::from);
-            let mix = |k: usize| (src[k] * a + dst[k] * (1.0 - a)).round().clamp(0.0, 255.0) as u8;
+            let mix = |k: usize| super::raster::to_byte(src[k] * a + dst[k] * (1.0 - a));
             let out_a = mix(3);
             let out = PremultipliedColorU8::from_rgba(
                 mix(0).min(out_a),

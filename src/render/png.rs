@@ -62,9 +62,11 @@ pub fn word(
     draw: &crate::draw::DrawOptions,
     opts: &super::RenderOptions,
 ) -> Result<Vec<u8>, WordError> {
-    super::check_size(opts.width, opts.height)?;
     let mut drawing = Events::new(Drawing::new(opts.view, word.len()));
     walk(word, alphabet, structs, draw, None, &mut drawing)?;
+    // After the walk, as `super::scene` checks it after the events are
+    // drawn: a failing module is told first.
+    super::check_size(opts.width, opts.height)?;
     let drawing = drawing.into_inner();
     let Some(bounds) = drawing.bounds.get()? else {
         return Err(super::nothing_to_draw().into());

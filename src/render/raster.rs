@@ -1232,7 +1232,7 @@ fn line_colour(scene: &Scene3, opts: &RasterOptions, k: usize, line: &Line) -> [
 /// to 0..=255, as `v.round().clamp(0.0, 255.0) as u8` (0 for NaN), without
 /// a call to `roundf` on targets without SSE4.1.
 #[inline(always)]
-fn to_byte(v: f32) -> u8 {
+pub(super) fn to_byte(v: f32) -> u8 {
     let v = v.clamp(0.0, 255.0);
     // Exact: the integer part and the fraction of a number below 2^23.
     let t = v as u32;

@@ -298,6 +298,26 @@ fn a_picture_painted_as_the_turtle_walks_fails_as_the_scene_does() {
         let painted = l.png_figures(&b).map(|_| ()).unwrap_err().to_string();
         assert_eq!(painted, scene, "{src}");
     }
+    // A size out of range and a module that fails: the module is told
+    // first, on either path (a reviewer found the picture told the size).
+    let l = load_text(
+        "derivation length: 0;
+Axiom: F(1) Surface(2, 1);
+",
+    );
+    for (w, h) in [(0, 10), (30_000, 10), (800, 800)] {
+        let opts = sized(w, h);
+        let scene = l.figure(&opts).map(|_| ()).unwrap_err().to_string();
+        let painted = l.png_figures(&opts).map(|_| ()).unwrap_err().to_string();
+        assert_eq!(painted, scene, "{w}x{h}");
+        assert!(scene.contains("Surface"), "{scene}");
+    }
+    // With nothing wrong but the size, both tell the size.
+    let l = load_text("derivation length: 0;\nAxiom: F(1);\n");
+    let scene = l.figure(&sized(0, 10)).map(|_| ()).unwrap_err().to_string();
+    let painted = (l.png_figures(&sized(0, 10)).map(|_| ()).unwrap_err()).to_string();
+    assert_eq!(painted, scene);
+    assert!(scene.contains("0x10"), "{scene}");
 }
 
 #[test]
