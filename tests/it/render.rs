@@ -195,19 +195,8 @@ fn a_picture_painted_as_the_turtle_walks_is_the_scenes_to_the_bit() {
                 })
                 .sum();
             assert!(lines > 65_536 && scene.items.len() > 10, "{lines}");
-            let expected = png::render(&scene).unwrap();
-            // Painted on this thread, and on a thread beside the walk.
-            for threads in [1, 2, 3] {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
-                let painted = pool.install(|| l.png_figures(&opts)).unwrap();
-                assert!(
-                    painted.main == expected,
-                    "{view:?}, widths in units {units}, {threads} threads: the pictures differ"
-                );
-            }
+            let what = format!("{view:?}, widths in units {units}");
+            paints_as_the_scene(&l, &opts, &png::render(&scene).unwrap(), &what);
         }
     }
     // With `each`, one panel a step, and a height fitted to them.
@@ -271,16 +260,22 @@ fn paths_the_layout_joins_are_painted_as_the_scene_paints_them() {
         lines,
         [koch(3) + 1, 2, 2, koch(2), koch(2), koch(2), koch(1)]
     );
-    let expected = png::render(&scene).unwrap();
+    paints_as_the_scene(&l, &opts, &png::render(&scene).unwrap(), "joins");
+}
+
+/// The picture painted from the walk (`png_figures`) is `expected`, the
+/// scene's PNG, in pools of one to three threads (one band of rows, or a
+/// band on each thread).
+fn paints_as_the_scene(l: &subgram::Curve, opts: &FigureOptions, expected: &[u8], what: &str) {
     for threads in [1, 2, 3] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap();
-        let painted = pool.install(|| l.png_figures(&opts)).unwrap();
+        let painted = pool.install(|| l.png_figures(opts)).unwrap();
         assert!(
             painted.main == expected,
-            "{threads} threads: the pictures differ"
+            "{what}, {threads} threads: the pictures differ"
         );
     }
 }
