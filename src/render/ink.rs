@@ -24,7 +24,10 @@ const PIECE: f64 = 0.5;
 
 /// Runs of thin lines with this many points or more in all are inked in
 /// bands of rows, one per thread of rayon's pool.
-const PARALLEL_POINTS: usize = 1 << 16;
+pub(crate) const PARALLEL_POINTS: usize = 1 << 16;
+
+/// The points of a [`Chunks`] chunk.
+const CHUNK: usize = 1024;
 
 /// Thin lines painted one after another (see [`Ink::paint`]).
 pub(crate) trait Run: Sync {
@@ -55,6 +58,35 @@ impl Run for [Line<'_>] {
             }
             band.blend(pixels, line.color);
         }
+    }
+}
+
+/// The span of y of a long array of points, chunk by chunk, so that a band
+/// passes over the chunks that lie wholly above or below its rows without
+/// looking at their points ([`Band::lay_chunked`]). Chunk `c` holds the
+/// points `c * CHUNK..(c + 1) * CHUNK` and its span also takes in the
+/// point before them, so that it covers every segment that ends in it.
+pub(crate) struct Chunks {
+    spans: Vec<[f64; 2]>,
+}
+
+impl Chunks {
+    /// The chunks of `points`, measured on rayon's pool.
+    pub(crate) fn new(points: &[DVec2]) -> Chunks {
+        use rayon::prelude::*;
+        let spans = (0..points.len().div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let from = (c * CHUNK).saturating_sub(1);
+                let to = ((c + 1) * CHUNK).min(points.len());
+                points[from..to]
+                    .iter()
+                    .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], p| {
+                        [lo.min(p.y), hi.max(p.y)]
+                    })
+            })
+            .collect();
+        Chunks { spans }
     }
 }
 
@@ -156,6 +188,56 @@ impl Band<'_> {
         })
     }
 
+    /// As [`Band::lay`] from `from` through `pixel` of `points[range]`,
+    /// where `chunks` measures `points`, and `pixel`'s y depends on a
+    /// point's y alone and monotonically (either way round): a chunk whose
+    /// pixels all lie above or below the band's rows is passed over, its
+    /// segments being ones that [`Band::segment`] would leave. The same
+    /// ink, to the bit.
+    #[inline]
+    pub(crate) fn lay_chunked(
+        &mut self,
+        from: DVec2,
+        points: &[DVec2],
+        range: std::ops::Range<usize>,
+        chunks: &Chunks,
+        pixel: impl Fn(DVec2) -> DVec2,
+        pen: f64,
+    ) -> DVec2 {
+        let Some(&second) = points.get(range.clone()).and_then(|r| r.first()) else {
+            return from;
+        };
+        // The first segment starts at `from`, which may lie outside the
+        // chunk's span (a line continued from another path).
+        let mut last = self.lay(from, std::iter::once(pixel(second)), pen);
+        let (top, bottom) = self.reach();
+        let mut i = range.start + 1;
+        while i < range.end {
+            let c = i / CHUNK;
+            let end = ((c + 1) * CHUNK).min(range.end);
+            let [lo, hi] = chunks.spans[c];
+            let (a, b) = (pixel(DVec2::new(0.0, lo)).y, pixel(DVec2::new(0.0, hi)).y);
+            let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+            last = if hi < top || lo > bottom {
+                pixel(points[end - 1])
+            } else {
+                self.lay(last, points[i..end].iter().map(|&q| pixel(q)), pen)
+            };
+            i = end;
+        }
+        last
+    }
+
+    /// The rows of y that a segment must reach for [`Band::segment`] to
+    /// ink the band: a segment wholly above the first or below the second
+    /// inks none of its rows.
+    #[inline(always)]
+    fn reach(&self) -> (f64, f64) {
+        // A piece's middle at y inks rows floor(y - 0.5) and the one below
+        // (nor does a piece clipping keeps of it reach further).
+        (self.row0 as f64 - 2.0, (self.row0 + self.rows) as f64 + 2.0)
+    }
+
     /// Blends `color` by the ink's coverage over the band's rows of the
     /// picture, `pixels`, where the ink lies, and clears the ink.
     pub(crate) fn blend(&mut self, pixels: &mut [PremultipliedColorU8], color: Rgba) {
@@ -188,10 +270,7 @@ impl Band<'_> {
     fn segment(&mut self, a: DVec2, b: DVec2, pen: f64) {
         let (w, h) = (self.width as f64, self.height as f64);
         let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= w && p.y <= h;
-        // A piece's middle at y inks rows floor(y - 0.5) and the one below:
-        // a segment wholly above `top` or below `bottom` inks none of the
-        // band's rows (nor does a piece clipping keeps of it).
-        let (top, bottom) = (self.row0 as f64 - 2.0, (self.row0 + self.rows) as f64 + 2.0);
+        let (top, bottom) = self.reach();
         if (a.y < top && b.y < top) || (a.y > bottom && b.y > bottom) {
             return;
         }
@@ -442,6 +521,87 @@ mod tests {
             .filter(|p| (p.red(), p.green(), p.blue()) != (240, 240, 200))
             .count();
         assert!(changed > 3000, "{changed}");
+    }
+
+    /// A band's ink and noted pixels, laid by `lay` over every segment
+    /// (the reference) and by `lay_chunked`, are the same to the bit: a
+    /// wandering line of several chunks that crosses the bands, leaves the
+    /// picture and jumps back, taken from starts inside and at the edge of
+    /// a chunk, after a first point off the line (a joined path's), under
+    /// a transform that turns y over and one that keeps it.
+    #[test]
+    fn chunks_outside_a_band_are_passed_over_to_the_bit() {
+        let mut bits = crate::testing::xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut next = || (bits() >> 11) as f64 / (1u64 << 53) as f64;
+        // Each chunk keeps near a level of its own, so that the chunks'
+        // spans end near the bands' edges as often as not, and the segment
+        // that joins two chunks crosses bands that neither chunk reaches.
+        let n = 24 * CHUNK + 77;
+        let mut level = 0.0;
+        let mut x = 30.0;
+        let points: Vec<DVec2> = (0..n)
+            .map(|i| {
+                if i % CHUNK == 0 {
+                    level = next() * 100.0 - 15.0;
+                }
+                x = (x + next() - 0.5).clamp(-5.0, 60.0);
+                if i == 3000 {
+                    return DVec2::new(-40.0, 200.0);
+                }
+                DVec2::new(x, level + (next() - 0.5) * 0.6)
+            })
+            .collect();
+        let chunks = Chunks::new(&points);
+        let flips: [fn(DVec2) -> DVec2; 2] = [
+            |q| DVec2::new(q.x * 1.1 + 2.0, 80.0 - q.y),
+            |q| DVec2::new(q.x - 1.0, q.y * 1.01 - 3.0),
+        ];
+        let (w, h) = (71usize, 83usize);
+        // Bands with ink and without.
+        let mut inked = [0, 0];
+        for pixel in flips {
+            for range in [
+                1..n,
+                CHUNK..n - 5,
+                CHUNK + 1..3 * CHUNK + 9,
+                2000..2001,
+                7..7,
+            ] {
+                for bands in 1..=4 {
+                    let rows = h.div_ceil(bands);
+                    for b in 0..bands {
+                        let row0 = b * rows;
+                        let height = rows.min(h - row0);
+                        let mut laid = [(vec![0.0f32; w * height], Vec::new()), Default::default()];
+                        laid[1].0 = vec![0.0f32; w * height];
+                        let from = DVec2::new(5.5, 40.25);
+                        let mut ends = [DVec2::ZERO; 2];
+                        for (k, (ink, touched)) in laid.iter_mut().enumerate() {
+                            let mut band = Band {
+                                width: w,
+                                height: h,
+                                row0,
+                                rows: height,
+                                ink,
+                                touched,
+                            };
+                            ends[k] = if k == 0 {
+                                band.lay(from, points[range.clone()].iter().map(|&q| pixel(q)), 0.8)
+                            } else {
+                                band.lay_chunked(from, &points, range.clone(), &chunks, pixel, 0.8)
+                            };
+                        }
+                        let [(ia, na), (ib, nb)] = &laid;
+                        let same = ia.iter().zip(ib).all(|(x, y)| x.to_bits() == y.to_bits());
+                        assert!(same && na == nb, "{range:?}, band {b} of {bands}");
+                        assert_eq!(ends[0], ends[1]);
+                        inked[usize::from(!na.is_empty())] += 1;
+                    }
+                }
+            }
+        }
+        // The line reaches some bands and misses others.
+        assert!(inked[0] > 10 && inked[1] > 40, "{inked:?}");
     }
 
     fn ink_of(points: &[DVec2], pen: f64) -> Ink {

@@ -123,6 +123,11 @@ impl Drawing {
         let thin = |layout: &super::Layout<'_, Painter>, pen: Pen| {
             Painter::thin(layout.width(pen.width)).is_some()
         };
+        // A long drawing is inked in bands, each of which passes over the
+        // chunks of points that lie wholly outside its rows.
+        let chunks = (self.points.len() >= super::ink::PARALLEL_POINTS
+            && rayon::current_num_threads() > 1)
+            .then(|| super::ink::Chunks::new(&self.points));
         let mut events = self.events.iter().peekable();
         let mut k = 0;
         loop {
@@ -158,6 +163,7 @@ impl Drawing {
                 drawing: &self,
                 paths: k..last,
                 style: layout.style,
+                chunks: chunks.as_ref(),
             };
             let painter = &mut layout.canvas;
             painter.ink.paint(&mut painter.pm, &run);
@@ -175,6 +181,9 @@ struct PathRun<'a> {
     drawing: &'a Drawing,
     paths: std::ops::Range<usize>,
     style: super::Style<'a>,
+    /// The drawing's points in chunks, when it is long enough to be
+    /// inked in bands.
+    chunks: Option<&'a super::ink::Chunks>,
 }
 
 impl super::ink::Run for PathRun<'_> {
@@ -200,9 +209,15 @@ impl super::ink::Run for PathRun<'_> {
                     first
                 }
             };
-            let rest = d.points[start + 1..d.end(k)].iter();
             let pen = Painter::thin(width).unwrap_or(1.0);
-            let last = band.lay(from, rest.map(|q| style.fit.pixel(*q)), pen);
+            let rest = start + 1..d.end(k);
+            // The pixel transform's y depends on a point's y alone, and
+            // monotonically, as `lay_chunked` needs.
+            let pixel = |q: DVec2| style.fit.pixel(q);
+            let last = match self.chunks {
+                Some(chunks) => band.lay_chunked(from, &d.points, rest, chunks, pixel, pen),
+                None => band.lay(from, d.points[rest].iter().map(|&q| pixel(q)), pen),
+            };
             open = Some((color, width, last));
         }
         if let Some((c, ..)) = open {

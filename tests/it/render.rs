@@ -220,11 +220,11 @@ fn a_picture_painted_as_the_turtle_walks_is_the_scenes_to_the_bit() {
 /// default palette, and a move of 1e-13 is no distance in pixels. Between
 /// them, paths that stay apart (another colour, a move of half a unit),
 /// and a disc; the Koch curves make the lines long enough to be painted in
-/// bands.
+/// bands, each of which passes over the chunks of points outside its rows.
 #[test]
 fn paths_the_layout_joins_are_painted_as_the_scene_paints_them() {
     let l = load_text(
-        "derivation length: 6;\n\
+        "derivation length: 7;\n\
          Axiom: SetColor(1) F(1) SetColor(13) F(1) f(1e-13) Right(60) F(1) SetColor(25) \
          G(1) SetColor(2) G(1) f(0.5) G(1) Circle(0.2) F(1) SetColor(14) F(1) Left(90) \
          SetColor(2) SetWidth(0.3) F(1) f(1e-14) F(1) SetWidth(3) F(1) f(1e-13) F(1) \
@@ -240,7 +240,7 @@ fn paths_the_layout_joins_are_painted_as_the_scene_paints_them() {
         })
         .collect();
     // The turtle draws thirteen paths; the layout joins them into seven
-    // lines: three Koch curves (4^6 segments each) and a `G`; two lines of
+    // lines: three Koch curves (4^7 segments each) and a `G`; two lines of
     // a `G` each; two Koch curves after the disc; two in another width;
     // two with a pen wider than a pixel (stroked by tiny-skia); one in
     // another colour.
@@ -255,7 +255,7 @@ fn paths_the_layout_joins_are_painted_as_the_scene_paints_them() {
         .filter(|e| matches!(e, subgram::draw::Event::Path { .. }))
         .count();
     assert_eq!(paths, 13);
-    let koch = |n: usize| n * 4096 + 1;
+    let koch = |n: usize| n * 16384 + 1;
     assert_eq!(
         lines,
         [koch(3) + 1, 2, 2, koch(2), koch(2), koch(2), koch(1)]
