@@ -14,6 +14,8 @@
 //!    1,024,000 points) and the whole run, in a pool of one rayon thread and
 //!    one of two, alternating, with the best and the median of each and
 //!    their speedups; the words are checked to be the same to the bit;
+//!    then the tight flat `f64` loop's last step into fresh memory on both
+//!    pools (what a second core gives a step that writes fresh memory),
 //!    then the same for three branching systems on the general path (a
 //!    plant whose rule is a stencil, a guarded body compiled to closures,
 //!    and a bush without parameters), about a million modules at the end.
@@ -281,6 +283,7 @@ fn threads(src: &str, runs: usize) {
         let label = format!("chaikin, {precision:?} precision");
         on_pools(&label, &loaded.program, &pools, runs);
     }
+    flat_step_on_pools(&pools, runs);
     // The general path (issue 16, item 6): branching words, which the
     // stencil fast path does not take. A plant whose rule is a stencil
     // (bench_solid's), and the guarded branching system of bench_body,
@@ -304,6 +307,80 @@ fn threads(src: &str, runs: usize) {
         let loaded = subgram::load_str("bench.lsys", src, &[]).expect("loads");
         on_pools(label, &loaded.program, &pools, runs);
     }
+}
+
+/// The reference for the last Chaikin step on two threads: the tight flat
+/// `f64` loop's last step (512,000 -> 1,024,000 points) written into fresh
+/// memory as the engine's step writes its new word (room asked for in huge
+/// pages, touched first by the writes), in parts of 65,536 points on the
+/// pool, in each pool alternating; its result is checked against
+/// `chaikin_flat`. What a second core gives a step bound by writing fresh
+/// memory on this machine.
+fn flat_step_on_pools(pools: &[rayon::ThreadPool], runs: usize) {
+    use std::time::{Duration, Instant};
+    const PART: usize = 65_536;
+    let start: Vec<f64> = polygon(1000).iter().flat_map(|p| [p.x, p.y]).collect();
+    let src = chaikin_flat::<f64>(&start, 9);
+    let step = |src: &[f64]| -> Vec<f64> {
+        use rayon::prelude::*;
+        let n = src.len() / 2;
+        let len = 4 * n;
+        let mut dst: Vec<f64> = Vec::with_capacity(len);
+        #[cfg(target_os = "linux")]
+        // SAFETY: the range is `dst`'s own allocation; MADV_HUGEPAGE never
+        // changes memory's contents.
+        unsafe {
+            libc::madvise(dst.as_mut_ptr().cast(), len * 8, libc::MADV_HUGEPAGE);
+        }
+        let room = &mut dst.spare_capacity_mut()[..len];
+        room.par_chunks_mut(4 * PART)
+            .enumerate()
+            .for_each(|(k, out)| {
+                for (j, o) in out.chunks_exact_mut(4).enumerate() {
+                    let i = k * PART + j;
+                    let l = if i == 0 { n - 1 } else { i - 1 };
+                    let r = if i + 1 == n { 0 } else { i + 1 };
+                    let (pl, pv, pr) = (&src[2 * l..], &src[2 * i..], &src[2 * r..]);
+                    o[0].write(pl[0] * 0.25 + pv[0] * 0.75);
+                    o[1].write(pl[1] * 0.25 + pv[1] * 0.75);
+                    o[2].write(pv[0] * 0.75 + pr[0] * 0.25);
+                    o[3].write(pv[1] * 0.75 + pr[1] * 0.25);
+                }
+            });
+        // SAFETY: the parts cover `room`, and every element of each part
+        // was written above.
+        unsafe { dst.set_len(len) };
+        dst
+    };
+    assert!(step(&src) == chaikin_flat::<f64>(&start, 10));
+    let mut times: [Vec<Duration>; 2] = Default::default();
+    for _ in 0..runs {
+        for (k, pool) in pools.iter().enumerate() {
+            let t = Instant::now();
+            let out = pool.install(|| step(&src));
+            times[k].push(t.elapsed());
+            drop(out);
+        }
+    }
+    for t in &mut times {
+        t.sort();
+    }
+    let ms = |t: Duration| t.as_secs_f64() * 1e3;
+    let (b, m) = (|k: usize| times[k][0], |k: usize| times[k][runs / 2]);
+    println!(
+        "reference: the flat f64 loop's last step {} -> {} points into fresh memory, {runs} runs alternating, 1 vs 2 threads",
+        src.len() / 2,
+        src.len()
+    );
+    println!(
+        "  best {:>7.2} / {:>7.2} ms (speedup {:.2}), median {:>7.2} / {:>7.2} ms (speedup {:.2})",
+        ms(b(0)),
+        ms(b(1)),
+        b(0).as_secs_f64() / b(1).as_secs_f64(),
+        ms(m(0)),
+        ms(m(1)),
+        m(0).as_secs_f64() / m(1).as_secs_f64()
+    );
 }
 
 /// The last step and the whole derivation of `program` in each pool (one
