@@ -14,7 +14,13 @@
 //!    deriving) and the PNG of the laid-out scene; and
 //!    tiny-skia stroking the island's segments as one path.
 //!
-//! `--runs N` keeps the best of N runs (3 by default).
+//! 3. Other pictures through the command line, each against a process
+//!    that only derives it: two branching plants of about a million
+//!    modules, lpfg's ABOP bush, and a dense tree of a million paths.
+//!
+//! `--runs N` keeps the best of N runs (3 by default); the commands of
+//! sections 2 and 3 alternate round by round, and their medians and the
+//! median of the rounds' ratios are printed beside the bests.
 
 mod common;
 
@@ -37,6 +43,7 @@ fn main() {
     let runs = common::runs_arg(&args, 3);
     snowflake(runs);
     island(runs);
+    others(runs);
 }
 
 /// The reference process for `render`'s: reads the file, derives it, and
@@ -50,6 +57,121 @@ fn derive_only(file: &str) {
         d.next_step().unwrap();
     }
     assert!(!d.word.is_empty());
+}
+
+/// Runs each of `cmds` (a program, its arguments before the file, and the
+/// file its output goes to: the PNG's by `-o`, the others' by stdout) on
+/// `file`, one after another, `runs` rounds; every command's time in
+/// every round. The last run's output is removed before the clock starts
+/// (freeing 119 MB of page cache is not the command's work).
+fn rounds(
+    runs: usize,
+    dir: &std::path::Path,
+    file: &std::path::Path,
+    cmds: &[(&std::path::Path, &[&str], &str)],
+) -> Vec<Vec<Duration>> {
+    let mut times = vec![Vec::new(); cmds.len()];
+    for _ in 0..runs {
+        for (k, (program, args, out)) in cmds.iter().enumerate() {
+            let target = dir.join(out);
+            let _ = std::fs::remove_file(&target);
+            let started = std::time::Instant::now();
+            let mut cmd = std::process::Command::new(program);
+            cmd.args(*args).arg(file);
+            if out.ends_with(".png") {
+                cmd.arg("-o").arg(&target);
+            } else {
+                cmd.stdout(std::fs::File::create(&target).unwrap());
+            }
+            let ok = cmd.status().unwrap().success();
+            times[k].push(started.elapsed());
+            assert!(ok, "{} {args:?} failed", program.display());
+        }
+    }
+    times
+}
+
+fn best(times: &[Duration]) -> Duration {
+    times.iter().copied().min().unwrap()
+}
+
+fn median(times: &[Duration]) -> Duration {
+    let mut t = times.to_vec();
+    t.sort();
+    t[t.len() / 2]
+}
+
+/// The median over the rounds of `a`'s time over `b`'s.
+fn median_ratio(a: &[Duration], b: &[Duration]) -> f64 {
+    let mut r: Vec<f64> = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| x.as_secs_f64() / y.as_secs_f64())
+        .collect();
+    r.sort_by(f64::total_cmp);
+    r[r.len() / 2]
+}
+
+/// Section 3: other pictures through the command line, each against a
+/// process that only derives it, alternating round by round: branching
+/// plants of about a million modules and a dense tree of a million paths.
+/// What `render` of other words costs, so that a change to the walk or
+/// the ink can be checked against them, not only against the island.
+fn others(runs: usize) {
+    let programs = [
+        (
+            "plant (stencil), 17 steps",
+            "module A(float, float);\nderivation length: 17;\n\
+             Axiom: SetColor(2) A(1, 0.05);\nproduction:\n\
+             A(l, w) -> SetWidth(w) F(l) RollR(137.5) SB() Left(32) A(l*0.78, w*0.7) EB() \
+             Right(18) A(l*0.86, w*0.8)\n",
+        ),
+        (
+            "guarded branching, 11 steps",
+            "module A(float, float);\nderivation length: 11;\nAxiom: A(1, 1);\n\
+             production:\nA(l, w) : { if (l > 0.01) produce F(l) SB() Left(30) \
+             A(l * 0.7, w * 0.7) EB() SB() Right(25) A(l * 0.6, w * 0.7) EB() \
+             A(l * 0.9, w * 0.9); }\n",
+        ),
+        (
+            "ABOP bush, 9 steps",
+            "angle: 22.5;\nderivation length: 9;\nAxiom: X;\nX -> F-[[X]+X]+F[+FX]-X\nF -> FF\n",
+        ),
+        (
+            "dense tree, 13 steps",
+            "angle: 25;\nderivation length: 13;\nAxiom: F;\nF -> F[+F][-F]\n",
+        ),
+    ];
+    let exe = std::env::current_exe().unwrap();
+    let bin = exe
+        .parent()
+        .and_then(|d| d.parent())
+        .unwrap()
+        .join("subgram");
+    if !bin.exists() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("subgram-bench-others-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    println!("\nother pictures through the command line, {runs} rounds alternating: best / median");
+    for (name, src) in programs {
+        let file = dir.join("program.lsys");
+        std::fs::write(&file, src).unwrap();
+        let cmds: [(&std::path::Path, &[&str], &str); 2] = [
+            (&exe, &["--derive-only"], "derived.txt"),
+            (&bin, &["render"], "picture.png"),
+        ];
+        let t = rounds(runs, &dir, &file, &cmds);
+        println!(
+            "  {name:<28} render {:>7.1} / {:>7.1} ms; derivation alone {:>6.1} / {:>6.1} ms; the rounds' median ratio {:.2}x",
+            ms(best(&t[1])),
+            ms(median(&t[1])),
+            ms(best(&t[0])),
+            ms(median(&t[0])),
+            median_ratio(&t[1], &t[0])
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 fn snowflake(runs: usize) {
@@ -198,36 +320,20 @@ fn island(runs: usize) {
         );
         return;
     }
-    // Each run writes a new file: the last run's output is removed before
-    // the clock starts (freeing 119 MB of page cache is not the command's
-    // work, nor the derivation's it is compared with).
-    let process = |program: &std::path::Path, args: &[&str], out: &str| {
-        let target = dir.join(out);
-        let mut best = std::time::Duration::MAX;
-        for _ in 0..runs {
-            let _ = std::fs::remove_file(&target);
-            let started = std::time::Instant::now();
-            let stdout = std::fs::File::create(&target).unwrap();
-            let mut cmd = std::process::Command::new(program);
-            cmd.args(args).arg(&file);
-            if out.ends_with(".png") {
-                cmd.arg("-o").arg(&target);
-            } else {
-                cmd.stdout(stdout);
-            }
-            let ok = cmd.status().unwrap().success();
-            best = best.min(started.elapsed());
-            assert!(ok, "{} {args:?} failed", program.display());
-        }
-        (best, std::fs::metadata(&target).unwrap().len())
-    };
-    let cli = |args: &[&str], out: &str| process(&bin, args, out);
-    let (t_process, _) = process(&exe, &["--derive-only"], "derived.txt");
-    let (t_text, text_len) = cli(&["derive", "--format", "text"], "island.txt");
-    let (t_json, json_len) = cli(&["derive", "--format", "json"], "island.json");
-    let (t_render, _) = cli(&["render"], "island.png");
+    // The four commands alternate round by round, so that each round's
+    // ratios compare runs made in the same seconds (this machine's speed
+    // swings by 2x within minutes).
+    let cmds: [(&std::path::Path, &[&str], &str); 4] = [
+        (&exe, &["--derive-only"], "derived.txt"),
+        (&bin, &["derive", "--format", "text"], "island.txt"),
+        (&bin, &["derive", "--format", "json"], "island.json"),
+        (&bin, &["render"], "island.png"),
+    ];
+    let times = rounds(runs, &dir, &file, &cmds);
+    let len = |out: &str| std::fs::metadata(dir.join(out)).map_or(0, |m| m.len());
+    let (text_len, json_len) = (len("island.txt"), len("island.json"));
     let _ = std::fs::remove_dir_all(&dir);
-
+    let [t_process, t_text, t_json, t_render] = [0, 1, 2, 3].map(|k| best(&times[k]));
     println!("\nquadratic Koch island, 7 steps: 3,894,711 modules, best of {runs}");
     println!(
         "  derivation in this process: first run (fresh memory) {:.1} ms, best of the rest {:.1} ms",
@@ -254,12 +360,24 @@ fn island(runs: usize) {
     );
     row("subgram render -o PNG", t_render, String::new());
     println!(
-        "  a process that only reads the file and derives {:.1} ms: render {:.2}x, derive --format text {:.2}x, --format json {:.2}x",
+        "  a process that only reads the file and derives {:.1} ms best, {:.1} median; best to best: render {:.2}x, derive --format text {:.2}x, --format json {:.2}x",
         ms(t_process),
+        ms(median(&times[0])),
         t_render.as_secs_f64() / t_process.as_secs_f64(),
         t_text.as_secs_f64() / t_process.as_secs_f64(),
         t_json.as_secs_f64() / t_process.as_secs_f64(),
     );
+    for (k, what) in [
+        (1, "derive --format text"),
+        (2, "derive --format json"),
+        (3, "render"),
+    ] {
+        println!(
+            "    {what:<22} {:>7.1} ms median; the median of the rounds' ratios to the process that only derives {:.2}x",
+            ms(median(&times[k])),
+            median_ratio(&times[k], &times[0])
+        );
+    }
     println!(
         "  in this process: the PNG of the derived word (what `render` does after deriving) {:.1} ms ({:.2}x the derivation's first run, {:.2}x the best)",
         ms(t_walked),
