@@ -59,6 +59,24 @@ fn derive_only(file: &str) {
     assert!(!d.word.is_empty());
 }
 
+/// This benchmark's own path and the `subgram` binary beside it; `None`,
+/// said once, when the binary has not been built.
+fn binaries() -> Option<(std::path::PathBuf, std::path::PathBuf)> {
+    let exe = std::env::current_exe().unwrap();
+    let bin = exe.parent()?.parent()?.join("subgram");
+    if !bin.exists() {
+        static SAID: std::sync::Once = std::sync::Once::new();
+        SAID.call_once(|| {
+            println!(
+                "\n{} is missing: run `cargo build --release` first",
+                bin.display()
+            )
+        });
+        return None;
+    }
+    Some((exe, bin))
+}
+
 /// Runs each of `cmds` (a program, its arguments before the file, and the
 /// file its output goes to: the PNG's by `-o`, the others' by stdout) on
 /// `file`, one after another, `runs` rounds; every command's time in
@@ -142,15 +160,9 @@ fn others(runs: usize) {
             "angle: 25;\nderivation length: 13;\nAxiom: F;\nF -> F[+F][-F]\n",
         ),
     ];
-    let exe = std::env::current_exe().unwrap();
-    let bin = exe
-        .parent()
-        .and_then(|d| d.parent())
-        .unwrap()
-        .join("subgram");
-    if !bin.exists() {
+    let Some((exe, bin)) = binaries() else {
         return;
-    }
+    };
     let dir = std::env::temp_dir().join(format!("subgram-bench-others-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     println!("\nother pictures through the command line, {runs} rounds alternating: best / median");
@@ -307,19 +319,9 @@ fn island(runs: usize) {
         subgram::draw::line_bounds(word, &p.alphabet, &p.structs, &Default::default()).unwrap()
     });
 
-    let exe = std::env::current_exe().unwrap();
-    let bin = exe
-        .parent()
-        .and_then(|d| d.parent())
-        .unwrap()
-        .join("subgram");
-    if !bin.exists() {
-        println!(
-            "\n{} is missing: run `cargo build --release` first",
-            bin.display()
-        );
+    let Some((exe, bin)) = binaries() else {
         return;
-    }
+    };
     // The four commands alternate round by round, so that each round's
     // ratios compare runs made in the same seconds (this machine's speed
     // swings by 2x within minutes).
