@@ -123,11 +123,10 @@ impl Drawing {
         let thin = |layout: &super::Layout<'_, Painter>, pen: Pen| {
             Painter::thin(layout.width(pen.width)).is_some()
         };
-        // A long drawing is inked in bands, each of which passes over the
-        // chunks of points that lie wholly outside its rows.
-        let chunks = (self.points.len() >= super::ink::PARALLEL_POINTS
-            && rayon::current_num_threads() > 1)
-            .then(|| super::ink::Chunks::new(&self.points));
+        // A long run is inked in bands, each of which passes over the
+        // chunks of points that lie wholly outside its rows: the chunks
+        // are measured for the first such run.
+        let chunks = std::cell::OnceCell::new();
         let mut events = self.events.iter().peekable();
         let mut k = 0;
         loop {
@@ -159,11 +158,14 @@ impl Drawing {
                 last += 1;
             }
             layout.end_run();
+            let banded = self.end(last - 1) - self.paths[k].0 >= super::ink::PARALLEL_POINTS
+                && rayon::current_num_threads() > 1;
             let run = PathRun {
                 drawing: &self,
                 paths: k..last,
                 style: layout.style,
-                chunks: chunks.as_ref(),
+                chunks: banded
+                    .then(|| chunks.get_or_init(|| super::ink::Chunks::new(&self.points))),
             };
             let painter = &mut layout.canvas;
             painter.ink.paint(&mut painter.pm, &run);
@@ -181,7 +183,7 @@ struct PathRun<'a> {
     drawing: &'a Drawing,
     paths: std::ops::Range<usize>,
     style: super::Style<'a>,
-    /// The drawing's points in chunks, when it is long enough to be
+    /// The drawing's points in chunks, when the run is long enough to be
     /// inked in bands.
     chunks: Option<&'a super::ink::Chunks>,
 }
