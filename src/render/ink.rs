@@ -24,7 +24,7 @@ const PIECE: f64 = 0.5;
 
 /// Runs of thin lines with this many points or more in all are inked in
 /// bands of rows, one per thread of rayon's pool.
-pub(crate) const PARALLEL_POINTS: usize = 1 << 16;
+const PARALLEL_POINTS: usize = 1 << 16;
 
 /// The points of a [`Chunks`] chunk.
 const CHUNK: usize = 1024;
@@ -110,6 +110,17 @@ impl Ink {
         }
     }
 
+    /// How many bands of rows [`Ink::paint`] paints a run of `points`
+    /// points in all in: one per thread of rayon's pool for a long run,
+    /// else one.
+    pub(crate) fn bands(&self, points: usize) -> usize {
+        if points >= PARALLEL_POINTS && self.width > 0 {
+            rayon::current_num_threads().min(self.height / 16).max(1)
+        } else {
+            1
+        }
+    }
+
     /// Paints the lines of `run` on `pm` one after another: the ink of a
     /// line is laid down, then its colour blended over the pixels it
     /// inked.
@@ -123,11 +134,7 @@ impl Ink {
     pub(crate) fn paint<R: Run + ?Sized>(&mut self, pm: &mut Pixmap, run: &R) {
         use rayon::prelude::*;
         let (width, height) = (self.width, self.height);
-        let bands = if run.points() >= PARALLEL_POINTS && width > 0 {
-            rayon::current_num_threads().min(height / 16).max(1)
-        } else {
-            1
-        };
+        let bands = self.bands(run.points());
         let rows = height.div_ceil(bands).max(1);
         if self.touched.len() < bands {
             self.touched.resize_with(bands, Vec::new);

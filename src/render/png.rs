@@ -115,6 +115,11 @@ impl Drawing {
         self.paths.get(k + 1).map_or(self.points.len(), |p| p.0)
     }
 
+    /// The points of the consecutive paths `paths` (not empty), in all.
+    fn run_points(&self, paths: std::ops::Range<usize>) -> usize {
+        self.end(paths.end - 1) - self.paths[paths.start].0
+    }
+
     /// Paints the drawing as `layout` lays out the events: each run of
     /// thin paths with no event between them is inked at once
     /// ([`PathRun`]), and wider paths and the other events go through the
@@ -158,8 +163,8 @@ impl Drawing {
                 last += 1;
             }
             layout.end_run();
-            let banded = self.end(last - 1) - self.paths[k].0 >= super::ink::PARALLEL_POINTS
-                && rayon::current_num_threads() > 1;
+            let painter = &mut layout.canvas;
+            let banded = painter.ink.bands(self.run_points(k..last)) > 1;
             let run = PathRun {
                 drawing: &self,
                 paths: k..last,
@@ -167,7 +172,6 @@ impl Drawing {
                 chunks: banded
                     .then(|| chunks.get_or_init(|| super::ink::Chunks::new(&self.points))),
             };
-            let painter = &mut layout.canvas;
             painter.ink.paint(&mut painter.pm, &run);
             k = last;
         }
@@ -190,8 +194,7 @@ struct PathRun<'a> {
 
 impl super::ink::Run for PathRun<'_> {
     fn points(&self) -> usize {
-        let d = self.drawing;
-        d.end(self.paths.end - 1) - d.paths[self.paths.start].0
+        self.drawing.run_points(self.paths.clone())
     }
 
     fn paint(&self, band: &mut super::ink::Band<'_>, pixels: &mut [PremultipliedColorU8]) {
