@@ -8,8 +8,10 @@ use crate::error::Error;
 use crate::lang::Program;
 use crate::render;
 use crate::rewrite::derive::{rule_kind, Maker, MAX_STEPS};
+use crate::rewrite::growth;
 use crate::rewrite::{Derivation, DeriveError, DeriveOptions, Derived, Word};
 use crate::scene3::Scene3;
+use crate::syntax::ast::Section;
 use crate::syntax::{Diagnostic, FileId, SourceMap};
 
 /// A checked curve L-system together with the sources its spans point into.
@@ -194,9 +196,11 @@ impl Curve {
     /// step has panels from that step on.
     pub fn figures(&self, opts: &FigureOptions) -> Result<Figures, Error> {
         let p = &self.program;
-        let panels = self.each_view(opts, |word, draw_opts| {
-            draw::draw(word, &p.alphabet, &p.structs, draw_opts)
-        })?;
+        let panels = self.each_view(
+            opts,
+            |word, draw_opts| draw::draw(word, &p.alphabet, &p.structs, draw_opts),
+            None,
+        )?;
         // The words are drawn and freed: each view's events are freed once
         // its picture is laid out.
         let mut scenes = Vec::with_capacity(panels.len());
@@ -219,13 +223,47 @@ impl Curve {
         let p = &self.program;
         // A drawing that cannot be pictured is told after every view is
         // drawn, as `figures` tells it.
-        let painted = self.each_view(opts, |word, draw_opts| {
-            match render::png::word(word, &p.alphabet, &p.structs, draw_opts, &opts.render) {
-                Ok(png) => Ok(Ok(png)),
-                Err(render::png::WordError::Draw(e)) => Err(e),
-                Err(render::png::WordError::Render(e)) => Ok(Err(e)),
-            }
-        })?;
+        let sorted = |made| match made {
+            Ok(png) => Ok(Ok(png)),
+            Err(render::png::WordError::Draw(e)) => Err(e),
+            Err(render::png::WordError::Render(e)) => Ok(Err(e)),
+        };
+        // The main view draws the last step's word as it is (no rule
+        // decomposes or interprets it): the turtle walks it on a thread of
+        // its own as the step writes it.
+        let as_derived = [Section::Decomposition, Section::Interpretation]
+            .into_iter()
+            .all(|s| p.rules_of(s).next().is_none());
+        let last_step = |d: &mut Derivation, draw_opts: &draw::DrawOptions| {
+            let (stepped, walked) = growth::alongside(
+                |g| d.next_step_read(g),
+                |g| {
+                    let mut walk = render::png::WordWalk::new(
+                        &p.alphabet,
+                        &p.structs,
+                        draw_opts,
+                        opts.render.view,
+                    );
+                    g.read_with(&mut walk, WALK_STRIDE).then(|| walk.walked())
+                },
+            );
+            stepped?;
+            // Painted on this thread, in its pool, as `draw` paints.
+            Ok(walked.flatten().map(|w| w.map(|w| w.png(&opts.render))))
+        };
+        let painted = self.each_view(
+            opts,
+            |word, draw_opts| {
+                sorted(render::png::word(
+                    word,
+                    &p.alphabet,
+                    &p.structs,
+                    draw_opts,
+                    &opts.render,
+                ))
+            },
+            as_derived.then_some(&last_step),
+        )?;
         let mut pictures = Vec::with_capacity(painted.len());
         for (view, mut list) in painted {
             let png = list.pop().expect("one picture a view without `each`")?;
@@ -239,10 +277,22 @@ impl Curve {
     /// order of its first `UseView`; a drawing of each step with `each`
     /// (a view activated after the first step from that step on), else of
     /// the last.
+    ///
+    /// Without `each`, `last_step`, when given, takes the derivation's
+    /// last step in place of [`Derivation::next_step`], and may draw the
+    /// main view's word as it does (what `draw` would make of it), in
+    /// which case `draw` does not draw it again.
+    #[allow(clippy::type_complexity)]
     fn each_view<T>(
         &self,
         opts: &FigureOptions,
         mut draw: impl FnMut(&Word, &draw::DrawOptions) -> Result<T, draw::DrawError>,
+        last_step: Option<
+            &dyn Fn(
+                &mut Derivation,
+                &draw::DrawOptions,
+            ) -> Result<Option<Result<T, draw::DrawError>>, DeriveError>,
+        >,
     ) -> Result<Vec<(i64, Vec<T>)>, Error> {
         check_steps(opts.derive.steps)?;
         let p = &self.program;
@@ -255,12 +305,20 @@ impl Curve {
             draw_opts.angle = a;
         }
         let mut drawn: Vec<(i64, Vec<T>)> = vec![(0, Vec::new())];
-        let mut panel = |d: &mut Derivation| -> Result<(), Error> {
+        // `main`: the main view's drawing of the word, made as it was
+        // derived.
+        let mut panel = |d: &mut Derivation,
+                         mut main: Option<Result<T, draw::DrawError>>|
+         -> Result<(), Error> {
             let others: Vec<i64> = d.views().iter().copied().filter(|v| *v != 0).collect();
             for view in std::iter::once(0).chain(others) {
                 let step = d.step;
                 let word = d.interpreted_view(view).map_err(fail)?;
-                let made = draw(&word, &draw_opts).map_err(|e| {
+                let made = match main.take() {
+                    Some(made) => made,
+                    None => draw(&word, &draw_opts),
+                };
+                let made = made.map_err(|e| {
                     let maker = (e.module)
                         .filter(|_| view == 0)
                         .and_then(|m| self.maker_in_figure(opts, step, &word, m));
@@ -274,17 +332,24 @@ impl Curve {
             Ok(())
         };
         if opts.each {
-            panel(&mut d)?;
+            panel(&mut d, None)?;
         }
+        let mut main = None;
         while d.has_next() {
-            d.next_step().map_err(fail)?;
+            // A drawing made in a step that turned out not to be the last
+            // is not the main view's.
+            main = None;
+            match last_step.filter(|_| !opts.each && d.step + 1 == d.length) {
+                Some(last_step) => main = last_step(&mut d, &draw_opts).map_err(fail)?,
+                None => d.next_step().map_err(fail)?,
+            }
             if opts.each {
-                panel(&mut d)?;
+                panel(&mut d, None)?;
             }
         }
         d.end().map_err(fail)?;
         if !opts.each {
-            panel(&mut d)?;
+            panel(&mut d, main)?;
         }
         Ok(drawn)
     }
@@ -318,6 +383,10 @@ impl<P> Figures<P> {
         })
     }
 }
+
+/// The turtle walking a word as it is derived walks at most this many
+/// modules between looks at how far the word is written.
+const WALK_STRIDE: usize = 1 << 16;
 
 /// More steps than this are refused before a derivation starts.
 fn check_steps(steps: Option<u64>) -> Result<(), Error> {

@@ -10,6 +10,7 @@ use glam::DVec3;
 
 use crate::lang::value::StructDef;
 use crate::lang::{Alphabet, Value};
+use crate::rewrite::word::Slices;
 use crate::rewrite::Word;
 
 /// The style of a stroke: colour index and width in pixels.
@@ -769,72 +770,134 @@ fn walk_loops<S: Sink>(
     alphabet: &Alphabet,
     structs: &[StructDef],
     opts: &DrawOptions,
-    mut queries: Option<&mut Vec<(usize, [f64; 3])>>,
+    queries: Option<&mut Vec<(usize, [f64; 3])>>,
     sink: &mut S,
     fast: bool,
 ) -> Result<(), DrawError> {
-    let cmds: Vec<Cmd> = alphabet
-        .kinds
-        .iter()
-        .map(|k| {
-            if k.builtin {
-                command(&k.name)
-            } else {
-                Cmd::None
-            }
-        })
-        .collect();
-    let tropisms = &opts.view.tropisms;
-    let field = tropism::Field::new(&tropisms.list);
-    let walker = Walker {
-        word,
-        alphabet,
-        structs,
-        opts,
-        cmds,
-        // lpfg's old rotations turn Up, Down, RollL and RollR the other way.
-        sense: if opts.view.corrected_rotation {
-            1.0
-        } else {
-            -1.0
-        },
-        // Parameters are checked a module at a time only when some number
-        // of the word is not finite (one pass over the slots, most words).
-        all_finite: word
-            .all_slots()
+    let mut walk = Walk::new(alphabet, opts, fast);
+    walk.advance(word.slices(), alphabet, structs, queries, sink)
+}
+
+/// The turtle's walk over a word that may come in pieces: each
+/// [`Walk::advance`] walks on from where the last one stopped to the end
+/// of the modules it is given, which begin with those it was given before.
+/// Walking a word in any number of advances draws what one walk over it
+/// draws, to the bit, and fails at the same module with the same message.
+pub(crate) struct Walk<'o> {
+    opts: &'o DrawOptions,
+    /// Each symbol's command.
+    cmds: Vec<Cmd>,
+    /// The sense of the turns about left and heading.
+    sense: f64,
+    /// Whether the fast loop walks the common modules.
+    fast: bool,
+    /// Whether every slot seen so far is finite, and how many were seen.
+    all_finite: bool,
+    seen_slots: usize,
+    /// The turtle between advances; `None` once an advance failed.
+    state: Option<Walking<'o>>,
+}
+
+impl<'o> Walk<'o> {
+    /// A walk, at the start of a word, on both loops when `fast` or on the
+    /// full loop alone.
+    pub(crate) fn new(alphabet: &Alphabet, opts: &'o DrawOptions, fast: bool) -> Walk<'o> {
+        let cmds: Vec<Cmd> = alphabet
+            .kinds
             .iter()
-            .fold(true, |ok, x| ok & x.is_finite()),
-        hand_back: fast,
-    };
-    let mut state = Walking {
-        t: Turtle::new(field.initial(), tropisms.simple),
-        stack: Vec::new(),
-        polygons: Vec::new(),
-        turns: TurnCache::default(),
-        field,
-        i: 0,
-    };
-    // The fast loop walks the common modules; the full loop takes over at
-    // any other, and hands back after a run of common ones.
-    while state.i < word.len() {
-        if fast {
-            state = walker.run::<S, false>(state, None, sink)?;
-        }
-        if state.i < word.len() {
-            state = walker.run::<S, true>(state, queries.as_deref_mut(), sink)?;
+            .map(|k| {
+                if k.builtin {
+                    command(&k.name)
+                } else {
+                    Cmd::None
+                }
+            })
+            .collect();
+        let tropisms = &opts.view.tropisms;
+        let field = tropism::Field::new(&tropisms.list);
+        Walk {
+            opts,
+            cmds,
+            // lpfg's old rotations turn Up, Down, RollL and RollR the other way.
+            sense: if opts.view.corrected_rotation {
+                1.0
+            } else {
+                -1.0
+            },
+            fast,
+            all_finite: true,
+            seen_slots: 0,
+            state: Some(Walking {
+                t: Turtle::new(field.initial(), tropisms.simple),
+                stack: Vec::new(),
+                polygons: Vec::new(),
+                turns: TurnCache::default(),
+                field,
+                i: 0,
+            }),
         }
     }
-    Ok(())
+
+    /// How many modules the walk has passed.
+    pub(crate) fn walked(&self) -> usize {
+        self.state.as_ref().map_or(0, |s| s.i)
+    }
+
+    /// Walks on to the end of `word`, whose first [`Walk::walked`] modules
+    /// are those walked before. After a failure the walk walks no more.
+    pub(crate) fn advance<S: Sink>(
+        &mut self,
+        word: Slices<'_>,
+        alphabet: &Alphabet,
+        structs: &[StructDef],
+        mut queries: Option<&mut Vec<(usize, [f64; 3])>>,
+        sink: &mut S,
+    ) -> Result<(), DrawError> {
+        let Some(mut state) = self.state.take() else {
+            return Ok(());
+        };
+        // Parameters are checked a module at a time only when some number
+        // of the word is not finite (one pass over the slots, most words).
+        let slots = word.all_slots();
+        self.all_finite &= slots
+            .get(self.seen_slots..)
+            .unwrap_or_default()
+            .iter()
+            .fold(true, |ok, x| ok & x.is_finite());
+        self.seen_slots = self.seen_slots.max(slots.len());
+        let walker = Walker {
+            word,
+            alphabet,
+            structs,
+            opts: self.opts,
+            cmds: &self.cmds,
+            sense: self.sense,
+            all_finite: self.all_finite,
+            hand_back: self.fast,
+        };
+        // The fast loop walks the common modules; the full loop takes over at
+        // any other, and hands back after a run of common ones.
+        while state.i < word.len() {
+            if self.fast {
+                state = walker.run::<S, false>(state, None, sink)?;
+            }
+            if state.i < word.len() {
+                state = walker.run::<S, true>(state, queries.as_deref_mut(), sink)?;
+            }
+        }
+        self.state = Some(state);
+        Ok(())
+    }
 }
 
 /// What the turtle's walk reads: the word and its commands.
 struct Walker<'a> {
-    word: &'a Word,
+    word: Slices<'a>,
     alphabet: &'a Alphabet,
     structs: &'a [StructDef],
     opts: &'a DrawOptions,
     /// Each symbol's command.
-    cmds: Vec<Cmd>,
+    cmds: &'a [Cmd],
     /// The sense of the turns about left and heading.
     sense: f64,
     /// Whether every slot of the word is finite.
@@ -895,7 +958,7 @@ impl Walker<'_> {
             alphabet,
             structs,
             opts,
-            ref cmds,
+            cmds,
             sense,
             all_finite,
             hand_back,
@@ -1347,7 +1410,7 @@ fn finite3(p: DVec3) -> bool {
 /// Module `i` took the drawing to an infinite coordinate: which one, with
 /// its parameters.
 fn beyond(
-    word: &Word,
+    word: Slices<'_>,
     i: usize,
     alphabet: &Alphabet,
     structs: &[StructDef],
@@ -1405,28 +1468,45 @@ mod tests {
             .join(" ")
     }
 
-    /// The events of `src`'s axiom, or the walk's error, on both loops
-    /// and on the full loop alone.
-    fn both_ways(src: &str) -> [Result<Vec<Event>, DrawError>; 2] {
+    /// The events of `src`'s axiom, or the walk's error: on both loops,
+    /// on the full loop alone, and on both loops walking the word in
+    /// pieces of 1 to 40 modules drawn by `next` ([`Walk::advance`]).
+    fn three_ways(src: &str, next: &mut impl FnMut() -> u64) -> [Result<Vec<Event>, DrawError>; 3] {
         // Double precision: a float parameter may be near the largest
         // double.
         let loaded =
             crate::load_str_with("walk.lsys", src, &[], crate::Precision::Double).expect("loads");
         let p = &loaded.program;
         let word = crate::derive(p, Default::default()).expect("derives").word;
-        [true, false].map(|fast| {
+        let opts = DrawOptions::default();
+        let [fast, full] = [true, false].map(|fast| {
             let mut events = Events::new(Vec::new());
             walk_loops(
                 &word,
                 &p.alphabet,
                 &p.structs,
-                &Default::default(),
+                &opts,
                 None,
                 &mut events,
                 fast,
             )
             .map(|()| events.into_inner())
-        })
+        });
+        let mut walk = Walk::new(&p.alphabet, &opts, true);
+        let mut events = Events::new(Vec::new());
+        let mut upto = 0;
+        let pieces = loop {
+            upto += 1 + (next() % 40) as usize;
+            let piece = word.slices().prefix(upto);
+            if let Err(e) = walk.advance(piece, &p.alphabet, &p.structs, None, &mut events) {
+                break Err(e);
+            }
+            assert_eq!(walk.walked(), piece.len());
+            if upto >= word.len() {
+                break Ok(events.into_inner());
+            }
+        };
+        [fast, full, pieces]
     }
 
     #[test]
@@ -1454,6 +1534,7 @@ mod tests {
             "EB",
             "EB",
             "SetColor(3)",
+            "SetColor(-1)",
             "IncColor",
             "DecColor",
             "SetWidth(2)",
@@ -1473,8 +1554,9 @@ mod tests {
         ];
         // The common modules alone, for long runs of them: the full loop
         // hands back after `COMMON_RUN` in a row.
-        let common: Vec<&str> = vocabulary[..22].to_vec();
+        let common: Vec<&str> = vocabulary[..23].to_vec();
         let mut next = crate::testing::xorshift(0x5eed_1234);
+        let mut cut = crate::testing::xorshift(0xc0ff_ee11);
         for round in 0..40 {
             let n = if round % 2 == 0 { 60 } else { 400 };
             let word = if round % 4 < 2 {
@@ -1484,36 +1566,59 @@ mod tests {
                 (0..n / 40)
                     .map(|_| {
                         let run = axiom(&common, 20 + (next() % 60) as usize, &mut next);
-                        format!("{} {run}", axiom(&vocabulary[22..], 1, &mut next))
+                        format!("{} {run}", axiom(&vocabulary[23..], 1, &mut next))
                     })
                     .collect::<Vec<_>>()
                     .join(" ")
             };
             let src = format!("derivation length: 0;\nAxiom: {word};\n");
-            let [fast, full] = both_ways(&src);
+            let [fast, full, pieces] = three_ways(&src, &mut cut);
             let (fast, full) = (fast.expect("draws"), full.expect("draws"));
             assert!(!fast.is_empty(), "{src}");
             assert_eq!(format!("{fast:?}"), format!("{full:?}"), "{src}");
+            assert_eq!(
+                format!("{:?}", pieces.expect("draws")),
+                format!("{full:?}"),
+                "{src}"
+            );
         }
     }
 
     #[test]
     fn a_move_past_the_largest_number_fails_at_the_same_module_on_either_loop() {
-        for word in [
-            "F(1) Left(90) F(1e308) F(1e308) F(1)",
-            "F(1) Circle(1) F(1e308) F(1e308) F(1)",
-            "SB F(1e308) EB MoveTo(1e308, 0, 0) MoveRel2d(V2d(1e308, 0)) F(1e308) F(1)",
+        let mut next = crate::testing::xorshift(0x0dd_ba11);
+        for (word, says) in [
+            (
+                "F(1) Left(90) F(1e308) F(1e308) F(1)",
+                "infinite coordinate",
+            ),
+            (
+                "F(1) Circle(1) F(1e308) F(1e308) F(1)",
+                "infinite coordinate",
+            ),
+            (
+                "SB F(1e308) EB MoveTo(1e308, 0, 0) MoveRel2d(V2d(1e308, 0)) F(1e308) F(1)",
+                "infinite coordinate",
+            ),
+            // An integer held as bits that read as a NaN: in pieces, only
+            // the pieces from the one that holds it on see a slot that is
+            // not finite.
+            (
+                "F(1) Left(90) F(2) Right(30) F(1) SetColor(-1) F(1) F(1e308) F(1e308) F(1e308)",
+                "infinite coordinate",
+            ),
         ] {
             let src = format!("derivation length: 0;\nAxiom: {word};\n");
-            let [fast, full] = both_ways(&src);
-            let (fast, full) = (fast.unwrap_err(), full.unwrap_err());
-            assert_eq!(fast.module, full.module, "{word}");
-            assert_eq!(fast.message, full.message, "{word}");
-            assert!(
-                fast.message.contains("infinite coordinate"),
-                "{}",
-                fast.message
-            );
+            for _ in 0..8 {
+                let [fast, full, pieces] = three_ways(&src, &mut next);
+                let (fast, full) = (fast.unwrap_err(), full.unwrap_err());
+                let pieces = pieces.unwrap_err();
+                for e in [&fast, &pieces] {
+                    assert_eq!(e.module, full.module, "{word}");
+                    assert_eq!(e.message, full.message, "{word}");
+                }
+                assert!(fast.message.contains(says), "{}", fast.message);
+            }
         }
     }
 }

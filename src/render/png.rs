@@ -9,7 +9,9 @@ use tiny_skia::{
 
 use glam::{DVec2, DVec3};
 
-use crate::draw::{walk, Event, Events, Pen};
+use crate::draw::{walk, Event, Events, Pen, Walk};
+use crate::rewrite::growth::Reader;
+use crate::rewrite::word::Slices;
 
 use super::{Item, RenderError, Rgba, Scene};
 
@@ -64,12 +66,94 @@ pub fn word(
 ) -> Result<Vec<u8>, WordError> {
     let mut drawing = Events::new(Drawing::new(opts.view, word.len()));
     walk(word, alphabet, structs, draw, None, &mut drawing)?;
+    Ok(finish(drawing.into_inner(), opts)?)
+}
+
+/// The turtle's walk of [`word`], reading a word as it grows
+/// ([`crate::rewrite::growth::Growth::read_with`]); [`Walked::png`]
+/// paints what it drew.
+pub(crate) struct WordWalk<'o> {
+    alphabet: &'o crate::lang::Alphabet,
+    structs: &'o [crate::lang::value::StructDef],
+    draw: &'o crate::draw::DrawOptions,
+    view: super::View,
+    walk: Option<Walk<'o>>,
+    drawing: Option<Events<Drawing>>,
+    failed: Option<crate::draw::DrawError>,
+}
+
+impl<'o> WordWalk<'o> {
+    pub(crate) fn new(
+        alphabet: &'o crate::lang::Alphabet,
+        structs: &'o [crate::lang::value::StructDef],
+        draw: &'o crate::draw::DrawOptions,
+        view: super::View,
+    ) -> WordWalk<'o> {
+        WordWalk {
+            alphabet,
+            structs,
+            draw,
+            view,
+            walk: None,
+            drawing: None,
+            failed: None,
+        }
+    }
+
+    /// What the turtle drew of the word read, which was read whole, or
+    /// where it failed.
+    pub(crate) fn walked(self) -> Result<Walked, crate::draw::DrawError> {
+        match (self.failed, self.drawing) {
+            (Some(e), _) => Err(e),
+            (None, Some(drawing)) => Ok(Walked(drawing.into_inner())),
+            // No word was read: the walk of an empty one.
+            (None, None) => Ok(Walked(Drawing::new(self.view, 0))),
+        }
+    }
+}
+
+/// The turtle's drawing of a word ([`WordWalk::walked`]), to be painted.
+pub(crate) struct Walked(Drawing);
+
+impl Walked {
+    /// The PNG that [`word`] makes of the word walked.
+    pub(crate) fn png(self, opts: &super::RenderOptions) -> Result<Vec<u8>, RenderError> {
+        finish(self.0, opts)
+    }
+}
+
+impl Reader for WordWalk<'_> {
+    fn start(&mut self, total: usize) {
+        self.walk = Some(Walk::new(self.alphabet, self.draw, true));
+        self.drawing = Some(Events::new(Drawing::new(self.view, total)));
+        self.failed = None;
+    }
+
+    fn read_so_far(&self) -> usize {
+        self.walk.as_ref().map_or(0, Walk::walked)
+    }
+
+    fn read(&mut self, word: Slices<'_>) -> bool {
+        let (Some(walk), Some(drawing)) = (&mut self.walk, &mut self.drawing) else {
+            return false;
+        };
+        match walk.advance(word, self.alphabet, self.structs, None, drawing) {
+            Ok(()) => true,
+            Err(e) => {
+                self.failed = Some(e);
+                false
+            }
+        }
+    }
+}
+
+/// Paints the turtle's drawing as [`word`] does once the walk is done.
+fn finish(drawing: Drawing, opts: &super::RenderOptions) -> Result<Vec<u8>, RenderError> {
     // After the walk, as `super::scene` checks it after the events are
     // drawn: a failing module is told first.
     super::check_size(opts.width, opts.height)?;
-    let drawing = drawing.into_inner();
     let Some(bounds) = drawing.bounds.get()? else {
-        return Err(super::nothing_to_draw().into());
+        return Err(super::nothing_to_draw());
     };
     let mut opts = std::borrow::Cow::Borrowed(opts);
     if opts.fit_height {
@@ -78,7 +162,7 @@ pub fn word(
     }
     let painter = Painter::new(opts.width, opts.height, opts.background)?;
     let layout = super::Layout::new(bounds, 0.0, opts.width as f64, &opts, painter);
-    Ok(drawing.paint(layout).encode()?)
+    drawing.paint(layout).encode()
 }
 
 /// The turtle's 2D drawing as it walks, compactly: the points of its

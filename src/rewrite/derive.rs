@@ -423,6 +423,25 @@ impl<'p> Derivation<'p> {
 
     /// Performs one derivation step with its control blocks.
     pub fn next_step(&mut self) -> Result<(), DeriveError> {
+        self.step_read(None)
+    }
+
+    /// [`Derivation::next_step`], with `growth`'s reader reading the
+    /// step's new word: as its parts are written, when the step writes it
+    /// in parts, and then whole, before the step's decomposition and
+    /// `EndEach`. When the step fails the reader may have read only some
+    /// of it, or none; the caller then abandons the growth.
+    pub(crate) fn next_step_read(
+        &mut self,
+        growth: &std::sync::Arc<super::growth::Growth>,
+    ) -> Result<(), DeriveError> {
+        self.step_read(Some(growth))
+    }
+
+    fn step_read(
+        &mut self,
+        growth: Option<&std::sync::Arc<super::growth::Growth>>,
+    ) -> Result<(), DeriveError> {
         if let Err(m) = crate::deadline::check(self.opts.deadline) {
             return Err(self.step_error(StepError::Timeout(m), self.step + 1));
         }
@@ -460,6 +479,7 @@ impl<'p> Derivation<'p> {
                 step,
             });
         }
+        self.rewriter.reader = growth.cloned();
         let result = if gillespie.is_some() {
             self.gillespie_step(&mut dst, traced.then_some(&mut origin))
         } else {
@@ -473,8 +493,12 @@ impl<'p> Derivation<'p> {
                 traced.then_some(&mut origin),
             )
         };
+        self.rewriter.reader = None;
         if let Err(e) = result {
             return Err(self.step_error(e, step));
+        }
+        if let Some(g) = growth {
+            g.hand_over(&dst);
         }
         if let Some(m) = &self.makers {
             self.makers = made_by(m, &origin);

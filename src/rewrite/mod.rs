@@ -4,6 +4,7 @@
 pub mod context;
 pub mod derive;
 pub mod gillespie;
+pub(crate) mod growth;
 pub mod step;
 pub mod word;
 

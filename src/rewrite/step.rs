@@ -127,6 +127,11 @@ pub struct Rewriter<'p> {
     /// The rules of the last step run in parts or on the lean path, by
     /// the symbol of their strict predecessor.
     dispatch: Dispatch,
+    /// Where a step written in parts says which of its new word's parts
+    /// are written, for a reader on another thread (the turtle walking
+    /// the last step's word): set for one step by
+    /// [`super::Derivation::next_step_read`].
+    pub(crate) reader: Option<std::sync::Arc<super::growth::Growth>>,
 }
 
 /// `Rewriter::choice` of a module that no rule rewrites.
@@ -156,6 +161,7 @@ impl<'p> Rewriter<'p> {
             parts: Vec::new(),
             choice: Vec::new(),
             dispatch: Dispatch::default(),
+            reader: None,
         }
     }
 
@@ -400,6 +406,7 @@ impl<'p> Rewriter<'p> {
             w.clear_with_capacity(want, slots);
         }
         let loop_limit = self.interp.loop_limit;
+        let reader = self.reader.clone();
         let (sh, machine, parts) = self.prepare_parts(rules, opts);
         let grown = std::sync::atomic::AtomicUsize::new(0);
         let shared_env = env.clone();
@@ -425,7 +432,7 @@ impl<'p> Rewriter<'p> {
             dst.clear();
             return None;
         };
-        if !dst.append_all(parts) {
+        if !dst.append_all_read(parts, reader.as_deref()) {
             dst.clear();
             return None;
         }
@@ -502,8 +509,10 @@ impl<'p> Rewriter<'p> {
             })
             .collect();
         // Parts of `chunk` modules, a few per thread, so that a thread done
-        // early takes another.
-        let chunk = n.div_ceil(threads * 4);
+        // early takes another; more when a reader walks the word as they
+        // are written, so that it starts sooner.
+        let per_thread = if self.reader.is_some() { 16 } else { 4 };
+        let chunk = n.div_ceil(threads * per_thread);
         let (sb, eb, tables) = (self.sb, self.eb, &self.tables);
         let ctx = |r: usize| Rules {
             sb,
@@ -569,7 +578,7 @@ impl<'p> Rewriter<'p> {
         let sizes_of: Vec<(usize, usize)> = counts.iter().map(|c| (c.0, c.1)).collect();
         let choice = &self.choice;
         dst.clear();
-        let written = dst.fill_parts(&sizes_of, |k, out| {
+        let written = dst.fill_parts(&sizes_of, self.reader.as_deref(), |k, out| {
             let mut matched = Vec::new();
             let mut scratch = Word::new();
             let from = k * chunk;

@@ -8,6 +8,8 @@ use crate::lang::eval::Emit;
 use crate::lang::value::{decode_all, encode, StructDef};
 use crate::lang::{Alphabet, Sym, Value};
 
+use super::growth::{Growth, RawWord};
+
 /// Read access to a sequence of modules, used by context matching.
 pub trait Seq {
     fn len(&self) -> usize;
@@ -141,8 +143,14 @@ impl Word {
     /// the thread that fills it. False, and the word as it was, when the
     /// slots would pass the offsets' `u32` range.
     pub fn append_all(&mut self, parts: &[Word]) -> bool {
+        self.append_all_read(parts, None)
+    }
+
+    /// [`Word::append_all`], the parts' modules given to `growth`'s reader
+    /// as they are written ([`Word::fill_parts`]).
+    pub(crate) fn append_all_read(&mut self, parts: &[Word], growth: Option<&Growth>) -> bool {
         let counts: Vec<(usize, usize)> = parts.iter().map(|w| (w.len(), w.data.len())).collect();
-        self.fill_parts(&counts, |k, out| out.push_word(&parts[k]))
+        self.fill_parts(&counts, growth, |k, out| out.push_word(&parts[k]))
     }
 
     /// Appends parts whose sizes are known beforehand, written at once on
@@ -151,9 +159,16 @@ impl Word {
     /// every part's `fill` returns true having written exactly its share,
     /// the word holds them all and this returns true; otherwise the word
     /// is left as it was and this returns false.
+    ///
+    /// With `growth`, its reader reads the word's modules while the parts
+    /// are written: the modules the word held at once, and each part's
+    /// once it and those before it are written. On return the reader has
+    /// let go of the word; when this returns false what it read is given
+    /// up.
     pub(crate) fn fill_parts(
         &mut self,
         counts: &[(usize, usize)],
+        growth: Option<&Growth>,
         fill: impl Fn(usize, &mut PartWriter<'_>) -> bool + Sync,
     ) -> bool {
         use rayon::prelude::*;
@@ -163,6 +178,10 @@ impl Word {
             return false;
         }
         self.reserve(modules, slots);
+        if let Some(g) = growth {
+            let parts: Vec<usize> = counts.iter().map(|c| c.0).collect();
+            g.begin(self.raw(), self.len(), &parts);
+        }
         let mut base = self.data.len();
         let (mut syms, mut starts, mut data) = (
             &mut self.syms.spare_capacity_mut()[..modules],
@@ -187,13 +206,52 @@ impl Word {
             });
             base += n;
         }
-        let whole = writers
-            .into_par_iter()
-            .enumerate()
-            .map(|(k, mut w)| {
+        let write = |(k, w): (usize, PartWriter<'_>)| {
+            // The part's stretch is written, and its writer gone, before
+            // the reader is told.
+            let whole = {
+                let mut w = w;
                 fill(k, &mut w) && w.modules == w.syms.len() && w.slots == w.data.len()
-            })
-            .reduce(|| true, |a, b| a & b);
+            };
+            if let (true, Some(g)) = (whole, growth) {
+                g.part_written(k);
+            }
+            whole
+        };
+        let whole = match growth {
+            // The reader walks the parts on a core of its own, as the other
+            // threads write them in order: each takes the first part that
+            // none has taken.
+            Some(_) => {
+                let writers: Vec<_> = (writers.into_iter())
+                    .map(|w| std::sync::Mutex::new(Some(w)))
+                    .collect();
+                let next = std::sync::atomic::AtomicUsize::new(0);
+                let threads = rayon::current_num_threads().saturating_sub(1).max(1);
+                (0..threads)
+                    .into_par_iter()
+                    .map(|_| {
+                        let mut whole = true;
+                        loop {
+                            let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                            let Some(cell) = writers.get(k) else {
+                                break whole;
+                            };
+                            let w = cell.lock().unwrap_or_else(|e| e.into_inner()).take();
+                            whole &= w.is_some_and(|w| write((k, w)));
+                        }
+                    })
+                    .reduce(|| true, |a, b| a & b)
+            }
+            None => writers
+                .into_par_iter()
+                .enumerate()
+                .map(write)
+                .reduce(|| true, |a, b| a & b),
+        };
+        if let Some(g) = growth {
+            g.end_writing(whole);
+        }
         if whole {
             // SAFETY: every writer wrote each element of its stretch of the
             // spare capacity (it counts what it wrote, never past the
@@ -255,6 +313,24 @@ impl Word {
         &self.data[self.starts[i] as usize..self.starts[i + 1] as usize]
     }
 
+    /// The word as borrowed arrays: what the turtle's walk reads.
+    pub(crate) fn slices(&self) -> Slices<'_> {
+        Slices {
+            syms: &self.syms,
+            starts: &self.starts,
+            data: &self.data,
+        }
+    }
+
+    /// Where the word's arrays start, for [`Growth`] to read them.
+    pub(super) fn raw(&self) -> RawWord {
+        RawWord {
+            syms: self.syms.as_ptr(),
+            starts: self.starts.as_ptr(),
+            data: self.data.as_ptr(),
+        }
+    }
+
     /// The storage, for engine fast paths that append many modules at once.
     /// Callers keep the invariants: one symbol and one offset per module,
     /// offsets increasing and ending at the slot count.
@@ -267,16 +343,9 @@ impl Word {
         &self.data
     }
 
-    /// Where each module's slots start in [`Word::all_slots`], and after
-    /// the last one the slot count: one more than the modules.
-    pub(crate) fn offsets(&self) -> &[u32] {
-        &self.starts
-    }
-
     /// The parameters of module `i` as values.
     pub fn values(&self, i: usize, alphabet: &Alphabet, structs: &[StructDef]) -> Vec<Value> {
-        let d = self.data(i);
-        decode_all(alphabet.layout(self.syms[i], d.len(), structs), d, structs)
+        self.slices().values(i, alphabet, structs)
     }
 
     /// Every module with its parameter values, for output and tests.
@@ -325,6 +394,64 @@ impl Seq for Reversed<'_> {
 
     fn data(&self, i: usize) -> &[f64] {
         self.0.data(self.0.len() - 1 - i)
+    }
+}
+
+/// A word's arrays, borrowed: all of a [`Word`] ([`Word::slices`]), or the
+/// modules of a step's new word written so far ([`Growth`]). The same
+/// invariants: one symbol per module, and one more offset, increasing and
+/// ending at the slot count.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Slices<'a> {
+    pub(super) syms: &'a [Sym],
+    pub(super) starts: &'a [u32],
+    pub(super) data: &'a [f64],
+}
+
+impl<'a> Slices<'a> {
+    pub(crate) fn len(&self) -> usize {
+        self.syms.len()
+    }
+
+    pub(crate) fn syms(&self) -> &'a [Sym] {
+        self.syms
+    }
+
+    #[inline]
+    pub(crate) fn sym(&self, i: usize) -> Sym {
+        self.syms[i]
+    }
+
+    /// Where each module's slots start, and after the last one the slot
+    /// count: one more than the modules.
+    pub(crate) fn offsets(&self) -> &'a [u32] {
+        self.starts
+    }
+
+    pub(crate) fn all_slots(&self) -> &'a [f64] {
+        self.data
+    }
+
+    /// The first `modules` modules (all of them when there are fewer).
+    #[cfg(test)]
+    pub(crate) fn prefix(&self, modules: usize) -> Slices<'a> {
+        let m = modules.min(self.len());
+        Slices {
+            syms: &self.syms[..m],
+            starts: &self.starts[..=m],
+            data: &self.data[..self.starts[m] as usize],
+        }
+    }
+
+    /// The parameters of module `i` as values.
+    pub(crate) fn values(
+        &self,
+        i: usize,
+        alphabet: &Alphabet,
+        structs: &[StructDef],
+    ) -> Vec<Value> {
+        let d = &self.data[self.starts[i] as usize..self.starts[i + 1] as usize];
+        decode_all(alphabet.layout(self.syms[i], d.len(), structs), d, structs)
     }
 }
 
@@ -411,7 +538,7 @@ mod tests {
         w.push_raw(b, &[9.0]);
         let before = w.clone();
         // The last part a module at a time, the others as whole runs.
-        assert!(w.fill_parts(&counts, |k, out| match k {
+        assert!(w.fill_parts(&counts, None, |k, out| match k {
             2 => runs[k].clone().all(|i| out.push_range(&src, i..i + 1)),
             _ => out.push_range(&src, runs[k].clone()),
         }));
@@ -426,13 +553,13 @@ mod tests {
             let end = if k == 2 { r.end - 1 } else { r.end };
             out.push_range(&src, r.start..end)
         };
-        assert!(!short.fill_parts(&counts, fill_short));
+        assert!(!short.fill_parts(&counts, None, fill_short));
         assert_eq!(short, before);
         let mut long = before.clone();
         let fill_long = |k: usize, out: &mut PartWriter<'_>| {
             out.push_range(&src, runs[k].clone()) && (k != 0 || out.push_range(&src, 0..1))
         };
-        assert!(!long.fill_parts(&counts, fill_long));
+        assert!(!long.fill_parts(&counts, None, fill_long));
         assert_eq!(long, before);
     }
 }

@@ -263,6 +263,56 @@ fn paths_the_layout_joins_are_painted_as_the_scene_paints_them() {
     paints_as_the_scene(&l, &opts, &png::render(&scene).unwrap(), "joins");
 }
 
+/// `A` quadruples each step, so the last step rewrites 2^16 modules and
+/// more (and so is written in parts, which the turtle walks as they are
+/// written); the axiom's lines, discs, branches and pens end up spread
+/// through the word, 4^8 `A`s apart. `SetColor(-1)`, which changes no
+/// colour, holds a slot that reads as a NaN: the walk checks the modules
+/// from the part that holds it on, one by one.
+const SPREAD: &str = "module A;\nmodule X(float);\nderivation length: 8;\n\
+    Axiom: SetWidth(0.5) A F(1) Right(90) F(1) SetColor(3) A F(1) Circle(0.3) F(2) A \
+    SetColor(-1) \
+    SB Left(30) F(1) EB SetWidth(3) F(1) A SetWidth(0.5) Left(45) F(1) A F(1) A;\n\
+    A -> A A A A;\n";
+
+/// The picture the turtle paints as it walks the last step's word while
+/// the step writes it is the scene's, in pools of one to three threads; a
+/// module of that word the turtle cannot draw, and a last step that fails
+/// part of the way, fail as the scene does.
+#[test]
+fn a_picture_walked_as_the_last_step_is_written_is_the_scenes() {
+    let l = load_text(SPREAD);
+    let opts = sized(300, 200);
+    let before_last = derive(&l, DeriveOptions::default().with_steps(7)).word;
+    assert!(before_last.len() > 65_536, "{}", before_last.len());
+    let scene = l.figure(&opts).unwrap();
+    paints_as_the_scene(&l, &opts, &png::render(&scene).unwrap(), "spread");
+    for src in [
+        // A surface the model does not have, near the word's end.
+        SPREAD.replace("Left(45) F(1) A", "Left(45) F(1) Surface(2, 1) A"),
+        // A value that is not finite in the last step (1e40 is past the
+        // largest `float`), at the end of the word.
+        SPREAD.replace(
+            "F(1) A;\nA -> A A A A;",
+            "F(1) A X(1);\nA -> A A A A;\nX(x) -> X(x * 1e5);",
+        ),
+    ] {
+        let l = load_text(&src);
+        let scene = l.figure(&opts).map(|_| ()).unwrap_err().to_string();
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let painted = pool
+                .install(|| l.png_figures(&opts))
+                .map(|_| ())
+                .unwrap_err();
+            assert_eq!(painted.to_string(), scene, "{threads} threads: {src}");
+        }
+    }
+}
+
 /// The picture painted from the walk (`png_figures`) is `expected`, the
 /// scene's PNG, in pools of one to three threads (one band of rows, or a
 /// band on each thread).
