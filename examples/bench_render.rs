@@ -318,6 +318,24 @@ fn island(runs: usize) {
     let (t_box, _) = best_of(runs, || {
         subgram::draw::line_bounds(word, &p.alphabet, &p.structs, &Default::default()).unwrap()
     });
+    drop(d);
+    // What `render` does in all, in this process (the derivation, the
+    // turtle walking the last step's word as the step writes it, the
+    // painting), alternating run by run with the derivation alone.
+    let (mut t_whole, mut t_alone) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        let started = std::time::Instant::now();
+        let png = loaded.png_figures(&Default::default()).unwrap();
+        t_whole.push(started.elapsed());
+        drop(png);
+        let started = std::time::Instant::now();
+        let mut d = Derivation::new(p, DeriveOptions::default()).unwrap();
+        while d.has_next() {
+            d.next_step().unwrap();
+        }
+        t_alone.push(started.elapsed());
+        drop(d);
+    }
 
     let Some((exe, bin)) = binaries() else {
         return;
@@ -389,6 +407,14 @@ fn island(runs: usize) {
     println!(
         "    a walk of the turtle that only finds the drawing's box {:.1} ms",
         ms(t_box)
+    );
+    println!(
+        "  in this process, alternating: derive and PNG (`Curve::png_figures`) {:.1} ms median, {:.1} best; the derivation alone {:.1} ms median, {:.1} best; the median of the runs' ratios {:.2}x",
+        ms(median(&t_whole)),
+        ms(best(&t_whole)),
+        ms(median(&t_alone)),
+        ms(best(&t_alone)),
+        median_ratio(&t_whole, &t_alone)
     );
     println!(
         "  in this process: PNG of the laid-out scene {:.1} ms; tiny-skia stroking its segments as one path {:.1} ms ({:.2}x)",

@@ -248,8 +248,11 @@ impl Curve {
                 },
             );
             stepped?;
+            // A failed step is told before a reader that panicked.
+            let walked =
+                walked.and_then(|w| w.unwrap_or_else(|panic| std::panic::resume_unwind(panic)));
             // Painted on this thread, in its pool, as `draw` paints.
-            Ok(walked.flatten().map(|w| w.map(|w| w.png(&opts.render))))
+            Ok(walked.map(|w| w.map(|w| w.png(&opts.render))))
         };
         let painted = self.each_view(
             opts,

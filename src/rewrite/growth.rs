@@ -63,14 +63,46 @@ pub(crate) trait Reader {
     fn read(&mut self, word: Slices<'_>) -> bool;
 }
 
+/// The writer's side of a growth while [`Word::fill_parts`] writes the
+/// word ([`Growth::begin`]). Dropped without [`Writing::end`] (a part
+/// panicked), it gives the word up, the reader let go of it first.
+pub(super) struct Writing<'g> {
+    growth: &'g Growth,
+    ended: bool,
+}
+
+impl Writing<'_> {
+    /// Part `k` is written, all of it, and nothing refers to it but the
+    /// word.
+    pub(super) fn part_written(&self, k: usize) {
+        self.growth.part_written(k);
+    }
+
+    /// The writing is over: the word kept or given up
+    /// ([`Growth::end_writing`]).
+    pub(super) fn end(mut self, kept: bool) {
+        self.ended = true;
+        self.growth.end_writing(kept);
+    }
+}
+
+impl Drop for Writing<'_> {
+    fn drop(&mut self) {
+        if !self.ended {
+            self.growth.end_writing(false);
+        }
+    }
+}
+
 /// Runs `write` on this thread while `read` reads a growth on a thread of
-/// its own: what each returned (nothing from `read` when no thread could
-/// be started, and then nobody reads). However `write` ends, the reader is
+/// its own: what each returned, or the reader's panic (nothing from `read`
+/// when no thread could be started, and then nobody reads), for the caller
+/// to weigh against what `write` says. However `write` ends, the reader is
 /// stopped before this returns or unwinds.
 pub(crate) fn alongside<W, R: Send>(
     write: impl FnOnce(&Arc<Growth>) -> W,
     read: impl FnOnce(&Growth) -> R + Send,
-) -> (W, Option<R>) {
+) -> (W, Option<std::thread::Result<R>>) {
     struct Stop<'g>(&'g Growth);
     impl Drop for Stop<'_> {
         fn drop(&mut self) {
@@ -87,10 +119,7 @@ pub(crate) fn alongside<W, R: Send>(
         }
         let written = write(&growth);
         drop(stop);
-        let read = reader
-            .ok()
-            .map(|r| r.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
-        (written, read)
+        (written, reader.ok().map(|r| r.join()))
     })
 }
 
@@ -138,8 +167,9 @@ impl Growth {
     }
 
     /// The writer starts to write parts of `parts[k]` modules each after
-    /// the `base` modules the word at `raw` already holds.
-    pub(super) fn begin(&self, raw: RawWord, base: usize, parts: &[usize]) {
+    /// the `base` modules the word at `raw` already holds; it says which are
+    /// written, and when it is done, through what this returns.
+    pub(super) fn begin(&self, raw: RawWord, base: usize, parts: &[usize]) -> Writing<'_> {
         let mut s = self.lock();
         let mut end = base;
         s.part_ends = parts
@@ -155,6 +185,10 @@ impl Growth {
         s.ready = base;
         Self::advance_ready(&mut s);
         self.changed.notify_all();
+        Writing {
+            growth: self,
+            ended: false,
+        }
     }
 
     /// Moves `ready` over the written parts at the front.
@@ -169,8 +203,9 @@ impl Growth {
         }
     }
 
-    /// Part `k` is written, all of it, by the thread calling this.
-    pub(super) fn part_written(&self, k: usize) {
+    /// Part `k` is written, all of it, and nothing refers to it but the
+    /// word.
+    fn part_written(&self, k: usize) {
         let mut s = self.lock();
         if let Some(w) = s.written.get_mut(k) {
             *w = true;
@@ -182,7 +217,7 @@ impl Growth {
     /// The writer is done with the word's arrays, which may change from
     /// now on: waits until the reader lets go of them. With `kept` false
     /// the word is given up, and the reader starts again on the next one.
-    pub(super) fn end_writing(&self, kept: bool) {
+    fn end_writing(&self, kept: bool) {
         let mut s = self.lock();
         s.closing = true;
         while s.reading {
@@ -354,7 +389,10 @@ mod tests {
                 (g.read_with(&mut reader, 5), reader)
             },
         );
-        read.expect("a thread to read on")
+        match read.expect("a thread to read on") {
+            Ok(read) => read,
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
     }
 
     /// In pools of one to three threads, with parts of every size (none
@@ -448,10 +486,8 @@ mod tests {
                 panic!("a reader that panics")
             }
         }
-        let panicked = std::panic::catch_unwind(|| {
-            alongside(|g| g.hand_over(&w), |g| g.read_with(&mut Panics, 5))
-        });
-        assert!(panicked.is_err());
+        let ((), read) = alongside(|g| g.hand_over(&w), |g| g.read_with(&mut Panics, 5));
+        assert!(read.expect("a thread to read on").is_err());
         // A writer that panics stops the reader, which would otherwise wait
         // for it forever.
         let panicked = std::panic::catch_unwind(|| {
@@ -461,5 +497,43 @@ mod tests {
             )
         });
         assert!(panicked.is_err());
+    }
+
+    /// A part that panics after others were read: the reader lets go of
+    /// the word before the unwinding frees it (a part of a million modules
+    /// has a mapping of its own, which is unmapped when freed).
+    #[test]
+    fn a_part_that_panics_lets_the_reader_go_before_the_word_is_freed() {
+        struct Slow(Copying);
+        impl Reader for Slow {
+            fn start(&mut self, total: usize) {
+                self.0.start(total);
+            }
+            fn read_so_far(&self) -> usize {
+                self.0.read_so_far()
+            }
+            fn read(&mut self, word: Slices<'_>) -> bool {
+                std::thread::sleep(std::time::Duration::from_millis(20));
+                self.0.read(word)
+            }
+        }
+        let big = parts(&[1 << 20], 4);
+        let counts = [(big[0].len(), big[0].slot_count()), (10, 0)];
+        let unwound = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            alongside(
+                |g| {
+                    let mut w = Word::new();
+                    w.fill_parts(&counts, Some(g), |k, out| {
+                        if k == 0 {
+                            return out.push_word(&big[0]);
+                        }
+                        std::thread::sleep(std::time::Duration::from_millis(50));
+                        panic!("a part that panics")
+                    })
+                },
+                |g| g.read_with(&mut Slow(Copying::default()), 1 << 18),
+            )
+        }));
+        assert!(unwound.is_err());
     }
 }

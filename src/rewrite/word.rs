@@ -178,10 +178,12 @@ impl Word {
             return false;
         }
         self.reserve(modules, slots);
-        if let Some(g) = growth {
+        // However the writing ends (a part's `fill` may panic), the reader
+        // lets go of the word before it can change.
+        let writing = growth.map(|g| {
             let parts: Vec<usize> = counts.iter().map(|c| c.0).collect();
-            g.begin(self.raw(), self.len(), &parts);
-        }
+            g.begin(self.raw(), self.len(), &parts)
+        });
         let mut base = self.data.len();
         let (mut syms, mut starts, mut data) = (
             &mut self.syms.spare_capacity_mut()[..modules],
@@ -206,23 +208,14 @@ impl Word {
             });
             base += n;
         }
-        let write = |(k, w): (usize, PartWriter<'_>)| {
-            // The part's stretch is written, and its writer gone, before
-            // the reader is told.
-            let whole = {
-                let mut w = w;
-                fill(k, &mut w) && w.modules == w.syms.len() && w.slots == w.data.len()
-            };
-            if let (true, Some(g)) = (whole, growth) {
-                g.part_written(k);
-            }
-            whole
+        let write = |(k, mut w): (usize, PartWriter<'_>)| {
+            fill(k, &mut w) && w.modules == w.syms.len() && w.slots == w.data.len()
         };
-        let whole = match growth {
+        let whole = match &writing {
             // The reader walks the parts on a core of its own, as the other
             // threads write them in order: each takes the first part that
             // none has taken.
-            Some(_) => {
+            Some(writing) => {
                 let writers: Vec<_> = (writers.into_iter())
                     .map(|w| std::sync::Mutex::new(Some(w)))
                     .collect();
@@ -238,7 +231,13 @@ impl Word {
                                 break whole;
                             };
                             let w = cell.lock().unwrap_or_else(|e| e.into_inner()).take();
-                            whole &= w.is_some_and(|w| write((k, w)));
+                            // The reader is told once the part's writer is
+                            // gone, its call returned.
+                            let written = w.is_some_and(|w| write((k, w)));
+                            if written {
+                                writing.part_written(k);
+                            }
+                            whole &= written;
                         }
                     })
                     .reduce(|| true, |a, b| a & b)
@@ -249,8 +248,8 @@ impl Word {
                 .map(write)
                 .reduce(|| true, |a, b| a & b),
         };
-        if let Some(g) = growth {
-            g.end_writing(whole);
+        if let Some(writing) = writing {
+            writing.end(whole);
         }
         if whole {
             // SAFETY: every writer wrote each element of its stretch of the

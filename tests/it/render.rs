@@ -286,7 +286,16 @@ fn a_picture_walked_as_the_last_step_is_written_is_the_scenes() {
     let before_last = derive(&l, DeriveOptions::default().with_steps(7)).word;
     assert!(before_last.len() > 65_536, "{}", before_last.len());
     let scene = l.figure(&opts).unwrap();
-    paints_as_the_scene(&l, &opts, &png::render(&scene).unwrap(), "spread");
+    let png = png::render(&scene).unwrap();
+    paints_as_the_scene(&l, &opts, &png, "spread");
+    // The same word made by a compiled body: the parts are rewritten apart
+    // and then copied into the new word after its first part.
+    let body = SPREAD.replace(
+        "A -> A A A A;",
+        "A : { float x; x = 2; if (x > 1) produce A A A A; }",
+    );
+    let l = load_text(&body);
+    paints_as_the_scene(&l, &opts, &png, "spread, a compiled body");
     for src in [
         // A surface the model does not have, near the word's end.
         SPREAD.replace("Left(45) F(1) A", "Left(45) F(1) Surface(2, 1) A"),
