@@ -221,13 +221,6 @@ impl Curve {
                 .try_map(|s| render::png::render(s).map_err(Error::from));
         }
         let p = &self.program;
-        // A drawing that cannot be pictured is told after every view is
-        // drawn, as `figures` tells it.
-        let sorted = |made| match made {
-            Ok(png) => Ok(Ok(png)),
-            Err(render::png::WordError::Draw(e)) => Err(e),
-            Err(render::png::WordError::Render(e)) => Ok(Err(e)),
-        };
         // The main view draws the last step's word as it is (no rule
         // decomposes or interprets it): the turtle walks it on a thread of
         // its own as the step writes it.
@@ -256,14 +249,18 @@ impl Curve {
         };
         let painted = self.each_view(
             opts,
-            |word, draw_opts| {
-                sorted(render::png::word(
-                    word,
-                    &p.alphabet,
-                    &p.structs,
-                    draw_opts,
-                    &opts.render,
-                ))
+            // A drawing that cannot be pictured is told after every view is
+            // drawn, as `figures` tells it.
+            |word, draw_opts| match render::png::word(
+                word,
+                &p.alphabet,
+                &p.structs,
+                draw_opts,
+                &opts.render,
+            ) {
+                Ok(png) => Ok(Ok(png)),
+                Err(render::png::WordError::Draw(e)) => Err(e),
+                Err(render::png::WordError::Render(e)) => Ok(Err(e)),
             },
             as_derived.then_some(&last_step),
         )?;

@@ -11,7 +11,7 @@
 //! word once, and tells the growth which parts are whole), and while the
 //! finished word is handed over ([`Growth::hand_over`], which holds the word
 //! borrowed until the reader has read it all). Before the word may change
-//! ([`Growth::end_writing`], [`Growth::abandon`]) the writer waits for the
+//! (a [`Writing`] dropped, [`Growth::abandon`]) the writer waits for the
 //! reader to let go of it.
 
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
@@ -64,33 +64,47 @@ pub(crate) trait Reader {
 }
 
 /// The writer's side of a growth while [`Word::fill_parts`] writes the
-/// word ([`Growth::begin`]). Dropped without [`Writing::end`] (a part
-/// panicked), it gives the word up, the reader let go of it first.
+/// word ([`Growth::begin`]). When it is dropped the writer is done with
+/// the word's arrays, which may change from then on: the drop waits until
+/// the reader lets go of them. The word is given up (the reader starts
+/// again on the next one) unless [`Writing::keep`] was called, so a part
+/// that panics gives it up too.
 pub(super) struct Writing<'g> {
     growth: &'g Growth,
-    ended: bool,
+    kept: bool,
 }
 
 impl Writing<'_> {
     /// Part `k` is written, all of it, and nothing refers to it but the
     /// word.
     pub(super) fn part_written(&self, k: usize) {
-        self.growth.part_written(k);
+        let g = self.growth;
+        let mut s = g.lock();
+        if let Some(w) = s.written.get_mut(k) {
+            *w = true;
+            Growth::advance_ready(&mut s);
+            g.changed.notify_all();
+        }
     }
 
-    /// The writing is over: the word kept or given up
-    /// ([`Growth::end_writing`]).
-    pub(super) fn end(mut self, kept: bool) {
-        self.ended = true;
-        self.growth.end_writing(kept);
+    /// Every part is written: the word is kept.
+    pub(super) fn keep(&mut self) {
+        self.kept = true;
     }
 }
 
 impl Drop for Writing<'_> {
     fn drop(&mut self) {
-        if !self.ended {
-            self.growth.end_writing(false);
+        let g = self.growth;
+        let mut s = g.lock();
+        s.closing = true;
+        while s.reading {
+            s = g.wait(s);
         }
+        s.closing = false;
+        s.raw = None;
+        s.restart |= !self.kept;
+        g.changed.notify_all();
     }
 }
 
@@ -187,7 +201,7 @@ impl Growth {
         self.changed.notify_all();
         Writing {
             growth: self,
-            ended: false,
+            kept: false,
         }
     }
 
@@ -201,32 +215,6 @@ impl Growth {
         if let Some(k) = first.checked_sub(1) {
             s.ready = s.ready.max(s.part_ends[k]);
         }
-    }
-
-    /// Part `k` is written, all of it, and nothing refers to it but the
-    /// word.
-    fn part_written(&self, k: usize) {
-        let mut s = self.lock();
-        if let Some(w) = s.written.get_mut(k) {
-            *w = true;
-            Self::advance_ready(&mut s);
-            self.changed.notify_all();
-        }
-    }
-
-    /// The writer is done with the word's arrays, which may change from
-    /// now on: waits until the reader lets go of them. With `kept` false
-    /// the word is given up, and the reader starts again on the next one.
-    fn end_writing(&self, kept: bool) {
-        let mut s = self.lock();
-        s.closing = true;
-        while s.reading {
-            s = self.wait(s);
-        }
-        s.closing = false;
-        s.raw = None;
-        s.restart |= !kept;
-        self.changed.notify_all();
     }
 
     /// Hands over the finished word: the reader reads the rest of it (all
@@ -297,10 +285,10 @@ impl Growth {
                     s.reading = true;
                     drop(s);
                     // SAFETY: the first `ready` modules are written: by
-                    // parts that said so through `part_written` (under the
+                    // parts that said so through `Writing::part_written` (under the
                     // lock taken since), or as the word was when
                     // `begin`/`hand_over` gave it. The writer changes or frees
-                    // the word only after `end_writing` or `abandon`, or
+                    // the word only after a `Writing` is dropped or `abandon`, or
                     // after `hand_over` returns, all of which wait until
                     // `reading` is false again.
                     let ok = reader.read(unsafe { raw.slices(upto) });

@@ -248,8 +248,12 @@ impl Word {
                 .map(write)
                 .reduce(|| true, |a, b| a & b),
         };
-        if let Some(writing) = writing {
-            writing.end(whole);
+        if let Some(mut writing) = writing {
+            if whole {
+                writing.keep();
+            }
+            // Dropped here: the reader lets go of the word before its
+            // lengths change.
         }
         if whole {
             // SAFETY: every writer wrote each element of its stretch of the
