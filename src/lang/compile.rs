@@ -182,6 +182,11 @@ struct Compiler {
     methods: HashMap<(u16, String), u16>,
     /// The array types made so far, by element type and length.
     array_types: HashMap<(Ty, Option<usize>), u16>,
+    /// The globals (and `static` locals) declared as `char` arrays, by
+    /// slot: the strings written into them must fit.
+    global_chars: HashMap<u16, CharArray>,
+    /// The struct fields declared as `char` arrays, by struct and field.
+    field_chars: HashMap<(u16, u16), CharArray>,
 }
 
 /// A user-defined function as its callers see it.
@@ -244,6 +249,8 @@ struct Scope {
     ret: Option<(Ty, String)>,
     /// The values its locals hold in all (an array counts its elements).
     values: usize,
+    /// The locals declared as `char` arrays, by index in `vars`.
+    chars: HashMap<usize, CharArray>,
 }
 
 /// The most local variables one body may have (their slots are `u16`s).
@@ -277,6 +284,9 @@ impl Scope {
     /// Forgets the variables from the `len`th on.
     fn truncate(&mut self, len: usize) {
         self.statics.retain(|&i| i < len);
+        if !self.chars.is_empty() {
+            self.chars.retain(|&i, _| i < len);
+        }
         for (name, _, _) in self.vars.drain(len.min(self.vars.len())..) {
             if let Some(at) = self.by_name.get_mut(&name) {
                 at.pop();
@@ -333,6 +343,24 @@ impl Scope {
         }
         let (_, t, s) = &self.vars[i];
         Some((*t, *s, self.statics.contains(&i)))
+    }
+
+    /// The `char` array that the visible variable `name` was declared
+    /// as, when it was: the last one bound (a `static` local's is the
+    /// compiler's, by its global slot).
+    fn chars_of(&self, name: &str) -> Option<&CharArray> {
+        let &i = self.by_name.get(name)?.last()?;
+        if i < self.barrier {
+            return None;
+        }
+        self.chars.get(&i)
+    }
+
+    /// Marks the variable bound last as declared `chars`.
+    fn set_chars(&mut self, chars: Option<CharArray>) {
+        if let (Some(c), Some(i)) = (chars, self.vars.len().checked_sub(1)) {
+            self.chars.insert(i, c);
+        }
     }
 
     /// Names global `slot` `name` in this scope: a `static` local.
@@ -411,6 +439,8 @@ impl Compiler {
             ctors: HashMap::new(),
             methods: HashMap::new(),
             array_types: HashMap::new(),
+            global_chars: HashMap::new(),
+            field_chars: HashMap::new(),
             single: false,
             props: Vec::new(),
         }
@@ -653,6 +683,10 @@ impl Compiler {
                             };
                             values = values.saturating_add(v);
                             depth = depth.max(d + 1);
+                            if let Some(c) = self.char_array(t, false, n, dims, &Init::None) {
+                                self.field_chars
+                                    .insert((self.structs.len() as u16, fs.len() as u16), c);
+                            }
                             index.insert(n.text.clone(), fs.len() as u16);
                             fs.push((n.text.clone(), ty));
                         }
@@ -1107,11 +1141,13 @@ impl Compiler {
             let Some(ty) = self.declarator_type(base, &decl.ty, d) else {
                 continue;
             };
+            let chars = self.char_array(&decl.ty, d.pointer, &d.name, &d.dims, &d.init);
             let mut scope = Scope::default();
             let init = match (ty, &d.init) {
                 (Ty::Elem(k), Init::None) => Some(Ex::Const((self.host.zero)(k))),
                 _ => self.initializer(ty, &d.init, d.name.span, &mut scope),
             };
+            let init = self.fit_init(init, chars.as_ref(), &d.init);
             if scope.max > 0 {
                 self.err(d.name.span, "a global initializer cannot declare variables");
             }
@@ -1132,6 +1168,9 @@ impl Compiler {
             self.count_global_values(ty, d.name.span);
             self.global_names
                 .insert(d.name.text.clone(), self.globals.len() as u16);
+            if let Some(c) = chars {
+                self.global_chars.insert(self.globals.len() as u16, c);
+            }
             self.globals.push(GlobalVar {
                 name: d.name.text.clone(),
                 ty,
@@ -1216,8 +1255,9 @@ impl Compiler {
             return None;
         }
         let mut parts = Vec::new();
-        for ((ex, et), (w, a)) in exs.into_iter().zip(want.iter().zip(args)) {
-            parts.push(self.coerce(ex, et, *w, a.span)?);
+        for (k, ((ex, et), (w, a))) in exs.into_iter().zip(want.iter().zip(args)).enumerate() {
+            let part = self.coerce(ex, et, *w, a.span)?;
+            parts.push(self.fit_field(ty, k, part, a.span)?);
         }
         assemble(ty, parts)
     }
@@ -1575,8 +1615,11 @@ impl Compiler {
                         self.static_local(d, v, ty, scope);
                         continue;
                     }
+                    let chars = self.char_array(&d.ty, v.pointer, &v.name, &v.dims, &v.init);
                     let init = self.initializer(ty, &v.init, v.name.span, scope);
+                    let init = self.fit_init(init, chars.as_ref(), &v.init);
                     let slot = self.local(scope, &v.name.text, ty, v.name.span);
+                    scope.set_chars(chars);
                     if d.is_const {
                         scope.consts.insert(slot);
                     }
@@ -1910,6 +1953,7 @@ impl Compiler {
                         slot,
                         path: Vec::new(),
                         ty,
+                        chars: self.global_chars.get(&slot).cloned().map(Box::new),
                     });
                 }
                 if let Some((ty, slot)) = scope.lookup(n) {
@@ -1925,6 +1969,7 @@ impl Compiler {
                         slot,
                         path: Vec::new(),
                         ty,
+                        chars: scope.chars_of(n).cloned().map(Box::new),
                     });
                 }
                 if let Some(&g) = self.global_names.get(n) {
@@ -1941,6 +1986,7 @@ impl Compiler {
                         slot: g,
                         path: Vec::new(),
                         ty: gv.ty,
+                        chars: self.global_chars.get(&g).cloned().map(Box::new),
                     });
                 }
                 self.err(e.span, format!("unknown identifier `{n}`"));
@@ -1949,6 +1995,16 @@ impl Compiler {
             ExprKind::Field(base, f) => {
                 let mut p = self.place_of(base, scope, write)?;
                 let (idx, ty) = self.field_of(p.ty, f)?;
+                // A field declared as a `char` array, or none.
+                p.chars = match p.ty {
+                    Ty::Struct(s) => self.field_chars.get(&(s, idx)).map(|c| {
+                        Box::new(CharArray {
+                            name: written_place(e),
+                            ..c.clone()
+                        })
+                    }),
+                    _ => None,
+                };
                 p.path.push(Step::Field(idx));
                 p.ty = ty;
                 Some(p)
@@ -1958,6 +2014,13 @@ impl Compiler {
                 let i = self.index(index, scope);
                 let (mut p, i) = (p?, i?);
                 let elem = self.elem_of(p.ty, e.span)?;
+                // An element of an array of `char` arrays is one of them;
+                // a string's character is none.
+                if p.ty == Ty::Str {
+                    p.chars = None;
+                } else if let Some(c) = &mut p.chars {
+                    c.name = written_place(e);
+                }
                 p.path.push(Step::Index(Box::new(i), e.span));
                 p.ty = elem;
                 Some(p)
@@ -2242,6 +2305,11 @@ impl Compiler {
                     fold_unary(Ex::Convert(Ty::Float, Box::new(rx)))
                 } else {
                     rx
+                };
+                // A string assigned to a declared `char` array must fit.
+                let rx = match &place.chars {
+                    Some(c) => self.fit(rx, c, "the assignment", span)?,
+                    None => rx,
                 };
                 Some((Ex::Assign(place, *op, Box::new(rx), ty), ty))
             }
@@ -3135,10 +3203,13 @@ impl Compiler {
                 Some(ast::Expr {
                     kind: ExprKind::List(inner),
                     span,
-                }) => self.list_init(*w, inner, *span, scope),
+                }) => self
+                    .list_init(*w, inner, *span, scope)
+                    .and_then(|x| self.fit_field(ty, k, x, *span)),
                 Some(e) => self
                     .expr(e, scope)
-                    .and_then(|(x, t)| self.coerce(x, t, *w, e.span)),
+                    .and_then(|(x, t)| self.coerce(x, t, *w, e.span))
+                    .and_then(|x| self.fit_field(ty, k, x, e.span)),
             };
             match part {
                 Some(p) => parts.push(p),
@@ -3165,6 +3236,167 @@ impl Compiler {
                 None
             }
         }
+    }
+
+    /// `e`'s value when it is an integer constant; `None`, and nothing
+    /// reported, otherwise.
+    fn quiet_const_int(&mut self, e: &ast::Expr) -> Option<i64> {
+        let (diags, warnings) = (self.diags.len(), self.warnings.len());
+        let mut scope = Scope::default();
+        let v = self
+            .expr(e, &mut scope)
+            .and_then(|(ex, _)| self.const_value(&ex, 0));
+        self.diags.truncate(diags);
+        self.warnings.truncate(warnings);
+        match v {
+            Some(Value::Int(i)) => Some(i),
+            Some(Value::Bool(b)) => Some(b as i64),
+            _ => None,
+        }
+    }
+
+    /// The `char` array that a declarator declares (`char b[4]`,
+    /// `char names[3][16]`, `char s[] = "abc"`): its size is the last
+    /// dimension, or the length of the literal that initialises it and its
+    /// NUL. `None` for any other declarator, for a `char *`, and for a
+    /// size that is not a constant (C's variable-length array: its strings
+    /// are not checked); a size of 0 or less is an error.
+    #[inline(never)]
+    fn char_array(
+        &mut self,
+        tref: &ast::TypeRef,
+        pointer: bool,
+        name: &ast::Name,
+        dims: &[Option<ast::Expr>],
+        init: &Init,
+    ) -> Option<CharArray> {
+        if tref.name != "char" || tref.pointer || pointer {
+            return None;
+        }
+        let (last, outer) = dims.split_last()?;
+        let size = match last {
+            Some(e) => {
+                let n = self.quiet_const_int(e)?;
+                if n <= 0 {
+                    self.err(e.span, format!("an array size must be positive, found {n}"));
+                    return None;
+                }
+                usize::try_from(n).ok()?
+            }
+            None if outer.is_empty() => match init {
+                Init::Expr(ast::Expr {
+                    kind: ExprKind::Str(s),
+                    ..
+                }) => super::stdio::unescape(s).len() + 1,
+                _ => return None,
+            },
+            None => return None,
+        };
+        let mut decl = format!("char {}", name.text);
+        for (k, d) in outer.iter().enumerate() {
+            let n = match d {
+                Some(e) => self.quiet_const_int(e).map(|n| n.to_string()),
+                None if k == 0 => match init {
+                    Init::List(items, _) => Some(items.len().to_string()),
+                    _ => None,
+                },
+                None => None,
+            };
+            decl.push_str(&format!("[{}]", n.unwrap_or_default()));
+        }
+        decl.push_str(&format!("[{size}]"));
+        Some(CharArray {
+            size,
+            name: name.text.clone(),
+            decl,
+        })
+    }
+
+    /// A declared `char` array's initializer, checked to fit ([`Self::fit`]).
+    fn fit_init(
+        &mut self,
+        init: Option<Ex>,
+        chars: Option<&CharArray>,
+        written: &Init,
+    ) -> Option<Ex> {
+        match (init, chars, written) {
+            (Some(ex), Some(c), Init::Expr(e)) => self.fit(ex, c, "the initializer", e.span),
+            (Some(ex), Some(c), Init::List(_, span)) => self.fit(ex, c, "the initializer", *span),
+            (init, ..) => init,
+        }
+    }
+
+    /// `part`, the value that initialises field `k` of a struct `ty`,
+    /// checked to fit when the field is a `char` array ([`Self::fit`]).
+    fn fit_field(&mut self, ty: Ty, k: usize, part: Ex, span: Span) -> Option<Ex> {
+        let Ty::Struct(s) = ty else {
+            return Some(part);
+        };
+        match u16::try_from(k)
+            .ok()
+            .and_then(|k| self.field_chars.get(&(s, k)))
+            .cloned()
+        {
+            Some(c) => self.fit(part, &c, "the initializer", span),
+            None => Some(part),
+        }
+    }
+
+    /// `value`, the string (or array of strings) that `what` writes into
+    /// the declared `char` array `c`, checked to fit there with its
+    /// terminating NUL: now when `value` is a constant (a string that does
+    /// not fit is reported at `span`, and gives `None`), else when it
+    /// runs, an error located at `span`.
+    fn fit(&mut self, value: Ex, c: &CharArray, what: &str, span: Span) -> Option<Ex> {
+        if let Some(v) = self.const_written(&value) {
+            if let Some(m) = c.overflow(what, &v) {
+                self.err(span, m);
+                return None;
+            }
+            return Some(value);
+        }
+        let text = |s: &str| Ex::Const(Value::Str(s.into()));
+        Some(Ex::Call(
+            Func::Io(super::stdio::IoFunc::Fit),
+            vec![
+                value,
+                Ex::Const(Value::Int(c.size as i64)),
+                text(what),
+                text(&c.name),
+                text(&c.decl),
+            ],
+            span,
+        ))
+    }
+
+    /// The value `ex` makes when it is known before the program runs: a
+    /// constant, a string function (`sprintf`'s formatting) of constants,
+    /// or an array or struct of those.
+    fn const_written(&self, ex: &Ex) -> Option<Value> {
+        use super::stdio::IoFunc;
+        Some(match ex {
+            Ex::Call(
+                Func::Io(
+                    f @ (IoFunc::Format | IoFunc::Concat | IoFunc::Strncat | IoFunc::Snprintf),
+                ),
+                args,
+                _,
+            ) => {
+                let vals = args
+                    .iter()
+                    .map(|a| self.const_value(a, 0))
+                    .collect::<Option<Vec<_>>>()?;
+                super::stdio::call(*f, &vals, &super::stdio::ProgramOutput::default()).ok()?
+            }
+            Ex::MakeStruct(parts) => Value::Struct(
+                parts
+                    .iter()
+                    .map(|p| self.const_written(p))
+                    .collect::<Option<Vec<_>>>()?
+                    .into(),
+            ),
+            _ => self.const_value(ex, 0)?,
+        })
     }
 
     fn const_value(&self, ex: &Ex, depth: usize) -> Option<Value> {
@@ -3278,8 +3510,10 @@ impl Compiler {
     /// initialised once before the run.
     #[inline(never)]
     fn static_local(&mut self, d: &ast::VarDecl, v: &ast::Declarator, ty: Ty, scope: &mut Scope) {
+        let chars = self.char_array(&d.ty, v.pointer, &v.name, &v.dims, &v.init);
         let mut init_scope = Scope::default();
         let init = self.initializer(ty, &v.init, v.name.span, &mut init_scope);
+        let init = self.fit_init(init, chars.as_ref(), &v.init);
         if init_scope.max > 0 {
             self.err(
                 v.name.span,
@@ -3293,6 +3527,9 @@ impl Compiler {
         self.count_global_values(ty, v.name.span);
         let owner = scope.ret.as_ref().map_or("a body", |(_, n)| n.as_str());
         let slot = self.globals.len() as u16;
+        if let Some(c) = chars {
+            self.global_chars.insert(slot, c);
+        }
         self.globals.push(GlobalVar {
             name: format!("{}::{}", owner, v.name.text),
             ty,
@@ -3595,6 +3832,7 @@ impl Compiler {
         let mut slots = Vec::with_capacity(fields.len());
         for (k, (name, ty)) in fields.iter().enumerate() {
             let slot = self.local(&mut scope, name, *ty, m.name.span);
+            scope.set_chars(self.field_chars.get(&(si, k as u16)).cloned());
             stmts.push(St::Init(slot, Ex::Field(Box::new(Ex::Local(0)), k as u16)));
             slots.push(slot);
         }
@@ -4188,6 +4426,24 @@ impl Compiler {
             "strcmp" => (IoFunc::Strcmp, &[Ty::Str, Ty::Str], false, Ty::Int),
             "strcpy" => (IoFunc::Concat, &[Ty::Str, Ty::Str], false, Ty::Str),
             "strcat" => (IoFunc::Concat, &[Ty::Str, Ty::Str], false, Ty::Str),
+            "strncpy" => (
+                IoFunc::Strncpy,
+                &[Ty::Str, Ty::Str, Ty::Int],
+                false,
+                Ty::Str,
+            ),
+            "strncat" => (
+                IoFunc::Strncat,
+                &[Ty::Str, Ty::Str, Ty::Int],
+                false,
+                Ty::Str,
+            ),
+            "snprintf" => (
+                IoFunc::Snprintf,
+                &[Ty::Str, Ty::Int, Ty::Str],
+                true,
+                Ty::Str,
+            ),
             "scanf" | "fscanf" | "sscanf" | "fgets" | "fgetc" | "getc" | "fread" | "gets"
             | "getchar" => {
                 self.err(
@@ -4215,8 +4471,12 @@ impl Compiler {
             );
             return Some(None);
         }
-        // `sprintf`, `strcpy` and `strcat` write their first argument.
-        let target = if matches!(n, "sprintf" | "strcpy" | "strcat") {
+        // `sprintf`, `strcpy`, `strcat` and their `n` forms write their
+        // first argument.
+        let target = if matches!(
+            n,
+            "sprintf" | "strcpy" | "strcat" | "snprintf" | "strncpy" | "strncat"
+        ) {
             let p = self.place(&args[0], scope);
             match p {
                 Some(p) if p.ty == Ty::Str => Some(p),
@@ -4235,7 +4495,9 @@ impl Compiler {
         };
         let mut exs = Vec::with_capacity(args.len());
         let mut ok = true;
-        let skip = usize::from(target.is_some() && n != "strcat");
+        // The functions that append, and `snprintf` (which may write
+        // nothing), read it too.
+        let skip = usize::from(matches!(n, "sprintf" | "strcpy" | "strncpy"));
         for (k, a) in args.iter().enumerate().skip(skip) {
             let Some((x, t)) = self.expr(a, scope) else {
                 ok = false;
@@ -4277,10 +4539,39 @@ impl Compiler {
         if !ok {
             return Some(None);
         }
-        let call = if n == "strcpy" {
-            exs.pop()?
-        } else {
-            Ex::Call(Func::Io(f), exs, span)
+        // A declared `char` array takes only what fits in it.
+        let chars = target.as_ref().and_then(|p| p.chars.as_deref()).cloned();
+        let call = match (n, &chars) {
+            ("strcpy", _) => exs.pop()?,
+            // `strncpy` writes its count of bytes, however short the
+            // string: the count must fit.
+            ("strncpy", Some(c)) => {
+                if let Some(Value::Int(k)) = self.const_value(&exs[1], 0) {
+                    if k > c.size as i64 {
+                        self.err(
+                            span,
+                            format!(
+                                "strncpy writes {k} bytes into `{}` (it always writes its count, \
+                                 padding with NULs), declared `{}` (room for {} bytes)",
+                                c.name, c.decl, c.size
+                            ),
+                        );
+                        return Some(None);
+                    }
+                }
+                exs.push(Ex::Const(Value::Int(c.size as i64)));
+                exs.push(Ex::Const(Value::Str(c.name.as_str().into())));
+                exs.push(Ex::Const(Value::Str(c.decl.as_str().into())));
+                Ex::Call(Func::Io(f), exs, span)
+            }
+            _ => Ex::Call(Func::Io(f), exs, span),
+        };
+        let call = match &chars {
+            Some(c) if n != "strncpy" => match self.fit(call, c, n, span) {
+                Some(x) => x,
+                None => return Some(None),
+            },
+            _ => call,
         };
         Some(Some(match target {
             Some(p) => (Ex::Assign(p, None, Box::new(call), Ty::Str), Ty::Str),
@@ -4403,6 +4694,25 @@ impl Compiler {
 }
 
 /// The index in `Program::structs` of a struct or array type.
+/// A destination as the program writes it (`b`, `s.name`, `names[i]`),
+/// for the error that a string does not fit there; an index other than a
+/// name or a number is `…`.
+fn written_place(e: &ast::Expr) -> String {
+    match &e.kind {
+        ExprKind::Ident(n) => n.clone(),
+        ExprKind::Field(b, f) => format!("{}.{}", written_place(b), f.text),
+        ExprKind::Index(b, i) => {
+            let i = match &i.kind {
+                ExprKind::Ident(n) => n.clone(),
+                ExprKind::Int(k) => k.to_string(),
+                _ => "…".to_string(),
+            };
+            format!("{}[{i}]", written_place(b))
+        }
+        _ => "…".to_string(),
+    }
+}
+
 fn pt_index(t: Ty) -> usize {
     match t {
         Ty::Struct(i) => i as usize,

@@ -746,6 +746,15 @@ impl<'p> Interp<'p> {
         let v = r?;
         for (k, place) in back {
             let value = std::mem::replace(&mut frame[*k as usize], Value::Void);
+            // What the function wrote into a declared `char` array of the
+            // caller's (through a `char *` parameter) must fit there.
+            if let Some(m) = place
+                .chars
+                .as_ref()
+                .and_then(|c| c.overflow(&format!("`{}`", f.name), &value))
+            {
+                return Err(rt(Some(span), m));
+            }
             self.store(place, value, cx)?;
         }
         Ok(v)

@@ -81,6 +81,33 @@ pub struct Place {
     pub slot: u16,
     pub path: Vec<Step>,
     pub ty: Ty,
+    /// The declared `char` array this place is (`char b[4]`), or whose
+    /// strings it holds (`char names[3][16]`): a string written into it
+    /// must fit. `None` for every other place, and for a `char *`.
+    pub chars: Option<Box<CharArray>>,
+}
+
+/// A declared `char` array: the most bytes a string written into it may
+/// take, its terminating NUL included, and how the error that one does
+/// not fit names it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CharArray {
+    /// The declared size (`4` for `char b[4]`): room for one character
+    /// fewer.
+    pub size: usize,
+    /// The destination as written (`b`, `s.name`, `names[i]`).
+    pub name: String,
+    /// Its declaration (`char b[4]`).
+    pub decl: String,
+}
+
+impl CharArray {
+    /// The error when `what` writes `v` here and a string of it does not
+    /// fit with its terminating NUL (an array of strings is checked
+    /// string by string); `None` when all fit.
+    pub fn overflow(&self, what: &str, v: &Value) -> Option<String> {
+        super::stdio::overflow_in(what, v, self.size, &self.name, &self.decl)
+    }
 }
 
 /// One step into a value: a field (or vector component), or an element

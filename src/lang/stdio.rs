@@ -1,7 +1,9 @@
 //! C's standard input and output as L+C programs use it: `printf` (and
 //! lpfg's `Printf`), `fprintf` to `stdout`, `stderr` or a file, `puts`,
 //! `fopen`/`fclose`, and the string functions `strlen`, `strcmp`, and the
-//! formatting behind `sprintf`, `strcpy`, `strcat`.
+//! formatting behind `sprintf`, `snprintf`, `strcpy`, `strncpy`,
+//! `strcat`, `strncat`. A string written into a declared `char` array
+//! must fit there with its terminating NUL ([`IoFunc::Fit`]).
 //!
 //! The library prints nothing itself: what a program prints and the files
 //! it writes are collected in a [`ProgramOutput`], which the caller (the
@@ -34,6 +36,24 @@ pub enum IoFunc {
     Strcmp,
     /// `a` followed by `b`: what `strcat(a, b)` leaves in `a`.
     Concat,
+    /// `a` followed by at most `n` characters of `b`: what
+    /// `strncat(a, b, n)` leaves in `a`.
+    Strncat,
+    /// What `strncpy(a, b, n)` leaves in `a`: at most `n` characters of
+    /// `b`. With three more arguments (`a`'s declared size, its name and
+    /// declaration), a count past the size is refused: `strncpy` always
+    /// writes `n` bytes, padding with NULs.
+    Strncpy,
+    /// What `snprintf(a, size, fmt, ...)` leaves in `a` (its arguments
+    /// `a`, `size`, `fmt`, ...): the formatted text cut to `size - 1`
+    /// characters; `a` unchanged when `size` is 0.
+    Snprintf,
+    /// Its first argument, a string that a C string function writes into
+    /// a declared `char` array (or an array of such strings), when it
+    /// fits there with its terminating NUL; the next arguments are the array's size, the function's name,
+    /// the array's name and its declaration, for the error when it does
+    /// not ([`overflow`]).
+    Fit,
 }
 
 /// Where printed text goes.
@@ -275,7 +295,101 @@ pub fn call(f: IoFunc, args: &[Value], out: &ProgramOutput) -> Result<Value, Str
             }
             Value::Str(s.into())
         }
+        IoFunc::Strncat => {
+            let n = count(&arg(2), "strncat's count")?;
+            let s = format!("{}{}", text(&arg(0)), prefix(&text(&arg(1)), n));
+            if s.len() > MAX_OUTPUT_BYTES {
+                return Err("strncat makes a string longer than the output limit".into());
+            }
+            Value::Str(s.into())
+        }
+        IoFunc::Strncpy => {
+            let n = count(&arg(1), "strncpy's count")?;
+            if args.len() > 2 {
+                let size = arg(2).as_i64().max(0) as usize;
+                if n > size {
+                    return Err(format!(
+                        "strncpy writes {n} bytes into `{}` (it always writes its count, padding \
+                         with NULs), declared `{}` (room for {size} bytes)",
+                        text(&arg(3)),
+                        text(&arg(4))
+                    ));
+                }
+            }
+            Value::Str(prefix(&text(&arg(0)), n).into())
+        }
+        IoFunc::Snprintf => {
+            let size = count(&arg(1), "snprintf's size")?;
+            if size == 0 {
+                // Nothing is written: `a` keeps its string.
+                return Ok(arg(0));
+            }
+            let s = cfmt::format(&text(&arg(2)), &args[3.min(args.len())..])?;
+            Value::Str(prefix(&s, size - 1).into())
+        }
+        IoFunc::Fit => {
+            let s = arg(0);
+            let size = arg(1).as_i64().max(0) as usize;
+            if let Some(m) = overflow_in(&text(&arg(2)), &s, size, &text(&arg(3)), &text(&arg(4))) {
+                return Err(m);
+            }
+            s
+        }
     })
+}
+
+/// A count or size given to a C string function (`strncpy`'s `n`): C's
+/// `size_t`, so a negative one is refused.
+fn count(v: &Value, what: &str) -> Result<usize, String> {
+    let n = v.as_i64();
+    usize::try_from(n).map_err(|_| format!("{what} is negative ({n})"))
+}
+
+/// The first `n` bytes of `s` (fewer where the `n`th falls inside a
+/// character of several bytes).
+fn prefix(s: &str, n: usize) -> &str {
+    if n >= s.len() {
+        return s;
+    }
+    let mut end = n;
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    &s[..end]
+}
+
+/// [`overflow`] for every string in `v`: an array of `char` arrays
+/// (`char names[3][16]`) is checked string by string.
+pub fn overflow_in(what: &str, v: &Value, size: usize, name: &str, decl: &str) -> Option<String> {
+    match v {
+        Value::Str(s) => overflow(what, s, size, name, decl),
+        Value::Struct(vs) => vs
+            .iter()
+            .find_map(|v| overflow_in(what, v, size, name, decl)),
+        _ => None,
+    }
+}
+
+/// The error when `what` (`sprintf`, `` `fill` ``) writes `s` and its
+/// terminating NUL into `name`, a `char` array declared `decl` with
+/// `size` bytes, and they do not fit; `None` when they do.
+pub fn overflow(what: &str, s: &str, size: usize, name: &str, decl: &str) -> Option<String> {
+    let len = s.len();
+    if len < size {
+        return None;
+    }
+    let chars = |n: usize| {
+        if n == 1 {
+            "1 character".to_string()
+        } else {
+            format!("{n} characters")
+        }
+    };
+    Some(format!(
+        "{what} writes {} and the terminating NUL into `{name}`, declared `{decl}` (room for {})",
+        chars(len),
+        chars(size.saturating_sub(1))
+    ))
 }
 
 /// A string literal's text with C's escapes (`\n`, `\t`, `\\`, `\"`,
@@ -347,6 +461,57 @@ mod tests {
         assert_eq!(out.files(), vec![("d/x.txt".to_string(), "5;".to_string())]);
         let r = call(IoFunc::Fopen, &[s("x.txt"), s("r")], &out).unwrap_err();
         assert!(r.contains("reading"));
+    }
+
+    #[test]
+    fn the_n_forms_cut_and_a_declared_array_takes_what_fits() {
+        let out = ProgramOutput::new();
+        let s = |t: &str| Value::Str(t.into());
+        let n = |k: i64| Value::Int(k);
+        assert_eq!(
+            call(IoFunc::Strncpy, &[s("abcdef"), n(3)], &out).unwrap(),
+            s("abc")
+        );
+        assert_eq!(
+            call(IoFunc::Strncat, &[s("ab"), s("cdef"), n(9)], &out).unwrap(),
+            s("abcdef")
+        );
+        assert_eq!(
+            call(
+                IoFunc::Snprintf,
+                &[s("old"), n(4), s("%d"), n(123456)],
+                &out
+            )
+            .unwrap(),
+            s("123")
+        );
+        // A size of 0 writes nothing.
+        assert_eq!(
+            call(IoFunc::Snprintf, &[s("old"), n(0), s("%d"), n(1)], &out).unwrap(),
+            s("old")
+        );
+        let e = call(IoFunc::Strncpy, &[s("ab"), n(-1)], &out).unwrap_err();
+        assert!(e.contains("negative"), "{e}");
+        // A cut does not split a character of several bytes.
+        assert_eq!(prefix("aé", 2), "a");
+        let fit = |t: &str, size: i64| {
+            call(
+                IoFunc::Fit,
+                &[s(t), n(size), s("strcpy"), s("b"), s("char b[4]")],
+                &out,
+            )
+        };
+        assert_eq!(fit("abc", 4).unwrap(), s("abc"));
+        assert_eq!(
+            fit("abcd", 4).unwrap_err(),
+            "strcpy writes 4 characters and the terminating NUL into `b`, declared \
+             `char b[4]` (room for 3 characters)"
+        );
+        assert_eq!(
+            overflow("sprintf", "a", 1, "b", "char b[1]").unwrap(),
+            "sprintf writes 1 character and the terminating NUL into `b`, declared \
+             `char b[1]` (room for 0 characters)"
+        );
     }
 
     #[test]

@@ -4,6 +4,7 @@
 mod abop;
 mod analyze;
 mod bad_inputs;
+mod c_strings;
 mod cli;
 mod curves;
 mod errors;
