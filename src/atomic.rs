@@ -1,4 +1,9 @@
 //! Atomic file writes, shared by every output (pictures, meshes, points).
+//!
+//! Inside a command's [`crate::files::Run`], each write is staged: the
+//! file is written whole beside its target, and the run puts every output
+//! in place at its commit, all or none. Outside a run each call puts its
+//! own files in place at once.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -23,11 +28,19 @@ fn write_temp_with(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".into());
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    // Unique within the process too: two threads may write one target.
+    static COUNT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let k = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let tmp = dir.join(format!(".{name}.tmp-{}-{k}", std::process::id()));
     let result = (|| {
-        let mut f = std::io::BufWriter::with_capacity(1 << 16, std::fs::File::create(&tmp)?);
+        let file = Timed {
+            file: std::fs::File::create(&tmp)?,
+            deadline: crate::deadline::current(),
+            writes: 0,
+        };
+        let mut f = std::io::BufWriter::with_capacity(1 << 16, file);
         fill(&mut f)?;
-        f.into_inner().map_err(|e| e.into_error())?.sync_all()
+        f.into_inner().map_err(|e| e.into_error())?.file.sync_all()
     })();
     match result {
         Ok(()) => Ok(tmp),
@@ -38,10 +51,41 @@ fn write_temp_with(
     }
 }
 
+/// A file being written that stops with the deadline's message once the
+/// run's deadline passes (looked at every 16 writes of the buffer, a
+/// megabyte), so that a large output ends the run at its limit too.
+struct Timed {
+    file: std::fs::File,
+    deadline: Option<crate::Deadline>,
+    writes: u32,
+}
+
+impl Write for Timed {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.writes = self.writes.wrapping_add(1);
+        if self.writes.is_multiple_of(16) {
+            if let Some(d) = self.deadline.filter(|d| d.passed()) {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::TimedOut,
+                    d.message(),
+                ));
+            }
+        }
+        self.file.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.flush()
+    }
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same folder and
 /// a rename, so that a failure never leaves a truncated file behind.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let tmp = write_temp(path, bytes)?;
+    let Some(tmp) = crate::files::stage(path, tmp) else {
+        return Ok(());
+    };
     let result = std::fs::rename(&tmp, path);
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -57,6 +101,9 @@ pub fn write_atomic_with(
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
     let tmp = write_temp_with(path, fill)?;
+    let Some(tmp) = crate::files::stage(path, tmp) else {
+        return Ok(());
+    };
     let result = std::fs::rename(&tmp, path);
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -66,10 +113,10 @@ pub fn write_atomic_with(
 
 /// Writes several files, all or none: every file is written to its
 /// temporary first, and only when all of them are written are they renamed
-/// into place. A failure removes the temporaries and the files this call
-/// created; a file that existed before and was already replaced stays
-/// replaced. The paths must be distinct files. The error names the file
-/// that failed.
+/// into place (see [`crate::files::rename_all`]: a file that a rename
+/// replaced is put back when a later one fails). Inside a run they are
+/// staged for the run's commit. The paths must be distinct files. The
+/// error names the file that failed.
 pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<(), (PathBuf, std::io::Error)> {
     let mut temps: Vec<PathBuf> = Vec::with_capacity(files.len());
     let cleanup = |temps: &[PathBuf]| {
@@ -86,21 +133,22 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<(), (PathBuf, std::i
             }
         }
     }
-    let mut created: Vec<&Path> = Vec::new();
-    for (k, ((path, _), tmp)) in files.iter().zip(&temps).enumerate() {
-        let existed = std::fs::symlink_metadata(path).is_ok();
-        if let Err(e) = std::fs::rename(tmp, path) {
-            cleanup(&temps[k..]);
-            for c in created {
-                let _ = std::fs::remove_file(c);
-            }
-            return Err((path.to_path_buf(), e));
+    if crate::files::in_run() {
+        for ((path, _), tmp) in files.iter().zip(temps) {
+            crate::files::stage(path, tmp);
         }
-        if !existed {
-            created.push(path);
-        }
+        return Ok(());
     }
-    Ok(())
+    let pairs: Vec<(&Path, &Path)> = files
+        .iter()
+        .zip(&temps)
+        .map(|((p, _), t)| (*p, t.as_path()))
+        .collect();
+    let result = crate::files::rename_all(&pairs);
+    if result.is_err() {
+        cleanup(&temps);
+    }
+    result
 }
 
 #[cfg(test)]
@@ -122,6 +170,12 @@ mod tests {
         assert_eq!(e.0, missing);
         // The second is renamed onto a folder and fails: the first goes.
         let e = write_all_atomic(&[(&a, b"a"), (&dir.join("taken"), b"t")]).unwrap_err();
+        assert_eq!(e.0, dir.join("taken"));
+        // A first file that existed is put back as it was.
+        std::fs::write(&a, "old").unwrap();
+        let e = write_all_atomic(&[(&a, b"new"), (&dir.join("taken"), b"t")]).unwrap_err();
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old");
+        std::fs::remove_file(&a).unwrap();
         assert_eq!(e.0, dir.join("taken"));
         let left: Vec<_> = std::fs::read_dir(dir)
             .unwrap()

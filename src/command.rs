@@ -134,7 +134,18 @@ pub fn derive_to(
     before: impl FnOnce(&[String]) -> Result<(), Error>,
     out: &mut dyn std::io::Write,
 ) -> Result<(), Error> {
-    let deadline = a.timeout.map(Deadline::after);
+    in_run(a.timeout, None, || {
+        derive_to_in_run(a, progress, before, out)
+    })
+}
+
+fn derive_to_in_run(
+    a: &DeriveArgs,
+    progress: impl FnMut(Progress),
+    before: impl FnOnce(&[String]) -> Result<(), Error>,
+    out: &mut dyn std::io::Write,
+) -> Result<(), Error> {
+    let deadline = crate::deadline::current();
     let dir = writes_folder(&a.allow_writes, &a.output)?;
     let system = load(&a.file, &load_options(&a.defines, a.double))?;
     let warnings = system.warnings();
@@ -366,7 +377,11 @@ pub enum Solidity {
 /// `subgram render`: a curve's picture, a surface grammar's subdivided
 /// mesh, or a mesh file, as PNG or SVG. Returns the program's warnings.
 pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<String>, Error> {
-    let deadline = a.timeout.map(Deadline::after);
+    in_run(a.timeout, Some(a.force), || render_in_run(a, progress))
+}
+
+fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<String>, Error> {
+    let deadline = crate::deadline::current();
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
     refuse_overwrite(&[output], &[file], a.force)?;
@@ -409,6 +424,8 @@ pub struct Drawn {
 /// without `--allow-writes`.
 pub fn render_edited(a: &RenderArgs, text: &str) -> Result<Drawn, Error> {
     let deadline = a.timeout.map(Deadline::after);
+    // The files the program reads are read under the deadline too.
+    let _deadline = crate::deadline::scope(deadline);
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
     let looks = MeshLooks::of_render(a);
@@ -471,6 +488,10 @@ pub struct InferArgs {
 /// §5–7). Returns the `.lsys` program (or, with `list`, every grouping),
 /// unless it was written to `output`.
 pub fn infer(a: &InferArgs) -> Result<String, Error> {
+    in_run(None, None, || infer_in_run(a))
+}
+
+fn infer_in_run(a: &InferArgs) -> Result<String, Error> {
     use crate::infer;
     let sources = [a.rows.is_some(), a.rows_file.is_some(), a.mask.is_some()];
     if sources.iter().filter(|&&x| x).count() != 1 {
@@ -963,21 +984,39 @@ fn write_program_files(
     let root = dir
         .canonicalize()
         .map_err(|e| Error::Failed(format!("cannot read the folder {}: {e}", dir.display())))?;
+    // Every path is checked, links resolved, before any folder is made.
     let mut out: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    let mut folders: Vec<PathBuf> = Vec::new();
     for (name, text) in files {
         let path = root.join(&name);
         let parent = path.parent().unwrap_or(&root).to_path_buf();
-        std::fs::create_dir_all(&parent).map_err(|e| Error::write(&parent, e))?;
-        let real = parent
+        // The deepest folder on the way that exists: it must lie inside
+        // the root once its links are resolved; what is missing below it
+        // is made of plain names (fopen allows no `..`), so stays inside.
+        let mut existing = parent.as_path();
+        while std::fs::symlink_metadata(existing).is_err() {
+            existing = existing.parent().unwrap_or(&root);
+        }
+        let real = existing
             .canonicalize()
-            .map_err(|e| Error::write(&parent, e))?;
+            .map_err(|e| Error::write(existing, e))?;
         if !real.starts_with(&root) {
             return Err(Error::Failed(format!(
                 "the program's file `{name}` would be written outside {}",
                 dir.display()
             )));
         }
+        if !real.is_dir() {
+            return Err(Error::Failed(format!(
+                "the program's file `{name}` cannot be written: {} is not a folder",
+                existing.display()
+            )));
+        }
+        folders.push(parent);
         out.push((path, text.into_bytes()));
+    }
+    for parent in &folders {
+        crate::files::make_folders(parent).map_err(|e| Error::write(parent, e))?;
     }
     let paths: Vec<&Path> = out.iter().map(|(p, _)| p.as_path()).collect();
     refuse_overwrite(&paths, inputs, false)?;
@@ -1024,10 +1063,17 @@ enum Kind {
 /// or derives a shape grammar, and writes the mesh or its picture. The
 /// file is read and lexed once.
 pub fn subdivide(a: &SubdivideArgs, progress: impl FnMut(Progress)) -> Result<Vec<String>, Error> {
+    in_run(a.timeout, Some(a.force), || subdivide_in_run(a, progress))
+}
+
+fn subdivide_in_run(
+    a: &SubdivideArgs,
+    progress: impl FnMut(Progress),
+) -> Result<Vec<String>, Error> {
     // One large mesh: freed working memory goes back at once, not kept
     // under the next step's peak.
     crate::huge::return_freed_memory();
-    let deadline = a.timeout.map(Deadline::after);
+    let deadline = crate::deadline::current();
     let grammar = Path::new(&a.grammar);
     let output = Path::new(&a.output);
     let mut inputs = vec![grammar.to_path_buf()];
@@ -1278,6 +1324,17 @@ pub fn mesh_convert(
     triangles: bool,
     force: bool,
 ) -> Result<Vec<String>, Error> {
+    in_run(None, Some(force), || {
+        mesh_convert_in_run(input, output, triangles, force)
+    })
+}
+
+fn mesh_convert_in_run(
+    input: &str,
+    output: &str,
+    triangles: bool,
+    force: bool,
+) -> Result<Vec<String>, Error> {
     let (input, output) = (Path::new(input), Path::new(output));
     if mesh::io::Format::from_path(output).is_none() {
         // As for pictures: an output whose format cannot be told is a
@@ -1352,7 +1409,11 @@ impl ReverseArgs {
 /// and the outputs (coarse polygon, details, figure) are written all or
 /// none.
 pub fn reverse(a: &ReverseArgs) -> Result<Option<String>, Error> {
-    let deadline = a.timeout.map(Deadline::after);
+    in_run(a.timeout, Some(a.force), || reverse_in_run(a))
+}
+
+fn reverse_in_run(a: &ReverseArgs) -> Result<Option<String>, Error> {
+    let deadline = crate::deadline::current();
     let fig = a
         .figure
         .as_ref()
@@ -1429,7 +1490,11 @@ pub struct ReconstructArgs {
 /// `subgram reconstruct`: restores a contour from a coarse polygon and its
 /// details.
 pub fn reconstruct(a: &ReconstructArgs) -> Result<(), Error> {
-    let deadline = a.timeout.map(Deadline::after);
+    in_run(a.timeout, Some(a.force), || reconstruct_in_run(a))
+}
+
+fn reconstruct_in_run(a: &ReconstructArgs) -> Result<(), Error> {
+    let deadline = crate::deadline::current();
     let (coarse, details, output) = (
         Path::new(&a.coarse),
         Path::new(&a.details),
@@ -1681,6 +1746,22 @@ fn check_steps(steps: Option<u64>) -> Result<(), Error> {
     }
 }
 
+/// Runs a command's work as one [`Run`](crate::files::Run): under the
+/// deadline `timeout` from now (none: no limit), its outputs put in place
+/// at the end, all or none, never over a file it read (unless `force` is
+/// `Some(true)`; `None` where the command has no `--force`),
+/// and not at all once the deadline has passed.
+fn in_run<T>(
+    timeout: Option<Duration>,
+    force: Option<bool>,
+    work: impl FnOnce() -> Result<T, Error>,
+) -> Result<T, Error> {
+    let run = crate::files::Run::begin(timeout.map(Deadline::after), force);
+    let value = work()?;
+    run.commit()?;
+    Ok(value)
+}
+
 fn as_paths(v: &[PathBuf]) -> Vec<&Path> {
     v.iter().map(PathBuf::as_path).collect()
 }
@@ -1758,6 +1839,10 @@ pub struct AnalyzeArgs {
 /// `subgram analyze FILE [--format json] [-D NAME=VALUE]…`: what the
 /// subdivision scheme in FILE is (see [`crate::analyze`]), as text or JSON.
 pub fn analyze(a: &AnalyzeArgs) -> Result<String, Error> {
+    in_run(None, None, || analyze_in_run(a))
+}
+
+fn analyze_in_run(a: &AnalyzeArgs) -> Result<String, Error> {
     if let Some(out) = &a.picture {
         let out = Path::new(out);
         // analyze has no --force: its one input is never replaced.

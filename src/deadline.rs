@@ -43,6 +43,17 @@ impl Deadline {
         self.limit
     }
 
+    /// The time left, `None` once the deadline has passed (a deadline too
+    /// far away to be an `Instant` leaves a day at a time).
+    pub fn left(&self) -> Option<Duration> {
+        match self.at {
+            None => Some(Duration::from_secs(86_400)),
+            Some(at) => at
+                .checked_duration_since(Instant::now())
+                .filter(|d| !d.is_zero()),
+        }
+    }
+
     /// True once the deadline has passed.
     #[inline]
     pub fn passed(&self) -> bool {
@@ -74,5 +85,64 @@ pub(crate) fn check(deadline: Option<Deadline>) -> Result<(), String> {
     match deadline {
         Some(d) => d.check(),
         None => Ok(()),
+    }
+}
+
+thread_local! {
+    /// The deadline of the run this thread is doing, for the code that is
+    /// reached through no argument: reading an input (a pipe waits under
+    /// it) and writing the outputs (nothing is written once it passed).
+    static CURRENT: std::cell::Cell<Option<Deadline>> = const { std::cell::Cell::new(None) };
+}
+
+/// While it lives, [`current`] on this thread is the deadline it was made
+/// with; dropped, the one before comes back.
+#[must_use = "the deadline holds only while the scope lives"]
+pub(crate) struct Scope(Option<Deadline>);
+
+/// Makes `deadline` the current one on this thread, for the scope's life.
+pub(crate) fn scope(deadline: Option<Deadline>) -> Scope {
+    Scope(CURRENT.with(|c| c.replace(deadline)))
+}
+
+impl Drop for Scope {
+    fn drop(&mut self) {
+        CURRENT.with(|c| c.set(self.0));
+    }
+}
+
+/// Runs `work` with a deadline `limit` from now (none: no limit) as this
+/// thread's current one: what it reads waits no longer (a pipe that nobody
+/// writes to), and the runs it begins without a limit of their own take
+/// this one.
+pub fn within<T>(limit: Option<Duration>, work: impl FnOnce() -> T) -> T {
+    let _scope = scope(limit.map(Deadline::after));
+    work()
+}
+
+/// The deadline of the run this thread is doing, if it set one.
+pub(crate) fn current() -> Option<Deadline> {
+    CURRENT.with(|c| c.get())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scopes_nest_and_restore() {
+        assert_eq!(current(), None);
+        let a = Deadline::after(Duration::from_secs(5));
+        let b = Deadline::after(Duration::from_secs(7));
+        {
+            let _outer = scope(Some(a));
+            assert_eq!(current(), Some(a));
+            {
+                let _inner = scope(Some(b));
+                assert_eq!(current(), Some(b));
+            }
+            assert_eq!(current(), Some(a));
+        }
+        assert_eq!(current(), None);
     }
 }

@@ -32,6 +32,7 @@ mod atomic;
 mod curve;
 mod deadline;
 mod error;
+mod files;
 mod huge;
 mod lang;
 mod limits;
@@ -61,7 +62,7 @@ pub(crate) mod shape;
 pub mod surface;
 
 pub use curve::{Curve, CurveRun, FigureOptions, Figures};
-pub use deadline::{Deadline, DEFAULT_TIMEOUT};
+pub use deadline::{within, Deadline, DEFAULT_TIMEOUT};
 pub use error::Error;
 pub use lang::{Program, ProgramOutput, Stream, Value};
 pub use load::{

@@ -511,8 +511,8 @@ pub(crate) fn read(path: &Path) -> Result<String, Error> {
 fn read_at_most(path: &Path, limit: u64) -> Result<Vec<u8>, Error> {
     use std::io::Read;
     let io = |e| Error::read(PathBuf::from(path), e);
-    let file = std::fs::File::open(path).map_err(io)?;
-    let meta = file.metadata().map_err(io)?;
+    let file = crate::files::open(path).map_err(io)?;
+    let size = file.size();
     let too_big = |size: Option<u64>| {
         let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
         let is = match size {
@@ -528,15 +528,15 @@ fn read_at_most(path: &Path, limit: u64) -> Result<Vec<u8>, Error> {
             ),
         )
     };
-    if meta.is_file() && meta.len() > limit {
-        return Err(too_big(Some(meta.len())));
+    if let Some(len) = size.filter(|&len| len > limit) {
+        return Err(too_big(Some(len)));
     }
-    let expected = if meta.is_file() { meta.len() } else { 0 };
+    let expected = size.unwrap_or(0);
     let mut bytes = Vec::with_capacity(expected as usize);
     file.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
     if bytes.len() as u64 > limit {
         // A file that grew while it was read, or one without a size.
-        return Err(too_big(meta.is_file().then_some(bytes.len() as u64)));
+        return Err(too_big(size.map(|_| bytes.len() as u64)));
     }
     Ok(bytes)
 }

@@ -137,6 +137,10 @@ enum Command {
         /// Write the .lsys file here (atomically) instead of printing it.
         #[arg(short = 'o', long = "output")]
         output: Option<String>,
+        /// Stop with an error after this many seconds (0: no limit).
+        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+        timeout: Timeout,
     },
     /// Reverse-subdivide a contour into a compact control polygon.
     Reverse {
@@ -259,6 +263,10 @@ enum Command {
         /// Compute float, V2f and V3f in double precision (lpfg: single).
         #[arg(long)]
         double: bool,
+        /// Stop with an error after this many seconds (0: no limit).
+        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+        timeout: Timeout,
     },
     /// Analyse a subdivision scheme (a curve L-system or a surface grammar):
     /// stencils, mask, degrees, smoothness; eigenvalues around valences 3 to 12.
@@ -272,6 +280,10 @@ enum Command {
         /// grammars) into this SVG file.
         #[arg(long, value_name = "OUT.svg")]
         picture: Option<String>,
+        /// Stop with an error after this many seconds (0: no limit).
+        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+        timeout: Timeout,
     },
 }
 
@@ -456,6 +468,10 @@ enum MeshCommand {
         file: String,
         #[arg(long, value_enum, default_value_t = Format::Text)]
         format: Format,
+        /// Stop with an error after this many seconds (0: no limit).
+        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+        timeout: Timeout,
     },
     /// Check a mesh and write it in another format (.obj, .off, .ply).
     Convert {
@@ -467,6 +483,10 @@ enum MeshCommand {
         /// Write the output even when it is the input (what the format cannot hold is lost).
         #[arg(long)]
         force: bool,
+        /// Stop with an error after this many seconds (0: no limit).
+        #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
+              default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
+        timeout: Timeout,
     },
 }
 
@@ -508,18 +528,24 @@ fn run(cli: Cli) -> Result<(), Error> {
             file,
             define,
             double,
-        } => print_out(&command::check(&file, &define, double)?),
+            timeout,
+        } => subgram::within(timeout.0, || {
+            print_out(&command::check(&file, &define, double)?)
+        }),
         Command::Analyze {
             file,
             format,
             define,
             picture,
-        } => print_out(&command::analyze(&command::AnalyzeArgs {
-            file,
-            json: matches!(format, Format::Json),
-            defines: define,
-            picture,
-        })?),
+            timeout,
+        } => subgram::within(timeout.0, || {
+            print_out(&command::analyze(&command::AnalyzeArgs {
+                file,
+                json: matches!(format, Format::Json),
+                defines: define,
+                picture,
+            })?)
+        }),
         Command::Derive {
             file,
             steps,
@@ -597,7 +623,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             list,
             ordered,
             output,
-        } => {
+            timeout,
+        } => subgram::within(timeout.0, || {
             let args = command::InferArgs {
                 rows,
                 rows_file,
@@ -611,7 +638,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 output,
             };
             print_out(&command::infer(&args)?)
-        }
+        }),
         Command::Serve {
             file,
             port,
@@ -713,18 +740,23 @@ fn run(cli: Cli) -> Result<(), Error> {
             Ok(())
         }
         Command::Mesh { command } => match command {
-            MeshCommand::Info { file, format } => {
+            MeshCommand::Info {
+                file,
+                format,
+                timeout,
+            } => subgram::within(timeout.0, || {
                 print_out(&command::mesh_info(&file, matches!(format, Format::Json))?)
-            }
+            }),
             MeshCommand::Convert {
                 input,
                 output,
                 triangles,
                 force,
-            } => {
+                timeout,
+            } => subgram::within(timeout.0, || {
                 print_warnings(&command::mesh_convert(&input, &output, triangles, force)?);
                 Ok(())
-            }
+            }),
         },
         Command::Reverse {
             input,

@@ -114,7 +114,9 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, MeshFileError> {
         _ => (read_str(&name, format, &bytes)?, Vec::new()),
     };
     drop(bytes);
+    check_deadline(&name, 0)?;
     let mut mesh = build_mesh(path, &soup)?;
+    check_deadline(&name, 0)?;
     apply_sharpness(&mut mesh, &marks, 0)?;
     let side = path.with_extension(CREASES_EXTENSION);
     if side.is_file() {
@@ -308,6 +310,17 @@ fn build_mesh(path: &Path, soup: &PolygonSoup) -> Result<Mesh, MeshFileError> {
     })
 }
 
+/// Every 65,536 lines or elements: an error once the run's deadline (see
+/// [`crate::deadline::current`]) has passed.
+fn check_deadline(name: &str, count: usize) -> Result<(), MeshFileError> {
+    if count.is_multiple_of(1 << 16) {
+        if let Some(d) = crate::deadline::current().filter(|d| d.passed()) {
+            return Err(error(name, None, d.message()));
+        }
+    }
+    Ok(())
+}
+
 /// Reads a mesh in `format` from `bytes`; `name` is the file name for
 /// messages.
 pub fn read_str(name: &str, format: Format, bytes: &[u8]) -> Result<PolygonSoup, MeshFileError> {
@@ -395,12 +408,8 @@ fn read_bounded_as(
     format: Option<Format>,
 ) -> Result<Vec<u8>, MeshFileError> {
     let cannot = |e: std::io::Error| error(name, None, format!("cannot read the file: {e}"));
-    let file = std::fs::File::open(path).map_err(cannot)?;
-    let size = file
-        .metadata()
-        .ok()
-        .filter(|m| m.is_file())
-        .map(|m| m.len());
+    let file = crate::files::open(path).map_err(cannot)?;
+    let size = file.size();
     if let Some(size) = size.filter(|&s| s > limit) {
         return Err(too_large(name, Some(size), limit));
     }
@@ -884,6 +893,7 @@ mod obj {
         let mut lines = text.lines().enumerate();
         let mut joined = String::new();
         while let Some((i, first)) = lines.next() {
+            check_deadline(name, i)?;
             let line = Line {
                 no: i + 1,
                 text: first,
@@ -998,6 +1008,7 @@ mod off {
         raw.positions.reserve(nv.min(text.len() / 6));
         raw.face_lines.reserve(nf.min(text.len() / 8));
         for v in 0..nv {
+            check_deadline(name, v)?;
             let line = lines
                 .next()
                 .ok_or_else(|| ends_early(name, source, v, nv, "vertices"))?;
@@ -1011,6 +1022,7 @@ mod off {
         }
         let mut toks = Vec::new();
         for f in 0..nf {
+            check_deadline(name, f)?;
             let line = lines
                 .next()
                 .ok_or_else(|| ends_early(name, source, f, nf, "faces"))?;
@@ -1748,6 +1760,7 @@ mod ply {
                 raw.vertex_lines.reserve(el.count.min(room));
             }
             for i in 0..el.count {
+                check_deadline(name, i)?;
                 read_instance(name, el, role, i, src, &mut raw)?;
             }
         }

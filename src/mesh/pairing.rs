@@ -22,7 +22,7 @@
 //! undone over the nodes it touched only, so that the whole runs in time
 //! close to linear on meshes (each search is local).
 
-use super::halfedge::{EdgeId, FaceId, Mesh, MeshError};
+use super::halfedge::{EdgeId, FaceId, Mesh, MeshError, VertexId};
 
 const NONE: u32 = u32::MAX;
 
@@ -98,6 +98,9 @@ struct Blossom<'g> {
     queue: Vec<u32>,
     /// Nodes at and above this are not part of the graph (yet).
     limit: u32,
+    /// The run's deadline: a search past it ends as one out of budget.
+    deadline: Option<crate::Deadline>,
+    ticks: u32,
 }
 
 impl<'g> Blossom<'g> {
@@ -117,6 +120,8 @@ impl<'g> Blossom<'g> {
             touched: Vec::new(),
             queue: Vec::new(),
             limit: n as u32,
+            deadline: crate::deadline::current(),
+            ticks: 0,
         }
     }
 
@@ -214,6 +219,12 @@ impl<'g> Blossom<'g> {
                     return None;
                 }
                 *budget -= 1;
+                self.ticks = self.ticks.wrapping_add(1);
+                if self.ticks.is_multiple_of(1 << 14) && self.deadline.is_some_and(|d| d.passed()) {
+                    // Past the deadline: every search from here on ends.
+                    *budget = 0;
+                    return None;
+                }
                 if to >= self.limit || self.dead[to as usize] {
                     continue;
                 }
@@ -480,7 +491,13 @@ impl Mesh {
         // in c4.lsys's terms), where the C4 scheme's subdominant
         // eigenvalue 1/4 is not above the next one (see
         // tests/it/surface_c4.rs); without one it is in 3 or 4 quads.
-        let low = |v| !self.is_boundary_vertex(v) && self.valence(v) <= 4;
+        // Once a vertex: a fan's centre has thousands of edges.
+        let mut lows = std::collections::HashMap::new();
+        let mut low = |v: VertexId| {
+            *lows
+                .entry(v)
+                .or_insert_with(|| !self.is_boundary_vertex(v) && self.valence(v) <= 4)
+        };
         let preferred: Vec<(u32, u32)> = links
             .iter()
             .zip(&via)
@@ -493,6 +510,12 @@ impl Mesh {
         let preferred = Graph::from_edges(real + stand_ins.len(), &preferred);
         let mut left = budget;
         let mate = maximum_matching(&g, &preferred, real, &mut left);
+        if let Some(d) = crate::deadline::current().filter(|d| d.passed()) {
+            return Err(MeshError::new(format!(
+                "pairing triangles into blocks: {}",
+                d.message()
+            )));
+        }
         if left == 0 {
             return Err(MeshError::new(format!(
                 "pairing triangles into blocks: the search for a maximum matching of {real} triangles \

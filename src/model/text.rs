@@ -21,7 +21,7 @@ pub const MAX_FILE_POINTS: usize = 20_000;
 pub fn read_bytes(path: &std::path::Path) -> Result<Vec<u8>, Error> {
     use std::io::Read;
     let io = |e| Error::read(path.to_path_buf(), e);
-    let file = std::fs::File::open(path).map_err(io)?;
+    let file = crate::files::open(path).map_err(io)?;
     let mut bytes = Vec::new();
     file.take(MAX_MODEL_FILE_BYTES + 1)
         .read_to_end(&mut bytes)

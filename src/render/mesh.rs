@@ -260,6 +260,7 @@ fn unchecked_scene(soup: &PolygonSoup, view: &MeshView) -> Scene {
 /// Renders the mesh as a PNG image, with the z-buffer (after [`validate`]).
 pub fn render_png(soup: &PolygonSoup, view: &MeshView) -> Result<Vec<u8>, RenderError> {
     validate(soup, view)?;
+    crate::deadline::check(crate::deadline::current()).map_err(RenderError::new)?;
     let (scene, polygons, back) = scene3(soup, view);
     if scene.triangle_count() == 0 {
         return Err(RenderError::new(

@@ -1326,9 +1326,15 @@ pub fn render(scene: &Scene3, opts: &RasterOptions) -> Result<Image, RenderError
             )));
         }
     }
+    // Between the phases: nothing more once the run's deadline passed.
+    let deadline = || crate::deadline::check(crate::deadline::current()).map_err(RenderError::new);
+    deadline()?;
     let frame = Frame::new(scene, opts);
+    deadline()?;
     let ids = frame.raster();
+    deadline()?;
     let pixels = frame.resolve(&ids);
+    deadline()?;
     Ok(Image {
         width: cam.width,
         height: cam.height,

@@ -82,13 +82,12 @@ pub fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, Error> {
             ),
         )
     };
-    let file = std::fs::File::open(path).map_err(cannot)?;
-    let meta = file.metadata().map_err(cannot)?;
-    if meta.is_dir() {
+    if path.is_dir() {
         return Err(Error::file(&name, "this is a folder, not a file"));
     }
-    if meta.is_file() && meta.len() > max_bytes {
-        return Err(too_big(Some(meta.len())));
+    let file = crate::files::open(path).map_err(cannot)?;
+    if let Some(len) = file.size().filter(|&len| len > max_bytes) {
+        return Err(too_big(Some(len)));
     }
     let mut bytes = Vec::new();
     file.take(max_bytes.saturating_add(1))
@@ -532,13 +531,13 @@ fn parse_path(name: &str, text: &str, attr: &Attr) -> Result<(Vec<DVec2>, bool),
 /// Whether the light side of `field` (values at or above `t`) is the
 /// shape: the side that does not touch the image's border, or, where both
 /// or neither do, the side with fewer pixels.
-fn light_is_the_shape(field: &[f64], w: usize, h: usize, t: f64) -> bool {
+fn light_is_the_shape(grey: &impl Fn(usize, usize) -> f64, w: usize, h: usize, t: f64) -> bool {
     let border = (0..w)
-        .flat_map(|x| [x, (h - 1) * w + x])
-        .chain((0..h).flat_map(|y| [y * w, y * w + w - 1]));
+        .flat_map(|x| [(x, 0), (x, h - 1)])
+        .chain((0..h).flat_map(|y| [(0, y), (w - 1, y)]));
     let (mut dark_edge, mut light_edge) = (false, false);
-    for k in border {
-        if field[k] < t {
+    for (x, y) in border {
+        if grey(x, y) < t {
             dark_edge = true;
         } else {
             light_edge = true;
@@ -548,8 +547,11 @@ fn light_is_the_shape(field: &[f64], w: usize, h: usize, t: f64) -> bool {
         (true, false) => true,
         (false, true) => false,
         _ => {
-            let dark = field.iter().filter(|&&v| v < t).count();
-            dark > field.len() - dark
+            let dark = (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .filter(|&(x, y)| grey(x, y) < t)
+                .count();
+            dark > w * h - dark
         }
     }
 }
@@ -626,37 +628,34 @@ pub fn read_png_with(name: &str, bytes: &[u8], silhouette: &Silhouette) -> Resul
     let pm = tiny_skia::Pixmap::decode_png(bytes)
         .map_err(|e| Error::file(name, format!("cannot read the PNG image: {e}")))?;
     let (w, h) = (pm.width() as usize, pm.height() as usize);
-    let field: Vec<f64> = pm
-        .pixels()
-        .iter()
-        .map(|p| {
-            // Premultiplied colour over white, then luminance in 0..1.
+    // The image's one copy: its colours demultiplied in place.
+    let mut rgba = pm.take();
+    for px in rgba.chunks_exact_mut(4) {
+        if let Some(p) = tiny_skia::PremultipliedColorU8::from_rgba(px[0], px[1], px[2], px[3]) {
             let c = p.demultiply();
-            let a = c.alpha() as f64 / 255.0;
-            let lum =
-                (0.2126 * c.red() as f64 + 0.7152 * c.green() as f64 + 0.0722 * c.blue() as f64)
-                    / 255.0;
-            a * lum + (1.0 - a)
-        })
-        .collect();
+            px.copy_from_slice(&[c.red(), c.green(), c.blue(), c.alpha()]);
+        }
+    }
+    // A pixel's colour over white, then its luminance in 0..1.
+    let grey = |x: usize, y: usize| -> f64 {
+        let p = &rgba[(y * w + x) * 4..][..4];
+        let a = p[3] as f64 / 255.0;
+        let lum = (0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64) / 255.0;
+        a * lum + (1.0 - a)
+    };
     let light = match silhouette.side {
         Side::Dark => false,
         Side::Light => true,
-        Side::Auto => light_is_the_shape(&field, w, h, t),
+        Side::Auto => light_is_the_shape(&grey, w, h, t),
     };
     // The tracer follows the dark side (below the level, outside white):
     // a light shape is traced on the negative image.
-    let (field, level) = if light {
-        (field.iter().map(|v| 1.0 - v).collect(), 1.0 - t)
-    } else {
-        (field, t)
-    };
-    let loops = trace::contours(&field, w, h, level, 1.0);
-    let Some(mut best) = loops.into_iter().max_by(|a, b| {
-        trace::signed_area2(a)
-            .abs()
-            .total_cmp(&trace::signed_area2(b).abs())
-    }) else {
+    let level = if light { 1.0 - t } else { t };
+    let value = |x: usize, y: usize| if light { 1.0 - grey(x, y) } else { grey(x, y) };
+    let deadline = crate::deadline::current();
+    let largest = trace::largest_contour(value, w, h, level, 1.0, deadline)
+        .map_err(|m| Error::file(name, m))?;
+    let Some(mut best) = largest else {
         let (shade, than) = if light {
             ("light", "as light as")
         } else {
