@@ -56,7 +56,7 @@ pub mod output;
 pub mod render;
 pub mod reverse;
 pub mod scene3;
-#[cfg(feature = "cli")]
+#[cfg(feature = "serve")]
 pub mod serve;
 pub(crate) mod shape;
 pub mod surface;

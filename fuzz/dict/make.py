@@ -107,3 +107,14 @@ model = ["funcgalleryver 1 1\n", "contourgalleryver 1 1\n", "timeEdit 1 2\n", "f
          "render mode: ", "first frame: ", "//", "/*", "*/", "0.000000 0.000000\n", "1.000000 1.000000\n", "1 2 3 1\n",
          "nan", "inf", "1e308", "-1", "0", "3", "1000000", "\n", " "]
 write('model_files', 'lpfg model files: function, contour, timeline, parameter, surface, view and animation keywords', model)
+serve = ["GET ", "POST ", "PUT ", "OPTIONS ", "HEAD ", "/", "/app.js", "/app.css", "/api/source", "/api/render", "/api/save", "?",
+         " HTTP/1.1\r\n", " HTTP/1.0\r\n", " HTTP/2.0\r\n", "\r\n", "\r\n\r\n", "\n", ": ", " ", "\t",
+         "Host: ", "Origin: ", "Content-Type: ", "Content-Length: ", "Content-Length: $LEN\r\n", "X-Subgram-Token: ",
+         "X-Subgram-Token: $TOKEN\r\n", "Sec-Fetch-Site: ", "Expect: 100-continue\r\n", "Transfer-Encoding: chunked\r\n",
+         "Connection: close\r\n", "127.0.0.1:$PORT", "localhost:$PORT", "LOCALHOST:$PORT", "127.0.0.1", "localhost", "evil.example",
+         ":$PORT", "$PORT", "$TOKEN", "$LEN", "http://127.0.0.1:$PORT", "http://localhost:$PORT", "http://evil.example", "null",
+         "same-origin", "same-site", "cross-site", "none", "application/json", "application/json; charset=utf-8", "text/plain",
+         '{"text": "', '"}', '"steps": ', '"defines": ["', '"]', "{", "}", ",", "0", "3", "4194305", "18446744073709551616", "-1",
+         "Axiom: F;", "F -> F+F", "derivation length: 9;", "mesh: \"/dev/null\";"]
+write('serve_request', 'subgram serve requests: methods, routes, headers, hosts, origins, content types; $TOKEN and $PORT stand for the run\'s',
+      serve)

@@ -40,6 +40,7 @@ pub const TARGETS: &[(&str, Body)] = &[
     ("model_files", model_files),
     ("vv_run", vv_run),
     ("shape_derive", shape_derive),
+    ("serve_request", serve_request),
 ];
 
 /// Steps of a curve derivation.
@@ -530,4 +531,118 @@ fn draw_small(soup: &subgram::mesh::PolygonSoup) {
     if let Ok(scene) = render::mesh::scene(soup, &view) {
         std::hint::black_box(scene);
     }
+}
+
+/// The port that `serve_request`'s server pretends to listen on: `$PORT`
+/// in an input stands for it.
+pub const SERVE_PORT: u16 = 8080;
+
+/// (j) `subgram serve`'s answer to one connection, without a socket
+/// (`subgram::serve::App::exchange`: the server's own HTTP/1.1 reading of
+/// the request, then its checks and routes), on a scratch copy of a small
+/// program with saving on, under the small limits above. The input is the
+/// bytes the client sends; in it `$TOKEN` stands for the run's token
+/// (which the fuzzer cannot guess), `$PORT` for [`SERVE_PORT`] and `$LEN`
+/// for the length of what follows the head, so that inputs get past the
+/// checks. What must hold: the output is an HTTP/1.1 reply with the
+/// status returned; every reply says `nosniff`; a refusal is JSON with
+/// `ok: false`; nothing is answered 200 unless `Host` names the server,
+/// nor on the API without the token.
+pub fn serve_request(data: &[u8]) {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use subgram::serve::{App, Limits, ServeOptions, TOKEN_HEADER};
+    static RUN: AtomicUsize = AtomicUsize::new(0);
+
+    let dir = std::env::temp_dir().join(format!(
+        "subgram-fuzz-serve-{}-{}",
+        std::process::id(),
+        RUN.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).expect("a scratch folder");
+    let program = dir.join("prog.lsys");
+    std::fs::write(
+        &program,
+        "angle: 60;\nderivation length: 2;\nAxiom: F--F--F;\nF -> F+F--F+F\n",
+    )
+    .expect("a scratch program");
+    let opts = ServeOptions {
+        path: program,
+        port: SERVE_PORT,
+        save: true,
+        limits: Limits {
+            max_modules: MAX_MODULES,
+            max_steps: CURVE_STEPS,
+            timeout: std::time::Duration::from_secs(2),
+        },
+        defines: Vec::new(),
+        double: false,
+    };
+    let app = App::new(opts, SERVE_PORT).expect("the scratch program reads");
+    let mut input = replace(data, b"$TOKEN", app.token().as_bytes());
+    input = replace(&input, b"$PORT", SERVE_PORT.to_string().as_bytes());
+    if let Some(at) = input.windows(4).position(|w| w == b"\r\n\r\n") {
+        let length = (input.len() - at - 4).to_string();
+        let head = replace(&input[..at], b"$LEN", length.as_bytes());
+        input = [&head[..], &input[at..]].concat();
+    }
+    let mut output = Vec::new();
+    let (head, reply) = app.exchange(&mut &input[..], &mut output);
+    let _ = std::fs::remove_dir_all(&dir);
+
+    let output = String::from_utf8_lossy(&output);
+    let status_line = format!("HTTP/1.1 {} ", reply.status);
+    assert!(
+        output.starts_with(&status_line)
+            || (output.starts_with("HTTP/1.1 100 Continue\r\n\r\n")
+                && output[25..].starts_with(&status_line)),
+        "{output}"
+    );
+    assert_eq!(reply.header("X-Content-Type-Options"), Some("nosniff"));
+    assert!((200..600).contains(&reply.status), "{}", reply.status);
+    if reply.status != 200 {
+        let v: serde_json::Value = serde_json::from_slice(&reply.body).expect("a refusal is JSON");
+        assert_eq!(v["ok"], false, "{v}");
+        assert!(v["message"].is_string(), "{v}");
+        return;
+    }
+    let head = head.expect("a request answered 200 was read");
+    let values = |name: &str| -> Vec<&str> {
+        head.headers
+            .iter()
+            .filter(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map(|(_, v)| v.trim())
+            .collect()
+    };
+    let host = values("Host");
+    let ours = [
+        format!("127.0.0.1:{SERVE_PORT}"),
+        format!("localhost:{SERVE_PORT}"),
+    ];
+    assert!(
+        host.len() == 1 && ours.iter().any(|o| o.eq_ignore_ascii_case(host[0])),
+        "answered 200 for Host {host:?}"
+    );
+    if head.url.starts_with("/api/") {
+        assert_eq!(
+            values(TOKEN_HEADER),
+            [app.token()],
+            "answered the API without the token"
+        );
+    }
+}
+
+/// `bytes` with every `from` replaced by `to`.
+fn replace(bytes: &[u8], from: &[u8], to: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i..].starts_with(from) {
+            out.extend_from_slice(to);
+            i += from.len();
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    out
 }

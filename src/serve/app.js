@@ -4,6 +4,34 @@
 // server (POST /api/render); nothing is fetched from anywhere else.
 "use strict";
 
+// The run's token, written into the page by the server. The API refuses a
+// call without it; a page of another origin cannot read this one, so it
+// cannot get the token.
+const API_TOKEN = document.querySelector('meta[name="subgram-token"]').content;
+
+// A call to the API, with the token; a body goes as JSON (POST). Answers
+// the status and the reply's JSON, or, when the reply is not JSON, an
+// error of the same shape ({ok: false, message}).
+async function api(path, body, signal) {
+  const headers = { "x-subgram-token": API_TOKEN };
+  const init = { headers, signal, cache: "no-store", credentials: "omit" };
+  if (body !== undefined) {
+    init.method = "POST";
+    init.body = JSON.stringify(body);
+    headers["content-type"] = "application/json";
+  }
+  const r = await fetch(path, init);
+  let reply;
+  try {
+    reply = await r.json();
+  } catch (e) {
+    if (e.name === "AbortError") throw e;
+    reply = { ok: false, message: `the server answered ${r.status} ${r.statusText}` };
+  }
+  if (!r.ok && reply.ok === undefined) reply.ok = false;
+  return { status: r.status, reply };
+}
+
 const $ = (id) => document.getElementById(id);
 const text = $("text"), highlight = $("highlight"), gutter = $("gutter");
 const picture = $("picture"), messages = $("messages"), status = $("status");
@@ -171,17 +199,25 @@ async function render() {
     steps: n === null ? null : Number(steps.value),
     defines: [...state.overrides].map(([k, v]) => `${k}=${v}`),
   };
-  let reply;
+  let reply, code;
   try {
-    const r = await fetch("/api/render", { method: "POST", body: JSON.stringify(body), signal: ctl.signal,
-                                           headers: { "content-type": "application/json" } });
-    reply = await r.json();
+    ({ status: code, reply } = await api("/api/render", body, ctl.signal));
   } catch (e) {
     if (e.name === "AbortError") return;
     reply = { ok: false, messages: [{ severity: "error", message: `the server did not answer: ${e}` }] };
   }
   if (state.inFlight !== ctl) return;
   state.inFlight = null;
+  if (code === 503) {
+    // Busy with earlier renders (each runs to its end): again in a moment.
+    status.textContent = "the server is busy; trying again…";
+    schedule(500);
+    return;
+  }
+  // A refusal (403, 415, ...) is {ok: false, message}: shown as a message.
+  if (!reply.messages && reply.message) {
+    reply.messages = [{ severity: "error", file: "", message: reply.message }];
+  }
   show(reply);
 }
 
@@ -243,16 +279,23 @@ steps.addEventListener("input", () => {
   schedule(0);
 });
 $("save").addEventListener("click", async () => {
-  const r = await fetch("/api/save", { method: "POST", body: JSON.stringify({ text: text.value }),
-                                       headers: { "content-type": "application/json" } });
-  const reply = await r.json();
+  let reply;
+  try {
+    ({ reply } = await api("/api/save", { text: text.value }));
+  } catch (e) {
+    reply = { ok: false, message: `the server did not answer: ${e}` };
+  }
   status.className = reply.ok ? "" : "error";
   status.textContent = reply.ok ? "saved" : `not saved: ${reply.message}`;
 });
 
 (async () => {
-  const r = await fetch("/api/source");
-  const src = await r.json();
+  const { status: code, reply: src } = await api("/api/source");
+  if (code !== 200) {
+    status.className = "error";
+    status.textContent = `cannot read the program: ${src.message}`;
+    return;
+  }
   $("file").textContent = src.name;
   document.title = `${src.name} — subgram`;
   $("save").hidden = !src.save;

@@ -10,9 +10,40 @@
 //! writes a file, except the program itself on `/api/save` when started
 //! with `--save` (atomically). Malformed requests get an error status and a
 //! message.
+//!
+//! Each connection brings one request (the server's small HTTP/1.1 is in
+//! `http.rs`), answered on a thread of its own, at most [`MAX_IN_FLIGHT`]
+//! at a time (past that a connection gets 503 at once, not a place in a
+//! queue); a client has [`REQUEST_TIMEOUT`] to send its request (408
+//! after). So a render that blocks (a FIFO named as a mesh) or a client
+//! that never sends its body holds one thread, not the server.
+//!
+//! What a request must show before it is answered ([`App::answer`], which
+//! decides without a socket, so that a fuzz target can drive it):
+//!
+//! - `Host` names the address the server listens on, `127.0.0.1:PORT` or
+//!   `localhost:PORT`: a name of the attacker's that resolves to 127.0.0.1
+//!   (DNS rebinding) gets 403, on every route, the page included;
+//! - an `Origin`, when there is one, is the page's own
+//!   (`http://127.0.0.1:PORT` or `http://localhost:PORT`), and
+//!   `Sec-Fetch-Site`, when there is one, is not another site's: 403;
+//! - the API (`/api/source`, `/api/render`, `/api/save`) needs the run's
+//!   token in [`TOKEN_HEADER`]: 32 random bytes drawn at start, written
+//!   into the page (`<meta name="subgram-token">`), which another origin
+//!   cannot read; missing or wrong, 403 (compared in constant time);
+//! - a POST's `Content-Type` is `application/json` (415 otherwise), a type
+//!   that a page of another origin cannot send without the browser asking
+//!   the server first (a CORS preflight, which gets 403).
+//!
+//! All of that keeps other web pages in the user's browser out. It does not
+//! keep out another process on the machine, which can read the page and
+//! its token as the browser does.
 
-use std::io::Read;
+use std::io::{Read, Write};
+use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
@@ -20,12 +51,36 @@ use serde::{Deserialize, Serialize};
 use crate::command::{self, RenderArgs};
 use crate::error::Error;
 
+mod http;
+
+pub use http::{MAX_HEAD, REQUEST_TIMEOUT};
+
 const PAGE: &str = include_str!("page.html");
 const SCRIPT: &str = include_str!("app.js");
 const STYLE: &str = include_str!("app.css");
 
+/// The place in `page.html` where the run's token goes.
+const TOKEN_SLOT: &str = "{{subgram-token}}";
+
 /// The largest request body read (a program's text with its fields).
 pub const MAX_BODY: usize = 4 << 20;
+
+/// The most requests answered at once; one more gets 503 at once.
+pub const MAX_IN_FLIGHT: usize = 8;
+
+/// The most 503 replies being written at once; past that a connection is
+/// closed unanswered.
+const MAX_REFUSING: usize = 4 * MAX_IN_FLIGHT;
+
+/// The header in which the page sends the run's token with each API call.
+pub const TOKEN_HEADER: &str = "X-Subgram-Token";
+
+/// The page's Content-Security-Policy: its own script and style, pictures
+/// from `data:` URLs (the SVG), requests to its own origin only, in no
+/// frame.
+const PAGE_POLICY: &str = "default-src 'none'; script-src 'self'; style-src 'self'; \
+     img-src data:; connect-src 'self'; base-uri 'none'; form-action 'none'; \
+     frame-ancestors 'none'";
 
 /// What one render may use: the page's edits run under these, so that a
 /// runaway rule stops with a message instead of holding the server.
@@ -64,10 +119,41 @@ pub struct ServeOptions {
 
 /// A running server, bound to 127.0.0.1.
 pub struct Server {
-    http: tiny_http::Server,
+    listener: TcpListener,
+    app: Arc<App>,
+    /// Requests being answered.
+    in_flight: Arc<AtomicUsize>,
+    /// Connections being told that the server is busy.
+    refusing: Arc<AtomicUsize>,
+}
+
+/// What the server answers, without its socket: the program, the options,
+/// the port that `Host` and `Origin` must name, and the run's token.
+pub struct App {
     opts: ServeOptions,
     /// The program file (a model folder's L-system).
     program: PathBuf,
+    port: u16,
+    token: String,
+    /// `page.html` with the token in it.
+    page: String,
+}
+
+/// A request as [`App::answer`] sees it: the method, the target as sent
+/// (path and query) and the headers, in order, names as sent.
+#[derive(Clone, Debug, Default)]
+pub struct Head {
+    pub method: String,
+    pub url: String,
+    pub headers: Vec<(String, String)>,
+}
+
+/// An answer: its status, its headers and its body.
+#[derive(Clone, Debug)]
+pub struct Reply {
+    pub status: u16,
+    pub headers: Vec<(&'static str, String)>,
+    pub body: Vec<u8>,
 }
 
 #[derive(Deserialize)]
@@ -114,69 +200,352 @@ struct RenderReply {
     limit: Option<&'static str>,
 }
 
+/// The routes.
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum Route {
+    Page,
+    Script,
+    Style,
+    Source,
+    Render,
+    Save,
+}
+
+impl Route {
+    /// The API: the routes that need the token.
+    fn api(self) -> bool {
+        matches!(self, Route::Source | Route::Render | Route::Save)
+    }
+}
+
 impl Server {
     /// Binds 127.0.0.1:`port` and reads the program once, so that a
     /// missing file is an error now rather than on the page.
     pub fn bind(opts: ServeOptions) -> Result<Server, Error> {
-        let program = crate::load::program_file(&opts.path)?;
-        std::fs::read_to_string(&program).map_err(|e| Error::read(&program, e))?;
-        let http = tiny_http::Server::http(("127.0.0.1", opts.port)).map_err(|e| {
+        let port = opts.port;
+        let mut app = App::new(opts, port)?;
+        let listener = TcpListener::bind(("127.0.0.1", port)).map_err(|e| {
             Error::Usage(format!(
-                "cannot listen on 127.0.0.1:{}: {e}; choose another --port",
-                opts.port
+                "cannot listen on 127.0.0.1:{port}: {e}; choose another --port"
             ))
         })?;
+        app.port = listener
+            .local_addr()
+            .map_err(|e| Error::Failed(format!("the server has no address: {e}")))?
+            .port();
         Ok(Server {
-            http,
-            opts,
-            program,
+            listener,
+            app: Arc::new(app),
+            in_flight: Arc::new(AtomicUsize::new(0)),
+            refusing: Arc::new(AtomicUsize::new(0)),
         })
     }
 
     /// The page's address.
     pub fn url(&self) -> String {
-        match self.http.server_addr().to_ip() {
-            Some(a) => format!("http://{a}/"),
-            None => "http://127.0.0.1/".into(),
-        }
+        format!("http://127.0.0.1:{}/", self.app.port)
     }
 
-    /// Answers requests, one at a time, until the process stops.
+    /// The run's token, which the API asks for (the page has it).
+    pub fn token(&self) -> &str {
+        self.app.token()
+    }
+
+    /// Answers connections until the process stops, one request each, on
+    /// a thread of its own, at most [`MAX_IN_FLIGHT`] at a time: one more
+    /// gets 503 at once (on a thread of its own too, at most
+    /// `4 × MAX_IN_FLIGHT` of those; past that it is closed unanswered).
+    /// This loop only accepts, counts and hands on: nothing it does waits
+    /// on a client.
     pub fn run(&self) {
-        for request in self.http.incoming_requests() {
-            self.answer(request);
+        for stream in self.listener.incoming() {
+            let stream = match stream {
+                Ok(s) => s,
+                Err(_) => {
+                    // Out of file descriptors, say: a moment for some to
+                    // close.
+                    std::thread::sleep(Duration::from_millis(20));
+                    continue;
+                }
+            };
+            let work: Box<dyn FnOnce() + Send> =
+                if let Some(slot) = Slot::take(&self.in_flight, MAX_IN_FLIGHT) {
+                    let app = Arc::clone(&self.app);
+                    Box::new(move || {
+                        let _slot = slot;
+                        app.connection(&stream);
+                    })
+                } else if let Some(slot) = Slot::take(&self.refusing, MAX_REFUSING) {
+                    Box::new(move || {
+                        let _slot = slot;
+                        busy(&stream);
+                    })
+                } else {
+                    continue;
+                };
+            // When no thread can be made, the connection is closed.
+            let _ = std::thread::Builder::new()
+                .name("subgram serve".into())
+                .spawn(work);
+        }
+    }
+}
+
+/// Tells a connection that the server is busy, without reading it.
+fn busy(stream: &TcpStream) {
+    http::prepare(stream);
+    let mut reply = guarded(failure(
+        503,
+        &format!("the server is busy: {MAX_IN_FLIGHT} requests are being answered; try again"),
+    ));
+    reply.headers.push(("Retry-After", "1".to_string()));
+    let _ = http::write_reply(&mut &*stream, &reply, false);
+    http::close(stream);
+}
+
+/// One of a bounded number of places, given back on drop.
+struct Slot(Arc<AtomicUsize>);
+
+impl Slot {
+    fn take(count: &Arc<AtomicUsize>, most: usize) -> Option<Slot> {
+        count
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| {
+                (n < most).then_some(n + 1)
+            })
+            .ok()
+            .map(|_| Slot(Arc::clone(count)))
+    }
+}
+
+impl Drop for Slot {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+impl App {
+    /// The answers for `opts`, as a server on `port` gives them: reads the
+    /// program once (a missing file is an error now) and draws the token.
+    pub fn new(opts: ServeOptions, port: u16) -> Result<App, Error> {
+        let program = crate::load::program_file(&opts.path)?;
+        std::fs::read_to_string(&program).map_err(|e| Error::read(&program, e))?;
+        let token = new_token()?;
+        let page = PAGE.replace(TOKEN_SLOT, &token);
+        Ok(App {
+            opts,
+            program,
+            port,
+            token,
+            page,
+        })
+    }
+
+    /// The run's token.
+    pub fn token(&self) -> &str {
+        &self.token
+    }
+
+    /// A connection: one request, read before [`REQUEST_TIMEOUT`], its
+    /// answer, and the end.
+    fn connection(&self, stream: &TcpStream) {
+        http::prepare(stream);
+        let mut input = http::Timed {
+            stream,
+            deadline: Instant::now() + REQUEST_TIMEOUT,
+        };
+        self.exchange(&mut input, &mut &*stream);
+        http::close(stream);
+    }
+
+    /// Reads one request from `input` (HTTP/1.1, as a connection brings
+    /// it) and writes the answer to `output`: the request's head (none
+    /// when it could not be read) and the reply. A protocol error (a
+    /// malformed head 400, a late one 408, a POST without a length 411, a
+    /// head too long 431, a chunked body 501) is answered before the
+    /// checks of [`App::answer`].
+    pub fn exchange(&self, input: &mut dyn Read, output: &mut dyn Write) -> (Option<Head>, Reply) {
+        let (head, reply) = match http::read_head(input) {
+            Err(r) => (None, guarded(r)),
+            Ok((head, rest)) => {
+                let reply = match body_length(&head) {
+                    Err(r) => guarded(r),
+                    Ok(length) => {
+                        let continues = single(&head, "Expect")
+                            .ok()
+                            .flatten()
+                            .is_some_and(|e| e.eq_ignore_ascii_case("100-continue"));
+                        let mut body = Body {
+                            rest: std::io::Cursor::new(rest),
+                            input,
+                            output: &mut *output,
+                            left: length,
+                            continues,
+                        };
+                        self.answer(&head, &mut body)
+                    }
+                };
+                (Some(head), reply)
+            }
+        };
+        let head_only = head.as_ref().is_some_and(|h| h.method == "HEAD");
+        let _ = http::write_reply(output, &reply, head_only);
+        (head, reply)
+    }
+
+    /// The answer to a request: the checks of the module's documentation
+    /// (`Host`, then `Origin`, then the route: 404 or 405, then
+    /// `Sec-Fetch-Site`, the token and the content type), then the route's
+    /// work. The body is read (at most [`MAX_BODY`] bytes) only when a POST
+    /// has passed them all.
+    pub fn answer(&self, head: &Head, body: &mut dyn Read) -> Reply {
+        guarded(self.decide(head, body))
+    }
+
+    fn decide(&self, head: &Head, body: &mut dyn Read) -> Reply {
+        if let Err(r) = self.check_host(head) {
+            return r;
+        }
+        if let Err(r) = self.check_origin(head) {
+            return r;
+        }
+        let path = head.url.split('?').next().unwrap_or("");
+        let route = match (head.method.as_str(), path) {
+            ("GET", "/") => Route::Page,
+            ("GET", "/app.js") => Route::Script,
+            ("GET", "/app.css") => Route::Style,
+            ("GET", "/api/source") => Route::Source,
+            ("POST", "/api/render") => Route::Render,
+            ("POST", "/api/save") => Route::Save,
+            (_, "/" | "/app.js" | "/app.css" | "/api/source" | "/api/render" | "/api/save") => {
+                return failure(
+                    405,
+                    &format!("{} is not allowed on {path}", clip(&head.method)),
+                )
+            }
+            _ => {
+                return failure(
+                    404,
+                    "no such page: the server serves the editor and its API only",
+                )
+            }
+        };
+        if let Err(r) = check_fetch_site(head, route) {
+            return r;
+        }
+        if route.api() {
+            if let Err(r) = self.check_token(head) {
+                return r;
+            }
+        }
+        match route {
+            Route::Page => {
+                let mut r = asset(self.page.as_bytes(), "text/html; charset=utf-8");
+                r.headers.extend([
+                    ("Content-Security-Policy", PAGE_POLICY.to_string()),
+                    ("X-Frame-Options", "DENY".to_string()),
+                    ("Cross-Origin-Opener-Policy", "same-origin".to_string()),
+                ]);
+                r
+            }
+            Route::Script => asset(SCRIPT.as_bytes(), "application/javascript; charset=utf-8"),
+            Route::Style => asset(STYLE.as_bytes(), "text/css; charset=utf-8"),
+            Route::Source => self.source(),
+            Route::Render | Route::Save => {
+                let bytes = match check_json(head).and_then(|()| read_body(head, body)) {
+                    Ok(b) => b,
+                    Err(r) => return r,
+                };
+                if route == Route::Render {
+                    self.render(&bytes)
+                } else {
+                    self.save(&bytes)
+                }
+            }
         }
     }
 
-    fn answer(&self, mut request: tiny_http::Request) {
-        let method = request.method().clone();
-        let url = request.url().to_string();
-        let path = url.split('?').next().unwrap_or("");
-        let reply = match (&method, path) {
-            (tiny_http::Method::Get, "/") => asset(PAGE, "text/html; charset=utf-8"),
-            (tiny_http::Method::Get, "/app.js") => {
-                asset(SCRIPT, "application/javascript; charset=utf-8")
+    /// `Host` names this server: `127.0.0.1:PORT` or `localhost:PORT` (the
+    /// port may be left out only when it is 80).
+    fn check_host(&self, head: &Head) -> Result<(), Reply> {
+        let host = match single(head, "Host") {
+            Ok(Some(h)) => h.trim(),
+            Ok(None) => {
+                return Err(failure(
+                    403,
+                    "refused: the request has no Host header; the server answers requests \
+                     for its own address only",
+                ))
             }
-            (tiny_http::Method::Get, "/app.css") => asset(STYLE, "text/css; charset=utf-8"),
-            (tiny_http::Method::Get, "/api/source") => self.source(),
-            (tiny_http::Method::Post, "/api/render") => match body(&mut request) {
-                Ok(b) => self.render(&b),
-                Err(r) => r,
-            },
-            (tiny_http::Method::Post, "/api/save") => match body(&mut request) {
-                Ok(b) => self.save(&b),
-                Err(r) => r,
-            },
-            (_, "/" | "/app.js" | "/app.css" | "/api/source" | "/api/render" | "/api/save") => {
-                failure(405, &format!("{method} is not allowed on {path}"))
-            }
-            _ => failure(
-                404,
-                "no such page: the server serves the editor and its API only",
-            ),
+            Err(r) => return Err(r),
         };
-        // The client may have gone: nothing to do about it.
-        let _ = request.respond(reply);
+        let port = self.port.to_string();
+        let ours = ["127.0.0.1", "localhost"].iter().any(|name| {
+            let Some(rest) = host
+                .get(..name.len())
+                .filter(|h| h.eq_ignore_ascii_case(name))
+                .map(|_| &host[name.len()..])
+            else {
+                return false;
+            };
+            rest.strip_prefix(':') == Some(port.as_str()) || (rest.is_empty() && self.port == 80)
+        });
+        if ours {
+            Ok(())
+        } else {
+            Err(failure(
+                403,
+                &format!(
+                    "refused: the Host header `{}` is not this server's address \
+                     (127.0.0.1:{p} or localhost:{p}); the server answers requests for its own \
+                     address only, against DNS rebinding",
+                    clip(host),
+                    p = self.port
+                ),
+            ))
+        }
+    }
+
+    /// An `Origin`, when there is one, is the page's own.
+    fn check_origin(&self, head: &Head) -> Result<(), Reply> {
+        let origin = match single(head, "Origin") {
+            Ok(Some(o)) => o.trim(),
+            Ok(None) => return Ok(()),
+            Err(r) => return Err(r),
+        };
+        let ours = ["127.0.0.1", "localhost"]
+            .iter()
+            .any(|name| origin.eq_ignore_ascii_case(&format!("http://{name}:{}", self.port)));
+        if ours {
+            Ok(())
+        } else {
+            Err(failure(
+                403,
+                &format!(
+                    "refused: a request from `{}`, not from the page's own origin \
+                     (http://127.0.0.1:{})",
+                    clip(origin),
+                    self.port
+                ),
+            ))
+        }
+    }
+
+    /// The token, once, compared in constant time.
+    fn check_token(&self, head: &Head) -> Result<(), Reply> {
+        match single(head, TOKEN_HEADER)? {
+            Some(t) if same(t.trim().as_bytes(), self.token.as_bytes()) => Ok(()),
+            Some(_) => Err(failure(
+                403,
+                &format!("refused: the {TOKEN_HEADER} header is not this run's token"),
+            )),
+            None => Err(failure(
+                403,
+                &format!(
+                    "refused: the API needs this run's token in the {TOKEN_HEADER} header, \
+                     as the page sends it"
+                ),
+            )),
+        }
     }
 
     fn source(&self) -> Reply {
@@ -241,6 +610,98 @@ impl Server {
     }
 }
 
+/// 32 bytes from the system's random source, in hex.
+fn new_token() -> Result<String, Error> {
+    let mut bytes = [0u8; 32];
+    getrandom::fill(&mut bytes)
+        .map_err(|e| Error::Failed(format!("cannot draw the page's token: {e}")))?;
+    Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
+}
+
+/// Equal, in a time that depends on the lengths only.
+fn same(a: &[u8], b: &[u8]) -> bool {
+    if a.len() != b.len() {
+        return false;
+    }
+    let diff = a.iter().zip(b).fold(0u8, |d, (x, y)| d | (x ^ y));
+    std::hint::black_box(diff) == 0
+}
+
+/// The value of the header `name` (any case), when it is there once; a
+/// header that comes twice is refused, since the two may be read
+/// differently on the way.
+fn single<'a>(head: &'a Head, name: &str) -> Result<Option<&'a str>, Reply> {
+    let mut found = head
+        .headers
+        .iter()
+        .filter(|(n, _)| n.trim().eq_ignore_ascii_case(name))
+        .map(|(_, v)| v.as_str());
+    let first = found.next();
+    if found.next().is_some() {
+        return Err(failure(
+            400,
+            &format!("the request has more than one {name} header"),
+        ));
+    }
+    Ok(first)
+}
+
+/// `Sec-Fetch-Site`, which browsers send: the API answers the page's own
+/// origin only (`same-origin`), the page and its files also a navigation
+/// the user made (`none`); another site, or another port of this host
+/// (`same-site`), gets 403.
+fn check_fetch_site(head: &Head, route: Route) -> Result<(), Reply> {
+    let Some(site) = single(head, "Sec-Fetch-Site")? else {
+        return Ok(());
+    };
+    let site = site.trim().to_ascii_lowercase();
+    let allowed = site == "same-origin" || (site == "none" && !route.api());
+    if allowed {
+        Ok(())
+    } else {
+        Err(failure(
+            403,
+            &format!(
+                "refused: a request from another site (Sec-Fetch-Site: {})",
+                clip(&site)
+            ),
+        ))
+    }
+}
+
+/// A POST's body is JSON: `application/json`, with parameters or not.
+fn check_json(head: &Head) -> Result<(), Reply> {
+    let kind = single(head, "Content-Type")?.unwrap_or("");
+    let media = kind.split(';').next().unwrap_or("").trim();
+    if media.eq_ignore_ascii_case("application/json") {
+        Ok(())
+    } else {
+        Err(failure(
+            415,
+            &format!(
+                "the API takes application/json, not `{}`",
+                clip(if kind.is_empty() { "(none)" } else { kind })
+            ),
+        ))
+    }
+}
+
+/// The headers every reply has: not to be sniffed as another type, nor
+/// cached, nor read by another origin through a no-cors request.
+fn guarded(mut reply: Reply) -> Reply {
+    reply.headers.extend([
+        ("X-Content-Type-Options", "nosniff".to_string()),
+        ("Cache-Control", "no-store".to_string()),
+        ("Referrer-Policy", "no-referrer".to_string()),
+        ("Cross-Origin-Resource-Policy", "same-origin".to_string()),
+    ]);
+    reply
+}
+
+/// At most 100 characters of a value the client sent, for a message.
+fn clip(s: &str) -> String {
+    s.chars().take(100).collect()
+}
 /// The SVG and the warnings, or the messages and the limit that stopped
 /// the run.
 type Rendered = (
@@ -386,28 +847,90 @@ fn warning(text: &str, program: &Path) -> Message {
     m
 }
 
-type Reply = tiny_http::Response<std::io::Cursor<Vec<u8>>>;
-
-fn header(name: &str, value: &str) -> tiny_http::Header {
-    // Both are ASCII constants of this file or the content types above.
-    tiny_http::Header::from_bytes(name.as_bytes(), value.as_bytes())
-        .unwrap_or_else(|()| tiny_http::Header::from_bytes(&b"X-Bad"[..], &b"1"[..]).unwrap())
+impl Reply {
+    /// The first header called `name` (any case).
+    pub fn header(&self, name: &str) -> Option<&str> {
+        self.headers
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map(|(_, v)| v.as_str())
+    }
 }
 
-fn asset(text: &'static str, kind: &str) -> Reply {
-    tiny_http::Response::from_data(text.as_bytes().to_vec())
-        .with_header(header("Content-Type", kind))
-        .with_header(header("Cache-Control", "no-store"))
+/// The length of a request's body: a `Content-Length`, once, or none (0)
+/// on a request other than POST; no chunked bodies.
+fn body_length(head: &Head) -> Result<u64, Reply> {
+    if single(head, "Transfer-Encoding")?.is_some() {
+        return Err(failure(
+            501,
+            "the server takes a body with a Content-Length only, not chunked",
+        ));
+    }
+    match single(head, "Content-Length")? {
+        Some(n) if !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) => n
+            .parse()
+            .map_err(|_| failure(413, "the Content-Length is too large")),
+        Some(_) => Err(failure(400, "the Content-Length is not a number")),
+        None if head.method == "POST" => Err(failure(411, "a POST needs a Content-Length")),
+        None => Ok(0),
+    }
+}
+
+/// A request's body: the bytes read with its head, then the connection,
+/// `left` bytes in all; `100 Continue` is sent before the first read when
+/// the client asked for it.
+struct Body<'a> {
+    rest: std::io::Cursor<Vec<u8>>,
+    input: &'a mut dyn Read,
+    output: &'a mut dyn Write,
+    left: u64,
+    continues: bool,
+}
+
+impl Read for Body<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if self.left == 0 || buf.is_empty() {
+            return Ok(0);
+        }
+        if std::mem::take(&mut self.continues) {
+            self.output.write_all(b"HTTP/1.1 100 Continue\r\n\r\n")?;
+            self.output.flush()?;
+        }
+        let most = buf
+            .len()
+            .min(usize::try_from(self.left).unwrap_or(usize::MAX));
+        let n = match self.rest.read(&mut buf[..most])? {
+            0 => self.input.read(&mut buf[..most])?,
+            n => n,
+        };
+        if n == 0 {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::UnexpectedEof,
+                "the request ended before its body did",
+            ));
+        }
+        self.left -= n as u64;
+        Ok(n)
+    }
+}
+
+fn asset(bytes: &[u8], kind: &str) -> Reply {
+    Reply {
+        status: 200,
+        headers: vec![("Content-Type", kind.to_string())],
+        body: bytes.to_vec(),
+    }
 }
 
 fn json_reply(status: u16, value: &impl Serialize) -> Reply {
-    let bytes = serde_json::to_vec(value).unwrap_or_else(|e| {
+    let body = serde_json::to_vec(value).unwrap_or_else(|e| {
         format!("{{\"ok\":false,\"message\":\"cannot write the reply: {e}\"}}").into_bytes()
     });
-    tiny_http::Response::from_data(bytes)
-        .with_status_code(status)
-        .with_header(header("Content-Type", "application/json"))
-        .with_header(header("Cache-Control", "no-store"))
+    Reply {
+        status,
+        headers: vec![("Content-Type", "application/json".to_string())],
+        body,
+    }
 }
 
 fn failure(status: u16, message: &str) -> Reply {
@@ -417,25 +940,27 @@ fn failure(status: u16, message: &str) -> Reply {
     )
 }
 
-/// The request's body, at most [`MAX_BODY`] bytes.
-fn body(request: &mut tiny_http::Request) -> Result<Vec<u8>, Reply> {
-    if request.body_length().is_some_and(|n| n > MAX_BODY) {
-        return Err(failure(
+/// The request's body, at most [`MAX_BODY`] bytes: one announced larger is
+/// refused before it is read.
+fn read_body(head: &Head, body: &mut dyn Read) -> Result<Vec<u8>, Reply> {
+    let too_large = || {
+        failure(
             413,
             &format!("the request is larger than {} MiB", MAX_BODY >> 20),
-        ));
+        )
+    };
+    if let Some(n) = single(head, "Content-Length")? {
+        match n.trim().parse::<u64>() {
+            Ok(n) if n > MAX_BODY as u64 => return Err(too_large()),
+            Ok(_) => {}
+            Err(_) => return Err(failure(400, "the Content-Length is not a number")),
+        }
     }
     let mut bytes = Vec::new();
-    let read = request
-        .as_reader()
-        .take(MAX_BODY as u64 + 1)
-        .read_to_end(&mut bytes);
-    match read {
+    match body.take(MAX_BODY as u64 + 1).read_to_end(&mut bytes) {
+        Err(e) if e.kind() == std::io::ErrorKind::TimedOut => Err(failure(408, &e.to_string())),
         Err(e) => Err(failure(400, &format!("cannot read the request: {e}"))),
-        Ok(_) if bytes.len() > MAX_BODY => Err(failure(
-            413,
-            &format!("the request is larger than {} MiB", MAX_BODY >> 20),
-        )),
+        Ok(_) if bytes.len() > MAX_BODY => Err(too_large()),
         Ok(_) => Ok(bytes),
     }
 }

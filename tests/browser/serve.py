@@ -12,7 +12,13 @@ beyond Python's own library), and checks, as a person would:
    the last picture;
 4. deleting the error brings the picture back;
 5. the step slider redraws with fewer steps;
-6. Save writes the edited text to the file.
+6. Save writes the edited text to the file;
+7. a page of another origin (a second server on another port) can
+   neither write the file (a no-cors text/plain POST, a JSON POST with the
+   token, which needs a preflight) nor read the page and its token;
+8. DNS rebinding, played with Chromium's --host-resolver-rules (a name of
+   the attacker's, evil.test, resolving to 127.0.0.1): the page, read
+   under that name, is refused, and so is a save with the right token.
 
 Screenshots of each stage go to OUTDIR (default target/browser). Run by
 .ci/run after `cargo build`:
@@ -23,6 +29,7 @@ Exit status 0 when every check passes.
 """
 
 import base64
+import http.server
 import json
 import os
 import select
@@ -30,6 +37,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -46,7 +54,7 @@ F -> F+F--F+F
 class Browser:
     """Headless Chromium with its DevTools protocol on fds 3 and 4."""
 
-    def __init__(self, chromium, profile, log):
+    def __init__(self, chromium, profile, log, extra=()):
         self.cmd_r, self.cmd_w = os.pipe()
         self.res_r, self.res_w = os.pipe()
 
@@ -61,7 +69,7 @@ class Browser:
             [chromium, "--headless=new", "--remote-debugging-pipe", "--no-sandbox",
              "--disable-gpu", "--no-first-run", "--no-default-browser-check",
              "--disable-extensions", "--hide-scrollbars", f"--user-data-dir={profile}",
-             "--window-size=1400,860", "about:blank"],
+             "--window-size=1400,860", *extra, "about:blank"],
             preexec_fn=child, close_fds=False, stdin=subprocess.DEVNULL,
             stdout=log, stderr=log)
         os.close(self.cmd_r)
@@ -164,6 +172,21 @@ class Page:
             f.write(base64.b64decode(data))
 
 
+class Attacker(http.server.BaseHTTPRequestHandler):
+    """Another origin on this host: a page that does nothing by itself."""
+
+    def do_GET(self):  # noqa: N802 (the name http.server calls)
+        body = b"<!doctype html><title>another origin</title><p>another origin</p>"
+        self.send_response(200)
+        self.send_header("Content-Type", "text/html")
+        self.send_header("Content-Length", str(len(body)))
+        self.end_headers()
+        self.wfile.write(body)
+
+    def log_message(self, *args):
+        pass
+
+
 def picture(page):
     return page.js("(document.querySelector('#picture img') || {}).src || ''")
 
@@ -194,7 +217,8 @@ def main():
         line = server.stdout.readline()
         url = next((w for w in line.split() if w.startswith("http://127.0.0.1:")), None)
         assert url, f"the server printed no address: {line!r}"
-        browser = Browser(chromium, os.path.join(work, "profile"), log)
+        browser = Browser(chromium, os.path.join(work, "profile"), log,
+                          ["--host-resolver-rules=MAP evil.test 127.0.0.1"])
         page = Page(browser, url)
 
         # 1. The picture appears.
@@ -256,6 +280,62 @@ def main():
         with open(program) as f:
             saved = f.read()
         assert saved == PROGRAM.replace("F -> F+F--F+F", "F -> F+F--F+F+F"), saved
+        checks += 1
+
+        # 7. Another origin: a page on another port of 127.0.0.1.
+        token = page.js("document.querySelector('meta[name=\"subgram-token\"]').content")
+        assert len(token) == 64, token
+        attacker = http.server.HTTPServer(("127.0.0.1", 0), Attacker)
+        threading.Thread(target=attacker.serve_forever, daemon=True).start()
+        other = Page(browser, f"http://127.0.0.1:{attacker.server_address[1]}/")
+        other.wait("document.title === 'another origin'", "the other origin's page")
+        pwned = json.dumps({"text": "pwned"})
+        tried = other.js(f"""(async () => {{
+            const out = [];
+            const save = {json.dumps(url + "api/save")};
+            // Sent without a preflight; the reply (403) has
+            // Cross-Origin-Resource-Policy: same-origin, so the browser
+            // does not even hand over an opaque response.
+            try {{
+                const r = await fetch(save, {{ method: "POST", mode: "no-cors",
+                    headers: {{ "content-type": "text/plain" }}, body: {json.dumps(pwned)} }});
+                out.push("no-cors: " + r.type);
+            }} catch (e) {{ out.push("no-cors: " + e.name); }}
+            try {{
+                await fetch(save, {{ method: "POST", body: {json.dumps(pwned)},
+                    headers: {{ "content-type": "application/json",
+                               "x-subgram-token": {json.dumps(token)} }} }});
+                out.push("json: answered");
+            }} catch (e) {{ out.push("json: " + e.name); }}
+            try {{
+                const t = await (await fetch({json.dumps(url)})).text();
+                out.push(t.includes({json.dumps(token)}) ? "page: token read" : "page: read");
+            }} catch (e) {{ out.push("page: " + e.name); }}
+            return out; }})()""")
+        assert tried[0] in ("no-cors: opaque", "no-cors: TypeError"), tried
+        assert tried[1:] == ["json: TypeError", "page: TypeError"], tried
+        with open(program) as f:
+            assert f.read() == saved, "another origin wrote the program"
+        attacker.shutdown()
+        checks += 1
+
+        # 8. DNS rebinding: evil.test resolves to 127.0.0.1; its page, same
+        # origin with itself, reads and posts to the server under that name.
+        port = url.rstrip("/").rsplit(":", 1)[1]
+        rebound = Page(browser, f"http://evil.test:{port}/")
+        rebound.wait("document.readyState === 'complete' && !!document.body", "the rebound page")
+        html = rebound.js("document.documentElement.outerHTML")
+        assert token not in html and "<textarea" not in html, html[:300]
+        assert "refused" in html and "Host" in html, html[:300]
+        tried = rebound.js(f"""(async () => {{
+            const page = await fetch("/");
+            const save = await fetch("/api/save", {{ method: "POST", body: {json.dumps(pwned)},
+                headers: {{ "content-type": "application/json",
+                           "x-subgram-token": {json.dumps(token)} }} }});
+            return [page.status, save.status]; }})()""")
+        assert tried == [403, 403], tried
+        with open(program) as f:
+            assert f.read() == saved, "a rebound page wrote the program"
         checks += 1
         print(f"browser test: {checks} checks passed; screenshots in {outdir}")
     finally:

@@ -140,6 +140,11 @@ fn model_files() {
     replay("model_files");
 }
 
+#[test]
+fn serve_request() {
+    replay("serve_request");
+}
+
 /// Every body has a `[[bin]]` in fuzz/Cargo.toml, a target file, seeds and
 /// a dictionary, and every folder of findings names a target.
 #[test]

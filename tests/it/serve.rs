@@ -1,23 +1,39 @@
 //! `subgram serve` over HTTP (issue 18): the page's API derives and draws
 //! an edited text, reports errors at their lines, stops runaway rules at
 //! its limits, serves nothing from the disk, writes nothing unless saving
-//! is on, and answers malformed requests with an error. The browser test
+//! is on, and answers malformed requests with an error. It answers only
+//! its own Host, refuses other origins, and its API needs the run's token
+//! and JSON; a blocked request does not stop the others. The browser test
 //! of the page itself is tests/browser/serve.py (run by .ci/run).
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::path::Path;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
-use subgram::serve::{Limits, ServeOptions, Server};
+use subgram::serve::{Limits, ServeOptions, Server, MAX_IN_FLIGHT};
 use tempfile::TempDir;
 
 use crate::support::scratch;
 
 /// A server on a free port in a thread of its own, serving a copy of
-/// `program` in a fresh folder; its address and the folder, removed when
-/// the caller drops it.
-fn start(name: &str, program: &str, save: bool, limits: Limits) -> (String, TempDir) {
+/// `program` in a fresh folder (removed when the `Live` is dropped).
+struct Live {
+    /// `127.0.0.1:PORT`
+    addr: String,
+    port: u16,
+    /// The run's token, as the page has it.
+    token: String,
+    dir: TempDir,
+}
+
+impl Live {
+    fn program(&self) -> Vec<u8> {
+        std::fs::read(self.dir.path().join("prog.lsys")).unwrap()
+    }
+}
+
+fn start(name: &str, program: &str, save: bool, limits: Limits) -> Live {
     let dir = scratch(&format!("serve-{name}"));
     let file = dir.path().join("prog.lsys");
     std::fs::write(&file, program).unwrap();
@@ -31,22 +47,41 @@ fn start(name: &str, program: &str, save: bool, limits: Limits) -> (String, Temp
     })
     .unwrap();
     let url = server.url();
+    let token = server.token().to_string();
     std::thread::spawn(move || server.run());
     let addr = url
         .trim_start_matches("http://")
         .trim_end_matches('/')
         .to_string();
-    (addr, dir)
+    let port = addr.rsplit(':').next().unwrap().parse().unwrap();
+    // The token as a browser finds it: in the page.
+    let (status, page) = send(&addr, "GET", "/", &[format!("Host: {addr}")], "");
+    assert_eq!(status, 200, "{page}");
+    let meta = "<meta name=\"subgram-token\" content=\"";
+    let at = page.find(meta).expect("the page carries the token") + meta.len();
+    let in_page = &page[at..at + page[at..].find('"').unwrap()];
+    assert_eq!(in_page, token);
+    assert_eq!(token.len(), 64, "32 random bytes in hex: {token}");
+    Live {
+        addr,
+        port,
+        token,
+        dir,
+    }
 }
 
-/// Sends raw bytes, returns the status code and the body.
-fn raw(addr: &str, request: &[u8]) -> (u16, String) {
+/// Sends raw bytes, returns the whole reply (head and body).
+fn exchange(addr: &str, request: &[u8]) -> String {
     let mut s = TcpStream::connect(addr).unwrap();
     s.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
     s.write_all(request).unwrap();
     let mut reply = Vec::new();
     let _ = s.read_to_end(&mut reply);
-    let reply = String::from_utf8_lossy(&reply).into_owned();
+    String::from_utf8_lossy(&reply).into_owned()
+}
+
+/// The status code and the body of a reply.
+fn split(reply: &str) -> (u16, String) {
     let status = reply
         .split_whitespace()
         .nth(1)
@@ -59,20 +94,57 @@ fn raw(addr: &str, request: &[u8]) -> (u16, String) {
     (status, body)
 }
 
-fn request(addr: &str, method: &str, path: &str, body: &str) -> (u16, String) {
-    let r = format!(
-        "{method} {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\nContent-Length: {}\r\n\r\n{body}",
-        body.len()
-    );
-    raw(addr, r.as_bytes())
+/// Sends raw bytes, returns the status code and the body.
+fn raw(addr: &str, request: &[u8]) -> (u16, String) {
+    split(&exchange(addr, request))
 }
 
-fn render(addr: &str, text: &str, extra: &str) -> serde_json::Value {
-    let body = format!(
+/// The text of a request with exactly these headers, and the length of its
+/// body.
+fn compose(method: &str, path: &str, headers: &[String], body: &str) -> String {
+    let mut r = format!("{method} {path} HTTP/1.1\r\n");
+    for h in headers {
+        r += h;
+        r += "\r\n";
+    }
+    r += &format!(
+        "Connection: close\r\nContent-Length: {}\r\n\r\n{body}",
+        body.len()
+    );
+    r
+}
+
+/// A request with exactly these headers.
+fn send(addr: &str, method: &str, path: &str, headers: &[String], body: &str) -> (u16, String) {
+    raw(addr, compose(method, path, headers, body).as_bytes())
+}
+
+/// The headers the page sends: its Host, the token, and JSON for a POST.
+fn page_headers(live: &Live, method: &str) -> Vec<String> {
+    let mut h = vec![
+        format!("Host: {}", live.addr),
+        format!("X-Subgram-Token: {}", live.token),
+    ];
+    if method == "POST" {
+        h.push("Content-Type: application/json".into());
+    }
+    h
+}
+
+/// A request as the page makes it.
+fn request(live: &Live, method: &str, path: &str, body: &str) -> (u16, String) {
+    send(&live.addr, method, path, &page_headers(live, method), body)
+}
+
+fn render_body(text: &str, extra: &str) -> String {
+    format!(
         "{{\"text\": {}{extra}}}",
         serde_json::to_string(text).unwrap()
-    );
-    let (status, reply) = request(addr, "POST", "/api/render", &body);
+    )
+}
+
+fn render(live: &Live, text: &str, extra: &str) -> serde_json::Value {
+    let (status, reply) = request(live, "POST", "/api/render", &render_body(text, extra));
     assert_eq!(status, 200, "{reply}");
     serde_json::from_str(&reply).unwrap()
 }
@@ -96,16 +168,17 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
 
 #[test]
 fn the_page_and_the_api_draw_an_edited_text_and_place_its_errors() {
-    let (addr, tmp) = start("draw", KOCH, false, Limits::default());
-    let dir = tmp.path();
+    let live = start("draw", KOCH, false, Limits::default());
+    let addr = &live;
+    let dir = live.dir.path();
     let before = files(dir);
-    let (status, page) = request(&addr, "GET", "/", "");
+    let (status, page) = request(addr, "GET", "/", "");
     assert_eq!(status, 200);
     assert!(page.contains("/app.js") && page.contains("<textarea"));
     for asset in ["/app.js", "/app.css"] {
-        assert_eq!(request(&addr, "GET", asset, "").0, 200, "{asset}");
+        assert_eq!(request(addr, "GET", asset, "").0, 200, "{asset}");
     }
-    let (status, source) = request(&addr, "GET", "/api/source", "");
+    let (status, source) = request(addr, "GET", "/api/source", "");
     assert_eq!(status, 200);
     let source: serde_json::Value = serde_json::from_str(&source).unwrap();
     assert_eq!(source["text"], KOCH);
@@ -113,11 +186,11 @@ fn the_page_and_the_api_draw_an_edited_text_and_place_its_errors() {
 
     // The text as it stands, then an edit: another picture. 3 steps of
     // the snowflake are 3 · 4³ segments, 2 steps 3 · 4².
-    let three = render(&addr, KOCH, "");
+    let three = render(addr, KOCH, "");
     assert_eq!(three["ok"], true, "{three}");
     let svg3 = three["svg"].as_str().unwrap();
     assert!(svg3.starts_with("<svg"));
-    let two = render(&addr, KOCH, ", \"steps\": 2");
+    let two = render(addr, KOCH, ", \"steps\": 2");
     let svg2 = two["svg"].as_str().unwrap();
     assert_ne!(svg2, svg3);
     let segments = |svg: &str| svg.matches('L').count();
@@ -126,12 +199,12 @@ fn the_page_and_the_api_draw_an_edited_text_and_place_its_errors() {
     // A -D value from the page's fields.
     let defined =
         "#define N 2\nangle: 60;\nderivation length: N;\nAxiom: F--F--F;\nF -> F+F--F+F\n";
-    let r = render(&addr, defined, ", \"defines\": [\"N=1\"]");
+    let r = render(addr, defined, ", \"defines\": [\"N=1\"]");
     assert_eq!(segments(r["svg"].as_str().unwrap()), 3 * 4);
 
     // An error: its line and column in the edited text.
     let bad = KOCH.replace("F -> F+F", "F -> F+F @");
-    let r = render(&addr, &bad, "");
+    let r = render(addr, &bad, "");
     assert_eq!(r["ok"], false);
     let m = &r["messages"][0];
     let col = bad.lines().nth(3).unwrap().find('@').unwrap() as u64 + 1;
@@ -153,10 +226,11 @@ fn runaway_rules_stop_at_the_page_limits_and_the_server_goes_on() {
         max_steps: 50,
         timeout: Duration::from_secs(2),
     };
-    let (addr, _dir) = start("limits", KOCH, false, limits);
+    let live = start("limits", KOCH, false, limits);
+    let addr = &live;
     let t = std::time::Instant::now();
     let r = render(
-        &addr,
+        addr,
         "module A;\nderivation length: 60;\nAxiom: A;\nA -> A A\n",
         "",
     );
@@ -166,23 +240,24 @@ fn runaway_rules_stop_at_the_page_limits_and_the_server_goes_on() {
         "{r}"
     );
     let r = render(
-        &addr,
+        addr,
         "module A;\nderivation length: 2;\nAxiom: A;\nA : { int i = 0; while (1) { i = i + 1; } produce A; }\n",
         "",
     );
     assert_eq!(r["ok"], false, "{r}");
     assert!(matches!(r["limit"].as_str(), Some("time" | "loop")), "{r}");
-    let r = render(&addr, KOCH, ", \"steps\": 51");
+    let r = render(addr, KOCH, ", \"steps\": 51");
     assert_eq!(r["limit"], "steps", "{r}");
     assert!(t.elapsed() < Duration::from_secs(20));
     // Still there.
-    assert_eq!(render(&addr, KOCH, "")["ok"], true);
+    assert_eq!(render(addr, KOCH, "")["ok"], true);
 }
 
 #[test]
 fn malformed_requests_get_errors_and_nothing_from_the_disk_is_served() {
-    let (addr, tmp) = start("bad", KOCH, false, Limits::default());
-    let dir = tmp.path();
+    let live = start("bad", KOCH, false, Limits::default());
+    let addr = &live;
+    let dir = live.dir.path();
     std::fs::write(dir.join("secret.txt"), "not for the page").unwrap();
     for path in [
         "/secret.txt",
@@ -192,46 +267,51 @@ fn malformed_requests_get_errors_and_nothing_from_the_disk_is_served() {
         "/api/../secret.txt",
         "/etc/passwd",
     ] {
-        let (status, body) = request(&addr, "GET", path, "");
+        let (status, body) = request(addr, "GET", path, "");
         assert_eq!(status, 404, "{path}: {body}");
         assert!(
             !body.contains("not for the page") && !body.contains("F--F"),
             "{path}"
         );
     }
-    assert_eq!(request(&addr, "PUT", "/", "").0, 405);
-    assert_eq!(request(&addr, "GET", "/api/render", "").0, 405);
-    let (status, body) = request(&addr, "POST", "/api/render", "{not json");
+    assert_eq!(request(addr, "PUT", "/", "").0, 405);
+    assert_eq!(request(addr, "GET", "/api/render", "").0, 405);
+    let (status, body) = request(addr, "POST", "/api/render", "{not json");
     assert_eq!(status, 400, "{body}");
-    let (status, _) = request(&addr, "POST", "/api/render", "{\"steps\": 2}");
+    let (status, _) = request(addr, "POST", "/api/render", "{\"steps\": 2}");
     assert_eq!(status, 400);
     // A body announced larger than the limit is refused before it is read.
-    let big = format!(
-        "POST /api/render HTTP/1.1\r\nHost: x\r\nConnection: close\r\nContent-Length: {}\r\n\r\n{{}}",
+    let mut big = String::from("POST /api/render HTTP/1.1\r\n");
+    for h in page_headers(&live, "POST") {
+        big += &format!("{h}\r\n");
+    }
+    big += &format!(
+        "Connection: close\r\nContent-Length: {}\r\n\r\n{{}}",
         subgram::serve::MAX_BODY + 1
     );
-    assert_eq!(raw(&addr, big.as_bytes()).0, 413);
+    assert_eq!(raw(&live.addr, big.as_bytes()).0, 413);
     // Not HTTP at all.
-    let (status, _) = raw(&addr, b"\x00\x01garbage\r\n\r\n");
+    let (status, _) = raw(&live.addr, b"\x00\x01garbage\r\n\r\n");
     assert!(status == 400 || status == 0, "{status}");
     // Saving is off.
-    let (status, body) = request(&addr, "POST", "/api/save", "{\"text\": \"x\"}");
+    let (status, body) = request(addr, "POST", "/api/save", "{\"text\": \"x\"}");
     assert_eq!(status, 403, "{body}");
     assert_eq!(
         std::fs::read_to_string(dir.join("prog.lsys")).unwrap(),
         KOCH
     );
     // And the server still answers.
-    assert_eq!(render(&addr, KOCH, "")["ok"], true);
+    assert_eq!(render(addr, KOCH, "")["ok"], true);
 }
 
 #[test]
 fn with_save_the_page_writes_the_program_back_and_nothing_else() {
-    let (addr, tmp) = start("save", KOCH, true, Limits::default());
-    let dir = tmp.path();
+    let live = start("save", KOCH, true, Limits::default());
+    let addr = &live;
+    let dir = live.dir.path();
     let edited = KOCH.replace("derivation length: 3", "derivation length: 2");
     let body = format!("{{\"text\": {}}}", serde_json::to_string(&edited).unwrap());
-    let (status, reply) = request(&addr, "POST", "/api/save", &body);
+    let (status, reply) = request(addr, "POST", "/api/save", &body);
     assert_eq!(status, 200, "{reply}");
     assert_eq!(
         std::fs::read_to_string(dir.join("prog.lsys")).unwrap(),
@@ -239,7 +319,7 @@ fn with_save_the_page_writes_the_program_back_and_nothing_else() {
     );
     let names: Vec<String> = files(dir).into_iter().map(|(n, _)| n).collect();
     assert_eq!(names, ["prog.lsys"], "no temporary file left");
-    let (_, source) = request(&addr, "GET", "/api/source", "");
+    let (_, source) = request(addr, "GET", "/api/source", "");
     assert!(source.contains("derivation length: 2"));
 }
 
@@ -256,11 +336,415 @@ fn a_surface_grammar_shows_its_shaded_mesh() {
             &format!("mesh: {:?};", mesh.to_str().unwrap()),
         );
     assert!(grammar.contains(mesh.to_str().unwrap()));
-    let (addr, _dir) = start("surface", &grammar, false, Limits::default());
-    let r = render(&addr, &grammar, ", \"steps\": 2");
+    let live = start("surface", &grammar, false, Limits::default());
+    let addr = &live;
+    let r = render(addr, &grammar, ", \"steps\": 2");
     assert_eq!(r["ok"], true, "{r}");
     assert_eq!(
         r["svg"].as_str().unwrap().matches("<polygon").count(),
         8 * 16
     );
+}
+
+/// The checks against other web pages: a page of another
+/// origin, or a name of an attacker's that resolves to 127.0.0.1 (DNS
+/// rebinding), can neither write the program (with `--save` on) nor read
+/// it, nor read the page with its token; a request without the run's
+/// token, or with a body that is not JSON, is refused. The program stays
+/// byte for byte as it was.
+#[test]
+fn other_origins_and_hosts_cannot_save_read_or_see_the_token() {
+    let live = start("origins", KOCH, true, Limits::default());
+    let addr = &live.addr;
+    let before = live.program();
+    let host = format!("Host: {addr}");
+    let token = format!("X-Subgram-Token: {}", live.token);
+    let json = "Content-Type: application/json".to_string();
+    let evil = "Origin: http://evil.example".to_string();
+    let save = "{\"text\": \"Axiom: F;\\n\"}";
+    let h = |v: &[&String]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let refused = |what: &str, status: u16, headers: Vec<String>, method: &str, path: &str| {
+        let (got, body) = send(addr, method, path, &headers, save);
+        assert_eq!(got, status, "{what}: {body}");
+        let reply: serde_json::Value = serde_json::from_str(&body)
+            .unwrap_or_else(|e| panic!("{what}: not JSON ({e}): {body}"));
+        assert_eq!(reply["ok"], false, "{what}: {body}");
+        assert!(reply["message"].is_string(), "{what}: {body}");
+        assert!(!body.contains(&live.token), "{what}: the token leaked");
+        assert!(!body.contains("F--F"), "{what}: the program leaked");
+        assert_eq!(live.program(), before, "{what}: the program was written");
+    };
+    let text_plain = "Content-Type: text/plain".to_string();
+    // A form or a no-cors fetch of another page: text/plain, no token.
+    refused(
+        "cross-origin text/plain save",
+        403,
+        h(&[&host, &evil, &text_plain]),
+        "POST",
+        "/api/save",
+    );
+    // Even with the token and JSON, another origin is refused.
+    refused(
+        "cross-origin save with the token",
+        403,
+        h(&[&host, &evil, &token, &json]),
+        "POST",
+        "/api/save",
+    );
+    for origin in [
+        "null",
+        "http://127.0.0.1",
+        "http://localhost:1",
+        "https://127.0.0.1",
+    ] {
+        let o = format!("Origin: {origin}");
+        refused(
+            origin,
+            403,
+            h(&[&host, &o, &token, &json]),
+            "POST",
+            "/api/save",
+        );
+    }
+    // JSON without the token, or with another one.
+    refused("no token", 403, h(&[&host, &json]), "POST", "/api/save");
+    let wrong = format!("X-Subgram-Token: {}", "0".repeat(64));
+    refused(
+        "a wrong token",
+        403,
+        h(&[&host, &json, &wrong]),
+        "POST",
+        "/api/save",
+    );
+    let short = format!("X-Subgram-Token: {}", &live.token[..63]);
+    refused(
+        "a token cut short",
+        403,
+        h(&[&host, &json, &short]),
+        "POST",
+        "/api/save",
+    );
+    // The token twice (one of them right): ambiguous, refused.
+    refused(
+        "two tokens",
+        400,
+        h(&[&host, &json, &wrong, &token]),
+        "POST",
+        "/api/save",
+    );
+    // The token, but not JSON: 415, on both POST routes.
+    refused(
+        "text/plain",
+        415,
+        h(&[&host, &token, &text_plain]),
+        "POST",
+        "/api/save",
+    );
+    refused(
+        "no content type",
+        415,
+        h(&[&host, &token]),
+        "POST",
+        "/api/save",
+    );
+    let form = "Content-Type: application/x-www-form-urlencoded".to_string();
+    refused(
+        "a form",
+        415,
+        h(&[&host, &token, &form]),
+        "POST",
+        "/api/render",
+    );
+    let jsonish = "Content-Type: application/jsonp".to_string();
+    refused(
+        "application/jsonp",
+        415,
+        h(&[&host, &token, &jsonish]),
+        "POST",
+        "/api/save",
+    );
+    // DNS rebinding: the attacker's name, on the page and on the API.
+    let rebound = "Host: evil.example".to_string();
+    let rebound_port = format!("Host: evil.example:{}", live.port);
+    for (what, headers, method, path) in [
+        ("rebound page", h(&[&rebound]), "GET", "/"),
+        (
+            "rebound page with the port",
+            h(&[&rebound_port]),
+            "GET",
+            "/",
+        ),
+        ("rebound script", h(&[&rebound_port]), "GET", "/app.js"),
+        (
+            "rebound source",
+            h(&[&rebound_port, &token]),
+            "GET",
+            "/api/source",
+        ),
+        (
+            "rebound save",
+            h(&[&rebound_port, &token, &json]),
+            "POST",
+            "/api/save",
+        ),
+        (
+            "rebound render",
+            h(&[&rebound_port, &token, &json]),
+            "POST",
+            "/api/render",
+        ),
+    ] {
+        refused(what, 403, headers, method, path);
+    }
+    // Another port, no port, no Host at all, two Hosts.
+    let other_port = format!("Host: 127.0.0.1:{}", live.port.wrapping_add(1));
+    refused("another port", 403, h(&[&other_port]), "GET", "/");
+    refused(
+        "no port",
+        403,
+        h(&[&"Host: 127.0.0.1".to_string()]),
+        "GET",
+        "/",
+    );
+    refused("no Host", 403, Vec::new(), "GET", "/");
+    let (status, body) = raw(addr, b"GET / HTTP/1.0\r\n\r\n");
+    assert_eq!(status, 403, "HTTP/1.0 without a Host: {body}");
+    refused("two Hosts", 400, h(&[&host, &rebound]), "GET", "/");
+    // Browsers' Sec-Fetch-Site: another site, or another port of this host.
+    let cross = "Sec-Fetch-Site: cross-site".to_string();
+    let same_site = "Sec-Fetch-Site: same-site".to_string();
+    let none = "Sec-Fetch-Site: none".to_string();
+    refused("cross-site page", 403, h(&[&host, &cross]), "GET", "/");
+    refused(
+        "cross-site save",
+        403,
+        h(&[&host, &cross, &token, &json]),
+        "POST",
+        "/api/save",
+    );
+    refused(
+        "same-site source",
+        403,
+        h(&[&host, &same_site, &token]),
+        "GET",
+        "/api/source",
+    );
+    refused(
+        "a navigation to the API",
+        403,
+        h(&[&host, &none, &token]),
+        "GET",
+        "/api/source",
+    );
+    // The program's text needs the token too.
+    refused(
+        "source without the token",
+        403,
+        h(&[&host]),
+        "GET",
+        "/api/source",
+    );
+    // A navigation the user made (typing the address) gets the page.
+    let (status, _) = send(addr, "GET", "/", &h(&[&host, &none]), "");
+    assert_eq!(status, 200);
+    // The page's headers: no sniffing, its own script and style only, in
+    // no frame, never cached.
+    let reply = exchange(addr, compose("GET", "/", &h(&[&host]), "").as_bytes());
+    let head = reply.split("\r\n\r\n").next().unwrap().to_ascii_lowercase();
+    for want in [
+        "x-content-type-options: nosniff",
+        "content-security-policy: default-src 'none'; script-src 'self'; style-src 'self'",
+        "frame-ancestors 'none'",
+        "x-frame-options: deny",
+        "cache-control: no-store",
+        "content-type: text/html",
+    ] {
+        assert!(head.contains(want), "no `{want}` in\n{head}");
+    }
+    let reply = exchange(
+        addr,
+        compose("GET", "/api/source", &h(&[&host]), "").as_bytes(),
+    );
+    assert!(reply
+        .to_ascii_lowercase()
+        .contains("x-content-type-options: nosniff"));
+    assert_eq!(live.program(), before);
+}
+
+/// The page's own requests: from its origin (either name of the loopback
+/// address), with the token and JSON (with a charset), as a browser sends
+/// them, are answered, and Save writes the program.
+#[test]
+fn the_page_s_own_origin_with_the_token_and_json_is_answered() {
+    let live = start("own", KOCH, true, Limits::default());
+    let edited = KOCH.replace("derivation length: 3", "derivation length: 1");
+    let body = format!("{{\"text\": {}}}", serde_json::to_string(&edited).unwrap());
+    for (host, origin) in [
+        (live.addr.clone(), live.addr.clone()),
+        (
+            format!("localhost:{}", live.port),
+            format!("localhost:{}", live.port),
+        ),
+        (
+            format!("LocalHost:{}", live.port),
+            format!("localhost:{}", live.port),
+        ),
+    ] {
+        let headers = vec![
+            format!("Host: {host}"),
+            format!("Origin: http://{origin}"),
+            "Sec-Fetch-Site: same-origin".to_string(),
+            format!("X-Subgram-Token: {}", live.token),
+            "Content-Type: application/json; charset=utf-8".to_string(),
+        ];
+        let (status, reply) = send(
+            &live.addr,
+            "POST",
+            "/api/render",
+            &headers,
+            &render_body(KOCH, ""),
+        );
+        assert_eq!(status, 200, "{host}: {reply}");
+        assert!(reply.contains("\"ok\":true"), "{host}: {reply}");
+        let (status, source) = send(&live.addr, "GET", "/api/source", &headers[..4], "");
+        assert_eq!(status, 200, "{host}: {source}");
+        std::fs::write(live.dir.path().join("prog.lsys"), KOCH).unwrap();
+        let (status, reply) = send(&live.addr, "POST", "/api/save", &headers, &body);
+        assert_eq!(status, 200, "{host}: {reply}");
+        assert_eq!(live.program(), edited.as_bytes(), "{host}");
+    }
+}
+
+/// A request that does not finish, opened and left as it is: the headers
+/// and a part of the announced body. The server's thread for it waits for
+/// the rest (until `REQUEST_TIMEOUT`, far longer than this test).
+fn hanging(live: &Live) -> TcpStream {
+    let mut s = TcpStream::connect(&live.addr).unwrap();
+    let mut r = "POST /api/render HTTP/1.1\r\n".to_string();
+    for h in page_headers(live, "POST") {
+        r += &h;
+        r += "\r\n";
+    }
+    r += "Content-Length: 100000\r\n\r\n{\"text\": \"";
+    s.write_all(r.as_bytes()).unwrap();
+    s
+}
+
+/// Until `f` is true, for at most `secs` seconds.
+fn within(secs: u64, what: &str, mut f: impl FnMut() -> bool) {
+    let t = Instant::now();
+    while !f() {
+        assert!(
+            t.elapsed() < Duration::from_secs(secs),
+            "{what}: not within {secs} s"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// One request that blocks (a client that never sends its body; a render
+/// of a grammar whose mesh is a FIFO nobody writes) stops neither the page
+/// nor other renders; past [`MAX_IN_FLIGHT`] requests at once the server
+/// answers 503 at once, and when they go it answers again.
+#[test]
+fn a_blocked_request_does_not_stop_the_others() {
+    let live = start("blocked", KOCH, false, Limits::default());
+    let mut held = vec![hanging(&live)];
+
+    // A FIFO as the base mesh: reading it blocks until someone writes, or
+    // is refused at once where FIFOs are refused; both are fine here.
+    #[cfg(unix)]
+    let fifo = {
+        let fifo = live.dir.path().join("mesh.obj");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let grammar = std::fs::read_to_string(crate::support::lsys("surfaces/loop.lsys"))
+            .unwrap()
+            .replace(
+                "mesh: \"../meshes/octahedron.obj\";",
+                &format!("mesh: {:?};", fifo.to_str().unwrap()),
+            );
+        assert!(grammar.contains(fifo.to_str().unwrap()));
+        let r = compose(
+            "POST",
+            "/api/render",
+            &page_headers(&live, "POST"),
+            &render_body(&grammar, ", \"steps\": 1"),
+        );
+        let addr = live.addr.clone();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || tx.send(raw(&addr, r.as_bytes())));
+        (fifo, rx)
+    };
+
+    // The others are answered, and quickly.
+    let t = Instant::now();
+    let (status, page) = request(&live, "GET", "/", "");
+    assert_eq!(status, 200);
+    assert!(page.contains("<textarea"));
+    assert_eq!(render(&live, KOCH, "")["ok"], true);
+    assert!(t.elapsed() < Duration::from_secs(5), "{:?}", t.elapsed());
+
+    #[cfg(unix)]
+    {
+        let (fifo, rx) = fifo;
+        // Let a blocked reader go: a writer that opens and closes gives
+        // it the end of the file. Opening without blocking fails while no
+        // reader has the FIFO open.
+        let mut reply = None;
+        within(30, "the FIFO render", || {
+            if let Ok(r) = rx.try_recv() {
+                reply = Some(r);
+                return true;
+            }
+            #[cfg(target_os = "linux")]
+            {
+                use std::os::unix::fs::OpenOptionsExt;
+                let _ = std::fs::OpenOptions::new()
+                    .write(true)
+                    .custom_flags(libc::O_NONBLOCK)
+                    .open(&fifo);
+            }
+            false
+        });
+        let (status, body) = reply.unwrap();
+        assert_eq!(status, 200, "{body}");
+        assert!(
+            body.contains("\"ok\":false"),
+            "an empty mesh draws nothing: {body}"
+        );
+    }
+
+    // The bound: with MAX_IN_FLIGHT requests hanging, one more gets 503 at
+    // once, not a place in a queue. (A hanging request that came while an
+    // earlier one still held its place got 503 itself: another is opened
+    // until the places are full.)
+    while held.len() < MAX_IN_FLIGHT {
+        held.push(hanging(&live));
+    }
+    within(10, "503 with every place taken", || {
+        let t = Instant::now();
+        let (status, body) = request(&live, "GET", "/", "");
+        assert!(t.elapsed() < Duration::from_secs(5), "{:?}", t.elapsed());
+        match status {
+            503 => assert!(body.contains("busy"), "{body}"),
+            200 => held.push(hanging(&live)),
+            _ => panic!("{status}: {body}"),
+        }
+        status == 503
+    });
+    assert!(
+        held.len() < 2 * MAX_IN_FLIGHT,
+        "{} requests held",
+        held.len()
+    );
+    // The clients go: their requests end, and the server answers again.
+    drop(held);
+    within(10, "answers again", || {
+        request(&live, "GET", "/", "").0 == 200
+    });
+    assert_eq!(render(&live, KOCH, "")["ok"], true);
 }
