@@ -293,6 +293,37 @@ fn outputs_are_all_or_none() {
         .contains("mtllib"));
 }
 
+/// A model with two views: when the second view's file cannot be written
+/// (a folder holds its name), the main picture that was there before
+/// stays as it was (before, it was replaced and the command failed).
+#[test]
+fn views_are_all_or_none() {
+    let tmp = scratch("nohang-views");
+    let dir = tmp.path();
+    std::fs::write(
+        dir.join("view.v"),
+        "window: Top 0.0 0.0 1.0 0.5\nwindow: Side 0.0 0.5 0.5 0.5\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("lsystem.l"),
+        "module A(int);\nderivation length: 2;\n\
+         Start: { UseView(Top); UseView(Side); }\nAxiom: A(1);\n\
+         A(x) : { produce F(1) SB() Left(45) A(x+1) EB() A(x+1); }\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("out.svg"), "old").unwrap();
+    std::fs::create_dir(dir.join("out-Side.svg")).unwrap();
+    std::fs::write(dir.join("out-Side.svg/keep"), "k").unwrap();
+    let (o, _) = bin(dir, &["render", "lsystem.l", "-o", "out.svg"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(dir.join("out.svg")).unwrap(), "old");
+    assert_eq!(
+        names(dir),
+        ["lsystem.l", "out-Side.svg", "out.svg", "view.v"]
+    );
+}
+
 /// `--allow-writes`: a path through a link that leads out of the folder
 /// is refused before any folder is made, there or elsewhere; and a run
 /// that fails leaves no folder it made for an earlier file.
