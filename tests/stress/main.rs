@@ -44,20 +44,28 @@ fn tracing_the_worst_8192_image_stays_under_1_gb() {
         .tempdir()
         .unwrap();
     let dir = tmp.path();
-    let n = 8192u32;
-    let mut pm = tiny_skia::Pixmap::new(n, n).unwrap();
-    pm.fill(tiny_skia::Color::WHITE);
-    let black = tiny_skia::PremultipliedColorU8::from_rgba(0, 0, 0, 255).unwrap();
-    let px = pm.pixels_mut();
-    for y in 4..n - 4 {
-        for x in 4..n - 4 {
-            if (x / 2 + y / 2) % 2 == 0 {
-                px[(y * n + x) as usize] = black;
+    let n = 8192usize;
+    // A 1-bit grey PNG written here (8 MiB, small beside the tracer's
+    // memory, so that the child's peak is its own): white, with 2-pixel
+    // black squares everywhere but a 4-pixel frame.
+    let mut raw = Vec::with_capacity(n * (n / 8 + 1));
+    for y in 0..n {
+        raw.push(0); // no filter
+        for byte in 0..n / 8 {
+            let mut b = 0u8;
+            for bit in 0..8 {
+                let x = byte * 8 + bit;
+                let inside = (4..n - 4).contains(&x) && (4..n - 4).contains(&y);
+                let black = inside && (x / 2 + y / 2) % 2 == 0;
+                if !black {
+                    b |= 0x80 >> bit;
+                }
             }
+            raw.push(b);
         }
     }
-    pm.save_png(dir.join("board.png")).unwrap();
-    drop(pm);
+    std::fs::write(dir.join("board.png"), png_1bit(n as u32, &raw)).unwrap();
+    drop(raw);
     let (code, err, rss, took) = run_measured(
         dir,
         &[
@@ -72,14 +80,66 @@ fn tracing_the_worst_8192_image_stays_under_1_gb() {
         ],
     );
     eprintln!(
-        "8192² board: exit {code:?}, peak {} MiB, {:.1} s",
+        "8192² board: exit {code:?}, peak {} MiB, {:.1} s: {err}",
         rss >> 20,
         took.as_secs_f64()
     );
     assert!(rss < 1_000_000_000, "peak resident size {rss} bytes; {err}");
+    assert!(!err.contains("input size limit"), "{err}");
     // The largest loop is one 2×2 square: a contour of a few points, which
     // reverse subdivision refuses or reduces; either way it ran to the end
     // without running out of memory.
     assert!(matches!(code, Some(0) | Some(1)), "{code:?}: {err}");
     assert!(!err.contains("memory"), "{err}");
+}
+
+/// A PNG of `n`×`n` 1-bit grey pixels from its filtered rows, its image
+/// data in stored (uncompressed) deflate blocks.
+fn png_1bit(n: u32, raw: &[u8]) -> Vec<u8> {
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in bytes {
+            c ^= b as u32;
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+    fn chunk(out: &mut Vec<u8>, kind: &[u8], data: &[u8]) {
+        out.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let start = out.len();
+        out.extend_from_slice(kind);
+        out.extend_from_slice(data);
+        let crc = crc32(&out[start..]);
+        out.extend_from_slice(&crc.to_be_bytes());
+    }
+    let mut zlib = vec![0x78, 0x01];
+    let blocks: Vec<&[u8]> = raw.chunks(65_535).collect();
+    for (k, b) in blocks.iter().enumerate() {
+        zlib.push(u8::from(k + 1 == blocks.len()));
+        let len = b.len() as u16;
+        zlib.extend_from_slice(&len.to_le_bytes());
+        zlib.extend_from_slice(&(!len).to_le_bytes());
+        zlib.extend_from_slice(b);
+    }
+    let (mut a, mut b) = (1u32, 0u32);
+    for &x in raw {
+        a = (a + x as u32) % 65_521;
+        b = (b + a) % 65_521;
+    }
+    zlib.extend_from_slice(&((b << 16) | a).to_be_bytes());
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&n.to_be_bytes());
+    ihdr.extend_from_slice(&n.to_be_bytes());
+    ihdr.extend_from_slice(&[1, 0, 0, 0, 0]); // 1 bit, grey
+    let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
+    chunk(&mut out, b"IHDR", &ihdr);
+    chunk(&mut out, b"IDAT", &zlib);
+    chunk(&mut out, b"IEND", &[]);
+    out
 }
