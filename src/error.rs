@@ -177,8 +177,15 @@ impl fmt::Display for Error {
                 sources,
                 diagnostics,
             } => {
-                for (i, d) in diagnostics.iter().enumerate() {
-                    if i > 0 {
+                // A diagnostic that renders as one already shown (an error
+                // inside a macro used twice, placed at the macro's text) is
+                // shown once.
+                let mut shown = std::collections::HashSet::new();
+                for d in diagnostics {
+                    if !shown.insert((d.span, d.message.as_str())) {
+                        continue;
+                    }
+                    if shown.len() > 1 {
                         f.write_str("\n\n")?;
                     }
                     f.write_str(&sources.render(d.span, &d.message))?;

@@ -168,6 +168,9 @@ struct Compiler {
     /// by name.
     user_fns: Vec<UserSig>,
     user_fn_names: HashMap<String, u16>,
+    /// "Did you mean" hints given so far: past [`MAX_HINTS`] none is
+    /// looked for (a million misspelt names cost a million searches).
+    hints: usize,
     /// `enum` constants; those declared in a struct also as `S::NAME`.
     enum_consts: HashMap<String, i64>,
     /// Enumerators declared in a struct that `NAME` alone names (no
@@ -219,6 +222,10 @@ const MAX_INLINED_CALLS: usize = 10_000;
 /// body's nesting to the checked expression, which the checker, the
 /// specialisations and the interpreter walk recursively.
 const MAX_INLINE_DEPTH: usize = 32;
+
+/// The most "did you mean" hints one program's check looks for (as many
+/// as the errors shown).
+const MAX_HINTS: usize = 100;
 
 /// Local variables of one body, with nested block scopes.
 #[derive(Default)]
@@ -433,6 +440,7 @@ impl Compiler {
             truncating: Vec::new(),
             user_fns: Vec::new(),
             user_fn_names: HashMap::new(),
+            hints: 0,
             enum_consts: HashMap::new(),
             struct_enums: HashSet::new(),
             ambiguous_enums: HashSet::new(),
@@ -994,6 +1002,7 @@ impl Compiler {
                         self.err(*span, "the axiom is given twice");
                     }
                     axiom_seen = true;
+                    self.check_branches(modules, "the axiom");
                     let mut scope = Scope::default();
                     program.axiom = self.successors(modules, &mut scope);
                 }
@@ -1373,6 +1382,7 @@ impl Compiler {
         let body = match &p.body {
             ast::Body::Block(b) => self.block_stmts(&b.stmts, &mut scope),
             ast::Body::Arrow(succ, _) => {
+                self.check_branches(succ, "the successor");
                 let modules = self.successors(succ, &mut scope);
                 vec![St::Produce {
                     modules,
@@ -1426,6 +1436,117 @@ impl Compiler {
         })
     }
 
+    /// A warning at a `]` that closes no branch of `modules`, or at the
+    /// first `[` that is never closed (`X -> F-[[X]+X]+F[+FX-X`): the
+    /// derivation runs, but the turtle's branches are not what was meant.
+    fn check_branches(&mut self, modules: &[ast::ModuleCall], what: &str) {
+        let mut open: Vec<Span> = Vec::new();
+        for m in modules {
+            match m.name.text.as_str() {
+                "SB" | "[" => open.push(m.name.span),
+                "EB" | "]" if open.pop().is_none() => {
+                    let at = Diagnostic::new(
+                        m.name.span,
+                        format!("this `]` closes no branch: the brackets of {what} do not balance"),
+                    );
+                    self.warnings.push(at);
+                    return;
+                }
+                _ => {}
+            }
+        }
+        if let Some(&first) = open.first() {
+            let n = open.len();
+            let more = if n > 1 {
+                format!(" ({n} branches are left open)")
+            } else {
+                String::new()
+            };
+            let at = Diagnostic::new(
+                first,
+                format!("this `[` is never closed: the brackets of {what} do not balance{more}"),
+            );
+            self.warnings.push(at);
+        }
+    }
+
+    /// The names a value may have here, sorted: the visible locals, the
+    /// globals, enumerators, the host's values and the language's
+    /// constants (for "did you mean").
+    fn value_names(&self, scope: &Scope) -> Vec<String> {
+        let mut names: Vec<String> = scope.vars[scope.barrier.min(scope.vars.len())..]
+            .iter()
+            .map(|(n, _, _)| n.clone())
+            .chain(self.global_names.keys().cloned())
+            .chain(self.enum_consts.keys().cloned())
+            .chain(self.host.values.iter().map(|(n, _, _)| n.to_string()))
+            .chain(
+                [
+                    "true", "false", "M_PI", "PI", "M_PI_2", "M_E", "M_SQRT2", "RAND_MAX", "NULL",
+                    "stdout", "stderr",
+                ]
+                .map(String::from),
+            )
+            .collect();
+        names.sort();
+        names.dedup();
+        names
+    }
+
+    /// The functions a call may name, sorted: the library's, the host's,
+    /// the program's own and C's input and output (for "did you mean").
+    fn function_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = builtins::LIBRARY
+            .iter()
+            .map(|b| b.name.to_string())
+            .chain(self.host.functions.iter().map(|b| b.name.to_string()))
+            .chain(self.user_fn_names.keys().cloned())
+            .chain(
+                [
+                    "printf", "fprintf", "sprintf", "snprintf", "puts", "fputs", "fopen", "fclose",
+                    "fflush", "strlen", "strcmp", "strcpy", "strcat", "strncpy", "strncat",
+                ]
+                .map(String::from),
+            )
+            .collect();
+        names.sort();
+        names.dedup();
+        names
+    }
+
+    /// True while fewer than [`MAX_HINTS`] hints were looked for; counts
+    /// this one.
+    fn hint_allowed(&mut self) -> bool {
+        self.hints += 1;
+        self.hints <= MAX_HINTS
+    }
+
+    /// "; did you mean `x`?" for a value's name that is not known.
+    fn value_hint(&mut self, name: &str, scope: &Scope) -> String {
+        if !self.hint_allowed() {
+            return String::new();
+        }
+        let names = self.value_names(scope);
+        super::suggest::hint(name, names.iter().map(String::as_str))
+    }
+
+    /// "; did you mean `Apex`?" for a module name that is not declared,
+    /// from the modules the program declares and the predefined ones.
+    fn module_hint(&mut self, name: &str) -> String {
+        if !self.hint_allowed() {
+            return String::new();
+        }
+        let mut names: Vec<&str> = self
+            .alphabet
+            .kinds
+            .iter()
+            .map(|k| k.name.as_str())
+            .collect();
+        names.sort_unstable();
+        names.dedup();
+        super::suggest::hint(name, names)
+    }
+
     /// The module `name` and its parameter types for `count` parameters.
     fn module_params(
         &mut self,
@@ -1433,7 +1554,9 @@ impl Compiler {
         count: usize,
     ) -> Option<(Sym, Vec<Ty>, Option<usize>)> {
         let Some(sym) = self.alphabet.lookup(&name.text) else {
-            let mut m = super::modules::undeclared(&name.text, &vec!["float"; count].join(", "));
+            let hint = self.module_hint(&name.text);
+            let mut m =
+                super::modules::undeclared(&name.text, &vec!["float"; count].join(", "), &hint);
             if name.text == "Step" && count == 0 {
                 // `Step:` is a block only in a vv program.
                 m.push_str(
@@ -1508,9 +1631,10 @@ impl Compiler {
             }
             let Some(sym) = self.alphabet.lookup(&m.name.text) else {
                 let types: Vec<String> = args.iter().map(|(_, t)| self.type_name(*t)).collect();
+                let hint = self.module_hint(&m.name.text);
                 self.err(
                     m.name.span,
-                    super::modules::undeclared(&m.name.text, &types.join(", ")),
+                    super::modules::undeclared(&m.name.text, &types.join(", "), &hint),
                 );
                 continue;
             };
@@ -1989,7 +2113,8 @@ impl Compiler {
                         chars: self.global_chars.get(&g).cloned().map(Box::new),
                     });
                 }
-                self.err(e.span, format!("unknown identifier `{n}`"));
+                let hint = self.value_hint(n, scope);
+                self.err(e.span, format!("unknown identifier `{n}`{hint}"));
                 None
             }
             ExprKind::Field(base, f) => {
@@ -2135,7 +2260,7 @@ impl Compiler {
                         let hint = if self.alphabet.lookup(n).is_some() {
                             format!(": `{n}` is a module, not a value")
                         } else {
-                            String::new()
+                            self.value_hint(n, scope)
                         };
                         self.err(span, format!("unknown identifier `{n}`{hint}"));
                         return None;
@@ -2616,6 +2741,9 @@ impl Compiler {
         let Some(b) = builtins::lookup(n, self.host) else {
             let hint = if self.alphabet.lookup(n).is_some() {
                 format!(": `{n}` is a module; modules go after `produce`, not in expressions")
+            } else if self.hint_allowed() {
+                let names = self.function_names();
+                super::suggest::hint(n, names.iter().map(String::as_str))
             } else {
                 String::new()
             };

@@ -10,6 +10,7 @@ pub mod modules;
 pub mod random;
 pub mod stdio;
 pub mod stencil;
+pub mod suggest;
 pub mod value;
 
 pub use ir::Program;

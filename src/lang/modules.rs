@@ -181,14 +181,16 @@ pub const NOT_YET: &[(&str, &str)] = &[
     ("PovRayStart", "it starts POV-Ray output"),
 ];
 
-/// The message for a module that is neither declared nor predefined.
-pub fn undeclared(name: &str, params: &str) -> String {
+/// The message for a module that is neither declared nor predefined;
+/// `hint` ("; did you mean `Apex`?", or nothing) follows, except for an
+/// lpfg module that is not supported yet.
+pub fn undeclared(name: &str, params: &str, hint: &str) -> String {
     match NOT_YET.iter().find(|(n, _)| *n == name) {
         Some((_, what)) => {
             format!("`{name}` is an lpfg module that subgram does not support yet: {what}")
         }
         None => format!(
-            "undeclared module `{name}`: declare it before use, e.g. `module {name}({params});`"
+            "undeclared module `{name}`: declare it before use, e.g. `module {name}({params});`{hint}"
         ),
     }
 }

@@ -1419,7 +1419,20 @@ impl<'t> Parser<'t> {
             });
         }
         if !matches!(self.peek().map(|t| &t.tok), Some(Tok::Ident(_))) {
-            return self.error("a module (a name, optionally with arguments in parentheses)");
+            let turtle = match self.peek().map(|t| &t.tok) {
+                Some(Tok::Punct(p)) if !self.abop && abop_punct(p).is_some() => Some(p.to_string()),
+                _ => None,
+            };
+            let mut e: PResult<ModuleCall> =
+                self.error("a module (a name, optionally with arguments in parentheses)");
+            if let (Some(p), Err(d)) = (turtle, e.as_mut()) {
+                d.message.push_str(&format!(
+                    "; `{p}` is a turtle command of the single-character notation (The \
+                     Algorithmic Beauty of Plants), which `angle: DEGREES;` at the start of a \
+                     line switches on"
+                ));
+            }
+            return e;
         }
         let name = self.name("a module name")?;
         let args = if self.eat_punct("(") {

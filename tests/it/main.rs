@@ -24,6 +24,7 @@ mod mesh;
 mod mesh_bounds;
 mod mesh_draw;
 mod mesh_io;
+mod mistakes;
 mod no_hang;
 mod model;
 mod one_language;

@@ -395,7 +395,7 @@ fn check_warns_about_view_commands_and_environmental_programs() {
         "{out}"
     );
     assert!(
-        out.lines().last().unwrap().contains(": ok (1 rules, "),
+        out.lines().last().unwrap().contains(": ok (1 production, "),
         "{out}"
     );
 }
