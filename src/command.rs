@@ -422,13 +422,27 @@ fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<S
     refuse_overwrite(&[output], &[file], a.force)?;
     let looks = MeshLooks::of_render(a);
     if mesh::io::Format::from_path(file).is_some() {
+        // Found before the mesh is read.
+        Picture::from_path(output).map_err(|_| {
+            Error::Usage(format!(
+                "cannot tell the format of `{}`: render draws a mesh as a picture (.png, .svg); \
+                 `subgram mesh convert` writes it as a mesh",
+                output.display()
+            ))
+        })?;
         write_mesh_picture(&load_mesh(file)?, output, &looks, &mut Out::Files)?;
         return Ok(Vec::new());
     }
     // A 3D file (.obj, .ply, .glb) is an L-system's geometry exported.
     let format = match crate::export::Format::from_path(output) {
         Some(_) => Picture::Png,
-        None => Picture::from_path(output)?,
+        None => Picture::from_path(output).map_err(|_| {
+            Error::Usage(format!(
+                "cannot tell the format of `{}`: render writes pictures (.png, .svg) and 3D \
+                 geometry (.obj, .ply, .glb)",
+                output.display()
+            ))
+        })?,
     };
     let system = load(file, &load_options(&a.defines, a.double))?;
     let mut warnings = system.warnings();
@@ -1121,6 +1135,16 @@ fn subdivide_in_run(
         output: a.program_output.clone(),
         ..RunOptions::default()
     };
+    if Picture::from_path(output).is_err()
+        && mesh::io::Format::from_path(output).is_none()
+        && !is_glb(output)
+    {
+        return Err(Error::Usage(format!(
+            "cannot tell the format of `{}`: subdivide writes meshes (.obj, .off, .ply, .glb) \
+             and pictures (.png, .svg)",
+            output.display()
+        )));
+    }
     let d = crate::render::mesh::MeshView::default();
     if Picture::from_path(output).is_err() && (a.shading.is_some() || a.no_wireframe) {
         let flag = if a.shading.is_some() {

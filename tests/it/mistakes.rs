@@ -159,3 +159,28 @@ fn check_counts_what_the_file_holds() {
         "{out}"
     );
 }
+
+/// A refused output names every format the command writes.
+#[test]
+fn a_refused_output_lists_what_the_command_writes() {
+    let tmp = scratch("mistakes-formats");
+    let dir = tmp.path();
+    let grammar = crate::support::root().join("lsystems/surfaces/loop.lsys");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .current_dir(dir)
+        .args([
+            "subdivide",
+            "--grammar",
+            grammar.to_str().unwrap(),
+            "-o",
+            "x.jpg",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim_end(),
+        "error: cannot tell the format of `x.jpg`: subdivide writes meshes (.obj, .off, .ply, \
+         .glb) and pictures (.png, .svg)"
+    );
+}
