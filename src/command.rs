@@ -105,6 +105,9 @@ pub struct DeriveArgs {
     pub allow_writes: Option<PathBuf>,
     /// What the program prints: the caller keeps a clone and prints it.
     pub output: ProgramOutput,
+    /// `-o FILE`: the word goes to this file (whole, or not at all)
+    /// instead of to `derive_to`'s writer.
+    pub word_file: Option<PathBuf>,
 }
 
 impl DeriveArgs {
@@ -123,6 +126,7 @@ impl DeriveArgs {
             timeout: Some(DEFAULT_TIMEOUT),
             allow_writes: None,
             output: ProgramOutput::default(),
+            word_file: None,
         }
     }
 }
@@ -181,11 +185,36 @@ fn derive_to_in_run(
     out: &mut dyn std::io::Write,
 ) -> Result<(), Error> {
     let deadline = crate::deadline::current();
+    if let Some(path) = a.word_file.as_deref() {
+        // derive has no --force: its program is never replaced.
+        if same_file(path, Path::new(&a.file)) {
+            return Err(Error::Usage(format!(
+                "the output `{}` is the program: writing it would replace it; name another output",
+                path.display()
+            )));
+        }
+    }
     let dir = writes_folder(&a.allow_writes, &a.output)?;
     let system = load(&a.file, &load_options(&a.defines, a.double))?;
     let warnings = system.warnings();
     let before = || before(&warnings);
-    derive_out(a, &system, deadline, dir.as_deref(), progress, before, out)
+    let Some(path) = &a.word_file else {
+        return derive_out(a, &system, deadline, dir.as_deref(), progress, before, out);
+    };
+    // Into a temporary beside the file, put in place when the run
+    // commits; the derivation's own error comes back as it is.
+    let mut failed = None;
+    let written = crate::atomic::write_atomic_with(path, |w| {
+        derive_out(a, &system, deadline, dir.as_deref(), progress, before, w).map_err(|e| {
+            failed = Some(e);
+            std::io::Error::other("the derivation failed")
+        })
+    });
+    match (written, failed) {
+        (_, Some(e)) => Err(e),
+        (Err(e), None) => Err(Error::write(path, e)),
+        (Ok(()), None) => Ok(()),
+    }
 }
 
 /// A mesh's counts after `steps` steps, as text or JSON.

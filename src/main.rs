@@ -58,6 +58,10 @@ enum Command {
         /// Let the program write files (fopen), under this folder.
         #[arg(long, value_name = "DIR")]
         allow_writes: Option<std::path::PathBuf>,
+        /// Write the word (or the mesh's description) to this file instead
+        /// of standard output: whole, or not at all.
+        #[arg(short = 'o', long = "output", value_name = "FILE")]
+        output: Option<std::path::PathBuf>,
         /// Stop with an error after this many seconds (0: no limit).
         #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
               default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
@@ -559,6 +563,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             seed,
             timeout,
             allow_writes,
+            output,
         } => {
             let json = matches!(format, Format::Json);
             let args = DeriveArgs {
@@ -575,6 +580,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 timeout: timeout.0,
                 allow_writes,
                 output: subgram::ProgramOutput::new(),
+                word_file: output,
             };
             // The word is written as it is made. Before it: what the
             // program printed (to standard error when the word is JSON,

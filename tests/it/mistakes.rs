@@ -184,3 +184,54 @@ fn a_refused_output_lists_what_the_command_writes() {
          .glb) and pictures (.png, .svg)"
     );
 }
+
+/// `derive -o FILE` (issue 40, item 7): the word goes to the file, whole,
+/// or not at all; never over the program.
+#[test]
+fn derive_writes_its_word_to_a_file() {
+    let tmp = scratch("mistakes-derive-o");
+    let dir = tmp.path();
+    let koch = "angle: 60;\nderivation length: 1;\nAxiom: F;\nF -> F+F--F+F\n";
+    std::fs::write(dir.join("k.lsys"), koch).unwrap();
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+            .current_dir(dir)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let o = run(&["derive", "k.lsys", "-o", "w.txt"]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.stdout.is_empty());
+    let printed = run(&["derive", "k.lsys"]);
+    assert_eq!(std::fs::read(dir.join("w.txt")).unwrap(), printed.stdout);
+    let o = run(&["derive", "k.lsys", "-o", "k.lsys"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains(
+        "the output `k.lsys` is the program: writing it would replace it; name another output"
+    ));
+    assert_eq!(std::fs::read_to_string(dir.join("k.lsys")).unwrap(), koch);
+    // A derivation that fails leaves no file.
+    let o = run(&[
+        "derive",
+        "k.lsys",
+        "-n",
+        "20",
+        "--max-modules",
+        "1000",
+        "-o",
+        "big.txt",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["k.lsys", "w.txt"]);
+}
