@@ -240,16 +240,29 @@ function show(reply) {
   if (reply.ok) {
     const url = "data:image/svg+xml;charset=utf-8," + encodeURIComponent(reply.svg);
     let img = picture.querySelector("img");
-    if (!img) { img = document.createElement("img"); img.alt = "the picture"; picture.append(img); }
+    if (!img) {
+      picture.querySelector(".empty")?.remove();
+      img = document.createElement("img"); img.alt = "the picture"; picture.append(img);
+    }
     img.src = url;
     picture.classList.remove("stale");
     state.version += 1;
     picture.dataset.version = state.version;
     status.textContent = `drawn in ${reply.seconds.toFixed(2)} s`;
   } else {
-    picture.classList.add("stale");
     status.className = "error";
-    status.textContent = reply.limit ? `stopped by the ${reply.limit} limit` : "error: the last good picture is kept";
+    const drawn = picture.querySelector("img") !== null;
+    if (drawn) picture.classList.add("stale");
+    const why = reply.limit ? `stopped by the ${reply.limit} limit` : "the program has errors";
+    status.textContent = drawn ? `${why}: the last good picture is kept` : `${why}: nothing drawn yet`;
+    if (!drawn) {
+      // An empty state that says why, in place of a blank pane.
+      let empty = picture.querySelector(".empty");
+      if (!empty) { empty = document.createElement("p"); empty.className = "empty"; picture.append(empty); }
+      empty.textContent = reply.limit
+        ? `No picture yet: the render was ${why}. Lower the steps, or edit the program.`
+        : "No picture yet: the program has errors (listed under the editor). Fix them and the picture appears here.";
+    }
   }
   paint();
 }

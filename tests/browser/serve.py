@@ -337,6 +337,31 @@ def main():
         with open(program) as f:
             assert f.read() == saved, "a rebound page wrote the program"
         checks += 1
+
+        # 9. A page opened on a broken program: the error under the editor,
+        # and in the picture's place an empty state that says why.
+        broken = os.path.join(work, "broken.lsys")
+        with open(broken, "w") as f:
+            f.write("angle: 60;\nAxiom: F;\nF -> F+F--F+F(\n")
+        second = subprocess.Popen([binary, "serve", broken, "--port", "0"],
+                                  stdout=subprocess.PIPE, stderr=log, text=True)
+        try:
+            line = second.stdout.readline()
+            url2 = next((w for w in line.split() if w.startswith("http://127.0.0.1:")), None)
+            assert url2, f"the second server printed no address: {line!r}"
+            page2 = Page(browser, url2)
+            page2.wait("document.getElementById('messages').children.length > 0",
+                       "the broken program's error")
+            status = page2.js("document.getElementById('status').textContent")
+            assert status == "the program has errors: nothing drawn yet", status
+            empty = page2.js("(document.querySelector('#picture .empty') || {}).textContent || ''")
+            assert empty.startswith("No picture yet: the program has errors"), empty
+            assert page2.js("document.querySelector('#picture img') === null")
+            page2.screenshot(os.path.join(outdir, "9-broken.png"))
+        finally:
+            second.terminate()
+            second.wait(timeout=10)
+        checks += 1
         print(f"browser test: {checks} checks passed; screenshots in {outdir}")
     finally:
         if browser:
