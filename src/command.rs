@@ -798,11 +798,28 @@ fn render_system(
     let white = Rgba(255, 255, 255, 255);
     let export = crate::export::Format::from_path(output);
     if export.is_some() && !matches!(system, System::Curve(_)) {
-        return Err(Error::Usage(format!(
-            "`{}`: render exports an L-system's 3D geometry; write a grammar's mesh with `subgram subdivide … -o {}`",
-            output.display(),
-            output.display()
-        )));
+        // A grammar's or a vv program's mesh, or a shape grammar's
+        // shapes: written as `subdivide` writes them.
+        if a.each {
+            return Err(Error::Usage(
+                "--each draws the steps of an L-system side by side; it writes no 3D file".into(),
+            ));
+        }
+        let sa = SubdivideArgs {
+            mesh: None,
+            grammar: a.file.clone(),
+            steps: a.steps,
+            output: a.output.clone(),
+            defines: a.defines.clone(),
+            view: None,
+            shading: None,
+            no_wireframe: false,
+            seed: a.seed,
+            timeout: a.timeout,
+            force: a.force,
+            program_output: a.program_output.clone(),
+        };
+        return subdivide_in_run(&sa, progress);
     }
     match system {
         System::Surface(s) => {

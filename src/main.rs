@@ -68,7 +68,9 @@ enum Command {
         timeout: Timeout,
     },
     /// Render an .lsys file's picture to PNG or SVG (in 3D when its model
-    /// asks, or with --solid), or export its 3D geometry to OBJ, PLY or GLB.
+    /// asks, or with --solid), or export its 3D geometry to OBJ, PLY or GLB
+    /// (a grammar's or a vv program's mesh, a shape grammar's shapes, as
+    /// `subdivide` writes them).
     Render(RenderCli),
     /// Render, then render again whenever the file or a file it reads
     /// changes (a model's files, a base mesh); an edit with an error keeps

@@ -235,3 +235,48 @@ fn derive_writes_its_word_to_a_file() {
     names.sort();
     assert_eq!(names, ["k.lsys", "w.txt"]);
 }
+
+/// `render` writes a surface grammar's, a vv program's and a shape
+/// grammar's 3D file as `subdivide` does (issue 40, item 7): the same
+/// bytes (a shape grammar's OBJ names its own MTL).
+#[test]
+fn render_writes_every_kind_of_system_as_subdivide_does() {
+    let tmp = scratch("mistakes-render-3d");
+    let dir = tmp.path();
+    let root = crate::support::root();
+    let run = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+            .current_dir(dir)
+            .args(args)
+            .output()
+            .unwrap();
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    for (file, steps, ext) in [
+        ("lsystems/surfaces/loop.lsys", "2", "obj"),
+        ("lsystems/vv/loop.lsys", "1", "ply"),
+        ("lsystems/shapes/building.lsys", "0", "obj"),
+        ("lsystems/shapes/building.lsys", "0", "glb"),
+    ] {
+        let g = root.join(file);
+        let g = g.to_str().unwrap();
+        let (r, s) = (format!("r.{ext}"), format!("s.{ext}"));
+        let mut render = vec!["render", g, "-o", &r];
+        let mut subdivide = vec!["subdivide", "--grammar", g, "-o", &s];
+        if steps != "0" {
+            render.extend(["-n", steps]);
+            subdivide.extend(["-n", steps]);
+        }
+        run(&render);
+        run(&subdivide);
+        let a = std::fs::read(dir.join(&r)).unwrap();
+        let b = std::fs::read(dir.join(&s)).unwrap();
+        let a = String::from_utf8_lossy(&a).replace("mtllib r.mtl", "mtllib s.mtl");
+        assert!(a == String::from_utf8_lossy(&b), "{file} .{ext} differs");
+    }
+}
