@@ -28,13 +28,26 @@ fn write_temp_with(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".into());
-    // Unique within the process too: two threads may write one target.
+    // Unique within the process too (two threads may write one target),
+    // and made new: a file or a link already under the name (another
+    // user's, in a shared folder) is never followed nor truncated.
     static COUNT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    let k = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let tmp = dir.join(format!(".{name}.tmp-{}-{k}", std::process::id()));
+    let (tmp, created) = loop {
+        let k = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let tmp = dir.join(format!(".{name}.tmp-{}-{k}", std::process::id()));
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+        {
+            Ok(f) => break (tmp, f),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        }
+    };
     let result = (|| {
         let file = Timed {
-            file: std::fs::File::create(&tmp)?,
+            file: created,
             deadline: crate::deadline::current(),
             writes: 0,
         };

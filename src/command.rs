@@ -750,7 +750,12 @@ pub fn watch(
         // What the program reads now; after an error that stops the
         // loading, the files of the last good load (and the file itself).
         if mesh::io::Format::from_path(&file).is_none() {
-            if let Ok(system) = load(&file, &load_options(&a.defines, a.double)) {
+            // Under the render's time limit: a pipe among the files waits
+            // no longer than the render would.
+            let loaded = crate::deadline::within(a.timeout, || {
+                load(&file, &load_options(&a.defines, a.double))
+            });
+            if let Ok(system) = loaded {
                 files = system.inputs();
                 if !files.contains(&file) {
                     files.insert(0, file.clone());
@@ -804,6 +809,13 @@ fn render_system(
             return Err(Error::Usage(
                 "--each draws the steps of an L-system side by side; it writes no 3D file".into(),
             ));
+        }
+        if a.allow_writes.is_some() {
+            return Err(Error::Usage(format!(
+                "--allow-writes: `{}` is written as `subdivide` writes a grammar's mesh, which \
+                 writes no program files; render to a picture to keep the program's files",
+                output.display()
+            )));
         }
         let sa = SubdivideArgs {
             mesh: None,

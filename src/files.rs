@@ -17,7 +17,9 @@
 //! every output in place, all or none: a file that a rename replaced is
 //! put back from a hard link kept beside it when a later rename fails, a
 //! file the run created is removed, and so is a folder it made. A run
-//! dropped without a commit leaves nothing behind.
+//! dropped without a commit leaves nothing behind; a process killed in the
+//! middle (Ctrl-C) leaves its hidden temporaries (`.NAME.tmp-PID-K`) and
+//! the folders it made, never a half-written output under its own name.
 
 use std::cell::RefCell;
 use std::io::Read;
@@ -51,6 +53,15 @@ impl Input {
 /// writer opens at once (and is read under the deadline), a folder or a
 /// socket is refused with a message that says what it is.
 pub(crate) fn open(path: &Path) -> std::io::Result<Input> {
+    // A socket cannot be opened at all (ENXIO, "no such device"): say
+    // what it is instead.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if std::fs::metadata(path).is_ok_and(|m| m.file_type().is_socket()) {
+            return Err(refused("it is a socket, not a file"));
+        }
+    }
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
     #[cfg(unix)]
@@ -104,6 +115,7 @@ pub(crate) fn open(path: &Path) -> std::io::Result<Input> {
         file,
         size: None,
         deadline: None,
+        began: false,
         what: "stream",
     })
 }
@@ -241,22 +253,60 @@ fn note_input(meta: &std::fs::Metadata) {
     });
 }
 
+/// Runs `work` on this thread (one without a run of its own, such as a
+/// thread with a larger stack that a command's work moved to) and gives
+/// back the (device, inode) of each regular file it opened, for the
+/// command's run ([`note_inputs`]).
+pub(crate) fn noting_inputs<T>(work: impl FnOnce() -> T) -> (T, Vec<(u64, u64)>) {
+    let fresh = LEDGER.with(|l| {
+        let mut l = l.borrow_mut();
+        if l.is_some() {
+            return false;
+        }
+        *l = Some(Ledger::default());
+        true
+    });
+    let value = work();
+    let inputs = if fresh {
+        LEDGER
+            .with(|l| l.borrow_mut().take())
+            .map(|l| {
+                // Nothing is written on such a thread; were anything
+                // staged, it is not left behind.
+                discard(&l);
+                l.inputs
+            })
+            .unwrap_or_default()
+    } else {
+        Vec::new()
+    };
+    (value, inputs)
+}
+
+/// Adds `inputs` to the current run's, if one is active on this thread.
+pub(crate) fn note_inputs(inputs: Vec<(u64, u64)>) {
+    LEDGER.with(|l| {
+        if let Some(l) = l.borrow_mut().as_mut() {
+            for id in inputs {
+                if !l.inputs.contains(&id) {
+                    l.inputs.push(id);
+                }
+            }
+        }
+    });
+}
+
 /// Hands the temporary file `temp`, written whole, to the current run to
 /// be renamed to `target` at its commit; gives it back when no run is
 /// active on this thread.
 pub(crate) fn stage(target: &Path, temp: PathBuf) -> Option<PathBuf> {
     LEDGER.with(|l| match l.borrow_mut().as_mut() {
         Some(l) => {
-            // The same target staged twice: the later one wins.
-            if let Some(old) = l.staged.iter_mut().find(|s| s.target == target) {
-                let _ = std::fs::remove_file(&old.temp);
-                old.temp = temp;
-            } else {
-                l.staged.push(Staged {
-                    target: target.to_path_buf(),
-                    temp,
-                });
-            }
+            // The same target staged twice is refused at the commit.
+            l.staged.push(Staged {
+                target: target.to_path_buf(),
+                temp,
+            });
             None
         }
         None => Some(temp),
@@ -383,12 +433,39 @@ fn commit(ledger: &Ledger) -> Result<(), Error> {
             }
         }
     }
+    // Two outputs of one run that are one file under two names (a program
+    // file of `--allow-writes` and `-o`): refused, not one lost.
+    let mut seen: Vec<(PathBuf, &Path)> = Vec::new();
+    for s in &ledger.staged {
+        let key = resolved(&s.target);
+        if let Some((_, first)) = seen.iter().find(|(k, _)| *k == key) {
+            return Err(Error::Usage(format!(
+                "`{}` and `{}` are the same output file; name two different files",
+                first.display(),
+                s.target.display()
+            )));
+        }
+        seen.push((key, &s.target));
+    }
     let targets: Vec<(&Path, &Path)> = ledger
         .staged
         .iter()
         .map(|s| (s.target.as_path(), s.temp.as_path()))
         .collect();
     rename_all(&targets).map_err(|(path, e)| Error::write(path, e))
+}
+
+/// `path` with its folder's links resolved (the folder exists: a staged
+/// temporary lies in it).
+fn resolved(path: &Path) -> PathBuf {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    match (dir.canonicalize(), path.file_name()) {
+        (Ok(d), Some(n)) => d.join(n),
+        _ => path.to_path_buf(),
+    }
 }
 
 /// The (device, inode) of the file `path` leads to, if it exists.
@@ -426,18 +503,15 @@ pub(crate) fn rename_all(files: &[(&Path, &Path)]) -> Result<(), (PathBuf, std::
             }
         }
     };
-    for (k, (target, temp)) in files.iter().enumerate() {
+    for (target, temp) in files {
         let backup = match std::fs::symlink_metadata(target) {
-            Ok(m) if !m.is_dir() => {
-                let b = sibling(target, &format!("bak-{k}"));
-                let _ = std::fs::remove_file(&b);
-                let kept = std::fs::hard_link(target, &b).or_else(|_| std::fs::rename(target, &b));
-                if let Err(e) = kept {
+            Ok(m) if !m.is_dir() => match keep_aside(target) {
+                Ok(b) => Some(b),
+                Err(e) => {
                     undo(&done);
                     return Err((target.to_path_buf(), e));
                 }
-                Some(b)
-            }
+            },
             _ => None,
         };
         if let Err(e) = std::fs::rename(temp, target) {
@@ -460,6 +534,33 @@ pub(crate) fn rename_all(files: &[(&Path, &Path)]) -> Result<(), (PathBuf, std::
         }
     }
     Ok(())
+}
+
+/// Keeps the file `target` under a fresh hidden name beside it: a hard
+/// link where the file system makes one, else the file moved there. No
+/// existing file is removed or replaced to make room.
+fn keep_aside(target: &Path) -> std::io::Result<PathBuf> {
+    static COUNT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    loop {
+        let k = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let b = sibling(target, &format!("bak-{k}"));
+        if std::fs::symlink_metadata(&b).is_ok() {
+            continue;
+        }
+        match std::fs::hard_link(target, &b) {
+            Ok(()) => return Ok(b),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(_) => {
+                // No hard links here: moved (the name was free a moment
+                // ago; rename would replace a file made since).
+                if std::fs::symlink_metadata(&b).is_ok() {
+                    continue;
+                }
+                std::fs::rename(target, &b)?;
+                return Ok(b);
+            }
+        }
+    }
 }
 
 /// A hidden name beside `path`: `.NAME.WHAT-PID`.
@@ -576,5 +677,9 @@ mod tests {
         // A folder and a socket are refused.
         let e = open(tmp.path()).err().unwrap();
         assert!(e.to_string().contains("folder"), "{e}");
+        let socket = tmp.path().join("s");
+        let _listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
+        let e = open(&socket).err().unwrap();
+        assert!(e.to_string().contains("socket"), "{e}");
     }
 }

@@ -639,15 +639,25 @@ const FRONT_STACK: usize = 64 << 20;
 /// used as needed), or on this thread when no thread can be made.
 pub(crate) fn with_stack<T: Send>(f: impl FnOnce() -> T + Send) -> T {
     let mut f = Some(f);
+    // The run's deadline and its list of inputs go with the work: a mesh
+    // that a shape grammar inserts is read under the one and noted in the
+    // other.
+    let deadline = crate::deadline::current();
     let spawned = std::thread::scope(|s| {
         std::thread::Builder::new()
             .name("subgram-check".into())
             .stack_size(FRONT_STACK)
-            .spawn_scoped(s, || (f.take().expect("not run yet"))())
+            .spawn_scoped(s, || {
+                let _scope = crate::deadline::scope(deadline);
+                crate::files::noting_inputs(|| (f.take().expect("not run yet"))())
+            })
             .map(|h| h.join())
     });
     match spawned {
-        Ok(Ok(v)) => v,
+        Ok(Ok((v, inputs))) => {
+            crate::files::note_inputs(inputs);
+            v
+        }
         Ok(Err(panic)) => std::panic::resume_unwind(panic),
         Err(_) => (f.take().expect("not run: the thread was not made"))(),
     }

@@ -61,7 +61,8 @@ pub fn analyze_at(path: &Path, defines: &[String], valences: &[usize]) -> Result
         precision: Precision::Double,
     };
     let name = path.display().to_string();
-    let deadline = Deadline::after(TIMEOUT);
+    // `--timeout` where the command set one, else the analysis's own.
+    let deadline = crate::deadline::current().unwrap_or_else(|| Deadline::after(TIMEOUT));
     let scheme = match load(path, &opts)? {
         System::Curve(c) => Scheme::Curve(Box::new(curve::analyze(&c, &name, deadline)?)),
         System::Surface(s) => {

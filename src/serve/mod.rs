@@ -284,8 +284,11 @@ impl Server {
                     continue;
                 };
             // When no thread can be made, the connection is closed.
+            // The stack the command line's thread has: a deep program
+            // recurses in the checker as it does there.
             let _ = std::thread::Builder::new()
                 .name("subgram serve".into())
+                .stack_size(256 << 20)
                 .spawn(work);
         }
     }
@@ -328,7 +331,10 @@ impl App {
     /// program once (a missing file is an error now) and draws the token.
     pub fn new(opts: ServeOptions, port: u16) -> Result<App, Error> {
         let program = crate::load::program_file(&opts.path)?;
-        std::fs::read_to_string(&program).map_err(|e| Error::read(&program, e))?;
+        // Read as every input is: without blocking (a pipe in its place
+        // waits no longer than a render may), and no more than a program
+        // may hold.
+        crate::deadline::within(Some(opts.limits.timeout), || crate::load::read(&program))?;
         let token = new_token()?;
         let page = PAGE.replace(TOKEN_SLOT, &token);
         Ok(App {
@@ -549,7 +555,8 @@ impl App {
     }
 
     fn source(&self) -> Reply {
-        match std::fs::read_to_string(&self.program) {
+        let limit = Some(self.opts.limits.timeout);
+        match crate::deadline::within(limit, || crate::load::read(&self.program)) {
             Ok(text) => json_reply(
                 200,
                 &serde_json::json!({
@@ -558,7 +565,7 @@ impl App {
                     "save": self.opts.save,
                 }),
             ),
-            Err(e) => failure(500, &format!("cannot read {}: {e}", self.program.display())),
+            Err(e) => failure(500, &format!("cannot read the program: {e}")),
         }
     }
 

@@ -371,3 +371,58 @@ fn program_files_stay_inside_and_leave_nothing_on_failure() {
         "b\n"
     );
 }
+
+/// Found in review: `serve` read its program with a plain read (a FIFO
+/// held it forever at start), `analyze` kept its own 120 s limit whatever
+/// `--timeout` said, and two outputs of one run under one name (`-o` and a
+/// program file of `--allow-writes`) lost one silently.
+#[test]
+fn serve_analyze_and_two_outputs_of_one_name() {
+    let tmp = scratch("nohang-review");
+    let dir = tmp.path();
+    mkfifo(&dir.join("p.lsys"));
+    let (o, took) = bin(dir, &["serve", "p.lsys", "--port", "0", "--timeout", "1"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(took < Duration::from_secs(4), "{took:?}");
+    assert!(err.contains("nothing came from this pipe"), "{err}");
+    let grammar = root().join("lsystems/surfaces/loop.lsys");
+    let (o, _) = bin(
+        dir,
+        &["analyze", grammar.to_str().unwrap(), "--timeout", "0.01"],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("time limit of 0.01 s"),
+        "{}",
+        stderr(&o)
+    );
+    // The program writes `w/word.txt`; `-o w/word.txt` names it too.
+    std::fs::create_dir(dir.join("w")).unwrap();
+    std::fs::write(
+        dir.join("two.lsys"),
+        "#include <lpfgall.h>\nderivation length: 1;\nStart: {\n\
+         FILE *f = fopen(\"word.txt\", \"w\"); fprintf(f, \"mine\\n\"); fclose(f);\n}\n\
+         Axiom: F;\n",
+    )
+    .unwrap();
+    let (o, _) = bin(
+        dir,
+        &[
+            "derive",
+            "two.lsys",
+            "--allow-writes",
+            "w",
+            "-o",
+            "w/word.txt",
+        ],
+    );
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("are the same output file"), "{err}");
+    assert!(
+        names(&dir.join("w")).is_empty(),
+        "{:?}",
+        names(&dir.join("w"))
+    );
+}
