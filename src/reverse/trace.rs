@@ -2,10 +2,12 @@
 //! interpolation (sub-pixel contours), segments linked into closed loops.
 //!
 //! The tracer keeps one byte a cell (its marching-squares case) and one bit
-//! an edge (seen), never a table of segments, and only the largest loop
-//! found so far: an 8192 × 8192 image of the worst kind (a checkerboard,
-//! where every cell holds a segment) is traced in about 100 MB beside the
-//! image. The deadline is looked at every row and every 65,536 steps along
+//! an edge (seen), never a table of segments, and of the loops only the
+//! largest so far (its area, first edge and length; its points are walked
+//! again at the end, at most [`MAX_CONTOUR_POINTS`]): an 8192 × 8192 image
+//! of any kind (a checkerboard, where every cell holds a segment, or one
+//! endless spiral) is traced in about 100 MB beside the image and the
+//! result. The deadline is looked at every row and every 65,536 steps along
 //! a loop.
 
 use glam::DVec2;
@@ -203,7 +205,11 @@ pub fn largest_contour(
         bits: vec![0; edges.div_ceil(64)],
         w: wi,
     };
-    let mut best: Option<(f64, Vec<DVec2>)> = None;
+    // The largest loop so far: its area, first edge and length. Loops are
+    // measured as they are followed and only the largest is walked again
+    // for its points, so that an image of one endless outline (a spiral)
+    // holds no points but the result's.
+    let mut best: Option<(f64, Key, usize)> = None;
     let mut steps: u64 = 0;
     // Loops start at their first edge in the order (y, x, d), so that the
     // same image always gives the same contour with the same first point.
@@ -223,7 +229,10 @@ pub fn largest_contour(
                 if seen.get(start) || cells.next(start).is_none() {
                     continue;
                 }
-                let mut pts = Vec::new();
+                // Twice the signed area, summed in the order
+                // `signed_area2` sums it, so equal to it to the bit.
+                let first = g.point(start);
+                let (mut prev, mut area, mut count) = (first, -0.0f64, 0usize);
                 let mut k = start;
                 loop {
                     steps += 1;
@@ -231,24 +240,55 @@ pub fn largest_contour(
                         deadline::check(deadline)?;
                     }
                     seen.set(k);
-                    pts.push(g.point(k));
+                    if count > 0 {
+                        let p = g.point(k);
+                        area += prev.perp_dot(p);
+                        prev = p;
+                    }
+                    count += 1;
                     match cells.next(k) {
                         Some(n) if n == start => break,
                         Some(n) if !seen.get(n) => k = n,
                         _ => break,
                     }
                 }
-                if pts.len() >= 3 {
-                    let area = signed_area2(&pts).abs();
-                    if best.as_ref().is_none_or(|(b, _)| area.total_cmp(b).is_ge()) {
-                        best = Some((area, pts));
+                area += prev.perp_dot(first);
+                if count >= 3 {
+                    let area = area.abs();
+                    if best
+                        .as_ref()
+                        .is_none_or(|(b, _, _)| area.total_cmp(b).is_ge())
+                    {
+                        best = Some((area, start, count));
                     }
                 }
             }
         }
     }
-    Ok(best.map(|(_, pts)| pts))
+    let Some((_, start, count)) = best else {
+        return Ok(None);
+    };
+    if count > MAX_CONTOUR_POINTS {
+        return Err(format!(
+            "the largest outline in the image has {count} points, more than the {MAX_CONTOUR_POINTS} \
+             a traced contour may have; scale the image down or simplify the shape"
+        ));
+    }
+    // The same walk again: `next` is a function of the cells, so the same
+    // `count` edges from `start`.
+    let mut pts = Vec::with_capacity(count);
+    let mut k = start;
+    for _ in 0..count {
+        pts.push(g.point(k));
+        k = cells.next(k).unwrap_or(k);
+    }
+    Ok(Some(pts))
 }
+
+/// The most points a traced contour may have (128 MiB of points): an
+/// outline a person draws has thousands; an 8192-pixel spiral would have
+/// tens of millions.
+pub const MAX_CONTOUR_POINTS: usize = 8 << 20;
 
 /// Twice the signed area of a closed polygon.
 pub fn signed_area2(p: &[DVec2]) -> f64 {

@@ -93,6 +93,75 @@ fn tracing_the_worst_8192_image_stays_under_1_gb() {
     assert!(!err.contains("memory"), "{err}");
 }
 
+/// The other worst case: one black serpentine (2-pixel rows joined at
+/// alternate ends) whose single outline runs through the whole image,
+/// about 33 million points. The tracer keeps no loop's points but the
+/// largest's, and refuses an outline past `MAX_CONTOUR_POINTS`: the peak
+/// stays under 1 GB too.
+#[test]
+fn tracing_one_endless_8192_outline_stays_under_1_gb() {
+    let tmp = tempfile::Builder::new()
+        .prefix("subgram-stress-")
+        .tempdir()
+        .unwrap();
+    let dir = tmp.path();
+    let n = 8192usize;
+    let black = |x: usize, y: usize| -> bool {
+        if !(8..n - 8).contains(&x) || !(8..n - 8).contains(&y) {
+            return false;
+        }
+        let (band, row) = ((y - 8) / 4, (y - 8) % 4);
+        if row < 2 {
+            return true;
+        }
+        // The joint to the next band: right for even bands, left for odd.
+        if band % 2 == 0 {
+            x >= n - 10
+        } else {
+            x < 10
+        }
+    };
+    let mut raw = Vec::with_capacity(n * (n / 8 + 1));
+    for y in 0..n {
+        raw.push(0);
+        for byte in 0..n / 8 {
+            let mut b = 0u8;
+            for bit in 0..8 {
+                if !black(byte * 8 + bit, y) {
+                    b |= 0x80 >> bit;
+                }
+            }
+            raw.push(b);
+        }
+    }
+    std::fs::write(dir.join("snake.png"), png_1bit(n as u32, &raw)).unwrap();
+    drop(raw);
+    let (code, err, rss, took) = run_measured(
+        dir,
+        &[
+            "reverse",
+            "snake.png",
+            "-n",
+            "1",
+            "-o",
+            "out.csv",
+            "--timeout",
+            "0",
+        ],
+    );
+    eprintln!(
+        "8192² serpentine: exit {code:?}, peak {} MiB, {:.1} s: {err}",
+        rss >> 20,
+        took.as_secs_f64()
+    );
+    assert!(rss < 1_000_000_000, "peak resident size {rss} bytes; {err}");
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("points, more than the 8388608 a traced contour may have"),
+        "{err}"
+    );
+}
+
 /// A PNG of `n`×`n` 1-bit grey pixels from its filtered rows, its image
 /// data in stored (uncompressed) deflate blocks.
 fn png_1bit(n: u32, raw: &[u8]) -> Vec<u8> {
