@@ -20,21 +20,13 @@ fn write_temp_with(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<PathBuf> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
     // Unique within the process too (two threads may write one target),
     // and made new: a file or a link already under the name (another
     // user's, in a shared folder) is never followed nor truncated.
     static COUNT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let (tmp, created) = loop {
         let k = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let tmp = dir.join(format!(".{name}.tmp-{}-{k}", std::process::id()));
+        let tmp = crate::files::sibling(path, &format!("tmp-{k}"));
         match std::fs::OpenOptions::new()
             .write(true)
             .create_new(true)

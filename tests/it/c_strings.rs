@@ -5,33 +5,7 @@
 //! never a silent overflow; a `char *` has no declared size and is not
 //! checked.
 
-use subgram::DeriveOptions;
-
 use crate::support::*;
-
-/// The word a program derives.
-fn run(src: &str) -> String {
-    let l = load_text(src);
-    let d = derive(&l, DeriveOptions::default());
-    text(&l, &d)
-}
-
-/// The error a program's derivation stops with, rendered.
-fn run_error(src: &str) -> String {
-    let l = load_text(src);
-    match subgram::derive(&l.program, DeriveOptions::default()) {
-        Ok(d) => panic!("expected an error, derived {}", text(&l, &d)),
-        Err(e) => l.error(e).to_string(),
-    }
-}
-
-/// The diagnostics of a program that does not load.
-fn load_error(src: &str) -> String {
-    match subgram::load_str("test.lsys", src, &[]) {
-        Ok(_) => panic!("expected the program to be refused"),
-        Err(e) => e.to_string(),
-    }
-}
 
 /// A program whose rule for `A(5)` runs `body` (from line 6 on), then
 /// produces `out`.

@@ -8,29 +8,6 @@ use subgram::{DeriveOptions, ProgramOutput, Stream};
 
 use crate::support::*;
 
-fn run(src: &str) -> String {
-    let l = load_text(src);
-    let d = derive(&l, DeriveOptions::default());
-    text(&l, &d)
-}
-
-/// The error a program's derivation stops with, rendered.
-fn run_error(src: &str) -> String {
-    let l = load_text(src);
-    match subgram::derive(&l.program, DeriveOptions::default()) {
-        Ok(d) => panic!("expected an error, derived {}", text(&l, &d)),
-        Err(e) => l.error(e).to_string(),
-    }
-}
-
-/// The diagnostics of a program that does not load.
-fn load_error(src: &str) -> String {
-    match subgram::load_str("test.lsys", src, &[]) {
-        Ok(_) => panic!("expected the program to be refused"),
-        Err(e) => e.to_string(),
-    }
-}
-
 #[test]
 fn functions_of_every_return_type() {
     let src = "module A(int, float, V2f, bool);\n\

@@ -265,3 +265,27 @@ pub fn jitter(mut s: PolygonSoup, seed: u64) -> PolygonSoup {
     }
     s
 }
+
+/// The word a program's text derives.
+pub fn run(src: &str) -> String {
+    let l = load_text(src);
+    let d = derive(&l, DeriveOptions::default());
+    text(&l, &d)
+}
+
+/// The error a program's derivation stops with, rendered.
+pub fn run_error(src: &str) -> String {
+    let l = load_text(src);
+    match subgram::derive(&l.program, DeriveOptions::default()) {
+        Ok(d) => panic!("expected an error, derived {}", text(&l, &d)),
+        Err(e) => l.error(e).to_string(),
+    }
+}
+
+/// The diagnostics of a program's text that does not load.
+pub fn load_error(src: &str) -> String {
+    match subgram::load_str("test.lsys", src, &[]) {
+        Ok(_) => panic!("expected the program to be refused"),
+        Err(e) => e.to_string(),
+    }
+}

@@ -48,24 +48,10 @@ fn tracing_the_worst_8192_image_stays_under_1_gb() {
     // A 1-bit grey PNG written here (8 MiB, small beside the tracer's
     // memory, so that the child's peak is its own): white, with 2-pixel
     // black squares everywhere but a 4-pixel frame.
-    let mut raw = Vec::with_capacity(n * (n / 8 + 1));
-    for y in 0..n {
-        raw.push(0); // no filter
-        for byte in 0..n / 8 {
-            let mut b = 0u8;
-            for bit in 0..8 {
-                let x = byte * 8 + bit;
-                let inside = (4..n - 4).contains(&x) && (4..n - 4).contains(&y);
-                let black = inside && (x / 2 + y / 2) % 2 == 0;
-                if !black {
-                    b |= 0x80 >> bit;
-                }
-            }
-            raw.push(b);
-        }
-    }
-    std::fs::write(dir.join("board.png"), png_1bit(n as u32, &raw)).unwrap();
-    drop(raw);
+    write_image(&dir.join("board.png"), n, |x, y| {
+        let inside = (4..n - 4).contains(&x) && (4..n - 4).contains(&y);
+        inside && (x / 2 + y / 2) % 2 == 0
+    });
     let (code, err, rss, took) = run_measured(
         dir,
         &[
@@ -121,21 +107,7 @@ fn tracing_one_endless_8192_outline_stays_under_1_gb() {
             x < 10
         }
     };
-    let mut raw = Vec::with_capacity(n * (n / 8 + 1));
-    for y in 0..n {
-        raw.push(0);
-        for byte in 0..n / 8 {
-            let mut b = 0u8;
-            for bit in 0..8 {
-                if !black(byte * 8 + bit, y) {
-                    b |= 0x80 >> bit;
-                }
-            }
-            raw.push(b);
-        }
-    }
-    std::fs::write(dir.join("snake.png"), png_1bit(n as u32, &raw)).unwrap();
-    drop(raw);
+    write_image(&dir.join("snake.png"), n, black);
     let (code, err, rss, took) = run_measured(
         dir,
         &[
@@ -160,6 +132,24 @@ fn tracing_one_endless_8192_outline_stays_under_1_gb() {
         err.contains("points, more than the 8388608 a traced contour may have"),
         "{err}"
     );
+}
+
+/// Writes an `n`×`n` 1-bit PNG, black where `black(x, y)`.
+fn write_image(path: &Path, n: usize, black: impl Fn(usize, usize) -> bool) {
+    let mut raw = Vec::with_capacity(n * (n / 8 + 1));
+    for y in 0..n {
+        raw.push(0); // no filter
+        for byte in 0..n / 8 {
+            let mut b = 0u8;
+            for bit in 0..8 {
+                if !black(byte * 8 + bit, y) {
+                    b |= 0x80 >> bit;
+                }
+            }
+            raw.push(b);
+        }
+    }
+    std::fs::write(path, png_1bit(n as u32, &raw)).unwrap();
 }
 
 /// A PNG of `n`×`n` 1-bit grey pixels from its filtered rows, its image
