@@ -641,7 +641,12 @@ impl Grammar {
         deadline: Option<crate::Deadline>,
         progress: impl FnMut(StepCounts),
     ) -> Result<(), RunError> {
-        let mut run = self.start(mesh)?;
+        let mut run = {
+            // The pairing of `init: match_blocks` reads the thread's
+            // deadline: this one, where the caller gave one.
+            let _scope = deadline.map(|d| crate::deadline::scope(Some(d)));
+            self.start(mesh)?
+        };
         run.state.deadline = deadline;
         run.until = steps as u32;
         let mut progress = progress;
