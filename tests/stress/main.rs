@@ -52,24 +52,7 @@ fn tracing_the_worst_8192_image_stays_under_1_gb() {
         let inside = (4..n - 4).contains(&x) && (4..n - 4).contains(&y);
         inside && (x / 2 + y / 2) % 2 == 0
     });
-    let (code, err, rss, took) = run_measured(
-        dir,
-        &[
-            "reverse",
-            "board.png",
-            "-n",
-            "1",
-            "-o",
-            "out.csv",
-            "--timeout",
-            "0",
-        ],
-    );
-    eprintln!(
-        "8192² board: exit {code:?}, peak {} MiB, {:.1} s: {err}",
-        rss >> 20,
-        took.as_secs_f64()
-    );
+    let (code, err, rss) = trace(dir, "board.png", "board");
     assert!(rss < 1_000_000_000, "peak resident size {rss} bytes; {err}");
     assert!(!err.contains("input size limit"), "{err}");
     // The largest loop is one 2×2 square: a contour of a few points, which
@@ -108,30 +91,35 @@ fn tracing_one_endless_8192_outline_stays_under_1_gb() {
         }
     };
     write_image(&dir.join("snake.png"), n, black);
-    let (code, err, rss, took) = run_measured(
-        dir,
-        &[
-            "reverse",
-            "snake.png",
-            "-n",
-            "1",
-            "-o",
-            "out.csv",
-            "--timeout",
-            "0",
-        ],
-    );
-    eprintln!(
-        "8192² serpentine: exit {code:?}, peak {} MiB, {:.1} s: {err}",
-        rss >> 20,
-        took.as_secs_f64()
-    );
+    let (code, err, rss) = trace(dir, "snake.png", "serpentine");
     assert!(rss < 1_000_000_000, "peak resident size {rss} bytes; {err}");
     assert_eq!(code, Some(1), "{err}");
     assert!(
         err.contains("points, more than the 8388608 a traced contour may have"),
         "{err}"
     );
+}
+
+/// Traces `image` (`reverse -n 1`, no time limit) and reports the exit
+/// code, standard error and peak resident size, printing them with `label`.
+fn trace(dir: &Path, image: &str, label: &str) -> (Option<i32>, String, u64) {
+    let args = [
+        "reverse",
+        image,
+        "-n",
+        "1",
+        "-o",
+        "out.csv",
+        "--timeout",
+        "0",
+    ];
+    let (code, err, rss, took) = run_measured(dir, &args);
+    eprintln!(
+        "8192² {label}: exit {code:?}, peak {} MiB, {:.1} s: {err}",
+        rss >> 20,
+        took.as_secs_f64()
+    );
+    (code, err, rss)
 }
 
 /// Writes an `n`×`n` 1-bit PNG, black where `black(x, y)`.
