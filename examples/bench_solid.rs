@@ -117,7 +117,7 @@ fn whole_path(args: &[String], runs: usize) {
             .expect("makes the geometry");
         drop(run);
         lap(3, &mut best);
-        let model = &c.program.model;
+        let model = &*c.model();
         let opts = model
             .camera
             .raster_options(&model.lights, scene.bounds(), size, size)

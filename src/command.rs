@@ -204,7 +204,7 @@ fn derive_to_in_run(
     // Into a temporary beside the file, put in place when the run
     // commits; the derivation's own error comes back as it is.
     let mut failed = None;
-    let written = crate::atomic::write_atomic_with(path, |w| {
+    let written = crate::files::atomic::write_atomic_with(path, |w| {
         derive_out(a, &system, deadline, dir.as_deref(), progress, before, w).map_err(|e| {
             failed = Some(e);
             std::io::Error::other("the derivation failed")
@@ -902,7 +902,7 @@ fn render_system(
                 }
             };
             let (opts, dir) = curve_run(a, deadline)?;
-            let model = &c.program.model;
+            let model = &*crate::model::of(&c.program);
             let palette = model
                 .palette()
                 .map(|p| std::sync::Arc::new(p.map(|[r, g, b]| Rgba(r, g, b, 255))));
@@ -959,7 +959,7 @@ fn curve_run(
 /// Whether `render` draws this L-system's 3D geometry (see [`Solidity`]).
 fn wants_solid(a: &RenderArgs, c: &crate::Curve, export: bool) -> bool {
     use crate::model::view::{LineStyle, RenderMode};
-    let m = &c.program.model;
+    let m = &*crate::model::of(&c.program);
     match a.solid {
         _ if export => true,
         Solidity::Solid => true,
@@ -996,7 +996,7 @@ fn render_solid(
         ));
     }
     let (opts, dir) = curve_run(a, deadline)?;
-    let model = &c.program.model;
+    let model = &*crate::model::of(&c.program);
     let (w, h) = looks.size;
     let mut run = c.run(opts.derive_options())?;
     let mut sopts = SolidOptions::default();
@@ -1745,7 +1745,8 @@ impl Out {
                     .iter()
                     .map(|(p, b)| (p.as_path(), b.as_slice()))
                     .collect();
-                crate::atomic::write_all_atomic(&all).map_err(|(path, e)| Error::write(path, e))
+                crate::files::atomic::write_all_atomic(&all)
+                    .map_err(|(path, e)| Error::write(path, e))
             }
             Out::Memory(kept) => {
                 kept.extend(files);
@@ -1832,10 +1833,10 @@ fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     render::write_atomic(path, bytes).map_err(|e| Error::write(path, e))
 }
 
-/// Writes every file or none (see [`crate::atomic::write_all_atomic`]).
+/// Writes every file or none (see [`crate::files::atomic::write_all_atomic`]).
 fn write_files(files: &[(&Path, Vec<u8>)]) -> Result<(), Error> {
     let all: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
-    crate::atomic::write_all_atomic(&all).map_err(|(path, e)| Error::write(path, e))
+    crate::files::atomic::write_all_atomic(&all).map_err(|(path, e)| Error::write(path, e))
 }
 
 fn json(value: &impl serde::Serialize) -> Result<String, Error> {

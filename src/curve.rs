@@ -35,6 +35,18 @@ pub struct FigureOptions {
 }
 
 impl Curve {
+    /// The model folder's functions, contours, surfaces, colours and view
+    /// settings that the program runs and is drawn with (lpfg's default
+    /// circle alone for a program without a folder).
+    pub fn model(&self) -> std::sync::Arc<crate::model::Model> {
+        crate::model::of(&self.program)
+    }
+
+    /// Runs and draws the program with `model` instead.
+    pub fn set_model(&mut self, model: crate::model::Model) {
+        self.program.model = crate::lang::model::ModelRef(std::sync::Arc::new(model));
+    }
+
     /// A derivation error as an [`Error`], located at the rule or directive
     /// at fault when there is one, else at the program's file.
     pub fn error(&self, e: DeriveError) -> Error {
@@ -112,7 +124,9 @@ impl Curve {
     /// `opts` with this program's view file settings.
     fn with_view(&self, opts: DeriveOptions) -> DeriveOptions {
         DeriveOptions {
-            view: self.view.clone(),
+            queries: std::sync::Arc::new(draw::QueryTurtle {
+                view: self.view.clone(),
+            }),
             ..opts
         }
     }
@@ -299,7 +313,7 @@ impl Curve {
         let fail = |e| self.error(e);
         let mut d = Derivation::new(p, self.with_view(opts.derive.clone())).map_err(fail)?;
         let mut draw_opts = opts.draw.clone();
-        draw_opts.model = p.model.clone();
+        draw_opts.model = crate::model::of(p);
         draw_opts.view = self.view.clone();
         if let Some(a) = d.angle().map_err(fail)? {
             draw_opts.angle = a;
@@ -489,7 +503,7 @@ impl<'c> CurveRun<'c> {
     fn draw_options(&mut self) -> Result<draw::DrawOptions, Error> {
         let curve = self.curve;
         let mut opts = draw::DrawOptions {
-            model: curve.program.model.clone(),
+            model: crate::model::of(&curve.program),
             view: curve.view.clone(),
             ..Default::default()
         };

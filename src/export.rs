@@ -158,7 +158,7 @@ pub fn write_obj(scene: &Scene3, path: &Path) -> Result<(), Error> {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene.mtl".into());
     let (obj, mtl_text) = obj_text(scene, &mtl_name);
-    crate::atomic::write_all_atomic(&[(path, obj.as_bytes()), (&mtl, mtl_text.as_bytes())])
+    crate::files::atomic::write_all_atomic(&[(path, obj.as_bytes()), (&mtl, mtl_text.as_bytes())])
         .map_err(|(p, e)| Error::write(p, e))
 }
 
@@ -227,7 +227,7 @@ pub fn write_ply(scene: &Scene3, path: &Path) -> Result<(), Error> {
             "cannot export the scene: PLY's uint indices hold at most 4294967295 vertices".into(),
         ));
     }
-    crate::atomic::write_atomic_with(path, |w| write_ply_to(scene, w))
+    crate::files::atomic::write_atomic_with(path, |w| write_ply_to(scene, w))
         .map_err(|e| Error::write(path, e))
 }
 
@@ -382,5 +382,5 @@ pub fn glb_bytes(scene: &Scene3) -> Result<Vec<u8>, Error> {
 /// Writes `scene` as a binary glTF file (see [`glb_bytes`]).
 pub fn write_glb(scene: &Scene3, path: &Path) -> Result<(), Error> {
     let bytes = glb_bytes(scene)?;
-    crate::atomic::write_atomic(path, &bytes).map_err(|e| Error::write(path, e))
+    crate::files::atomic::write_atomic(path, &bytes).map_err(|e| Error::write(path, e))
 }

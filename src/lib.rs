@@ -28,11 +28,13 @@
 //! for meshes and their files, [`surface`] for grammars, [`reverse`] for
 //! reverse subdivision, and [`command`] for the binary's commands.
 
-mod atomic;
+mod colour;
 mod curve;
 mod deadline;
 mod error;
 mod files;
+// `crate::atomic` until every caller names `files::atomic`.
+use files::atomic;
 mod huge;
 mod lang;
 mod limits;

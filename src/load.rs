@@ -9,10 +9,12 @@ use crate::error::Error;
 use crate::lang;
 pub use crate::lang::compile::Precision;
 use crate::model::{self, Model};
+use crate::production::{Checked, Entry};
 use crate::surface;
-use crate::syntax::lex::{self, Token};
-use crate::syntax::{parse, preprocess, Diagnostic, FileId, SourceFile, SourceMap, Span};
-use crate::system::{Surface, System};
+use crate::syntax::{parse, Diagnostic, SourceFile, Span};
+use crate::system::System;
+
+pub(crate) use crate::syntax::source::{front, read, Front};
 
 /// Settings of loading.
 #[derive(Clone, Debug, Default)]
@@ -88,20 +90,28 @@ fn load_path(path: &Path, edited: Option<&str>, opts: &LoadOptions) -> Result<Sy
     let view = read_view_file(path)?;
     let defines = view.defines(&opts.defines);
     let front = front(&path.display().to_string(), text, &defines)?;
-    if surface::is_surface(&front.tokens) {
-        let grammar = with_stack(move || surface::from_front(front))?;
-        Ok(System::Surface(Surface::new(grammar, Some(path))))
-    } else if crate::vv::is_vv(&front.tokens) {
-        let program = with_stack(move || crate::vv::from_front(front))?;
-        Ok(System::Vv(crate::system::Vv::new(program, Some(path))))
-    } else if crate::shape::is_shapes(&front.tokens) {
-        let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
-        let g = with_stack(move || crate::shape::from_front(front, Some(&dir)))?;
-        Ok(System::Shapes(crate::system::Shapes::new(g)))
-    } else {
-        let mut c = curve(front, opts.precision)?;
-        view.give_to(&mut c);
-        Ok(System::Curve(c))
+    let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    match checked(front, Some(&dir))? {
+        Ok(checked) => Ok(System::checked(checked, Some(path))),
+        Err(front) => {
+            let mut c = curve(front, opts.precision)?;
+            view.give_to(&mut c);
+            Ok(System::Curve(c))
+        }
+    }
+}
+
+/// The loader's table: each topology that programs are written for, asked
+/// in this order whether a program is its own.
+const TOPOLOGIES: [&Entry; 3] = [&surface::ENTRY, &crate::vv::ENTRY, &crate::shape::ENTRY];
+
+/// The program checked by the topology that claims it (`dir`: the folder
+/// its relative file names are read from), or its front back when none
+/// does: a curve L-system.
+fn checked(front: Front, dir: Option<&Path>) -> Result<Result<Checked, Front>, Error> {
+    match TOPOLOGIES.iter().find(|t| (t.claims)(&front.tokens)) {
+        Some(t) => Ok(Ok(with_stack(move || (t.check)(front, dir))?)),
+        None => Ok(Err(front)),
     }
 }
 
@@ -140,7 +150,7 @@ fn load_model_file(
             note.message.clone(),
         ));
     }
-    c.program.model = std::sync::Arc::new(m);
+    c.program.model = lang::model::ModelRef(std::sync::Arc::new(m));
     view.give_to(&mut c);
     Ok(c)
 }
@@ -367,17 +377,9 @@ pub fn load_text(name: &str, text: &str, opts: &LoadOptions) -> Result<System, E
 
 fn load_text_as(name: &str, text: &str, opts: &LoadOptions) -> Result<System, Error> {
     let front = front(name, text.to_string(), &opts.defines)?;
-    if surface::is_surface(&front.tokens) {
-        let grammar = with_stack(move || surface::from_front(front))?;
-        Ok(System::Surface(Surface::new(grammar, None)))
-    } else if crate::vv::is_vv(&front.tokens) {
-        let program = with_stack(move || crate::vv::from_front(front))?;
-        Ok(System::Vv(crate::system::Vv::new(program, None)))
-    } else if crate::shape::is_shapes(&front.tokens) {
-        let g = with_stack(move || crate::shape::from_front(front, None))?;
-        Ok(System::Shapes(crate::system::Shapes::new(g)))
-    } else {
-        Ok(System::Curve(curve(front, opts.precision)?))
+    match checked(front, None)? {
+        Ok(checked) => Ok(System::checked(checked, None)),
+        Err(front) => Ok(System::Curve(curve(front, opts.precision)?)),
     }
 }
 
@@ -467,162 +469,6 @@ fn at_most_some(e: Error) -> Error {
     }
 }
 
-/// The largest program file read, in bytes: lpfg programs are a few
-/// kilobytes, and the front end holds about fifty bytes per character of a
-/// file at worst. The environment variable [`MAX_PROGRAM_SIZE_VAR`] raises
-/// (or lowers) it, in mebibytes.
-pub const MAX_PROGRAM_BYTES: u64 = 16 << 20;
-
-/// The environment variable that sets the largest program file read, in
-/// mebibytes (`SUBGRAM_MAX_PROGRAM_MIB=64`).
-pub const MAX_PROGRAM_SIZE_VAR: &str = "SUBGRAM_MAX_PROGRAM_MIB";
-
-/// The limit on a program file's size: [`MAX_PROGRAM_BYTES`], or what
-/// [`MAX_PROGRAM_SIZE_VAR`] says.
-fn program_size_limit() -> Result<u64, Error> {
-    match std::env::var(MAX_PROGRAM_SIZE_VAR) {
-        Err(std::env::VarError::NotPresent) => Ok(MAX_PROGRAM_BYTES),
-        Ok(v) => match v.trim().parse::<u64>() {
-            Ok(mib) if mib > 0 && mib <= 1 << 20 => Ok(mib << 20),
-            _ => Err(Error::Usage(format!(
-                "{MAX_PROGRAM_SIZE_VAR}={v}: expected a whole number of mebibytes from 1 to {}",
-                1 << 20
-            ))),
-        },
-        Err(std::env::VarError::NotUnicode(v)) => Err(Error::Usage(format!(
-            "{MAX_PROGRAM_SIZE_VAR}={}: expected a whole number of mebibytes",
-            v.to_string_lossy()
-        ))),
-    }
-}
-
-/// Reads a program file, once: its size is checked against the limit
-/// before it is read whole (a device or a pipe, which has no size, is read
-/// up to the limit and no further), and text that is not UTF-8 is refused
-/// at its first bad byte.
-pub(crate) fn read(path: &Path) -> Result<String, Error> {
-    let limit = program_size_limit()?;
-    let bytes = read_at_most(path, limit)?;
-    utf8(&path.display().to_string(), bytes)
-}
-
-/// The bytes of `path`, or an error that names `limit` when there are
-/// more.
-fn read_at_most(path: &Path, limit: u64) -> Result<Vec<u8>, Error> {
-    use std::io::Read;
-    let io = |e| Error::read(PathBuf::from(path), e);
-    let file = crate::files::open(path).map_err(io)?;
-    let size = file.size();
-    let too_big = |size: Option<u64>| {
-        let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
-        let is = match size {
-            Some(b) => format!("the file is {:.1} MiB ({b} bytes)", mib(b)),
-            None => format!("more than {} MiB were read from it", limit >> 20),
-        };
-        Error::file(
-            path.display().to_string(),
-            format!(
-                "{is}; a program may be at most {} MiB: set {MAX_PROGRAM_SIZE_VAR} to a larger \
-                 number of mebibytes to raise the limit",
-                limit >> 20
-            ),
-        )
-    };
-    if let Some(len) = size.filter(|&len| len > limit) {
-        return Err(too_big(Some(len)));
-    }
-    let expected = size.unwrap_or(0);
-    let mut bytes = Vec::with_capacity(expected as usize);
-    file.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
-    if bytes.len() as u64 > limit {
-        // A file that grew while it was read, or one without a size.
-        return Err(too_big(size.map(|_| bytes.len() as u64)));
-    }
-    Ok(bytes)
-}
-
-/// `bytes` as text, or an error located at the first byte that is not
-/// UTF-8, shown in the line as a replacement character.
-pub(crate) fn utf8(name: &str, bytes: Vec<u8>) -> Result<String, Error> {
-    let e = match String::from_utf8(bytes) {
-        Ok(text) => return Ok(text),
-        Err(e) => e,
-    };
-    let at = e.utf8_error().valid_up_to();
-    let bad_len = e
-        .utf8_error()
-        .error_len()
-        .unwrap_or(e.as_bytes().len() - at);
-    let bad: Vec<String> = e.as_bytes()[at..at + bad_len]
-        .iter()
-        .map(|b| format!("0x{b:02X}"))
-        .collect();
-    // The valid prefix is kept as it is; the bad byte becomes U+FFFD.
-    let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
-    let mut sources = SourceMap::default();
-    let file = sources.add(SourceFile::new(name, text));
-    let what = if e.utf8_error().error_len().is_none() {
-        "the file ends inside a character"
-    } else if bad.len() == 1 {
-        "the byte"
-    } else {
-        "the bytes"
-    };
-    let message = format!(
-        "invalid UTF-8 ({what} {}): a program must be UTF-8 text; save the file as UTF-8",
-        bad.join(" ")
-    );
-    let span = Span::new(file, at, at + '\u{FFFD}'.len_utf8());
-    Err(Error::at(&sources, Diagnostic::new(span, message)))
-}
-
-/// A program's text after lexing and preprocessing.
-pub(crate) struct Front {
-    /// The file, then one source per `-D` override.
-    pub sources: SourceMap,
-    pub main: FileId,
-    pub tokens: Vec<Token>,
-}
-
-impl Front {
-    /// The empty span at the end of the file, for "expected ..., found the
-    /// end of the file".
-    pub fn eof(&self) -> Span {
-        let n = self.sources.get(self.main).text.len();
-        Span::new(self.main, n, n)
-    }
-}
-
-/// Lexes and preprocesses `text` with `defines` (`NAME=VALUE` each).
-pub(crate) fn front(name: &str, text: String, defines: &[String]) -> Result<Front, Error> {
-    let mut sources = SourceMap::default();
-    let main = sources.add(SourceFile::new(name, text));
-    let mut overrides = Vec::new();
-    for d in defines {
-        let bad = || {
-            Error::Usage(format!(
-                "`-D {d}` must have the form NAME=VALUE, e.g. -D STEPS=4"
-            ))
-        };
-        let (n, v) = d.split_once('=').ok_or_else(bad)?;
-        let n = n.trim();
-        if n.is_empty() || !n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            return Err(bad());
-        }
-        let id = sources.add(SourceFile::new(format!("<-D {n}>"), v));
-        let toks = lex::lex(id, v).map_err(|e| Error::at(&sources, e))?;
-        overrides.push((n.to_string(), toks));
-    }
-    let tokens = lex::lex_all(main, &sources.get(main).text)
-        .and_then(|t| preprocess::preprocess(t, &overrides))
-        .map_err(|e| Error::at(&sources, e))?;
-    Ok(Front {
-        sources,
-        main,
-        tokens,
-    })
-}
-
 /// Parses and checks preprocessed tokens as a curve L-system.
 pub(crate) fn curve(front: Front, precision: Precision) -> Result<Curve, Error> {
     with_stack(move || check_curve(front, precision))
@@ -680,6 +526,9 @@ fn check_curve(front: Front, precision: Precision) -> Result<Curve, Error> {
     };
     match lang::compile::compile_with(&file, precision) {
         Ok(mut program) => {
+            // lpfg's default circle, until a model folder gives more.
+            program.model =
+                lang::model::ModelRef(std::sync::Arc::new(crate::model::Model::default()));
             // What the turtle does not act on is said, not dropped.
             program
                 .warnings

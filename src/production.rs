@@ -21,8 +21,34 @@
 //! [`Emit`]: crate::lang::eval::Emit
 //! [`Host`]: crate::lang::eval::Host
 
+use std::path::Path;
+
 use crate::lang::builtins::{HostTable, WORD_HOST};
 use crate::rewrite::{Derivation, DeriveError, Word};
+use crate::syntax::lex::Token;
+use crate::syntax::source::Front;
+use crate::syntax::SourceError;
+
+/// A topology's entry in the loader's table: how a program written for it
+/// is told from its tokens, and checked. Each topology that programs are
+/// written for (`surface`, `vv`, `shape`) defines its `ENTRY`; the loader
+/// lists them and asks each in turn, and a program none claims is a curve
+/// L-system. No topology knows the loader.
+pub struct Entry {
+    /// True when a program's preprocessed tokens are written for this
+    /// topology (a surface grammar's `mesh:` directive, a vv program's
+    /// `mesh S;`, …).
+    pub claims: fn(&[Token]) -> bool,
+    /// Parses and checks the program; `dir` is the folder its relative
+    /// file names are read from (`None`: the current folder). The checked
+    /// program is the topology's own type ([`Checked`]).
+    pub check: fn(Front, Option<&Path>) -> Result<Checked, SourceError>,
+}
+
+/// A program checked by a topology's [`Entry`], as the topology's own type
+/// (`surface::Grammar`, `vv::VvProgram`, `shape::ShapeGrammar`): the
+/// loader, which knows every topology, takes it back by that type.
+pub type Checked = Box<dyn std::any::Any + Send>;
 
 /// A system running on its topology: its structure, its schedule, and the
 /// table of elements and built-ins its rules were checked with.

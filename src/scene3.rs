@@ -52,7 +52,7 @@ impl Look {
 ///
 /// `lines` are for pictures only: tubes thinner than a pixel, which the
 /// geometry of a picture keeps as their axes (see
-/// [`crate::draw::solid::SolidOptions::picture_pixel`] and [`Line`]); the
+/// the drawing's `SolidOptions::picture_pixel` and [`Line`]); the
 /// exporters refuse a scene that has any.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriMesh {

@@ -15,7 +15,7 @@ use crate::syntax::Diagnostic;
 use crate::syntax::{FileId, SourceMap};
 use crate::vv::{VvError, VvProgram};
 
-/// A checked `.lsys` file: what [`crate::load`] returns.
+/// A checked `.lsys` file: what the loader (`subgram::load`) returns.
 #[derive(Debug)]
 #[allow(clippy::large_enum_variant)] // one per loaded file: boxing saves nothing
 pub enum System {
@@ -28,6 +28,26 @@ pub enum System {
     /// A shape grammar (paper 003, CGA shape), derived into a tree of
     /// shapes.
     Shapes(Shapes),
+}
+
+impl System {
+    /// The system of a program that a topology's entry checked
+    /// ([`crate::production::Entry`]), read from `file` (relative file
+    /// names are then found beside it) or from text.
+    pub(crate) fn checked(checked: crate::production::Checked, file: Option<&Path>) -> System {
+        let checked = match checked.downcast::<Grammar>() {
+            Ok(g) => return System::Surface(Surface::new(*g, file)),
+            Err(other) => other,
+        };
+        let checked = match checked.downcast::<VvProgram>() {
+            Ok(p) => return System::Vv(Vv::new(*p, file)),
+            Err(other) => other,
+        };
+        match checked.downcast::<crate::shape::ShapeGrammar>() {
+            Ok(g) => System::Shapes(Shapes::new(*g)),
+            Err(_) => unreachable!("every topology's entry checks into its own type, listed here"),
+        }
+    }
 }
 
 /// Settings of [`System::run`].
@@ -179,7 +199,7 @@ impl System {
             .filter(|p| p.is_file())
             .collect();
         match self {
-            System::Curve(c) => files.extend(c.program.model.files.iter().cloned()),
+            System::Curve(c) => files.extend(crate::model::of(&c.program).files.iter().cloned()),
             System::Surface(s) => files.extend(s.base_mesh()),
             System::Vv(v) => files.extend(v.base_mesh()),
             System::Shapes(s) => files.extend(s.inputs()),

@@ -404,7 +404,7 @@ pub fn model_files(data: &[u8]) {
     };
     let text = text(rest);
     let xs = [-1.0f32, 0.0, 0.3, 0.5, 1.0, 2.0, f32::NAN, f32::INFINITY];
-    let funcs = |r: Result<Vec<functions::Function>, subgram::Error>| match r {
+    let funcs = |r: Result<Vec<functions::Function>, subgram::model::ModelError>| match r {
         Ok(fs) => {
             for f in fs {
                 for x in xs {
@@ -416,7 +416,7 @@ pub fn model_files(data: &[u8]) {
             std::hint::black_box(e.to_string());
         }
     };
-    let conts = |r: Result<Vec<contours::Contour>, subgram::Error>| match r {
+    let conts = |r: Result<Vec<contours::Contour>, subgram::model::ModelError>| match r {
         Ok(cs) => {
             for mut c in cs {
                 for x in xs {

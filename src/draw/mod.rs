@@ -3,8 +3,11 @@
 //! events, so the two always agree.
 
 pub(crate) mod coverage;
+mod queries;
 pub mod solid;
 pub mod tropism;
+
+pub use queries::QueryTurtle;
 
 use glam::DVec3;
 
@@ -465,10 +468,7 @@ pub fn acts_on(name: &str) -> bool {
     command(name) != Cmd::None
 }
 
-/// True for lpfg's query modules, which the turtle fills in.
-pub fn is_query(name: &str) -> bool {
-    matches!(name, "GetPos" | "GetHead" | "GetLeft" | "GetUp")
-}
+pub use crate::rewrite::is_query;
 
 /// The sines and cosines of the last four angles turned by: words turn by
 /// a few angles over and over (`+(90) ... -(90)`, or a branching angle

@@ -581,7 +581,7 @@ impl<'m> Builder<'m> {
                 }
             }
             None => {
-                let c = crate::render::palette(i);
+                let c = crate::colour::palette(i);
                 Look::colour(format!("colour{k}"), i, [c.0, c.1, c.2])
             }
         }

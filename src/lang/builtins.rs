@@ -204,7 +204,7 @@ macro_rules! model {
             name: $name,
             resolve: |a| {
                 numbers(a, $n)?;
-                Ok((Func::Model(crate::model::Accessor::$acc), $t))
+                Ok((Func::Model(super::model::Accessor::$acc), $t))
             },
         }
     };

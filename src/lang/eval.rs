@@ -30,7 +30,7 @@ pub struct Env {
     /// Gillespie steps).
     pub random: Random,
     /// The model folder's functions and contours, for `func` and its kin.
-    pub model: std::sync::Arc<crate::model::Model>,
+    pub model: super::model::ModelRef,
     /// What the program prints and the files it writes.
     pub output: ProgramOutput,
     /// The views `UseView` activated, in the order of their first call,
@@ -1171,7 +1171,7 @@ impl<'p> Interp<'p> {
             Func::Random(op) => cx.env.random.call(op, vals),
             Func::Model(a) if a.changes_the_model() => {
                 // The run's own copy, made on the first change.
-                return std::sync::Arc::make_mut(&mut cx.env.model).call_mut(a, vals);
+                return cx.env.model.make_mut().call_mut(a, vals);
             }
             Func::Model(a) => return cx.env.model.call(a, vals),
             Func::NoOp => {

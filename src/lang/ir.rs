@@ -146,8 +146,8 @@ pub enum Func {
     Random(super::random::Op),
     NoOp,
     /// An accessor of the model's files (`func`, `curveX`, `val`, …),
-    /// evaluated by the [`Model`](crate::model::Model) of the run.
-    Model(crate::model::Accessor),
+    /// evaluated by the [`ModelData`](super::model::ModelData) of the run.
+    Model(super::model::Accessor),
     /// C's standard input and output (`printf`, `fopen`, `strlen`, …);
     /// see [`super::stdio`].
     Io(super::stdio::IoFunc),
@@ -355,7 +355,7 @@ pub struct Program {
     pub warnings: Vec<Diagnostic>,
     /// The functions, contours and colours of the model folder the program
     /// came with (empty for a program alone).
-    pub model: std::sync::Arc<crate::model::Model>,
+    pub model: super::model::ModelRef,
     /// `float` is single precision (lpfg's): what the turtle writes into
     /// `float` parameters (query modules' answers) is rounded to it.
     pub single: bool,

@@ -6,6 +6,7 @@ pub mod closure;
 pub mod compile;
 pub mod eval;
 pub mod ir;
+pub mod model;
 pub mod modules;
 pub mod random;
 pub mod stdio;

@@ -45,7 +45,7 @@ pub struct Place {
 impl std::fmt::Display for MeshFileError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match (self.line, &self.place) {
-            (Some(l), Some(p)) => f.write_str(&crate::error::render_line(
+            (Some(l), Some(p)) => f.write_str(&crate::syntax::render_line(
                 &self.path,
                 l,
                 &p.text,

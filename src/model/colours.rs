@@ -15,7 +15,7 @@
 //! direction). Its 3D pictures light each surface by its normal
 //! (`render::raster`), with the same lights.
 
-use crate::error::Error;
+use super::error::ModelError as Error;
 
 /// The bytes of one material record after its index byte.
 const RECORD: usize = 15;

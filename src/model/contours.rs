@@ -12,8 +12,8 @@
 //! the clamped B-spline at equal parameter steps instead. The normal at a
 //! sample is the unit tangent turned a quarter to the left (z × t).
 
+use super::error::ModelError as Error;
 use super::text::{count, no_more, number, words, Lines, MAX_POINTS};
-use crate::error::Error;
 
 /// lpfg's default number of samples, and its bounds.
 const DEFAULT_SAMPLES: usize = 8;

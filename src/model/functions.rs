@@ -11,8 +11,8 @@
 //! The editor's `flip:` setting changes only how the editor shows the
 //! function; lpfg reads and ignores it, and so does this reader.
 
+use super::error::ModelError as Error;
 use super::text::{count, no_more, number, words, Lines, MAX_POINTS};
-use crate::error::Error;
 
 /// The fewest and the most samples lpfg takes (it clamps `samples:`).
 const MIN_SAMPLES: i64 = 10;

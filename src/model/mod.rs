@@ -15,6 +15,7 @@
 
 pub mod colours;
 pub mod contours;
+mod error;
 pub mod functions;
 pub mod surface;
 pub mod text;
@@ -22,7 +23,9 @@ pub mod view;
 
 use std::path::{Path, PathBuf};
 
-use crate::error::Error;
+pub use self::error::ModelError;
+use self::error::ModelError as Error;
+pub use crate::lang::model::{Accessor, ACCESSOR_NAMES};
 use crate::lang::value::Value;
 
 pub use colours::Colours;
@@ -575,61 +578,30 @@ impl Model {
     }
 }
 
-/// The accessors of a model's functions, parameters and contours.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Accessor {
-    Func,
-    PFunc,
-    TFunc,
-    FuncTangent,
-    Val,
-    CurveX,
-    CurveY,
-    CurveZ,
-    CurveXY,
-    CurveXYZ,
-    CurveNormal,
-    CurveScale,
-    CurveSetPoint,
-    CurveRecalculate,
-    CurveReset,
-}
+impl crate::lang::model::ModelData for Model {
+    fn call(&self, f: Accessor, args: &[Value]) -> Result<Value, String> {
+        Model::call(self, f, args)
+    }
 
-impl Accessor {
-    /// True for the accessors that change the model: the contour
-    /// editing functions, and `pfunc`, which in lpfg sets the function's
-    /// interval for later calls of `tfunc` and `funcTangent` too.
-    pub fn changes_the_model(self) -> bool {
-        matches!(
-            self,
-            Accessor::PFunc
-                | Accessor::CurveScale
-                | Accessor::CurveSetPoint
-                | Accessor::CurveRecalculate
-                | Accessor::CurveReset
-        )
+    fn call_mut(&mut self, f: Accessor, args: &[Value]) -> Result<Value, String> {
+        Model::call_mut(self, f, args)
+    }
+
+    fn boxed(&self) -> Box<dyn crate::lang::model::ModelData> {
+        Box::new(self.clone())
+    }
+
+    fn into_any(self: std::sync::Arc<Self>) -> std::sync::Arc<dyn std::any::Any + Send + Sync> {
+        self
     }
 }
 
-/// The accessors' names, for messages about a name the model lacks.
-pub const ACCESSOR_NAMES: &[&str] = &[
-    "func",
-    "pfunc",
-    "tfunc",
-    "funcTangent",
-    "val",
-    "curveX",
-    "curveY",
-    "curveZ",
-    "curveXY",
-    "curveXYf",
-    "curveXYd",
-    "curveXYZ",
-    "curveXYZf",
-    "curveXYZd",
-    "curveNormal",
-    "curveScale",
-    "curveSetPoint",
-    "curveRecalculate",
-    "curveReset",
-];
+/// The model `program` runs with: the one its folder gave, or the
+/// default one (lpfg's default circle, nothing else) for a program that
+/// came without a folder.
+pub fn of(program: &crate::lang::Program) -> std::sync::Arc<Model> {
+    std::sync::Arc::clone(&program.model.0)
+        .into_any()
+        .downcast::<Model>()
+        .unwrap_or_default()
+}

@@ -7,8 +7,8 @@
 //! turtle, its heading and up vectors on the turtle's, scaled by s divided
 //! by `SIZE:`.
 
+use super::error::ModelError as Error;
 use super::text::{number, words, Lines};
-use crate::error::Error;
 
 pub type V3 = [f64; 3];
 

@@ -2,7 +2,7 @@
 //! line and columns, so a malformed file is reported at `file:line:col`
 //! with the line and a caret under the word at fault.
 
-use crate::error::Error;
+use super::error::ModelError as Error;
 
 /// The largest model file read, in bytes. vlab's files are a few kilobytes;
 /// a contour or a function with a million points is not a model's.

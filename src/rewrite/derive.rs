@@ -31,13 +31,38 @@ pub struct DeriveOptions {
     /// go; the caller reads them from its clone. Default: a new one,
     /// which refuses `fopen` for writing.
     pub output: ProgramOutput,
-    /// The view file's turtle settings (rotations, tropisms), for the
-    /// interpretation that answers query modules. Default: none.
-    pub view: crate::draw::TurtleView,
+    /// What answers query modules before each step: the turtle's
+    /// interpretation of the word. `Default` gives `draw`'s turtle with no
+    /// view file's settings (see [`Queries`]).
+    pub queries: std::sync::Arc<dyn Queries>,
 }
 
-impl Default for DeriveOptions {
-    fn default() -> Self {
+/// What answers the query modules of a word (`GetPos`, `GetHead`, …;
+/// [`is_query`]) before a step: the turtle, walking the word after
+/// interpretation. The derivation knows only this trait; the drawing
+/// layer implements it (`draw::QueryTurtle`), and the `Default` of
+/// [`DeriveOptions`], which lives beside that turtle, uses it.
+pub trait Queries: Send + Sync + std::fmt::Debug {
+    /// Walks `shown` (a word of `program`'s, after interpretation) with
+    /// the turtle turning by `angle` where the program set one, and gives
+    /// each query module met: its index in `shown` and the vector it asks
+    /// for. An error is the turtle's message.
+    fn answer(
+        &self,
+        shown: &Word,
+        program: &Program,
+        angle: Option<f64>,
+    ) -> Result<Vec<(usize, [f64; 3])>, String>;
+}
+
+/// True for lpfg's query modules, which the turtle fills in.
+pub fn is_query(name: &str) -> bool {
+    matches!(name, "GetPos" | "GetHead" | "GetLeft" | "GetUp")
+}
+
+impl DeriveOptions {
+    /// lpfg's behaviour, with query modules answered by `queries`.
+    pub fn answered_by(queries: std::sync::Arc<dyn Queries>) -> DeriveOptions {
         DeriveOptions {
             steps: None,
             max_modules: DEFAULT_MAX_MODULES,
@@ -45,7 +70,7 @@ impl Default for DeriveOptions {
             deadline: None,
             seed: None,
             output: ProgramOutput::default(),
-            view: crate::draw::TurtleView::default(),
+            queries,
         }
     }
 }
@@ -103,7 +128,7 @@ pub struct DeriveError {
     pub step: u64,
 }
 
-/// The message alone; [`crate::Curve::error`] adds the rule's line and
+/// The message alone; `Curve::error` adds the rule's line and
 /// caret.
 impl std::fmt::Display for DeriveError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -304,29 +329,19 @@ impl<'p> Derivation<'p> {
             depth,
             &mut sources,
         )?;
-        let mut draw_opts = crate::draw::DrawOptions {
-            view: self.opts.view.clone(),
-            ..Default::default()
-        };
-        if let Some(a) = self.angle()? {
-            draw_opts.angle = a;
-        }
-        let mut answers = Vec::new();
-        crate::draw::draw_with_queries(
-            &shown,
-            &p.alphabet,
-            &p.structs,
-            &draw_opts,
-            Some(&mut answers),
-        )
-        .map_err(|e| DeriveError {
-            span: None,
-            message: format!(
-                "at step {}, the interpretation step for query modules failed: {}",
-                self.step, e.message
-            ),
-            step: self.step,
-        })?;
+        let angle = self.angle()?;
+        let answers = self
+            .opts
+            .queries
+            .answer(&shown, p, angle)
+            .map_err(|message| DeriveError {
+                span: None,
+                message: format!(
+                    "at step {}, the interpretation step for query modules failed: {message}",
+                    self.step
+                ),
+                step: self.step,
+            })?;
         let sources = sources.unwrap_or_default();
         let mut answer: Vec<Option<[f64; 3]>> = vec![None; self.word.len()];
         for (j, v) in answers {
@@ -366,7 +381,7 @@ impl<'p> Derivation<'p> {
                 .iter()
                 .chain(&r.strict)
                 .chain(&r.right)
-                .any(|pat| crate::draw::is_query(p.alphabet.name(pat.sym)))
+                .any(|pat| is_query(p.alphabet.name(pat.sym)))
         })
     }
 

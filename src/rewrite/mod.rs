@@ -8,5 +8,5 @@ pub(crate) mod growth;
 pub mod step;
 pub mod word;
 
-pub use derive::{derive, Derivation, DeriveError, DeriveOptions, Derived};
+pub use derive::{derive, is_query, Derivation, DeriveError, DeriveOptions, Derived, Queries};
 pub use word::Word;

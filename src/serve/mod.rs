@@ -607,7 +607,7 @@ impl App {
             Ok(r) => r,
             Err(e) => return failure(400, &format!("the request is not a save request: {e}")),
         };
-        match crate::atomic::write_atomic(&self.program, req.text.as_bytes()) {
+        match crate::files::atomic::write_atomic(&self.program, req.text.as_bytes()) {
             Ok(()) => json_reply(200, &serde_json::json!({ "ok": true })),
             Err(e) => failure(
                 500,

@@ -20,15 +20,16 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
-use crate::error::Error;
 use crate::lang::compile::RuleCompiler;
 use crate::lang::eval::{Env, Interp};
 use crate::lang::ir::Ex;
 use crate::lang::value::{Ty, Value};
-use crate::load::Front;
 use crate::mesh::PolygonSoup;
+use crate::production::Entry;
 use crate::syntax::ast::{Expr, ExprKind};
+use crate::syntax::source::Front;
 use crate::syntax::span::{Diagnostic, SourceMap, Span};
+use crate::syntax::SourceError;
 
 use geom::Selector;
 use grammar::{Axis, CompKind, Op, ShapeFile, SizeKind};
@@ -141,6 +142,12 @@ pub(crate) struct CPart {
     pub span: Span,
 }
 
+/// This topology's entry in the loader's table.
+pub(crate) const ENTRY: Entry = Entry {
+    claims: is_shapes,
+    check: |front, dir| from_front(front, dir).map(|g| Box::new(g) as crate::production::Checked),
+};
+
 /// True when preprocessed tokens are a shape grammar.
 pub(crate) fn is_shapes(toks: &[crate::syntax::lex::Token]) -> bool {
     grammar::is_shapes(toks)
@@ -148,7 +155,7 @@ pub(crate) fn is_shapes(toks: &[crate::syntax::lex::Token]) -> bool {
 
 /// Parses and checks a shape grammar; `dir` is the folder inserted mesh
 /// files are found in.
-pub(crate) fn from_front(front: Front, dir: Option<&Path>) -> Result<ShapeGrammar, Error> {
+pub(crate) fn from_front(front: Front, dir: Option<&Path>) -> Result<ShapeGrammar, SourceError> {
     let eof = front.eof();
     let Front {
         sources, tokens, ..
@@ -163,7 +170,7 @@ pub(crate) fn from_front(front: Front, dir: Option<&Path>) -> Result<ShapeGramma
     };
     let file = match grammar::parse(&tokens, eof, col, text_of) {
         Ok(f) => f,
-        Err(e) => return Err(Error::at(&sources, e)),
+        Err(e) => return Err(SourceError::at(&sources, e)),
     };
     let mut c = Checker {
         rc: RuleCompiler::new(&host::SHAPE_HOST, &file.functions),
@@ -184,7 +191,7 @@ pub(crate) fn from_front(front: Front, dir: Option<&Path>) -> Result<ShapeGramma
     c.warnings.extend(warns);
     if !c.diags.is_empty() {
         c.diags.sort_by_key(|d| (d.span.file.0, d.span.start));
-        return Err(Error::Program {
+        return Err(SourceError::Program {
             sources,
             diagnostics: c.diags,
         });
@@ -754,7 +761,7 @@ impl Checker {
             }
             "color" | "colour" => match args {
                 [a] => match &a.kind {
-                    ExprKind::Str(s) => match crate::render::Rgba::parse(s) {
+                    ExprKind::Str(s) => match crate::colour::Rgba::parse(s) {
                         Some(c) => COp::Colour([c.0, c.1, c.2]),
                         None => {
                             self.err(

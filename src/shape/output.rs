@@ -6,8 +6,8 @@
 use std::collections::HashMap;
 use std::fmt::Write as _;
 
+use crate::colour::Rgba;
 use crate::mesh::PolygonSoup;
-use crate::render::Rgba;
 
 use super::geom::Geometry;
 use super::run::{Node, ShapeTree, State};
@@ -18,7 +18,7 @@ pub fn colour_of(node: &Node) -> [u8; 3] {
     match node.colour {
         Some(c) => c,
         None => {
-            let Rgba(r, g, b, _) = crate::render::palette(node.symbol as i64 + 1);
+            let Rgba(r, g, b, _) = crate::colour::palette(node.symbol as i64 + 1);
             [r, g, b]
         }
     }

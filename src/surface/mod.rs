@@ -1,7 +1,7 @@
 //! Stellar subdivision grammars (paper 000): rules over faces, edges and
 //! vertices with levels, run on the half-edge mesh.
 //!
-//! [`crate::load`] tells a grammar from a curve L-system by its syntax;
+//! The loader tells a grammar from a curve L-system by its syntax;
 //! [`load_str`] and [`load_file`] read text as a grammar whatever it says.
 
 pub(crate) mod grammar;
@@ -10,12 +10,19 @@ pub(crate) mod run;
 
 use std::path::Path;
 
-use crate::error::Error;
-use crate::load::{self, Front};
+use crate::production::{Checked, Entry};
 use crate::syntax::lex::Token;
+use crate::syntax::source::{self, Front};
+use crate::syntax::SourceError;
 use crate::syntax::Span;
 
 pub use run::{Grammar, GrammarRun, Protection, RunError, StepCounts};
+
+/// This topology's entry in the loader's table.
+pub(crate) const ENTRY: Entry = Entry {
+    claims: is_surface,
+    check: |front, _| from_front(front).map(|g| Box::new(g) as Checked),
+};
 
 /// True when preprocessed tokens are a surface grammar: a `mesh:` directive
 /// at the start of a line, or a rule in paper 000's form on one line: `F(`,
@@ -59,12 +66,12 @@ fn is_rule_at(toks: &[Token], i: usize) -> bool {
 }
 
 /// Parses and checks preprocessed tokens as a surface grammar.
-pub(crate) fn from_front(front: Front) -> Result<Grammar, Error> {
+pub(crate) fn from_front(front: Front) -> Result<Grammar, SourceError> {
     from_front_with(front, true)
 }
 
 /// [`from_front`], with or without the specialisations of the IR.
-pub(crate) fn from_front_with(front: Front, specialise: bool) -> Result<Grammar, Error> {
+pub(crate) fn from_front_with(front: Front, specialise: bool) -> Result<Grammar, SourceError> {
     let eof = front.eof();
     let Front {
         sources, tokens, ..
@@ -78,24 +85,26 @@ pub(crate) fn from_front_with(front: Front, specialise: bool) -> Result<Grammar,
     };
     let file = match grammar::parse(&tokens, eof, text_of) {
         Ok(f) => f,
-        Err(e) => return Err(Error::at(&sources, e)),
+        Err(e) => return Err(SourceError::at(&sources, e)),
     };
-    run::compile_with(&file, sources, specialise).map_err(|(sources, diagnostics)| Error::Program {
-        sources,
-        diagnostics,
+    run::compile_with(&file, sources, specialise).map_err(|(sources, diagnostics)| {
+        SourceError::Program {
+            sources,
+            diagnostics,
+        }
     })
 }
 
 /// Checks text as a surface grammar. `defines` are `NAME=VALUE`
 /// overrides; `name` is the file name in messages.
-pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Grammar, Error> {
-    from_front(load::front(name, text.to_string(), defines)?)
+pub fn load_str(name: &str, text: &str, defines: &[String]) -> Result<Grammar, SourceError> {
+    from_front(source::front(name, text.to_string(), defines)?)
 }
 
 /// Reads and checks a surface grammar file.
-pub fn load_file(path: &Path, defines: &[String]) -> Result<Grammar, Error> {
-    let text = load::read(path)?;
-    from_front(load::front(&path.display().to_string(), text, defines)?)
+pub fn load_file(path: &Path, defines: &[String]) -> Result<Grammar, SourceError> {
+    let text = source::read(path)?;
+    from_front(source::front(&path.display().to_string(), text, defines)?)
 }
 
 #[cfg(test)]
@@ -104,6 +113,28 @@ mod tests {
 
     use super::*;
     use crate::mesh::{io, Mesh};
+
+    /// A mesh that each scheme has subdivided gives the same soups by the
+    /// fast walk as by the reference one (`mesh::build`'s tests check the
+    /// same after splits and flips).
+    #[test]
+    fn soups_match_after_grammars() {
+        use crate::mesh::shapes;
+        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("lsystems/surfaces");
+        for (grammar, base) in [
+            ("catmull-clark.lsys", shapes::quad_torus(6, 5)),
+            ("doo-sabin.lsys", shapes::quad_torus(6, 5)),
+            ("four-eight.lsys", shapes::quad_grid(4, 4)),
+            ("loop.lsys", shapes::icosphere(1)),
+            ("sqrt3.lsys", shapes::icosphere(1)),
+        ] {
+            let g = load_file(&root.join(grammar), &[]).unwrap();
+            let tags: Vec<u32> = (0..base.faces.len()).map(|i| (i % 2) as u32).collect();
+            let mut m = Mesh::from_soup_tagged(&base, &tags).unwrap();
+            g.run(&mut m, 2, |_| {}).unwrap();
+            crate::mesh::build::tests::soups_agree(&m);
+        }
+    }
 
     /// Runs the grammar `steps` steps on its own mesh, with or without the
     /// specialisations, protecting every third face and every fourth
@@ -117,7 +148,7 @@ mod tests {
         steps: usize,
         protect: bool,
     ) -> Result<Mesh, String> {
-        let front = load::front(name, text.to_string(), &[]).unwrap();
+        let front = source::front(name, text.to_string(), &[]).unwrap();
         let g = from_front_with(front, specialise).unwrap_or_else(|e| panic!("{e}"));
         let (mesh, _) = g.mesh.clone().expect("the grammar names its mesh");
         let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("lsystems/surfaces");

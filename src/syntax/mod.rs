@@ -5,6 +5,8 @@ pub mod ifexpr;
 pub mod lex;
 pub mod parse;
 pub mod preprocess;
+pub mod source;
 pub mod span;
 
-pub use span::{Diagnostic, FileId, SourceFile, SourceMap, Span};
+pub use source::SourceError;
+pub use span::{render_line, Diagnostic, FileId, SourceFile, SourceMap, Span};

@@ -121,6 +121,28 @@ impl SourceMap {
         self.files.iter().map(|f| f.name.as_str())
     }
 
+    /// Every diagnostic rendered as [`SourceMap::render`] does, a blank
+    /// line between two. A diagnostic that renders as one already shown
+    /// (an error inside a macro used twice, placed at the macro's text) is
+    /// shown once.
+    pub fn render_all(
+        &self,
+        diagnostics: &[Diagnostic],
+        f: &mut std::fmt::Formatter<'_>,
+    ) -> std::fmt::Result {
+        let mut shown = std::collections::HashSet::new();
+        for d in diagnostics {
+            if !shown.insert((d.span, d.message.as_str())) {
+                continue;
+            }
+            if shown.len() > 1 {
+                f.write_str("\n\n")?;
+            }
+            f.write_str(&self.render(d.span, &d.message))?;
+        }
+        Ok(())
+    }
+
     /// Renders `file:line:col: error: message`, the source line and a caret.
     pub fn render(&self, span: Span, message: &str) -> String {
         self.render_as("error", span, message)
@@ -226,5 +248,87 @@ impl Diagnostic {
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.message)
+    }
+}
+
+/// `path:line:col: error: message`, then `text`, line `line` of the file,
+/// and a caret under its bytes `range`: what [`SourceMap::render`] shows
+/// for a diagnostic in a program, for a file of which only the one line is
+/// at hand. The one renderer draws it from a file of that line alone; the
+/// line number is then put back in the three places that show it.
+pub fn render_line(
+    path: &str,
+    line: usize,
+    text: &str,
+    range: std::ops::Range<usize>,
+    message: &str,
+) -> String {
+    let text = text.split(['\n', '\r']).next().unwrap_or("");
+    if u32::try_from(text.len()).is_err() {
+        // Spans hold 32-bit offsets: a line of 4 GiB is named, not shown.
+        return format!("{path}:{line}: error: {message}");
+    }
+    let at = |i: usize| {
+        (0..=i.min(text.len()))
+            .rev()
+            .find(|&i| text.is_char_boundary(i))
+    };
+    let start = at(range.start).unwrap_or(0);
+    let end = at(range.end).unwrap_or(start).max(start);
+    let mut map = SourceMap::default();
+    let file = map.add(SourceFile::new(path, text));
+    let shown = map.render(Span::new(file, start, end), message);
+    // `path:1:col: ...`, ` |`, `1 | text`, `  | ^`: the gutter is one wide.
+    let mut parts = shown.rsplitn(4, '\n');
+    let (Some(caret), Some(source), Some(gutter), Some(header)) =
+        (parts.next(), parts.next(), parts.next(), parts.next())
+    else {
+        return shown;
+    };
+    let (Some(rest), Some(source), Some(gutter), Some(caret)) = (
+        header.strip_prefix(&format!("{path}:1:")),
+        source.strip_prefix('1'),
+        gutter.strip_prefix(' '),
+        caret.strip_prefix(' '),
+    ) else {
+        return shown;
+    };
+    let pad = " ".repeat(line.to_string().len());
+    format!("{path}:{line}:{rest}\n{pad}{gutter}\n{line}{source}\n{pad}{caret}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A line rendered alone reads as the same line rendered in its file.
+    #[test]
+    fn render_line_is_the_one_rendering() {
+        let long = format!("f {}", "12 ".repeat(80));
+        let lines = ["v 0 0 0", "\tv 1 x 0", "é v 2 0 0", long.as_str()];
+        let mut text = String::new();
+        let mut starts = Vec::new();
+        for k in 0..1200 {
+            starts.push(text.len());
+            text.push_str(lines[k % lines.len()]);
+            text.push('\n');
+        }
+        let mut map = SourceMap::default();
+        let file = map.add(SourceFile::new("m.obj", text.clone()));
+        for k in [0, 1, 2, 3, 9, 10, 98, 99, 1001, 1199] {
+            let line = lines[k % lines.len()];
+            let ranges = [(0, 1), (4, 5), (3, 3), (200, 203), (2, 200)];
+            let fits = |&(a, b): &(usize, usize)| {
+                b <= line.len() && line.is_char_boundary(a) && line.is_char_boundary(b)
+            };
+            for (a, b) in ranges.into_iter().filter(fits) {
+                let want = map.render(
+                    Span::new(file, starts[k] + a, starts[k] + b),
+                    "expected a number",
+                );
+                let got = render_line("m.obj", k + 1, line, a..b, "expected a number");
+                assert_eq!(got, want, "line {} bytes {a}..{b}", k + 1);
+            }
+        }
     }
 }

@@ -12,15 +12,22 @@ pub(crate) mod host;
 pub(crate) mod mesh;
 pub(crate) mod run;
 
-use crate::error::Error;
 use crate::lang;
-use crate::load::Front;
+use crate::production::{Checked, Entry};
 use crate::syntax::ast::{ExprKind, Init, Item};
 use crate::syntax::lex::{Tok, Token};
+use crate::syntax::source::Front;
+use crate::syntax::SourceError;
 use crate::syntax::{parse, Diagnostic, Span};
 
 pub use mesh::{Rotation, NULL};
 pub use run::{VvError, VvProgram, VvRun};
+
+/// This topology's entry in the loader's table.
+pub(crate) const ENTRY: Entry = Entry {
+    claims: is_vv,
+    check: |front, _| from_front(front).map(|p| Box::new(p) as Checked),
+};
 
 /// True when preprocessed tokens are a vv program: `mesh NAME` that
 /// starts a line or follows a `;` or `}` (a declaration of a set of
@@ -42,12 +49,12 @@ fn is_type(n: &str) -> bool {
 }
 
 /// Parses and checks preprocessed tokens as a vv program.
-pub(crate) fn from_front(front: Front) -> Result<VvProgram, Error> {
+pub(crate) fn from_front(front: Front) -> Result<VvProgram, SourceError> {
     let eof = front.eof();
     let Front {
         sources, tokens, ..
     } = front;
-    let fail = |sources, d: Vec<Diagnostic>| Error::Program {
+    let fail = |sources, d: Vec<Diagnostic>| SourceError::Program {
         sources,
         diagnostics: d,
     };

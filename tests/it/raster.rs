@@ -635,11 +635,11 @@ fn the_view_files_camera_commands_are_kept() {
         &mut Vec::new(),
     )
     .expect("reads");
-    let l = subgram::model::view::raster_lights(&v.lights);
+    let l = subgram::render::view_file::raster_lights(&v.lights);
     assert_eq!(l[0].specular, [0.5, 0.4, 0.3]);
     assert_eq!(l[0].direction, Vec3::Y);
     assert_eq!(
-        subgram::model::view::raster_lights(&[]),
+        subgram::render::view_file::raster_lights(&[]),
         vec![Light::default()]
     );
 }

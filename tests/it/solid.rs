@@ -10,7 +10,6 @@
 //! triangles per side and segment, a fan per cap).
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
 use glam::{DVec3, Vec3};
 use subgram::draw::solid::SolidOptions;
@@ -74,7 +73,7 @@ fn cylinders(sides: u32, capped: bool) -> Model {
 /// settings.
 fn solid_of(src: &str, model: Model) -> Scene3 {
     let mut c = load_text(src);
-    c.program.model = Arc::new(model);
+    c.set_model(model);
     let mut run = c.run(Default::default()).unwrap_or_else(|e| panic!("{e}"));
     run.solid(&SolidOptions::default())
         .unwrap_or_else(|e| panic!("{e}"))
@@ -401,7 +400,8 @@ fn patch_point(net: &[[DVec3; 4]; 4], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
 fn bezier_patches_are_tessellated_on_the_turtles_frame() {
     let (c, scene) = model_solid(models("solid/leaf.l"));
     let m = only_mesh(&scene);
-    let surface = &c.program.model.surfaces[0];
+    let model = c.model();
+    let surface = &model.surfaces[0];
     // `surface: leaf.s 2 4 2`: each patch cut 4 × 2, so 5 × 3 points and
     // 2 × 4 × 2 triangles per patch.
     assert_eq!(surface.patches.len(), 2);
@@ -461,7 +461,8 @@ fn bezier_patches_are_tessellated_on_the_turtles_frame() {
 fn a_generalized_cylinder_keeps_its_section_on_a_twisting_path() {
     let (c, scene) = model_solid(models("solid/gc.l"));
     let m = only_mesh(&scene);
-    let contour = &c.program.model.contours[1];
+    let model = c.model();
+    let contour = &model.contours[1];
     assert_eq!(contour.name, "section");
     // `samples: 9`: 9 points, the last the first again, so 8 a ring; five
     // rings (`StartGC` and four `F`), four strips of 16 triangles, and a
@@ -575,7 +576,7 @@ fn a_runaway_word_stops_at_the_limit_and_huge_widths_are_refused() {
     assert!(e.contains("past its limit of 10000 triangles"), "{e}");
     assert!(e.contains("`Sphere`"), "{e}");
     let mut c = load_text("derivation length: 0;\nAxiom: SetWidth(3e38) F(1);\n");
-    c.program.model = Arc::new(cylinders(8, false));
+    c.set_model(cylinders(8, false));
     let mut run = c.run(Default::default()).unwrap();
     let e = run.solid(&SolidOptions::default()).unwrap_err().to_string();
     assert!(e.contains("infinite coordinate"), "{e}");
@@ -730,7 +731,8 @@ fn a_blended_contour_lies_between_its_two_and_a_missing_one_is_an_error() {
     // (sin, cos) of i/8 turns.
     let (c, s) = model_solid(models("solid/blend.l"));
     let m = only_mesh(&s);
-    let section = &c.program.model.contours[1];
+    let model = c.model();
+    let section = &model.contours[1];
     for (k, y) in [(0, 0.0), (1, 1.0)] {
         for i in 0..8 {
             let (sn, cs) = (std::f64::consts::TAU * i as f64 / 8.0).sin_cos();
@@ -758,7 +760,7 @@ fn negative_integer_parameters_are_numbers_not_nans() {
     );
     assert_eq!(s.looks[0].index, 1);
     let mut c = load_text("derivation length: 0;\nAxiom: CurrentContour(-1);\n");
-    c.program.model = Arc::new(cylinders(8, false));
+    c.set_model(cylinders(8, false));
     let e = c
         .solid(Default::default(), &SolidOptions::default())
         .unwrap_err()
@@ -773,7 +775,7 @@ fn negative_integer_parameters_are_numbers_not_nans() {
 fn pixel_lines_become_tubes_only_when_asked_with_the_size_of_a_pixel() {
     let src = "derivation length: 0;\nAxiom: SetWidth(3) F(1) F(1);\n";
     let mut c = load_text(src);
-    c.program.model = Arc::new(Model::default());
+    c.set_model(Model::default());
     let none = c
         .solid(Default::default(), &SolidOptions::default())
         .unwrap();
@@ -808,7 +810,7 @@ fn a_picture_gives_thin_tubes_fewer_sides() {
         let mut c = load_text(&format!(
             "derivation length: 0;\nAxiom: SetWidth({width}) F(10);\n"
         ));
-        c.program.model = Arc::new(cylinders(16, false));
+        c.set_model(cylinders(16, false));
         let mut run = c.run(Default::default()).unwrap();
         let picture = run
             .solid(&SolidOptions {
@@ -829,7 +831,7 @@ fn a_picture_gives_thin_tubes_fewer_sides() {
 #[test]
 fn a_picture_keeps_a_tube_under_a_pixel_as_its_axis() {
     let mut c = load_text("derivation length: 0;\nAxiom: SetWidth(0.9) F(10) Left(90) F(5);\n");
-    c.program.model = Arc::new(cylinders(16, false));
+    c.set_model(cylinders(16, false));
     let mut run = c.run(Default::default()).unwrap();
     let picture = run
         .solid(&SolidOptions {
@@ -904,7 +906,7 @@ fn a_picture_found_in_one_walk_is_the_one_made_knowing_its_scale() {
     let fit = 0.9 * 300.0;
     for (src, capped) in [(plant, true), (plant, false)] {
         let mut c = load_text(src);
-        c.program.model = Arc::new(cylinders(8, capped));
+        c.set_model(cylinders(8, capped));
         let mut run = c.run(Default::default()).unwrap();
         let found = run
             .solid(&SolidOptions {

@@ -51,7 +51,7 @@ fn monopodial_renders_with_lpfgs_background_and_leaf_colour() {
     };
     // The specifications' lpfg line: material.mat, view.v, anim.a,
     // functions.fset beside lsystem.l; two functions, numbered 1 and 2.
-    let m = &c.program.model;
+    let m = &*c.model();
     assert_eq!(m.functions.len(), 2);
     assert_eq!(m.defines()[..2], ["internode_length=1", "leaf_length=2"]);
     let tmp = crate::support::scratch("mono");

@@ -1,6 +1,6 @@
 //! Atomic file writes, shared by every output (pictures, meshes, points).
 //!
-//! Inside a command's [`crate::files::Run`], each write is staged: the
+//! Inside a command's [`super::Run`], each write is staged: the
 //! file is written whole beside its target, and the run puts every output
 //! in place at its commit, all or none. Outside a run each call puts its
 //! own files in place at once.
@@ -26,7 +26,7 @@ fn write_temp_with(
     static COUNT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let (tmp, created) = loop {
         let k = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let tmp = crate::files::sibling(path, &format!("tmp-{k}"));
+        let tmp = super::sibling(path, &format!("tmp-{k}"));
         match std::fs::OpenOptions::new()
             .write(true)
             .create_new(true)
@@ -88,7 +88,7 @@ impl Write for Timed {
 /// a rename, so that a failure never leaves a truncated file behind.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let tmp = write_temp(path, bytes)?;
-    let Some(tmp) = crate::files::stage(path, tmp) else {
+    let Some(tmp) = super::stage(path, tmp) else {
         return Ok(());
     };
     let result = std::fs::rename(&tmp, path);
@@ -106,7 +106,7 @@ pub fn write_atomic_with(
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
     let tmp = write_temp_with(path, fill)?;
-    let Some(tmp) = crate::files::stage(path, tmp) else {
+    let Some(tmp) = super::stage(path, tmp) else {
         return Ok(());
     };
     let result = std::fs::rename(&tmp, path);
@@ -118,7 +118,7 @@ pub fn write_atomic_with(
 
 /// Writes several files, all or none: every file is written to its
 /// temporary first, and only when all of them are written are they renamed
-/// into place (see [`crate::files::rename_all`]: a file that a rename
+/// into place (see [`super::rename_all`]: a file that a rename
 /// replaced is put back when a later one fails). Inside a run they are
 /// staged for the run's commit. The paths must be distinct files. The
 /// error names the file that failed.
@@ -138,9 +138,9 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<(), (PathBuf, std::i
             }
         }
     }
-    if crate::files::in_run() {
+    if super::in_run() {
         for ((path, _), tmp) in files.iter().zip(temps) {
-            crate::files::stage(path, tmp);
+            super::stage(path, tmp);
         }
         return Ok(());
     }
@@ -149,7 +149,7 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<(), (PathBuf, std::i
         .zip(&temps)
         .map(|((p, _), t)| (*p, t.as_path()))
         .collect();
-    let result = crate::files::rename_all(&pairs);
+    let result = super::rename_all(&pairs);
     if result.is_err() {
         cleanup(&temps);
     }

@@ -8,7 +8,7 @@
 //! message instead of holding it. A socket or a folder is refused.
 //!
 //! **Writing.** A command begins a [`Run`]; while it lives, every output
-//! that [`crate::atomic`] writes on this thread is staged (written whole to
+//! that [`crate::files::atomic`] writes on this thread is staged (written whole to
 //! a temporary file beside its target) instead of put in place, and the
 //! regular files this thread opens with [`open`] are noted as the run's
 //! inputs. [`Run::commit`] then checks that the deadline has not passed
@@ -27,7 +27,38 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use crate::deadline::{self, Deadline};
-use crate::error::Error;
+
+pub(crate) mod atomic;
+
+/// Why [`Run::commit`] put nothing in place. The crate's `Error`
+/// wraps it: `Late` and `Refused` as the run's failure and a usage error,
+/// `Write` as a write error of the file named.
+#[derive(Debug)]
+pub enum CommitError {
+    /// The run's deadline passed before its outputs were put in place.
+    Late(String),
+    /// The outputs cannot be put in place as named: one would replace an
+    /// input, or two are one file.
+    Refused(String),
+    /// Putting `path` in place failed.
+    Write {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+}
+
+impl std::fmt::Display for CommitError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CommitError::Late(m) | CommitError::Refused(m) => f.write_str(m),
+            CommitError::Write { path, error } => {
+                write!(f, "cannot write `{}`: {error}", path.display())
+            }
+        }
+    }
+}
+
+impl std::error::Error for CommitError {}
 
 /// An input opened by [`open`]: a regular file, read as it is, or a stream
 /// (a pipe, a device) read under the run's deadline.
@@ -375,7 +406,7 @@ impl Run {
     }
 
     /// Puts every staged output in place, or none; see the module's text.
-    pub fn commit(self) -> Result<(), Error> {
+    pub fn commit(self) -> Result<(), CommitError> {
         if !self.owner {
             return Ok(());
         }
@@ -411,9 +442,9 @@ fn discard(ledger: &Ledger) {
     }
 }
 
-fn commit(ledger: &Ledger) -> Result<(), Error> {
+fn commit(ledger: &Ledger) -> Result<(), CommitError> {
     if let Some(d) = deadline::current() {
-        d.check().map_err(Error::Failed)?;
+        d.check().map_err(CommitError::Late)?;
     }
     if ledger.force != Some(true) {
         for s in &ledger.staged {
@@ -424,7 +455,7 @@ fn commit(ledger: &Ledger) -> Result<(), Error> {
                     } else {
                         ""
                     };
-                    return Err(Error::Usage(format!(
+                    return Err(CommitError::Refused(format!(
                         "the output `{}` is a file this run read: writing it would replace an input; \
                          name another output{force}",
                         s.target.display()
@@ -439,7 +470,7 @@ fn commit(ledger: &Ledger) -> Result<(), Error> {
     for s in &ledger.staged {
         let key = resolved(&s.target);
         if let Some((_, first)) = seen.iter().find(|(k, _)| *k == key) {
-            return Err(Error::Usage(format!(
+            return Err(CommitError::Refused(format!(
                 "`{}` and `{}` are the same output file; name two different files",
                 first.display(),
                 s.target.display()
@@ -452,7 +483,7 @@ fn commit(ledger: &Ledger) -> Result<(), Error> {
         .iter()
         .map(|s| (s.target.as_path(), s.temp.as_path()))
         .collect();
-    rename_all(&targets).map_err(|(path, e)| Error::write(path, e))
+    rename_all(&targets).map_err(|(path, error)| CommitError::Write { path, error })
 }
 
 /// `path` with its folder's links resolved (the folder exists: a staged
@@ -605,9 +636,9 @@ mod tests {
         std::fs::create_dir(dir.join("taken")).unwrap();
         std::fs::write(dir.join("taken/x"), "x").unwrap();
         let run = Run::begin(None, Some(false));
-        crate::atomic::write_atomic(&a, b"new a").unwrap();
-        crate::atomic::write_atomic(&b, b"new b").unwrap();
-        crate::atomic::write_atomic(&dir.join("taken"), b"t").unwrap();
+        crate::files::atomic::write_atomic(&a, b"new a").unwrap();
+        crate::files::atomic::write_atomic(&b, b"new b").unwrap();
+        crate::files::atomic::write_atomic(&dir.join("taken"), b"t").unwrap();
         // Staged: nothing is in place yet.
         assert_eq!(std::fs::read_to_string(&a).unwrap(), "old a");
         assert!(!b.exists());
@@ -627,8 +658,8 @@ mod tests {
         let run = Run::begin(None, Some(false));
         let mut text = String::new();
         open(&input).unwrap().read_to_string(&mut text).unwrap();
-        crate::atomic::write_atomic(&dir.join("other.txt"), b"o").unwrap();
-        crate::atomic::write_atomic(&dir.join("link.txt"), b"gone").unwrap();
+        crate::files::atomic::write_atomic(&dir.join("other.txt"), b"o").unwrap();
+        crate::files::atomic::write_atomic(&dir.join("link.txt"), b"gone").unwrap();
         let e = run.commit().unwrap_err().to_string();
         assert!(e.contains("link.txt") && e.contains("--force"), "{e}");
         assert_eq!(std::fs::read_to_string(&input).unwrap(), "keep");
@@ -636,7 +667,7 @@ mod tests {
         // With --force it is written.
         let run = Run::begin(None, Some(true));
         open(&input).unwrap();
-        crate::atomic::write_atomic(&input, b"new").unwrap();
+        crate::files::atomic::write_atomic(&input, b"new").unwrap();
         run.commit().unwrap();
         assert_eq!(std::fs::read_to_string(&input).unwrap(), "new");
     }
@@ -647,13 +678,13 @@ mod tests {
         let dir = tmp.path();
         let run = Run::begin(Some(Deadline::after(Duration::from_millis(1))), Some(false));
         make_folders(&dir.join("new/deeper")).unwrap();
-        crate::atomic::write_atomic(&dir.join("new/deeper/x"), b"x").unwrap();
+        crate::files::atomic::write_atomic(&dir.join("new/deeper/x"), b"x").unwrap();
         std::thread::sleep(Duration::from_millis(5));
         let e = run.commit().unwrap_err().to_string();
         assert!(e.contains("time limit"), "{e}");
         assert!(names(dir).is_empty(), "{:?}", names(dir));
         let run = Run::begin(None, Some(false));
-        crate::atomic::write_atomic(&dir.join("y"), b"y").unwrap();
+        crate::files::atomic::write_atomic(&dir.join("y"), b"y").unwrap();
         drop(run);
         assert!(names(dir).is_empty(), "{:?}", names(dir));
     }
