@@ -33,8 +33,6 @@ mod curve;
 mod deadline;
 mod error;
 mod files;
-// `crate::atomic` until every caller names `files::atomic`.
-use files::atomic;
 mod huge;
 mod lang;
 mod limits;

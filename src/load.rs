@@ -527,8 +527,7 @@ fn check_curve(front: Front, precision: Precision) -> Result<Curve, Error> {
     match lang::compile::compile_with(&file, precision) {
         Ok(mut program) => {
             // lpfg's default circle, until a model folder gives more.
-            program.model =
-                lang::model::ModelRef(std::sync::Arc::new(crate::model::Model::default()));
+            program.model = model::default_ref();
             // What the turtle does not act on is said, not dropped.
             program
                 .warnings

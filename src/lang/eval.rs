@@ -72,6 +72,15 @@ impl Env {
 pub const MAX_VIEWS: usize = 64;
 
 impl Env {
+    /// An environment with `globals` whose model accessors ask `model`.
+    pub fn with_model(globals: Vec<Value>, model: super::model::ModelRef) -> Env {
+        Env {
+            model,
+            ..Env::new(globals)
+        }
+    }
+
+    /// An environment with `globals` and no model ([`super::model::NoModel`]).
     pub fn new(globals: Vec<Value>) -> Env {
         Env {
             globals,

@@ -596,6 +596,16 @@ impl crate::lang::model::ModelData for Model {
     }
 }
 
+/// The model of a program that came without a folder: lpfg's default
+/// circle alone (contour 0), shared by every such program.
+pub fn default_ref() -> crate::lang::model::ModelRef {
+    static DEFAULT: std::sync::LazyLock<crate::lang::model::ModelRef> =
+        std::sync::LazyLock::new(|| {
+            crate::lang::model::ModelRef(std::sync::Arc::new(Model::default()))
+        });
+    DEFAULT.clone()
+}
+
 /// The model `program` runs with: the one its folder gave, or the
 /// default one (lpfg's default circle, nothing else) for a program that
 /// came without a folder.

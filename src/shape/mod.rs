@@ -276,7 +276,12 @@ impl Checker {
             let mut frame = attr_init.clone();
             frame.resize(frame_len, Value::Void);
             let mut host = host::ShapeHost::default();
-            match Interp::new(&[]).eval(&ex, &mut frame, &mut Env::new(Vec::new()), &mut host) {
+            match Interp::new(&[]).eval(
+                &ex,
+                &mut frame,
+                &mut Env::with_model(Vec::new(), crate::model::default_ref()),
+                &mut host,
+            ) {
                 Ok(v) => attr_init.push(v),
                 Err(e) => {
                     self.err(e.span.unwrap_or(a.init.span), e.message);

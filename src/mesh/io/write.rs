@@ -63,7 +63,7 @@ fn write_streamed(
 ) -> Result<(), MeshFileError> {
     let name = path.display().to_string();
     let format = format_of(&name, path)?;
-    crate::atomic::write_atomic_with(path, |w| write_polygons(w, format, s, edges))
+    crate::files::atomic::write_atomic_with(path, |w| write_polygons(w, format, s, edges))
         .map_err(|e| error(&name, None, format!("cannot write the file: {e}")))
 }
 

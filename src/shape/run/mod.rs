@@ -229,7 +229,7 @@ pub fn derive(g: &ShapeGrammar, opts: &ShapeOptions, deadline: &Deadline) -> R<S
         seam_planes: HashMap::new(),
         next_cut: 1,
         interp: Interp::new(&[]),
-        env: Env::new(Vec::new()),
+        env: Env::with_model(Vec::new(), crate::model::default_ref()),
         groups: Vec::new(),
         ticks: 0,
         held: 0,

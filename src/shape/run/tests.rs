@@ -4,7 +4,7 @@
 use super::*;
 
 fn grammar(text: &str) -> ShapeGrammar {
-    let front = crate::load::front("t.lsys", text.to_string(), &[]).unwrap();
+    let front = crate::syntax::source::front("t.lsys", text.to_string(), &[]).unwrap();
     super::super::from_front(front, None).unwrap_or_else(|e| panic!("{e}"))
 }
 

@@ -151,7 +151,7 @@ pub(crate) fn compile_with(
                 let got = Interp::new(&[]).eval(
                     &x,
                     &mut vec![Value::Void; c.frame_size().max(1)],
-                    &mut Env::new(Vec::new()),
+                    &mut Env::with_model(Vec::new(), crate::model::default_ref()),
                     &mut host,
                 );
                 match got {

@@ -42,7 +42,7 @@ impl<'m> Evaluator<'m> {
     pub(super) fn new(mesh: &'m Mesh, current: u32, step: u32, frame: usize) -> Evaluator<'m> {
         Evaluator {
             interp: Interp::new(&[]),
-            env: Env::new(Vec::new()),
+            env: Env::with_model(Vec::new(), crate::model::default_ref()),
             host: MeshHost {
                 mesh,
                 current,

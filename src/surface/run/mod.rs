@@ -184,7 +184,7 @@ impl From<RuntimeError> for RunError {
     }
 }
 
-/// The message alone; [`crate::Surface::error`] adds the rule's line and
+/// The message alone; `Surface::error` adds the rule's line and
 /// caret.
 impl std::fmt::Display for RunError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

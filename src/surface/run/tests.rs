@@ -7,7 +7,7 @@ use super::Grammar;
 use crate::mesh::{io, shapes, Mesh};
 
 fn grammar(name: &str, text: &str) -> Grammar {
-    let front = crate::load::front(name, text.to_string(), &[]).expect("reads");
+    let front = crate::syntax::source::front(name, text.to_string(), &[]).expect("reads");
     crate::surface::from_front_with(front, true).unwrap_or_else(|e| panic!("{e}"))
 }
 
