@@ -11,6 +11,10 @@
 //! schemes), its leading eigenvalues, Reif's check and the limit and
 //! tangent stencils. A dual scheme's centres of blocks, which its rules
 //! may read, are put at their polygons' centroids with each impulse.
+//!
+//! **Layer.** It uses `curve`, `deadline`, `error`, `lang`, `load`, `mesh`,
+//! `rewrite`, `surface`, `system`; it is used by `command`. Nothing here names
+//! a layer above (see ARCHITECTURE.md, "Layers").
 
 pub mod curve;
 mod num;

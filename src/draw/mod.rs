@@ -1,6 +1,11 @@
 //! Interpretation of a word as drawing: the turtle walks the modules and
 //! emits renderer-neutral [`Event`]s in 3D. PNG and SVG both draw these
 //! events, so the two always agree.
+//!
+//! **Layer.** It uses `colour`, `lang`, `model`, `rewrite`, `scene3`,
+//! `syntax`; it is used by `command`, `curve`, `error`, `load`, `render`,
+//! `reverse`. Nothing here names a layer above (see ARCHITECTURE.md,
+//! "Layers").
 
 pub(crate) mod coverage;
 mod queries;

@@ -20,6 +20,10 @@
 //! dropped without a commit leaves nothing behind; a process killed in the
 //! middle (Ctrl-C) leaves its hidden temporaries (`.NAME.tmp-PID-K`) and
 //! the folders it made, never a half-written output under its own name.
+//!
+//! **Layer.** It uses `deadline`; it is used by `command`, `error`, `export`,
+//! `load`, `mesh`, `model`, `render`, `reverse`, `serve`, `syntax`. Nothing
+//! here names a layer above (see ARCHITECTURE.md, "Layers").
 
 use std::cell::RefCell;
 use std::io::Read;

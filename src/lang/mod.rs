@@ -1,4 +1,9 @@
 //! The language's meaning: types, values, checking and the interpreter.
+//!
+//! **Layer.** It uses `deadline`, `syntax`; it is used by `analyze`,
+//! `command`, `curve`, `draw`, `load`, `model`, `output`, `production`,
+//! `render`, `reverse`, `rewrite`, `shape`, `surface`, `system`, `vv`. Nothing
+//! here names a layer above (see ARCHITECTURE.md, "Layers").
 
 pub mod builtins;
 pub mod cfmt;

@@ -1,5 +1,10 @@
 //! Meshes: polygon soups from files, the half-edge mesh with levels, the
 //! stellar operators and validation: geometry and topology only.
+//!
+//! **Layer.** It uses `deadline`, `files`, `huge`, `limits`, `syntax`; it is
+//! used by `analyze`, `command`, `error`, `render`, `shape`, `surface`,
+//! `system`, `vv`. Nothing here names a layer above (see ARCHITECTURE.md,
+//! "Layers").
 
 pub mod build;
 pub mod halfedge;

@@ -12,6 +12,10 @@
 //!   number, as lpfg's invisible `-D NAME=N` do; [`Model::call`] evaluates
 //!   the accessors (`func`, `tfunc`, `curveX`, `val`, …) for the
 //!   interpreter.
+//!
+//! **Layer.** It uses `files`, `lang`, `syntax`; it is used by `command`,
+//! `curve`, `draw`, `error`, `load`, `render`, `shape`, `surface`, `system`.
+//! Nothing here names a layer above (see ARCHITECTURE.md, "Layers").
 
 pub mod colours;
 pub mod contours;

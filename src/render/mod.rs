@@ -2,6 +2,11 @@
 //! (tiny-skia) or SVG (the svg crate) from the same [`Scene`]. Turtle
 //! events are laid out here; [`mesh`] turns a polygon mesh into shaded
 //! polygons of a scene.
+//!
+//! **Layer.** It uses `colour`, `deadline`, `draw`, `files`, `huge`, `lang`,
+//! `mesh`, `model`, `rewrite`, `scene3`; it is used by `command`, `curve`,
+//! `error`, `export`, `system`. Nothing here names a layer above (see
+//! ARCHITECTURE.md, "Layers").
 
 mod ink;
 pub mod mesh;

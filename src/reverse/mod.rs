@@ -3,6 +3,10 @@
 //! 2 (the forward scheme) reconstructs and measures. Details between levels
 //! make the representation lossless, in the spirit of Bartels and
 //! Samavati's multiresolution curves.
+//!
+//! **Layer.** It uses `curve`, `deadline`, `draw`, `error`, `files`, `lang`,
+//! `load`, `rewrite`; it is used by `command`. Nothing here names a layer
+//! above (see ARCHITECTURE.md, "Layers").
 
 pub mod details;
 pub mod input;

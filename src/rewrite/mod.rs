@@ -1,5 +1,10 @@
 //! Rewriting words of modules: storage, context matching, one parallel step,
 //! and whole derivations with decomposition and interpretation.
+//!
+//! **Layer.** It uses `deadline`, `huge`, `lang`, `syntax`; it is used by
+//! `analyze`, `command`, `curve`, `draw`, `output`, `production`, `render`,
+//! `reverse`, `system`. Nothing here names a layer above (see ARCHITECTURE.md,
+//! "Layers").
 
 pub mod context;
 pub mod derive;

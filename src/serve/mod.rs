@@ -38,6 +38,10 @@
 //! All of that keeps other web pages in the user's browser out. It does not
 //! keep out another process on the machine, which can read the page and
 //! its token as the browser does.
+//!
+//! **Layer.** It uses `command`, `deadline`, `error`, `files`, `load`; nothing
+//! in the library uses it. Nothing here names a layer above (see
+//! ARCHITECTURE.md, "Layers").
 
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};

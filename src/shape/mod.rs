@@ -7,6 +7,10 @@
 //! language's one checker against [`host::SHAPE_HOST`]; the successor's
 //! operations (scope rules, split, repeat, comp, extrude, insert,
 //! Subdivide) are the topology's. The schedule is [`run::derive`].
+//!
+//! **Layer.** It uses `colour`, `deadline`, `lang`, `mesh`, `model`,
+//! `production`, `surface`, `syntax`; it is used by `command`, `load`,
+//! `system`. Nothing here names a layer above (see ARCHITECTURE.md, "Layers").
 
 pub(crate) mod geom;
 pub(crate) mod grammar;

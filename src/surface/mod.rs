@@ -3,6 +3,11 @@
 //!
 //! The loader tells a grammar from a curve L-system by its syntax;
 //! [`load_str`] and [`load_file`] read text as a grammar whatever it says.
+//!
+//! **Layer.** It uses `deadline`, `lang`, `limits`, `mesh`, `model`,
+//! `production`, `syntax`; it is used by `analyze`, `command`, `load`,
+//! `shape`, `system`, `vv`. Nothing here names a layer above (see
+//! ARCHITECTURE.md, "Layers").
 
 pub(crate) mod grammar;
 pub(crate) mod host;

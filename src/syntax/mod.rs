@@ -1,4 +1,9 @@
 //! The `.lsys` language as text: lexing, preprocessing, parsing, spans.
+//!
+//! **Layer.** It uses `files`; it is used by `command`, `curve`, `draw`,
+//! `error`, `lang`, `load`, `mesh`, `model`, `production`, `rewrite`, `shape`,
+//! `surface`, `system`, `vv`. Nothing here names a layer above (see
+//! ARCHITECTURE.md, "Layers").
 
 pub mod ast;
 pub mod ifexpr;

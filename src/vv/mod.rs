@@ -7,6 +7,10 @@
 //! one checker and run by the one interpreter; [`run::VvRun`] is its
 //! schedule (`Start`, then `StartEach`, `Step`, `EndEach` per step, with
 //! the mesh's consistency checked after each).
+//!
+//! **Layer.** It uses `deadline`, `lang`, `limits`, `mesh`, `production`,
+//! `surface`, `syntax`; it is used by `command`, `load`, `system`. Nothing
+//! here names a layer above (see ARCHITECTURE.md, "Layers").
 
 pub(crate) mod host;
 pub(crate) mod mesh;
