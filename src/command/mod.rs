@@ -1,0 +1,49 @@
+//! The commands of the `subgram` binary, one function each, with their
+//! arguments as plain structs. A command returns the text it prints on
+//! standard output, if any; it writes its output files whole or not at all,
+//! and never over one of its inputs.
+//!
+//! - `check.rs`: `check`.
+//! - `derive.rs`: `derive`, `derive_to` and `DeriveArgs`: the word, streamed.
+//! - `render.rs`: `render`, `render_edited` (for `serve`), `RenderArgs`,
+//!   `Solidity`; an L-system drawn in 2D or 3D, or exported.
+//! - `watch.rs`: `watch`, `WatchOptions`, `WatchEvent`.
+//! - `infer.rs`: `infer` and `InferArgs`.
+//! - `subdivide.rs`: `subdivide` and `SubdivideArgs`; a shape grammar's
+//!   outputs.
+//! - `mesh.rs`: `mesh_info`, `mesh_convert`, and `write_mesh`.
+//! - `reverse.rs`: `reverse`, `reconstruct` and their arguments.
+//! - `analyze.rs`: `analyze` and `AnalyzeArgs`.
+//! - `picture.rs`: `Picture`, `write_picture`; how a mesh is drawn
+//!   (`MeshLooks`), a curve's views, and where pictures go (`Out`).
+//! - `common.rs`: what several commands share: `in_run`, load options, the
+//!   steps' limit, JSON, `refuse_overwrite`, writing all or none, and the
+//!   files a program wrote.
+//!
+//! `command` uses every layer below it: load and system, curve, surface,
+//! shape and vv, render, draw, export, mesh, model, reverse, infer,
+//! analyze, files and deadline; only `main` (the binary) and `serve` use it.
+//! Its children are private; what is public is re-exported here.
+
+mod analyze;
+mod check;
+mod common;
+mod derive;
+mod infer;
+mod mesh;
+mod picture;
+mod render;
+mod reverse;
+mod subdivide;
+mod watch;
+
+pub use analyze::{analyze, AnalyzeArgs};
+pub use check::check;
+pub use derive::{derive, derive_to, DeriveArgs, Printed};
+pub use infer::{infer, InferArgs};
+pub use mesh::{mesh_convert, mesh_info};
+pub use picture::{write_picture, Picture};
+pub use render::{render, render_edited, Drawn, RenderArgs, Solidity};
+pub use reverse::{reconstruct, reverse, ReconstructArgs, ReverseArgs};
+pub use subdivide::{subdivide, SubdivideArgs};
+pub use watch::{watch, WatchEvent, WatchOptions};

@@ -1,0 +1,473 @@
+//! `subgram render`: an L-system's 2D figures or shaded 3D geometry, a
+//! grammar's or vv program's mesh, or a mesh file, as a picture or a 3D
+//! export; `render_edited`, the same in memory for `serve`.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use super::common::{
+    as_paths, check_steps, in_run, load_options, refuse_overwrite, write_program_files,
+    writes_folder,
+};
+use super::picture::{
+    picture_bytes, write_mesh_picture, write_soup_picture, write_views, MeshLooks, Out, Picture,
+};
+use super::subdivide::{subdivide_in_run, write_shapes_picture, SubdivideArgs};
+use crate::curve::FigureOptions;
+use crate::deadline::{Deadline, DEFAULT_TIMEOUT};
+use crate::error::Error;
+use crate::lang::ProgramOutput;
+use crate::load::load;
+use crate::mesh;
+use crate::render::{self, Rgba, View};
+use crate::rewrite::derive::DEFAULT_MAX_MODULES;
+use crate::system::{load_mesh, Progress, RunOptions, System};
+
+/// The arguments of `subgram render`.
+#[derive(Clone, Debug)]
+pub struct RenderArgs {
+    /// An `.lsys` file, or a mesh (`.obj`, `.off`, `.ply`) to draw as it is.
+    pub file: String,
+    /// The picture: `.png` or `.svg`.
+    pub output: String,
+    pub steps: Option<u64>,
+    /// Width and height in pixels; `None`: 800×800, and with `each` the
+    /// height the panels' drawings need.
+    pub size: Option<(u32, u32)>,
+    /// Draw every step 0..=N side by side (curves).
+    pub each: bool,
+    /// The background; `None`: colour 0 of the model's colour map or
+    /// material 0's emission when the program comes with one, else white.
+    pub background: Option<Rgba>,
+    /// L-systems: draw the turtle's lines in 2D, or its 3D geometry shaded
+    /// (tubes, surfaces, generalized cylinders); by default 3D when the
+    /// model's view file asks for it.
+    pub solid: Solidity,
+    /// Curves: xy (the default), xz or yz. Meshes: iso, front, back, left,
+    /// right, top or bottom.
+    pub view: Option<String>,
+    /// Meshes: draw the edges over the faces.
+    pub wireframe: bool,
+    pub defines: Vec<String>,
+    /// `--double`: `float` in double precision instead of lpfg's single.
+    pub double: bool,
+    pub max_modules: usize,
+    pub phase: usize,
+    /// `--seed`: seeds every random number generator (see
+    /// [`RunOptions::seed`]).
+    pub seed: Option<u32>,
+    /// `--timeout`: the command stops with an error after this long.
+    pub timeout: Option<Duration>,
+    /// Write the picture even over one of the inputs.
+    pub force: bool,
+    /// `--allow-writes DIR`: the program may write files, under DIR.
+    pub allow_writes: Option<PathBuf>,
+    /// What the program prints: the caller keeps a clone and prints it.
+    pub program_output: ProgramOutput,
+}
+
+impl RenderArgs {
+    pub fn new(file: impl Into<String>, output: impl Into<String>) -> RenderArgs {
+        RenderArgs {
+            solid: Solidity::Auto,
+            file: file.into(),
+            output: output.into(),
+            steps: None,
+            size: None,
+            each: false,
+            background: None,
+            view: None,
+            wireframe: true,
+            defines: Vec::new(),
+            double: false,
+            max_modules: DEFAULT_MAX_MODULES,
+            phase: 0,
+            seed: None,
+            timeout: Some(DEFAULT_TIMEOUT),
+            force: false,
+            allow_writes: None,
+            program_output: ProgramOutput::default(),
+        }
+    }
+}
+
+/// How `render` draws an L-system.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Solidity {
+    /// 3D when the model's view file asks for tubes (`line style:
+    /// cylinder` or `polygon`) or shading (`render mode: shaded`), or the
+    /// output is a 3D file; else the 2D line drawing.
+    #[default]
+    Auto,
+    /// The 2D line drawing.
+    Lines,
+    /// The shaded 3D geometry.
+    Solid,
+}
+
+/// `subgram render`: a curve's picture, a surface grammar's subdivided
+/// mesh, or a mesh file, as PNG or SVG. Returns the program's warnings.
+pub fn render(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<String>, Error> {
+    in_run(a.timeout, Some(a.force), || render_in_run(a, progress))
+}
+
+fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<String>, Error> {
+    let deadline = crate::deadline::current();
+    let file = Path::new(&a.file);
+    let output = Path::new(&a.output);
+    refuse_overwrite(&[output], &[file], a.force)?;
+    let looks = MeshLooks::of_render(a);
+    if mesh::io::Format::from_path(file).is_some() {
+        // Found before the mesh is read.
+        Picture::from_path(output).map_err(|_| {
+            Error::Usage(format!(
+                "cannot tell the format of `{}`: render draws a mesh as a picture (.png, .svg); \
+                 `subgram mesh convert` writes it as a mesh",
+                output.display()
+            ))
+        })?;
+        write_mesh_picture(&load_mesh(file)?, output, &looks, &mut Out::Files)?;
+        return Ok(Vec::new());
+    }
+    // A 3D file (.obj, .ply, .glb) is an L-system's geometry exported.
+    let format = match crate::export::Format::from_path(output) {
+        Some(_) => Picture::Png,
+        None => Picture::from_path(output).map_err(|_| {
+            Error::Usage(format!(
+                "cannot tell the format of `{}`: render writes pictures (.png, .svg) and 3D \
+                 geometry (.obj, .ply, .glb)",
+                output.display()
+            ))
+        })?,
+    };
+    let system = load(file, &load_options(&a.defines, a.double))?;
+    let mut warnings = system.warnings();
+    warnings.extend(render_system(
+        a,
+        system,
+        (&looks, format),
+        deadline,
+        progress,
+        &mut Out::Files,
+    )?);
+    Ok(warnings)
+}
+
+/// A picture computed in memory and not written: what `serve` shows.
+#[derive(Clone, Debug)]
+pub struct Drawn {
+    /// The main picture's bytes (SVG or PNG, as `RenderArgs::output`'s
+    /// extension says).
+    pub picture: Vec<u8>,
+    /// The program's warnings.
+    pub warnings: Vec<String>,
+}
+
+/// Renders as [`render()`] does, with the program's text replaced by `text`
+/// (see [`crate::load_edited`]), and writes nothing: the picture
+/// comes back in memory. A program's own files (`fopen`) are refused as
+/// without `--allow-writes`.
+pub fn render_edited(a: &RenderArgs, text: &str) -> Result<Drawn, Error> {
+    let deadline = a.timeout.map(Deadline::after);
+    // The files the program reads are read under the deadline too.
+    let _deadline = crate::deadline::scope(deadline);
+    let file = Path::new(&a.file);
+    let output = Path::new(&a.output);
+    let looks = MeshLooks::of_render(a);
+    let format = Picture::from_path(output)?;
+    let system = crate::load::load_edited(file, text, &load_options(&a.defines, a.double))?;
+    let mut warnings = system.warnings();
+    let mut a = a.clone();
+    a.allow_writes = None;
+    a.force = true;
+    let mut out = Out::Memory(Vec::new());
+    warnings.extend(render_system(
+        &a,
+        system,
+        (&looks, format),
+        deadline,
+        |_| {},
+        &mut out,
+    )?);
+    let mut files = match out {
+        Out::Memory(files) => files,
+        Out::Files => Vec::new(),
+    };
+    if files.is_empty() {
+        return Err(Error::Failed("nothing was drawn".into()));
+    }
+    Ok(Drawn {
+        picture: files.swap_remove(0).1,
+        warnings,
+    })
+}
+
+fn render_system(
+    a: &RenderArgs,
+    system: System,
+    (looks, format): (&MeshLooks, Picture),
+    deadline: Option<Deadline>,
+    progress: impl FnMut(Progress),
+    out: &mut Out,
+) -> Result<Vec<String>, Error> {
+    let output = Path::new(&a.output);
+    let file = Path::new(&a.file);
+    let white = Rgba(255, 255, 255, 255);
+    let export = crate::export::Format::from_path(output);
+    if export.is_some() && !matches!(system, System::Curve(_)) {
+        // A grammar's or a vv program's mesh, or a shape grammar's
+        // shapes: written as `subdivide` writes them.
+        if a.each {
+            return Err(Error::Usage(
+                "--each draws the steps of an L-system side by side; it writes no 3D file".into(),
+            ));
+        }
+        if a.allow_writes.is_some() {
+            return Err(Error::Usage(format!(
+                "--allow-writes: `{}` is written as `subdivide` writes a grammar's mesh, which \
+                 writes no program files; render to a picture to keep the program's files",
+                output.display()
+            )));
+        }
+        let sa = SubdivideArgs {
+            mesh: None,
+            grammar: a.file.clone(),
+            steps: a.steps,
+            output: a.output.clone(),
+            defines: a.defines.clone(),
+            view: None,
+            shading: None,
+            no_wireframe: false,
+            seed: a.seed,
+            timeout: a.timeout,
+            force: a.force,
+            program_output: a.program_output.clone(),
+        };
+        return subdivide_in_run(&sa, progress);
+    }
+    match system {
+        System::Surface(s) => {
+            looks.check()?;
+            let opts = RunOptions {
+                steps: a.steps,
+                deadline,
+                ..RunOptions::default()
+            };
+            let run = s.subdivide(&opts, progress)?;
+            write_mesh_picture(&run.mesh, output, looks, out)?;
+            Ok(Vec::new())
+        }
+        System::Shapes(s) => {
+            looks.check()?;
+            if a.each {
+                return Err(Error::Usage(
+                    "--each draws the steps of an L-system side by side; a shape grammar draws \
+                     its terminal shapes"
+                        .into(),
+                ));
+            }
+            let opts = RunOptions {
+                seed: a.seed,
+                deadline,
+                ..RunOptions::default()
+            };
+            let run = s.derive(&opts)?;
+            write_shapes_picture(&run, output, looks, out)?;
+            Ok(Vec::new())
+        }
+        System::Vv(v) => {
+            looks.check()?;
+            if a.each {
+                return Err(Error::Usage(
+                    "--each draws the steps of an L-system side by side; a vv program draws its \
+                     mesh after the last step (`-n` chooses it)"
+                        .into(),
+                ));
+            }
+            let dir = writes_folder(&a.allow_writes, &a.program_output)?;
+            let opts = RunOptions {
+                steps: a.steps,
+                seed: a.seed,
+                deadline,
+                output: a.program_output.clone(),
+                ..RunOptions::default()
+            };
+            let run = v.run(&opts, progress)?;
+            let mut inputs = vec![file.to_path_buf(), output.to_path_buf()];
+            inputs.extend(v.base_mesh());
+            write_program_files(&a.program_output, dir.as_deref(), &as_paths(&inputs))?;
+            write_soup_picture(&run.soup, output, looks, out)?;
+            Ok(Vec::new())
+        }
+        System::Curve(c) if wants_solid(a, &c, export.is_some()) => {
+            render_solid(a, &c, (looks, format), deadline, out)
+        }
+        System::Curve(c) => {
+            let view = match a.view.as_deref().unwrap_or("xy") {
+                "xy" => View::Xy,
+                "xz" => View::Xz,
+                "yz" => View::Yz,
+                other => {
+                    return Err(Error::Usage(format!(
+                        "`--view {other}` is not a view of an L-system: use xy, xz or yz"
+                    )))
+                }
+            };
+            let (opts, dir) = curve_run(a, deadline)?;
+            let model = &*crate::model::of(&c.program);
+            let palette = model
+                .palette()
+                .map(|p| std::sync::Arc::new(p.map(|[r, g, b]| Rgba(r, g, b, 255))));
+            let model_background = model.colours.as_ref().map(|m| {
+                let [r, g, b] = m.background();
+                Rgba(r, g, b, 255)
+            });
+            let figure = FigureOptions {
+                derive: opts.derive_options(),
+                each: a.each,
+                draw: Default::default(),
+                render: render::RenderOptions {
+                    width: a.size.map_or(800, |s| s.0),
+                    height: a.size.map_or(800, |s| s.1),
+                    fit_height: a.each && a.size.is_none(),
+                    background: a.background.or(model_background).unwrap_or(white),
+                    view,
+                    palette,
+                    widths_in_units: model.widths_in_units,
+                    ..Default::default()
+                },
+            };
+            let figures = match format {
+                Picture::Png => c.png_figures(&figure)?,
+                Picture::Svg => c.figures(&figure)?.try_map(|s| picture_bytes(s, format))?,
+            };
+            write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
+            write_views(figures, Path::new(&a.file), output, a.force, out)
+        }
+    }
+}
+
+/// How `render` runs an L-system: the steps checked, the folder the
+/// program may write in, the run's options.
+fn curve_run(
+    a: &RenderArgs,
+    deadline: Option<Deadline>,
+) -> Result<(RunOptions, Option<PathBuf>), Error> {
+    check_steps(a.steps)?;
+    let dir = writes_folder(&a.allow_writes, &a.program_output)?;
+    let opts = RunOptions {
+        steps: a.steps,
+        max_modules: a.max_modules,
+        phase: a.phase,
+        seed: a.seed,
+        base_mesh: None,
+        deadline,
+        output: a.program_output.clone(),
+        max_shapes: None,
+    };
+    Ok((opts, dir))
+}
+
+/// Whether `render` draws this L-system's 3D geometry (see [`Solidity`]).
+fn wants_solid(a: &RenderArgs, c: &crate::Curve, export: bool) -> bool {
+    use crate::model::view::{LineStyle, RenderMode};
+    let m = &*crate::model::of(&c.program);
+    match a.solid {
+        _ if export => true,
+        Solidity::Solid => true,
+        Solidity::Lines => false,
+        Solidity::Auto => {
+            m.line_style != LineStyle::Pixel
+                || matches!(
+                    m.camera.render_mode,
+                    RenderMode::Shaded | RenderMode::Shadows
+                )
+        }
+    }
+}
+
+/// An L-system's 3D geometry: exported (`.obj` with its `.mtl`, `.ply`,
+/// `.glb`) or drawn by the z-buffer with the view file's camera and
+/// lights (`--view` with a mesh view's name turns the camera, y up).
+/// Lines in lpfg's `pixel` style become tubes as wide as their pixels at
+/// the picture's scale.
+fn render_solid(
+    a: &RenderArgs,
+    c: &crate::Curve,
+    (looks, format): (&MeshLooks, Picture),
+    deadline: Option<Deadline>,
+    out: &mut Out,
+) -> Result<Vec<String>, Error> {
+    use crate::draw::solid::SolidOptions;
+    use crate::model::view::LineStyle;
+    let output = Path::new(&a.output);
+    let file = Path::new(&a.file);
+    if a.each {
+        return Err(Error::Usage(
+            "--each draws the 2D steps side by side; add --lines, or draw one step in 3D".into(),
+        ));
+    }
+    let (opts, dir) = curve_run(a, deadline)?;
+    let model = &*crate::model::of(&c.program);
+    let (w, h) = looks.size;
+    let mut run = c.run(opts.derive_options())?;
+    let mut sopts = SolidOptions::default();
+    let picture = crate::export::Format::from_path(output).is_none();
+    // The picture's scale from the drawing's extent, as the camera will
+    // frame it (lpfg's 0.9 of the window by default).
+    let fit = 0.9 * w.min(h) as f64;
+    if model.line_style == LineStyle::Pixel {
+        // Pixel-wide lines are tubes of that many units: the scale first.
+        let extent = run
+            .line_bounds()?
+            .map_or(f64::NAN, |(lo, hi)| (hi - lo).max_element());
+        let units_per_pixel = crate::draw::solid::pixel_of(extent, fit);
+        sopts.pixel_tubes = Some(units_per_pixel);
+        // A picture needs no more sides than its pixels show; an export
+        // keeps them all.
+        if picture {
+            sopts.picture_pixel = Some(units_per_pixel);
+        }
+    } else if picture {
+        // The same scale, found by the walk that makes the geometry.
+        sopts.fit_pixels = Some(fit);
+    }
+    let scene = run.solid(&sopts)?;
+    write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
+    if crate::export::Format::from_path(output).is_some() {
+        if scene.triangle_count() == 0 {
+            return Err(Error::Failed(
+                "nothing to export: the turtle made no 3D geometry (no lines, surfaces, polygons or spheres)".into(),
+            ));
+        }
+        crate::export::write(&scene, output)?;
+        return Ok(Vec::new());
+    }
+    let mut camera = model.camera.clone();
+    if let Some(name) = a.view.as_deref().filter(|v| *v != "xy") {
+        let Some((d, u)) = crate::render::mesh::view_direction(name) else {
+            return Err(Error::Usage(format!(
+                "`--view {name}` is not a view of a 3D drawing: use xy (the view file's), iso, front, back, left, right, top or bottom"
+            )));
+        };
+        // The mesh views are named for z up; a plant grows along y.
+        let y_up = |v: glam::DVec3| [v.x, v.z, -v.y];
+        camera.dir = Some(y_up(d));
+        camera.up = Some(y_up(u));
+    }
+    let mut ropts = camera.raster_options(&model.lights, scene.bounds(), w, h)?;
+    let model_background = model.colours.as_ref().map(|m| {
+        let [r, g, b] = m.background();
+        Rgba(r, g, b, 255)
+    });
+    ropts.background = a
+        .background
+        .or(model_background)
+        .unwrap_or(Rgba(255, 255, 255, 255));
+    let bytes = match format {
+        Picture::Png => crate::render::raster::render_png(&scene, &ropts)?,
+        Picture::Svg => crate::render::raster::render_svg(&scene, &ropts)?.into_bytes(),
+    };
+    out.put(vec![(output.to_path_buf(), bytes)])?;
+    Ok(Vec::new())
+}
