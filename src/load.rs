@@ -66,7 +66,8 @@ pub fn load_edited(
 }
 
 /// The L-system file that [`load`] reads for `path`: the model folder's
-/// L-system, or the file itself.
+/// L-system, or the file itself. (`subgram serve` reads it.)
+#[cfg(feature = "serve")]
 pub fn program_file(path: impl AsRef<Path>) -> Result<PathBuf, Error> {
     let path = path.as_ref();
     Ok(match model::find(path)? {
