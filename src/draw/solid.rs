@@ -1504,7 +1504,8 @@ impl Sink for Builder<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{tropism, walk_loops, DrawOptions, Events, TurtleView};
+    use super::super::walk::walk_loops;
+    use super::super::{tropism, DrawOptions, Events, TurtleView};
     use super::{Builder, SolidOptions};
     use crate::model::view::LineStyle;
     use glam::DVec3;
