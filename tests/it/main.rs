@@ -14,6 +14,7 @@ mod fuzz_replay;
 mod gillespie;
 mod golden;
 mod golden_tests;
+mod guide;
 mod infer;
 mod lang_features;
 mod limits;

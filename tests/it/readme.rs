@@ -1,11 +1,18 @@
-//! The README as a new user reads it (issue 18's rough edges): what its
-//! commands write is ignored by git, the `subgram` command is installed
-//! before it is used, and the command table names every view.
+//! The README and the user guide as a new user reads them (issue 18's
+//! rough edges, issue 40's front door): what their commands write is
+//! ignored by git, the `subgram` command is installed before it is used,
+//! the command table names every view, the language example draws its
+//! closed curve, and the README is a short page that starts with the two
+//! commands and needs nothing beside the clone.
 
 use crate::support::root;
 
-/// The shell commands of the README's `sh` blocks, continuation lines
-/// joined, comments dropped.
+fn read(rel: &str) -> String {
+    std::fs::read_to_string(root().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+/// The shell commands of a Markdown text's `sh` blocks, continuation
+/// lines joined, comments dropped.
 fn commands(readme: &str) -> Vec<String> {
     let mut out = Vec::new();
     let mut inside = false;
@@ -73,14 +80,18 @@ fn ignored(gitignore: &str, name: &str) -> bool {
 
 #[test]
 fn every_file_the_readme_commands_write_at_the_top_level_is_ignored() {
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let gitignore = std::fs::read_to_string(root().join(".gitignore")).unwrap();
-    let cmds = commands(&readme);
+    let gitignore = read(".gitignore");
+    let mut pages = vec!["README.md".to_string()];
+    pages.extend(crate::guide::chapters());
+    let mut cmds = Vec::new();
+    for p in &pages {
+        cmds.extend(commands(&read(p)).into_iter().map(|c| (p.clone(), c)));
+    }
     assert!(cmds.len() > 10, "{cmds:?}");
     let mut seen = 0;
-    for c in cmds
+    for (page, c) in cmds
         .iter()
-        .filter(|c| c.contains("subgram ") || c.starts_with("cargo run"))
+        .filter(|(_, c)| c.contains("subgram ") || c.starts_with("cargo run"))
     {
         for f in outputs(c) {
             if f.contains('/') {
@@ -89,7 +100,7 @@ fn every_file_the_readme_commands_write_at_the_top_level_is_ignored() {
             seen += 1;
             assert!(
                 ignored(&gitignore, &f),
-                "`{f}`, written by `{c}`, is not in .gitignore"
+                "`{f}`, written by `{c}` in {page}, is not in .gitignore"
             );
         }
     }
@@ -98,24 +109,35 @@ fn every_file_the_readme_commands_write_at_the_top_level_is_ignored() {
     assert!(ignored("/*.png\n", "a.png") && !ignored("/*.png\n", "a.txt"));
 }
 
+/// In the README, and in the guide read in its order, the install comes
+/// before the first command that runs a bare `subgram`.
 #[test]
 fn the_readme_says_how_to_get_the_subgram_command_before_using_it() {
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let install = readme
-        .find("cargo install --path .")
-        .expect("the README says how to install the command");
-    let first_use = commands(&readme)
-        .into_iter()
-        .find(|c| c.starts_with("subgram "))
-        .expect("a bare subgram command");
-    let used = readme.find(&first_use).unwrap();
-    assert!(install < used, "`{first_use}` comes before the install");
+    let mut guide = String::new();
+    for c in crate::guide::chapters() {
+        guide.push_str(&read(&c));
+    }
+    for (name, text) in [("README.md", read("README.md")), ("the guide", guide)] {
+        let install = text
+            .find("cargo install --path .")
+            .unwrap_or_else(|| panic!("{name} says how to install the command"));
+        let first_use = commands(&text)
+            .into_iter()
+            .find(|c| c.starts_with("subgram "))
+            .expect("a bare subgram command");
+        let used = text.find(&first_use).unwrap();
+        assert!(
+            install < used,
+            "{name}: `{first_use}` comes before the install"
+        );
+    }
 }
 
+/// The guide's command table (the README's, before issue 40).
 #[test]
 fn the_command_table_names_every_view() {
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let row = readme
+    let table = read("docs/guide/src/commands.md");
+    let row = table
         .lines()
         .find(|l| l.starts_with("| `subgram render "))
         .expect("the render row");
@@ -128,17 +150,17 @@ fn the_command_table_names_every_view() {
     }
 }
 
-/// The program of "The language in one example", run as printed: its
-/// picture is the closed curve of its points, each segment from a point
-/// to the next around the ring, and no segment from the turtle's start at
-/// the origin (no derived point is there).
+/// The program of the guide's "The language in one example", run as
+/// printed: its picture is the closed curve of its points, each segment
+/// from a point to the next around the ring, and no segment from the
+/// turtle's start at the origin (no derived point is there).
 #[test]
 fn the_language_example_draws_its_closed_curve_and_nothing_else() {
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let at = readme.find("## The language in one example").unwrap();
-    let start = at + readme[at..].find("```c\n").unwrap() + 5;
-    let end = start + readme[start..].find("```").unwrap();
-    let l = crate::support::load_text(&readme[start..end]);
+    let guide = read("docs/guide/src/language.md");
+    let at = guide.find("## The language in one example").unwrap();
+    let start = at + guide[at..].find("```c\n").unwrap() + 5;
+    let end = start + guide[start..].find("```").unwrap();
+    let l = crate::support::load_text(&guide[start..end]);
     let mut run = l.run(subgram::DeriveOptions::default()).unwrap();
     let pts = crate::support::points(&l, &crate::support::derive(&l, Default::default()), "P");
     assert_eq!(pts.len(), 3 << 4, "three points, four Chaikin steps");
@@ -158,6 +180,32 @@ fn the_language_example_draws_its_closed_curve_and_nothing_else() {
         pts.iter().all(|p| p.length() > 0.1),
         "no point at the origin"
     );
+}
+
+/// The README is a front door (issue 40): at most 250 lines, starting
+/// with the two commands, every shell command in it runnable in a clone
+/// with nothing beside it, and links into the guide.
+#[test]
+fn the_readme_is_a_short_front_door_that_starts_with_the_two_commands() {
+    let readme = read("README.md");
+    let lines = readme.lines().count();
+    assert!(
+        lines <= 250,
+        "README.md has {lines} lines; the guide takes the rest"
+    );
+    let first = readme.find("```").expect("a code block");
+    assert!(
+        readme[first..].starts_with(
+            "```sh\ncargo run --release -- render lsystems/figures/fig10-kolam.lsys -o kolam.png\ncargo test\n```\n"
+        ),
+        "the README's first block is not the two commands"
+    );
+    assert!(
+        !readme.contains("../shared"),
+        "the README points into ../shared, which a clone does not have"
+    );
+    let links = readme.matches("](docs/guide/src/").count();
+    assert!(links >= 10, "{links} links into the guide");
 }
 
 /// Every package the Python scripts of `benches/` import, beyond Python's
