@@ -273,7 +273,7 @@ impl Bounds {
     #[inline]
     fn grow_projected(&mut self, p: DVec2, r: f64) {
         self.finite &= p.is_finite() && r.is_finite();
-        // Plain comparisons (as `draw::grown`): a coordinate that is not
+        // Plain comparisons (as `draw::bounds::grown`): a coordinate that is not
         // finite fails `get` whatever the box.
         let (a, b) = (p - r, p + r);
         self.lo = DVec2::select(a.cmplt(self.lo), a, self.lo);

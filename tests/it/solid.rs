@@ -6,7 +6,7 @@
 //! and tangents by de Casteljau's construction, counts from the manual's
 //! definitions (§5.5: a sphere has `contour sides` slices and (sides + 1)
 //! / 2 stacks; §8.1.3: 16 sides by default) and from the tessellation
-//! that `draw/solid.rs` documents (a ring of `sides` points per joint, two
+//! that `draw/solid/` documents (a ring of `sides` points per joint, two
 //! triangles per side and segment, a fan per cap).
 
 use std::path::PathBuf;

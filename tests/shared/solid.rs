@@ -2,7 +2,7 @@
 //! (`line style: cylinder`, materials): stems become tubes and leaves
 //! Bézier surfaces. The expected counts come from the interpreted word
 //! (how many `F` and `Surface` modules it holds) and the tessellation
-//! that `draw/solid.rs` documents: lpfg's 16 contour sides (neither view
+//! that `draw/solid/` documents: lpfg's 16 contour sides (neither view
 //! file sets them), tubes that go on through branch points, 10 × 10 quads
 //! per patch (the view file gives no divisions); the bounds from the
 //! turtle's own lines (the 2D drawing of the same word).
