@@ -14,6 +14,9 @@ pub struct AnalyzeArgs {
     pub defines: Vec<String>,
     /// `--picture OUT.svg`: the characteristic maps' control nets.
     pub picture: Option<String>,
+    /// `--valences 3,4,12`: a surface grammar measured at these only
+    /// (default: all of [`crate::analyze::surface::VALENCES`]).
+    pub valences: Option<Vec<usize>>,
 }
 
 /// `subgram analyze FILE [--format json] [-D NAME=VALUE]…`: what the
@@ -42,7 +45,10 @@ fn analyze_in_run(a: &AnalyzeArgs) -> Result<String, Error> {
             )));
         }
     }
-    let r = crate::analyze::analyze(Path::new(&a.file), &a.defines)?;
+    let r = match &a.valences {
+        Some(ns) => crate::analyze::analyze_at(Path::new(&a.file), &a.defines, ns)?,
+        None => crate::analyze::analyze(Path::new(&a.file), &a.defines)?,
+    };
     if let Some(out) = &a.picture {
         let svg = r.characteristic_svg().map_err(Error::Usage)?;
         write_file(Path::new(out), svg.as_bytes())?;

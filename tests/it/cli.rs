@@ -588,22 +588,64 @@ fn render_each_sizes_the_canvas_to_its_panels() {
 /// `analyze --picture OUT.svg` draws one panel per valence of a surface
 /// grammar; a curve scheme, or an output that is the input, is a usage
 /// error (exit code 2) that writes nothing.
+/// `--valences` takes valences from 3 to 12; anything else is a usage
+/// error that says what it expects.
+#[test]
+fn analyze_valences_are_checked() {
+    let f = lsys("surfaces/loop.lsys");
+    for (bad, want) in [
+        ("2,4", "valence 2 is outside 3 to 12"),
+        (
+            "3,x",
+            "expected valences from 3 to 12 separated by commas (3,4,12), not `x`",
+        ),
+    ] {
+        let o = subgram(&["analyze", f.to_str().unwrap(), "--valences", bad]);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{bad}: {}", stderr(&o));
+    }
+    let o = subgram(&[
+        "analyze",
+        f.to_str().unwrap(),
+        "--valences",
+        "4",
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(json["valences"].as_array().unwrap().len(), 1);
+    assert_eq!(json["valences"][0]["n"], 4);
+}
+
 #[test]
 fn analyze_draws_the_characteristic_maps() {
     let tmp = scratch("cli-picture");
     let dir = tmp.path();
     let out = dir.join("loop.svg");
     let f = lsys("surfaces/loop.lsys");
-    let o = subgram(&[
+    // Every valence (3..12, the default) in an optimised build; two with
+    // `--valences` in a debug one, where each takes seconds.
+    let ns = crate::support::valences(&(3..=12).collect::<Vec<_>>(), &[3, 5]);
+    let list: Vec<String> = ns.iter().map(|n| n.to_string()).collect();
+    let list = list.join(",");
+    let mut args = vec![
         "analyze",
         f.to_str().unwrap(),
         "--picture",
         out.to_str().unwrap(),
-    ]);
+    ];
+    if ns.len() < 10 {
+        args.extend(["--valences", &list]);
+    }
+    let o = subgram(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     let svg = std::fs::read_to_string(&out).unwrap();
     assert!(svg.starts_with("<svg"));
-    assert_eq!(svg.matches("n = ").count(), 10, "a panel per valence 3..12");
+    assert_eq!(svg.matches("n = ").count(), ns.len(), "a panel per valence");
+    for n in &ns {
+        assert!(svg.contains(&format!("n = {n}")), "no panel for {n}");
+    }
     assert!(svg.matches("<line").count() > 10);
     let curve = dir.join("curve.svg");
     let c = lsys("curves/cubic-22.lsys");

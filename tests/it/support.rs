@@ -289,3 +289,16 @@ pub fn load_error(src: &str) -> String {
         Err(e) => e.to_string(),
     }
 }
+
+/// The valences a test measures: every one it names (`all`) in an
+/// optimised build, and `quick` in a debug build, where one valence of a
+/// two-step grammar takes seconds. `.ci/run` runs these tests in release
+/// too (`cargo test --release --test it -- analyze:: surface_c4::`), so
+/// every valence named here is checked there.
+pub fn valences(all: &[usize], quick: &[usize]) -> Vec<usize> {
+    if cfg!(debug_assertions) {
+        quick.to_vec()
+    } else {
+        all.to_vec()
+    }
+}
