@@ -203,3 +203,17 @@ pub(super) fn write_program_files(
     let files: Vec<(&Path, Vec<u8>)> = out.iter().map(|(p, b)| (p.as_path(), b.clone())).collect();
     write_files(&files)
 }
+
+/// `"; did you mean `.png`?"` when the extension of `path` is a misspelt
+/// one of `known` (`.pgn`, `.svgg`), else nothing.
+pub(super) fn extension_hint(path: &Path, known: &[&str]) -> String {
+    let Some(ext) = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+    else {
+        return String::new();
+    };
+    crate::lang::suggest::nearest(&ext, known.iter().copied())
+        .map(|e| format!("; did you mean `.{e}`?"))
+        .unwrap_or_default()
+}

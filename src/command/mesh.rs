@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::common::{in_run, json, refuse_overwrite};
+use super::common::{extension_hint, in_run, json, refuse_overwrite};
 use crate::error::Error;
 use crate::mesh::{self, Mesh};
 use crate::system::load_mesh;
@@ -98,8 +98,9 @@ fn mesh_convert_in_run(
             .extension()
             .map_or(String::new(), |e| format!(" `.{}`", e.to_string_lossy()));
         return Err(Error::Usage(format!(
-            "{}: unknown mesh format{ext}: expected a file ending in .obj, .off or .ply",
-            output.display()
+            "{}: unknown mesh format{ext}: expected a file ending in .obj, .off or .ply{}",
+            output.display(),
+            extension_hint(output, &["obj", "off", "ply"])
         )));
     }
     refuse_overwrite(&[output], &[input], force)?;

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::common::{refuse_overwrite, write_file};
+use super::common::{extension_hint, refuse_overwrite, write_file};
 use super::render::RenderArgs;
 use crate::error::Error;
 use crate::mesh::{Mesh, PolygonSoup};
@@ -26,8 +26,9 @@ impl Picture {
             Some("png") => Ok(Picture::Png),
             Some("svg") => Ok(Picture::Svg),
             _ => Err(Error::Usage(format!(
-                "cannot tell the format of `{}`: name it .png or .svg",
-                path.display()
+                "cannot tell the format of `{}`: name it .png or .svg{}",
+                path.display(),
+                extension_hint(path, &["png", "svg"])
             ))),
         }
     }

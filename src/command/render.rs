@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use super::common::{
-    as_paths, check_steps, in_run, load_options, refuse_overwrite, write_program_files,
-    writes_folder,
+    as_paths, check_steps, extension_hint, in_run, load_options, refuse_overwrite,
+    write_program_files, writes_folder,
 };
 use super::picture::{
     picture_bytes, write_mesh_picture, write_soup_picture, write_views, MeshLooks, Out, Picture,
@@ -122,8 +122,9 @@ fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<S
         Picture::from_path(output).map_err(|_| {
             Error::Usage(format!(
                 "cannot tell the format of `{}`: render draws a mesh as a picture (.png, .svg); \
-                 `subgram mesh convert` writes it as a mesh",
-                output.display()
+                 `subgram mesh convert` writes it as a mesh{}",
+                output.display(),
+                extension_hint(output, &["png", "svg"])
             ))
         })?;
         write_mesh_picture(&load_mesh(file)?, output, &looks, &mut Out::Files)?;
@@ -135,8 +136,9 @@ fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<S
         None => Picture::from_path(output).map_err(|_| {
             Error::Usage(format!(
                 "cannot tell the format of `{}`: render writes pictures (.png, .svg) and 3D \
-                 geometry (.obj, .ply, .glb)",
-                output.display()
+                 geometry (.obj, .ply, .glb){}",
+                output.display(),
+                extension_hint(output, &["png", "svg", "obj", "ply", "glb"])
             ))
         })?,
     };

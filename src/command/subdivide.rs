@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use super::common::{as_paths, in_run, refuse_overwrite, write_files};
+use super::common::{as_paths, extension_hint, in_run, refuse_overwrite, write_files};
 use super::mesh::write_mesh;
 use super::picture::{write_mesh_picture, write_soup_picture, MeshLooks, Out, Picture};
 use crate::error::Error;
@@ -81,8 +81,9 @@ pub(super) fn subdivide_in_run(
     {
         return Err(Error::Usage(format!(
             "cannot tell the format of `{}`: subdivide writes meshes (.obj, .off, .ply, .glb) \
-             and pictures (.png, .svg)",
-            output.display()
+             and pictures (.png, .svg){}",
+            output.display(),
+            extension_hint(output, &["obj", "off", "ply", "glb", "png", "svg"])
         )));
     }
     let d = crate::render::mesh::MeshView::default();

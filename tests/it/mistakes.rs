@@ -185,6 +185,42 @@ fn a_refused_output_lists_what_the_command_writes() {
     );
 }
 
+/// A misspelt output extension (issue 40, item 6: file kinds) gets the
+/// nearest one the command writes; one too far from any gets none.
+#[test]
+fn a_misspelt_output_extension_is_suggested() {
+    let tmp = scratch("mistakes-extension");
+    let dir = tmp.path();
+    std::fs::write(dir.join("k.lsys"), "angle: 60;\nAxiom: F;\nF -> F+F--F+F\n").unwrap();
+    std::fs::write(dir.join("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let run = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+            .current_dir(dir)
+            .args(args)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        String::from_utf8_lossy(&o.stderr).trim_end().to_string()
+    };
+    assert_eq!(
+        run(&["render", "k.lsys", "-o", "k.pgn"]),
+        "error: cannot tell the format of `k.pgn`: render writes pictures (.png, .svg) and 3D \
+         geometry (.obj, .ply, .glb); did you mean `.png`?"
+    );
+    assert_eq!(
+        run(&["mesh", "convert", "t.obj", "t.plyy"]),
+        "error: t.plyy: unknown mesh format `.plyy`: expected a file ending in .obj, .off or \
+         .ply; did you mean `.ply`?"
+    );
+    assert_eq!(
+        run(&["render", "t.obj", "-o", "t.svgg"]),
+        "error: cannot tell the format of `t.svgg`: render draws a mesh as a picture (.png, \
+         .svg); `subgram mesh convert` writes it as a mesh; did you mean `.svg`?"
+    );
+    // `.jpg` is two edits from `.png`: no guess.
+    assert!(!run(&["render", "k.lsys", "-o", "k.jpg"]).contains("did you mean"));
+}
+
 /// `derive -o FILE` (issue 40, item 7): the word goes to the file, whole,
 /// or not at all; never over the program.
 #[test]
