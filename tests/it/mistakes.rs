@@ -194,11 +194,7 @@ fn a_misspelt_output_extension_is_suggested() {
     std::fs::write(dir.join("k.lsys"), "angle: 60;\nAxiom: F;\nF -> F+F--F+F\n").unwrap();
     std::fs::write(dir.join("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let run = |args: &[&str]| {
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
-            .current_dir(dir)
-            .args(args)
-            .output()
-            .unwrap();
+        let o = crate::support::subgram_in(dir, args);
         assert_eq!(o.status.code(), Some(2), "{args:?}");
         String::from_utf8_lossy(&o.stderr).trim_end().to_string()
     };
@@ -281,11 +277,7 @@ fn render_writes_every_kind_of_system_as_subdivide_does() {
     let dir = tmp.path();
     let root = crate::support::root();
     let run = |args: &[&str]| {
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
-            .current_dir(dir)
-            .args(args)
-            .output()
-            .unwrap();
+        let o = crate::support::subgram_in(dir, args);
         assert_eq!(
             o.status.code(),
             Some(0),

@@ -302,3 +302,12 @@ pub fn valences(all: &[usize], quick: &[usize]) -> Vec<usize> {
         all.to_vec()
     }
 }
+
+/// The `subgram` binary run with `args` in the folder `dir`.
+pub fn subgram_in(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
