@@ -135,10 +135,20 @@ impl Curve {
     /// `End` and keeps the derivation, so that its word can be interpreted
     /// and drawn.
     pub fn run(&self, opts: DeriveOptions) -> Result<CurveRun<'_>, Error> {
+        self.run_reporting(opts, |_| {})
+    }
+
+    /// [`Curve::run`], telling `on_step` the derivation after each step
+    /// (for progress: [`crate::Progress::of_derivation`]).
+    pub fn run_reporting(
+        &self,
+        opts: DeriveOptions,
+        on_step: impl FnMut(&Derivation),
+    ) -> Result<CurveRun<'_>, Error> {
         check_steps(opts.steps)?;
         let mut d =
             Derivation::new(&self.program, self.with_view(opts)).map_err(|e| self.error(e))?;
-        crate::production::run(&mut d, |_| {}).map_err(|e| self.error(e))?;
+        crate::production::run(&mut d, on_step).map_err(|e| self.error(e))?;
         d.end().map_err(|e| self.error(e))?;
         Ok(CurveRun { curve: self, d })
     }
@@ -209,11 +219,22 @@ impl Curve {
     /// their first `UseView`. With `each`, a view activated after the first
     /// step has panels from that step on.
     pub fn figures(&self, opts: &FigureOptions) -> Result<Figures, Error> {
+        self.figures_reporting(opts, &mut |_| {})
+    }
+
+    /// [`Curve::figures`], telling `on_step` the derivation after each
+    /// step.
+    pub fn figures_reporting(
+        &self,
+        opts: &FigureOptions,
+        on_step: &mut dyn FnMut(&Derivation),
+    ) -> Result<Figures, Error> {
         let p = &self.program;
         let panels = self.each_view(
             opts,
             |word, draw_opts| draw::draw(word, &p.alphabet, &p.structs, draw_opts),
             None,
+            on_step,
         )?;
         // The words are drawn and freed: each view's events are freed once
         // its picture is laid out.
@@ -229,9 +250,19 @@ impl Curve {
     /// keeps as it walks its word (`render::png::word`), with no events or
     /// items in memory.
     pub fn png_figures(&self, opts: &FigureOptions) -> Result<Figures<Vec<u8>>, Error> {
+        self.png_figures_reporting(opts, &mut |_| {})
+    }
+
+    /// [`Curve::png_figures`], telling `on_step` the derivation after each
+    /// step.
+    pub fn png_figures_reporting(
+        &self,
+        opts: &FigureOptions,
+        on_step: &mut dyn FnMut(&Derivation),
+    ) -> Result<Figures<Vec<u8>>, Error> {
         if opts.each {
             return self
-                .figures(opts)?
+                .figures_reporting(opts, on_step)?
                 .try_map(|s| render::png::render(s).map_err(Error::from));
         }
         let p = &self.program;
@@ -277,6 +308,7 @@ impl Curve {
                 Err(render::png::WordError::Render(e)) => Ok(Err(e)),
             },
             as_derived.then_some(&last_step),
+            on_step,
         )?;
         let mut pictures = Vec::with_capacity(painted.len());
         for (view, mut list) in painted {
@@ -307,6 +339,7 @@ impl Curve {
                 &draw::DrawOptions,
             ) -> Result<Option<Result<T, draw::DrawError>>, DeriveError>,
         >,
+        on_step: &mut dyn FnMut(&Derivation),
     ) -> Result<Vec<(i64, Vec<T>)>, Error> {
         check_steps(opts.derive.steps)?;
         let p = &self.program;
@@ -357,6 +390,7 @@ impl Curve {
                 Some(last_step) => main = last_step(&mut d, &draw_opts).map_err(fail)?,
                 None => d.next_step().map_err(fail)?,
             }
+            on_step(&d);
             if opts.each {
                 panel(&mut d, None)?;
             }

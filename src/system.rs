@@ -231,15 +231,31 @@ pub struct Surface {
     dir: Option<PathBuf>,
 }
 
-/// Where a surface run stands, for progress reports: after `step` of
-/// `steps` (0 before the first), the mesh's counts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Where a run stands, for progress reports: after `step` of `steps` (0
+/// before the first), the mesh's counts (surfaces, vv programs) or the
+/// word's modules (curves; the mesh counts are then 0). `valences`: the
+/// steps are the valences `analyze` has measured, not derivation steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Progress {
+    pub valences: bool,
     pub step: usize,
     pub steps: usize,
     pub vertices: usize,
     pub edges: usize,
     pub faces: usize,
+    pub modules: usize,
+}
+
+impl Progress {
+    /// A curve's derivation after its step `d.step`.
+    pub fn of_derivation(d: &crate::rewrite::Derivation) -> Progress {
+        Progress {
+            step: d.step as usize,
+            steps: d.length as usize,
+            modules: d.word.len(),
+            ..Progress::default()
+        }
+    }
 }
 
 /// A subdivided mesh and the number of steps that made it.
@@ -310,6 +326,7 @@ impl Surface {
             vertices: c.vertices,
             edges: c.edges,
             faces: c.faces,
+            ..Progress::default()
         };
         progress(at(StepCounts {
             step: 0,
@@ -527,7 +544,7 @@ impl Vv {
                 steps,
                 vertices: n,
                 edges: 0,
-                faces: 0,
+                ..Progress::default()
             }
         };
         progress(at(&run));

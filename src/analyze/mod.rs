@@ -60,6 +60,17 @@ pub fn analyze(path: &Path, defines: &[String]) -> Result<Report, Error> {
 /// [`analyze`], a surface grammar at the valences `valences` only (each
 /// at least 3; curves ignore them).
 pub fn analyze_at(path: &Path, defines: &[String], valences: &[usize]) -> Result<Report, Error> {
+    analyze_reporting(path, defines, valences, &mut |_, _| {})
+}
+
+/// [`analyze_at`], telling `on_valence` how many valences of how many a
+/// surface grammar has been measured at, after each.
+pub fn analyze_reporting(
+    path: &Path,
+    defines: &[String],
+    valences: &[usize],
+    on_valence: &mut dyn FnMut(usize, usize),
+) -> Result<Report, Error> {
     let opts = LoadOptions {
         defines: defines.to_vec(),
         precision: Precision::Double,
@@ -69,9 +80,9 @@ pub fn analyze_at(path: &Path, defines: &[String], valences: &[usize]) -> Result
     let deadline = crate::deadline::current().unwrap_or_else(|| Deadline::after(TIMEOUT));
     let scheme = match load(path, &opts)? {
         System::Curve(c) => Scheme::Curve(Box::new(curve::analyze(&c, &name, deadline)?)),
-        System::Surface(s) => {
-            Scheme::Surface(surface::analyze_at(&s.grammar, &name, deadline, valences)?)
-        }
+        System::Surface(s) => Scheme::Surface(surface::analyze_at(
+            &s.grammar, &name, deadline, valences, on_valence,
+        )?),
         _ => {
             return Err(Error::File {
                 path: name,

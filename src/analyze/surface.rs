@@ -1014,7 +1014,7 @@ fn valence(
 /// the valences [`VALENCES`].
 pub fn analyze(g: &Grammar, path: &str, deadline: Deadline) -> Result<SurfaceReport, Error> {
     let all: Vec<usize> = VALENCES.collect();
-    analyze_at(g, path, deadline, &all)
+    analyze_at(g, path, deadline, &all, &mut |_, _| {})
 }
 
 /// [`analyze`] at the valences `ns` only (each at least 3).
@@ -1023,6 +1023,7 @@ pub fn analyze_at(
     path: &str,
     deadline: Deadline,
     ns: &[usize],
+    on_valence: &mut dyn FnMut(usize, usize),
 ) -> Result<SurfaceReport, Error> {
     let _ = path;
     let mut notes = Vec::new();
@@ -1063,6 +1064,7 @@ pub fn analyze_at(
             )));
         }
         valences.push(valence(g, n, quads, dual, deadline, budget)?);
+        on_valence(valences.len(), ns.len());
     }
     for v in valences.iter().filter(|v| v.skipped.is_none()) {
         if !v.reif {

@@ -4,7 +4,7 @@ use subgram::command;
 use subgram::Error;
 
 use super::args::{parse_timeout, Format, Timeout};
-use super::print::print_out;
+use super::print::{print_out, with_progress};
 
 #[derive(clap::Args)]
 pub(super) struct AnalyzeCli {
@@ -38,13 +38,14 @@ impl AnalyzeCli {
             timeout,
         } = self;
         subgram::within(timeout.0, || {
-            print_out(&command::analyze(&command::AnalyzeArgs {
+            let args = command::AnalyzeArgs {
                 file,
                 json: matches!(format, Format::Json),
                 defines: define,
                 picture,
                 valences: valences.map(|v| v.0),
-            })?)
+            };
+            print_out(&with_progress(|p| command::analyze_reporting(&args, p))?)
         })
     }
 }

@@ -3,8 +3,7 @@
 
 use subgram::{Error, Progress};
 
-/// Runs `f` with a progress bar on standard error for surface grammars'
-/// steps (shown only on a terminal).
+/// Runs `f` with a progress bar on standard error (see [`progress_to`]).
 pub(super) fn with_progress<T>(f: impl FnOnce(&mut dyn FnMut(Progress)) -> T) -> T {
     let bar = std::cell::RefCell::new(None);
     let result = f(&mut |p: Progress| progress_to(&bar, p));
@@ -14,22 +13,46 @@ pub(super) fn with_progress<T>(f: impl FnOnce(&mut dyn FnMut(Progress)) -> T) ->
     result
 }
 
-/// Shows `p` on the progress bar in `bar`, made on the first report.
+/// How long a run goes on before its progress is shown: a quick run
+/// prints nothing but its result.
+const QUIET_FOR: std::time::Duration = std::time::Duration::from_secs(1);
+
+/// Shows `p` on the progress bar in `bar`, made once the run has gone on
+/// for [`QUIET_FOR`] since its first report: the step, and the word's
+/// modules (curves) or the mesh's counts (surfaces, vv programs); for
+/// `analyze`, the valences measured.
+/// indicatif draws nothing when standard error is not a terminal.
 pub(super) fn progress_to(bar: &std::cell::RefCell<Option<indicatif::ProgressBar>>, p: Progress) {
+    static FIRST: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+    let first = *FIRST.get_or_init(std::time::Instant::now);
     let mut bar = bar.borrow_mut();
+    if bar.is_none() && first.elapsed() < QUIET_FOR {
+        return;
+    }
     let b = bar.get_or_insert_with(|| {
         let b = indicatif::ProgressBar::new(p.steps as u64);
+        let template = if p.valences {
+            "{spinner} valence {pos}/{len} measured [{elapsed}]"
+        } else {
+            "{spinner} step {pos}/{len} {msg} [{elapsed}]"
+        };
         b.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} step {pos}/{len} {msg} [{elapsed}]")
+            indicatif::ProgressStyle::with_template(template)
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         b
     });
     b.set_position(p.step as u64);
-    b.set_message(format!(
-        "{} vertices, {} edges, {} faces",
-        p.vertices, p.edges, p.faces
-    ));
+    if p.valences {
+        // The template says it all.
+    } else if p.modules > 0 {
+        b.set_message(format!("{} modules", p.modules));
+    } else {
+        b.set_message(format!(
+            "{} vertices, {} edges, {} faces",
+            p.vertices, p.edges, p.faces
+        ));
+    }
 }
 
 /// Writes what an L+C program printed (`printf`, `fprintf(stderr, …)`):

@@ -4,6 +4,7 @@ use std::path::Path;
 
 use super::common::{in_run, same_file, write_file};
 use crate::error::Error;
+use crate::Progress;
 
 /// The arguments of `subgram analyze`.
 #[derive(Clone, Debug, Default)]
@@ -22,10 +23,16 @@ pub struct AnalyzeArgs {
 /// `subgram analyze FILE [--format json] [-D NAME=VALUE]…`: what the
 /// subdivision scheme in FILE is (see [`crate::analyze`]), as text or JSON.
 pub fn analyze(a: &AnalyzeArgs) -> Result<String, Error> {
-    in_run(None, None, || analyze_in_run(a))
+    analyze_reporting(a, |_| {})
 }
 
-fn analyze_in_run(a: &AnalyzeArgs) -> Result<String, Error> {
+/// [`analyze`], telling `progress` after each valence a surface grammar
+/// is measured at (`Progress::valences`).
+pub fn analyze_reporting(a: &AnalyzeArgs, progress: impl FnMut(Progress)) -> Result<String, Error> {
+    in_run(None, None, || analyze_in_run(a, progress))
+}
+
+fn analyze_in_run(a: &AnalyzeArgs, mut progress: impl FnMut(Progress)) -> Result<String, Error> {
     if let Some(out) = &a.picture {
         let out = Path::new(out);
         // analyze has no --force: its one input is never replaced.
@@ -45,10 +52,17 @@ fn analyze_in_run(a: &AnalyzeArgs) -> Result<String, Error> {
             )));
         }
     }
-    let r = match &a.valences {
-        Some(ns) => crate::analyze::analyze_at(Path::new(&a.file), &a.defines, ns)?,
-        None => crate::analyze::analyze(Path::new(&a.file), &a.defines)?,
+    let all: Vec<usize> = crate::analyze::surface::VALENCES.collect();
+    let ns = a.valences.as_deref().unwrap_or(&all);
+    let mut on_valence = |done: usize, of: usize| {
+        progress(Progress {
+            valences: true,
+            step: done,
+            steps: of,
+            ..Progress::default()
+        })
     };
+    let r = crate::analyze::analyze_reporting(Path::new(&a.file), &a.defines, ns, &mut on_valence)?;
     if let Some(out) = &a.picture {
         let svg = r.characteristic_svg().map_err(Error::Usage)?;
         write_file(Path::new(out), svg.as_bytes())?;

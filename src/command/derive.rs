@@ -273,7 +273,10 @@ fn derive_text(
         }
         System::Curve(c) => {
             check_steps(a.steps)?;
-            let mut run = c.run(opts.derive_options())?;
+            let mut progress = progress;
+            let mut run = c.run_reporting(opts.derive_options(), |d| {
+                progress(Progress::of_derivation(d))
+            })?;
             let interpreted = if a.interpreted {
                 Some(run.interpreted()?)
             } else {

@@ -13,7 +13,7 @@
 //!   outputs.
 //! - `mesh.rs`: `mesh_info`, `mesh_convert`, and `write_mesh`.
 //! - `reverse.rs`: `reverse`, `reconstruct` and their arguments.
-//! - `analyze.rs`: `analyze` and `AnalyzeArgs`.
+//! - `analyze.rs`: `analyze`, `analyze_reporting` and `AnalyzeArgs`.
 //! - `picture.rs`: `Picture`, `write_picture`; how a mesh is drawn
 //!   (`MeshLooks`), a curve's views, and where pictures go (`Out`).
 //! - `common.rs`: what several commands share: `in_run`, load options, the
@@ -37,7 +37,7 @@ mod reverse;
 mod subdivide;
 mod watch;
 
-pub use analyze::{analyze, AnalyzeArgs};
+pub use analyze::{analyze, analyze_reporting, AnalyzeArgs};
 pub use check::check;
 pub use derive::{derive, derive_to, DeriveArgs, Printed};
 pub use infer::{infer, InferArgs};

@@ -302,7 +302,7 @@ fn render_system(
             Ok(Vec::new())
         }
         System::Curve(c) if wants_solid(a, &c, export.is_some()) => {
-            render_solid(a, &c, (looks, format), deadline, out)
+            render_solid(a, &c, (looks, format), deadline, progress, out)
         }
         System::Curve(c) => {
             let view = match a.view.as_deref().unwrap_or("xy") {
@@ -339,9 +339,14 @@ fn render_system(
                     ..Default::default()
                 },
             };
+            let mut progress = progress;
+            let on_step =
+                &mut |d: &crate::rewrite::Derivation| progress(Progress::of_derivation(d));
             let figures = match format {
-                Picture::Png => c.png_figures(&figure)?,
-                Picture::Svg => c.figures(&figure)?.try_map(|s| picture_bytes(s, format))?,
+                Picture::Png => c.png_figures_reporting(&figure, on_step)?,
+                Picture::Svg => c
+                    .figures_reporting(&figure, on_step)?
+                    .try_map(|s| picture_bytes(s, format))?,
             };
             write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
             write_views(figures, Path::new(&a.file), output, a.force, out)
@@ -398,6 +403,7 @@ fn render_solid(
     c: &crate::Curve,
     (looks, format): (&MeshLooks, Picture),
     deadline: Option<Deadline>,
+    progress: impl FnMut(Progress),
     out: &mut Out,
 ) -> Result<Vec<String>, Error> {
     use crate::draw::solid::SolidOptions;
@@ -412,7 +418,10 @@ fn render_solid(
     let (opts, dir) = curve_run(a, deadline)?;
     let model = &*crate::model::of(&c.program);
     let (w, h) = looks.size;
-    let mut run = c.run(opts.derive_options())?;
+    let mut progress = progress;
+    let mut run = c.run_reporting(opts.derive_options(), |d| {
+        progress(Progress::of_derivation(d))
+    })?;
     let mut sopts = SolidOptions::default();
     let picture = crate::export::Format::from_path(output).is_none();
     // The picture's scale from the drawing's extent, as the camera will

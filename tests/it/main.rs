@@ -31,6 +31,7 @@ mod no_hang;
 mod one_language;
 mod precision;
 mod preprocessor;
+mod progress;
 mod random;
 mod raster;
 mod readme;
