@@ -17,6 +17,7 @@ mod golden_tests;
 mod guide;
 mod infer;
 mod lang_features;
+mod layers;
 mod limits;
 mod lpfg_agreement;
 mod lpfg_semantics;
