@@ -4,7 +4,7 @@
 use std::fmt;
 use std::path::PathBuf;
 
-use crate::syntax::{render_line, Diagnostic, SourceMap};
+use crate::syntax::{write_file_problem, Diagnostic, SourceMap};
 
 /// What went wrong. Every variant displays as a message for a person; none
 /// starts with `error: ` (a program that prints it adds its own prefix, as
@@ -179,14 +179,9 @@ impl fmt::Display for Error {
             } => sources.render_all(diagnostics, f),
             Error::File {
                 path,
-                line: Some(line),
+                line,
                 message,
-            } => write!(f, "{path}:{line}: error: {message}"),
-            Error::File {
-                path,
-                line: None,
-                message,
-            } => write!(f, "{path}: error: {message}"),
+            } => write_file_problem(f, path, *line, None, message),
             Error::FileAt {
                 path,
                 line,
@@ -194,7 +189,7 @@ impl fmt::Display for Error {
                 start,
                 end,
                 message,
-            } => f.write_str(&render_line(path, *line, text, *start..*end, message)),
+            } => write_file_problem(f, path, Some(*line), Some((text, *start..*end)), message),
             Error::Failed(m) | Error::Usage(m) => f.write_str(m),
         }
     }

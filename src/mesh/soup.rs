@@ -44,17 +44,11 @@ pub struct Place {
 
 impl std::fmt::Display for MeshFileError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match (self.line, &self.place) {
-            (Some(l), Some(p)) => f.write_str(&crate::syntax::render_line(
-                &self.path,
-                l,
-                &p.text,
-                p.start..p.end,
-                &self.message,
-            )),
-            (Some(l), None) => write!(f, "{}:{}: error: {}", self.path, l, self.message),
-            (None, _) => write!(f, "{}: error: {}", self.path, self.message),
-        }
+        let at = self
+            .place
+            .as_ref()
+            .map(|p| (p.text.as_str(), p.start..p.end));
+        crate::syntax::write_file_problem(f, &self.path, self.line, at, &self.message)
     }
 }
 

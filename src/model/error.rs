@@ -4,6 +4,8 @@
 use std::fmt;
 use std::path::PathBuf;
 
+use crate::syntax::write_file_problem;
+
 /// A model folder's problem: a file that cannot be read, or what is wrong
 /// in one, with its place where there is one to point at.
 #[derive(Debug)]
@@ -62,14 +64,9 @@ impl fmt::Display for ModelError {
             }
             ModelError::File {
                 path,
-                line: Some(line),
+                line,
                 message,
-            } => write!(f, "{path}:{line}: error: {message}"),
-            ModelError::File {
-                path,
-                line: None,
-                message,
-            } => write!(f, "{path}: error: {message}"),
+            } => write_file_problem(f, path, *line, None, message),
             ModelError::FileAt {
                 path,
                 line,
@@ -77,13 +74,7 @@ impl fmt::Display for ModelError {
                 start,
                 end,
                 message,
-            } => f.write_str(&crate::syntax::render_line(
-                path,
-                *line,
-                text,
-                *start..*end,
-                message,
-            )),
+            } => write_file_problem(f, path, Some(*line), Some((text, *start..*end)), message),
             ModelError::Usage(m) => f.write_str(m),
         }
     }

@@ -14,4 +14,4 @@ pub mod source;
 pub mod span;
 
 pub use source::SourceError;
-pub use span::{render_line, Diagnostic, FileId, SourceFile, SourceMap, Span};
+pub use span::{write_file_problem, Diagnostic, FileId, SourceFile, SourceMap, Span};

@@ -63,7 +63,9 @@ impl fmt::Display for SourceError {
             SourceError::Io { path, error } => {
                 write!(f, "cannot read `{}`: {error}", path.display())
             }
-            SourceError::File { path, message } => write!(f, "{path}: error: {message}"),
+            SourceError::File { path, message } => {
+                super::write_file_problem(f, path, None, None, message)
+            }
             SourceError::Usage(m) => f.write_str(m),
             SourceError::Program {
                 sources,

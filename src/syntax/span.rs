@@ -251,6 +251,26 @@ impl fmt::Display for Diagnostic {
     }
 }
 
+/// A data file's problem as every error type shows it: `path: error:
+/// message` for the whole file, `path:line: error: message` for one line,
+/// and with `at` (the line's text and the bytes the caret marks) the line
+/// and a caret ([`render_line`]).
+pub fn write_file_problem(
+    f: &mut std::fmt::Formatter<'_>,
+    path: &str,
+    line: Option<usize>,
+    at: Option<(&str, std::ops::Range<usize>)>,
+    message: &str,
+) -> std::fmt::Result {
+    match (line, at) {
+        (Some(line), Some((text, range))) => {
+            f.write_str(&render_line(path, line, text, range, message))
+        }
+        (Some(line), None) => write!(f, "{path}:{line}: error: {message}"),
+        (None, _) => write!(f, "{path}: error: {message}"),
+    }
+}
+
 /// `path:line:col: error: message`, then `text`, line `line` of the file,
 /// and a caret under its bytes `range`: what [`SourceMap::render`] shows
 /// for a diagnostic in a program, for a file of which only the one line is
