@@ -22,6 +22,9 @@ pub struct Curve {
     /// What the view file beside the program sets for the turtle
     /// (rotations, tropisms); the default without one.
     pub view: draw::TurtleView,
+    /// The environment of an open L-system (a model's `.e` file), started
+    /// afresh for every run; runs whose options name none use it.
+    pub environment: Option<std::sync::Arc<dyn crate::rewrite::environment::EnvironmentStarter>>,
 }
 
 /// Settings of a figure: how far to derive, how to draw, how to render.
@@ -127,6 +130,7 @@ impl Curve {
             queries: std::sync::Arc::new(draw::QueryTurtle {
                 view: self.view.clone(),
             }),
+            environment: opts.environment.or_else(|| self.environment.clone()),
             ..opts
         }
     }

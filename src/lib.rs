@@ -31,6 +31,7 @@
 mod colour;
 mod curve;
 mod deadline;
+pub mod enviro;
 mod error;
 mod files;
 mod huge;

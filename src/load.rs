@@ -25,6 +25,8 @@ pub struct LoadOptions {
     /// What C's `float` is: single precision as in lpfg (the default), or
     /// double (`--double`). Surface grammars compute in double always.
     pub precision: Precision,
+    /// How a model's environmental program is run (a `.e` file).
+    pub environment: crate::enviro::Options,
 }
 
 impl LoadOptions {
@@ -84,7 +86,19 @@ fn load_path(path: &Path, edited: Option<&str>, opts: &LoadOptions) -> Result<Sy
     if let Some(files) = model::find(path)? {
         let m = Model::read(&files.files)?;
         let text = text_of(&files.lsystem)?;
-        let c = load_model_file(&files.lsystem, text, m, &opts.defines, opts.precision)?;
+        let environment = match &m.environment {
+            Some(spec) => Some(crate::enviro::starter(spec, &opts.environment)?),
+            None => None,
+        };
+        let mut c = load_model_file(&files.lsystem, text, m, &opts.defines, opts.precision)?;
+        if environment.is_some() {
+            // The communication modules get their answers: the warning
+            // that they would not is not for this model.
+            c.program
+                .warnings
+                .retain(|d| !crate::draw::coverage::is_environment_warning(&d.message));
+        }
+        c.environment = environment;
         return Ok(System::Curve(c));
     }
     let text = text_of(path)?;
@@ -540,6 +554,7 @@ fn check_curve(front: Front, precision: Precision) -> Result<Curve, Error> {
                 program,
                 sources,
                 view: Default::default(),
+                environment: None,
             })
         }
         Err(mut diagnostics) => {

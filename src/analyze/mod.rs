@@ -74,6 +74,7 @@ pub fn analyze_reporting(
     let opts = LoadOptions {
         defines: defines.to_vec(),
         precision: Precision::Double,
+        ..Default::default()
     };
     let name = path.display().to_string();
     // `--timeout` where the command set one, else the analysis's own.

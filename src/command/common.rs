@@ -34,6 +34,7 @@ pub(super) fn load_options(defines: &[String], double: bool) -> LoadOptions {
         } else {
             Precision::Single
         },
+        ..Default::default()
     }
 }
 

@@ -34,6 +34,8 @@ pub(super) enum Cmd {
     /// surface.
     Surface,
     Query(u8),
+    /// `E1`, `E2`, `EA20`: the turtle's frame is sent to the environment.
+    Communicate,
     SetHead,
     SetHead3,
     RollToVert,
@@ -156,6 +158,7 @@ pub(super) fn command(name: &str) -> Cmd {
         "GetHead" => Cmd::Query(1),
         "GetLeft" => Cmd::Query(2),
         "GetUp" => Cmd::Query(3),
+        "E1" | "E2" | "EA20" => Cmd::Communicate,
         "SetHead" => Cmd::SetHead,
         "SetHead3f" => Cmd::SetHead3,
         "RollToVert" => Cmd::RollToVert,

@@ -38,12 +38,22 @@ fn gap(name: &str) -> Option<String> {
         "Camera" => no_effect("subgram fits the view to the drawing"),
         "PovRayStart" => no_effect("subgram does not write POV-Ray files"),
         "E1" | "E2" | "EA20" => Some(format!(
-            "`{name}` communicates with an environmental program, and subgram does not run \
-             environmental programs: its parameters stay as the model produced them, so the \
-             derivation and the picture will differ from lpfg's with its environment"
+            "`{name}` {ENVIRONMENT_WARNING} (a model folder's `.e` file names one): its \
+             parameters stay as the model produced them"
         )),
         _ => None,
     }
+}
+
+/// The words of the warning about communication modules without an
+/// environment.
+const ENVIRONMENT_WARNING: &str =
+    "communicates with an environmental program, and this program has none";
+
+/// True for the warning about communication modules that no environment
+/// answers (the loader drops it for a model with a `.e` file).
+pub fn is_environment_warning(message: &str) -> bool {
+    message.contains(ENVIRONMENT_WARNING)
 }
 
 /// The warnings for `program`: one per predefined module that it puts into

@@ -57,7 +57,7 @@ use glam::DVec3;
 
 use crate::lang::value::StructDef;
 use crate::lang::Alphabet;
-use crate::rewrite::Word;
+use crate::rewrite::{TurtleAnswers, Word};
 
 /// Settings of interpretation.
 #[derive(Clone, Debug)]
@@ -177,7 +177,7 @@ pub fn draw_with_queries(
     alphabet: &Alphabet,
     structs: &[StructDef],
     opts: &DrawOptions,
-    queries: Option<&mut Vec<(usize, [f64; 3])>>,
+    queries: Option<&mut TurtleAnswers>,
 ) -> Result<Vec<Event>, DrawError> {
     let mut events = Events::new(Vec::new());
     walk(word, alphabet, structs, opts, queries, &mut events)?;

@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use crate::lang::ir::Program;
-use crate::rewrite::{DeriveOptions, Queries, Word};
+use crate::rewrite::{DeriveOptions, Queries, TurtleAnswers, Word};
 
 use super::{draw_with_queries, DrawOptions, TurtleView};
 
@@ -23,7 +23,7 @@ impl Queries for QueryTurtle {
         shown: &Word,
         program: &Program,
         angle: Option<f64>,
-    ) -> Result<Vec<(usize, [f64; 3])>, String> {
+    ) -> Result<TurtleAnswers, String> {
         let mut draw_opts = DrawOptions {
             view: self.view.clone(),
             ..Default::default()
@@ -31,7 +31,7 @@ impl Queries for QueryTurtle {
         if let Some(a) = angle {
             draw_opts.angle = a;
         }
-        let mut answers = Vec::new();
+        let mut answers = TurtleAnswers::default();
         draw_with_queries(
             shown,
             &program.alphabet,

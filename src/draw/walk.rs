@@ -10,8 +10,9 @@ use super::turtle::{turned, Cartesian, DVec3Axis};
 use super::{tropism, DrawError, DrawOptions, Sink, Turtle, EPSILON};
 use crate::lang::value::StructDef;
 use crate::lang::{Alphabet, Value};
+use crate::rewrite::environment::Frame;
 use crate::rewrite::word::Slices;
-use crate::rewrite::Word;
+use crate::rewrite::{TurtleAnswers, Word};
 
 /// The sines and cosines of the last four angles turned by: words turn by
 /// a few angles over and over (`+(90) ... -(90)`, or a branching angle
@@ -59,7 +60,7 @@ pub(crate) fn walk<S: Sink>(
     alphabet: &Alphabet,
     structs: &[StructDef],
     opts: &DrawOptions,
-    queries: Option<&mut Vec<(usize, [f64; 3])>>,
+    queries: Option<&mut TurtleAnswers>,
     sink: &mut S,
 ) -> Result<(), DrawError> {
     walk_loops(word, alphabet, structs, opts, queries, sink, true)
@@ -72,7 +73,7 @@ pub(super) fn walk_loops<S: Sink>(
     alphabet: &Alphabet,
     structs: &[StructDef],
     opts: &DrawOptions,
-    queries: Option<&mut Vec<(usize, [f64; 3])>>,
+    queries: Option<&mut TurtleAnswers>,
     sink: &mut S,
     fast: bool,
 ) -> Result<(), DrawError> {
@@ -152,7 +153,7 @@ impl<'o> Walk<'o> {
         word: Slices<'_>,
         alphabet: &Alphabet,
         structs: &[StructDef],
-        mut queries: Option<&mut Vec<(usize, [f64; 3])>>,
+        mut queries: Option<&mut TurtleAnswers>,
         sink: &mut S,
     ) -> Result<(), DrawError> {
         let Some(mut state) = self.state.take() else {
@@ -252,7 +253,7 @@ impl Walker<'_> {
     fn run<'t, S: Sink, const FULL: bool>(
         &self,
         state: Walking<'t>,
-        mut queries: Option<&mut Vec<(usize, [f64; 3])>>,
+        mut queries: Option<&mut TurtleAnswers>,
         sink: &mut S,
     ) -> Result<Walking<'t>, DrawError> {
         let Walker {
@@ -502,7 +503,21 @@ impl Walker<'_> {
                         Cmd::Query(q) => {
                             if let Some(qs) = queries.as_deref_mut() {
                                 let v = [t.pos, t.head, t.left, t.up][q as usize];
-                                qs.push((i, [v.x, v.y, v.z]));
+                                qs.queries.push((i, [v.x, v.y, v.z]));
+                            }
+                        }
+                        Cmd::Communicate => {
+                            if let Some(qs) = queries.as_deref_mut() {
+                                let v = |v: DVec3| [v.x, v.y, v.z];
+                                qs.communication.push((
+                                    i,
+                                    Frame {
+                                        position: v(t.pos),
+                                        heading: v(t.head),
+                                        left: v(t.left),
+                                        up: v(t.up),
+                                    },
+                                ));
                             }
                         }
                         Cmd::Surface => {

@@ -18,6 +18,7 @@
 //! Nothing here names a layer above (see ARCHITECTURE.md, "Layers").
 
 pub mod colours;
+pub mod comm;
 pub mod contours;
 mod error;
 pub mod functions;
@@ -94,6 +95,9 @@ pub struct Model {
     pub lights: Vec<view::Light>,
     /// The view file's camera and render mode.
     pub camera: view::ViewCamera,
+    /// The communication file (`.e`): the environmental program of an
+    /// open L-system.
+    pub environment: Option<comm::CommSpec>,
     /// The files read, in order.
     pub files: Vec<PathBuf>,
     pub notes: Vec<Note>,
@@ -361,16 +365,9 @@ impl Model {
             view::read_a(&n, &t, &mut m.notes)?;
         }
         for p in by("e") {
-            let (n, t) = text_of(p)?;
-            let first = t.lines().next().unwrap_or("").trim_end().len();
-            m.notes.push(Note::at(
-                &n,
-                &t,
-                0..first,
-                "this file sets up an environmental program, which subgram does not run: \
-                 the modules that talk to it get no answers, and the picture will differ from lpfg's"
-                    .into(),
-            ));
+            let (_, t) = text_of(p)?;
+            // lpfg keeps the last communication file it is given.
+            m.environment = Some(comm::CommSpec::read(p, &t)?);
         }
         m.files.extend(files.iter().cloned());
         Ok(m)

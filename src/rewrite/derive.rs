@@ -35,6 +35,14 @@ pub struct DeriveOptions {
     /// interpretation of the word. `Default` gives `draw`'s turtle with no
     /// view file's settings (see [`Queries`]).
     pub queries: std::sync::Arc<dyn Queries>,
+    /// The environment of an open L-system (a model's `.e` file): started
+    /// when the derivation starts, it answers the communication modules
+    /// before every step (see [`super::environment`]). Default: none, and
+    /// those modules keep their parameters.
+    pub environment: Option<std::sync::Arc<dyn super::environment::EnvironmentStarter>>,
+    /// lpfg's `-cleanEA20`: an `EA20` answered with fewer than twenty
+    /// values has the rest set to zero (else they keep their values).
+    pub clean_ea20: bool,
 }
 
 /// What answers the query modules of a word (`GetPos`, `GetHead`, …;
@@ -52,7 +60,17 @@ pub trait Queries: Send + Sync + std::fmt::Debug {
         shown: &Word,
         program: &Program,
         angle: Option<f64>,
-    ) -> Result<Vec<(usize, [f64; 3])>, String>;
+    ) -> Result<TurtleAnswers, String>;
+}
+
+/// What the turtle met walking an interpreted word for [`Queries`]: each
+/// query module (its index and the vector it asks for), and each
+/// communication module (`E1`, `E2`, `EA20`: its index and the turtle's
+/// frame there).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TurtleAnswers {
+    pub queries: Vec<(usize, [f64; 3])>,
+    pub communication: Vec<(usize, super::environment::Frame)>,
 }
 
 /// True for lpfg's query modules, which the turtle fills in.
@@ -71,6 +89,8 @@ impl DeriveOptions {
             seed: None,
             output: ProgramOutput::default(),
             queries,
+            environment: None,
+            clean_ea20: false,
         }
     }
 }
@@ -195,6 +215,11 @@ pub struct Derivation<'p> {
     /// The view whose interpretation rules (`vgroup`) interpretation uses:
     /// 0, the main view, but while [`Derivation::interpret_view`] runs.
     view: i64,
+    /// The running environment of an open L-system (dropping it ends it).
+    running: Option<Box<dyn super::environment::Environment>>,
+    /// The program's communication modules (`E1`, `E2`, `EA20`) among its
+    /// symbols.
+    communication: Vec<Sym>,
 }
 
 impl<'p> Derivation<'p> {
@@ -234,7 +259,26 @@ impl<'p> Derivation<'p> {
             opts,
             makers: None,
             view: 0,
+            running: None,
+            communication: ["E1", "E2", "EA20"]
+                .iter()
+                .filter_map(|n| program.alphabet.lookup(n))
+                .collect(),
         };
+        if let Some(starter) = d.opts.environment.clone() {
+            if !d.communication.is_empty() {
+                d.running =
+                    Some(
+                        starter
+                            .start(d.opts.deadline)
+                            .map_err(|message| DeriveError {
+                                span: None,
+                                message,
+                                step: 0,
+                            })?,
+                    );
+            }
+        }
         // `Start` runs before the directives are read, as in lpfg, whose
         // `derivation length:` may read what `Start` computed
         // (`derivation length: (int)(simulation_ends/dt);`).
@@ -303,20 +347,38 @@ impl<'p> Derivation<'p> {
         Ok(d)
     }
 
-    /// lpfg's query modules (`GetPos`, `GetHead`, `GetLeft`, `GetUp`): when
-    /// a rule's predecessor mentions one, an interpretation step runs at the
-    /// start of every derivation step, before `StartEach` (so on the axiom
-    /// and on every word but the last, as lpfg's "interpretation for the
-    /// environment" does), and each query module of the word that the
-    /// turtle meets receives the turtle's position (or heading, left, up
-    /// vector) at that point, unless `NoEnvironment()` was called. As in lpfg, the turtle
-    /// writes only into the word's own modules: a query module that an
-    /// interpretation rule rewrites keeps its parameters, and one that an
-    /// interpretation rule produces is answered in the interpreted word
-    /// alone.
+    /// lpfg's "interpretation for the environment", at the start of every
+    /// derivation step, before `StartEach` (so on the axiom and on every
+    /// word but the last), unless `NoEnvironment()` was called:
+    ///
+    /// * query modules (`GetPos`, `GetHead`, `GetLeft`, `GetUp`), when a
+    ///   rule's predecessor mentions one: each that the turtle meets
+    ///   receives the turtle's position (or heading, left, up vector) at
+    ///   that point;
+    /// * communication modules (`E1`, `E2`, `EA20`), when the run has an
+    ///   environment ([`DeriveOptions::environment`]): each that the turtle
+    ///   meets is sent with the turtle's frame, in the word's order, and
+    ///   the environment's answers overwrite their parameters (E1 one
+    ///   value, E2 two, EA20 up to twenty, the rest zeroed with
+    ///   `clean_ea20`); a module it does not answer keeps its values.
+    ///
+    /// As in lpfg, the answers go into the word's own modules only: a
+    /// module that an interpretation rule rewrites keeps its parameters,
+    /// and one that an interpretation rule produces is answered in the
+    /// interpreted word alone (it is still sent).
     fn answer_queries(&mut self) -> Result<(), DeriveError> {
         let p = self.program;
-        if !self.env.environment || !self.queries_used() {
+        if !self.env.environment {
+            return Ok(());
+        }
+        let queries = self.queries_used();
+        let communicating = self.running.is_some()
+            && self
+                .word
+                .syms()
+                .iter()
+                .any(|s| self.communication.contains(s));
+        if !queries && !communicating {
             return Ok(());
         }
         // Which module of the word each interpreted module copies: a
@@ -330,7 +392,7 @@ impl<'p> Derivation<'p> {
             &mut sources,
         )?;
         let angle = self.angle()?;
-        let answers = self
+        let met = self
             .opts
             .queries
             .answer(&shown, p, angle)
@@ -343,11 +405,20 @@ impl<'p> Derivation<'p> {
                 step: self.step,
             })?;
         let sources = sources.unwrap_or_default();
-        let mut answer: Vec<Option<[f64; 3]>> = vec![None; self.word.len()];
-        for (j, v) in answers {
-            if let Some(Maker::Axiom(i)) = sources.get(j) {
-                answer[*i] = Some(v);
+        let source = |j: usize| match sources.get(j) {
+            Some(Maker::Axiom(i)) => Some(*i),
+            _ => None,
+        };
+        let mut answer: Vec<Option<Vec<f64>>> = vec![None; self.word.len()];
+        for (j, v) in met.queries {
+            if let Some(i) = source(j) {
+                if self.word.data(i).len() == 3 {
+                    answer[i] = Some(v.to_vec());
+                }
             }
+        }
+        if communicating && !met.communication.is_empty() {
+            self.exchange(&shown, &met.communication, &source, &mut answer)?;
         }
         if answer.iter().all(Option::is_none) {
             return Ok(());
@@ -356,18 +427,102 @@ impl<'p> Derivation<'p> {
         out.reserve(self.word.len(), self.word.slot_count());
         for (i, a) in answer.iter().enumerate() {
             match a {
-                Some(v) if self.word.data(i).len() == 3 => {
+                Some(v) => {
                     // A `float` parameter holds the answer as lpfg's does.
-                    let v = match p.single {
-                        true => v.map(|x| x as f32 as f64),
-                        false => *v,
+                    let v: Vec<f64> = match p.single {
+                        true => v.iter().map(|x| *x as f32 as f64).collect(),
+                        false => v.clone(),
                     };
                     out.push_raw(self.word.sym(i), &v)
                 }
-                _ => out.push_from(&self.word, i),
+                None => out.push_from(&self.word, i),
             }
         }
         self.word = out;
+        Ok(())
+    }
+
+    /// Sends the communication modules the turtle met (`met`: index in
+    /// `shown` and frame) to the running environment and puts its answers
+    /// into `answer`, by the word's module each copies (`source`).
+    fn exchange(
+        &mut self,
+        shown: &Word,
+        met: &[(usize, super::environment::Frame)],
+        source: &dyn Fn(usize) -> Option<usize>,
+        answer: &mut [Option<Vec<f64>>],
+    ) -> Result<(), DeriveError> {
+        use super::environment::{Following, Query};
+        let p = self.program;
+        let following = self
+            .opts
+            .environment
+            .as_ref()
+            .is_some_and(|e| e.following_module());
+        let queries: Vec<Query> = met
+            .iter()
+            .map(|(j, frame)| Query {
+                id: *j as u64,
+                values: shown.data(*j).to_vec(),
+                following: (following && j + 1 < shown.len()).then(|| Following {
+                    name: p.alphabet.name(shown.sym(j + 1)).to_string(),
+                    params: shown.data(j + 1).to_vec(),
+                }),
+                frame: *frame,
+            })
+            .collect();
+        let step = self.step;
+        let fail = |message: String| DeriveError {
+            span: None,
+            message: format!("before step {}, {message}", step + 1),
+            step,
+        };
+        let running = self.running.as_mut().expect("an environment");
+        let answers = running.exchange(&queries).map_err(&fail)?;
+        for a in answers {
+            let j = usize::try_from(a.id).unwrap_or(usize::MAX);
+            let Some((_, _)) = met.iter().find(|(k, _)| *k == j) else {
+                return Err(fail(format!(
+                    "the environmental program answered module {}, which it was not sent \
+                     (it was sent {} module{})",
+                    a.id,
+                    met.len(),
+                    if met.len() == 1 { "" } else { "s" }
+                )));
+            };
+            let name = p.alphabet.name(shown.sym(j));
+            let width = shown.data(j).len();
+            let ok = match name {
+                "EA20" => a.values.len() <= width,
+                _ => a.values.len() == width,
+            };
+            if !ok {
+                return Err(fail(format!(
+                    "the environmental program answered module {} (`{name}`) with {} value{}, \
+                     and `{name}` takes {}{width}",
+                    a.id,
+                    a.values.len(),
+                    if a.values.len() == 1 { "" } else { "s" },
+                    if name == "EA20" { "at most " } else { "" },
+                )));
+            }
+            let Some(i) = source(j) else { continue };
+            let mut v = answer[i]
+                .take()
+                .unwrap_or_else(|| self.word.data(i).to_vec());
+            if v.len() != width {
+                continue;
+            }
+            for (k, x) in a.values.iter().enumerate() {
+                v[k] = *x as f32 as f64;
+            }
+            if name == "EA20" && self.opts.clean_ea20 {
+                for x in &mut v[a.values.len()..] {
+                    *x = 0.0;
+                }
+            }
+            answer[i] = Some(v);
+        }
         Ok(())
     }
 

@@ -8,10 +8,13 @@
 
 pub mod context;
 pub mod derive;
+pub mod environment;
 pub mod gillespie;
 pub(crate) mod growth;
 pub mod step;
 pub mod word;
 
-pub use derive::{derive, is_query, Derivation, DeriveError, DeriveOptions, Derived, Queries};
+pub use derive::{
+    derive, is_query, Derivation, DeriveError, DeriveOptions, Derived, Queries, TurtleAnswers,
+};
 pub use word::Word;

@@ -1,0 +1,296 @@
+//! vlab's `honda81`, built in: the density field of Honda (1981) that
+//! open L-systems use to stop colliding branches.
+//!
+//! Its parameter file (`density.spec` in vlab's models) has the lines
+//! `radius: R`, `3d case: on|off` and `verbose: on|off`. Each step, every
+//! query `E(vigor[, index])` is answered 0 (stop) when another query of the
+//! same index with a vigor at least its own lies within the radius, and 1
+//! (grow) otherwise. Distances are taken in x, y and z with `3d case: on`,
+//! else in x and z; the index is the second value cut to an integer (0
+//! without one).
+//!
+//! The answers are vlab's to the bit: the program reads the position that
+//! lpfg prints with the `.e` file's format back into `float`s, and works
+//! in `float` (the squared radius and the squared distances too), which is
+//! what this port does (see `honda81.c` of vlab's ENVIRO, whose facts are
+//! described in `../shared/tools/lpfg/README.md`).
+
+use std::path::{Path, PathBuf};
+
+use crate::deadline::Deadline;
+use crate::lang::cfmt;
+use crate::lang::Value;
+use crate::model::comm::CommSpec;
+use crate::model::ModelError;
+use crate::rewrite::environment::{Answer, Environment, EnvironmentStarter, Query};
+
+use super::protocol::as_received;
+
+/// honda81's settings, from its parameter file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// The radius, squared in `float` as honda81 squares it.
+    pub radius2: f32,
+    /// `3d case: on`.
+    pub three_d: bool,
+    pub verbose: bool,
+}
+
+impl Settings {
+    /// honda81's defaults: radius 0, the 2D case (x and z).
+    pub fn new(radius: f32, three_d: bool) -> Settings {
+        Settings {
+            radius2: radius * radius,
+            three_d,
+            verbose: false,
+        }
+    }
+
+    /// Reads a parameter file (`path`, whose text is `text`).
+    pub fn read(path: &Path, text: &str) -> Result<Settings, ModelError> {
+        let shown = path.display().to_string();
+        let mut s = Settings::new(0.0, false);
+        for (n, raw) in text.lines().enumerate() {
+            let l = raw.trim_end_matches('\r');
+            if l.trim().is_empty() {
+                continue;
+            }
+            let at = |start: usize, end: usize, message: String| ModelError::FileAt {
+                path: shown.clone(),
+                line: n + 1,
+                text: l.to_string(),
+                start,
+                end: end.max(start + 1),
+                message,
+            };
+            // honda81 takes the keyword up to a colon or tab, and the value
+            // as the next word.
+            let key_end = l.find([':', '\t']).unwrap_or(l.len());
+            let key = &l[..key_end];
+            let rest = l.get(key_end + 1..).unwrap_or("");
+            let vstart = key_end + 1 + (rest.len() - rest.trim_start().len());
+            let value = rest
+                .split(|c: char| " \t:,;x\n".contains(c))
+                .find(|w| !w.is_empty())
+                .unwrap_or("");
+            match key {
+                "radius" => {
+                    let r: f32 = value.parse::<f64>().map(|v| v as f32).map_err(|_| {
+                        at(
+                            vstart,
+                            l.len(),
+                            format!("expected the radius, a number, found `{}`", rest.trim()),
+                        )
+                    })?;
+                    if !r.is_finite() {
+                        return Err(at(vstart, l.len(), "the radius must be finite".into()));
+                    }
+                    s.radius2 = r * r;
+                }
+                "3d case" | "verbose" => {
+                    if !matches!(value, "on" | "off") {
+                        return Err(at(
+                            vstart,
+                            l.len(),
+                            format!("expected `on` or `off`, found `{}`", rest.trim()),
+                        ));
+                    }
+                    if key == "verbose" {
+                        s.verbose = value == "on";
+                    } else {
+                        s.three_d = value == "on";
+                    }
+                }
+                _ => {
+                    let known = ["radius", "3d case", "verbose"];
+                    let hint = known
+                        .iter()
+                        .find(|k| strsim::damerau_levenshtein(k, key.trim()) <= 2)
+                        .map(|k| format!("; did you mean `{k}:`?"))
+                        .unwrap_or_default();
+                    return Err(at(
+                        0,
+                        key_end,
+                        format!(
+                            "honda81 has no setting `{}`: expected `radius:`, `3d case:` or \
+                             `verbose:`{hint}",
+                            key.trim()
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(s)
+    }
+}
+
+/// One query as honda81 holds it.
+#[derive(Clone, Copy, Debug)]
+struct Item {
+    /// (x, y, z), or (x, z) in the 2D case.
+    at: [f32; 3],
+    vigor: f32,
+    index: i32,
+    id: u64,
+}
+
+/// honda81's answers to one step's queries: 0 or 1 each.
+pub fn answer(settings: &Settings, spec: &CommSpec, queries: &[Query]) -> Vec<Answer> {
+    let items: Vec<Item> = queries
+        .iter()
+        .filter_map(|q| item(settings, spec, q))
+        .collect();
+    let dims = if settings.three_d { 3 } else { 2 };
+    let blocked = |i: usize, j: usize| -> bool {
+        let (a, b) = (&items[i], &items[j]);
+        if i == j || a.index != b.index || a.vigor > b.vigor {
+            return false;
+        }
+        let mut d2 = 0.0f32;
+        for k in 0..dims {
+            let d = a.at[k] - b.at[k];
+            d2 += d * d;
+        }
+        d2 <= settings.radius2
+    };
+    let grow: Vec<bool> = match Grid::new(&items, settings.radius2, dims) {
+        Some(grid) => (0..items.len())
+            .map(|i| !grid.near(&items[i]).any(|j| blocked(i, j)))
+            .collect(),
+        None => (0..items.len())
+            .map(|i| !(0..items.len()).any(|j| blocked(i, j)))
+            .collect(),
+    };
+    items
+        .iter()
+        .zip(grow)
+        .map(|(it, g)| Answer {
+            id: it.id,
+            values: vec![if g { 1.0 } else { 0.0 }],
+        })
+        .collect()
+}
+
+/// The query as honda81 reads it from lpfg's text: the position line
+/// printed with the `.e` file's format and read back as three `float`s
+/// after the text before its first conversion. `None` where honda81 gets
+/// no position or no value (it answers nothing then).
+fn item(settings: &Settings, spec: &CommSpec, q: &Query) -> Option<Item> {
+    let fmt = spec.position.as_deref()?;
+    let line = cfmt::format(
+        fmt,
+        &q.frame.position.map(|x| Value::Float(x as f32 as f64)),
+    )
+    .ok()?;
+    let skip = fmt.find('%').unwrap_or(0);
+    let mut words = line.get(skip..)?.split_whitespace();
+    let mut p = [0f32; 3];
+    for v in &mut p {
+        *v = words.next()?.parse::<f32>().ok()?;
+    }
+    let vigor = as_received(*q.values.first()?);
+    let index = q.values.get(1).map_or(0, |v| as_received(*v) as i32);
+    let at = if settings.three_d {
+        p
+    } else {
+        [p[0], p[2], 0.0]
+    };
+    Some(Item {
+        at,
+        vigor,
+        index,
+        id: q.id,
+    })
+}
+
+/// Queries bucketed by cells one radius wide, so that each query is
+/// compared with its neighbours only; the comparison itself is the exact
+/// one. `None` when a plain double loop is as good (few queries, a zero or
+/// non-finite radius, positions too far out for cells).
+struct Grid {
+    cells: std::collections::HashMap<[i64; 3], Vec<usize>>,
+    size: f64,
+    dims: usize,
+}
+
+impl Grid {
+    fn new(items: &[Item], radius2: f32, dims: usize) -> Option<Grid> {
+        let size = (radius2 as f64).sqrt();
+        if items.len() < 512 || !(size > 0.0) || !size.is_finite() {
+            return None;
+        }
+        let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
+        for (i, it) in items.iter().enumerate() {
+            cells
+                .entry(Self::cell(it, size, dims)?)
+                .or_default()
+                .push(i);
+        }
+        Some(Grid { cells, size, dims })
+    }
+
+    fn cell(it: &Item, size: f64, dims: usize) -> Option<[i64; 3]> {
+        let mut c = [0i64; 3];
+        for k in 0..dims {
+            let v = (it.at[k] as f64 / size).floor();
+            if !(v.abs() < 1e15) {
+                return None;
+            }
+            c[k] = v as i64;
+        }
+        Some(c)
+    }
+
+    /// The queries in the cells around `it`'s (its own included).
+    fn near<'a>(&'a self, it: &Item) -> impl Iterator<Item = usize> + 'a {
+        let c = Self::cell(it, self.size, self.dims).unwrap_or_default();
+        let span = |k: usize| if k < self.dims { -1..=1 } else { 0..=0 };
+        let mut keys = Vec::with_capacity(27);
+        for dx in span(0) {
+            for dy in span(1) {
+                for dz in span(2) {
+                    keys.push([c[0] + dx, c[1] + dy, c[2] + dz]);
+                }
+            }
+        }
+        keys.into_iter()
+            .filter_map(|k| self.cells.get(&k))
+            .flatten()
+            .copied()
+    }
+}
+
+/// Starts the built-in honda81 for each run.
+#[derive(Clone, Debug)]
+pub struct Starter {
+    pub settings: Settings,
+    pub spec: CommSpec,
+    /// The parameter file read, for messages.
+    pub file: PathBuf,
+}
+
+impl EnvironmentStarter for Starter {
+    fn start(&self, _deadline: Option<Deadline>) -> Result<Box<dyn Environment>, String> {
+        Ok(Box::new(Honda81 {
+            settings: self.settings.clone(),
+            spec: self.spec.clone(),
+        }))
+    }
+
+    fn following_module(&self) -> bool {
+        self.spec.following
+    }
+}
+
+/// The built-in honda81, running.
+#[derive(Debug)]
+struct Honda81 {
+    settings: Settings,
+    spec: CommSpec,
+}
+
+impl Environment for Honda81 {
+    fn exchange(&mut self, queries: &[Query]) -> Result<Vec<Answer>, String> {
+        Ok(answer(&self.settings, &self.spec, queries))
+    }
+}
