@@ -97,7 +97,7 @@ fn the_two_loops_agree_in_3d_with_tropisms_queries_and_hand_backs() {
             ..Default::default()
         };
         let [fast, full] = [true, false].map(|fast| {
-            let mut queries = Vec::new();
+            let mut queries = crate::rewrite::TurtleAnswers::default();
             let mut events = Events::new(Vec::new());
             let drawn = walk_loops(
                 &w,
