@@ -216,7 +216,7 @@ struct Grid {
 impl Grid {
     fn new(items: &[Item], radius2: f32, dims: usize) -> Option<Grid> {
         let size = (radius2 as f64).sqrt();
-        if items.len() < 512 || !(size > 0.0) || !size.is_finite() {
+        if items.len() < 512 || size.is_nan() || size <= 0.0 || !size.is_finite() {
             return None;
         }
         let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
@@ -231,12 +231,12 @@ impl Grid {
 
     fn cell(it: &Item, size: f64, dims: usize) -> Option<[i64; 3]> {
         let mut c = [0i64; 3];
-        for k in 0..dims {
-            let v = (it.at[k] as f64 / size).floor();
-            if !(v.abs() < 1e15) {
+        for (c, x) in c.iter_mut().zip(&it.at).take(dims) {
+            let v = (*x as f64 / size).floor();
+            if v.is_nan() || v.abs() >= 1e15 {
                 return None;
             }
-            c[k] = v as i64;
+            *c = v as i64;
         }
         Some(c)
     }
