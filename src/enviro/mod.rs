@@ -2,8 +2,9 @@
 //! communication modules (`E1`, `E2`, `EA20`) of a model whose folder has
 //! a `.e` file (see [`crate::rewrite::environment`] for the exchange).
 //!
-//! * [`honda81`]: vlab's `honda81`, built in (no process, nothing to
-//!   install), chosen when the `.e` file's `executable:` names it.
+//! * [`honda81`] and [`shadowpyramid`]: vlab's programs of those names,
+//!   built in (no process, nothing to install), chosen when the `.e`
+//!   file's `executable:` names one of them.
 //! * [`external`]: any other program, started as lpfg starts it and spoken
 //!   to with lpfg's protocol ([`protocol`]: the `.to_field`/`.from_field`
 //!   files and a pair of SysV semaphores), so that vlab's programs and a
@@ -19,6 +20,7 @@
 pub mod external;
 pub mod honda81;
 pub mod protocol;
+pub mod shadowpyramid;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -27,7 +29,9 @@ use std::time::Duration;
 use crate::model::comm::CommSpec;
 use crate::model::text::read_text;
 use crate::model::ModelError;
-use crate::rewrite::environment::EnvironmentStarter;
+pub use crate::rewrite::environment::{
+    Answer, Environment, EnvironmentStarter, Following, Frame, Query,
+};
 
 /// How environmental programs are run.
 #[derive(Clone, Debug)]
@@ -50,7 +54,7 @@ impl Default for Options {
 }
 
 /// The built-in programs, by the name an `.e` file gives them.
-pub const BUILT_IN: &[&str] = &["honda81"];
+pub const BUILT_IN: &[&str] = &["honda81", "shadowpyramid"];
 
 /// What starts the environment that `spec` asks for: the built-in program
 /// of its name (reading its parameter file now, so that a bad one is
@@ -61,7 +65,7 @@ pub fn starter(spec: &CommSpec, opts: &Options) -> Result<Arc<dyn EnvironmentSta
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    if !opts.external && name == "honda81" {
+    if !opts.external && BUILT_IN.contains(&name.as_str()) {
         let files = spec.spec_files();
         let Some(file) = files.first() else {
             return Err(ModelError::FileAt {
@@ -70,13 +74,22 @@ pub fn starter(spec: &CommSpec, opts: &Options) -> Result<Arc<dyn EnvironmentSta
                 text: spec.command_line.1.clone(),
                 start: 0,
                 end: spec.command_line.1.len(),
-                message: "honda81 needs its parameter file after `-e FILE` \
-                          (`executable: honda81 -e commfile.e density.spec`)"
-                    .into(),
+                message: format!(
+                    "{name} needs its parameter file after `-e FILE` \
+                     (`executable: {name} -e commfile.e {name}.spec`)"
+                ),
             });
         };
         let path = folder.join(file);
         let text = read_text(&path)?;
+        if name == "shadowpyramid" {
+            let settings = shadowpyramid::Settings::read(&path, &text)?;
+            return Ok(Arc::new(shadowpyramid::Starter {
+                settings,
+                spec: spec.clone(),
+                file: path,
+            }));
+        }
         let settings = honda81::Settings::read(&path, &text)?;
         return Ok(Arc::new(honda81::Starter {
             settings,

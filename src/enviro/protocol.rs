@@ -137,7 +137,10 @@ pub fn parse_answer(line: &str) -> Result<Answer, String> {
     for w in inner.split(',') {
         let w = w.trim();
         if w.is_empty() {
-            return Err("an empty value".into());
+            // A value the program left unset (`E(0.5,)`): lpfg's `atof`
+            // of nothing, 0.
+            values.push(0.0);
+            continue;
         }
         let v: f32 = atof(w).ok_or_else(|| format!("`{w}` is not a number"))?;
         values.push(v as f64);

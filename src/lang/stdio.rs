@@ -120,6 +120,12 @@ impl ProgramOutput {
         std::mem::take(&mut self.state().text)
     }
 
+    /// Appends a message of subgram's own to the standard error stream,
+    /// among what the program printed (where lpfg prints its messages).
+    pub fn message(&self, text: &str) {
+        self.state().text.push((Stream::Stderr, text.to_string()));
+    }
+
     /// The files the program wrote: paths relative to the output folder
     /// (checked to stay inside it) and contents.
     pub fn files(&self) -> Vec<(String, String)> {

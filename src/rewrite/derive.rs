@@ -479,17 +479,17 @@ impl<'p> Derivation<'p> {
         };
         let running = self.running.as_mut().expect("an environment");
         let answers = running.exchange(&queries).map_err(&fail)?;
+        // An answer lpfg cannot use (a module it did not send, the wrong
+        // number of values) is reported and passed over, as lpfg does
+        // ("Invalid response received from environment"): the module keeps
+        // its values.
+        let mut invalid: Vec<String> = Vec::new();
         for a in answers {
             let j = usize::try_from(a.id).unwrap_or(usize::MAX);
-            let Some((_, _)) = met.iter().find(|(k, _)| *k == j) else {
-                return Err(fail(format!(
-                    "the environmental program answered module {}, which it was not sent \
-                     (it was sent {} module{})",
-                    a.id,
-                    met.len(),
-                    if met.len() == 1 { "" } else { "s" }
-                )));
-            };
+            if met.iter().all(|(k, _)| *k != j) {
+                invalid.push(format!("module {}, which it was not sent", a.id));
+                continue;
+            }
             let name = p.alphabet.name(shown.sym(j));
             let width = shown.data(j).len();
             let ok = match name {
@@ -497,14 +497,14 @@ impl<'p> Derivation<'p> {
                 _ => a.values.len() == width,
             };
             if !ok {
-                return Err(fail(format!(
-                    "the environmental program answered module {} (`{name}`) with {} value{}, \
-                     and `{name}` takes {}{width}",
+                invalid.push(format!(
+                    "module {} (`{name}`, which takes {}{width}) with {} value{}",
                     a.id,
+                    if name == "EA20" { "at most " } else { "" },
                     a.values.len(),
                     if a.values.len() == 1 { "" } else { "s" },
-                    if name == "EA20" { "at most " } else { "" },
-                )));
+                ));
+                continue;
             }
             let Some(i) = source(j) else { continue };
             let mut v = answer[i]
@@ -522,6 +522,18 @@ impl<'p> Derivation<'p> {
                 }
             }
             answer[i] = Some(v);
+        }
+        if let Some(first) = invalid.first() {
+            let more = match invalid.len() {
+                1 => String::new(),
+                n => format!(" (and {} more)", n - 1),
+            };
+            self.opts.output.message(&format!(
+                "warning: before step {}, the environmental program answered {first}{more}; \
+                 lpfg passes over such answers, and so does subgram: those modules keep their \
+                 values\n",
+                step + 1
+            ));
         }
         Ok(())
     }

@@ -18,7 +18,7 @@ const LAYERS: &[&[&str]] = &[
     &["lang"],
     &["model"],
     &["rewrite"],
-    &["production"],
+    &["production", "enviro"],
     &["mesh"],
     &["surface"],
     &["vv", "shape"],

@@ -7,6 +7,7 @@ mod bad_inputs;
 mod c_strings;
 mod cli;
 mod curves;
+mod enviro;
 mod errors;
 mod export3;
 mod front_limits;

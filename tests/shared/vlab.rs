@@ -1,4 +1,4 @@
-//! The three vlab model folders of `$SUBGRAM_SHARED/corpus/vlab-models`:
+//! The five vlab model folders of `$SUBGRAM_SHARED/corpus/vlab-models`:
 //! each is found and read as lpfg reads it, and the colours of subgram's
 //! pictures are those of lpfg's own pictures (`lpfg-picture.png`).
 
@@ -139,4 +139,92 @@ fn lychnis_files_read_without_the_missing_one() {
     ] {
         assert!(d.contains(&want.to_string()), "{want} not in {d:?}");
     }
+}
+
+/// The open models (`open-01-ulam-collide`, `open-06-canalization`): their
+/// `.e` files name vlab's honda81, which subgram runs built in; lpfg's word
+/// (`lpfg-string.txt.gz`, made by lpfg with vlab's honda81) is theirs,
+/// module by module, every parameter within 1e-5 relative.
+fn open_model_gives_lpfgs_word(name: &str) {
+    use std::io::Read;
+    let System::Curve(c) = subgram::load(folder(name), &LoadOptions::default()).unwrap() else {
+        panic!("a curve")
+    };
+    let d = c.derive(Default::default()).unwrap();
+    let ours = c.word_text(&d.word).replace(", ", ",");
+    let gz = std::fs::read(folder(name).join("lpfg-string.txt.gz")).unwrap();
+    let mut theirs = String::new();
+    flate2::read::GzDecoder::new(&gz[..])
+        .read_to_string(&mut theirs)
+        .unwrap();
+    let split = |t: &str| -> (String, Vec<f64>) {
+        let (n, rest) = t.split_once('(').unwrap_or((t, ""));
+        let v = rest
+            .trim_end_matches(')')
+            .split(',')
+            .filter(|s| !s.is_empty())
+            .map(|s| s.parse().unwrap())
+            .collect();
+        (n.to_string(), v)
+    };
+    let ours: Vec<_> = ours.split_whitespace().map(split).collect();
+    let theirs: Vec<_> = theirs.split_whitespace().map(split).collect();
+    assert_eq!(ours.len(), theirs.len(), "{name}");
+    for (i, (a, b)) in ours.iter().zip(&theirs).enumerate() {
+        assert_eq!(a.0, b.0, "{name}: module {i}");
+        assert_eq!(a.1.len(), b.1.len(), "{name}: module {i}");
+        for (x, y) in a.1.iter().zip(&b.1) {
+            assert!(
+                (x - y).abs() <= 1e-5 * x.abs().max(y.abs()).max(1.0),
+                "{name}: module {i} ({}): {x} and lpfg's {y}",
+                a.0
+            );
+        }
+    }
+}
+
+#[test]
+fn ulam_collide_gives_lpfgs_word() {
+    open_model_gives_lpfgs_word("open-01-ulam-collide");
+}
+
+#[test]
+fn canalization_gives_lpfgs_word() {
+    open_model_gives_lpfgs_word("open-06-canalization");
+}
+
+/// The colours of subgram's picture of an open model and of lpfg's: the
+/// background is lpfg's, and every colour that covers more than 1% of
+/// subgram's picture is within 3 of one that covers more than 0.1% of
+/// lpfg's (the model's colour map entries, as lpfg draws them).
+fn open_model_picture_has_lpfgs_colours(name: &str) {
+    let tmp = crate::support::scratch("open-picture");
+    let a = subgram::command::RenderArgs::new(
+        folder(name).display().to_string(),
+        tmp.path().join("p.png").display().to_string(),
+    );
+    subgram::command::render(&a, |_| {}).unwrap();
+    let (pm, ours) = colours(&std::fs::read(&a.output).unwrap());
+    let theirs = lpfg_picture(name);
+    assert_eq!(ours[0].0, theirs[0].0, "{name}: background");
+    let total: usize = theirs.iter().map(|c| c.1).sum();
+    let n = (pm.width() * pm.height()) as usize;
+    for (c, count) in ours.iter().filter(|(_, k)| *k * 100 > n) {
+        assert!(
+            theirs
+                .iter()
+                .any(|(t, k)| *k * 1000 > total && (0..3).all(|i| t[i].abs_diff(c[i]) <= 3)),
+            "{name}: subgram's colour {c:?} ({count} pixels) is not lpfg's"
+        );
+    }
+}
+
+#[test]
+fn ulam_collide_picture_has_lpfgs_colours() {
+    open_model_picture_has_lpfgs_colours("open-01-ulam-collide");
+}
+
+#[test]
+fn canalization_picture_has_lpfgs_colours() {
+    open_model_picture_has_lpfgs_colours("open-06-canalization");
 }
