@@ -391,7 +391,7 @@ fn modules(text: &str) -> Vec<(String, Vec<f64>)> {
             let (name, rest) = t.split_once('(').unwrap_or((t, ""));
             let nums = rest
                 .trim_end_matches(')')
-                .split(|c| matches!(c, ',' | '{' | '}'))
+                .split([',', '{', '}'])
                 .filter(|s| !s.is_empty())
                 .map(|s| s.parse::<f64>().unwrap_or_else(|_| panic!("{t}")))
                 .collect();
