@@ -84,3 +84,40 @@ pub(super) enum Format {
     Text,
     Json,
 }
+
+/// The options of open L-systems (a model folder with a `.e` file),
+/// shared by the commands that derive.
+#[derive(clap::Args, Clone, Debug)]
+pub(super) struct EnvCli {
+    /// Open L-systems: set the values an environmental program leaves out
+    /// of an EA20's answer to zero (lpfg's -cleanEA20).
+    #[arg(long)]
+    clean_ea20: bool,
+    /// Open L-systems: start the .e file's program as a process even
+    /// where subgram has it built in (honda81, shadowpyramid).
+    #[arg(long)]
+    env_process: bool,
+    /// Open L-systems: stop a run whose environmental program has not
+    /// answered a step after this many seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 30.0, value_parser = parse_env_timeout)]
+    env_timeout: f64,
+}
+
+fn parse_env_timeout(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 86_400.0 => Ok(v),
+        _ => Err(format!(
+            "`{s}` is not a number of seconds above 0 and at most 86400"
+        )),
+    }
+}
+
+impl EnvCli {
+    pub(super) fn options(&self) -> subgram::enviro::Options {
+        subgram::enviro::Options {
+            external: self.env_process,
+            answer_timeout: std::time::Duration::from_secs_f64(self.env_timeout),
+            clean_ea20: self.clean_ea20,
+        }
+    }
+}

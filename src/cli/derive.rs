@@ -3,7 +3,7 @@
 use subgram::command::{self, DeriveArgs};
 use subgram::Error;
 
-use super::args::{parse_timeout, Format, Timeout};
+use super::args::{parse_timeout, EnvCli, Format, Timeout};
 use super::print::{print_program_output, print_warnings, progress_to, Unbuffered};
 
 #[derive(clap::Args)]
@@ -49,6 +49,8 @@ pub(super) struct DeriveCli {
     #[arg(long, value_name = "SECONDS", value_parser = parse_timeout,
           default_value_t = Timeout(Some(subgram::DEFAULT_TIMEOUT)))]
     timeout: Timeout,
+    #[command(flatten)]
+    environment: EnvCli,
 }
 
 impl DeriveCli {
@@ -67,6 +69,7 @@ impl DeriveCli {
             timeout,
             allow_writes,
             output,
+            environment,
         } = self;
         let json = matches!(format, Format::Json);
         let args = DeriveArgs {
@@ -84,6 +87,7 @@ impl DeriveCli {
             allow_writes,
             output: subgram::ProgramOutput::new(),
             word_file: output,
+            environment: environment.options(),
         };
         // The word is written as it is made. Before it: what the
         // program printed (to standard error when the word is JSON,

@@ -68,6 +68,8 @@ pub(super) struct RenderCli {
     /// Write the output even when it is one of the inputs.
     #[arg(long)]
     force: bool,
+    #[command(flatten)]
+    environment: super::args::EnvCli,
 }
 
 impl RenderCli {
@@ -97,6 +99,7 @@ impl RenderCli {
             force: self.force,
             allow_writes: self.allow_writes,
             program_output: subgram::ProgramOutput::new(),
+            environment: self.environment.options(),
         }
     }
 }

@@ -8,7 +8,7 @@ use crate::system::System;
 /// `subgram check FILE [-D NAME=VALUE]…`: reports every diagnostic, or one
 /// line that says what the file holds.
 pub fn check(file: &str, defines: &[String], double: bool) -> Result<String, Error> {
-    let opts = load_options(defines, double);
+    let opts = load_options(defines, double, &Default::default());
     let system = load(file, &opts)?;
     let ok = match &system {
         System::Surface(s) => format!(

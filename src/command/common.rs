@@ -26,15 +26,19 @@ pub(super) fn json(value: &impl serde::Serialize) -> Result<String, Error> {
     serde_json::to_string_pretty(value).map_err(|e| Error::Failed(e.to_string()))
 }
 
-pub(super) fn load_options(defines: &[String], double: bool) -> LoadOptions {
+pub(super) fn load_options(
+    defines: &[String],
+    double: bool,
+    environment: &crate::enviro::Options,
+) -> LoadOptions {
     LoadOptions {
+        environment: environment.clone(),
         defines: defines.to_vec(),
         precision: if double {
             Precision::Double
         } else {
             Precision::Single
         },
-        ..Default::default()
     }
 }
 

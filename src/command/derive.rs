@@ -44,6 +44,9 @@ pub struct DeriveArgs {
     /// `-o FILE`: the word goes to this file (whole, or not at all)
     /// instead of to `derive_to`'s writer.
     pub word_file: Option<PathBuf>,
+    /// How a model's environmental program runs (`--clean-ea20`,
+    /// `--env-process`, `--env-timeout`).
+    pub environment: crate::enviro::Options,
 }
 
 impl DeriveArgs {
@@ -63,6 +66,7 @@ impl DeriveArgs {
             allow_writes: None,
             output: ProgramOutput::default(),
             word_file: None,
+            environment: Default::default(),
         }
     }
 }
@@ -131,7 +135,7 @@ fn derive_to_in_run(
         }
     }
     let dir = writes_folder(&a.allow_writes, &a.output)?;
-    let system = load(&a.file, &load_options(&a.defines, a.double))?;
+    let system = load(&a.file, &load_options(&a.defines, a.double, &a.environment))?;
     let warnings = system.warnings();
     let before = || before(&warnings);
     let Some(path) = &a.word_file else {

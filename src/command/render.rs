@@ -64,6 +64,9 @@ pub struct RenderArgs {
     pub allow_writes: Option<PathBuf>,
     /// What the program prints: the caller keeps a clone and prints it.
     pub program_output: ProgramOutput,
+    /// How a model's environmental program runs (`--clean-ea20`,
+    /// `--env-process`, `--env-timeout`).
+    pub environment: crate::enviro::Options,
 }
 
 impl RenderArgs {
@@ -87,6 +90,7 @@ impl RenderArgs {
             force: false,
             allow_writes: None,
             program_output: ProgramOutput::default(),
+            environment: Default::default(),
         }
     }
 }
@@ -142,7 +146,7 @@ fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<S
             ))
         })?,
     };
-    let system = load(file, &load_options(&a.defines, a.double))?;
+    let system = load(file, &load_options(&a.defines, a.double, &a.environment))?;
     let mut warnings = system.warnings();
     warnings.extend(render_system(
         a,
@@ -177,7 +181,11 @@ pub fn render_edited(a: &RenderArgs, text: &str) -> Result<Drawn, Error> {
     let output = Path::new(&a.output);
     let looks = MeshLooks::of_render(a);
     let format = Picture::from_path(output)?;
-    let system = crate::load::load_edited(file, text, &load_options(&a.defines, a.double))?;
+    let system = crate::load::load_edited(
+        file,
+        text,
+        &load_options(&a.defines, a.double, &a.environment),
+    )?;
     let mut warnings = system.warnings();
     let mut a = a.clone();
     a.allow_writes = None;

@@ -76,7 +76,7 @@ pub fn watch(
             // Under the render's time limit: a pipe among the files waits
             // no longer than the render would.
             let loaded = crate::deadline::within(a.timeout, || {
-                load(&file, &load_options(&a.defines, a.double))
+                load(&file, &load_options(&a.defines, a.double, &a.environment))
             });
             if let Ok(system) = loaded {
                 files = system.inputs();

@@ -42,6 +42,9 @@ pub struct Options {
     /// How long an external program may take to answer one step before it
     /// is stopped (default 30 s).
     pub answer_timeout: Duration,
+    /// lpfg's `-cleanEA20`: an `EA20` answered with fewer than twenty
+    /// values has the rest zeroed.
+    pub clean_ea20: bool,
 }
 
 impl Default for Options {
@@ -49,6 +52,7 @@ impl Default for Options {
         Options {
             external: false,
             answer_timeout: Duration::from_secs(30),
+            clean_ea20: false,
         }
     }
 }
@@ -60,6 +64,37 @@ pub const BUILT_IN: &[&str] = &["honda81", "shadowpyramid"];
 /// of its name (reading its parameter file now, so that a bad one is
 /// reported before the run), or the named program as a process.
 pub fn starter(spec: &CommSpec, opts: &Options) -> Result<Arc<dyn EnvironmentStarter>, ModelError> {
+    let inner = program(spec, opts)?;
+    Ok(match opts.clean_ea20 {
+        true => Arc::new(Cleaning(inner)),
+        false => inner,
+    })
+}
+
+/// An environment whose runs zero what an `EA20` answer leaves
+/// (`-cleanEA20`).
+#[derive(Debug)]
+struct Cleaning(Arc<dyn EnvironmentStarter>);
+
+impl EnvironmentStarter for Cleaning {
+    fn start(
+        &self,
+        deadline: Option<crate::deadline::Deadline>,
+    ) -> Result<Box<dyn crate::rewrite::environment::Environment>, String> {
+        self.0.start(deadline)
+    }
+
+    fn following_module(&self) -> bool {
+        self.0.following_module()
+    }
+
+    fn clean_ea20(&self) -> bool {
+        true
+    }
+}
+
+/// The program itself: built in, or a process.
+fn program(spec: &CommSpec, opts: &Options) -> Result<Arc<dyn EnvironmentStarter>, ModelError> {
     let folder = folder_of(spec);
     let name = Path::new(spec.program())
         .file_name()

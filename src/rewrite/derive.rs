@@ -459,6 +459,12 @@ impl<'p> Derivation<'p> {
             .environment
             .as_ref()
             .is_some_and(|e| e.following_module());
+        let clean_ea20 = self.opts.clean_ea20
+            || self
+                .opts
+                .environment
+                .as_ref()
+                .is_some_and(|e| e.clean_ea20());
         let queries: Vec<Query> = met
             .iter()
             .map(|(j, frame)| Query {
@@ -516,7 +522,7 @@ impl<'p> Derivation<'p> {
             for (k, x) in a.values.iter().enumerate() {
                 v[k] = *x as f32 as f64;
             }
-            if name == "EA20" && self.opts.clean_ea20 {
+            if name == "EA20" && clean_ea20 {
                 for x in &mut v[a.values.len()..] {
                     *x = 0.0;
                 }

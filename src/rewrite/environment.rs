@@ -74,4 +74,9 @@ pub trait EnvironmentStarter: Send + Sync + std::fmt::Debug {
     fn following_module(&self) -> bool {
         false
     }
+    /// lpfg's `-cleanEA20` for this environment's runs (see
+    /// `DeriveOptions::clean_ea20`, which also turns it on).
+    fn clean_ea20(&self) -> bool {
+        false
+    }
 }

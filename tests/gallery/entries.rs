@@ -109,6 +109,12 @@ const FOLDERS: &[(&str, &str, &str)] = &[
         "An L+C program with C functions and tables.",
     ),
     (
+        "open",
+        "Open L-systems",
+        "Model folders whose `.e` file names an environmental program (built in): \
+         growth that stops at collisions, and crowns shaped by their own shade.",
+    ),
+    (
         "surfaces",
         "Surface grammars",
         "Stellar subdivision grammars (paper 000, paper 004), each on the base mesh \
@@ -131,8 +137,9 @@ const FOLDERS: &[(&str, &str, &str)] = &[
     ),
 ];
 
-/// Every `.lsys` file under `lsystems/`, relative to it, `/`-separated,
-/// sorted.
+/// Every `.lsys` file under `lsystems/`, and every model folder (a folder
+/// with an `lsystem.l`: the open L-systems of `lsystems/open/`), relative
+/// to it, `/`-separated, sorted.
 pub fn examples(root: &Path) -> Vec<String> {
     fn walk(dir: &Path, base: &Path, out: &mut Vec<String>) {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
@@ -141,9 +148,9 @@ pub fn examples(root: &Path) -> Vec<String> {
             .collect();
         entries.sort();
         for p in entries {
-            if p.is_dir() {
+            if p.is_dir() && !p.join("lsystem.l").is_file() {
                 walk(&p, base, out);
-            } else if p.extension().is_some_and(|e| e == "lsys") {
+            } else if p.is_dir() || p.extension().is_some_and(|e| e == "lsys") {
                 let rel = p.strip_prefix(base).unwrap();
                 let parts: Vec<String> = rel
                     .components()
@@ -236,9 +243,14 @@ pub fn entries(root: &Path) -> Vec<Entry> {
     files
         .into_iter()
         .map(|file| {
-            let text = std::fs::read_to_string(root.join("lsystems").join(&file))
-                .unwrap_or_else(|e| panic!("lsystems/{file}: {e}"));
-            let stem = file.strip_suffix(".lsys").unwrap();
+            let path = root.join("lsystems").join(&file);
+            let path = match path.is_dir() {
+                true => path.join("lsystem.l"),
+                false => path,
+            };
+            let text = std::fs::read_to_string(&path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            let stem = file.strip_suffix(".lsys").unwrap_or(&file);
             let picture = format!("{PICTURES}/{stem}.png");
             let program = format!("lsystems/{file}");
             let owned = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();

@@ -21,6 +21,9 @@
 //! * a base mesh (`meshes/*.obj`, `meshes/*.ply`): `subgram mesh info
 //!   FILE` as `NAME.txt`; a `meshes/*.creases` file is read with the mesh
 //!   beside it;
+//! * an open L-system (`open/NAME/`, a model folder): the word of its
+//!   `lsystem.l`, derived with the environment its `.e` file names, as
+//!   `open/NAME/lsystem.json`; the folder's other files are read with it;
 //! * a shape grammar (`shapes/*.lsys`): the OBJ file `subgram subdivide
 //!   --grammar FILE -o NAME.obj` writes (one group per terminal shape, in
 //!   tree order) as `NAME.obj`, and the shape tree `subgram derive FILE`
@@ -36,7 +39,8 @@ use crate::support::{root, scratch};
 
 /// The folders of `lsystems/`, each checked by its own test below.
 const FOLDERS: &[&str] = &[
-    "abop", "curves", "figures", "lplusc", "meshes", "paper", "reverse", "shapes", "surfaces", "vv",
+    "abop", "curves", "figures", "lplusc", "meshes", "open", "paper", "reverse", "shapes",
+    "surfaces", "vv",
 ];
 
 /// Surface grammars with boundary rules, run on the open grid as well.
@@ -59,7 +63,16 @@ fn goldens(rel: &Path) -> Option<Vec<(PathBuf, Kind)>> {
     let stem = rel.file_stem()?.to_str()?;
     let folder = rel.parent()?.to_str()?;
     let with = |suffix: &str| base.with_file_name(format!("{stem}{suffix}"));
-    match (folder, rel.extension()?.to_str()?) {
+    let ext = rel.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if folder.starts_with("open/") {
+        // A model folder: its program's word (derived with the model's
+        // environment); its other files are read with it.
+        return Some(match ext {
+            "l" => vec![(with(".json"), Kind::Numeric)],
+            _ => vec![],
+        });
+    }
+    match (folder, ext) {
         ("meshes", "obj" | "ply") => Some(vec![(with(".txt"), Kind::Exact)]),
         // The sharpness of the mesh beside it: read with it.
         ("meshes", "creases") => Some(vec![]),
@@ -296,6 +309,11 @@ fn meshes() {
 #[test]
 fn paper() {
     check_folder("paper");
+}
+
+#[test]
+fn open() {
+    check_folder("open");
 }
 
 #[test]
