@@ -37,8 +37,13 @@ fn start(name: &str, program: &str, save: bool, limits: Limits) -> Live {
     let dir = scratch(&format!("serve-{name}"));
     let file = dir.path().join("prog.lsys");
     std::fs::write(&file, program).unwrap();
+    start_at(dir, file, save, limits)
+}
+
+/// The server of `path` (a file or model folder inside `dir`).
+fn start_at(dir: tempfile::TempDir, path: std::path::PathBuf, save: bool, limits: Limits) -> Live {
     let server = Server::bind(ServeOptions {
-        path: file,
+        path,
         port: 0,
         save,
         limits,
@@ -344,6 +349,33 @@ fn a_surface_grammar_shows_its_shaded_mesh() {
         r["svg"].as_str().unwrap().matches("<polygon").count(),
         8 * 16
     );
+}
+
+/// An open L-system (a model folder with a `.e` file) is drawn with its
+/// environment, started afresh for every run: two runs draw the same
+/// picture, a run that turns the environment off draws another (its
+/// tentacles never grow), and the folder gains no file.
+#[test]
+fn an_open_model_runs_with_its_environment_each_time() {
+    let dir = scratch("serve-open");
+    let model = crate::support::lsys("open/collide-3d");
+    for e in std::fs::read_dir(&model).unwrap() {
+        let p = e.unwrap().path();
+        std::fs::copy(&p, dir.path().join(p.file_name().unwrap())).unwrap();
+    }
+    let before = files(dir.path());
+    let folder = dir.path().to_path_buf();
+    let live = start_at(dir, folder, false, Limits::default());
+    let text = std::fs::read_to_string(model.join("lsystem.l")).unwrap();
+    let first = render(&live, &text, ", \"steps\": 4");
+    assert_eq!(first["ok"], true, "{first}");
+    let again = render(&live, &text, ", \"steps\": 4");
+    assert_eq!(first["svg"], again["svg"]);
+    let closed = text.replace("Axiom:", "Start: { NoEnvironment(); }\nAxiom:");
+    let off = render(&live, &closed, ", \"steps\": 4");
+    assert_eq!(off["ok"], true, "{off}");
+    assert_ne!(first["svg"], off["svg"]);
+    assert_eq!(files(live.dir.path()), before);
 }
 
 /// The checks against other web pages: a page of another
