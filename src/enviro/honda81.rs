@@ -18,13 +18,11 @@
 use std::path::{Path, PathBuf};
 
 use crate::deadline::Deadline;
-use crate::lang::cfmt;
-use crate::lang::Value;
 use crate::model::comm::CommSpec;
 use crate::model::ModelError;
 use crate::rewrite::environment::{Answer, Environment, EnvironmentStarter, Query};
 
-use super::protocol::as_received;
+use super::protocol::{as_received, position_as_read};
 
 /// honda81's settings, from its parameter file.
 #[derive(Clone, Debug, PartialEq)]
@@ -176,18 +174,7 @@ pub fn answer(settings: &Settings, spec: &CommSpec, queries: &[Query]) -> Vec<An
 /// after the text before its first conversion. `None` where honda81 gets
 /// no position or no value (it answers nothing then).
 fn item(settings: &Settings, spec: &CommSpec, q: &Query) -> Option<Item> {
-    let fmt = spec.position.as_deref()?;
-    let line = cfmt::format(
-        fmt,
-        &q.frame.position.map(|x| Value::Float(x as f32 as f64)),
-    )
-    .ok()?;
-    let skip = fmt.find('%').unwrap_or(0);
-    let mut words = line.get(skip..)?.split_whitespace();
-    let mut p = [0f32; 3];
-    for v in &mut p {
-        *v = words.next()?.parse::<f32>().ok()?;
-    }
+    let p = position_as_read(spec, q.frame.position)?;
     let vigor = as_received(*q.values.first()?);
     let index = q.values.get(1).map_or(0, |v| as_received(*v) as i32);
     let at = if settings.three_d {
@@ -208,7 +195,7 @@ fn item(settings: &Settings, spec: &CommSpec, q: &Query) -> Option<Item> {
 /// one. `None` when a plain double loop is as good (few queries, a zero or
 /// non-finite radius, positions too far out for cells).
 struct Grid {
-    cells: std::collections::HashMap<[i64; 3], Vec<usize>>,
+    cells: std::collections::HashMap<[i64; 3], Vec<usize>, CellHash>,
     size: f64,
     dims: usize,
 }
@@ -219,7 +206,8 @@ impl Grid {
         if items.len() < 512 || size.is_nan() || size <= 0.0 || !size.is_finite() {
             return None;
         }
-        let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
+        let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>, CellHash> =
+            Default::default();
         for (i, it) in items.iter().enumerate() {
             cells
                 .entry(Self::cell(it, size, dims)?)
@@ -257,6 +245,41 @@ impl Grid {
             .filter_map(|k| self.cells.get(&k))
             .flatten()
             .copied()
+    }
+}
+
+/// A fast hash of cell coordinates (no defence against chosen keys is
+/// needed: the keys are the model's own positions, and a bad spread only
+/// costs time).
+#[derive(Clone, Copy, Default)]
+struct CellHash;
+
+impl std::hash::BuildHasher for CellHash {
+    type Hasher = CellHasher;
+    fn build_hasher(&self) -> CellHasher {
+        CellHasher(0)
+    }
+}
+
+/// Multiply-rotate mixing, one word at a time.
+struct CellHasher(u64);
+
+impl std::hash::Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for c in bytes.chunks(8) {
+            let mut w = [0u8; 8];
+            w[..c.len()].copy_from_slice(c);
+            self.write_u64(u64::from_le_bytes(w));
+        }
+    }
+    fn write_i64(&mut self, v: i64) {
+        self.write_u64(v as u64);
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
     }
 }
 

@@ -37,7 +37,54 @@ pub fn sent(v: f64) -> String {
 /// A value as the program reads what lpfg sent: the `%f` text read back
 /// into a `float` (what vlab's programs hold).
 pub fn as_received(v: f64) -> f32 {
-    sent(v).parse::<f32>().unwrap_or(f32::NAN)
+    round6(v as f32)
+}
+
+/// `x` printed with `%f` and read back as a `float`. For |x| < 1e9 without
+/// formatting: x·10⁶ is exact in `f64` (24 bits times 20), rounded to an
+/// integer with ties to even as `printf` rounds, and the six-decimal text
+/// of that integer is read back.
+pub fn round6(x: f32) -> f32 {
+    if x.is_nan() || x.abs() >= 1e9 {
+        return format!("{x:.6}").parse::<f32>().unwrap_or(f32::NAN);
+    }
+    let k = (x as f64 * 1e6).round_ties_even() as i64;
+    let (int, frac) = (k.unsigned_abs() / 1_000_000, k.unsigned_abs() % 1_000_000);
+    let mut buf = itoa::Buffer::new();
+    let mut text = String::with_capacity(20);
+    // printf writes the sign of a negative value that rounds to zero
+    // (`-0.000000`), and of -0.
+    if x.is_sign_negative() {
+        text.push('-');
+    }
+    text.push_str(buf.format(int));
+    text.push('.');
+    let f = buf.format(frac);
+    for _ in f.len()..6 {
+        text.push('0');
+    }
+    text.push_str(f);
+    text.parse::<f32>().unwrap_or(f32::NAN)
+}
+
+/// The turtle's position as a program reads it from lpfg's text: printed
+/// with the `.e` file's format (three conversions) and read back as three
+/// `float`s after the text before the first conversion, as vlab's
+/// communication library reads it. `None` where nothing is sent or the
+/// text does not read back.
+pub fn position_as_read(spec: &CommSpec, position: [f64; 3]) -> Option<[f32; 3]> {
+    let fmt = spec.position.as_deref()?;
+    let skip = fmt.find('%').unwrap_or(0);
+    if &fmt[skip..] == "%f %f %f" {
+        return Some(position.map(|x| round6(x as f32)));
+    }
+    let line = cfmt::format(fmt, &position.map(|x| Value::Float(x as f32 as f64))).ok()?;
+    let mut words = line.get(skip..)?.split_whitespace();
+    let mut p = [0f32; 3];
+    for v in &mut p {
+        *v = words.next()?.parse::<f32>().ok()?;
+    }
+    Some(p)
 }
 
 /// The text of one step's queries, ending with [`END_OF_QUERIES`].
@@ -208,6 +255,28 @@ mod tests {
         assert!(queries_text(&spec(true), &[q])
             .unwrap()
             .starts_with("17 E(0.500000,2.000000)F(1.000000)\n"));
+    }
+
+    #[test]
+    fn round6_is_printf_and_read_back() {
+        // Ties (exact in binary) go to even, as glibc's printf rounds.
+        for x in [
+            0.0f32, -0.0, 1.0, 0.5, 2.5e-7, 7.5e-7, -2.5e-7, 1e-7, 123.45679, -0.1, 3.0e8,
+            16777215.0, 0.3, 1.2345675, 9.999999e8, 2e9, f32::INFINITY,
+        ] {
+            let want = format!("{x:.6}").parse::<f32>().unwrap();
+            assert_eq!(round6(x).to_bits(), want.to_bits(), "{x}");
+        }
+        let mut s = 1u64;
+        for _ in 0..100_000 {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let x = f32::from_bits((s >> 32) as u32);
+            if x.is_nan() {
+                continue;
+            }
+            let want = format!("{x:.6}").parse::<f32>().unwrap();
+            assert_eq!(round6(x).to_bits(), want.to_bits(), "{x:e}");
+        }
     }
 
     #[test]

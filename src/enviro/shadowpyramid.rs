@@ -29,7 +29,7 @@ use crate::model::comm::CommSpec;
 use crate::model::ModelError;
 use crate::rewrite::environment::{Answer, Environment, EnvironmentStarter, Query};
 
-use super::protocol::as_received;
+use super::protocol::{as_received, position_as_read};
 
 /// The largest `grid size:` taken (N³ voxels of 4 bytes: 1.6 GB at 750).
 pub const MAX_GRID_SIZE: i64 = 750;
@@ -332,24 +332,6 @@ fn printed(v: f32) -> f64 {
     text.parse::<f32>().map_or(f64::NAN, |v| v as f64)
 }
 
-/// The position as shadowpyramid reads it from lpfg's text (see
-/// `honda81::item`).
-fn position(spec: &CommSpec, q: &Query) -> Option<[f32; 3]> {
-    let fmt = spec.position.as_deref()?;
-    let line = cfmt::format(
-        fmt,
-        &q.frame.position.map(|x| Value::Float(x as f32 as f64)),
-    )
-    .ok()?;
-    let skip = fmt.find('%').unwrap_or(0);
-    let mut words = line.get(skip..)?.split_whitespace();
-    let mut p = [0f32; 3];
-    for v in &mut p {
-        *v = words.next()?.parse::<f32>().ok()?;
-    }
-    Some(p)
-}
-
 /// Starts the built-in shadowpyramid for each run.
 #[derive(Clone, Debug)]
 pub struct Starter {
@@ -385,7 +367,7 @@ impl Environment for ShadowPyramid {
         self.light.reset();
         let mut kept = Vec::new();
         for q in queries {
-            let Some(p) = position(&self.spec, q) else {
+            let Some(p) = position_as_read(&self.spec, q.frame.position) else {
                 continue;
             };
             if q.values.is_empty() {

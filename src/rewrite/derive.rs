@@ -490,9 +490,11 @@ impl<'p> Derivation<'p> {
         // ("Invalid response received from environment"): the module keeps
         // its values.
         let mut invalid: Vec<String> = Vec::new();
+        // The turtle meets the modules in the word's order.
+        debug_assert!(met.windows(2).all(|w| w[0].0 < w[1].0));
         for a in answers {
             let j = usize::try_from(a.id).unwrap_or(usize::MAX);
-            if met.iter().all(|(k, _)| *k != j) {
+            if met.binary_search_by_key(&j, |(k, _)| *k).is_err() {
                 invalid.push(format!("module {}, which it was not sent", a.id));
                 continue;
             }
