@@ -8,6 +8,7 @@ mod c_strings;
 mod cli;
 mod curves;
 mod enviro;
+mod enviro_external;
 mod errors;
 mod export3;
 mod front_limits;
