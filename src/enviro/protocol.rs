@@ -261,15 +261,32 @@ mod tests {
     fn round6_is_printf_and_read_back() {
         // Ties (exact in binary) go to even, as glibc's printf rounds.
         for x in [
-            0.0f32, -0.0, 1.0, 0.5, 2.5e-7, 7.5e-7, -2.5e-7, 1e-7, 123.45679, -0.1, 3.0e8,
-            16777215.0, 0.3, 1.2345675, 9.999999e8, 2e9, f32::INFINITY,
+            0.0f32,
+            -0.0,
+            1.0,
+            0.5,
+            2.5e-7,
+            7.5e-7,
+            -2.5e-7,
+            1e-7,
+            123.45679,
+            -0.1,
+            3.0e8,
+            16777215.0,
+            0.3,
+            1.2345675,
+            9.999999e8,
+            2e9,
+            f32::INFINITY,
         ] {
             let want = format!("{x:.6}").parse::<f32>().unwrap();
             assert_eq!(round6(x).to_bits(), want.to_bits(), "{x}");
         }
         let mut s = 1u64;
         for _ in 0..100_000 {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             let x = f32::from_bits((s >> 32) as u32);
             if x.is_nan() {
                 continue;

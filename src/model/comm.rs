@@ -42,9 +42,32 @@ pub struct CommSpec {
     pub following: bool,
     /// `verbose: on`.
     pub verbose: bool,
+    /// The `communication type:` line (1-based) and its value, where there
+    /// is one.
+    pub communication: Option<(usize, String)>,
 }
 
 impl CommSpec {
+    /// What to say about the file's `communication type:` line: lpfg talks
+    /// through files whatever it says, but vlab's programs read it too and
+    /// talk through files only when it says `files` (they wait on their
+    /// standard input otherwise, and lpfg's run hangs).
+    pub fn communication_note(&self) -> Option<String> {
+        match &self.communication {
+            Some((_, v)) if v == "files" => None,
+            Some((_, v)) => Some(format!(
+                "`communication type: {v}`: lpfg talks to the program through files, and vlab's \
+                 programs do the same only when this line says `files`"
+            )),
+            None => Some(
+                "no `communication type: files` line: lpfg talks to the program through files, \
+                 and vlab's programs do the same only when this file says so (subgram's built-in \
+                 honda81 and shadowpyramid do not need it)"
+                    .into(),
+            ),
+        }
+    }
+
     /// The program's name as the `.e` file gives it (`honda81`).
     pub fn program(&self) -> &str {
         &self.command[0]
@@ -81,6 +104,7 @@ impl CommSpec {
             up: None,
             following: false,
             verbose: false,
+            communication: None,
         };
         let at = |line: usize, text: &str, start: usize, end: usize, message: String| {
             ModelError::FileAt {
@@ -141,6 +165,7 @@ impl CommSpec {
                             ),
                         ));
                     }
+                    spec.communication = Some((line, v.to_string()));
                 }
                 "turtle position" | "turtle heading" | "turtle left" | "turtle up" => {
                     let fmt = value.to_string();

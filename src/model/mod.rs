@@ -367,7 +367,19 @@ impl Model {
         for p in by("e") {
             let (_, t) = text_of(p)?;
             // lpfg keeps the last communication file it is given.
-            m.environment = Some(comm::CommSpec::read(p, &t)?);
+            let spec = comm::CommSpec::read(p, &t)?;
+            if let Some(message) = spec.communication_note() {
+                let line = spec.communication.as_ref().map_or(1, |(l, _)| *l);
+                let start: usize = t.lines().take(line - 1).map(|l| l.len() + 1).sum();
+                let len = t.lines().nth(line - 1).map_or(0, |l| l.trim_end().len());
+                m.notes.push(Note::at(
+                    &p.display().to_string(),
+                    &t,
+                    start..start + len,
+                    message,
+                ));
+            }
+            m.environment = Some(spec);
         }
         m.files.extend(files.iter().cloned());
         Ok(m)

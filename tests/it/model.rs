@@ -367,7 +367,11 @@ fn check_warns_about_view_commands_not_an_environmental_program() {
         "// a comment\nshadow map: on\nlight: V: 0 0 1\nzoom: 3\nline style: wireframe\nz buffer: on\n",
     )
     .unwrap();
-    std::fs::write(tmp.join("field.e"), "executable: field\n").unwrap();
+    std::fs::write(
+        tmp.join("field.e"),
+        "executable: field\ncommunication type: files\n",
+    )
+    .unwrap();
     let out = subgram::command::check(&tmp.display().to_string(), &[], false).unwrap();
     // `light:` is acted on, and `z buffer:` (3D pictures always test
     // depth); `shadow map:` is named as not acted on, at its line; `zoom:`
