@@ -179,7 +179,10 @@ pub(super) fn command(name: &str) -> Cmd {
 }
 
 /// True when the turtle acts on the predefined module `name` (draws, moves,
-/// turns, sets the pen, answers a query).
+/// turns, sets the pen, answers a query). The communication modules are
+/// not among them: the turtle only reports where it met them, for an
+/// environment to answer (`draw::coverage` warns about them when a program
+/// has none).
 pub fn acts_on(name: &str) -> bool {
-    command(name) != Cmd::None
+    !matches!(command(name), Cmd::None | Cmd::Communicate)
 }
