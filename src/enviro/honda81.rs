@@ -23,6 +23,7 @@ use crate::model::ModelError;
 use crate::rewrite::environment::{Answer, Environment, EnvironmentStarter, Query};
 
 use super::protocol::{as_received, position_as_read};
+use super::spec_file;
 
 /// honda81's settings, from its parameter file.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,74 +49,18 @@ impl Settings {
     pub fn read(path: &Path, text: &str) -> Result<Settings, ModelError> {
         let shown = path.display().to_string();
         let mut s = Settings::new(0.0, false);
-        for (n, raw) in text.lines().enumerate() {
-            let l = raw.trim_end_matches('\r');
-            if l.trim().is_empty() {
-                continue;
-            }
-            let at = |start: usize, end: usize, message: String| ModelError::FileAt {
-                path: shown.clone(),
-                line: n + 1,
-                text: l.to_string(),
-                start,
-                end: end.max(start + 1),
-                message,
-            };
-            // honda81 takes the keyword up to a colon or tab, and the value
-            // as the next word.
-            let key_end = l.find([':', '\t']).unwrap_or(l.len());
-            let key = &l[..key_end];
-            let rest = l.get(key_end + 1..).unwrap_or("");
-            let vstart = key_end + 1 + (rest.len() - rest.trim_start().len());
-            let value = rest
-                .split(|c: char| " \t:,;x\n".contains(c))
-                .find(|w| !w.is_empty())
-                .unwrap_or("");
-            match key {
+        for line in spec_file::lines(&shown, text) {
+            match line.key {
                 "radius" => {
-                    let r: f32 = value.parse::<f64>().map(|v| v as f32).map_err(|_| {
-                        at(
-                            vstart,
-                            l.len(),
-                            format!("expected the radius, a number, found `{}`", rest.trim()),
-                        )
-                    })?;
+                    let r = line.number()? as f32;
                     if !r.is_finite() {
-                        return Err(at(vstart, l.len(), "the radius must be finite".into()));
+                        return Err(line.bad_value("the radius must be finite".into()));
                     }
                     s.radius2 = r * r;
                 }
-                "3d case" | "verbose" => {
-                    if !matches!(value, "on" | "off") {
-                        return Err(at(
-                            vstart,
-                            l.len(),
-                            format!("expected `on` or `off`, found `{}`", rest.trim()),
-                        ));
-                    }
-                    if key == "verbose" {
-                        s.verbose = value == "on";
-                    } else {
-                        s.three_d = value == "on";
-                    }
-                }
-                _ => {
-                    let known = ["radius", "3d case", "verbose"];
-                    let hint = known
-                        .iter()
-                        .find(|k| strsim::damerau_levenshtein(k, key.trim()) <= 2)
-                        .map(|k| format!("; did you mean `{k}:`?"))
-                        .unwrap_or_default();
-                    return Err(at(
-                        0,
-                        key_end,
-                        format!(
-                            "honda81 has no setting `{}`: expected `radius:`, `3d case:` or \
-                             `verbose:`{hint}",
-                            key.trim()
-                        ),
-                    ));
-                }
+                "3d case" => s.three_d = line.on_off()?,
+                "verbose" => s.verbose = line.on_off()?,
+                _ => return Err(line.unknown("honda81", &["radius", "3d case", "verbose"])),
             }
         }
         Ok(s)

@@ -21,6 +21,7 @@ pub mod external;
 pub mod honda81;
 pub mod protocol;
 pub mod shadowpyramid;
+mod spec_file;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

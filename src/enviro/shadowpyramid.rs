@@ -30,6 +30,7 @@ use crate::model::ModelError;
 use crate::rewrite::environment::{Answer, Environment, EnvironmentStarter, Query};
 
 use super::protocol::{as_received, position_as_read};
+use super::spec_file;
 
 /// The largest `grid size:` taken (N³ voxels of 4 bytes: 1.6 GB at 750).
 pub const MAX_GRID_SIZE: i64 = 750;
@@ -85,69 +86,24 @@ impl Settings {
     pub fn read(path: &Path, text: &str) -> Result<Settings, ModelError> {
         let shown = path.display().to_string();
         let mut s = Settings::default();
-        for (n, raw) in text.lines().enumerate() {
-            let l = raw.trim_end_matches('\r');
-            if l.trim().is_empty() {
+        for line in spec_file::lines(&shown, text) {
+            if !KEYS.contains(&line.key) {
+                return Err(line.unknown("shadowpyramid", KEYS));
+            }
+            if line.key == "verbose" {
+                s.verbose = line.on_off()?;
                 continue;
             }
-            let at = |start: usize, end: usize, message: String| ModelError::FileAt {
-                path: shown.clone(),
-                line: n + 1,
-                text: l.to_string(),
-                start,
-                end: end.max(start + 1),
-                message,
-            };
-            let key_end = l.find([':', '\t']).unwrap_or(l.len());
-            let key = &l[..key_end];
-            let rest = l.get(key_end + 1..).unwrap_or("");
-            let vstart = key_end + 1 + (rest.len() - rest.trim_start().len());
-            let value = rest
-                .split(|c: char| " \t:,;x\n".contains(c))
-                .find(|w| !w.is_empty())
-                .unwrap_or("");
-            if !KEYS.contains(&key) {
-                let hint = KEYS
-                    .iter()
-                    .find(|k| strsim::damerau_levenshtein(k, key.trim()) <= 2)
-                    .map(|k| format!("; did you mean `{k}:`?"))
-                    .unwrap_or_default();
-                return Err(at(
-                    0,
-                    key_end,
-                    format!(
-                        "shadowpyramid has no setting `{}` (it has {}){hint}",
-                        key.trim(),
-                        KEYS.iter()
-                            .map(|k| format!("`{k}:`"))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ),
-                ));
-            }
-            if key == "verbose" {
-                s.verbose = value == "on";
-                continue;
-            }
-            let number = value.parse::<f64>().ok().filter(|v| v.is_finite());
-            let Some(v) = number else {
-                return Err(at(
-                    vstart,
-                    l.len(),
-                    format!("expected a number after `{key}:`, found `{}`", rest.trim()),
-                ));
-            };
+            let v = line.number()?;
             let whole = |what: &str, lo: i64, hi: i64| -> Result<i64, ModelError> {
                 if v.fract() != 0.0 || v < lo as f64 || v > hi as f64 {
-                    return Err(at(
-                        vstart,
-                        l.len(),
-                        format!("{what} must be a whole number from {lo} to {hi}"),
-                    ));
+                    return Err(
+                        line.bad_value(format!("{what} must be a whole number from {lo} to {hi}"))
+                    );
                 }
                 Ok(v as i64)
             };
-            match key {
+            match line.key {
                 "grid size" => s.grid_size = whole("the grid size", 2, MAX_GRID_SIZE)? as usize,
                 "grid span" => s.grid_span = v as f32,
                 "shadow spread" => s.spread = v as f32,

@@ -212,7 +212,7 @@ fn spec_files_with_mistakes_are_located() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("density.spec:1:9"), "{e}");
-    assert!(e.contains("expected the radius, a number"), "{e}");
+    assert!(e.contains("expected a number after `radius:`"), "{e}");
     let e = shadowpyramid::Settings::read(Path::new("light.spec"), "grid size: 2000\n")
         .unwrap_err()
         .to_string();
