@@ -340,6 +340,7 @@ mod linux {
                     text.trim()
                 )
             })?;
+            interrupt::enter();
             Ok(Running {
                 who,
                 spec: s.spec.clone(),
@@ -407,6 +408,10 @@ mod linux {
                 if got {
                     return Ok(());
                 }
+                if interrupt::pending() {
+                    self.kill();
+                    return Err(format!("interrupted while waiting for {}", self.who));
+                }
                 if let Some(status) = self.exited() {
                     return Err(match status.code() {
                         Some(code) => {
@@ -422,6 +427,9 @@ mod linux {
             let who = self.who.clone();
             if let Some(status) = self.exited() {
                 return Err(format!("{who} is no longer running ({status})"));
+            }
+            if interrupt::pending() {
+                return Err(format!("interrupted before {who} was asked"));
             }
             let until = Instant::now() + self.timeout;
             let text = queries_text(&self.spec, queries)
@@ -494,6 +502,75 @@ mod linux {
     impl Drop for Running {
         fn drop(&mut self) {
             self.stop();
+            interrupt::leave();
+        }
+    }
+
+    /// Ctrl-C (SIGINT), SIGTERM and SIGHUP while an external program runs:
+    /// instead of dying at once (and leaving the two files and the
+    /// semaphore set behind), the process notes the signal; the wait for
+    /// an answer sees it within its 50 ms slice and fails, the derivation
+    /// stops, the environment is dropped and cleans up, and then the
+    /// signal is raised again with its default action, so that the
+    /// command ends as the user asked. With no external program running,
+    /// the signals act as always.
+    pub(super) mod interrupt {
+        use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+        const SIGNALS: [libc::c_int; 3] = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP];
+        static ACTIVE: AtomicUsize = AtomicUsize::new(0);
+        static CAUGHT: std::sync::atomic::AtomicI32 = std::sync::atomic::AtomicI32::new(0);
+        static INSTALLED: std::sync::Once = std::sync::Once::new();
+        static PENDING: AtomicBool = AtomicBool::new(false);
+
+        extern "C" fn on_signal(sig: libc::c_int) {
+            if ACTIVE.load(Ordering::SeqCst) == 0 {
+                // SAFETY: signal and raise are async-signal-safe.
+                unsafe {
+                    libc::signal(sig, libc::SIG_DFL);
+                    libc::raise(sig);
+                }
+                return;
+            }
+            CAUGHT.store(sig, Ordering::SeqCst);
+            PENDING.store(true, Ordering::SeqCst);
+        }
+
+        /// An external program starts running.
+        pub fn enter() {
+            INSTALLED.call_once(|| {
+                for sig in SIGNALS {
+                    // SAFETY: installs a handler that only touches atomics
+                    // and async-signal-safe calls.
+                    unsafe {
+                        let old = libc::signal(sig, on_signal as *const () as libc::sighandler_t);
+                        // A signal the process ignores (nohup) stays ignored.
+                        if old == libc::SIG_IGN {
+                            libc::signal(sig, libc::SIG_IGN);
+                        }
+                    }
+                }
+            });
+            ACTIVE.fetch_add(1, Ordering::SeqCst);
+        }
+
+        /// Whether a signal came while a program ran.
+        pub fn pending() -> bool {
+            PENDING.load(Ordering::SeqCst)
+        }
+
+        /// An external program has ended and been cleaned up: when a
+        /// signal came meanwhile and no other program runs, it now takes
+        /// its default action.
+        pub fn leave() {
+            if ACTIVE.fetch_sub(1, Ordering::SeqCst) == 1 && PENDING.load(Ordering::SeqCst) {
+                let sig = CAUGHT.load(Ordering::SeqCst);
+                // SAFETY: plain system calls with a signal number.
+                unsafe {
+                    libc::signal(sig, libc::SIG_DFL);
+                    libc::raise(sig);
+                }
+            }
         }
     }
 }

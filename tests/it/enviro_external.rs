@@ -352,3 +352,87 @@ fn an_abandoned_derivation_leaves_nothing() {
     assert!(r.is_err());
     m.assert_clean(true);
 }
+
+/// Ctrl-C (SIGINT to `subgram derive`) while the program is asked: the
+/// command still ends by the signal, as it would without an environment,
+/// and the files, the semaphore set and the program are gone.
+#[test]
+fn ctrl_c_leaves_nothing() {
+    use std::os::unix::process::ExitStatusExt;
+    let m = Model::new("sigint", ECHO, "silent");
+    let mut run = Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .args(["derive", m.path().to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // The stand-in writes its pid once it has started; its command line
+    // carries the run's key (`-k KEY`).
+    let pid_file = m.aside.path().join("pid");
+    let t = Instant::now();
+    let pid = loop {
+        if let Some(p) = std::fs::read_to_string(&pid_file)
+            .ok()
+            .filter(|p| p.ends_with('\n') || !p.trim().is_empty())
+        {
+            break p.trim().to_string();
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(20),
+            "the stand-in never started"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let args = std::fs::read(format!("/proc/{pid}/cmdline")).unwrap();
+    let args: Vec<String> = args
+        .split(|b| *b == 0)
+        .map(|a| String::from_utf8_lossy(a).into_owned())
+        .collect();
+    let key: i32 = args[args.iter().position(|a| a == "-k").unwrap() + 1]
+        .parse()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(200));
+    let sent = Command::new("kill")
+        .args(["-INT", &run.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let t = Instant::now();
+    let status = loop {
+        if let Some(s) = run.try_wait().unwrap() {
+            break s;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(10),
+            "subgram did not stop"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(status.signal(), Some(libc_sigint()), "{status}");
+    let names: Vec<String> = std::fs::read_dir(m.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        names
+            .iter()
+            .all(|n| !n.starts_with(".to_field") && !n.starts_with(".from_field")),
+        "{names:?}"
+    );
+    assert!(
+        !Path::new(&format!("/proc/{pid}")).exists(),
+        "the stand-in (pid {pid}) is still there"
+    );
+    let sets = std::fs::read_to_string("/proc/sysvipc/sem").unwrap();
+    assert!(
+        sets.lines()
+            .skip(1)
+            .all(|l| l.split_whitespace().next() != Some(&key.to_string())),
+        "the semaphore set {key} is left"
+    );
+}
+
+/// SIGINT's number on Linux.
+fn libc_sigint() -> i32 {
+    2
+}
