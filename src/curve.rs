@@ -157,6 +157,17 @@ impl Curve {
         Ok(CurveRun { curve: self, d })
     }
 
+    /// The derivation that [`Curve::run`] drives, started (globals set,
+    /// `Start` run, the axiom decomposed) but not stepped: a caller that
+    /// takes the steps itself (`has_next`, `next_step`, then `end`) gets
+    /// the same word as [`Curve::run`], and may stop between steps (the
+    /// Python bindings check for Ctrl-C there). Errors of the steps become
+    /// [`Error`]s with [`Curve::error`].
+    pub fn derivation(&self, opts: DeriveOptions) -> Result<Derivation<'_>, Error> {
+        check_steps(opts.steps)?;
+        Derivation::new(&self.program, self.with_view(opts)).map_err(|e| self.error(e))
+    }
+
     /// `word` as text: `P([0, 0.25]) E A(1, 2)`, vectors in brackets.
     pub fn word_text(&self, word: &Word) -> String {
         crate::output::word_text(word, &self.program.alphabet, &self.program.structs)
