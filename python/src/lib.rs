@@ -283,6 +283,28 @@ fn kind_name(s: &subgram::System) -> &'static str {
     }
 }
 
+impl System {
+    fn curve(&self) -> PyResult<&subgram::Curve> {
+        match &*self.inner {
+            subgram::System::Curve(c) => Ok(c),
+            other => Err(PyTypeError::new_err(format!(
+                "this is a {} system, not a curve: use mesh() or render()",
+                kind_name(other)
+            ))),
+        }
+    }
+
+    /// The CLI's run options for a curve (`subgram derive`'s).
+    fn run_options(&self, steps: Option<u64>, seed: Option<u32>, timeout: Option<f64>) -> RunOptions {
+        RunOptions {
+            steps,
+            seed: seed.or(self.seed),
+            deadline: deadline(timeout),
+            ..RunOptions::default()
+        }
+    }
+}
+
 #[pymethods]
 impl System {
     /// "curve", "surface", "vv" or "shapes".
@@ -441,6 +463,55 @@ impl System {
         let bytes = std::fs::read(&output)
             .map_err(|e| PyException::new_err(format!("cannot read {}: {e}", output.display())))?;
         Ok(Some(PyBytes::new(py, &bytes)))
+    }
+
+    /// `lines(steps=None, *, seed=None, timeout=None)`: the turtle's
+    /// polylines (the interpreted word drawn, as `render` draws it), each an
+    /// n×3 float64 array.
+    #[pyo3(signature = (steps=None, *, seed=None, timeout=None))]
+    fn lines<'py>(
+        &self,
+        py: Python<'py>,
+        steps: Option<u64>,
+        seed: Option<u32>,
+        timeout: Option<f64>,
+    ) -> PyResult<Vec<Bound<'py, PyArray2<f64>>>> {
+        let curve = self.curve()?;
+        let dopts = self.run_options(steps, seed, timeout).derive_options();
+        let r = run_off_thread(py, |_| curve.run(dopts)?.polylines())?;
+        let lines = r.map_err(|e| py_error(py, e))?;
+        Ok(lines
+            .iter()
+            .map(|l| {
+                let flat: Vec<f64> = l.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+                Array2::from_shape_vec((l.len(), 3), flat)
+                    .expect("n × 3")
+                    .into_pyarray(py)
+            })
+            .collect())
+    }
+
+    /// `bounds(steps=None, *, seed=None, timeout=None)`: the box around the
+    /// turtle's lines, `(lo, hi)` as 3-element float64 arrays, or None when
+    /// it draws none.
+    #[pyo3(signature = (steps=None, *, seed=None, timeout=None))]
+    fn bounds<'py>(
+        &self,
+        py: Python<'py>,
+        steps: Option<u64>,
+        seed: Option<u32>,
+        timeout: Option<f64>,
+    ) -> PyResult<Option<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)>> {
+        let curve = self.curve()?;
+        let dopts = self.run_options(steps, seed, timeout).derive_options();
+        let r = run_off_thread(py, |_| curve.run(dopts)?.line_bounds())?;
+        let b = r.map_err(|e| py_error(py, e))?;
+        Ok(b.map(|(lo, hi)| {
+            (
+                vec![lo.x, lo.y, lo.z].into_pyarray(py),
+                vec![hi.x, hi.y, hi.z].into_pyarray(py),
+            )
+        }))
     }
 
     /// A surface grammar or vv program run on its own base mesh (its
@@ -958,6 +1029,27 @@ fn serde_json_string(v: &impl serde::Serialize) -> Result<String, subgram::Error
     serde_json::to_string(v).map_err(|e| subgram::Error::Failed(e.to_string()))
 }
 
+/// `_render_mesh_file(file, output, size, view, wireframe)`: `subgram
+/// render FILE -o OUTPUT` for a mesh file, drawn as it is.
+#[pyfunction]
+#[pyo3(signature = (file, output, size=None, view=None, wireframe=true))]
+fn _render_mesh_file(
+    py: Python<'_>,
+    file: String,
+    output: String,
+    size: Option<(u32, u32)>,
+    view: Option<String>,
+    wireframe: bool,
+) -> PyResult<()> {
+    let mut a = subgram::command::RenderArgs::new(file, output);
+    a.size = size;
+    a.view = view;
+    a.wireframe = wireframe;
+    a.force = true;
+    let r = run_off_thread(py, |_| subgram::command::render(&a, |_| {}))?;
+    r.map(|_| ()).map_err(|e| py_error(py, e))
+}
+
 /// `_infer(rows, rows_file, mask, arity, open, reverse, shift, list,
 /// ordered)`: the program text `subgram infer` prints.
 #[pyfunction]
@@ -1045,6 +1137,7 @@ fn _subgram(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_write_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(_reverse, m)?)?;
     m.add_function(wrap_pyfunction!(_infer, m)?)?;
+    m.add_function(wrap_pyfunction!(_render_mesh_file, m)?)?;
     m.add_function(wrap_pyfunction!(_analyze, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -34,6 +34,7 @@ __all__ = [
     "mesh",
     "read_mesh",
     "write_mesh",
+    "render_mesh",
     "reverse",
     "infer",
     "analyze",
@@ -168,6 +169,33 @@ def write_mesh(path: Union[str, "_os.PathLike[str]"], vertices: Any, faces: Any)
     v = _np.ascontiguousarray(vertices, dtype=_np.float64)
     idx, sizes = _faces_in(faces)
     _subgram._write_mesh(_os.fspath(path), v, idx, sizes)
+
+
+def render_mesh(
+    vertices: Any,
+    faces: Any,
+    path: Optional[Union[str, "_os.PathLike[str]"]] = None,
+    *,
+    format: Optional[str] = None,
+    size: Optional[Tuple[int, int]] = None,
+    view: Optional[str] = None,
+    wireframe: bool = True,
+) -> Optional[bytes]:
+    """Draws a mesh as ``subgram render MESH.obj -o OUT`` does (PNG or SVG;
+    ``view``: iso, front, back, left, right, top or bottom): written to
+    ``path``, or returned as bytes when ``path`` is None."""
+    import tempfile
+
+    fmt = (format or (_os.path.splitext(_os.fspath(path))[1][1:] if path is not None else "png")).lower()
+    with tempfile.TemporaryDirectory(prefix="subgram-py-") as d:
+        obj = _os.path.join(d, "mesh.obj")
+        write_mesh(obj, vertices, faces)
+        out = _os.fspath(path) if path is not None else _os.path.join(d, f"picture.{fmt}")
+        _subgram._render_mesh_file(obj, out, size, view, wireframe)
+        if path is not None:
+            return None
+        with open(out, "rb") as f:
+            return f.read()
 
 
 def _define_list(defines: Any) -> List[str]:

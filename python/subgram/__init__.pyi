@@ -115,6 +115,16 @@ class System:
         returned as bytes when ``path`` is None. ``size``: (width, height);
         ``view``: xy, xz, yz for curves, iso, front, ... for meshes;
         ``solid``: force the shaded 3D drawing (True) or the lines (False)."""
+    def lines(
+        self, steps: Optional[int] = None, *, seed: Optional[int] = None, timeout: Optional[float] = None
+    ) -> List[npt.NDArray[np.float64]]:
+        """A curve's turtle polylines (the interpreted word, as ``render``
+        draws it), each an n×3 float64 array."""
+    def bounds(
+        self, steps: Optional[int] = None, *, seed: Optional[int] = None, timeout: Optional[float] = None
+    ) -> Optional[Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
+        """The box around a curve's turtle lines, ``(lo, hi)``, or None when
+        it draws none."""
     def mesh(
         self, steps: Optional[int] = None, *, timeout: Optional[float] = None
     ) -> Tuple[npt.NDArray[np.float64], _Faces]:
@@ -156,6 +166,19 @@ def mesh(path: _Path) -> Tuple[npt.NDArray[np.float64], _Faces]:
 
 def write_mesh(path: _Path, vertices: Any, faces: Any) -> None:
     """Writes a mesh as the CLI writes it (.obj, .off or .ply)."""
+
+def render_mesh(
+    vertices: Any,
+    faces: Any,
+    path: Optional[_Path] = None,
+    *,
+    format: Optional[str] = None,
+    size: Optional[Tuple[int, int]] = None,
+    view: Optional[str] = None,
+    wireframe: bool = True,
+) -> Optional[bytes]:
+    """Draws a mesh as ``subgram render MESH.obj -o OUT`` does: written to
+    ``path``, or the PNG/SVG bytes when ``path`` is None."""
 
 def padded(faces: Any, fill: int = -1) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
     """Faces as ``(padded m×k array, sizes)``."""
