@@ -131,9 +131,9 @@ fn run_off_thread<T: Send>(
                     }
                 }
             }
-            worker.join().map_err(|_| {
-                PyException::new_err("internal failure (this is a bug in subgram)")
-            })
+            worker
+                .join()
+                .map_err(|_| PyException::new_err("internal failure (this is a bug in subgram)"))
         })
     })
 }
@@ -149,10 +149,8 @@ impl TempDir {
             .duration_since(std::time::UNIX_EPOCH)
             .map(|d| d.subsec_nanos())
             .unwrap_or(0);
-        let dir = std::env::temp_dir().join(format!(
-            "subgram-py-{}-{n}-{nanos}",
-            std::process::id()
-        ));
+        let dir =
+            std::env::temp_dir().join(format!("subgram-py-{}-{n}-{nanos}", std::process::id()));
         std::fs::create_dir_all(&dir)
             .map_err(|e| PyException::new_err(format!("cannot make {}: {e}", dir.display())))?;
         Ok(TempDir(dir))
@@ -171,6 +169,9 @@ fn deadline(timeout: Option<f64>) -> Option<subgram::Deadline> {
 
 // ---------------------------------------------------------------------------
 // System
+
+/// A box's lowest and highest corners.
+type Corners<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// Where a system's program came from: `render` hands it to the CLI's
 /// command.
@@ -295,7 +296,12 @@ impl System {
     }
 
     /// The CLI's run options for a curve (`subgram derive`'s).
-    fn run_options(&self, steps: Option<u64>, seed: Option<u32>, timeout: Option<f64>) -> RunOptions {
+    fn run_options(
+        &self,
+        steps: Option<u64>,
+        seed: Option<u32>,
+        timeout: Option<f64>,
+    ) -> RunOptions {
         RunOptions {
             steps,
             seed: seed.or(self.seed),
@@ -424,8 +430,9 @@ impl System {
                     .filter(|n| n.ends_with(".lsys") || n.ends_with(".l"))
                     .unwrap_or_else(|| "program.lsys".into());
                 let f = dir.0.join(base);
-                std::fs::write(&f, text)
-                    .map_err(|e| PyException::new_err(format!("cannot write {}: {e}", f.display())))?;
+                std::fs::write(&f, text).map_err(|e| {
+                    PyException::new_err(format!("cannot write {}: {e}", f.display()))
+                })?;
                 f.display().to_string()
             }
         };
@@ -501,7 +508,7 @@ impl System {
         steps: Option<u64>,
         seed: Option<u32>,
         timeout: Option<f64>,
-    ) -> PyResult<Option<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)>> {
+    ) -> PyResult<Option<Corners<'py>>> {
         let curve = self.curve()?;
         let dopts = self.run_options(steps, seed, timeout).derive_options();
         let r = run_off_thread(py, |_| curve.run(dopts)?.line_bounds())?;
@@ -632,7 +639,10 @@ impl Word {
         let names = self.names(py);
         PyList::new(
             py,
-            self.word.syms().iter().map(|s| names[s.0 as usize].bind(py)),
+            self.word
+                .syms()
+                .iter()
+                .map(|s| names[s.0 as usize].bind(py)),
         )
     }
 
@@ -757,7 +767,13 @@ impl Word {
             .map(|v| value_to_py(py, v))
             .collect::<PyResult<Vec<_>>>()?;
         let name = self.names(py)[sym.0 as usize].clone_ref(py);
-        PyTuple::new(py, [name.into_any(), PyTuple::new(py, values)?.into_any().unbind()])
+        PyTuple::new(
+            py,
+            [
+                name.into_any(),
+                PyTuple::new(py, values)?.into_any().unbind(),
+            ],
+        )
     }
 
     /// The CLI's `subgram derive --format json` (without the final newline).
@@ -835,7 +851,9 @@ fn soup_in(
         }
         let end = at + s as usize;
         let Some(corners) = idx.get(at..end) else {
-            return Err(PyValueError::new_err("faces: fewer indices than the sizes say"));
+            return Err(PyValueError::new_err(
+                "faces: fewer indices than the sizes say",
+            ));
         };
         face.clear();
         for &i in corners {
@@ -875,7 +893,10 @@ const SCHEMES: &[(&str, &str)] = &[
         include_str!("../../lsystems/surfaces/four-eight.lsys"),
     ),
     ("c4", include_str!("../../lsystems/surfaces/c4.lsys")),
-    ("peters", include_str!("../../lsystems/surfaces/peters.lsys")),
+    (
+        "peters",
+        include_str!("../../lsystems/surfaces/peters.lsys"),
+    ),
 ];
 
 /// The names `subdivide` takes as built-in schemes.
