@@ -43,3 +43,23 @@ def test_notebook_hooks(root):
 def test_render_of_program_text():
     text = "module P(float);\nderivation length: 2;\nAxiom: P(1);\nP(x) : produce P(x) P(x);\ninterpretation:\nP(x) : produce F(x) Left(60);\n"
     assert subgram.load(text).render().startswith(b"\x89PNG")
+
+
+def test_render_mesh_is_the_clis(root, cli, tmp_path):
+    v, f = subgram.mesh(root / "lsystems/meshes/octahedron.obj")
+    out = tmp_path / "cli.png"
+    cli("render", "lsystems/meshes/octahedron.obj", "--size", "200x200", "-o", out)
+    assert subgram.render_mesh(v, f, size=(200, 200)) == out.read_bytes()
+
+
+def test_lines_and_bounds(root):
+    import numpy as np
+
+    s = subgram.load(str(root / "examples/python/bush.lsys"), seed=5)
+    lines = s.lines()
+    assert lines and all(l.ndim == 2 and l.shape[1] == 3 for l in lines)
+    pts = np.concatenate(lines)
+    lo, hi = s.bounds()
+    assert np.allclose(pts.min(axis=0), lo) and np.allclose(pts.max(axis=0), hi)
+    with pytest.raises(TypeError):
+        subgram.load(str(root / "lsystems/surfaces/loop.lsys")).lines()
