@@ -456,7 +456,8 @@ impl System {
         a.double = self.double;
         a.seed = seed.or(self.seed);
         a.timeout = timeout.filter(|t| *t > 0.0).map(Duration::from_secs_f64);
-        a.force = path.is_some();
+        // As the CLI without --force: never over one of the inputs.
+        a.force = false;
         a.solid = match solid {
             None => subgram::command::Solidity::Auto,
             Some(true) => subgram::command::Solidity::Solid,
@@ -1066,7 +1067,7 @@ fn _render_mesh_file(
     a.size = size;
     a.view = view;
     a.wireframe = wireframe;
-    a.force = true;
+    a.force = false;
     let r = run_off_thread(py, |_| subgram::command::render(&a, |_| {}))?;
     r.map(|_| ()).map_err(|e| py_error(py, e))
 }
