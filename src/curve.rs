@@ -157,6 +157,34 @@ impl Curve {
         Ok(CurveRun { curve: self, d })
     }
 
+    /// The derivation that [`Curve::run`] drives, started (globals set,
+    /// `Start` run, the axiom decomposed) but not stepped: a caller that
+    /// takes the steps itself (`has_next`, `next_step`, then `end`) gets
+    /// the same word as [`Curve::run`], and may stop between steps (the
+    /// Python bindings check for Ctrl-C there). Errors of the steps become
+    /// [`Error`]s with [`Curve::error`].
+    ///
+    /// ```
+    /// # fn main() -> Result<(), subgram::Error> {
+    /// let root = env!("CARGO_MANIFEST_DIR");
+    /// let file = format!("{root}/lsystems/curves/chaikin-13.lsys");
+    /// let subgram::System::Curve(curve) = subgram::load(&file, &Default::default())? else {
+    ///     unreachable!()
+    /// };
+    /// let opts = subgram::DeriveOptions::default().with_steps(3);
+    /// let mut d = curve.derivation(opts.clone())?;
+    /// while d.has_next() {
+    ///     d.next_step().map_err(|e| curve.error(e))?; // or stop here
+    /// }
+    /// d.end().map_err(|e| curve.error(e))?;
+    /// assert_eq!(d.word, *curve.run(opts)?.word());
+    /// # Ok(()) }
+    /// ```
+    pub fn derivation(&self, opts: DeriveOptions) -> Result<Derivation<'_>, Error> {
+        check_steps(opts.steps)?;
+        Derivation::new(&self.program, self.with_view(opts)).map_err(|e| self.error(e))
+    }
+
     /// `word` as text: `P([0, 0.25]) E A(1, 2)`, vectors in brackets.
     pub fn word_text(&self, word: &Word) -> String {
         crate::output::word_text(word, &self.program.alphabet, &self.program.structs)
