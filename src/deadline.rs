@@ -3,7 +3,11 @@
 //! thousand modules, loop iterations or rules, never per expression), and
 //! stop with a message that names the limit and how to raise it.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
+
+/// Set by [`Deadline::stop_all`]: every deadline counts as passed.
+static STOP_ALL: AtomicBool = AtomicBool::new(false);
 
 /// The time limit of the `subgram` commands that derive, render,
 /// subdivide, reverse or reconstruct (`--timeout SECONDS`; 0 for none).
@@ -38,6 +42,21 @@ impl Deadline {
         (!limit.is_zero()).then(|| Deadline::after(limit))
     }
 
+    /// From `true` until called with `false`, every deadline of this
+    /// process counts as passed, so that every run that has one stops at
+    /// its next check, with a message that says it was stopped. The Python
+    /// package calls it on Ctrl-C (a run there holds no signal of its own);
+    /// the command line never does.
+    pub fn stop_all(stop: bool) {
+        STOP_ALL.store(stop, Ordering::SeqCst);
+    }
+
+    /// Whether [`Deadline::stop_all`] holds.
+    #[inline]
+    fn stopped() -> bool {
+        STOP_ALL.load(Ordering::Relaxed)
+    }
+
     /// The limit it was set from.
     pub fn limit(&self) -> Duration {
         self.limit
@@ -46,6 +65,9 @@ impl Deadline {
     /// The time left, `None` once the deadline has passed (a deadline too
     /// far away to be an `Instant` leaves a day at a time).
     pub fn left(&self) -> Option<Duration> {
+        if Self::stopped() {
+            return None;
+        }
         match self.at {
             None => Some(Duration::from_secs(86_400)),
             Some(at) => at
@@ -57,11 +79,14 @@ impl Deadline {
     /// True once the deadline has passed.
     #[inline]
     pub fn passed(&self) -> bool {
-        self.at.is_some_and(|at| Instant::now() >= at)
+        Self::stopped() || self.at.is_some_and(|at| Instant::now() >= at)
     }
 
     /// What a run that went past the deadline says.
     pub fn message(&self) -> String {
+        if Self::stopped() {
+            return "the run was stopped (interrupted)".to_string();
+        }
         format!(
             "the run went past its time limit of {} s; raise it with --timeout SECONDS (0 for no limit)",
             self.limit.as_secs_f64()

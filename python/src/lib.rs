@@ -100,8 +100,10 @@ fn py_error(py: Python<'_>, e: subgram::Error) -> PyErr {
 /// Runs `work` on a worker thread with the binary's stack, the GIL
 /// released; every 20 ms the calling thread takes the GIL back briefly and
 /// checks for signals. When a handler raises (Ctrl-C: KeyboardInterrupt),
-/// `stop` is set, the worker is waited for (it stops at its next step) and
-/// the exception is returned.
+/// `stop` is set and every run's deadline counts as passed
+/// (`Deadline::stop_all`), the worker is waited for (a derivation stops
+/// at its next step, any other run at its next deadline check) and the
+/// exception is returned.
 fn run_off_thread<T: Send>(
     py: Python<'_>,
     work: impl FnOnce(&AtomicBool) -> T + Send,
@@ -125,7 +127,9 @@ fn run_off_thread<T: Send>(
                     Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
                         if let Err(e) = Python::attach(|py| py.check_signals()) {
                             stop.store(true, Ordering::SeqCst);
+                            subgram::Deadline::stop_all(true);
                             let _ = worker.join();
+                            subgram::Deadline::stop_all(false);
                             return Err(e);
                         }
                     }
@@ -163,8 +167,13 @@ impl Drop for TempDir {
     }
 }
 
+/// The deadline of a run: `timeout` seconds, or none (0 or None) — a
+/// deadline that never passes but is there, so that Ctrl-C
+/// (`Deadline::stop_all`) reaches the run all the same.
 fn deadline(timeout: Option<f64>) -> Option<subgram::Deadline> {
-    timeout.and_then(subgram::Deadline::from_secs)
+    timeout
+        .and_then(subgram::Deadline::from_secs)
+        .or(Some(subgram::Deadline::after(Duration::MAX)))
 }
 
 // ---------------------------------------------------------------------------
@@ -455,7 +464,13 @@ impl System {
         a.defines = self.defines.clone();
         a.double = self.double;
         a.seed = seed.or(self.seed);
-        a.timeout = timeout.filter(|t| *t > 0.0).map(Duration::from_secs_f64);
+        // No limit is a limit that never comes: Ctrl-C still reaches it.
+        a.timeout = Some(
+            timeout
+                .filter(|t| *t > 0.0)
+                .and_then(|t| Duration::try_from_secs_f64(t).ok())
+                .unwrap_or(Duration::MAX),
+        );
         // As the CLI without --force: never over one of the inputs.
         a.force = false;
         a.solid = match solid {
