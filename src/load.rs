@@ -151,11 +151,23 @@ fn load_model_file(
     });
     // The view names, then the user's `-D`s, which win.
     defines.extend(view.defines(user));
+    let first_line = text.lines().next().map_or(0, |l| l.trim_end().len());
+    let lacks_lpfgall = !includes_lpfgall(&text);
     let front = front(&path.display().to_string(), text, &defines)?;
     let mut c = match curve(front, precision) {
         Ok(c) => c,
         Err(e) => return Err(name_missing_entities(e, &m)),
     };
+    if lacks_lpfgall {
+        c.program.warnings.insert(
+            0,
+            Diagnostic::new(
+                Span::new(crate::syntax::FileId(0), 0, first_line),
+                "no `#include <lpfgall.h>`: lpfg refuses an L+C program without it; \
+                 subgram runs it as it is",
+            ),
+        );
+    }
     for note in &m.notes {
         let file = c
             .sources
@@ -168,6 +180,21 @@ fn load_model_file(
     c.program.model = lang::model::ModelRef(std::sync::Arc::new(m));
     view.give_to(&mut c);
     Ok(c)
+}
+
+/// True when `text` has a line `#include <lpfgall.h>` (or with quotes),
+/// which lpfg requires of every L+C program.
+fn includes_lpfgall(text: &str) -> bool {
+    text.lines().any(|l| {
+        let l = l.trim_start();
+        l.strip_prefix('#')
+            .map(str::trim_start)
+            .and_then(|l| l.strip_prefix("include"))
+            .is_some_and(|rest| {
+                let name = rest.trim().trim_matches(['<', '>', '"']);
+                name == "lpfgall.h"
+            })
+    })
 }
 
 /// A check that failed because the program names a function, contour or

@@ -530,3 +530,28 @@ fn the_turtle_reads_the_view_file_the_specifications_name() {
     assert!(!out.contains("a.v"), "{out}");
     assert!(out.lines().last().unwrap().contains(": ok ("), "{out}");
 }
+
+/// lpfg refuses an L+C program without `#include <lpfgall.h>`; subgram
+/// runs it and says so, at the program's first line (issue 37).
+#[test]
+fn a_program_without_lpfgall_is_run_with_a_warning() {
+    let folder = scratch("noinclude");
+    let tmp = folder.path();
+    std::fs::write(
+        tmp.join("lsystem.l"),
+        "derivation length: 1;\nAxiom: F(1);\nF(x) : { produce F(x) F(x); }\n",
+    )
+    .unwrap();
+    let out = subgram::command::check(&tmp.display().to_string(), &[], false).unwrap();
+    assert!(
+        out.contains("lsystem.l:1:1: warning: no `#include <lpfgall.h>`: lpfg refuses"),
+        "{out}"
+    );
+    std::fs::write(
+        tmp.join("lsystem.l"),
+        "#include <lpfgall.h>\nderivation length: 1;\nAxiom: F(1);\nF(x) : { produce F(x) F(x); }\n",
+    )
+    .unwrap();
+    let out = subgram::command::check(&tmp.display().to_string(), &[], false).unwrap();
+    assert!(!out.contains("lpfgall"), "{out}");
+}
