@@ -422,7 +422,8 @@ tropism: T: 0,1,0 E: 0.2
     let file = dir.join("lsystem.l");
     std::fs::write(
         &file,
-        "derivation length: 1;
+        "#include <lpfgall.h>
+derivation length: 1;
 Axiom: F(1);
 ",
     )
