@@ -1,6 +1,6 @@
 //! Environmental programs of open L-systems: what answers the
 //! communication modules (`E1`, `E2`, `EA20`) of a model whose folder has
-//! a `.e` file (see [`crate::rewrite::environment`] for the exchange).
+//! a `.e` file (the exchange: [`EnvironmentStarter`], [`Environment`], re-exported here).
 //!
 //! * [`honda81`] and [`shadowpyramid`]: vlab's programs of those names,
 //!   built in (no process, nothing to install), chosen when the `.e`

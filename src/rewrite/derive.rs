@@ -37,7 +37,7 @@ pub struct DeriveOptions {
     pub queries: std::sync::Arc<dyn Queries>,
     /// The environment of an open L-system (a model's `.e` file): started
     /// when the derivation starts, it answers the communication modules
-    /// before every step (see [`super::environment`]). Default: none, and
+    /// before every step (see `enviro`). Default: none, and
     /// those modules keep their parameters.
     pub environment: Option<std::sync::Arc<dyn super::environment::EnvironmentStarter>>,
     /// lpfg's `-cleanEA20`: an `EA20` answered with fewer than twenty
