@@ -237,6 +237,7 @@ const UNSIGNED_INT: u32 = 5125;
 const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 const TRIANGLES: u32 = 4;
+const LINES: u32 = 1;
 
 /// The binary glTF 2.0 of `scene`: a 12-byte header, a JSON chunk padded
 /// with spaces and a BIN chunk padded with zeros to 4 bytes. One node
@@ -247,7 +248,25 @@ const TRIANGLES: u32 = 4;
 /// `sqrt(2 / (shininess + 2))` (the usual match of a Blinn-Phong exponent),
 /// double-sided as lpfg lights both sides.
 pub fn glb_bytes(scene: &Scene3) -> Result<Vec<u8>, Error> {
+    glb_bytes_with_edges(scene, &[])
+}
+
+/// [`glb_bytes`], with each mesh's `edges` (in its own numbering, as
+/// `render::mesh::soup_scene3_edges` gives them) as a second primitive of
+/// mode `LINES` over the same positions, with the material of the
+/// triangles: a mesh's polygon edges, for a viewer's wireframe. A mesh
+/// without edges, or past the end of `edges`, has none.
+pub fn glb_bytes_with_edges(scene: &Scene3, edges: &[Vec<[u32; 2]>]) -> Result<Vec<u8>, Error> {
     check(scene)?;
+    if let Some((k, e)) = edges.iter().enumerate().find(|(k, e)| {
+        let n = scene.meshes.get(*k).map_or(0, |m| m.positions.len()) as u32;
+        e.iter().flatten().any(|&i| i >= n)
+    }) {
+        return Err(Error::Failed(format!(
+            "cannot export the scene: mesh {k} has an edge with an index out of range ({} edges)",
+            e.len()
+        )));
+    }
     let names = names(&scene.looks);
     let mut bin: Vec<u8> = Vec::new();
     let mut views: Vec<Value> = Vec::new();
@@ -268,7 +287,13 @@ pub fn glb_bytes(scene: &Scene3) -> Result<Vec<u8>, Error> {
         }));
         views.len() - 1
     };
-    for ((m, l), name) in scene.meshes.iter().zip(&scene.looks).zip(&names) {
+    for (k, ((m, l), name)) in scene
+        .meshes
+        .iter()
+        .zip(&scene.looks)
+        .zip(&names)
+        .enumerate()
+    {
         if m.triangles.is_empty() {
             continue;
         }
@@ -317,6 +342,21 @@ pub fn glb_bytes(scene: &Scene3) -> Result<Vec<u8>, Error> {
             "count": m.triangles.len() * 3,
             "type": "SCALAR",
         }));
+        let triangles = accessors.len() - 1;
+        let lines = match edges.get(k).filter(|e| !e.is_empty()) {
+            Some(e) => {
+                let bytes: Vec<u8> = e.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+                let ev = view(&mut bin, &bytes, ELEMENT_ARRAY_BUFFER);
+                accessors.push(json!({
+                    "bufferView": ev,
+                    "componentType": UNSIGNED_INT,
+                    "count": e.len() * 2,
+                    "type": "SCALAR",
+                }));
+                Some(accessors.len() - 1)
+            }
+            None => None,
+        };
         let opacity = l.opacity.clamp(0.0, 1.0);
         let mut material = json!({
             "name": name,
@@ -339,10 +379,18 @@ pub fn glb_bytes(scene: &Scene3) -> Result<Vec<u8>, Error> {
         materials.push(material);
         primitives.push(json!({
             "attributes": attributes,
-            "indices": accessors.len() - 1,
+            "indices": triangles,
             "material": materials.len() - 1,
             "mode": TRIANGLES,
         }));
+        if let Some(lines) = lines {
+            primitives.push(json!({
+                "attributes": { "POSITION": attributes["POSITION"] },
+                "indices": lines,
+                "material": materials.len() - 1,
+                "mode": LINES,
+            }));
+        }
     }
     let doc = json!({
         "asset": { "version": "2.0", "generator": "subgram" },

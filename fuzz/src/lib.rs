@@ -573,6 +573,7 @@ pub fn serve_request(data: &[u8]) {
             max_modules: MAX_MODULES,
             max_steps: CURVE_STEPS,
             timeout: std::time::Duration::from_secs(2),
+            ..Limits::default()
         },
         defines: Vec::new(),
         double: false,

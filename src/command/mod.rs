@@ -7,6 +7,8 @@
 //! - `derive.rs`: `derive`, `derive_to` and `DeriveArgs`: the word, streamed.
 //! - `render.rs`: `render`, `render_edited` (for `serve`), `RenderArgs`,
 //!   `Solidity`; an L-system drawn in 2D or 3D, or exported.
+//! - `sight.rs`: `sight_edited`, what the live page shows: an SVG, or 3D
+//!   geometry with its first camera.
 //! - `watch.rs`: `watch`, `WatchOptions`, `WatchEvent`.
 //! - `infer.rs`: `infer` and `InferArgs`.
 //! - `subdivide.rs`: `subdivide` and `SubdivideArgs`; a shape grammar's
@@ -34,6 +36,7 @@ mod mesh;
 mod picture;
 mod render;
 mod reverse;
+mod sight;
 mod subdivide;
 mod watch;
 
@@ -45,5 +48,6 @@ pub use mesh::{mesh_convert, mesh_info};
 pub use picture::{write_picture, Picture};
 pub use render::{render, render_edited, Drawn, RenderArgs, Solidity};
 pub use reverse::{reconstruct, reverse, ReconstructArgs, ReverseArgs};
+pub use sight::{sight_edited, Seen, Sight, Solid};
 pub use subdivide::{subdivide, SubdivideArgs};
 pub use watch::{watch, WatchEvent, WatchOptions};

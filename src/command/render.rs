@@ -212,7 +212,7 @@ pub fn render_edited(a: &RenderArgs, text: &str) -> Result<Drawn, Error> {
     })
 }
 
-fn render_system(
+pub(super) fn render_system(
     a: &RenderArgs,
     system: System,
     (looks, format): (&MeshLooks, Picture),
@@ -384,7 +384,7 @@ fn curve_run(
 }
 
 /// Whether `render` draws this L-system's 3D geometry (see [`Solidity`]).
-fn wants_solid(a: &RenderArgs, c: &crate::Curve, export: bool) -> bool {
+pub(super) fn wants_solid(a: &RenderArgs, c: &crate::Curve, export: bool) -> bool {
     use crate::model::view::{LineStyle, RenderMode};
     let m = &*crate::model::of(&c.program);
     match a.solid {
@@ -414,8 +414,6 @@ fn render_solid(
     progress: impl FnMut(Progress),
     out: &mut Out,
 ) -> Result<Vec<String>, Error> {
-    use crate::draw::solid::SolidOptions;
-    use crate::model::view::LineStyle;
     let output = Path::new(&a.output);
     let file = Path::new(&a.file);
     if a.each {
@@ -423,15 +421,48 @@ fn render_solid(
             "--each draws the 2D steps side by side; add --lines, or draw one step in 3D".into(),
         ));
     }
+    let picture = crate::export::Format::from_path(output).is_none();
+    let (scene, dir) = solid_scene(a, c, looks.size, deadline, progress, picture)?;
+    write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
+    if !picture {
+        if scene.triangle_count() == 0 {
+            return Err(Error::Failed(
+                "nothing to export: the turtle made no 3D geometry (no lines, surfaces, polygons or spheres)".into(),
+            ));
+        }
+        crate::export::write(&scene, output)?;
+        return Ok(Vec::new());
+    }
+    let (w, h) = looks.size;
+    let ropts = solid_raster_options(a, c, &scene, w, h)?;
+    let bytes = match format {
+        Picture::Png => crate::render::raster::render_png(&scene, &ropts)?,
+        Picture::Svg => crate::render::raster::render_svg(&scene, &ropts)?.into_bytes(),
+    };
+    out.put(vec![(output.to_path_buf(), bytes)])?;
+    Ok(Vec::new())
+}
+
+/// An L-system's 3D geometry for a picture `size` pixels wide and high
+/// (`picture`), or for export and the live page's own view (lines of
+/// lpfg's `pixel` style as tubes of that many units, no thin lines), and
+/// the folder the program may write in.
+pub(super) fn solid_scene(
+    a: &RenderArgs,
+    c: &crate::Curve,
+    (w, h): (u32, u32),
+    deadline: Option<Deadline>,
+    mut progress: impl FnMut(Progress),
+    picture: bool,
+) -> Result<(crate::scene3::Scene3, Option<PathBuf>), Error> {
+    use crate::draw::solid::SolidOptions;
+    use crate::model::view::LineStyle;
     let (opts, dir) = curve_run(a, deadline)?;
     let model = &*crate::model::of(&c.program);
-    let (w, h) = looks.size;
-    let mut progress = progress;
     let mut run = c.run_reporting(opts.derive_options(), |d| {
         progress(Progress::of_derivation(d))
     })?;
     let mut sopts = SolidOptions::default();
-    let picture = crate::export::Format::from_path(output).is_none();
     // The picture's scale from the drawing's extent, as the camera will
     // frame it (lpfg's 0.9 of the window by default).
     let fit = 0.9 * w.min(h) as f64;
@@ -451,17 +482,20 @@ fn render_solid(
         // The same scale, found by the walk that makes the geometry.
         sopts.fit_pixels = Some(fit);
     }
-    let scene = run.solid(&sopts)?;
-    write_program_files(&a.program_output, dir.as_deref(), &[file, output])?;
-    if crate::export::Format::from_path(output).is_some() {
-        if scene.triangle_count() == 0 {
-            return Err(Error::Failed(
-                "nothing to export: the turtle made no 3D geometry (no lines, surfaces, polygons or spheres)".into(),
-            ));
-        }
-        crate::export::write(&scene, output)?;
-        return Ok(Vec::new());
-    }
+    Ok((run.solid(&sopts)?, dir))
+}
+
+/// The z-buffer's settings for an L-system's 3D geometry in a picture of
+/// `w`×`h`: the view file's camera and lights (`--view` with a mesh
+/// view's name turns the camera, y up) and the background.
+pub(super) fn solid_raster_options(
+    a: &RenderArgs,
+    c: &crate::Curve,
+    scene: &crate::scene3::Scene3,
+    w: u32,
+    h: u32,
+) -> Result<crate::render::raster::RasterOptions, Error> {
+    let model = &*crate::model::of(&c.program);
     let mut camera = model.camera.clone();
     if let Some(name) = a.view.as_deref().filter(|v| *v != "xy") {
         let Some((d, u)) = crate::render::mesh::view_direction(name) else {
@@ -483,10 +517,5 @@ fn render_solid(
         .background
         .or(model_background)
         .unwrap_or(Rgba(255, 255, 255, 255));
-    let bytes = match format {
-        Picture::Png => crate::render::raster::render_png(&scene, &ropts)?,
-        Picture::Svg => crate::render::raster::render_svg(&scene, &ropts)?.into_bytes(),
-    };
-    out.put(vec![(output.to_path_buf(), bytes)])?;
-    Ok(Vec::new())
+    Ok(ropts)
 }

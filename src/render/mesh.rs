@@ -501,6 +501,17 @@ pub fn scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<u32>, Vec<Loo
 /// between faces), no normals. Faces with fewer than three corners or an
 /// index out of range are left out.
 pub fn soup_scene3(soup: &PolygonSoup, face_colours: &[Rgba]) -> Scene3 {
+    soup_scene3_edges(soup, face_colours).0
+}
+
+/// [`soup_scene3`], and for each of its meshes the polygons' edges (each
+/// once, in the mesh's own numbering): what a wireframe draws, without the
+/// diagonals that fan a polygon into triangles.
+pub fn soup_scene3_edges(
+    soup: &PolygonSoup,
+    face_colours: &[Rgba],
+) -> (Scene3, Vec<Vec<[u32; 2]>>) {
+    let mut edges: Vec<std::collections::HashSet<[u32; 2]>> = Vec::new();
     let mut scene = Scene3::default();
     let mut keys: Vec<Option<Rgba>> = Vec::new();
     let mut maps: Vec<std::collections::HashMap<u32, u32>> = Vec::new();
@@ -523,6 +534,7 @@ pub fn soup_scene3(soup: &PolygonSoup, face_colours: &[Rgba]) -> Scene3 {
                 scene.looks.push(look);
                 scene.meshes.push(TriMesh::default());
                 maps.push(Default::default());
+                edges.push(Default::default());
                 keys.len() - 1
             }
         };
@@ -540,8 +552,20 @@ pub fn soup_scene3(soup: &PolygonSoup, face_colours: &[Rgba]) -> Scene3 {
         for j in 1..local.len() - 1 {
             m.triangles.push([local[0], local[j], local[j + 1]]);
         }
+        for (j, &a) in local.iter().enumerate() {
+            let b = local[(j + 1) % local.len()];
+            edges[k].insert([a.min(b), a.max(b)]);
+        }
     }
-    scene
+    let edges = edges
+        .into_iter()
+        .map(|set| {
+            let mut list: Vec<[u32; 2]> = set.into_iter().collect();
+            list.sort_unstable();
+            list
+        })
+        .collect();
+    (scene, edges)
 }
 
 /// The z-buffer's settings for a picture of `soup` seen with `view`: the
@@ -553,25 +577,7 @@ pub fn raster_options(
     polygons: Vec<u32>,
     back: Vec<Look>,
 ) -> Result<RasterOptions, RenderError> {
-    let cam = Camera::or_default(view);
-    let margin = if view.margin.is_finite() {
-        view.margin.clamp(0.0, 0.45)
-    } else {
-        0.04
-    };
-    let spec = ViewSpec {
-        dir: cam.dir.as_vec3(),
-        up: cam.up.as_vec3(),
-        scale: (1.0 - 2.0 * margin) as f32,
-        tight: true,
-        ..ViewSpec::default()
-    };
-    let camera = raster::Camera::from_view(
-        &spec,
-        &mut used_vertices(soup).map(|p| p.as_vec3()),
-        view.width,
-        view.height,
-    )?;
+    let camera = camera(soup, view)?;
     Ok(RasterOptions {
         background: view.background,
         lights: lights(),
@@ -585,6 +591,30 @@ pub fn raster_options(
         }),
         ..RasterOptions::new(camera)
     })
+}
+
+/// The camera of a picture of `soup` seen with `view`: the view's
+/// direction, fitted tightly to the outline of the faces' vertices.
+pub fn camera(soup: &PolygonSoup, view: &MeshView) -> Result<raster::Camera, RenderError> {
+    let cam = Camera::or_default(view);
+    let margin = if view.margin.is_finite() {
+        view.margin.clamp(0.0, 0.45)
+    } else {
+        0.04
+    };
+    let spec = ViewSpec {
+        dir: cam.dir.as_vec3(),
+        up: cam.up.as_vec3(),
+        scale: (1.0 - 2.0 * margin) as f32,
+        tight: true,
+        ..ViewSpec::default()
+    };
+    raster::Camera::from_view(
+        &spec,
+        &mut used_vertices(soup).map(|p| p.as_vec3()),
+        view.width,
+        view.height,
+    )
 }
 
 /// The width of edge strokes: thin, growing slowly with the image.

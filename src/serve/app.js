@@ -36,6 +36,7 @@ const $ = (id) => document.getElementById(id);
 const text = $("text"), highlight = $("highlight"), gutter = $("gutter");
 const picture = $("picture"), messages = $("messages"), status = $("status");
 const steps = $("steps"), stepsOut = $("steps-out"), definesBox = $("defines");
+const wire = $("wire"), flat = $("flat"), viewHint = $("view-hint");
 
 const state = {
   overrides: new Map(), // define name -> value typed in its field
@@ -44,6 +45,10 @@ const state = {
   timer: null,
   version: 0,           // renders shown so far (the browser test reads it)
   marks: [],            // [{line, col, endLine, endCol, severity}] in the program
+  mode: null,           // "2d" (an SVG), "3d" (WebGL), "png" (the server's picture)
+  view3d: null,         // the View3D, made on the first 3D render
+  flat2d: { zoom: 1, x: 0, y: 0 }, // the 2D picture's zoom and pan
+  scene: null,          // the last 3D render's scene reply
 };
 window.subgram = state;
 
@@ -222,7 +227,8 @@ async function render() {
 }
 
 function show(reply) {
-  const list = reply.messages || [];
+  const list = (reply.messages || []).concat(
+    reply.scene?.note ? [{ severity: "warning", file: "", message: reply.scene.note }] : []);
   state.marks = list.filter((m) => m.line && m.program).map((m) => ({
     line: m.line, col: m.col, endLine: m.end_line || m.line, endCol: m.end_col || m.col + 1,
     severity: m.severity,
@@ -238,20 +244,15 @@ function show(reply) {
     messages.append(li);
   }
   if (reply.ok) {
-    const url = "data:image/svg+xml;charset=utf-8," + encodeURIComponent(reply.svg);
-    let img = picture.querySelector("img");
-    if (!img) {
-      picture.querySelector(".empty")?.remove();
-      img = document.createElement("img"); img.alt = "the picture"; picture.append(img);
+    if (reply.scene) {
+      showScene(reply);
+    } else {
+      showFlat("data:image/svg+xml;charset=utf-8," + encodeURIComponent(reply.svg));
+      shown(`drawn in ${reply.seconds.toFixed(2)} s`);
     }
-    img.src = url;
-    picture.classList.remove("stale");
-    state.version += 1;
-    picture.dataset.version = state.version;
-    status.textContent = `drawn in ${reply.seconds.toFixed(2)} s`;
   } else {
     status.className = "error";
-    const drawn = picture.querySelector("img") !== null;
+    const drawn = state.mode !== null;
     if (drawn) picture.classList.add("stale");
     const why = reply.limit ? `stopped by the ${reply.limit} limit` : "the program has errors";
     status.textContent = drawn ? `${why}: the last good picture is kept` : `${why}: nothing drawn yet`;
@@ -266,6 +267,156 @@ function show(reply) {
   }
   paint();
 }
+
+// A picture has been put in place: the counter the browser tests read.
+function shown(text) {
+  picture.classList.remove("stale");
+  state.version += 1;
+  picture.dataset.version = state.version;
+  status.className = "";
+  status.textContent = text;
+}
+
+// The pane holds one kind of picture at a time.
+function setMode(mode) {
+  if (state.mode === mode) return;
+  state.mode = mode;
+  picture.querySelector(".empty")?.remove();
+  for (const el of picture.querySelectorAll("img, canvas")) el.hidden = true;
+  $("wire-box").hidden = mode !== "3d";
+  $("flat-box").hidden = mode !== "3d";
+  viewHint.textContent = mode === "3d"
+    ? "drag: turn · right or shift drag: pan · wheel: zoom · double-click: reset"
+    : mode === "2d" ? "drag: pan · wheel: zoom · double-click: reset" : "";
+}
+
+// A 2D picture (an SVG, or the server's PNG of a large scene), zoomed and
+// panned by the page: the image is laid out at its zoomed size, so that
+// an SVG stays sharp.
+function showFlat(url, mode = "2d") {
+  setMode(mode);
+  let img = picture.querySelector("img");
+  if (!img) {
+    img = document.createElement("img");
+    img.alt = "the picture";
+    img.draggable = false;
+    picture.append(img);
+    bindFlat(img);
+  }
+  img.hidden = false;
+  if (img.dataset.blob) URL.revokeObjectURL(img.dataset.blob);
+  img.dataset.blob = url.startsWith("blob:") ? url : "";
+  img.onload = () => placeFlat();
+  img.src = url;
+}
+
+function placeFlat() {
+  const img = picture.querySelector("img");
+  if (!img || !img.naturalWidth) return;
+  const pw = picture.clientWidth, ph = picture.clientHeight;
+  const fit = Math.min(pw / img.naturalWidth, ph / img.naturalHeight);
+  const v = state.flat2d;
+  const w = img.naturalWidth * fit * v.zoom, h = img.naturalHeight * fit * v.zoom;
+  img.style.width = `${w}px`;
+  img.style.height = `${h}px`;
+  img.style.left = `${(pw - w) / 2 + v.x}px`;
+  img.style.top = `${(ph - h) / 2 + v.y}px`;
+}
+
+function bindFlat(img) {
+  let drag = null;
+  picture.addEventListener("pointerdown", (e) => {
+    if (state.mode === "3d") return;
+    drag = { x: e.clientX, y: e.clientY };
+    picture.setPointerCapture(e.pointerId);
+  });
+  picture.addEventListener("pointermove", (e) => {
+    if (!drag || state.mode === "3d") return;
+    state.flat2d.x += e.clientX - drag.x;
+    state.flat2d.y += e.clientY - drag.y;
+    drag = { x: e.clientX, y: e.clientY };
+    placeFlat();
+  });
+  picture.addEventListener("pointerup", () => { drag = null; });
+  picture.addEventListener("wheel", (e) => {
+    if (state.mode === "3d") return;
+    e.preventDefault();
+    // Zoom about the point under the cursor.
+    const v = state.flat2d, r = picture.getBoundingClientRect();
+    const cx = e.clientX - r.left - r.width / 2 - v.x, cy = e.clientY - r.top - r.height / 2 - v.y;
+    const f = Math.exp(-Math.sign(e.deltaY) * Math.min(Math.abs(e.deltaY), 200) * 0.002);
+    const zoom = Math.min(64, Math.max(0.1, v.zoom * f));
+    const k = zoom / v.zoom;
+    v.x -= cx * (k - 1); v.y -= cy * (k - 1); v.zoom = zoom;
+    placeFlat();
+  }, { passive: false });
+  picture.addEventListener("dblclick", () => { if (state.mode !== "3d") resetView(); });
+  new ResizeObserver(() => placeFlat()).observe(picture);
+}
+
+function resetView() {
+  if (state.mode === "3d") state.view3d?.reset();
+  else { state.flat2d = { zoom: 1, x: 0, y: 0 }; placeFlat(); }
+}
+
+// 3D geometry: the GLB fetched and drawn by the page's own viewer, or the
+// server's PNG when the geometry is too large to send.
+async function showScene(reply) {
+  const info = reply.scene;
+  const took = reply.seconds;
+  let r;
+  try {
+    r = await fetch(`/api/blob/${info.blob}`, { headers: { "x-subgram-token": API_TOKEN }, cache: "no-store", credentials: "omit" });
+    if (!r.ok) throw new Error(`the server answered ${r.status}`);
+  } catch (e) {
+    status.className = "error";
+    status.textContent = `cannot fetch the geometry: ${e.message}`;
+    return;
+  }
+  const bytes = await r.arrayBuffer();
+  if (info.kind === "png") {
+    showFlat(URL.createObjectURL(new Blob([bytes], { type: "image/png" })), "png");
+    state.scene = null;
+    shown(`drawn in ${took.toFixed(2)} s`);
+    return;
+  }
+  let canvas = picture.querySelector("canvas");
+  try {
+    if (!state.view3d) {
+      canvas = document.createElement("canvas");
+      canvas.className = "view3d";
+      picture.append(canvas);
+      state.view3d = new View3D(canvas);
+      state.view3d.setWireframe(wire.checked);
+    }
+  } catch (e) {
+    canvas?.remove();
+    state.view3d = null;
+    status.className = "error";
+    status.textContent = `cannot draw in 3D here: ${e.message}`;
+    return;
+  }
+  const sameKind = state.scene && state.scene.turn_axis.join() === info.turn_axis.join() &&
+    state.scene.projection === info.projection;
+  const first = state.mode !== "3d";
+  setMode("3d");
+  state.view3d.canvas.hidden = false;
+  if (first && !state.scene) {
+    // The first 3D render: a mesh shows its edges, a plant does not.
+    wire.checked = info.edges;
+    flat.checked = !info.smooth;
+    state.view3d.setWireframe(wire.checked);
+    state.view3d.setFlat(flat.checked);
+  }
+  state.view3d.show(bytes, info, sameKind);
+  state.scene = info;
+  const mb = (info.bytes / 1e6).toFixed(info.bytes < 1e7 ? 1 : 0);
+  shown(`drawn in ${took.toFixed(2)} s · ${info.triangles.toLocaleString()} triangles, ${mb} MB`);
+}
+
+wire.addEventListener("change", () => state.view3d?.setWireframe(wire.checked));
+flat.addEventListener("change", () => state.view3d?.setFlat(flat.checked));
+$("reset").addEventListener("click", resetView);
 
 function goTo(line, col) {
   if (!line) return;

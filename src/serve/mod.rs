@@ -52,8 +52,9 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use crate::command::{self, RenderArgs};
+use crate::command::{self, RenderArgs, Sight, Solid};
 use crate::error::Error;
+use crate::render::Rgba;
 
 mod http;
 
@@ -61,6 +62,7 @@ pub use http::{MAX_HEAD, REQUEST_TIMEOUT};
 
 const PAGE: &str = include_str!("page.html");
 const SCRIPT: &str = include_str!("app.js");
+const VIEWER: &str = include_str!("view3d.js");
 const STYLE: &str = include_str!("app.css");
 
 /// The place in `page.html` where the run's token goes.
@@ -80,10 +82,11 @@ const MAX_REFUSING: usize = 4 * MAX_IN_FLIGHT;
 pub const TOKEN_HEADER: &str = "X-Subgram-Token";
 
 /// The page's Content-Security-Policy: its own script and style, pictures
-/// from `data:` URLs (the SVG), requests to its own origin only, in no
+/// from `data:` URLs (the SVG) and `blob:` URLs (a server's PNG of a
+/// scene too large to send), requests to its own origin only, in no
 /// frame.
 const PAGE_POLICY: &str = "default-src 'none'; script-src 'self'; style-src 'self'; \
-     img-src data:; connect-src 'self'; base-uri 'none'; form-action 'none'; \
+     img-src data: blob:; connect-src 'self'; base-uri 'none'; form-action 'none'; \
      frame-ancestors 'none'";
 
 /// What one render may use: the page's edits run under these, so that a
@@ -93,6 +96,13 @@ pub struct Limits {
     pub max_modules: usize,
     pub max_steps: u64,
     pub timeout: Duration,
+    /// The largest 3D geometry sent to the page (a GLB file's bytes); a
+    /// larger one is drawn by the server's z-buffer and sent as a PNG,
+    /// with a message.
+    pub max_scene_bytes: usize,
+    /// The most bytes of geometry and pictures the server keeps for the
+    /// page to fetch (the oldest are dropped first).
+    pub max_kept_bytes: usize,
 }
 
 impl Default for Limits {
@@ -101,6 +111,8 @@ impl Default for Limits {
             max_modules: 2_000_000,
             max_steps: 1_000,
             timeout: Duration::from_secs(10),
+            max_scene_bytes: 256 << 20,
+            max_kept_bytes: 1 << 30,
         }
     }
 }
@@ -141,6 +153,39 @@ pub struct App {
     token: String,
     /// `page.html` with the token in it.
     page: String,
+    /// What renders made for the page to fetch (`/api/blob/ID`).
+    blobs: std::sync::Mutex<Blobs>,
+}
+
+/// Files kept for the page: the newest first to stay, within
+/// [`Limits::max_kept_bytes`].
+#[derive(Default)]
+struct Blobs {
+    next: u64,
+    bytes: usize,
+    items: std::collections::VecDeque<(u64, &'static str, Arc<Vec<u8>>)>,
+}
+
+impl Blobs {
+    /// Keeps `bytes` of type `kind`; drops the oldest past `most` bytes.
+    fn keep(&mut self, kind: &'static str, bytes: Vec<u8>, most: usize) -> u64 {
+        self.next += 1;
+        self.bytes += bytes.len();
+        self.items.push_back((self.next, kind, Arc::new(bytes)));
+        while self.bytes > most && self.items.len() > 1 {
+            if let Some((_, _, b)) = self.items.pop_front() {
+                self.bytes -= b.len();
+            }
+        }
+        self.next
+    }
+
+    fn get(&self, id: u64) -> Option<(&'static str, Arc<Vec<u8>>)> {
+        self.items
+            .iter()
+            .find(|(i, _, _)| *i == id)
+            .map(|(_, k, b)| (*k, Arc::clone(b)))
+    }
 }
 
 /// A request as [`App::answer`] sees it: the method, the target as sent
@@ -197,6 +242,9 @@ struct RenderReply {
     ok: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     svg: Option<String>,
+    /// 3D geometry, fetched from `/api/blob/ID`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    scene: Option<SceneReply>,
     seconds: f64,
     messages: Vec<Message>,
     /// The limit that stopped the run, when one did.
@@ -204,11 +252,47 @@ struct RenderReply {
     limit: Option<&'static str>,
 }
 
+/// 3D geometry for the page: a GLB (`kind` "glb") to draw with its
+/// camera, or, when it is larger than [`Limits::max_scene_bytes`], the
+/// server's picture of it (`kind` "png") and why.
+#[derive(Serialize, Debug)]
+pub struct SceneReply {
+    pub blob: u64,
+    pub kind: &'static str,
+    pub bytes: usize,
+    pub triangles: usize,
+    pub vertices: usize,
+    /// The lowest and highest corners of the geometry.
+    pub bounds: [[f32; 3]; 2],
+    /// The command line's camera: eye, orthonormal right, up and viewing
+    /// direction, "parallel" or "perspective", and half the visible
+    /// height (parallel) or the tangent of half the field of view.
+    pub eye: [f32; 3],
+    pub right: [f32; 3],
+    pub up: [f32; 3],
+    pub dir: [f32; 3],
+    pub projection: &'static str,
+    pub half_height: f32,
+    /// The axis the view turns about.
+    pub turn_axis: [f32; 3],
+    pub lit: bool,
+    /// Polygon edges come with the geometry (meshes); a plant's wireframe
+    /// is its triangles'.
+    pub edges: bool,
+    /// Shade smooth (normals given or averaged), else flat.
+    pub smooth: bool,
+    pub background: [u8; 3],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
 /// The routes.
 #[derive(Clone, Copy, PartialEq, Debug)]
 enum Route {
     Page,
     Script,
+    Viewer,
+    Blob(u64),
     Style,
     Source,
     Render,
@@ -218,7 +302,10 @@ enum Route {
 impl Route {
     /// The API: the routes that need the token.
     fn api(self) -> bool {
-        matches!(self, Route::Source | Route::Render | Route::Save)
+        matches!(
+            self,
+            Route::Source | Route::Render | Route::Save | Route::Blob(_)
+        )
     }
 }
 
@@ -347,6 +434,7 @@ impl App {
             port,
             token,
             page,
+            blobs: Default::default(),
         })
     }
 
@@ -422,11 +510,22 @@ impl App {
         let route = match (head.method.as_str(), path) {
             ("GET", "/") => Route::Page,
             ("GET", "/app.js") => Route::Script,
+            ("GET", "/view3d.js") => Route::Viewer,
             ("GET", "/app.css") => Route::Style,
             ("GET", "/api/source") => Route::Source,
             ("POST", "/api/render") => Route::Render,
             ("POST", "/api/save") => Route::Save,
-            (_, "/" | "/app.js" | "/app.css" | "/api/source" | "/api/render" | "/api/save") => {
+            ("GET", blob) if blob.starts_with("/api/blob/") => {
+                match blob["/api/blob/".len()..].parse::<u64>() {
+                    Ok(id) => Route::Blob(id),
+                    Err(_) => return failure(404, "no such file: a blob's name is its number"),
+                }
+            }
+            (
+                _,
+                "/" | "/app.js" | "/view3d.js" | "/app.css" | "/api/source" | "/api/render"
+                | "/api/save",
+            ) => {
                 return failure(
                     405,
                     &format!("{} is not allowed on {path}", clip(&head.method)),
@@ -458,6 +557,8 @@ impl App {
                 r
             }
             Route::Script => asset(SCRIPT.as_bytes(), "application/javascript; charset=utf-8"),
+            Route::Viewer => asset(VIEWER.as_bytes(), "application/javascript; charset=utf-8"),
+            Route::Blob(id) => self.blob(id),
             Route::Style => asset(STYLE.as_bytes(), "text/css; charset=utf-8"),
             Route::Source => self.source(),
             Route::Render | Route::Save => {
@@ -580,24 +681,124 @@ impl App {
         };
         let t = Instant::now();
         let (result, limit) = render_text(&self.opts, &self.program, &req);
-        let seconds = t.elapsed().as_secs_f64();
         let reply = match result {
-            Ok((svg, warnings)) => RenderReply {
+            Ok((Sight::Flat(svg), warnings)) => RenderReply {
                 ok: true,
                 svg: Some(svg),
-                seconds,
+                scene: None,
+                seconds: t.elapsed().as_secs_f64(),
                 messages: warnings,
                 limit: None,
+            },
+            Ok((Sight::Solid(solid), mut warnings)) => match self.keep_solid(&solid) {
+                Ok(scene) => RenderReply {
+                    ok: true,
+                    svg: None,
+                    scene: Some(scene),
+                    seconds: t.elapsed().as_secs_f64(),
+                    messages: warnings,
+                    limit: None,
+                },
+                Err(e) => {
+                    warnings.extend(messages(&e, &self.program));
+                    RenderReply {
+                        ok: false,
+                        svg: None,
+                        scene: None,
+                        seconds: t.elapsed().as_secs_f64(),
+                        messages: warnings,
+                        limit: which_limit(&e),
+                    }
+                }
             },
             Err(messages) => RenderReply {
                 ok: false,
                 svg: None,
-                seconds,
+                scene: None,
+                seconds: t.elapsed().as_secs_f64(),
                 messages,
                 limit,
             },
         };
         json_reply(200, &reply)
+    }
+
+    /// Keeps a render's 3D geometry for the page: its GLB (with the
+    /// meshes' polygon edges), or the server's PNG of it when the GLB is
+    /// larger than the page's limit.
+    fn keep_solid(&self, solid: &Solid) -> Result<SceneReply, Error> {
+        let limits = &self.opts.limits;
+        let glb = crate::export::glb_bytes_with_edges(&solid.scene, &solid.edges)?;
+        let (kind, bytes, note) = if glb.len() <= limits.max_scene_bytes {
+            ("glb", glb, None)
+        } else {
+            let mut ropts = crate::render::raster::RasterOptions::new(solid.camera);
+            ropts.background = solid.background;
+            ropts.shading = if solid.lit {
+                crate::render::raster::Shading::Lit
+            } else {
+                crate::render::raster::Shading::Unlit
+            };
+            let png = crate::render::raster::render_png(&solid.scene, &ropts)?;
+            let note = format!(
+                "the geometry ({} triangles, {:.0} MB) is larger than the {:.0} MB the page takes \
+                 whole: this is the server's picture of it, which does not turn; lower the steps \
+                 to turn it, or export it with `subgram render FILE -o model.glb`",
+                solid.scene.triangle_count(),
+                glb.len() as f64 / 1e6,
+                limits.max_scene_bytes as f64 / 1e6
+            );
+            ("png", png, Some(note))
+        };
+        let c = &solid.camera;
+        let (lo, hi) = solid.scene.bounds().unwrap_or_default();
+        let Rgba(r, g, b, _) = solid.background;
+        let size = bytes.len();
+        let content = if kind == "glb" {
+            "model/gltf-binary"
+        } else {
+            "image/png"
+        };
+        let blob = self.blobs.lock().unwrap_or_else(|p| p.into_inner()).keep(
+            content,
+            bytes,
+            limits.max_kept_bytes,
+        );
+        Ok(SceneReply {
+            blob,
+            kind,
+            bytes: size,
+            triangles: solid.scene.triangle_count(),
+            vertices: solid.scene.vertex_count(),
+            bounds: [lo.to_array(), hi.to_array()],
+            eye: c.eye.to_array(),
+            right: c.right.to_array(),
+            up: c.up.to_array(),
+            dir: c.dir.to_array(),
+            projection: match c.projection {
+                crate::render::raster::Projection::Parallel => "parallel",
+                crate::render::raster::Projection::Perspective => "perspective",
+            },
+            half_height: c.half_height,
+            turn_axis: solid.up,
+            lit: solid.lit,
+            edges: solid.edges.iter().any(|e| !e.is_empty()),
+            smooth: solid.smooth,
+            background: [r, g, b],
+            note,
+        })
+    }
+
+    /// A file a render kept: `/api/blob/ID`.
+    fn blob(&self, id: u64) -> Reply {
+        let found = self.blobs.lock().unwrap_or_else(|p| p.into_inner()).get(id);
+        match found {
+            Some((kind, bytes)) => asset(&bytes, kind),
+            None => failure(
+                404,
+                "no such file: it was dropped to keep the server's memory within its limit; render again",
+            ),
+        }
     }
 
     fn save(&self, body: &[u8]) -> Reply {
@@ -713,10 +914,10 @@ fn guarded(mut reply: Reply) -> Reply {
 fn clip(s: &str) -> String {
     s.chars().take(100).collect()
 }
-/// The SVG and the warnings, or the messages and the limit that stopped
-/// the run.
+/// What the page shows and the warnings, or the messages and the limit
+/// that stopped the run.
 type Rendered = (
-    Result<(String, Vec<Message>), Vec<Message>>,
+    Result<(Sight, Vec<Message>), Vec<Message>>,
     Option<&'static str>,
 );
 
@@ -734,11 +935,10 @@ fn render_text(opts: &ServeOptions, program: &Path, req: &RenderRequest) -> Rend
     a.double = opts.double;
     a.max_modules = l.max_modules;
     a.timeout = Some(l.timeout);
-    match command::render_edited(&a, &req.text) {
-        Ok(drawn) => {
-            let svg = String::from_utf8_lossy(&drawn.picture).into_owned();
-            let warnings = drawn.warnings.iter().map(|w| warning(w, program)).collect();
-            (Ok((svg, warnings)), None)
+    match command::sight_edited(&a, &req.text) {
+        Ok(seen) => {
+            let warnings = seen.warnings.iter().map(|w| warning(w, program)).collect();
+            (Ok((seen.sight, warnings)), None)
         }
         Err(e) => {
             let limit = which_limit(&e);

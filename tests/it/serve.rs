@@ -154,6 +154,45 @@ fn render(live: &Live, text: &str, extra: &str) -> serde_json::Value {
     serde_json::from_str(&reply).unwrap()
 }
 
+/// A file a render kept (`/api/blob/ID`), fetched as the page fetches it:
+/// its status, content type and bytes.
+fn blob(live: &Live, id: &serde_json::Value) -> (u16, String, Vec<u8>) {
+    let path = format!("/api/blob/{}", id.as_u64().expect("a blob number"));
+    let request = compose("GET", &path, &page_headers(live, "GET"), "");
+    let mut s = TcpStream::connect(&live.addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
+    s.write_all(request.as_bytes()).unwrap();
+    let mut reply = Vec::new();
+    let _ = s.read_to_end(&mut reply);
+    let at = reply
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .expect("a reply head");
+    let head = String::from_utf8_lossy(&reply[..at]).into_owned();
+    let status = head.split_whitespace().nth(1).unwrap().parse().unwrap();
+    let kind = head
+        .lines()
+        .find_map(|l| l.strip_prefix("Content-Type: "))
+        .unwrap_or("")
+        .to_string();
+    (status, kind, reply[at + 4..].to_vec())
+}
+
+/// A GLB's JSON chunk and its BIN chunk, read by the container's layout
+/// (glTF 2.0, section 4.4).
+fn glb(bytes: &[u8]) -> (serde_json::Value, &[u8]) {
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[..4], b"glTF");
+    assert_eq!(word(4), 2);
+    assert_eq!(word(8), bytes.len());
+    let json_len = word(12);
+    assert_eq!(&bytes[16..20], b"JSON");
+    let doc = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let bin_at = 20 + json_len;
+    assert_eq!(&bytes[bin_at + 4..bin_at + 8], b"BIN\0");
+    (doc, &bytes[bin_at + 8..bin_at + 8 + word(bin_at)])
+}
+
 const KOCH: &str = "angle: 60;\nderivation length: 3;\nAxiom: F--F--F;\nF -> F+F--F+F\n";
 
 fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
@@ -230,6 +269,7 @@ fn runaway_rules_stop_at_the_page_limits_and_the_server_goes_on() {
         max_modules: 10_000,
         max_steps: 50,
         timeout: Duration::from_secs(2),
+        ..Limits::default()
     };
     let live = start("limits", KOCH, false, limits);
     let addr = &live;
@@ -328,9 +368,11 @@ fn with_save_the_page_writes_the_program_back_and_nothing_else() {
     assert!(source.contains("derivation length: 2"));
 }
 
-/// A surface grammar on the page: the shaded mesh, one polygon per face
-/// of the subdivided octahedron (8 · 4² after two Loop steps), its base
-/// mesh read from the disk as the grammar names it.
+/// A surface grammar on the page: its mesh for the page's 3D view, a GLB
+/// of the subdivided octahedron (8 · 4² triangles after two Loop steps)
+/// with its polygon edges as lines (a closed triangle mesh has 3F/2 edges,
+/// and V = E - F + 2 vertices), its base mesh read from the disk as the
+/// grammar names it; the camera is the command line's, orthonormal.
 #[test]
 fn a_surface_grammar_shows_its_shaded_mesh() {
     let mesh = crate::support::root().join("lsystems/meshes/octahedron.obj");
@@ -345,10 +387,111 @@ fn a_surface_grammar_shows_its_shaded_mesh() {
     let addr = &live;
     let r = render(addr, &grammar, ", \"steps\": 2");
     assert_eq!(r["ok"], true, "{r}");
-    assert_eq!(
-        r["svg"].as_str().unwrap().matches("<polygon").count(),
-        8 * 16
+    let scene = &r["scene"];
+    assert_eq!(scene["kind"], "glb", "{r}");
+    let (faces, edges) = (8 * 16, 8 * 16 * 3 / 2);
+    assert_eq!(scene["triangles"], faces);
+    assert_eq!(scene["edges"], true);
+    let (status, kind, bytes) = blob(addr, &scene["blob"]);
+    assert_eq!((status, kind.as_str()), (200, "model/gltf-binary"));
+    assert_eq!(scene["bytes"], bytes.len());
+    let (doc, bin) = glb(&bytes);
+    let prims = doc["meshes"][0]["primitives"].as_array().unwrap();
+    let count = |mode: u64| -> u64 {
+        prims
+            .iter()
+            .filter(|p| p["mode"] == mode)
+            .map(|p| {
+                doc["accessors"][p["indices"].as_u64().unwrap() as usize]["count"]
+                    .as_u64()
+                    .unwrap()
+            })
+            .sum()
+    };
+    assert_eq!(count(4), 3 * faces as u64);
+    assert_eq!(count(1), 2 * edges as u64);
+    let positions = doc["accessors"][prims[0]["attributes"]["POSITION"].as_u64().unwrap() as usize]
+        ["count"]
+        .as_u64()
+        .unwrap();
+    assert_eq!(positions, (edges - faces + 2) as u64);
+    assert_eq!(doc["buffers"][0]["byteLength"], bin.len());
+    // The camera's frame is orthonormal, and it looks at the mesh.
+    let v = |k: &str| -> [f64; 3] {
+        let a = scene[k].as_array().unwrap();
+        [0, 1, 2].map(|i| a[i].as_f64().unwrap())
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    for (a, b, want) in [
+        ("right", "right", 1.0),
+        ("up", "up", 1.0),
+        ("dir", "dir", 1.0),
+        ("right", "up", 0.0),
+        ("up", "dir", 0.0),
+        ("right", "dir", 0.0),
+    ] {
+        assert!((dot(v(a), v(b)) - want).abs() < 1e-5, "{a}·{b}: {r}");
+    }
+    assert_eq!(scene["projection"], "parallel");
+    // The octahedron's subdivided mesh lies within its base's box, ±1.
+    let [lo, hi] = [0, 1].map(|k| scene["bounds"][k].as_array().unwrap().clone());
+    for i in 0..3 {
+        assert!(
+            lo[i].as_f64().unwrap() >= -1.0 && hi[i].as_f64().unwrap() <= 1.0,
+            "{r}"
+        );
+    }
+}
+
+/// A plant drawn in 3D (its view file asks for cylinders) comes to the
+/// page as the GLB that `render -o plant.glb` writes, byte for byte; a
+/// mesh too large for the page's limit comes as the server's PNG of it,
+/// with a message that says why.
+#[test]
+fn a_3d_plant_comes_as_the_exported_glb_and_a_large_one_as_a_picture() {
+    let dir = scratch("serve-plant");
+    let model = crate::support::lsys("open/collide-3d");
+    for e in std::fs::read_dir(&model).unwrap() {
+        let p = e.unwrap().path();
+        std::fs::copy(&p, dir.path().join(p.file_name().unwrap())).unwrap();
+    }
+    let export = scratch("serve-plant-export");
+    let glb_path = export.path().join("plant.glb");
+    let mut a =
+        subgram::command::RenderArgs::new(dir.path().to_string_lossy(), glb_path.to_string_lossy());
+    a.steps = Some(4);
+    subgram::command::render(&a, |_| {}).unwrap();
+    let exported = std::fs::read(&glb_path).unwrap();
+    let folder = dir.path().to_path_buf();
+    let text = std::fs::read_to_string(model.join("lsystem.l")).unwrap();
+    let live = start_at(dir, folder, false, Limits::default());
+    let r = render(&live, &text, ", \"steps\": 4");
+    assert_eq!(r["ok"], true, "{r}");
+    assert_eq!(r["scene"]["kind"], "glb");
+    assert_eq!(r["scene"]["edges"], false);
+    let (_, _, bytes) = blob(&live, &r["scene"]["blob"]);
+    assert!(bytes == exported, "the page's GLB is the exported file");
+    // Past the page's limit: the server's picture, and why.
+    let folder = live.dir.path().to_path_buf();
+    let small = Limits {
+        max_scene_bytes: exported.len() - 1,
+        ..Limits::default()
+    };
+    let tight = start_at(scratch("serve-plant-tight"), folder, false, small);
+    let r = render(&tight, &text, ", \"steps\": 4");
+    assert_eq!(r["ok"], true, "{r}");
+    assert_eq!(r["scene"]["kind"], "png");
+    let note = r["scene"]["note"].as_str().unwrap();
+    assert!(
+        note.contains("larger than") && note.contains("-o model.glb"),
+        "{note}"
     );
+    let (status, kind, png) = blob(&tight, &r["scene"]["blob"]);
+    assert_eq!((status, kind.as_str()), (200, "image/png"));
+    assert_eq!(&png[1..4], b"PNG");
+    // A blob that is not there.
+    let (status, _, _) = blob(&tight, &serde_json::json!(999_999));
+    assert_eq!(status, 404);
 }
 
 /// An open L-system (a model folder with a `.e` file) is drawn with its
@@ -367,14 +510,15 @@ fn an_open_model_runs_with_its_environment_each_time() {
     let folder = dir.path().to_path_buf();
     let live = start_at(dir, folder, false, Limits::default());
     let text = std::fs::read_to_string(model.join("lsystem.l")).unwrap();
+    let geometry = |r: &serde_json::Value| blob(&live, &r["scene"]["blob"]).2;
     let first = render(&live, &text, ", \"steps\": 4");
     assert_eq!(first["ok"], true, "{first}");
     let again = render(&live, &text, ", \"steps\": 4");
-    assert_eq!(first["svg"], again["svg"]);
+    assert_eq!(geometry(&first), geometry(&again));
     let closed = text.replace("Axiom:", "Start: { NoEnvironment(); }\nAxiom:");
     let off = render(&live, &closed, ", \"steps\": 4");
     assert_eq!(off["ok"], true, "{off}");
-    assert_ne!(first["svg"], off["svg"]);
+    assert_ne!(geometry(&first), geometry(&off));
     assert_eq!(files(live.dir.path()), before);
 }
 
