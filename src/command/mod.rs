@@ -7,6 +7,9 @@
 //! - `derive.rs`: `derive`, `derive_to` and `DeriveArgs`: the word, streamed.
 //! - `render.rs`: `render`, `render_edited` (for `serve`), `RenderArgs`,
 //!   `Solidity`; an L-system drawn in 2D or 3D, or exported.
+//! - `frames.rs`: `frames`, `FrameOptions`, `Frames`: a system run once,
+//!   one picture per step with one camera (animations, the page's
+//!   playback).
 //! - `watch.rs`: `watch`, `WatchOptions`, `WatchEvent`.
 //! - `infer.rs`: `infer` and `InferArgs`.
 //! - `subdivide.rs`: `subdivide` and `SubdivideArgs`; a shape grammar's
@@ -29,6 +32,7 @@ mod analyze;
 mod check;
 mod common;
 mod derive;
+mod frames;
 mod infer;
 mod mesh;
 mod picture;
@@ -40,6 +44,10 @@ mod watch;
 pub use analyze::{analyze, analyze_reporting, AnalyzeArgs};
 pub use check::check;
 pub use derive::{derive, derive_to, DeriveArgs, Printed};
+pub use frames::{
+    frames, Frame, FrameGeometry, FrameOptions, FrameSelection, Frames, SolidFrame, MAX_FRAMES,
+    MAX_FRAME_PIXELS,
+};
 pub use infer::{infer, InferArgs};
 pub use mesh::{mesh_convert, mesh_info};
 pub use picture::{write_picture, Picture};

@@ -48,6 +48,12 @@ pub struct RenderArgs {
     pub view: Option<String>,
     /// Meshes: draw the edges over the faces.
     pub wireframe: bool,
+    /// Meshes: one flat shade per face (by default smooth, from vertex
+    /// normals).
+    pub flat: bool,
+    /// Animations (`.gif`, `.png` with `{n}`…): frames a second; `None`:
+    /// the model's `swap interval:`, else [`DEFAULT_FPS`].
+    pub fps: Option<f64>,
     pub defines: Vec<String>,
     /// `--double`: `float` in double precision instead of lpfg's single.
     pub double: bool,
@@ -81,6 +87,8 @@ impl RenderArgs {
             background: None,
             view: None,
             wireframe: true,
+            flat: false,
+            fps: None,
             defines: Vec::new(),
             double: false,
             max_modules: DEFAULT_MAX_MODULES,
@@ -94,6 +102,10 @@ impl RenderArgs {
         }
     }
 }
+
+/// Frames a second of an animation when neither `--fps` nor the model's
+/// `swap interval:` says.
+pub const DEFAULT_FPS: f64 = 4.0;
 
 /// How `render` draws an L-system.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -309,7 +321,7 @@ fn render_system(
             write_soup_picture(&run.soup, output, looks, out)?;
             Ok(Vec::new())
         }
-        System::Curve(c) if wants_solid(a, &c, export.is_some()) => {
+        System::Curve(c) if export.is_some() || wants_solid(a.solid, &c) => {
             render_solid(a, &c, (looks, format), deadline, progress, out)
         }
         System::Curve(c) => {
@@ -383,12 +395,12 @@ fn curve_run(
     Ok((opts, dir))
 }
 
-/// Whether `render` draws this L-system's 3D geometry (see [`Solidity`]).
-fn wants_solid(a: &RenderArgs, c: &crate::Curve, export: bool) -> bool {
+/// Whether `render` draws this L-system's 3D geometry in a picture (see
+/// [`Solidity`]).
+pub(super) fn wants_solid(solid: Solidity, c: &crate::Curve) -> bool {
     use crate::model::view::{LineStyle, RenderMode};
     let m = &*crate::model::of(&c.program);
-    match a.solid {
-        _ if export => true,
+    match solid {
         Solidity::Solid => true,
         Solidity::Lines => false,
         Solidity::Auto => {
