@@ -14,7 +14,9 @@ use super::print::{print_program_output, print_warnings, with_progress};
 #[derive(clap::Args)]
 pub(super) struct RenderCli {
     file: String,
-    /// The picture: OUT.png or OUT.svg.
+    /// The picture: OUT.png or OUT.svg; an animation of the steps:
+    /// OUT.gif or OUT.apng; one still a step: a name with {n} (the step),
+    /// OUT-{n}.png or OUT-{n}.svg.
     #[arg(short = 'o', long = "output")]
     output: String,
     #[arg(short = 'n', long = "steps")]

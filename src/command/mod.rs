@@ -7,6 +7,8 @@
 //! - `derive.rs`: `derive`, `derive_to` and `DeriveArgs`: the word, streamed.
 //! - `render.rs`: `render`, `render_edited` (for `serve`), `RenderArgs`,
 //!   `Solidity`; an L-system drawn in 2D or 3D, or exported.
+//! - `animate.rs`: `render -o growth.gif`, `.apng`, or one still a frame
+//!   (`{n}`): the frames encoded.
 //! - `frames.rs`: `frames`, `FrameOptions`, `Frames`: a system run once,
 //!   one picture per step with one camera (animations, the page's
 //!   playback).
@@ -29,6 +31,7 @@
 //! Its children are private; what is public is re-exported here.
 
 mod analyze;
+mod animate;
 mod check;
 mod common;
 mod derive;
@@ -51,7 +54,7 @@ pub use frames::{
 pub use infer::{infer, InferArgs};
 pub use mesh::{mesh_convert, mesh_info};
 pub use picture::{write_picture, Picture};
-pub use render::{render, render_edited, Drawn, RenderArgs, Solidity};
+pub use render::{render, render_edited, Drawn, RenderArgs, Solidity, DEFAULT_FPS};
 pub use reverse::{reconstruct, reverse, ReconstructArgs, ReverseArgs};
 pub use subdivide::{subdivide, SubdivideArgs};
 pub use watch::{watch, WatchEvent, WatchOptions};

@@ -5,10 +5,12 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use super::animate::{self, Animated};
 use super::common::{
     as_paths, check_steps, extension_hint, in_run, load_options, refuse_overwrite,
     write_program_files, writes_folder,
 };
+use super::frames::FrameOptions;
 use super::picture::{
     picture_bytes, write_mesh_picture, write_soup_picture, write_views, MeshLooks, Out, Picture,
 };
@@ -132,6 +134,9 @@ fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<S
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
     refuse_overwrite(&[output], &[file], a.force)?;
+    if let Some(format) = Animated::from_path(output)? {
+        return animate(a, format, deadline, progress);
+    }
     let looks = MeshLooks::of_render(a);
     if mesh::io::Format::from_path(file).is_some() {
         // Found before the mesh is read.
@@ -168,6 +173,80 @@ fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<S
         progress,
         &mut Out::Files,
     )?);
+    Ok(warnings)
+}
+
+/// `render` to an animation (`.gif`, `.apng`) or to one still a frame
+/// (`{n}` in a `.png` or `.svg` name): [`super::frames()`] encoded, and
+/// every file written or none.
+fn animate(
+    a: &RenderArgs,
+    format: Animated,
+    deadline: Option<Deadline>,
+    progress: impl FnMut(Progress),
+) -> Result<Vec<String>, Error> {
+    let file = Path::new(&a.file);
+    let output = Path::new(&a.output);
+    if mesh::io::Format::from_path(file).is_some() {
+        return Err(Error::Usage(format!(
+            "`{}` is a mesh: it has no steps to animate; render a grammar or an L-system, or \
+             the mesh as a .png or .svg",
+            file.display()
+        )));
+    }
+    if a.each {
+        return Err(Error::Usage(
+            "--each draws the steps side by side in one picture; an animation shows them one \
+             after the other: leave out --each"
+                .into(),
+        ));
+    }
+    if let Some(fps) = a.fps {
+        animate::check_fps(fps)?;
+    }
+    if let Animated::Stills(_) = format {
+        animate::check_folder(output)?;
+    }
+    check_steps(a.steps)?;
+    let system = load(file, &load_options(&a.defines, a.double, &a.environment))?;
+    let mut warnings = system.warnings();
+    let dir = writes_folder(&a.allow_writes, &a.program_output)?;
+    let opts = FrameOptions {
+        run: RunOptions {
+            steps: a.steps,
+            max_modules: a.max_modules,
+            phase: a.phase,
+            seed: a.seed,
+            base_mesh: None,
+            deadline,
+            output: a.program_output.clone(),
+            max_shapes: None,
+        },
+        size: a.size.unwrap_or((800, 800)),
+        background: a.background,
+        solid: a.solid,
+        view: a.view.clone(),
+        wireframe: a.wireframe,
+        flat: a.flat,
+        selection: None,
+    };
+    let frames = super::frames::frames(&system, &opts, progress)?;
+    warnings.extend(frames.notes.iter().cloned());
+    let fps = match (a.fps, frames.interval) {
+        (Some(fps), _) => fps,
+        // lpfg's hundredths of a second; faster than a GIF shows, 100.
+        (None, Some(t)) => (1.0 / t.as_secs_f64()).min(100.0),
+        (None, None) => DEFAULT_FPS,
+    };
+    let files = animate::files(&frames, format, output, fps)?;
+    let mut inputs = system.inputs();
+    inputs.push(file.to_path_buf());
+    let outputs: Vec<&Path> = files.iter().map(|(p, _)| p.as_path()).collect();
+    refuse_overwrite(&outputs, &as_paths(&inputs), a.force)?;
+    let mut all = as_paths(&inputs);
+    all.extend(outputs.iter().copied());
+    write_program_files(&a.program_output, dir.as_deref(), &all)?;
+    Out::Files.put(files)?;
     Ok(warnings)
 }
 
