@@ -156,10 +156,10 @@ fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<S
         Some(_) => Picture::Png,
         None => Picture::from_path(output).map_err(|_| {
             Error::Usage(format!(
-                "cannot tell the format of `{}`: render writes pictures (.png, .svg) and 3D \
-                 geometry (.obj, .ply, .glb){}",
+                "cannot tell the format of `{}`: render writes pictures (.png, .svg), animations \
+                 (.gif, .apng) and 3D geometry (.obj, .ply, .glb){}",
                 output.display(),
-                extension_hint(output, &["png", "svg", "obj", "ply", "glb"])
+                extension_hint(output, &["png", "svg", "gif", "apng", "obj", "ply", "glb"])
             ))
         })?,
     };
