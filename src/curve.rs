@@ -85,6 +85,13 @@ impl Curve {
         Error::at(&self.sources, Diagnostic::new(span, message))
     }
 
+    /// A word of step `step` that the turtle cannot draw, as an [`Error`]
+    /// named by the program's file (for a word drawn outside
+    /// [`Curve::each_step`], which names the production too).
+    pub fn drawing_error(&self, e: draw::DrawError, step: u64) -> Error {
+        self.draw_error(e, step, None)
+    }
+
     /// What made module `module` of `drawn`, the interpreted word that
     /// [`Curve::figure`] drew at step `step`: the figure's derivation run
     /// again, traced. `None` when the replay does not draw the same word.
@@ -264,7 +271,7 @@ impl Curve {
         let p = &self.program;
         let panels = self.each_view(
             opts,
-            |word, draw_opts| draw::draw(word, &p.alphabet, &p.structs, draw_opts),
+            |_, _, word, draw_opts| draw::draw(word, &p.alphabet, &p.structs, draw_opts),
             None,
             on_step,
         )?;
@@ -328,7 +335,7 @@ impl Curve {
             opts,
             // A drawing that cannot be pictured is told after every view is
             // drawn, as `figures` tells it.
-            |word, draw_opts| match render::png::word(
+            |_, _, word, draw_opts| match render::png::word(
                 word,
                 &p.alphabet,
                 &p.structs,
@@ -350,8 +357,37 @@ impl Curve {
         Ok(Figures::from_views(pictures))
     }
 
+    /// Derives once and hands `each` the main view's interpreted word of
+    /// every step, 0 (the axiom) to the last, with the turtle's settings
+    /// (the model, the view file's, the program's angle): `each` draws it,
+    /// or returns `None` to leave the step out. A drawing that fails is
+    /// told as [`Curve::figures`] tells it (the step, the module, and the
+    /// production that made it). `on_step` hears after each step.
+    /// Animations are made so (`command::frames`).
+    pub fn each_step<T>(
+        &self,
+        opts: &FigureOptions,
+        mut each: impl FnMut(u64, &Word, &draw::DrawOptions) -> Result<Option<T>, draw::DrawError>,
+        on_step: &mut dyn FnMut(&Derivation),
+    ) -> Result<Vec<T>, Error> {
+        let opts = FigureOptions {
+            each: true,
+            ..opts.clone()
+        };
+        let mut drawn = self.each_view(
+            &opts,
+            |view, step, word, draw_opts| match view {
+                0 => each(step, word, draw_opts),
+                _ => Ok(None),
+            },
+            None,
+            on_step,
+        )?;
+        Ok(drawn.swap_remove(0).1.into_iter().flatten().collect())
+    }
+
     /// Derives once and draws the interpreted word of every view with
-    /// `draw`: the main view's drawings first, then each view's in the
+    /// `draw` (given the view and the step): the main view's drawings first, then each view's in the
     /// order of its first `UseView`; a drawing of each step with `each`
     /// (a view activated after the first step from that step on), else of
     /// the last.
@@ -364,7 +400,7 @@ impl Curve {
     fn each_view<T>(
         &self,
         opts: &FigureOptions,
-        mut draw: impl FnMut(&Word, &draw::DrawOptions) -> Result<T, draw::DrawError>,
+        mut draw: impl FnMut(i64, u64, &Word, &draw::DrawOptions) -> Result<T, draw::DrawError>,
         last_step: Option<
             &dyn Fn(
                 &mut Derivation,
@@ -395,7 +431,7 @@ impl Curve {
                 let word = d.interpreted_view(view).map_err(fail)?;
                 let made = match main.take() {
                     Some(made) => made,
-                    None => draw(&word, &draw_opts),
+                    None => draw(view, step, &word, &draw_opts),
                 };
                 let made = made.map_err(|e| {
                     let maker = (e.module)

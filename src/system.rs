@@ -346,6 +346,53 @@ impl Surface {
         opts: &RunOptions,
         progress: impl FnMut(Progress),
     ) -> Result<SurfaceRun, Error> {
+        let mut mesh = self.base(opts)?;
+        let steps = self.steps(opts.steps)?;
+        self.run_on(&mut mesh, steps, opts.deadline, progress)?;
+        Ok(SurfaceRun { mesh, steps })
+    }
+
+    /// [`Surface::subdivide`], handing `each` the mesh of every level as
+    /// the run makes it: level 0 (the base mesh after the `init:` rules),
+    /// then after each step. `progress` hears as `subdivide`'s does.
+    pub fn subdivide_each(
+        &self,
+        opts: &RunOptions,
+        mut progress: impl FnMut(Progress),
+        mut each: impl FnMut(usize, &Mesh) -> Result<(), Error>,
+    ) -> Result<SurfaceRun, Error> {
+        let mut mesh = self.base(opts)?;
+        let steps = self.steps(opts.steps)?;
+        let at = |step: usize, m: &Mesh| Progress {
+            step,
+            steps,
+            vertices: m.vertex_count(),
+            edges: m.edge_count(),
+            faces: m.face_count(),
+            ..Progress::default()
+        };
+        progress(at(0, &mesh));
+        {
+            let mut run = {
+                // The pairing of `init: match_blocks` reads the thread's
+                // deadline.
+                let _scope = opts.deadline.map(|d| crate::deadline::scope(Some(d)));
+                self.grammar.start(&mut mesh).map_err(|e| self.error(e))?
+            };
+            run.set_deadline(opts.deadline);
+            each(0, run.mesh())?;
+            for step in 1..=steps {
+                run.steps(1, |_| {}).map_err(|e| self.error(e))?;
+                progress(at(step, run.mesh()));
+                each(step, run.mesh())?;
+            }
+        }
+        Ok(SurfaceRun { mesh, steps })
+    }
+
+    /// The base mesh a run starts from: `opts.base_mesh`, else the
+    /// grammar's `mesh:` (an unreadable one shown at that line).
+    fn base(&self, opts: &RunOptions) -> Result<Mesh, Error> {
         let path = match (&opts.base_mesh, self.base_mesh()) {
             (Some(m), _) => m.clone(),
             (None, Some(p)) => p,
@@ -358,7 +405,7 @@ impl Surface {
             }
         };
         let named_here = opts.base_mesh.is_none();
-        let mut mesh = load_mesh(&path).map_err(|e| match &self.grammar.mesh {
+        load_mesh(&path).map_err(|e| match &self.grammar.mesh {
             // A mesh the grammar names but that cannot be read at all is
             // shown at its `mesh:` line; a problem inside the mesh file
             // keeps its own place.
@@ -375,10 +422,7 @@ impl Surface {
                 ),
             ),
             _ => e,
-        })?;
-        let steps = self.steps(opts.steps)?;
-        self.run_on(&mut mesh, steps, opts.deadline, progress)?;
-        Ok(SurfaceRun { mesh, steps })
+        })
     }
 }
 
@@ -468,6 +512,19 @@ impl Vv {
         opts: &RunOptions,
         progress: impl FnMut(Progress),
     ) -> Result<VvResult, Error> {
+        self.run_each(opts, progress, |_| false, |_, _| {})
+    }
+
+    /// [`Vv::run`], handing `each` the mesh's polygons after `Start` (step
+    /// 0) and after each step (before `End`: the result's soup is the last
+    /// step's after `End`), for every step that `wanted` names.
+    pub fn run_each(
+        &self,
+        opts: &RunOptions,
+        progress: impl FnMut(Progress),
+        wanted: impl Fn(u64) -> bool,
+        each: impl FnMut(u64, PolygonSoup),
+    ) -> Result<VvResult, Error> {
         let path = opts.base_mesh.clone().or_else(|| self.base_mesh());
         let soup = match &path {
             Some(p) => Some(crate::mesh::io::read(p).map_err(|e| {
@@ -484,7 +541,7 @@ impl Vv {
             })?),
             None => None,
         };
-        let r = self.run_from(soup.as_ref(), opts, progress);
+        let r = self.run_from(soup.as_ref(), opts, progress, (wanted, each));
         match (r, &path, &self.program.base) {
             // A base mesh given on the command line is refused at its
             // file, not at the program's own `mesh S = "...";`.
@@ -511,7 +568,7 @@ impl Vv {
     /// Runs the program on the polygons `base` (instead of a file), as
     /// [`Vv::run`] does.
     pub fn run_soup(&self, base: &PolygonSoup, opts: &RunOptions) -> Result<VvResult, Error> {
-        self.run_from(Some(base), opts, |_| {})
+        self.run_from(Some(base), opts, |_| {}, (|_| false, |_, _| {}))
     }
 
     fn run_from(
@@ -519,6 +576,7 @@ impl Vv {
         soup: Option<&PolygonSoup>,
         opts: &RunOptions,
         mut progress: impl FnMut(Progress),
+        (wanted, mut each): (impl Fn(u64) -> bool, impl FnMut(u64, PolygonSoup)),
     ) -> Result<VvResult, Error> {
         if let Some(n) = opts.steps.filter(|&n| n > crate::vv::run::MAX_VV_STEPS) {
             return Err(Error::Usage(format!(
@@ -547,8 +605,28 @@ impl Vv {
                 ..Progress::default()
             }
         };
+        // The polygons of a step the caller wants, or the first error
+        // in making them.
+        let mut failed = None;
+        let mut hand = |r: &crate::vv::VvRun| {
+            let step = crate::production::Topology::steps_done(r);
+            if failed.is_none() && wanted(step) {
+                match r.soup() {
+                    Ok((soup, _)) => each(step, soup),
+                    Err(e) => failed = Some(e),
+                }
+            }
+        };
         progress(at(&run));
-        run.finish(|r| progress(at(r))).map_err(|e| self.error(e))?;
+        hand(&run);
+        run.finish(|r| {
+            progress(at(r));
+            hand(r);
+        })
+        .map_err(|e| self.error(e))?;
+        if let Some(e) = failed {
+            return Err(self.error(e));
+        }
         let (soup, holes) = run.soup().map_err(|e| self.error(e))?;
         let info = vv_info(&run, &soup, holes);
         Ok(VvResult {

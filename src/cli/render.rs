@@ -14,7 +14,9 @@ use super::print::{print_program_output, print_warnings, with_progress};
 #[derive(clap::Args)]
 pub(super) struct RenderCli {
     file: String,
-    /// The picture: OUT.png or OUT.svg.
+    /// The picture: OUT.png or OUT.svg; an animation of the steps:
+    /// OUT.gif or OUT.apng; one still a step: a name with {n} (the step),
+    /// OUT-{n}.png or OUT-{n}.svg.
     #[arg(short = 'o', long = "output")]
     output: String,
     #[arg(short = 'n', long = "steps")]
@@ -44,6 +46,14 @@ pub(super) struct RenderCli {
     /// Meshes: draw the faces without their edges.
     #[arg(long)]
     no_wireframe: bool,
+    /// Meshes: one flat shade per face [default: smooth, from vertex
+    /// normals].
+    #[arg(long)]
+    flat: bool,
+    /// Animations (.gif, .apng, or OUT-{n}.png): frames a second
+    /// [default: the model's `swap interval:`, else 4].
+    #[arg(long, value_name = "N")]
+    fps: Option<f64>,
     #[arg(short = 'D', value_name = "NAME=VALUE")]
     define: Vec<String>,
     /// Compute float, V2f and V3f in double precision (lpfg: single).
@@ -83,6 +93,8 @@ impl RenderCli {
             background: self.background,
             view: self.view,
             wireframe: !self.no_wireframe,
+            flat: self.flat,
+            fps: self.fps,
             solid: if self.solid {
                 command::Solidity::Solid
             } else if self.lines {

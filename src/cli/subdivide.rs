@@ -22,8 +22,9 @@ pub(super) struct SubdivideCli {
     /// For pictures: iso, front, back, left, right, top, bottom.
     #[arg(long)]
     view: Option<String>,
-    /// For pictures: lit (the default), normals (a normal map) or
-    /// reflection (reflection lines); the last two draw no edges.
+    /// For pictures: lit (the default: smooth, from vertex normals), flat
+    /// (one shade a face), normals (a normal map) or reflection
+    /// (reflection lines); the last two draw no edges.
     #[arg(long)]
     shading: Option<String>,
     /// For pictures: draw the faces without their edges.

@@ -9,6 +9,11 @@
 //!   `Solidity`; an L-system drawn in 2D or 3D, or exported.
 //! - `sight.rs`: `sight_edited`, what the live page shows: an SVG, or 3D
 //!   geometry with its first camera.
+//! - `animate.rs`: `render -o growth.gif`, `.apng`, or one still a frame
+//!   (`{n}`): the frames encoded.
+//! - `frames.rs`: `frames`, `FrameOptions`, `Frames`: a system run once,
+//!   one picture per step with one camera (animations, the page's
+//!   playback).
 //! - `watch.rs`: `watch`, `WatchOptions`, `WatchEvent`.
 //! - `infer.rs`: `infer` and `InferArgs`.
 //! - `subdivide.rs`: `subdivide` and `SubdivideArgs`; a shape grammar's
@@ -28,9 +33,11 @@
 //! Its children are private; what is public is re-exported here.
 
 mod analyze;
+mod animate;
 mod check;
 mod common;
 mod derive;
+mod frames;
 mod infer;
 mod mesh;
 mod picture;
@@ -43,10 +50,14 @@ mod watch;
 pub use analyze::{analyze, analyze_reporting, AnalyzeArgs};
 pub use check::check;
 pub use derive::{derive, derive_to, DeriveArgs, Printed};
+pub use frames::{
+    frames, Frame, FrameGeometry, FrameOptions, FrameSelection, Frames, SolidFrame, MAX_FRAMES,
+    MAX_FRAME_PIXELS,
+};
 pub use infer::{infer, InferArgs};
 pub use mesh::{mesh_convert, mesh_info};
 pub use picture::{write_picture, Picture};
-pub use render::{render, render_edited, Drawn, RenderArgs, Solidity};
+pub use render::{render, render_edited, Drawn, RenderArgs, Solidity, DEFAULT_FPS};
 pub use reverse::{reconstruct, reverse, ReconstructArgs, ReverseArgs};
 pub use sight::{sight_edited, Seen, Sight, Solid};
 pub use subdivide::{subdivide, SubdivideArgs};

@@ -125,6 +125,8 @@ pub(super) struct MeshLooks<'a> {
     pub(super) view: Option<&'a str>,
     pub(super) wireframe: bool,
     pub(super) shading: crate::render::mesh::Shading,
+    /// One flat shade per face, not smoothed across faces.
+    pub(super) flat: bool,
 }
 
 impl<'a> MeshLooks<'a> {
@@ -137,6 +139,7 @@ impl<'a> MeshLooks<'a> {
             view: a.view.as_deref(),
             wireframe: a.wireframe,
             shading: crate::render::mesh::Shading::Lit,
+            flat: a.flat,
         }
     }
 }
@@ -150,6 +153,7 @@ impl MeshLooks<'_> {
             background: self.background,
             wireframe: self.wireframe,
             shading: self.shading,
+            smooth: !self.flat,
             ..Default::default()
         };
         if let Some(name) = self.view {

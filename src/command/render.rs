@@ -5,10 +5,12 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use super::animate::{self, Animated};
 use super::common::{
     as_paths, check_steps, extension_hint, in_run, load_options, refuse_overwrite,
     write_program_files, writes_folder,
 };
+use super::frames::FrameOptions;
 use super::picture::{
     picture_bytes, write_mesh_picture, write_soup_picture, write_views, MeshLooks, Out, Picture,
 };
@@ -48,6 +50,12 @@ pub struct RenderArgs {
     pub view: Option<String>,
     /// Meshes: draw the edges over the faces.
     pub wireframe: bool,
+    /// Meshes: one flat shade per face (by default smooth, from vertex
+    /// normals).
+    pub flat: bool,
+    /// Animations (`.gif`, `.png` with `{n}`…): frames a second; `None`:
+    /// the model's `swap interval:`, else [`DEFAULT_FPS`].
+    pub fps: Option<f64>,
     pub defines: Vec<String>,
     /// `--double`: `float` in double precision instead of lpfg's single.
     pub double: bool,
@@ -81,6 +89,8 @@ impl RenderArgs {
             background: None,
             view: None,
             wireframe: true,
+            flat: false,
+            fps: None,
             defines: Vec::new(),
             double: false,
             max_modules: DEFAULT_MAX_MODULES,
@@ -94,6 +104,10 @@ impl RenderArgs {
         }
     }
 }
+
+/// Frames a second of an animation when neither `--fps` nor the model's
+/// `swap interval:` says.
+pub const DEFAULT_FPS: f64 = 4.0;
 
 /// How `render` draws an L-system.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -120,6 +134,9 @@ fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<S
     let file = Path::new(&a.file);
     let output = Path::new(&a.output);
     refuse_overwrite(&[output], &[file], a.force)?;
+    if let Some(format) = Animated::from_path(output)? {
+        return animate(a, format, deadline, progress);
+    }
     let looks = MeshLooks::of_render(a);
     if mesh::io::Format::from_path(file).is_some() {
         // Found before the mesh is read.
@@ -139,10 +156,10 @@ fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<S
         Some(_) => Picture::Png,
         None => Picture::from_path(output).map_err(|_| {
             Error::Usage(format!(
-                "cannot tell the format of `{}`: render writes pictures (.png, .svg) and 3D \
-                 geometry (.obj, .ply, .glb){}",
+                "cannot tell the format of `{}`: render writes pictures (.png, .svg), animations \
+                 (.gif, .apng) and 3D geometry (.obj, .ply, .glb){}",
                 output.display(),
-                extension_hint(output, &["png", "svg", "obj", "ply", "glb"])
+                extension_hint(output, &["png", "svg", "gif", "apng", "obj", "ply", "glb"])
             ))
         })?,
     };
@@ -156,6 +173,80 @@ fn render_in_run(a: &RenderArgs, progress: impl FnMut(Progress)) -> Result<Vec<S
         progress,
         &mut Out::Files,
     )?);
+    Ok(warnings)
+}
+
+/// `render` to an animation (`.gif`, `.apng`) or to one still a frame
+/// (`{n}` in a `.png` or `.svg` name): [`super::frames()`] encoded, and
+/// every file written or none.
+fn animate(
+    a: &RenderArgs,
+    format: Animated,
+    deadline: Option<Deadline>,
+    progress: impl FnMut(Progress),
+) -> Result<Vec<String>, Error> {
+    let file = Path::new(&a.file);
+    let output = Path::new(&a.output);
+    if mesh::io::Format::from_path(file).is_some() {
+        return Err(Error::Usage(format!(
+            "`{}` is a mesh: it has no steps to animate; render a grammar or an L-system, or \
+             the mesh as a .png or .svg",
+            file.display()
+        )));
+    }
+    if a.each {
+        return Err(Error::Usage(
+            "--each draws the steps side by side in one picture; an animation shows them one \
+             after the other: leave out --each"
+                .into(),
+        ));
+    }
+    if let Some(fps) = a.fps {
+        animate::check_fps(fps)?;
+    }
+    if let Animated::Stills(_) = format {
+        animate::check_folder(output)?;
+    }
+    check_steps(a.steps)?;
+    let system = load(file, &load_options(&a.defines, a.double, &a.environment))?;
+    let mut warnings = system.warnings();
+    let dir = writes_folder(&a.allow_writes, &a.program_output)?;
+    let opts = FrameOptions {
+        run: RunOptions {
+            steps: a.steps,
+            max_modules: a.max_modules,
+            phase: a.phase,
+            seed: a.seed,
+            base_mesh: None,
+            deadline,
+            output: a.program_output.clone(),
+            max_shapes: None,
+        },
+        size: a.size.unwrap_or((800, 800)),
+        background: a.background,
+        solid: a.solid,
+        view: a.view.clone(),
+        wireframe: a.wireframe,
+        flat: a.flat,
+        selection: None,
+    };
+    let frames = super::frames::frames(&system, &opts, progress)?;
+    warnings.extend(frames.notes.iter().cloned());
+    let fps = match (a.fps, frames.interval) {
+        (Some(fps), _) => fps,
+        // lpfg's hundredths of a second; faster than a GIF shows, 100.
+        (None, Some(t)) => (1.0 / t.as_secs_f64()).min(100.0),
+        (None, None) => DEFAULT_FPS,
+    };
+    let files = animate::files(&frames, format, output, fps)?;
+    let mut inputs = system.inputs();
+    inputs.push(file.to_path_buf());
+    let outputs: Vec<&Path> = files.iter().map(|(p, _)| p.as_path()).collect();
+    refuse_overwrite(&outputs, &as_paths(&inputs), a.force)?;
+    let mut all = as_paths(&inputs);
+    all.extend(outputs.iter().copied());
+    write_program_files(&a.program_output, dir.as_deref(), &all)?;
+    Out::Files.put(files)?;
     Ok(warnings)
 }
 
@@ -309,7 +400,7 @@ pub(super) fn render_system(
             write_soup_picture(&run.soup, output, looks, out)?;
             Ok(Vec::new())
         }
-        System::Curve(c) if wants_solid(a, &c, export.is_some()) => {
+        System::Curve(c) if export.is_some() || wants_solid(a.solid, &c) => {
             render_solid(a, &c, (looks, format), deadline, progress, out)
         }
         System::Curve(c) => {
@@ -383,12 +474,12 @@ fn curve_run(
     Ok((opts, dir))
 }
 
-/// Whether `render` draws this L-system's 3D geometry (see [`Solidity`]).
-pub(super) fn wants_solid(a: &RenderArgs, c: &crate::Curve, export: bool) -> bool {
+/// Whether `render` draws this L-system's 3D geometry in a picture (see
+/// [`Solidity`]).
+pub(super) fn wants_solid(solid: Solidity, c: &crate::Curve) -> bool {
     use crate::model::view::{LineStyle, RenderMode};
     let m = &*crate::model::of(&c.program);
-    match a.solid {
-        _ if export => true,
+    match solid {
         Solidity::Solid => true,
         Solidity::Lines => false,
         Solidity::Auto => {

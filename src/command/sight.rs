@@ -89,7 +89,10 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
         }
         crate::render::mesh::validate(soup, &mv)?;
         let (scene, edges) = crate::render::mesh::soup_scene3_edges(soup, colours);
-        let camera = crate::render::mesh::camera(soup, &mv)?;
+        let camera = crate::render::mesh::camera(
+            &mv,
+            &mut crate::render::mesh::used_vertices(soup).map(|p| p.as_vec3()),
+        )?;
         Ok(Sight::Solid(Box::new(Solid {
             scene,
             edges,
@@ -142,7 +145,7 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
             }
             mesh(&run.soup, &run.colours, true)?
         }
-        System::Curve(c) if wants_solid(&a, &c, false) => {
+        System::Curve(c) if wants_solid(a.solid, &c) => {
             let (scene, dir) = solid_scene(&a, &c, (w, h), deadline, |_| {}, false)?;
             write_program_files(&a.program_output, dir.as_deref(), &[file])?;
             if scene.triangle_count() == 0 {

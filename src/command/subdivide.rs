@@ -25,8 +25,9 @@ pub struct SubdivideArgs {
     pub defines: Vec<String>,
     /// For pictures: iso, front, back, left, right, top or bottom.
     pub view: Option<String>,
-    /// For pictures: `lit`, `normals` or `reflection`; the last two draw
-    /// no edges.
+    /// For pictures: `lit` (smooth: lit from vertex normals), `flat` (lit,
+    /// one shade a face), `normals` or `reflection`; the last two draw no
+    /// edges.
     pub shading: Option<String>,
     /// For pictures: no edges.
     pub no_wireframe: bool,
@@ -99,10 +100,10 @@ pub(super) fn subdivide_in_run(
         )));
     }
     let shading = match a.shading.as_deref() {
-        None => d.shading,
+        None | Some("flat") => d.shading,
         Some(name) => crate::render::mesh::Shading::from_name(name).ok_or_else(|| {
             Error::Usage(format!(
-                "`--shading {name}` is not a shading: use lit, normals or reflection"
+                "`--shading {name}` is not a shading: use lit, flat, normals or reflection"
             ))
         })?,
     };
@@ -112,6 +113,7 @@ pub(super) fn subdivide_in_run(
         view: a.view.as_deref(),
         wireframe: d.wireframe && !a.no_wireframe && shading == crate::render::mesh::Shading::Lit,
         shading,
+        flat: a.shading.as_deref() == Some("flat"),
     };
     // The file is read and lexed once; its tokens say what it is.
     let text = crate::load::read(grammar)?;

@@ -98,6 +98,8 @@ pub struct Model {
     /// The communication file (`.e`): the environmental program of an
     /// open L-system.
     pub environment: Option<comm::CommSpec>,
+    /// The animation file (`.a`): the frames of an animation.
+    pub animation: Option<view::Animation>,
     /// The files read, in order.
     pub files: Vec<PathBuf>,
     pub notes: Vec<Note>,
@@ -362,7 +364,7 @@ impl Model {
         }
         for p in by("a") {
             let (n, t) = text_of(p)?;
-            view::read_a(&n, &t, &mut m.notes)?;
+            m.animation = Some(view::read_a(&n, &t, &mut m.notes)?);
         }
         for p in by("e") {
             let (_, t) = text_of(p)?;

@@ -13,8 +13,8 @@
 //! the others set up lpfg's OpenGL window (shadows, fonts, …) and are
 //! reported as not acted on. The views' names (`window:`) and the turtle's settings
 //! (`corrected rotation:`, `tropism:`, `torque:`, `stropism:`) are read by
-//! `load::read_view_file`. The animation file only matters in lpfg's
-//! animate mode, which a still picture is not: it is checked and kept.
+//! `load::read_view_file`. The animation file (`.a`) chooses the frames of
+//! `render -o growth.gif` ([`Animation`]); a still picture ignores it.
 
 use super::error::ModelError as Error;
 use super::text::{number, words, Lines};
@@ -76,19 +76,6 @@ const ACTED_ON_BY_THE_TURTLE: &[&str] = &[
     "tropism",
     "torque",
     "stropism",
-];
-
-const ANIMATION_COMMANDS: &[&str] = &[
-    "first frame",
-    "last frame",
-    "step",
-    "swap interval",
-    "double buffer",
-    "clear between frames",
-    "hcenter between frames",
-    "scale between frames",
-    "new view between frames",
-    "display on request",
 ];
 
 /// A `surface:` command: the file, its line, the scale.
@@ -668,10 +655,54 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
     Ok(view)
 }
 
-/// Checks an animation file: `command: value` lines of §8.2.
-pub fn read_a(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<(), Error> {
+/// An animation file's settings (§8.2): which derivation steps are the
+/// frames of an animation, and how they are shown.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Animation {
+    /// `first frame:` (0 by default).
+    pub first_frame: u64,
+    /// `last frame:`; `None`: the derivation length.
+    pub last_frame: Option<u64>,
+    /// `step:`, the derivation steps between frames (1 by default).
+    pub step: u64,
+    /// `swap interval:`, the time between frames in hundredths of a
+    /// second (0 by default: as fast as the display goes).
+    pub swap_interval: f64,
+    /// `scale between frames:` (off by default): each frame fitted to
+    /// the window on its own.
+    pub scale_between_frames: bool,
+    /// `hcenter between frames:` (off by default): each frame centred
+    /// horizontally on its own.
+    pub hcenter_between_frames: bool,
+    /// `clear between frames:` (on by default).
+    pub clear_between_frames: bool,
+    /// `display on request:` (off by default).
+    pub display_on_request: bool,
+}
+
+impl Default for Animation {
+    /// The manual's defaults.
+    fn default() -> Self {
+        Animation {
+            first_frame: 0,
+            last_frame: None,
+            step: 1,
+            swap_interval: 0.0,
+            scale_between_frames: false,
+            hcenter_between_frames: false,
+            clear_between_frames: true,
+            display_on_request: false,
+        }
+    }
+}
+
+/// Reads an animation file: `command: value` lines of §8.2. The frame
+/// commands are kept ([`Animation`]); `double buffer:` and `new view
+/// between frames:` belong to lpfg's window and are only checked.
+pub fn read_a(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<Animation, Error> {
     let clean = blank_comments(text);
     let mut lines = Lines::shown_as(path, &clean, text);
+    let mut a = Animation::default();
     while !lines.at_end() {
         let line = lines.next_line("")?;
         let n = lines.line_no();
@@ -682,15 +713,55 @@ pub fn read_a(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<(), Error
                 "expected a command such as `step: 1` (a name, a colon, a value)",
             ));
         };
-        if !ANIMATION_COMMANDS.contains(&k.as_str()) {
-            let base = line_start(text, n - 1);
-            notes.push(Note::at(
-                path,
-                text,
-                base + first.start..base + after,
-                format!("`{k}:` is not an animation-file command that lpfg's manual lists"),
-            ));
+        let ws = words_after(line, after);
+        let frame = |what: &str| -> Result<u64, Error> {
+            let v = number(&lines, &ws, 0, what)?;
+            if v < 0.0 || v.fract() != 0.0 || v > u32::MAX as f64 {
+                return Err(lines.error(ws[0], format!("{what} must be a whole number, 0 or more")));
+            }
+            Ok(v as u64)
+        };
+        let switch = || -> Result<bool, Error> {
+            match ws.first().map(|w| w.text.to_ascii_lowercase()) {
+                Some(w) if w == "on" => Ok(true),
+                Some(w) if w == "off" => Ok(false),
+                Some(w) => Err(lines.error(ws[0], format!("expected `on` or `off`, found `{w}`"))),
+                None => Err(lines.error_at_end("expected `on` or `off`")),
+            }
+        };
+        match k.as_str() {
+            "first frame" => a.first_frame = frame("the first frame")?,
+            "last frame" => a.last_frame = Some(frame("the last frame")?),
+            "step" => {
+                a.step = frame("the step")?;
+                if a.step == 0 {
+                    return Err(lines.error(ws[0], "the step must be 1 or more"));
+                }
+            }
+            "swap interval" => {
+                let t = number(&lines, &ws, 0, "the interval")?;
+                if t < 0.0 {
+                    return Err(lines.error(ws[0], "the interval must be 0 or more"));
+                }
+                a.swap_interval = t;
+            }
+            "scale between frames" => a.scale_between_frames = switch()?,
+            "hcenter between frames" => a.hcenter_between_frames = switch()?,
+            "clear between frames" => a.clear_between_frames = switch()?,
+            "display on request" => a.display_on_request = switch()?,
+            "double buffer" | "new view between frames" => {
+                switch()?;
+            }
+            _ => {
+                let base = line_start(text, n - 1);
+                notes.push(Note::at(
+                    path,
+                    text,
+                    base + first.start..base + after,
+                    format!("`{k}:` is not an animation-file command that lpfg's manual lists"),
+                ));
+            }
         }
     }
-    Ok(())
+    Ok(a)
 }

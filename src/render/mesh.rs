@@ -58,6 +58,9 @@ pub struct MeshView {
     pub face_colours: Vec<Rgba>,
     /// How faces are coloured.
     pub shading: Shading,
+    /// Lit from vertex normals, smooth across faces (not across a sharp
+    /// edge or a fold); `false`: one flat shade per face.
+    pub smooth: bool,
 }
 
 pub use super::raster::Shading;
@@ -76,6 +79,7 @@ impl Default for MeshView {
             margin: 0.04,
             face_colours: Vec::new(),
             shading: Shading::Lit,
+            smooth: true,
         }
     }
 }
@@ -176,8 +180,9 @@ fn fit(soup: &PolygonSoup, cam: &Camera, view: &MeshView) -> Fit {
     Fit::new(lo, hi, 0.0, w, h, margin)
 }
 
-/// The vertices that faces refer to (valid indices only).
-fn used_vertices(soup: &PolygonSoup) -> impl Iterator<Item = DVec3> + '_ {
+/// The vertices that faces refer to (valid indices only): what a mesh
+/// picture's camera frames (and the page's).
+pub fn used_vertices(soup: &PolygonSoup) -> impl Iterator<Item = DVec3> + '_ {
     soup.faces
         .iter()
         .flatten()
@@ -577,25 +582,17 @@ pub fn raster_options(
     polygons: Vec<u32>,
     back: Vec<Look>,
 ) -> Result<RasterOptions, RenderError> {
-    let camera = camera(soup, view)?;
-    Ok(RasterOptions {
-        background: view.background,
-        lights: lights(),
-        global_ambient: [AMBIENT; 3],
-        shading: view.shading,
-        back_looks: Some(back),
-        wireframe: view.wireframe.then_some(Wireframe {
-            color: EDGE,
-            polygons,
-            wide: edge_width(view) >= 0.8,
-        }),
-        ..RasterOptions::new(camera)
-    })
+    let camera = camera(view, &mut used_vertices(soup).map(|p| p.as_vec3()))?;
+    Ok(raster_options_with(camera, view, polygons, back))
 }
 
-/// The camera of a picture of `soup` seen with `view`: the view's
-/// direction, fitted tightly to the outline of the faces' vertices.
-pub fn camera(soup: &PolygonSoup, view: &MeshView) -> Result<raster::Camera, RenderError> {
+/// The camera of a mesh picture seen with `view` that frames `points` (the
+/// vertices of one mesh, or of every frame of an animation): the view's
+/// direction, the tight fit of the points' outline within the margin.
+pub fn camera(
+    view: &MeshView,
+    points: &mut dyn Iterator<Item = Vec3>,
+) -> Result<raster::Camera, RenderError> {
     let cam = Camera::or_default(view);
     let margin = if view.margin.is_finite() {
         view.margin.clamp(0.0, 0.45)
@@ -609,12 +606,31 @@ pub fn camera(soup: &PolygonSoup, view: &MeshView) -> Result<raster::Camera, Ren
         tight: true,
         ..ViewSpec::default()
     };
-    raster::Camera::from_view(
-        &spec,
-        &mut used_vertices(soup).map(|p| p.as_vec3()),
-        view.width,
-        view.height,
-    )
+    raster::Camera::from_view(&spec, points, view.width, view.height)
+}
+
+/// The z-buffer's settings for a mesh picture with `camera`: the key and
+/// fill lights, the view's background and shading, the back looks and the
+/// wireframe of [`scene3`]'s `polygons`.
+pub fn raster_options_with(
+    camera: raster::Camera,
+    view: &MeshView,
+    polygons: Vec<u32>,
+    back: Vec<Look>,
+) -> RasterOptions {
+    RasterOptions {
+        background: view.background,
+        lights: lights(),
+        global_ambient: [AMBIENT; 3],
+        shading: view.shading,
+        back_looks: Some(back),
+        wireframe: view.wireframe.then_some(Wireframe {
+            color: EDGE,
+            polygons,
+            wide: edge_width(view) >= 0.8,
+        }),
+        ..RasterOptions::new(camera)
+    }
 }
 
 /// The width of edge strokes: thin, growing slowly with the image.

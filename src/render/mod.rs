@@ -210,6 +210,38 @@ pub fn scene(panels: &[Vec<Event>], opts: &RenderOptions) -> Result<Scene, Rende
     })
 }
 
+/// The box around `events` in the plane of `view` (discs and rings with
+/// their radius): `None` for no events, an error for a coordinate that is
+/// not finite. Frames of an animation are laid out in the union of theirs.
+pub fn bounds(events: &[Event], view: View) -> Result<Option<(DVec2, DVec2)>, RenderError> {
+    panel_bounds(events, view)
+}
+
+/// One panel of `events` laid out in the box `lo..hi` of the drawing plane
+/// (not the events' own box, as [`scene`] takes): frames that share a box
+/// share a camera, so a drawing that grows is not scaled up to fill each
+/// frame. An empty list of events is an empty picture.
+pub fn scene_within(
+    events: &[Event],
+    (lo, hi): (DVec2, DVec2),
+    opts: &RenderOptions,
+) -> Result<Scene, RenderError> {
+    check_size(opts.width, opts.height)?;
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Err(RenderError::new(
+            "the drawing has a NaN or infinite coordinate and cannot be fitted",
+        ));
+    }
+    let mut layout = Layout::new((lo, hi), 0.0, opts.width as f64, opts, Vec::new());
+    events.iter().for_each(|e| layout.lay(e));
+    Ok(Scene {
+        width: opts.width,
+        height: opts.height,
+        background: opts.background,
+        items: layout.finish(),
+    })
+}
+
 fn nothing_to_draw() -> RenderError {
     RenderError::new(
         "nothing to draw: after interpretation the word has no drawing modules (F, LineTo2f, Circle, ...)",

@@ -46,6 +46,26 @@ pub fn render(scene: &Scene) -> Result<Vec<u8>, RenderError> {
     painter.encode()
 }
 
+/// A scene's pixels, as [`render`] paints them before encoding:
+/// premultiplied RGBA, row by row from the top (the frames of an
+/// animation are encoded from these).
+pub fn image(scene: &Scene) -> Result<super::raster::Image, RenderError> {
+    let mut painter = Painter::new(scene.width, scene.height, scene.background)?;
+    painter.paint(scene.items.iter().map(|item| match item {
+        Item::Polyline {
+            points,
+            color,
+            width,
+        } => Piece::Line(points, *color, *width),
+        item => Piece::Item(item),
+    }));
+    Ok(super::raster::Image {
+        width: scene.width,
+        height: scene.height,
+        pixels: painter.pm.take(),
+    })
+}
+
 /// The PNG of the turtle's 2D drawing of `word` in one cell the size of
 /// the picture, as [`render`] makes it from the [`super::scene`] of
 /// [`crate::draw::draw`]'s events, to the bit; but with no list of events

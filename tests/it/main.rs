@@ -3,6 +3,7 @@
 
 mod abop;
 mod analyze;
+mod animation;
 mod bad_inputs;
 mod c_strings;
 mod cli;

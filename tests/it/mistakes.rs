@@ -200,8 +200,8 @@ fn a_misspelt_output_extension_is_suggested() {
     };
     assert_eq!(
         run(&["render", "k.lsys", "-o", "k.pgn"]),
-        "error: cannot tell the format of `k.pgn`: render writes pictures (.png, .svg) and 3D \
-         geometry (.obj, .ply, .glb); did you mean `.png`?"
+        "error: cannot tell the format of `k.pgn`: render writes pictures (.png, .svg), \
+         animations (.gif, .apng) and 3D geometry (.obj, .ply, .glb); did you mean `.png`?"
     );
     assert_eq!(
         run(&["mesh", "convert", "t.obj", "t.plyy"]),
