@@ -47,6 +47,10 @@ pub struct FrameOptions {
     /// Which steps are frames; `None`: the model's animation file (`.a`)
     /// where it has one, else every step 0..=N.
     pub selection: Option<FrameSelection>,
+    /// L-systems in 3D: geometry for a viewer or a file (the live page's
+    /// playback), with pixel-wide lines as whole tubes and no thin lines,
+    /// which only the z-buffer draws.
+    pub viewer: bool,
 }
 
 impl Default for FrameOptions {
@@ -63,6 +67,7 @@ impl Default for FrameOptions {
             wireframe: true,
             flat: false,
             selection: None,
+            viewer: false,
         }
     }
 }
@@ -515,7 +520,9 @@ fn solid_curve_frames(
             .map_or(f64::NAN, |(lo, hi)| (hi - lo).max_element());
         let units_per_pixel = crate::draw::solid::pixel_of(extent, 0.9 * w.min(h) as f64);
         sopts.pixel_tubes = Some(units_per_pixel);
-        sopts.picture_pixel = Some(units_per_pixel);
+        if !opts.viewer {
+            sopts.picture_pixel = Some(units_per_pixel);
+        }
     }
     let mut scenes = Vec::with_capacity(words.len());
     for (step, word, draw_opts, _) in words {

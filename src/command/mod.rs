@@ -59,6 +59,6 @@ pub use mesh::{mesh_convert, mesh_info};
 pub use picture::{write_picture, Picture};
 pub use render::{render, render_edited, Drawn, RenderArgs, Solidity, DEFAULT_FPS};
 pub use reverse::{reconstruct, reverse, ReconstructArgs, ReverseArgs};
-pub use sight::{sight_edited, Seen, Sight, Solid};
+pub use sight::{frames_edited, sight_edited, Seen, SeenFrames, Sight, Solid};
 pub use subdivide::{subdivide, SubdivideArgs};
 pub use watch::{watch, WatchEvent, WatchOptions};

@@ -229,6 +229,7 @@ fn animate(
         wireframe: a.wireframe,
         flat: a.flat,
         selection: None,
+        viewer: false,
     };
     let frames = super::frames::frames(&system, &opts, progress)?;
     warnings.extend(frames.notes.iter().cloned());

@@ -186,3 +186,62 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
     };
     Ok(Seen { sight, warnings })
 }
+
+/// A run's frames for the page's playback.
+#[derive(Clone, Debug)]
+pub struct SeenFrames {
+    /// One per step (or per frame of the model's `.a` file), one camera:
+    /// 2D drawings laid out in one box, or 3D geometry for a viewer (no
+    /// thin lines: pixel-wide lines are whole tubes).
+    pub frames: super::Frames,
+    pub warnings: Vec<String>,
+    /// The up direction a 3D view turns about: the camera's for an
+    /// L-system, z for a mesh.
+    pub up: [f32; 3],
+}
+
+/// The frames of the program with its text replaced by `text`, as
+/// [`super::frames`] draws them for `render -o growth.gif` (2D frames in
+/// one box, 3D frames with one camera), derived once; `progress` hears
+/// after each step. Writes nothing. The page shows them one by one.
+pub fn frames_edited(
+    a: &RenderArgs,
+    text: &str,
+    progress: impl FnMut(crate::system::Progress),
+) -> Result<SeenFrames, Error> {
+    let deadline = a.timeout.map(Deadline::after);
+    let _deadline = crate::deadline::scope(deadline);
+    let system = crate::load::load_edited(
+        Path::new(&a.file),
+        text,
+        &load_options(&a.defines, a.double, &a.environment),
+    )?;
+    let warnings = system.warnings();
+    let opts = super::FrameOptions {
+        run: RunOptions {
+            steps: a.steps,
+            max_modules: a.max_modules,
+            seed: a.seed,
+            deadline,
+            ..RunOptions::default()
+        },
+        size: a.size.unwrap_or((800, 800)),
+        background: a.background,
+        solid: a.solid,
+        wireframe: a.wireframe,
+        viewer: true,
+        ..Default::default()
+    };
+    let frames = super::frames(&system, &opts, progress)?;
+    let up = match (&system, frames.frames.first().map(|f| &f.geometry)) {
+        (System::Curve(_), Some(super::FrameGeometry::Solid(s))) => s.raster.camera.up.to_array(),
+        _ => [0.0, 0.0, 1.0],
+    };
+    let mut warnings = warnings;
+    warnings.extend(frames.notes.iter().cloned());
+    Ok(SeenFrames {
+        frames,
+        warnings,
+        up,
+    })
+}

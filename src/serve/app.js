@@ -49,6 +49,8 @@ const state = {
   view3d: null,         // the View3D, made on the first 3D render
   flat2d: { zoom: 1, x: 0, y: 0 }, // the 2D picture's zoom and pan
   scene: null,          // the last 3D render's scene reply
+  play: null,           // the growth being played (see `startPlay`)
+  frameShown: null,     // the step of the frame on show while playing
 };
 window.subgram = state;
 
@@ -179,12 +181,26 @@ function lengthOf(src, defs) {
   return Number.isFinite(n) && n >= 0 ? n : null;
 }
 
+// What a render or a playback of the text as it stands asks for.
+function requestBody() {
+  const src = text.value;
+  const n = lengthOf(src, defines(src));
+  return {
+    text: src,
+    steps: n === null ? null : Number(steps.value),
+    defines: [...state.overrides].map(([k, v]) => `${k}=${v}`),
+  };
+}
+
 function schedule(ms) {
   clearTimeout(state.timer);
   state.timer = setTimeout(render, ms);
 }
 
 async function render() {
+  // A playback of this very text goes on; any change ends it.
+  if (state.play && state.play.key === JSON.stringify(requestBody())) return;
+  stopPlay();
   const src = text.value;
   const defs = defines(src);
   const n = lengthOf(src, defs);
@@ -199,11 +215,7 @@ async function render() {
   state.inFlight = ctl;
   status.className = "";
   status.textContent = "deriving…";
-  const body = {
-    text: src,
-    steps: n === null ? null : Number(steps.value),
-    defines: [...state.overrides].map(([k, v]) => `${k}=${v}`),
-  };
+  const body = requestBody();
   let reply, code;
   try {
     ({ status: code, reply } = await api("/api/render", body, ctl.signal));
@@ -417,6 +429,180 @@ async function showScene(reply) {
 wire.addEventListener("change", () => state.view3d?.setWireframe(wire.checked));
 flat.addEventListener("change", () => state.view3d?.setFlat(flat.checked));
 $("reset").addEventListener("click", resetView);
+
+// Growth playback: every step derived once by the server (POST
+// /api/play, then its progress polled), each frame fetched once and kept
+// (an SVG's URL, or a GLB on the GPU), so that scrubbing back needs no
+// request; play, pause, one frame back or on, loop and speed. An edit
+// ends it (the still picture of the edited text comes back).
+const playButton = $("play"), frameSlider = $("frame"), frameOut = $("frame-out");
+const playStatus = $("play-status");
+
+function playMessage(text, error = false) {
+  playStatus.className = error ? "error" : "";
+  playStatus.textContent = text;
+}
+
+async function startPlay() {
+  const body = requestBody();
+  const key = JSON.stringify(body);
+  const play = { key, frames: [], index: 0, playing: false, timer: null, ready: false, intervalMs: 250 };
+  stopPlay();
+  state.play = play;
+  playButton.disabled = true;
+  playMessage("deriving…");
+  let reply, code;
+  try {
+    ({ status: code, reply } = await api("/api/play", body));
+  } catch (e) {
+    reply = { ok: false, message: `the server did not answer: ${e}` };
+  }
+  if (state.play !== play) return;
+  if (!reply.ok) {
+    playButton.disabled = false;
+    state.play = null;
+    playMessage(code === 503 ? `busy: ${reply.message}` : `cannot play: ${reply.message}`, true);
+    return;
+  }
+  let job;
+  for (;;) {
+    await new Promise((r) => setTimeout(r, 200));
+    if (state.play !== play) return;
+    try {
+      ({ reply: job } = await api(`/api/play/${reply.job}`));
+    } catch (e) {
+      job = { phase: "failed", messages: [{ message: `the server did not answer: ${e}` }] };
+    }
+    if (state.play !== play) return;
+    if (job.phase === "deriving") {
+      playMessage(job.steps ? `deriving step ${job.step} of ${job.steps} · ${job.modules.toLocaleString()} modules` : "deriving…");
+    } else if (job.phase === "drawing") {
+      playMessage("drawing the frames…");
+    } else break;
+  }
+  if (job.phase !== "done") {
+    playButton.disabled = false;
+    state.play = null;
+    const why = job.limit ? `stopped by the ${job.limit} limit: ` : "";
+    const first = (job.messages || [])[0];
+    playMessage(`cannot play: ${why}${first ? first.message : "the run failed"}`, true);
+    return;
+  }
+  if (job.interval_ms) play.intervalMs = job.interval_ms;
+  for (const [i, f] of job.frames.entries()) {
+    playMessage(`loading frame ${i + 1} of ${job.frames.length}`);
+    const r = await fetch(`/api/blob/${f.blob}`, { headers: { "x-subgram-token": API_TOKEN }, cache: "no-store", credentials: "omit" });
+    if (state.play !== play) return;
+    if (!r.ok) { stopPlay(); playMessage(`cannot fetch frame ${i + 1}: the server answered ${r.status}`, true); return; }
+    if (f.kind === "svg") {
+      play.frames.push({ step: f.step, kind: "svg", url: "data:image/svg+xml;charset=utf-8," + encodeURIComponent(await r.text()) });
+    } else {
+      const bytes = await r.arrayBuffer();
+      if (state.play !== play) return;
+      if (!ensureView3d()) { stopPlay(); return; }
+      const model = bytes.byteLength ? state.view3d.load(bytes) : { prims: [], hasEdges: false };
+      play.frames.push({ step: f.step, kind: "glb", model, info: f.scene || job.frames.find((g) => g.scene)?.scene });
+    }
+  }
+  play.ready = true;
+  playButton.disabled = false;
+  frameSlider.disabled = false;
+  frameSlider.max = play.frames.length - 1;
+  const warn = (job.messages || []).length ? ` · ${job.messages[0].message}` : "";
+  playMessage(`${play.frames.length} frames, derived in ${job.seconds.toFixed(2)} s${warn}`);
+  showFrame(0);
+  setPlaying(true);
+}
+
+// The 3D view, made when first needed.
+function ensureView3d() {
+  if (state.view3d) return true;
+  let canvas;
+  try {
+    canvas = document.createElement("canvas");
+    canvas.className = "view3d";
+    picture.append(canvas);
+    state.view3d = new View3D(canvas);
+    state.view3d.setWireframe(wire.checked);
+    return true;
+  } catch (e) {
+    canvas?.remove();
+    state.view3d = null;
+    status.className = "error";
+    status.textContent = `cannot draw in 3D here: ${e.message}`;
+    return false;
+  }
+}
+
+function showFrame(i) {
+  const play = state.play;
+  if (!play || !play.ready) return;
+  play.index = Math.max(0, Math.min(play.frames.length - 1, i));
+  const f = play.frames[play.index];
+  if (f.kind === "svg") {
+    showFlat(f.url);
+  } else {
+    const first = state.mode !== "3d";
+    setMode("3d");
+    state.view3d.canvas.hidden = false;
+    // One camera for every frame: the frames' own (fitted to them all),
+    // set by the first frame shown and kept after.
+    state.view3d.use(f.model, f.info, !first && play.cameraSet);
+    play.cameraSet = true;
+  }
+  frameSlider.value = play.index;
+  frameOut.textContent = `step ${f.step} (${play.index + 1}/${play.frames.length})`;
+  state.frameShown = f.step;
+  picture.classList.remove("stale");
+}
+
+function setPlaying(on) {
+  const play = state.play;
+  if (!play) return;
+  play.playing = on;
+  clearTimeout(play.timer);
+  playButton.innerHTML = on ? "&#10074;&#10074; Pause" : "&#9654; Play";
+  if (on) tick();
+}
+
+function tick() {
+  const play = state.play;
+  if (!play || !play.playing) return;
+  play.timer = setTimeout(() => {
+    if (state.play !== play || !play.playing) return;
+    if (play.index + 1 < play.frames.length) showFrame(play.index + 1);
+    else if ($("loop").checked) showFrame(0);
+    else { setPlaying(false); return; }
+    tick();
+  }, play.intervalMs / Number($("speed").value));
+}
+
+// Ends the playback: its frames freed, the controls back to their rest.
+function stopPlay() {
+  const play = state.play;
+  if (!play) return;
+  state.play = null;
+  clearTimeout(play.timer);
+  for (const f of play.frames) if (f.model && state.view3d) state.view3d.free(f.model);
+  // The view drew a frame: nothing until the still picture comes back.
+  if (state.view3d && !state.view3d.owned) { state.view3d.prims = []; state.view3d.redraw(); }
+  playButton.innerHTML = "&#9654; Play";
+  playButton.disabled = false;
+  frameSlider.disabled = true;
+  frameSlider.max = 0;
+  frameOut.textContent = "";
+  state.frameShown = null;
+  playMessage("");
+}
+
+playButton.addEventListener("click", () => {
+  const play = state.play;
+  if (play && play.ready && play.key === JSON.stringify(requestBody())) setPlaying(!play.playing);
+  else if (!play || play.ready) startPlay();
+});
+frameSlider.addEventListener("input", () => { setPlaying(false); showFrame(Number(frameSlider.value)); });
+$("back").addEventListener("click", () => { setPlaying(false); showFrame((state.play?.index ?? 0) - 1); });
+$("fwd").addEventListener("click", () => { setPlaying(false); showFrame((state.play?.index ?? 0) + 1); });
 
 function goTo(line, col) {
   if (!line) return;

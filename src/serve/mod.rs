@@ -1,15 +1,25 @@
 //! `subgram serve`: a live preview page on 127.0.0.1.
 //!
-//! The page (`page.html`, `app.js`, `app.css`, built into the binary) edits
-//! the program's text; each edit is posted to `/api/render`, which derives
-//! and draws it as [`command::render_edited`] does, in memory, under the
-//! derivation limits of [`Limits`], and answers the SVG or the diagnostics
-//! with their lines and columns. The server reads the program and the files
-//! a run reads (a model's files, a base mesh) and serves nothing from the
-//! disk: its only routes are the page's three assets and the API. It never
-//! writes a file, except the program itself on `/api/save` when started
-//! with `--save` (atomically). Malformed requests get an error status and a
-//! message.
+//! The page (`page.html`, `app.js`, `view3d.js`, `app.css`, built into
+//! the binary) edits the program's text; each edit is posted to
+//! `/api/render`, which derives it as [`command::sight_edited`] does, in
+//! memory, under the derivation limits of [`Limits`], and answers a 2D
+//! drawing's SVG, or 3D geometry (a plant the view file draws in 3D, a
+//! grammar's, vv program's or shape grammar's mesh) kept as the GLB that
+//! `render -o model.glb` writes, which the page fetches from
+//! `/api/blob/ID` and draws itself with WebGL (`view3d.js`: orbit, pan,
+//! zoom, reset, wireframe, flat); or the diagnostics with their lines and
+//! columns. Geometry larger than [`Limits::max_scene_bytes`] comes as the
+//! server's z-buffer picture of it, with a message. `/api/play` derives
+//! every step once on a thread of its own (`play.rs`: the frames of
+//! `render -o growth.gif`, one camera) and answers its progress at
+//! `/api/play/ID`, then each frame's file for the page to keep and play.
+//! The server reads the program and the files a run reads (a model's
+//! files, a base mesh) and serves nothing from the disk: its only routes
+//! are the page's four assets and the API; what renders made is kept in
+//! memory within [`Limits::max_kept_bytes`]. It never writes a file,
+//! except the program itself on `/api/save` when started with `--save`
+//! (atomically). Malformed requests get an error status and a message.
 //!
 //! Each connection brings one request (the server's small HTTP/1.1 is in
 //! `http.rs`), answered on a thread of its own, at most [`MAX_IN_FLIGHT`]
@@ -27,7 +37,8 @@
 //! - an `Origin`, when there is one, is the page's own
 //!   (`http://127.0.0.1:PORT` or `http://localhost:PORT`), and
 //!   `Sec-Fetch-Site`, when there is one, is not another site's: 403;
-//! - the API (`/api/source`, `/api/render`, `/api/save`) needs the run's
+//! - the API (`/api/source`, `/api/render`, `/api/save`, `/api/blob/ID`,
+//!   `/api/play`, `/api/play/ID`) needs the run's
 //!   token in [`TOKEN_HEADER`]: 32 random bytes drawn at start, written
 //!   into the page (`<meta name="subgram-token">`), which another origin
 //!   cannot read; missing or wrong, 403 (compared in constant time);
@@ -57,6 +68,7 @@ use crate::error::Error;
 use crate::render::Rgba;
 
 mod http;
+mod play;
 
 pub use http::{MAX_HEAD, REQUEST_TIMEOUT};
 
@@ -103,6 +115,9 @@ pub struct Limits {
     /// The most bytes of geometry and pictures the server keeps for the
     /// page to fetch (the oldest are dropped first).
     pub max_kept_bytes: usize,
+    /// The time a growth's playback may take to derive and draw all its
+    /// frames.
+    pub play_timeout: Duration,
 }
 
 impl Default for Limits {
@@ -113,6 +128,7 @@ impl Default for Limits {
             timeout: Duration::from_secs(10),
             max_scene_bytes: 256 << 20,
             max_kept_bytes: 1 << 30,
+            play_timeout: Duration::from_secs(60),
         }
     }
 }
@@ -154,7 +170,9 @@ pub struct App {
     /// `page.html` with the token in it.
     page: String,
     /// What renders made for the page to fetch (`/api/blob/ID`).
-    blobs: std::sync::Mutex<Blobs>,
+    blobs: Arc<std::sync::Mutex<Blobs>>,
+    /// Growth playbacks (`/api/play`).
+    jobs: Arc<std::sync::Mutex<play::Jobs>>,
 }
 
 /// Files kept for the page: the newest first to stay, within
@@ -221,7 +239,7 @@ struct SaveRequest {
 
 /// A diagnostic as the page shows it: `program` when it lies in the text
 /// being edited (the page marks it there).
-#[derive(Serialize, Debug, PartialEq)]
+#[derive(Serialize, Clone, Debug, PartialEq)]
 pub struct Message {
     pub severity: &'static str,
     pub file: String,
@@ -255,7 +273,7 @@ struct RenderReply {
 /// 3D geometry for the page: a GLB (`kind` "glb") to draw with its
 /// camera, or, when it is larger than [`Limits::max_scene_bytes`], the
 /// server's picture of it (`kind` "png") and why.
-#[derive(Serialize, Debug)]
+#[derive(Serialize, Clone, Debug)]
 pub struct SceneReply {
     pub blob: u64,
     pub kind: &'static str,
@@ -293,6 +311,8 @@ enum Route {
     Script,
     Viewer,
     Blob(u64),
+    Play,
+    Job(u64),
     Style,
     Source,
     Render,
@@ -304,7 +324,12 @@ impl Route {
     fn api(self) -> bool {
         matches!(
             self,
-            Route::Source | Route::Render | Route::Save | Route::Blob(_)
+            Route::Source
+                | Route::Render
+                | Route::Save
+                | Route::Blob(_)
+                | Route::Play
+                | Route::Job(_)
         )
     }
 }
@@ -435,6 +460,7 @@ impl App {
             token,
             page,
             blobs: Default::default(),
+            jobs: Default::default(),
         })
     }
 
@@ -515,6 +541,13 @@ impl App {
             ("GET", "/api/source") => Route::Source,
             ("POST", "/api/render") => Route::Render,
             ("POST", "/api/save") => Route::Save,
+            ("POST", "/api/play") => Route::Play,
+            ("GET", job) if job.starts_with("/api/play/") => {
+                match job["/api/play/".len()..].parse::<u64>() {
+                    Ok(id) => Route::Job(id),
+                    Err(_) => return failure(404, "no such playback: its name is its number"),
+                }
+            }
             ("GET", blob) if blob.starts_with("/api/blob/") => {
                 match blob["/api/blob/".len()..].parse::<u64>() {
                     Ok(id) => Route::Blob(id),
@@ -524,7 +557,7 @@ impl App {
             (
                 _,
                 "/" | "/app.js" | "/view3d.js" | "/app.css" | "/api/source" | "/api/render"
-                | "/api/save",
+                | "/api/save" | "/api/play",
             ) => {
                 return failure(
                     405,
@@ -559,17 +592,18 @@ impl App {
             Route::Script => asset(SCRIPT.as_bytes(), "application/javascript; charset=utf-8"),
             Route::Viewer => asset(VIEWER.as_bytes(), "application/javascript; charset=utf-8"),
             Route::Blob(id) => self.blob(id),
+            Route::Job(id) => self.job(id),
             Route::Style => asset(STYLE.as_bytes(), "text/css; charset=utf-8"),
             Route::Source => self.source(),
-            Route::Render | Route::Save => {
+            Route::Render | Route::Save | Route::Play => {
                 let bytes = match check_json(head).and_then(|()| read_body(head, body)) {
                     Ok(b) => b,
                     Err(r) => return r,
                 };
-                if route == Route::Render {
-                    self.render(&bytes)
-                } else {
-                    self.save(&bytes)
+                match route {
+                    Route::Render => self.render(&bytes),
+                    Route::Play => self.play(&bytes),
+                    _ => self.save(&bytes),
                 }
             }
         }
@@ -750,43 +784,23 @@ impl App {
             );
             ("png", png, Some(note))
         };
-        let c = &solid.camera;
-        let (lo, hi) = solid.scene.bounds().unwrap_or_default();
-        let Rgba(r, g, b, _) = solid.background;
         let size = bytes.len();
         let content = if kind == "glb" {
             "model/gltf-binary"
         } else {
             "image/png"
         };
-        let blob = self.blobs.lock().unwrap_or_else(|p| p.into_inner()).keep(
+        let blob = self.keep(content, bytes);
+        Ok(scene_reply(solid, blob, kind, size, note))
+    }
+
+    /// Keeps a file for the page to fetch; its number.
+    fn keep(&self, content: &'static str, bytes: Vec<u8>) -> u64 {
+        self.blobs.lock().unwrap_or_else(|p| p.into_inner()).keep(
             content,
             bytes,
-            limits.max_kept_bytes,
-        );
-        Ok(SceneReply {
-            blob,
-            kind,
-            bytes: size,
-            triangles: solid.scene.triangle_count(),
-            vertices: solid.scene.vertex_count(),
-            bounds: [lo.to_array(), hi.to_array()],
-            eye: c.eye.to_array(),
-            right: c.right.to_array(),
-            up: c.up.to_array(),
-            dir: c.dir.to_array(),
-            projection: match c.projection {
-                crate::render::raster::Projection::Parallel => "parallel",
-                crate::render::raster::Projection::Perspective => "perspective",
-            },
-            half_height: c.half_height,
-            turn_axis: solid.up,
-            lit: solid.lit,
-            edges: solid.edges.iter().any(|e| !e.is_empty()),
-            smooth: solid.smooth,
-            background: [r, g, b],
-            note,
-        })
+            self.opts.limits.max_kept_bytes,
+        )
     }
 
     /// A file a render kept: `/api/blob/ID`.
@@ -819,6 +833,43 @@ impl App {
                 &format!("cannot write {}: {e}", self.program.display()),
             ),
         }
+    }
+}
+
+/// What the page is told of 3D geometry kept as `blob` (`bytes` long, of
+/// `kind` "glb" or "png").
+fn scene_reply(
+    solid: &Solid,
+    blob: u64,
+    kind: &'static str,
+    bytes: usize,
+    note: Option<String>,
+) -> SceneReply {
+    let c = &solid.camera;
+    let (lo, hi) = solid.scene.bounds().unwrap_or_default();
+    let Rgba(r, g, b, _) = solid.background;
+    SceneReply {
+        blob,
+        kind,
+        bytes,
+        triangles: solid.scene.triangle_count(),
+        vertices: solid.scene.vertex_count(),
+        bounds: [lo.to_array(), hi.to_array()],
+        eye: c.eye.to_array(),
+        right: c.right.to_array(),
+        up: c.up.to_array(),
+        dir: c.dir.to_array(),
+        projection: match c.projection {
+            crate::render::raster::Projection::Parallel => "parallel",
+            crate::render::raster::Projection::Perspective => "perspective",
+        },
+        half_height: c.half_height,
+        turn_axis: solid.up,
+        lit: solid.lit,
+        edges: solid.edges.iter().any(|e| !e.is_empty()),
+        smooth: solid.smooth,
+        background: [r, g, b],
+        note,
     }
 }
 

@@ -162,12 +162,19 @@ class View3D {
     return p;
   }
 
-  // Replaces the geometry; the camera is kept when `keepCamera` (an edit
-  // of the same model), else set from the reply's.
+  // Replaces the geometry with a GLB's; the camera is kept when
+  // `keepCamera` (an edit of the same model), else set from the reply's.
   show(buffer, info, keepCamera) {
+    if (this.owned) this.free(this.owned);
+    this.owned = this.load(buffer);
+    this.use(this.owned, info, keepCamera);
+  }
+
+  // A GLB's geometry on the GPU, to draw with `use` (a playback keeps one
+  // per frame) and free with `free`.
+  load(buffer) {
     const gl = this.gl;
-    for (const p of this.prims) p.free();
-    this.prims = [];
+    const prims = [];
     const parsed = parseGlb(buffer);
     const vaos = new Map(); // position accessor -> {vao, count}
     for (const p of parsed) {
@@ -195,7 +202,7 @@ class View3D {
           free: () => { gl.deleteVertexArray(vao); for (const b of [pb, nb, ib]) gl.deleteBuffer(b); if (prim.edges) prim.edges.free(); },
         };
         vaos.set(p.positionAccessor, prim);
-        this.prims.push(prim);
+        prims.push(prim);
       }
     }
     // LINES primitives: the polygon edges over their triangles' positions.
@@ -204,7 +211,20 @@ class View3D {
       const tri = vaos.get(p.positionAccessor);
       if (tri) tri.edges = this.edgeBuffer(tri, p.indices);
     }
-    this.hasEdges = parsed.some((p) => p.mode === 1);
+    return { prims, hasEdges: parsed.some((p) => p.mode === 1) };
+  }
+
+  free(model) {
+    for (const p of model.prims) p.free();
+    model.prims = [];
+    if (this.owned === model) this.owned = null;
+  }
+
+  // Draws `model` (from `load`) from now on.
+  use(model, info, keepCamera) {
+    if (this.owned && this.owned !== model) this.free(this.owned);
+    this.prims = model.prims;
+    this.hasEdges = model.hasEdges;
     this.info = info;
     this.lit = info.lit;
     this.background = info.background.map((c) => c / 255);

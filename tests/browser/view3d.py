@@ -131,6 +131,51 @@ def check_3d(page, what, outdir, name):
     return first
 
 
+def frame_to(page, index):
+    page.js(f"""(() => {{ const s = document.getElementById('frame'); s.value = {index};
+               s.dispatchEvent(new Event('input')); return true; }})()""")
+
+
+def play_checks(page, outdir):
+    """Play advances the step and the picture; Pause stops; scrubbing back
+    shows a step's picture again without a request; Step moves one frame."""
+    page.js("document.getElementById('play').click() || true")
+    page.wait("window.subgram.frameShown !== null", "the first frame", timeout=120)
+    status = page.js("document.getElementById('play-status').textContent")
+    assert status.startswith("5 frames"), status
+    seen = {}
+    deadline = time.time() + 20
+    while len(seen) < 5 and time.time() < deadline:
+        step = page.js("window.subgram.frameShown")
+        seen.setdefault(step, sample(page)["sum"])
+        time.sleep(0.05)
+    assert sorted(seen) == [0, 1, 2, 3, 4], f"play showed steps {sorted(seen)}"
+    assert len(set(seen.values())) == 5, "the frames' pictures are not all different"
+    page.js("document.getElementById('play').click() || true")  # pause
+    paused = page.js("window.subgram.frameShown")
+    time.sleep(0.8)
+    assert page.js("window.subgram.frameShown") == paused, "Pause did not stop the playback"
+    requests = page.js("performance.getEntriesByType('resource').length")
+    frame_to(page, 1)
+    one = sample(page)["sum"]
+    assert one == seen[1], "frame 1 is not the picture that play showed for step 1"
+    frame_to(page, 4)
+    frame_to(page, 1)
+    assert sample(page)["sum"] == one, "scrubbing back did not show step 1 again"
+    assert page.js("performance.getEntriesByType('resource').length") == requests, \
+        "scrubbing made a request"
+    page.js("document.getElementById('fwd').click() || true")
+    assert page.js("window.subgram.frameShown") == 2, "Step did not move one frame on"
+    page.screenshot(os.path.join(outdir, "plant-4-playback.png"))
+    # An edit ends the playback; the still picture of the edit comes back.
+    n = version(page)
+    page.caret(3, len("#define STEPS 4") + 1)
+    page.backspace()
+    page.type("3")
+    page.wait(f"window.subgram.version > {n} && window.subgram.frameShown === null",
+              "the still picture after an edit")
+
+
 def main():
     binary = os.path.abspath(sys.argv[1] if len(sys.argv) > 1
                              else os.path.join(ROOT, "target", "debug", "subgram"))
@@ -189,6 +234,10 @@ def main():
         page.wait(f"window.subgram.version > {n}", "the view back")
         checks += 1
 
+        # 5. Playback: every step derived once, then played and scrubbed.
+        play_checks(page, outdir)
+        checks += 1
+
         for what, path in [("mesh", os.path.join(surfaces, "loop.lsys")),
                            ("building", os.path.join(shapes, "building.lsys"))]:
             server, url = start(binary, path, log)
@@ -217,6 +266,18 @@ def main():
                                                "button": "left", "clickCount": 2})
         page.wait(f"Math.abs(document.querySelector('#picture img').getBoundingClientRect().width - {width}) < 1",
                   "the curve back at its size")
+        # Its playback: one SVG per step, each another picture.
+        page.js("document.getElementById('play').click() || true")
+        page.wait("window.subgram.frameShown !== null", "the curve's frames")
+        pictures = {}
+        deadline = time.time() + 20
+        while len(pictures) < 4 and time.time() < deadline:
+            pictures.setdefault(page.js("window.subgram.frameShown"),
+                                page.js("document.querySelector('#picture img').src"))
+            time.sleep(0.05)
+        assert sorted(pictures) == [0, 1, 2, 3], sorted(pictures)
+        assert all(p.startswith("data:image/svg+xml") for p in pictures.values())
+        assert len(set(pictures.values())) == 4, "the curve's frames are not all different"
         checks += 1
         print(f"view3d: {checks} checks passed; screenshots in {outdir}")
     finally:
