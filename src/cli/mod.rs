@@ -57,6 +57,10 @@ enum Command {
     Watch(render::WatchCli),
     /// A live preview page on 127.0.0.1: edit the program, see its picture.
     Serve(serve::ServeCli),
+    /// `serve`, and its page opened in the default browser (the address
+    /// printed where there is none): orbit a plant or a mesh in 3D, play
+    /// its growth step by step.
+    View(serve::ServeCli),
     /// Infer L-system productions from a subdivision matrix or mask
     /// (paper 002, sections 5-7).
     Infer(infer::InferCli),
@@ -84,6 +88,7 @@ pub(crate) fn run(cli: Cli) -> Result<(), Error> {
         Command::Render(c) => c.run(),
         Command::Watch(c) => c.run(),
         Command::Serve(c) => c.run(),
+        Command::View(c) => c.view(),
         Command::Infer(c) => c.run(),
         Command::Reverse(c) => c.run(),
         Command::Reconstruct(c) => c.run(),

@@ -924,3 +924,155 @@ fn a_blocked_request_does_not_stop_the_others() {
     });
     assert_eq!(render(&live, KOCH, "")["ok"], true);
 }
+
+/// `subgram view`: the server started as `serve` starts it, and its page
+/// opened with the browser `$BROWSER` names (here a script that writes
+/// down the address it was given): the address printed, the page there.
+#[cfg(unix)]
+#[test]
+fn view_opens_the_page_in_the_browser() {
+    use std::io::BufRead;
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch("serve-view");
+    let program = dir.path().join("koch.lsys");
+    std::fs::write(&program, KOCH).unwrap();
+    let opened = dir.path().join("opened");
+    let browser = dir.path().join("browser.sh");
+    std::fs::write(
+        &browser,
+        format!(
+            "#!/bin/sh\nprintf '%s' \"$1\" > '{}.part' && mv '{0}.part' '{0}'\n",
+            opened.display()
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&browser, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .args(["view", program.to_str().unwrap(), "--port", "0"])
+        .env("BROWSER", &browser)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    std::io::BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let url = line
+        .split_whitespace()
+        .find(|w| w.starts_with("http://127.0.0.1:"))
+        .unwrap_or_else(|| panic!("no address printed: {line:?}"))
+        .to_string();
+    let t = Instant::now();
+    while !opened.exists() && t.elapsed() < Duration::from_secs(20) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let given = std::fs::read_to_string(&opened);
+    let addr = url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    let (status, page) = send(&addr, "GET", "/", &[format!("Host: {addr}")], "");
+    let _ = child.kill();
+    let _ = child.wait();
+    assert_eq!(given.expect("the browser was not opened"), url);
+    assert_eq!(status, 200);
+    assert!(page.contains("subgram-token"), "{page}");
+}
+
+/// A playback's job to its end, polled as the page polls it.
+fn play(live: &Live, text: &str, extra: &str) -> serde_json::Value {
+    let (status, reply) = request(live, "POST", "/api/play", &render_body(text, extra));
+    assert_eq!(status, 200, "{reply}");
+    let job: serde_json::Value = serde_json::from_str(&reply).unwrap();
+    let id = job["job"].as_u64().expect("a job number");
+    let t = Instant::now();
+    loop {
+        let (status, reply) = request(live, "GET", &format!("/api/play/{id}"), "");
+        assert_eq!(status, 200, "{reply}");
+        let state: serde_json::Value = serde_json::from_str(&reply).unwrap();
+        assert_eq!(state["id"], id);
+        if state["phase"] == "done" || state["phase"] == "failed" {
+            return state;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(60),
+            "the job did not end: {state}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Growth playback over HTTP: one SVG frame per step of a curve (steps 0
+/// to 3, each another drawing, all in one box: the same `viewBox`), one
+/// GLB frame per level of a surface grammar with one camera for all; a
+/// runaway growth stops at the module limit with a message; an unknown
+/// job is 404 and the route needs the token.
+#[test]
+fn playback_derives_every_step_once_and_keeps_each_frame() {
+    let live = start("play", KOCH, false, Limits::default());
+    let done = play(&live, KOCH, "");
+    assert_eq!(done["phase"], "done", "{done}");
+    let frames = done["frames"].as_array().unwrap();
+    let steps: Vec<u64> = frames.iter().map(|f| f["step"].as_u64().unwrap()).collect();
+    assert_eq!(steps, [0, 1, 2, 3]);
+    let svgs: Vec<String> = frames
+        .iter()
+        .map(|f| {
+            assert_eq!(f["kind"], "svg");
+            let (status, kind, bytes) = blob(&live, &f["blob"]);
+            assert_eq!((status, kind.as_str()), (200, "image/svg+xml"));
+            String::from_utf8(bytes).unwrap()
+        })
+        .collect();
+    for w in svgs.windows(2) {
+        assert_ne!(w[0], w[1]);
+    }
+    let view_box = |svg: &str| {
+        let at = svg.find("viewBox=\"").unwrap() + 9;
+        svg[at..at + svg[at..].find('"').unwrap()].to_string()
+    };
+    assert!(svgs.iter().all(|s| view_box(s) == view_box(&svgs[0])));
+
+    // A surface grammar: a GLB per level, one camera.
+    let mesh = crate::support::root().join("lsystems/meshes/octahedron.obj");
+    let grammar = std::fs::read_to_string(crate::support::lsys("surfaces/loop.lsys"))
+        .unwrap()
+        .replace(
+            "mesh: \"../meshes/octahedron.obj\";",
+            &format!("mesh: {:?};", mesh.to_str().unwrap()),
+        );
+    let done = play(&live, &grammar, ", \"steps\": 2");
+    assert_eq!(done["phase"], "done", "{done}");
+    let frames = done["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 3);
+    for (k, f) in frames.iter().enumerate() {
+        assert_eq!(f["kind"], "glb");
+        assert_eq!(f["scene"]["triangles"], 8 * 4usize.pow(k as u32), "{f}");
+        for key in ["eye", "dir", "up", "half_height"] {
+            assert_eq!(f["scene"][key], frames[0]["scene"][key], "{key}");
+        }
+        let (status, _, bytes) = blob(&live, &f["blob"]);
+        assert_eq!(status, 200);
+        let (doc, _) = glb(&bytes);
+        assert_eq!(doc["asset"]["version"], "2.0");
+    }
+
+    // A runaway growth stops at the page's module limit.
+    let limits = Limits {
+        max_modules: 10_000,
+        ..Limits::default()
+    };
+    let tight = start("play-tight", KOCH, false, limits);
+    let runaway = "angle: 90;\nderivation length: 40;\nAxiom: F;\nF -> FF\n";
+    let failed = play(&tight, runaway, "");
+    assert_eq!(failed["phase"], "failed", "{failed}");
+    assert_eq!(failed["limit"], "modules", "{failed}");
+    assert!(!failed["messages"].as_array().unwrap().is_empty());
+
+    let (status, _) = request(&live, "GET", "/api/play/999999", "");
+    assert_eq!(status, 404);
+    let addr = &live.addr;
+    let (status, _) = send(addr, "GET", "/api/play/1", &[format!("Host: {addr}")], "");
+    assert_eq!(status, 403);
+}
