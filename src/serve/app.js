@@ -218,7 +218,9 @@ async function render() {
   const body = requestBody();
   let reply, code;
   try {
+    state.timing = { asked: performance.now() };
     ({ status: code, reply } = await api("/api/render", body, ctl.signal));
+    state.timing.answered = performance.now();
   } catch (e) {
     if (e.name === "AbortError") return;
     reply = { ok: false, messages: [{ severity: "error", message: `the server did not answer: ${e}` }] };
@@ -420,10 +422,17 @@ async function showScene(reply) {
     state.view3d.setWireframe(wire.checked);
     state.view3d.setFlat(flat.checked);
   }
+  const fetched = performance.now();
   state.view3d.show(bytes, info, sameKind);
+  // Drawn now, not at the next animation frame: the time an edit takes
+  // to become a view (the status says it; the benchmark reads it).
+  state.view3d.draw();
+  state.view3d.gl.finish();
+  if (state.timing) Object.assign(state.timing, { fetched, drawn: performance.now() });
   state.scene = info;
   const mb = (info.bytes / 1e6).toFixed(info.bytes < 1e7 ? 1 : 0);
-  shown(`drawn in ${took.toFixed(2)} s · ${info.triangles.toLocaleString()} triangles, ${mb} MB`);
+  const page = state.timing?.drawn ? ` + ${((state.timing.drawn - state.timing.answered) / 1000).toFixed(2)} s in the page` : "";
+  shown(`drawn in ${took.toFixed(2)} s${page} · ${info.triangles.toLocaleString()} triangles, ${mb} MB`);
 }
 
 wire.addEventListener("change", () => state.view3d?.setWireframe(wire.checked));
