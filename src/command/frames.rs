@@ -219,11 +219,13 @@ pub fn frames(
             s.subdivide_each(&opts.run, &mut progress, |step, mesh| {
                 if selection.contains(step as u64) {
                     check_count(soups.len() + 1, opts.size)?;
-                    soups.push((step as u64, mesh.to_quad_soup()));
+                    let (soup, sharp) = mesh.to_soup_with_sharpness(false);
+                    let sharp = sharp.edges.iter().map(|&(a, b, _)| (a, b)).collect();
+                    soups.push((step as u64, soup, sharp));
                 }
                 Ok(())
             })?;
-            mesh_frames(soups, opts)
+            mesh_frames(soups, opts, false)
         }
         System::Vv(v) => {
             let selection = opts.selection.unwrap_or_default();
@@ -232,15 +234,19 @@ pub fn frames(
                 &opts.run,
                 &mut progress,
                 |step| selection.contains(step),
-                |step, soup| soups.push((step, soup)),
+                |step, soup| soups.push((step, soup, Vec::new())),
             )?;
             check_count(soups.len(), opts.size)?;
             // The last step's mesh as `End` leaves it (what `render`
             // draws).
-            if let Some(last) = soups.last_mut().filter(|(s, _)| *s == run.steps) {
+            if let Some(last) = soups.last_mut().filter(|(s, ..)| *s == run.steps) {
                 last.1 = run.soup;
             }
-            mesh_frames(soups, opts)
+            // A sheet of cells at the end: its cells in colours all along.
+            let cells = soups
+                .last()
+                .is_some_and(|(_, s, _)| crate::render::mesh::has_cells(s));
+            mesh_frames(soups, opts, cells)
         }
         System::Shapes(_) => Err(Error::Usage(
             "a shape grammar has no steps to animate: it draws its terminal shapes once \
@@ -565,9 +571,15 @@ fn solid_curve_frames(
         .collect()
 }
 
-/// A mesh's frames (a surface grammar's levels, a vv program's steps):
-/// the tight fit of every frame's vertices, the mesh pictures' looks.
-fn mesh_frames(soups: Vec<(u64, PolygonSoup)>, opts: &FrameOptions) -> Result<Frames, Error> {
+/// A mesh's frames (a surface grammar's levels with their sharp edges, a
+/// vv program's steps): the tight fit of every frame's vertices, the mesh
+/// pictures' looks, with `cells` each face in a colour.
+#[allow(clippy::type_complexity)]
+fn mesh_frames(
+    soups: Vec<(u64, PolygonSoup, Vec<(u32, u32)>)>,
+    opts: &FrameOptions,
+    cells: bool,
+) -> Result<Frames, Error> {
     let looks = MeshLooks {
         size: opts.size,
         background: opts.background.unwrap_or(Rgba(255, 255, 255, 255)),
@@ -575,15 +587,16 @@ fn mesh_frames(soups: Vec<(u64, PolygonSoup)>, opts: &FrameOptions) -> Result<Fr
         wireframe: opts.wireframe,
         shading: crate::render::mesh::Shading::Lit,
         flat: opts.flat,
+        cells,
     };
-    let view = looks.check()?;
+    let view = looks.view_of(soups.iter().map(|(_, s, _)| s))?;
     if soups.is_empty() {
         return Err(no_frames(opts.selection.unwrap_or_default()));
     }
-    for (_, soup) in &soups {
+    for (_, soup, _) in &soups {
         crate::render::mesh::validate(soup, &view)?;
     }
-    let mut points = soups.iter().flat_map(|(_, soup)| {
+    let mut points = soups.iter().flat_map(|(_, soup, _)| {
         soup.faces
             .iter()
             .flatten()
@@ -593,7 +606,12 @@ fn mesh_frames(soups: Vec<(u64, PolygonSoup)>, opts: &FrameOptions) -> Result<Fr
     let camera = crate::render::mesh::camera(&view, &mut points as &mut dyn Iterator<Item = Vec3>)?;
     let frames = soups
         .into_iter()
-        .map(|(step, soup)| {
+        .map(|(step, soup, sharp)| {
+            let mut view = view.clone();
+            view.sharp_edges = sharp;
+            if cells {
+                view.face_colours = crate::render::mesh::cell_colours(&soup);
+            }
             let (scene, polygons, back) = crate::render::mesh::scene3(&soup, &view);
             let raster = crate::render::mesh::raster_options_with(camera, &view, polygons, back);
             Frame {
