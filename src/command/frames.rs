@@ -94,7 +94,7 @@ impl FrameSelection {
     pub fn contains(&self, n: u64) -> bool {
         n >= self.first
             && self.last.is_none_or(|l| n <= l)
-            && (n - self.first) % self.step.max(1) == 0
+            && (n - self.first).is_multiple_of(self.step.max(1))
     }
 }
 
@@ -265,7 +265,7 @@ fn check_count(frames: usize, (w, h): (u32, u32)) -> Result<(), Error> {
             "{frames} frames of {w}x{h} pixels are too many: an animation has at most {MAX_FRAMES} \
              frames and {} GiB of pixels; choose fewer steps (-n, or `step:` in the model's .a \
              file) or a smaller --size",
-            MAX_FRAME_PIXELS * 4 >> 30
+            (MAX_FRAME_PIXELS * 4) >> 30
         )));
     }
     Ok(())
@@ -335,10 +335,16 @@ fn curve_frames(
     };
     let on_step = &mut |d: &crate::rewrite::Derivation| progress(Progress::of_derivation(d));
     let p = &c.program;
+    // Frames past the limits stop the run at once: the drawing callback
+    // fails, and the run's error is replaced by the limit's.
+    let refused = std::cell::RefCell::new(None);
     let mut count = 0;
-    let counted = |count: &mut usize| {
-        *count += 1;
-        check_count(*count, opts.size)
+    let mut admit = || {
+        count += 1;
+        check_count(count, opts.size).map_err(|e| {
+            *refused.borrow_mut() = Some(e);
+            too_many()
+        })
     };
     let frames = if super::render::wants_solid(opts.solid, c) {
         // The interpreted words of the frames, each walked once for its
@@ -352,19 +358,13 @@ fn curve_frames(
                     if !selection.contains(step) {
                         return Ok(None);
                     }
-                    counted(&mut count).map_err(|_| too_many())?;
+                    admit()?;
                     let lines = crate::draw::line_bounds(word, &p.alphabet, &p.structs, draw_opts)?;
                     Ok(Some((step, word.clone(), draw_opts.clone(), lines)))
                 },
                 on_step,
             )
-            .map_err(|e| {
-                if count > MAX_FRAMES {
-                    check_count(count, opts.size).unwrap_err()
-                } else {
-                    e
-                }
-            })?;
+            .map_err(|e| refused.take().unwrap_or(e))?;
         check_count(words.len(), opts.size)?;
         solid_curve_frames(c, words, opts, background, each_fitted)?
     } else {
@@ -396,19 +396,13 @@ fn curve_frames(
                     if !selection.contains(step) {
                         return Ok(None);
                     }
-                    counted(&mut count).map_err(|_| too_many())?;
+                    admit()?;
                     let events = crate::draw::draw(word, &p.alphabet, &p.structs, draw_opts)?;
                     Ok(Some((step, events)))
                 },
                 on_step,
             )
-            .map_err(|e| {
-                if count > MAX_FRAMES {
-                    check_count(count, opts.size).unwrap_err()
-                } else {
-                    e
-                }
-            })?;
+            .map_err(|e| refused.take().unwrap_or(e))?;
         check_count(drawn.len(), opts.size)?;
         flat_frames(drawn, &figure.render, model.camera.bbox, each_fitted)?
     };
@@ -492,17 +486,21 @@ fn flat_frames(
         .collect()
 }
 
+/// A frame's step, its interpreted word, the turtle's settings and the box
+/// of its lines.
+type StepWord = (
+    u64,
+    crate::rewrite::Word,
+    crate::draw::DrawOptions,
+    Option<(glam::DVec3, glam::DVec3)>,
+);
+
 /// An L-system's frames in 3D: tubes for pixel-wide lines as wide as a
 /// pixel at the animation's scale, the view file's camera fitted to all
 /// frames (or each, with `each_fitted`).
 fn solid_curve_frames(
     c: &crate::Curve,
-    words: Vec<(
-        u64,
-        crate::rewrite::Word,
-        crate::draw::DrawOptions,
-        Option<(glam::DVec3, glam::DVec3)>,
-    )>,
+    words: Vec<StepWord>,
     opts: &FrameOptions,
     background: Rgba,
     each_fitted: bool,

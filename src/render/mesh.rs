@@ -569,7 +569,8 @@ fn corner_normals(
         c
     }
     // Each edge's (face, corner of its first end, corner of its second).
-    let mut edges: HashMap<(u32, u32), Vec<(usize, usize, usize)>> = HashMap::new();
+    type Sides = Vec<(usize, usize, usize)>;
+    let mut edges: HashMap<(u32, u32), Sides> = HashMap::new();
     for (f, face) in soup.faces.iter().enumerate() {
         if newell[f].is_none() {
             continue;

@@ -431,3 +431,25 @@ fn frames_share_one_camera_in_the_library() {
             .starts_with(b"glTF"));
     }
 }
+
+#[test]
+fn frames_past_the_limits_are_refused_while_the_run_goes() {
+    // 40 steps of 4000×4000 pixels: the 34th frame passes 2 GiB of RGBA,
+    // and the run stops there with the limit's message, not at the end.
+    let dir = scratch("anim-limits");
+    std::fs::write(
+        dir.path().join("still.lsys"),
+        "derivation length: 40;\nAxiom: F(1);\n",
+    )
+    .unwrap();
+    let e = run_usage_error(
+        dir.path(),
+        &["render", "still.lsys", "--size", "4000x4000", "-o", "s.gif"],
+    );
+    assert!(
+        e.contains("34 frames of 4000x4000 pixels are too many"),
+        "{e}"
+    );
+    assert!(e.contains("at most 1000 frames and 2 GiB of pixels"), "{e}");
+    assert_eq!(files_in(dir.path()), ["still.lsys"]);
+}
