@@ -117,6 +117,14 @@ pub struct SolidFrame {
     pub raster: RasterOptions,
 }
 
+impl SolidFrame {
+    /// Whether the frame has nothing to draw (a plant before its first
+    /// line): its picture is the background.
+    pub fn is_empty(&self) -> bool {
+        self.scene.triangle_count() == 0 && self.scene.line_count() == 0
+    }
+}
+
 /// One frame: the step it shows and its geometry.
 #[derive(Clone, Debug)]
 pub struct Frame {
@@ -129,6 +137,17 @@ impl Frame {
     pub fn picture(&self, format: Picture) -> Result<Vec<u8>, Error> {
         Ok(match (&self.geometry, format) {
             (FrameGeometry::Flat(scene), format) => picture_bytes(scene, format)?,
+            (FrameGeometry::Solid(s), format) if s.is_empty() => {
+                // A step with nothing drawn yet: the background.
+                let (width, height) = self.size();
+                let blank = Scene {
+                    width,
+                    height,
+                    background: s.raster.background,
+                    items: Vec::new(),
+                };
+                picture_bytes(&blank, format)?
+            }
             (FrameGeometry::Solid(s), Picture::Png) => {
                 render::raster::render_png(&s.scene, &s.raster)?
             }
@@ -142,21 +161,18 @@ impl Frame {
     pub fn image(&self) -> Result<Image, Error> {
         Ok(match &self.geometry {
             FrameGeometry::Flat(scene) => render::png::image(scene)?,
-            FrameGeometry::Solid(s) => {
-                if s.scene.triangle_count() == 0 && s.scene.line_count() == 0 {
-                    // A step with nothing drawn yet: the background.
-                    let (w, h) = (s.raster.camera.width, s.raster.camera.height);
-                    let Rgba(r, g, b, a) = s.raster.background;
-                    let pre = |c: u8| ((c as u32 * a as u32 + 127) / 255) as u8;
-                    Image {
-                        width: w,
-                        height: h,
-                        pixels: [pre(r), pre(g), pre(b), a].repeat(w as usize * h as usize),
-                    }
-                } else {
-                    render::raster::render(&s.scene, &s.raster)?
+            FrameGeometry::Solid(s) if s.is_empty() => {
+                // A step with nothing drawn yet: the background.
+                let (w, h) = self.size();
+                let Rgba(r, g, b, a) = s.raster.background;
+                let pre = |c: u8| ((c as u32 * a as u32 + 127) / 255) as u8;
+                Image {
+                    width: w,
+                    height: h,
+                    pixels: [pre(r), pre(g), pre(b), a].repeat(w as usize * h as usize),
                 }
             }
+            FrameGeometry::Solid(s) => render::raster::render(&s.scene, &s.raster)?,
         })
     }
 

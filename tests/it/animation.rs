@@ -453,3 +453,57 @@ fn frames_past_the_limits_are_refused_while_the_run_goes() {
     assert!(e.contains("at most 1000 frames and 2 GiB of pixels"), "{e}");
     assert_eq!(files_in(dir.path()), ["still.lsys"]);
 }
+
+#[test]
+fn a_3d_frame_with_nothing_drawn_yet_is_the_background() {
+    // Step 0 is the axiom `A()`, which draws nothing; steps 1 and 2 draw
+    // tubes, shaded by the z-buffer.
+    let dir = scratch("anim-empty");
+    std::fs::write(
+        dir.path().join("grow.lsys"),
+        "derivation length: 2;\nmodule A();\nAxiom: SetWidth(0.2) A();\nA() : { produce F(1) A(); }\n",
+    )
+    .unwrap();
+    std::fs::create_dir(dir.path().join("f")).unwrap();
+    run_ok(
+        dir.path(),
+        &[
+            "render",
+            "grow.lsys",
+            "--solid",
+            "--size",
+            "80x80",
+            "-o",
+            "f/{n}.png",
+        ],
+    );
+    run_ok(
+        dir.path(),
+        &[
+            "render",
+            "grow.lsys",
+            "--solid",
+            "--size",
+            "80x80",
+            "-o",
+            "g.apng",
+        ],
+    );
+    let d = decode_apng(&dir.path().join("g.apng"));
+    assert_eq!(d.frames.len(), 3);
+    assert_eq!(ink_box(&d.frames[0], 80, 0), None);
+    let (a, b) = (
+        ink_box(&d.frames[1], 80, 8).unwrap(),
+        ink_box(&d.frames[2], 80, 8).unwrap(),
+    );
+    // The second tube doubles the plant's height in the one camera.
+    assert!(
+        inside(a, b, 0) && (b.3 - b.1) > (a.3 - a.1) * 3 / 2,
+        "{a:?} {b:?}"
+    );
+    let still = png::Decoder::new(std::fs::File::open(dir.path().join("f/0.png")).unwrap());
+    let mut r = still.read_info().unwrap();
+    let mut buf = vec![0; r.output_buffer_size()];
+    r.next_frame(&mut buf).unwrap();
+    assert!(buf.chunks_exact(4).all(|p| p == [255, 255, 255, 255]));
+}
