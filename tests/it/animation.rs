@@ -507,3 +507,45 @@ fn a_3d_frame_with_nothing_drawn_yet_is_the_background() {
     r.next_frame(&mut buf).unwrap();
     assert!(buf.chunks_exact(4).all(|p| p == [255, 255, 255, 255]));
 }
+
+#[test]
+fn animation_files_read_as_lpfgs_manual_and_vlabs_models_write_them() {
+    use subgram::model::view::{read_a, Animation};
+    // As vlab's own models write it (monopodial's, leaf-rnd's): `last
+    // frame: -1` is up to the derivation length; `frame numbers:` is not
+    // in the manual's list, a note.
+    let text = "double buffer: on\nclear between frames: on\nscale between frames: off\n\
+                new view between frames: off\nhcenter between frames: off\nswap interval: 1\n\
+                first frame: 1\nlast frame: -1\nstep: 1\nframe numbers: consecutive\n";
+    let mut notes = Vec::new();
+    let a = read_a("anim.a", text, &mut notes).unwrap();
+    assert_eq!(
+        a,
+        Animation {
+            first_frame: 1,
+            swap_interval: 1.0,
+            ..Animation::default()
+        }
+    );
+    assert_eq!(notes.len(), 1);
+    assert!(notes[0].message.contains("`frame numbers:`"));
+    let a = read_a(
+        "a.a",
+        "first frame: 2\nlast frame: 9\nstep: 3\nscale between frames: on\n",
+        &mut notes,
+    )
+    .unwrap();
+    assert_eq!(
+        (a.first_frame, a.last_frame, a.step, a.scale_between_frames),
+        (2, Some(9), 3, true)
+    );
+    for bad in [
+        "step: 0\n",
+        "first frame: 1.5\n",
+        "swap interval: -2\n",
+        "double buffer: maybe\n",
+    ] {
+        let e = read_a("bad.a", bad, &mut notes).unwrap_err().to_string();
+        assert!(e.starts_with("bad.a:1:"), "{bad}: {e}");
+    }
+}
