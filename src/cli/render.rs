@@ -15,8 +15,8 @@ use super::print::{print_program_output, print_warnings, with_progress};
 pub(super) struct RenderCli {
     file: String,
     /// The picture: OUT.png or OUT.svg; an animation of the steps:
-    /// OUT.gif or OUT.apng; one still a step: a name with {n} (the step),
-    /// OUT-{n}.png or OUT-{n}.svg.
+    /// OUT.gif or OUT.apng; one still a step: a .png or .svg name with
+    /// {N} (or lower-case n) where the step goes, as OUT-{N}.png.
     #[arg(short = 'o', long = "output")]
     output: String,
     #[arg(short = 'n', long = "steps")]
@@ -50,8 +50,8 @@ pub(super) struct RenderCli {
     /// normals].
     #[arg(long)]
     flat: bool,
-    /// Animations (.gif, .apng, or OUT-{n}.png): frames a second
-    /// [default: the model's `swap interval:`, else 4].
+    /// Animations (.gif, .apng): frames a second [default: the
+    /// model's `swap interval:`, else 4].
     #[arg(long, value_name = "N")]
     fps: Option<f64>,
     #[arg(short = 'D', value_name = "NAME=VALUE")]

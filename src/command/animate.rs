@@ -21,6 +21,9 @@ pub(super) enum Animated {
 
 /// The stand-in for a frame's step in a name of stills.
 pub(super) const STEP: &str = "{n}";
+/// The same in capitals: what `--help` shows, where clap would make
+/// `{n}` a line break.
+const STEP_CAPITAL: &str = "{N}";
 
 impl Animated {
     /// What `path` asks for: an animation, stills, or `None` for a single
@@ -29,7 +32,8 @@ impl Animated {
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase());
-        let stills = path.to_string_lossy().contains(STEP);
+        let name = path.to_string_lossy();
+        let stills = name.contains(STEP) || name.contains(STEP_CAPITAL);
         match (ext.as_deref(), stills) {
             (Some("gif"), false) => Ok(Some(Animated::Gif)),
             (Some("apng"), false) => Ok(Some(Animated::Apng)),
@@ -67,7 +71,8 @@ pub(super) fn check_folder(output: &Path) -> Result<(), Error> {
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    if dir.to_string_lossy().contains(STEP) {
+    let d = dir.to_string_lossy();
+    if d.contains(STEP) || d.contains(STEP_CAPITAL) {
         return Err(Error::Usage(format!(
             "`{}`: {STEP} may stand in the file's name only, not in a folder's",
             output.display()
@@ -83,7 +88,7 @@ pub(super) fn check_folder(output: &Path) -> Result<(), Error> {
     Ok(())
 }
 
-/// The still of the frame of `step`: `{n}` replaced by the step, padded
+/// The still of the frame of `step`: `{n}` (or `{N}`) replaced by the step, padded
 /// with zeros to the digits of the last frame's step (`step-07.png` when
 /// the last is 12), so that the names sort in the frames' order.
 pub(super) fn still_path(output: &Path, step: u64, last: u64) -> PathBuf {

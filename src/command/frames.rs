@@ -99,7 +99,7 @@ impl FrameSelection {
     pub fn contains(&self, n: u64) -> bool {
         n >= self.first
             && self.last.is_none_or(|l| n <= l)
-            && (n - self.first) % self.step.max(1) == 0
+            && (n - self.first).is_multiple_of(self.step.max(1))
     }
 }
 
@@ -122,6 +122,14 @@ pub struct SolidFrame {
     pub raster: RasterOptions,
 }
 
+impl SolidFrame {
+    /// Whether the frame has nothing to draw (a plant before its first
+    /// line): its picture is the background.
+    pub fn is_empty(&self) -> bool {
+        self.scene.triangle_count() == 0 && self.scene.line_count() == 0
+    }
+}
+
 /// One frame: the step it shows and its geometry.
 #[derive(Clone, Debug)]
 pub struct Frame {
@@ -134,6 +142,17 @@ impl Frame {
     pub fn picture(&self, format: Picture) -> Result<Vec<u8>, Error> {
         Ok(match (&self.geometry, format) {
             (FrameGeometry::Flat(scene), format) => picture_bytes(scene, format)?,
+            (FrameGeometry::Solid(s), format) if s.is_empty() => {
+                // A step with nothing drawn yet: the background.
+                let (width, height) = self.size();
+                let blank = Scene {
+                    width,
+                    height,
+                    background: s.raster.background,
+                    items: Vec::new(),
+                };
+                picture_bytes(&blank, format)?
+            }
             (FrameGeometry::Solid(s), Picture::Png) => {
                 render::raster::render_png(&s.scene, &s.raster)?
             }
@@ -147,21 +166,18 @@ impl Frame {
     pub fn image(&self) -> Result<Image, Error> {
         Ok(match &self.geometry {
             FrameGeometry::Flat(scene) => render::png::image(scene)?,
-            FrameGeometry::Solid(s) => {
-                if s.scene.triangle_count() == 0 && s.scene.line_count() == 0 {
-                    // A step with nothing drawn yet: the background.
-                    let (w, h) = (s.raster.camera.width, s.raster.camera.height);
-                    let Rgba(r, g, b, a) = s.raster.background;
-                    let pre = |c: u8| ((c as u32 * a as u32 + 127) / 255) as u8;
-                    Image {
-                        width: w,
-                        height: h,
-                        pixels: [pre(r), pre(g), pre(b), a].repeat(w as usize * h as usize),
-                    }
-                } else {
-                    render::raster::render(&s.scene, &s.raster)?
+            FrameGeometry::Solid(s) if s.is_empty() => {
+                // A step with nothing drawn yet: the background.
+                let (w, h) = self.size();
+                let Rgba(r, g, b, a) = s.raster.background;
+                let pre = |c: u8| ((c as u32 * a as u32 + 127) / 255) as u8;
+                Image {
+                    width: w,
+                    height: h,
+                    pixels: [pre(r), pre(g), pre(b), a].repeat(w as usize * h as usize),
                 }
             }
+            FrameGeometry::Solid(s) => render::raster::render(&s.scene, &s.raster)?,
         })
     }
 
@@ -224,11 +240,13 @@ pub fn frames(
             s.subdivide_each(&opts.run, &mut progress, |step, mesh| {
                 if selection.contains(step as u64) {
                     check_count(soups.len() + 1, opts.size)?;
-                    soups.push((step as u64, mesh.to_quad_soup()));
+                    let (soup, sharp) = mesh.to_soup_with_sharpness(false);
+                    let sharp = sharp.edges.iter().map(|&(a, b, _)| (a, b)).collect();
+                    soups.push((step as u64, soup, sharp));
                 }
                 Ok(())
             })?;
-            mesh_frames(soups, opts)
+            mesh_frames(soups, opts, false)
         }
         System::Vv(v) => {
             let selection = opts.selection.unwrap_or_default();
@@ -237,15 +255,19 @@ pub fn frames(
                 &opts.run,
                 &mut progress,
                 |step| selection.contains(step),
-                |step, soup| soups.push((step, soup)),
+                |step, soup| soups.push((step, soup, Vec::new())),
             )?;
             check_count(soups.len(), opts.size)?;
             // The last step's mesh as `End` leaves it (what `render`
             // draws).
-            if let Some(last) = soups.last_mut().filter(|(s, _)| *s == run.steps) {
+            if let Some(last) = soups.last_mut().filter(|(s, ..)| *s == run.steps) {
                 last.1 = run.soup;
             }
-            mesh_frames(soups, opts)
+            // A sheet of cells at the end: its cells in colours all along.
+            let cells = soups
+                .last()
+                .is_some_and(|(_, s, _)| crate::render::mesh::has_cells(s));
+            mesh_frames(soups, opts, cells)
         }
         System::Shapes(_) => Err(Error::Usage(
             "a shape grammar has no steps to animate: it draws its terminal shapes once \
@@ -264,7 +286,7 @@ fn check_count(frames: usize, (w, h): (u32, u32)) -> Result<(), Error> {
             "{frames} frames of {w}x{h} pixels are too many: an animation has at most {MAX_FRAMES} \
              frames and {} GiB of pixels; choose fewer steps (-n, or `step:` in the model's .a \
              file) or a smaller --size",
-            MAX_FRAME_PIXELS * 4 >> 30
+            (MAX_FRAME_PIXELS * 4) >> 30
         )));
     }
     Ok(())
@@ -334,10 +356,16 @@ fn curve_frames(
     };
     let on_step = &mut |d: &crate::rewrite::Derivation| progress(Progress::of_derivation(d));
     let p = &c.program;
+    // Frames past the limits stop the run at once: the drawing callback
+    // fails, and the run's error is replaced by the limit's.
+    let refused = std::cell::RefCell::new(None);
     let mut count = 0;
-    let counted = |count: &mut usize| {
-        *count += 1;
-        check_count(*count, opts.size)
+    let mut admit = || {
+        count += 1;
+        check_count(count, opts.size).map_err(|e| {
+            *refused.borrow_mut() = Some(e);
+            too_many()
+        })
     };
     let frames = if super::render::wants_solid(opts.solid, c) {
         // The interpreted words of the frames, each walked once for its
@@ -351,19 +379,13 @@ fn curve_frames(
                     if !selection.contains(step) {
                         return Ok(None);
                     }
-                    counted(&mut count).map_err(|_| too_many())?;
+                    admit()?;
                     let lines = crate::draw::line_bounds(word, &p.alphabet, &p.structs, draw_opts)?;
                     Ok(Some((step, word.clone(), draw_opts.clone(), lines)))
                 },
                 on_step,
             )
-            .map_err(|e| {
-                if count > MAX_FRAMES {
-                    check_count(count, opts.size).unwrap_err()
-                } else {
-                    e
-                }
-            })?;
+            .map_err(|e| refused.take().unwrap_or(e))?;
         check_count(words.len(), opts.size)?;
         solid_curve_frames(c, words, opts, background, each_fitted)?
     } else {
@@ -395,19 +417,13 @@ fn curve_frames(
                     if !selection.contains(step) {
                         return Ok(None);
                     }
-                    counted(&mut count).map_err(|_| too_many())?;
+                    admit()?;
                     let events = crate::draw::draw(word, &p.alphabet, &p.structs, draw_opts)?;
                     Ok(Some((step, events)))
                 },
                 on_step,
             )
-            .map_err(|e| {
-                if count > MAX_FRAMES {
-                    check_count(count, opts.size).unwrap_err()
-                } else {
-                    e
-                }
-            })?;
+            .map_err(|e| refused.take().unwrap_or(e))?;
         check_count(drawn.len(), opts.size)?;
         flat_frames(drawn, &figure.render, model.camera.bbox, each_fitted)?
     };
@@ -491,17 +507,21 @@ fn flat_frames(
         .collect()
 }
 
+/// A frame's step, its interpreted word, the turtle's settings and the box
+/// of its lines.
+type StepWord = (
+    u64,
+    crate::rewrite::Word,
+    crate::draw::DrawOptions,
+    Option<(glam::DVec3, glam::DVec3)>,
+);
+
 /// An L-system's frames in 3D: tubes for pixel-wide lines as wide as a
 /// pixel at the animation's scale, the view file's camera fitted to all
 /// frames (or each, with `each_fitted`).
 fn solid_curve_frames(
     c: &crate::Curve,
-    words: Vec<(
-        u64,
-        crate::rewrite::Word,
-        crate::draw::DrawOptions,
-        Option<(glam::DVec3, glam::DVec3)>,
-    )>,
+    words: Vec<StepWord>,
     opts: &FrameOptions,
     background: Rgba,
     each_fitted: bool,
@@ -572,9 +592,15 @@ fn solid_curve_frames(
         .collect()
 }
 
-/// A mesh's frames (a surface grammar's levels, a vv program's steps):
-/// the tight fit of every frame's vertices, the mesh pictures' looks.
-fn mesh_frames(soups: Vec<(u64, PolygonSoup)>, opts: &FrameOptions) -> Result<Frames, Error> {
+/// A mesh's frames (a surface grammar's levels with their sharp edges, a
+/// vv program's steps): the tight fit of every frame's vertices, the mesh
+/// pictures' looks, with `cells` each face in a colour.
+#[allow(clippy::type_complexity)]
+fn mesh_frames(
+    soups: Vec<(u64, PolygonSoup, Vec<(u32, u32)>)>,
+    opts: &FrameOptions,
+    cells: bool,
+) -> Result<Frames, Error> {
     let looks = MeshLooks {
         size: opts.size,
         background: opts.background.unwrap_or(Rgba(255, 255, 255, 255)),
@@ -582,15 +608,16 @@ fn mesh_frames(soups: Vec<(u64, PolygonSoup)>, opts: &FrameOptions) -> Result<Fr
         wireframe: opts.wireframe,
         shading: crate::render::mesh::Shading::Lit,
         flat: opts.flat,
+        cells,
     };
-    let view = looks.check()?;
+    let view = looks.view_of(soups.iter().map(|(_, s, _)| s))?;
     if soups.is_empty() {
         return Err(no_frames(opts.selection.unwrap_or_default()));
     }
-    for (_, soup) in &soups {
+    for (_, soup, _) in &soups {
         crate::render::mesh::validate(soup, &view)?;
     }
-    let mut points = soups.iter().flat_map(|(_, soup)| {
+    let mut points = soups.iter().flat_map(|(_, soup, _)| {
         soup.faces
             .iter()
             .flatten()
@@ -600,7 +627,12 @@ fn mesh_frames(soups: Vec<(u64, PolygonSoup)>, opts: &FrameOptions) -> Result<Fr
     let camera = crate::render::mesh::camera(&view, &mut points as &mut dyn Iterator<Item = Vec3>)?;
     let frames = soups
         .into_iter()
-        .map(|(step, soup)| {
+        .map(|(step, soup, sharp)| {
+            let mut view = view.clone();
+            view.sharp_edges = sharp;
+            if cells {
+                view.face_colours = crate::render::mesh::cell_colours(&soup);
+            }
             let (scene, polygons, back) = crate::render::mesh::scene3(&soup, &view);
             let raster = crate::render::mesh::raster_options_with(camera, &view, polygons, back);
             Frame {

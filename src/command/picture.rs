@@ -119,6 +119,7 @@ impl Out {
 }
 
 /// How a mesh is drawn.
+#[derive(Clone)]
 pub(super) struct MeshLooks<'a> {
     pub(super) size: (u32, u32),
     pub(super) background: Rgba,
@@ -127,6 +128,9 @@ pub(super) struct MeshLooks<'a> {
     pub(super) shading: crate::render::mesh::Shading,
     /// One flat shade per face, not smoothed across faces.
     pub(super) flat: bool,
+    /// Each face in a colour of its own, told apart from its neighbours:
+    /// a vv program's cells.
+    pub(super) cells: bool,
 }
 
 impl<'a> MeshLooks<'a> {
@@ -140,11 +144,37 @@ impl<'a> MeshLooks<'a> {
             wireframe: a.wireframe,
             shading: crate::render::mesh::Shading::Lit,
             flat: a.flat,
+            cells: false,
         }
     }
 }
 
 impl MeshLooks<'_> {
+    /// These looks for a vv program's mesh: its cells each in a colour
+    /// when it is a sheet of cells (see [`crate::render::mesh::has_cells`]).
+    pub(super) fn for_vv(&self, soup: &PolygonSoup) -> Self {
+        MeshLooks {
+            cells: crate::render::mesh::has_cells(soup),
+            ..self.clone()
+        }
+    }
+
+    /// The view of `soups` (one mesh, or an animation's): [`MeshLooks::check`]'s,
+    /// from the top when no view is named and every mesh lies in the xy
+    /// plane (a sheet of cells).
+    pub(super) fn view_of<'s>(
+        &self,
+        mut soups: impl Iterator<Item = &'s PolygonSoup>,
+    ) -> Result<crate::render::mesh::MeshView, Error> {
+        let mut mv = self.check()?;
+        if self.view.is_none() && soups.all(crate::render::mesh::is_flat_in_z) {
+            let (dir, up) = crate::render::mesh::view_direction("top").expect("a view");
+            mv.direction = dir;
+            mv.up = up;
+        }
+        Ok(mv)
+    }
+
     /// The view: the default one, or a named one.
     pub(super) fn check(&self) -> Result<crate::render::mesh::MeshView, Error> {
         let mut mv = crate::render::mesh::MeshView {
@@ -169,14 +199,17 @@ impl MeshLooks<'_> {
     }
 }
 
-/// A mesh's picture, flat-shaded, to `.png` or `.svg`.
+/// A mesh's picture, to `.png` or `.svg`; its sharp edges stay sharp in
+/// smooth shading.
 pub(super) fn write_mesh_picture(
     m: &Mesh,
     output: &Path,
     looks: &MeshLooks,
     out: &mut Out,
 ) -> Result<(), Error> {
-    write_soup_picture(&m.to_quad_soup(), output, looks, out)
+    let (soup, sharp) = m.to_soup_with_sharpness(false);
+    let sharp: Vec<(u32, u32)> = sharp.edges.iter().map(|&(a, b, _)| (a, b)).collect();
+    write_soup_picture_sharp(&soup, &sharp, output, looks, out)
 }
 
 pub(super) fn write_soup_picture(
@@ -185,8 +218,22 @@ pub(super) fn write_soup_picture(
     looks: &MeshLooks,
     out: &mut Out,
 ) -> Result<(), Error> {
+    write_soup_picture_sharp(soup, &[], output, looks, out)
+}
+
+fn write_soup_picture_sharp(
+    soup: &PolygonSoup,
+    sharp: &[(u32, u32)],
+    output: &Path,
+    looks: &MeshLooks,
+    out: &mut Out,
+) -> Result<(), Error> {
     let format = Picture::from_path(output)?;
-    let mv = looks.check()?;
+    let mut mv = looks.view_of(std::iter::once(soup))?;
+    mv.sharp_edges = sharp.to_vec();
+    if looks.cells {
+        mv.face_colours = crate::render::mesh::cell_colours(soup);
+    }
     crate::render::mesh::validate(soup, &mv)?;
     let bytes = match format {
         Picture::Svg => crate::render::mesh::render_svg(soup, &mv).into_bytes(),

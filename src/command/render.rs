@@ -398,7 +398,7 @@ pub(super) fn render_system(
             let mut inputs = vec![file.to_path_buf(), output.to_path_buf()];
             inputs.extend(v.base_mesh());
             write_program_files(&a.program_output, dir.as_deref(), &as_paths(&inputs))?;
-            write_soup_picture(&run.soup, output, looks, out)?;
+            write_soup_picture(&run.soup, output, &looks.for_vv(&run.soup), out)?;
             Ok(Vec::new())
         }
         System::Curve(c) if export.is_some() || wants_solid(a.solid, &c) => {

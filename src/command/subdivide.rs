@@ -114,6 +114,7 @@ pub(super) fn subdivide_in_run(
         wireframe: d.wireframe && !a.no_wireframe && shading == crate::render::mesh::Shading::Lit,
         shading,
         flat: a.shading.as_deref() == Some("flat"),
+        cells: false,
     };
     // The file is read and lexed once; its tokens say what it is.
     let text = crate::load::read(grammar)?;
@@ -152,8 +153,13 @@ pub(super) fn subdivide_in_run(
         }
         let run = v.run(&opts, progress)?;
         if Picture::from_path(output).is_ok() {
-            return write_soup_picture(&run.soup, output, &looks, &mut Out::Files)
-                .map(|()| Vec::new());
+            return write_soup_picture(
+                &run.soup,
+                output,
+                &looks.for_vv(&run.soup),
+                &mut Out::Files,
+            )
+            .map(|()| Vec::new());
         }
         if is_glb(output) {
             return write_soup_glb(&run.soup, &[], output).map(|()| Vec::new());

@@ -661,7 +661,8 @@ pub fn read_v(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<ViewFile,
 pub struct Animation {
     /// `first frame:` (0 by default).
     pub first_frame: u64,
-    /// `last frame:`; `None`: the derivation length.
+    /// `last frame:`; `None` (or a negative number, as vlab's models
+    /// write -1): the derivation length.
     pub last_frame: Option<u64>,
     /// `step:`, the derivation steps between frames (1 by default).
     pub step: u64,
@@ -731,6 +732,8 @@ pub fn read_a(path: &str, text: &str, notes: &mut Vec<Note>) -> Result<Animation
         };
         match k.as_str() {
             "first frame" => a.first_frame = frame("the first frame")?,
+            // vlab's models write -1: up to the derivation length.
+            "last frame" if number(&lines, &ws, 0, "the last frame")? < 0.0 => a.last_frame = None,
             "last frame" => a.last_frame = Some(frame("the last frame")?),
             "step" => {
                 a.step = frame("the step")?;

@@ -1,17 +1,21 @@
-//! Pictures of polygon meshes: a flat-shaded orthographic view.
+//! Pictures of polygon meshes: a smooth- or flat-shaded orthographic view.
 //!
 //! The mesh is projected along the view direction and fitted into the
 //! image with a margin (uniform scale, centred). The PNG is drawn by the
 //! z-buffer renderer ([`super::raster`]), the one that draws plants: the
 //! polygons are fanned into a [`Scene3`] (one mesh per face colour, each
-//! polygon with its own vertices and its Newell normal, so a polygon is
-//! one flat shade), and the wireframe is drawn where the polygon seen
+//! polygon with its own vertices; their normals are the area-weighted
+//! normals of the faces around each corner that meet it across edges that
+//! are neither sharp nor folded past 35°, so a smooth surface is shaded
+//! smoothly and a cube keeps its edges, or with `smooth` off each
+//! polygon's Newell normal, one flat shade), and the wireframe is drawn where the polygon seen
 //! changes from one sample to the next, so hidden edges stay hidden. The
 //! SVG paints the polygons back to front (painter's algorithm, by mean
-//! depth) in the same colours. Each face gets OpenGL's lighting of a
-//! light grey-blue from a key light and a weak fill light that are fixed
-//! relative to the viewer, so every view is lit the same way; faces seen
-//! from behind (the inside of an open mesh) get a warmer tint.
+//! depth) in the same colours, flat. Each face gets OpenGL's lighting of
+//! a warm clay from a key light (with a soft highlight) and a weak fill
+//! light that are fixed relative to the viewer, so every view is lit the
+//! same way; faces seen from behind (the inside of an open mesh) are a
+//! cool blue-grey.
 
 use glam::{DVec2, DVec3};
 
@@ -22,10 +26,34 @@ use super::{check_size, svg, Fit, Item, Outline, RenderError, Rgba, Scene};
 use crate::mesh::PolygonSoup;
 use crate::scene3::{Look, Scene3, TriMesh};
 
-/// The colour of faces seen from the front (a light grey-blue).
-const FRONT_BASE: DVec3 = DVec3::new(0.70, 0.77, 0.88);
-/// The colour of faces seen from behind (a light warm grey).
-const BACK_BASE: DVec3 = DVec3::new(0.88, 0.76, 0.68);
+/// The colour of faces seen from the front: a warm clay, the neutral
+/// matte that modelling tools show an unpainted surface in (Blender's
+/// matcap and MeshLab's default are greys of this kind), warm so that the
+/// key light's shading reads as form, not as a tint.
+const FRONT_BASE: DVec3 = DVec3::new(0.80, 0.70, 0.58);
+/// The colour of faces seen from behind (the inside of an open mesh): a
+/// cool blue-grey, set apart from the clay.
+const BACK_BASE: DVec3 = DVec3::new(0.56, 0.64, 0.76);
+/// The default look's highlight: a soft sheen of the key light that shows
+/// how a smooth surface curves.
+const SHEEN: f32 = 0.22;
+const SHININESS: f32 = 24.0;
+/// The largest angle between two faces' normals across an edge that
+/// smooth shading smooths over: a fold sharper than this stays a fold
+/// (a cube's edges, a coarse base mesh's), as 3D tools' auto-smooth does.
+const SMOOTH_ANGLE_DEGREES: f64 = 35.0;
+/// The colours of a vv program's cells (ColorBrewer's Set3, soft and
+/// told apart): each cell one, neighbours different where eight do.
+const CELL_COLOURS: [Rgba; 8] = [
+    Rgba(141, 211, 199, 255),
+    Rgba(255, 237, 160, 255),
+    Rgba(190, 186, 218, 255),
+    Rgba(251, 128, 114, 255),
+    Rgba(128, 177, 211, 255),
+    Rgba(253, 180, 98, 255),
+    Rgba(179, 222, 105, 255),
+    Rgba(252, 205, 229, 255),
+];
 /// The light every face gets, whatever its orientation (OpenGL's global
 /// ambient light).
 const AMBIENT: f32 = 0.40;
@@ -33,8 +61,8 @@ const AMBIENT: f32 = 0.40;
 const KEY: f32 = 0.62;
 /// The strength of the fill light (lower right, in front of the viewer).
 const FILL: f32 = 0.22;
-/// The colour of the wireframe edges.
-const EDGE: Rgba = Rgba(38, 46, 60, 255);
+/// The colour of the wireframe edges (a dark warm brown).
+const EDGE: Rgba = Rgba(58, 46, 38, 255);
 /// The width of the seam-closing outline drawn in the face colour when the
 /// wireframe is off, so antialiased neighbours leave no light cracks (SVG).
 const SEAM_WIDTH: f64 = 0.7;
@@ -59,8 +87,12 @@ pub struct MeshView {
     /// How faces are coloured.
     pub shading: Shading,
     /// Lit from vertex normals, smooth across faces (not across a sharp
-    /// edge or a fold); `false`: one flat shade per face.
+    /// edge or a fold); `false`: one flat shade per face. The PNG only
+    /// (the SVG's polygons are flat), and lit shading only.
     pub smooth: bool,
+    /// Edges between soup vertices that smooth shading does not smooth
+    /// over (a mesh's sharp edges), either way round.
+    pub sharp_edges: Vec<(u32, u32)>,
 }
 
 pub use super::raster::Shading;
@@ -80,6 +112,7 @@ impl Default for MeshView {
             face_colours: Vec::new(),
             shading: Shading::Lit,
             smooth: true,
+            sharp_edges: Vec::new(),
         }
     }
 }
@@ -409,17 +442,18 @@ fn shade(seen: DVec3, back: bool, cam: &Camera, base: Option<DVec3>) -> Rgba {
     Rgba(c[0], c[1], c[2], 255)
 }
 
-/// The key and fill lights, in eye coordinates (fixed to the viewer).
+/// The key and fill lights, in eye coordinates (fixed to the viewer); the
+/// key light alone makes a highlight.
 fn lights() -> Vec<Light> {
-    let light = |d: Vec3, strength: f32| Light {
+    let light = |d: Vec3, strength: f32, sheen: f32| Light {
         direction: d.normalize(),
         ambient: [0.0; 3],
         diffuse: [strength; 3],
-        specular: [0.0; 3],
+        specular: [sheen; 3],
     };
     vec![
-        light(Vec3::new(-0.45, 0.75, 0.55), KEY),
-        light(Vec3::new(0.6, -0.3, 0.7), FILL),
+        light(Vec3::new(-0.45, 0.75, 0.55), KEY, 1.0),
+        light(Vec3::new(0.6, -0.3, 0.7), FILL, 0.0),
     ]
 }
 
@@ -438,11 +472,161 @@ fn face_look(base: Option<DVec3>, back: bool) -> Look {
         index: 0,
         ambient: c,
         diffuse: c,
-        specular: [0.0; 3],
+        specular: [SHEEN; 3],
         emission: [0.0; 3],
-        shininess: 0.0,
+        shininess: SHININESS,
         opacity: 1.0,
     }
+}
+
+/// A colour for each face of `soup`, from [`CELL_COLOURS`]: each face the
+/// first colour none of its neighbours (faces sharing an edge) took
+/// before it, in face order (greedy colouring), or by its number when
+/// its neighbours took all eight.
+pub fn cell_colours(soup: &PolygonSoup) -> Vec<Rgba> {
+    use std::collections::HashMap;
+    let mut by_edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (f, face) in soup.faces.iter().enumerate() {
+        for (k, &a) in face.iter().enumerate() {
+            let b = face[(k + 1) % face.len()];
+            by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
+        }
+    }
+    let mut colour: Vec<Option<usize>> = vec![None; soup.faces.len()];
+    for (f, face) in soup.faces.iter().enumerate() {
+        let mut taken = [false; CELL_COLOURS.len()];
+        for (k, &a) in face.iter().enumerate() {
+            let b = face[(k + 1) % face.len()];
+            for &g in &by_edge[&(a.min(b), a.max(b))] {
+                if let Some(c) = colour[g] {
+                    taken[c] = true;
+                }
+            }
+        }
+        colour[f] = Some(
+            taken
+                .iter()
+                .position(|t| !t)
+                .unwrap_or(f % CELL_COLOURS.len()),
+        );
+    }
+    colour
+        .into_iter()
+        .map(|c| CELL_COLOURS[c.unwrap_or(0)])
+        .collect()
+}
+
+/// Whether `soup` is a sheet of cells rather than a surface: some face
+/// has more than four sides (a vv tissue; subdivision makes triangles and
+/// quads).
+pub fn has_cells(soup: &PolygonSoup) -> bool {
+    soup.faces.iter().any(|f| f.len() > 4)
+}
+
+/// Whether every vertex that a face of `soup` uses has one z (a mesh in
+/// the xy plane, as a tissue of cells is): seen best from the top.
+pub fn is_flat_in_z(soup: &PolygonSoup) -> bool {
+    let mut zs = used_vertices(soup).map(|p| p.z);
+    let Some(z0) = zs.next() else { return false };
+    let (mut lo, mut hi) = (z0, z0);
+    for z in zs {
+        (lo, hi) = (lo.min(z), hi.max(z));
+    }
+    let (mut a, mut b) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in used_vertices(soup) {
+        (a, b) = (a.min(p.truncate()), b.max(p.truncate()));
+    }
+    let extent = (b - a).max_element();
+    extent > 0.0 && (hi - lo) <= 1e-9 * extent
+}
+
+/// The normal of each corner of each face for smooth shading: the sum of
+/// the area-weighted normals (Newell's vectors) of the faces around the
+/// corner's vertex that reach it across edges of two faces which are not
+/// `sharp` and fold by at most [`SMOOTH_ANGLE_DEGREES`]; `None` for a
+/// face that cannot be drawn. A face alone at its vertex keeps its own
+/// normal.
+fn corner_normals(
+    soup: &PolygonSoup,
+    newell: &[Option<DVec3>],
+    sharp: &[(u32, u32)],
+) -> Vec<Option<Vec<DVec3>>> {
+    use std::collections::{HashMap, HashSet};
+    let sharp: HashSet<(u32, u32)> = sharp.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
+    // Corners numbered face after face.
+    let mut first = Vec::with_capacity(soup.faces.len() + 1);
+    let mut n = 0;
+    for face in soup.faces.iter() {
+        first.push(n);
+        n += face.len();
+    }
+    first.push(n);
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut c: usize) -> usize {
+        while parent[c] != c {
+            parent[c] = parent[parent[c]];
+            c = parent[c];
+        }
+        c
+    }
+    // Each edge's (face, corner of its first end, corner of its second).
+    type Sides = Vec<(usize, usize, usize)>;
+    let mut edges: HashMap<(u32, u32), Sides> = HashMap::new();
+    for (f, face) in soup.faces.iter().enumerate() {
+        if newell[f].is_none() {
+            continue;
+        }
+        for k in 0..face.len() {
+            let (a, b) = (face[k], face[(k + 1) % face.len()]);
+            let j = (k + 1) % face.len();
+            let (ca, cb) = (first[f] + k, first[f] + j);
+            let key = (a.min(b), a.max(b));
+            let ends = if a <= b { (ca, cb) } else { (cb, ca) };
+            edges.entry(key).or_default().push((f, ends.0, ends.1));
+        }
+    }
+    let cos = SMOOTH_ANGLE_DEGREES.to_radians().cos();
+    for (key, list) in &edges {
+        let [(f, fa, fb), (g, ga, gb)] = list.as_slice() else {
+            continue;
+        };
+        if sharp.contains(key) {
+            continue;
+        }
+        let (Some(nf), Some(ng)) = (newell[*f], newell[*g]) else {
+            continue;
+        };
+        if nf.normalize().dot(ng.normalize()) < cos {
+            continue;
+        }
+        for (x, y) in [(*fa, *ga), (*fb, *gb)] {
+            let (rx, ry) = (root(&mut parent, x), root(&mut parent, y));
+            parent[rx] = ry;
+        }
+    }
+    let mut sum = vec![DVec3::ZERO; n];
+    for (f, face) in soup.faces.iter().enumerate() {
+        let Some(nf) = newell[f] else { continue };
+        for k in 0..face.len() {
+            let r = root(&mut parent, first[f] + k);
+            sum[r] += nf;
+        }
+    }
+    soup.faces
+        .iter()
+        .enumerate()
+        .map(|(f, face)| {
+            let own = newell[f]?.normalize();
+            Some(
+                (0..face.len())
+                    .map(|k| {
+                        let r = root(&mut parent, first[f] + k);
+                        sum[r].try_normalize().unwrap_or(own)
+                    })
+                    .collect(),
+            )
+        })
+        .collect()
 }
 
 /// The faces of `soup` as a [`Scene3`] for the z-buffer: one mesh per face
@@ -456,20 +640,29 @@ pub fn scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<u32>, Vec<Loo
     let mut back = Vec::new();
     let mut keys: Vec<Option<Rgba>> = Vec::new();
     let mut polygons: Vec<Vec<u32>> = Vec::new();
+    // Each drawable face's Newell vector (twice its vector area).
+    let newell: Vec<Option<DVec3>> = soup
+        .faces
+        .iter()
+        .map(|face| {
+            let corners = face
+                .iter()
+                .map(|&i| soup.positions.get(i as usize).copied())
+                .collect::<Option<Vec<DVec3>>>()?;
+            if corners.len() < 3 || corners.iter().any(|p| !p.is_finite()) {
+                return None;
+            }
+            let n = newell_normal(&corners);
+            n.try_normalize().map(|_| n)
+        })
+        .collect();
+    let smooth = (view.smooth && view.shading == Shading::Lit)
+        .then(|| corner_normals(soup, &newell, &view.sharp_edges));
     for (f, face) in soup.faces.iter().enumerate() {
-        let Some(corners) = face
-            .iter()
-            .map(|&i| soup.positions.get(i as usize).copied())
-            .collect::<Option<Vec<DVec3>>>()
-        else {
+        let Some(normal) = newell[f].map(DVec3::normalize) else {
             continue;
         };
-        if corners.len() < 3 || corners.iter().any(|p| !p.is_finite()) {
-            continue;
-        }
-        let Some(normal) = newell_normal(&corners).try_normalize() else {
-            continue;
-        };
+        let corners: Vec<DVec3> = face.iter().map(|&i| soup.positions[i as usize]).collect();
         let key = view.face_colours.get(f).copied();
         let k = match keys.iter().position(|c| *c == key) {
             Some(k) => k,
@@ -490,8 +683,12 @@ pub fn scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<u32>, Vec<Loo
         let m = &mut scene.meshes[k];
         let start = m.positions.len() as u32;
         m.positions.extend(corners.iter().map(|p| p.as_vec3()));
-        m.normals
-            .extend(std::iter::repeat_n(normal.as_vec3(), corners.len()));
+        match smooth.as_ref().and_then(|s| s[f].as_ref()) {
+            Some(normals) => m.normals.extend(normals.iter().map(|n| n.as_vec3())),
+            None => m
+                .normals
+                .extend(std::iter::repeat_n(normal.as_vec3(), corners.len())),
+        }
         for j in 1..corners.len() as u32 - 1 {
             m.triangles.push([start, start + j, start + j + 1]);
             polygons[k].push(f as u32);

@@ -149,6 +149,14 @@ fn check_size(width: u32, height: u32) -> Result<(), RenderError> {
     Ok(())
 }
 
+/// A cell of the picture: its left column, top row, width and height in
+/// pixels.
+type Cell = (f64, f64, f64, f64);
+
+/// The least height of a row of `--each`'s panels whose height is fitted
+/// (no `--size`): panels too wide for it are wrapped into more rows.
+pub const MIN_PANEL_HEIGHT: f64 = 160.0;
+
 /// The map from drawing-plane coordinates (y up) to pixels (y down): a
 /// bounding box scaled uniformly into a cell of the image, with a margin,
 /// and centred in it.
@@ -164,12 +172,17 @@ impl Fit {
     /// and is `width`×`height` pixels, leaving `margin` (a fraction of the
     /// cell's smaller side) on every side.
     fn new(lo: DVec2, hi: DVec2, x0: f64, width: f64, height: f64, margin: f64) -> Fit {
+        Fit::in_cell(lo, hi, (x0, 0.0, width, height), margin)
+    }
+
+    /// [`Fit::new`] into the cell `(x0, y0, width, height)`.
+    fn in_cell(lo: DVec2, hi: DVec2, (x0, y0, width, height): Cell, margin: f64) -> Fit {
         let m = margin * width.min(height);
         let avail = DVec2::new(width - 2.0 * m, height - 2.0 * m).max(DVec2::ONE);
         Fit {
             scale: fit_scale(avail, hi - lo),
             centre: (lo + hi) * 0.5,
-            mid: DVec2::new(x0 + width * 0.5, height * 0.5),
+            mid: DVec2::new(x0 + width * 0.5, y0 + height * 0.5),
         }
     }
 
@@ -181,26 +194,49 @@ impl Fit {
 }
 
 /// Lays out panels side by side: each list of events is fitted into its own
-/// cell of equal width. One panel is the usual single picture.
+/// cell of equal width. One panel is the usual single picture. With
+/// `fit_height`, the picture is as tall as the panels' drawings need, and
+/// panels whose drawings would be less than [`MIN_PANEL_HEIGHT`] pixels
+/// tall side by side are wrapped into rows (of as many panels as keep
+/// them that tall, at least one), read left to right, top to bottom.
 pub fn scene(panels: &[Vec<Event>], opts: &RenderOptions) -> Result<Scene, RenderError> {
     check_size(opts.width, opts.height)?;
     if panels.iter().all(|p| p.is_empty()) {
         return Err(nothing_to_draw());
     }
-    let cell_w = opts.width as f64 / panels.len() as f64;
+    let n = panels.len().max(1);
     let mut opts = std::borrow::Cow::Borrowed(opts);
+    let (mut columns, mut row_h) = (n, opts.height as f64);
     if opts.fit_height {
         let mut boxes = Vec::new();
         for events in panels {
             boxes.extend(panel_bounds(events, opts.view)?);
         }
-        let height = fitted_height(&opts, cell_w, boxes);
-        opts.to_mut().height = height;
+        let w = opts.width as f64;
+        let h = opts.height as f64;
+        // The fewest rows whose panels are tall enough (one panel a row at
+        // the most).
+        for c in (1..=n).rev() {
+            let rows = n.div_ceil(c);
+            let row = fitted_height(&opts, w / c as f64, boxes.iter().copied()) as f64;
+            (columns, row_h) = (c, row);
+            if row >= MIN_PANEL_HEIGHT.min(h) || (rows + 1) as f64 * row > MAX_SIDE as f64 {
+                break;
+            }
+        }
+        let rows = n.div_ceil(columns);
+        opts.to_mut().height = (rows as f64 * row_h).min(MAX_SIDE as f64) as u32;
     }
+    let cell_w = opts.width as f64 / columns as f64;
     let mut items = Vec::new();
     for (k, events) in panels.iter().enumerate() {
-        let x0 = k as f64 * cell_w;
-        fit_panel(events, &opts, x0, cell_w, &mut items)?;
+        let cell = (
+            (k % columns) as f64 * cell_w,
+            (k / columns) as f64 * row_h,
+            cell_w,
+            row_h,
+        );
+        fit_panel(events, &opts, cell, &mut items)?;
     }
     Ok(Scene {
         width: opts.width,
@@ -232,7 +268,8 @@ pub fn scene_within(
             "the drawing has a NaN or infinite coordinate and cannot be fitted",
         ));
     }
-    let mut layout = Layout::new((lo, hi), 0.0, opts.width as f64, opts, Vec::new());
+    let cell = (0.0, 0.0, opts.width as f64, opts.height as f64);
+    let mut layout = Layout::new((lo, hi), cell, opts, Vec::new());
     events.iter().for_each(|e| layout.lay(e));
     Ok(Scene {
         width: opts.width,
@@ -423,18 +460,17 @@ pub(crate) struct Layout<'o, C> {
 }
 
 impl<'o, C: Canvas> Layout<'o, C> {
-    /// The layout of events within the box `lo..hi` into the cell of width
-    /// `cell_w` that starts at column `x0`.
+    /// The layout of events within the box `lo..hi` into `cell` of the
+    /// picture.
     pub(crate) fn new(
         (lo, hi): (DVec2, DVec2),
-        x0: f64,
-        cell_w: f64,
+        cell: Cell,
         opts: &'o RenderOptions,
         canvas: C,
     ) -> Self {
         Layout {
             style: Style {
-                fit: Fit::new(lo, hi, x0, cell_w, opts.height as f64, opts.margin),
+                fit: Fit::in_cell(lo, hi, cell, opts.margin),
                 opts,
             },
             canvas,
@@ -533,14 +569,13 @@ impl<'o, C: Canvas> Layout<'o, C> {
 fn fit_panel(
     events: &[Event],
     opts: &RenderOptions,
-    x0: f64,
-    cell_w: f64,
+    cell: Cell,
     items: &mut Vec<Item>,
 ) -> Result<(), RenderError> {
     let Some(bounds) = panel_bounds(events, opts.view)? else {
         return Ok(());
     };
-    let mut layout = Layout::new(bounds, x0, cell_w, opts, std::mem::take(items));
+    let mut layout = Layout::new(bounds, cell, opts, std::mem::take(items));
     events.iter().for_each(|e| layout.lay(e));
     *items = layout.finish();
     Ok(())

@@ -181,7 +181,8 @@ fn finish(drawing: Drawing, opts: &super::RenderOptions) -> Result<Vec<u8>, Rend
         opts.to_mut().height = height;
     }
     let painter = Painter::new(opts.width, opts.height, opts.background)?;
-    let layout = super::Layout::new(bounds, 0.0, opts.width as f64, &opts, painter);
+    let cell = (0.0, 0.0, opts.width as f64, opts.height as f64);
+    let layout = super::Layout::new(bounds, cell, &opts, painter);
     drawing.paint(layout).encode()
 }
 

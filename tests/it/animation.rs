@@ -431,3 +431,121 @@ fn frames_share_one_camera_in_the_library() {
             .starts_with(b"glTF"));
     }
 }
+
+#[test]
+fn frames_past_the_limits_are_refused_while_the_run_goes() {
+    // 40 steps of 4000×4000 pixels: the 34th frame passes 2 GiB of RGBA,
+    // and the run stops there with the limit's message, not at the end.
+    let dir = scratch("anim-limits");
+    std::fs::write(
+        dir.path().join("still.lsys"),
+        "derivation length: 40;\nAxiom: F(1);\n",
+    )
+    .unwrap();
+    let e = run_usage_error(
+        dir.path(),
+        &["render", "still.lsys", "--size", "4000x4000", "-o", "s.gif"],
+    );
+    assert!(
+        e.contains("34 frames of 4000x4000 pixels are too many"),
+        "{e}"
+    );
+    assert!(e.contains("at most 1000 frames and 2 GiB of pixels"), "{e}");
+    assert_eq!(files_in(dir.path()), ["still.lsys"]);
+}
+
+#[test]
+fn a_3d_frame_with_nothing_drawn_yet_is_the_background() {
+    // Step 0 is the axiom `A()`, which draws nothing; steps 1 and 2 draw
+    // tubes, shaded by the z-buffer.
+    let dir = scratch("anim-empty");
+    std::fs::write(
+        dir.path().join("grow.lsys"),
+        "derivation length: 2;\nmodule A();\nAxiom: SetWidth(0.2) A();\nA() : { produce F(1) A(); }\n",
+    )
+    .unwrap();
+    std::fs::create_dir(dir.path().join("f")).unwrap();
+    run_ok(
+        dir.path(),
+        &[
+            "render",
+            "grow.lsys",
+            "--solid",
+            "--size",
+            "80x80",
+            "-o",
+            "f/{n}.png",
+        ],
+    );
+    run_ok(
+        dir.path(),
+        &[
+            "render",
+            "grow.lsys",
+            "--solid",
+            "--size",
+            "80x80",
+            "-o",
+            "g.apng",
+        ],
+    );
+    let d = decode_apng(&dir.path().join("g.apng"));
+    assert_eq!(d.frames.len(), 3);
+    assert_eq!(ink_box(&d.frames[0], 80, 0), None);
+    let (a, b) = (
+        ink_box(&d.frames[1], 80, 8).unwrap(),
+        ink_box(&d.frames[2], 80, 8).unwrap(),
+    );
+    // The second tube doubles the plant's height in the one camera.
+    assert!(
+        inside(a, b, 0) && (b.3 - b.1) > (a.3 - a.1) * 3 / 2,
+        "{a:?} {b:?}"
+    );
+    let still = png::Decoder::new(std::fs::File::open(dir.path().join("f/0.png")).unwrap());
+    let mut r = still.read_info().unwrap();
+    let mut buf = vec![0; r.output_buffer_size()];
+    r.next_frame(&mut buf).unwrap();
+    assert!(buf.chunks_exact(4).all(|p| p == [255, 255, 255, 255]));
+}
+
+#[test]
+fn animation_files_read_as_lpfgs_manual_and_vlabs_models_write_them() {
+    use subgram::model::view::{read_a, Animation};
+    // As vlab's own models write it (monopodial's, leaf-rnd's): `last
+    // frame: -1` is up to the derivation length; `frame numbers:` is not
+    // in the manual's list, a note.
+    let text = "double buffer: on\nclear between frames: on\nscale between frames: off\n\
+                new view between frames: off\nhcenter between frames: off\nswap interval: 1\n\
+                first frame: 1\nlast frame: -1\nstep: 1\nframe numbers: consecutive\n";
+    let mut notes = Vec::new();
+    let a = read_a("anim.a", text, &mut notes).unwrap();
+    assert_eq!(
+        a,
+        Animation {
+            first_frame: 1,
+            swap_interval: 1.0,
+            ..Animation::default()
+        }
+    );
+    assert_eq!(notes.len(), 1);
+    assert!(notes[0].message.contains("`frame numbers:`"));
+    let a = read_a(
+        "a.a",
+        "first frame: 2\nlast frame: 9\nstep: 3\nscale between frames: on\n",
+        &mut notes,
+    )
+    .unwrap();
+    assert_eq!(
+        (a.first_frame, a.last_frame, a.step, a.scale_between_frames),
+        (2, Some(9), 3, true)
+    );
+    for bad in [
+        "step: 0\n",
+        "first frame: 1.5\n",
+        "swap interval: -2\n",
+        "double buffer: maybe\n",
+    ] {
+        let e = read_a("bad.a", bad, &mut notes).unwrap_err().to_string();
+        assert!(e.starts_with("bad.a:1:"), "{bad}: {e}");
+    }
+}

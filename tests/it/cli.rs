@@ -149,7 +149,7 @@ fn picture_options_with_a_mesh_output_are_usage_errors() {
         png.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("use lit, normals or reflection"));
+    assert!(stderr(&o).contains("use lit, flat, normals or reflection"));
     assert!(!png.exists());
 }
 
