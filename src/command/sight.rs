@@ -80,15 +80,29 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
     let looks = MeshLooks::of_render(&a);
     let (w, h) = looks.size;
     let white = Rgba(255, 255, 255, 255);
-    let mesh = |soup: &PolygonSoup, colours: &[Rgba], y_up: bool| -> Result<Sight, Error> {
-        let mut mv = looks.check()?;
+    // A mesh as the command line's picture shades it (`MeshLooks`: the
+    // view, smooth or flat, sharp edges, a vv program's cells, a shape
+    // grammar's colours), y up for a shape grammar's buildings.
+    let mesh = |soup: &PolygonSoup,
+                sharp: Vec<(u32, u32)>,
+                looks: &MeshLooks,
+                colours: &[Rgba],
+                y_up: bool|
+     -> Result<Sight, Error> {
+        let mut mv = looks.view_of(std::iter::once(soup))?;
+        mv.sharp_edges = sharp;
+        if looks.cells {
+            mv.face_colours = crate::render::mesh::cell_colours(soup);
+        } else {
+            mv.face_colours = colours.to_vec();
+        }
         if y_up {
             let turn = |v: glam::DVec3| glam::DVec3::new(v.x, v.z, -v.y);
             mv.direction = turn(mv.direction);
             mv.up = turn(mv.up);
         }
         crate::render::mesh::validate(soup, &mv)?;
-        let (scene, edges) = crate::render::mesh::soup_scene3_edges(soup, colours);
+        let (scene, edges) = crate::render::mesh::viewer_scene3(soup, &mv);
         let camera = crate::render::mesh::camera(
             &mv,
             &mut crate::render::mesh::used_vertices(soup).map(|p| p.as_vec3()),
@@ -102,9 +116,9 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
             up: if y_up {
                 [0.0, 1.0, 0.0]
             } else {
-                [0.0, 0.0, 1.0]
+                mv.up.as_vec3().to_array()
             },
-            smooth: !y_up,
+            smooth: mv.smooth,
         })))
     };
     let sight = match system {
@@ -115,7 +129,9 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
                 ..RunOptions::default()
             };
             let run = s.subdivide(&opts, |_| {})?;
-            mesh(&run.mesh.to_quad_soup(), &[], false)?
+            let (soup, sharp) = run.mesh.to_soup_with_sharpness(false);
+            let sharp = sharp.edges.iter().map(|&(a, b, _)| (a, b)).collect();
+            mesh(&soup, sharp, &looks, &[], false)?
         }
         System::Vv(v) => {
             let dir = writes_folder(&a.allow_writes, &a.program_output)?;
@@ -128,7 +144,7 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
             };
             let run = v.run(&opts, |_| {})?;
             write_program_files(&a.program_output, dir.as_deref(), &[file])?;
-            mesh(&run.soup, &[], false)?
+            mesh(&run.soup, Vec::new(), &looks.for_vv(&run.soup), &[], false)?
         }
         // Shape grammars: buildings, flat-shaded, y up.
         System::Shapes(s) => {
@@ -143,7 +159,7 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
                     "the derivation left no terminal shape with faces to draw".into(),
                 ));
             }
-            mesh(&run.soup, &run.colours, true)?
+            mesh(&run.soup, Vec::new(), &looks, &run.colours, true)?
         }
         System::Curve(c) if wants_solid(a.solid, &c) => {
             let (scene, dir) = solid_scene(&a, &c, (w, h), deadline, |_| {}, false)?;

@@ -629,20 +629,11 @@ fn corner_normals(
         .collect()
 }
 
-/// The faces of `soup` as a [`Scene3`] for the z-buffer: one mesh per face
-/// colour (in the order first used), each polygon fanned from its first
-/// corner with its own copies of its vertices and its Newell normal as
-/// their normals, so a polygon (even a warped one) is one flat shade as in
-/// the SVG. Also the polygon of each triangle (for the wireframe) and each
-/// mesh's back look. Faces that cannot be drawn are left out.
-pub fn scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<u32>, Vec<Look>) {
-    let mut scene = Scene3::default();
-    let mut back = Vec::new();
-    let mut keys: Vec<Option<Rgba>> = Vec::new();
-    let mut polygons: Vec<Vec<u32>> = Vec::new();
-    // Each drawable face's Newell vector (twice its vector area).
-    let newell: Vec<Option<DVec3>> = soup
-        .faces
+/// Each face's Newell vector (twice its vector area), or `None` for a face
+/// that cannot be drawn (fewer than three corners, an index out of range,
+/// a coordinate not finite, no area).
+fn newell_vectors(soup: &PolygonSoup) -> Vec<Option<DVec3>> {
+    soup.faces
         .iter()
         .map(|face| {
             let corners = face
@@ -655,7 +646,21 @@ pub fn scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<u32>, Vec<Loo
             let n = newell_normal(&corners);
             n.try_normalize().map(|_| n)
         })
-        .collect();
+        .collect()
+}
+
+/// The faces of `soup` as a [`Scene3`] for the z-buffer: one mesh per face
+/// colour (in the order first used), each polygon fanned from its first
+/// corner with its own copies of its vertices and its Newell normal as
+/// their normals, so a polygon (even a warped one) is one flat shade as in
+/// the SVG. Also the polygon of each triangle (for the wireframe) and each
+/// mesh's back look. Faces that cannot be drawn are left out.
+pub fn scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<u32>, Vec<Look>) {
+    let mut scene = Scene3::default();
+    let mut back = Vec::new();
+    let mut keys: Vec<Option<Rgba>> = Vec::new();
+    let mut polygons: Vec<Vec<u32>> = Vec::new();
+    let newell = newell_vectors(soup);
     let smooth = (view.smooth && view.shading == Shading::Lit)
         .then(|| corner_normals(soup, &newell, &view.sharp_edges));
     for (f, face) in soup.faces.iter().enumerate() {
@@ -703,17 +708,6 @@ pub fn scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<u32>, Vec<Loo
 /// between faces), no normals. Faces with fewer than three corners or an
 /// index out of range are left out.
 pub fn soup_scene3(soup: &PolygonSoup, face_colours: &[Rgba]) -> Scene3 {
-    soup_scene3_edges(soup, face_colours).0
-}
-
-/// [`soup_scene3`], and for each of its meshes the polygons' edges (each
-/// once, in the mesh's own numbering): what a wireframe draws, without the
-/// diagonals that fan a polygon into triangles.
-pub fn soup_scene3_edges(
-    soup: &PolygonSoup,
-    face_colours: &[Rgba],
-) -> (Scene3, Vec<Vec<[u32; 2]>>) {
-    let mut edges: Vec<std::collections::HashSet<[u32; 2]>> = Vec::new();
     let mut scene = Scene3::default();
     let mut keys: Vec<Option<Rgba>> = Vec::new();
     let mut maps: Vec<std::collections::HashMap<u32, u32>> = Vec::new();
@@ -736,7 +730,6 @@ pub fn soup_scene3_edges(
                 scene.looks.push(look);
                 scene.meshes.push(TriMesh::default());
                 maps.push(Default::default());
-                edges.push(Default::default());
                 keys.len() - 1
             }
         };
@@ -749,6 +742,64 @@ pub fn soup_scene3_edges(
                     m.positions.push(soup.positions[i as usize].as_vec3());
                     m.positions.len() as u32 - 1
                 })
+            })
+            .collect();
+        for j in 1..local.len() - 1 {
+            m.triangles.push([local[0], local[j], local[j + 1]]);
+        }
+    }
+    scene
+}
+
+/// The faces of `soup` for a viewer (the live page's GLB): shaded as
+/// [`scene3`] shades them for the z-buffer (the view's face colours,
+/// smooth corner normals split at sharp edges and folds, or each face's
+/// own), with a vertex shared by every face whose corner there has the
+/// same normal, so that a smooth surface sends each vertex once; and each
+/// mesh's polygon edges in its own numbering (the wireframe, without the
+/// fans' diagonals).
+pub fn viewer_scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<Vec<[u32; 2]>>) {
+    use std::collections::{HashMap, HashSet};
+    let newell = newell_vectors(soup);
+    let smooth = (view.smooth && view.shading == Shading::Lit)
+        .then(|| corner_normals(soup, &newell, &view.sharp_edges));
+    let mut scene = Scene3::default();
+    let mut keys: Vec<Option<Rgba>> = Vec::new();
+    let mut maps: Vec<HashMap<(u32, [u32; 3]), u32>> = Vec::new();
+    let mut edges: Vec<HashSet<[u32; 2]>> = Vec::new();
+    for (f, face) in soup.faces.iter().enumerate() {
+        let Some(normal) = newell[f].map(DVec3::normalize) else {
+            continue;
+        };
+        let key = view.face_colours.get(f).copied();
+        let k = match keys.iter().position(|c| *c == key) {
+            Some(k) => k,
+            None => {
+                let base = key.map(|c| DVec3::new(c.0 as f64, c.1 as f64, c.2 as f64) / 255.0);
+                let mut look = face_look(base, false);
+                look.name = format!("face{}", keys.len());
+                keys.push(key);
+                scene.looks.push(look);
+                scene.meshes.push(TriMesh::default());
+                maps.push(HashMap::new());
+                edges.push(HashSet::new());
+                keys.len() - 1
+            }
+        };
+        let corner_normals = smooth.as_ref().and_then(|s| s[f].as_ref());
+        let m = &mut scene.meshes[k];
+        let map = &mut maps[k];
+        let local: Vec<u32> = face
+            .iter()
+            .enumerate()
+            .map(|(c, &i)| {
+                let n = corner_normals.map_or(normal, |ns| ns[c]).as_vec3();
+                *map.entry((i, n.to_array().map(f32::to_bits)))
+                    .or_insert_with(|| {
+                        m.positions.push(soup.positions[i as usize].as_vec3());
+                        m.normals.push(n);
+                        m.positions.len() as u32 - 1
+                    })
             })
             .collect();
         for j in 1..local.len() - 1 {
