@@ -299,10 +299,13 @@ pub fn glb_bytes_with_edges(scene: &Scene3, edges: &[Vec<[u32; 2]>]) -> Result<V
         }
         let (lo, hi) = m.bounds().unwrap_or((Vec3::ZERO, Vec3::ZERO));
         let floats = |vs: &[Vec3]| -> Vec<u8> {
-            vs.iter()
-                .flat_map(|v| v.to_array())
-                .flat_map(f32::to_le_bytes)
-                .collect()
+            let mut out = Vec::with_capacity(vs.len() * 12);
+            for v in vs {
+                for x in v.to_array() {
+                    out.extend_from_slice(&x.to_le_bytes());
+                }
+            }
+            out
         };
         let pv = view(&mut bin, &floats(&m.positions), ARRAY_BUFFER);
         accessors.push(json!({
@@ -329,12 +332,10 @@ pub fn glb_bytes_with_edges(scene: &Scene3, edges: &[Vec<[u32; 2]>]) -> Result<V
             }));
             attributes["NORMAL"] = json!(accessors.len() - 1);
         }
-        let indices: Vec<u8> = m
-            .triangles
-            .iter()
-            .flatten()
-            .flat_map(|i| i.to_le_bytes())
-            .collect();
+        let mut indices: Vec<u8> = Vec::with_capacity(m.triangles.len() * 12);
+        for i in m.triangles.iter().flatten() {
+            indices.extend_from_slice(&i.to_le_bytes());
+        }
         let iv = view(&mut bin, &indices, ELEMENT_ARRAY_BUFFER);
         accessors.push(json!({
             "bufferView": iv,
@@ -345,7 +346,10 @@ pub fn glb_bytes_with_edges(scene: &Scene3, edges: &[Vec<[u32; 2]>]) -> Result<V
         let triangles = accessors.len() - 1;
         let lines = match edges.get(k).filter(|e| !e.is_empty()) {
             Some(e) => {
-                let bytes: Vec<u8> = e.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+                let mut bytes: Vec<u8> = Vec::with_capacity(e.len() * 8);
+                for i in e.iter().flatten() {
+                    bytes.extend_from_slice(&i.to_le_bytes());
+                }
                 let ev = view(&mut bin, &bytes, ELEMENT_ARRAY_BUFFER);
                 accessors.push(json!({
                     "bufferView": ev,

@@ -551,7 +551,7 @@ fn corner_normals(
     newell: &[Option<DVec3>],
     sharp: &[(u32, u32)],
 ) -> Vec<Option<Vec<DVec3>>> {
-    use std::collections::{HashMap, HashSet};
+    use std::collections::HashSet;
     let sharp: HashSet<(u32, u32)> = sharp.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
     // Corners numbered face after face.
     let mut first = Vec::with_capacity(soup.faces.len() + 1);
@@ -569,9 +569,10 @@ fn corner_normals(
         }
         c
     }
-    // Each edge's (face, corner of its first end, corner of its second).
-    type Sides = Vec<(usize, usize, usize)>;
-    let mut edges: HashMap<(u32, u32), Sides> = HashMap::new();
+    // Each side of an edge: the edge, its face, the corner of its first
+    // end and of its second; sorted by edge (no map, no allocation per
+    // edge: a million faces take a few hundred milliseconds).
+    let mut sides: Vec<((u32, u32), usize, usize, usize)> = Vec::with_capacity(n);
     for (f, face) in soup.faces.iter().enumerate() {
         if newell[f].is_none() {
             continue;
@@ -580,14 +581,14 @@ fn corner_normals(
             let (a, b) = (face[k], face[(k + 1) % face.len()]);
             let j = (k + 1) % face.len();
             let (ca, cb) = (first[f] + k, first[f] + j);
-            let key = (a.min(b), a.max(b));
             let ends = if a <= b { (ca, cb) } else { (cb, ca) };
-            edges.entry(key).or_default().push((f, ends.0, ends.1));
+            sides.push(((a.min(b), a.max(b)), f, ends.0, ends.1));
         }
     }
+    sides.sort_unstable_by_key(|s| s.0);
     let cos = SMOOTH_ANGLE_DEGREES.to_radians().cos();
-    for (key, list) in &edges {
-        let [(f, fa, fb), (g, ga, gb)] = list.as_slice() else {
+    for list in sides.chunk_by(|x, y| x.0 == y.0) {
+        let [(key, f, fa, fb), (_, g, ga, gb)] = list else {
             continue;
         };
         if sharp.contains(key) {
@@ -759,14 +760,17 @@ pub fn soup_scene3(soup: &PolygonSoup, face_colours: &[Rgba]) -> Scene3 {
 /// mesh's polygon edges in its own numbering (the wireframe, without the
 /// fans' diagonals).
 pub fn viewer_scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<Vec<[u32; 2]>>) {
-    use std::collections::{HashMap, HashSet};
+    use std::collections::HashMap;
     let newell = newell_vectors(soup);
     let smooth = (view.smooth && view.shading == Shading::Lit)
         .then(|| corner_normals(soup, &newell, &view.sharp_edges));
     let mut scene = Scene3::default();
     let mut keys: Vec<Option<Rgba>> = Vec::new();
-    let mut maps: Vec<HashMap<(u32, [u32; 3]), u32>> = Vec::new();
-    let mut edges: Vec<HashSet<[u32; 2]>> = Vec::new();
+    // Per mesh: each soup vertex's first copy (`u32::MAX`: none yet), and
+    // the copies with other normals (few: along sharp edges and folds).
+    let mut firsts: Vec<Vec<u32>> = Vec::new();
+    let mut others: Vec<HashMap<(u32, [u32; 3]), u32>> = Vec::new();
+    let mut edges: Vec<Vec<[u32; 2]>> = Vec::new();
     for (f, face) in soup.faces.iter().enumerate() {
         let Some(normal) = newell[f].map(DVec3::normalize) else {
             continue;
@@ -781,25 +785,36 @@ pub fn viewer_scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<Vec<[u
                 keys.push(key);
                 scene.looks.push(look);
                 scene.meshes.push(TriMesh::default());
-                maps.push(HashMap::new());
-                edges.push(HashSet::new());
+                firsts.push(vec![u32::MAX; soup.positions.len()]);
+                others.push(HashMap::new());
+                edges.push(Vec::new());
                 keys.len() - 1
             }
         };
         let corner_normals = smooth.as_ref().and_then(|s| s[f].as_ref());
         let m = &mut scene.meshes[k];
-        let map = &mut maps[k];
+        let (first, other) = (&mut firsts[k], &mut others[k]);
         let local: Vec<u32> = face
             .iter()
             .enumerate()
             .map(|(c, &i)| {
                 let n = corner_normals.map_or(normal, |ns| ns[c]).as_vec3();
-                *map.entry((i, n.to_array().map(f32::to_bits)))
-                    .or_insert_with(|| {
-                        m.positions.push(soup.positions[i as usize].as_vec3());
-                        m.normals.push(n);
-                        m.positions.len() as u32 - 1
-                    })
+                let bits = n.to_array().map(f32::to_bits);
+                let at = first[i as usize];
+                if at != u32::MAX && m.normals[at as usize].to_array().map(f32::to_bits) == bits {
+                    return at;
+                }
+                let copy = |m: &mut TriMesh| {
+                    m.positions.push(soup.positions[i as usize].as_vec3());
+                    m.normals.push(n);
+                    m.positions.len() as u32 - 1
+                };
+                if at == u32::MAX {
+                    let at = copy(m);
+                    first[i as usize] = at;
+                    return at;
+                }
+                *other.entry((i, bits)).or_insert_with(|| copy(m))
             })
             .collect();
         for j in 1..local.len() - 1 {
@@ -807,17 +822,13 @@ pub fn viewer_scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<Vec<[u
         }
         for (j, &a) in local.iter().enumerate() {
             let b = local[(j + 1) % local.len()];
-            edges[k].insert([a.min(b), a.max(b)]);
+            edges[k].push([a.min(b), a.max(b)]);
         }
     }
-    let edges = edges
-        .into_iter()
-        .map(|set| {
-            let mut list: Vec<[u32; 2]> = set.into_iter().collect();
-            list.sort_unstable();
-            list
-        })
-        .collect();
+    for list in &mut edges {
+        list.sort_unstable();
+        list.dedup();
+    }
     (scene, edges)
 }
 

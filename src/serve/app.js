@@ -427,7 +427,7 @@ async function showScene(reply) {
   // Drawn now, not at the next animation frame: the time an edit takes
   // to become a view (the status says it; the benchmark reads it).
   state.view3d.draw();
-  state.view3d.gl.finish();
+  state.view3d.settle();
   if (state.timing) Object.assign(state.timing, { fetched, drawn: performance.now() });
   state.scene = info;
   const mb = (info.bytes / 1e6).toFixed(info.bytes < 1e7 ? 1 : 0);

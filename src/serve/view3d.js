@@ -366,6 +366,13 @@ class View3D {
     this.frames += 1;
   }
 
+  // Waits for the GPU to finish what was drawn (reading a pixel back
+  // does; gl.finish need not).
+  settle() {
+    const gl = this.gl;
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+  }
+
   // Draws now and reads the picture back: how many pixels differ from
   // the background, and a checksum (the browser tests' eyes).
   sample() {
