@@ -184,6 +184,21 @@ pub struct Mesh {
     /// built from, which was fanned into triangles: where the mesh came
     /// from, so that schemes that read quads can refuse those triangles.
     pub(crate) fanned: Option<FannedPolygon>,
+    /// Every polygon of five or more sides of the soup, as its fan of
+    /// triangles, until a polygon split ([`Mesh::polygon_split_with`])
+    /// joins its corners to a centre; `fan_of` maps each of its
+    /// triangles' slots to its index here.
+    pub(crate) fans: Vec<Fan>,
+    pub(crate) fan_of: std::collections::BTreeMap<u32, u32>,
+}
+
+/// A polygon of five or more sides of the soup the mesh was built from,
+/// fanned into triangles from its first corner: its corners in order and
+/// the triangles `(c0, c(i+1), c(i+2))` of its fan, first to last.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Fan {
+    pub(crate) corners: Vec<VertexId>,
+    pub(crate) faces: Vec<FaceId>,
 }
 
 /// A polygon of more than four sides that [`Mesh::from_soup`] fanned into

@@ -30,7 +30,7 @@ fn run(file: &Path, mesh: &Path, steps: u64, defines: &[&str]) -> PolygonSoup {
     };
     match system.run(&ro).unwrap_or_else(|e| panic!("{e}")) {
         Run::Vv(v) => v.soup,
-        Run::Surface(s) => s.mesh.to_soup(),
+        Run::Surface(s) => s.mesh.to_quad_soup(),
         Run::Curve(_) | Run::Shapes(_) => panic!("{} is not a mesh program", file.display()),
     }
 }
@@ -801,6 +801,237 @@ fn vv_modified_butterfly_is_zorins_masks_with_vtks_boundary() {
                 (got - expected).abs().max_element() < 1e-12,
                 "{name}: edge {edge:?}: {got} against the mask's {expected}"
             );
+        }
+    }
+}
+
+/// `soup` with every vertex moved a little (a fixed sequence), written to
+/// `dir/name.obj` and read back as the programs read it.
+fn jiggled(dir: &Path, name: &str, mut soup: PolygonSoup, mut seed: u64) -> (PathBuf, PolygonSoup) {
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for p in &mut soup.positions {
+        *p += 0.1 * DVec3::new(next(), next(), next());
+    }
+    let path = dir.join(format!("{name}.obj"));
+    io::write(&path, &soup).unwrap();
+    let soup = io::read(&path).unwrap();
+    (path, soup)
+}
+
+/// The dual vv programs (Doo-Sabin, Peters-Reif) are the stellar grammars
+/// on closed meshes: quads, triangles, a torus, two steps, 1e-12, the
+/// same faces.
+#[test]
+fn vv_doo_sabin_and_peters_reif_are_the_grammars_on_closed_meshes() {
+    let dir = scratch("vv");
+    for m in ["cube.obj", "octahedron.obj", "torus.obj"] {
+        let (path, _) = jiggled(
+            dir.path(),
+            m.trim_end_matches(".obj"),
+            io::read(&mesh(m)).unwrap(),
+            7,
+        );
+        for (program, g) in [
+            ("doo-sabin.lsys", "doo-sabin.lsys"),
+            ("peters-reif.lsys", "peters.lsys"),
+        ] {
+            let a = run(&vv(program), &path, 2, &[]);
+            let b = run(&grammar(g), &path, 2, &[]);
+            assert_same_mesh(&a, &b, 1e-12, &format!("{program} on {m}"));
+        }
+    }
+}
+
+/// The points a dual program makes from `s`, one per face corner, by the
+/// rules its comment states: `interior(face positions, k)` at a corner
+/// with no boundary edge; at a corner p whose face has the boundary edge
+/// p-q, 3/4 p + 1/4 q; with both its edges on the boundary,
+/// 3/4 p + 1/8 (q + r).
+fn dual_points(s: &PolygonSoup, interior: impl Fn(&[DVec3], usize) -> DVec3) -> Vec<DVec3> {
+    let mut uses = std::collections::HashMap::new();
+    for f in &s.faces {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    let on_boundary = |a: u32, b: u32| uses[&(a.min(b), a.max(b))] == 1;
+    let mut out = Vec::new();
+    for f in &s.faces {
+        let n = f.len();
+        let ps: Vec<DVec3> = f.iter().map(|&i| s.positions[i as usize]).collect();
+        for k in 0..n {
+            let (p, q, r) = (f[k], f[(k + 1) % n], f[(k + n - 1) % n]);
+            let (pq, rp) = (on_boundary(p, q), on_boundary(r, p));
+            let (pp, qq, rr) = (ps[k], ps[(k + 1) % n], ps[(k + n - 1) % n]);
+            out.push(match (pq, rp) {
+                (true, true) => 0.75 * pp + 0.125 * (qq + rr),
+                (true, false) => 0.75 * pp + 0.25 * qq,
+                (false, true) => 0.75 * pp + 0.25 * rr,
+                (false, false) => interior(&ps, k),
+            });
+        }
+    }
+    out
+}
+
+/// One to one by position: every point of `want` has its own point of
+/// `got`; the largest distance.
+fn match_points(got: &[DVec3], want: &[DVec3]) -> f64 {
+    assert_eq!(got.len(), want.len(), "point counts");
+    let mut used = vec![false; got.len()];
+    let mut worst = 0.0f64;
+    for w in want {
+        let (i, d) = got
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !used[*i])
+            .map(|(i, g)| (i, g.distance(*w)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("a point left");
+        used[i] = true;
+        worst = worst.max(d);
+    }
+    worst
+}
+
+/// Faces a dual step makes from `s`: one per face, interior edge and
+/// interior vertex, and one per boundary vertex on three faces or more;
+/// and the boundary edges it has: Chaikin's polygon, two per boundary
+/// edge, less one per boundary vertex on a single face.
+fn dual_counts(s: &PolygonSoup) -> (usize, usize) {
+    let mut uses = std::collections::HashMap::new();
+    let mut faces_at = vec![0usize; s.positions.len()];
+    for f in &s.faces {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            faces_at[f[k] as usize] += 1;
+        }
+    }
+    let mut boundary_v = vec![false; s.positions.len()];
+    for (&(a, b), &n) in &uses {
+        if n == 1 {
+            boundary_v[a as usize] = true;
+            boundary_v[b as usize] = true;
+        }
+    }
+    let interior_e = uses.values().filter(|&&n| n == 2).count();
+    let boundary_e = uses.len() - interior_e;
+    let interior_v = boundary_v.iter().filter(|b| !**b).count();
+    let wide = (0..s.positions.len())
+        .filter(|&v| boundary_v[v] && faces_at[v] >= 3)
+        .count();
+    let single = (0..s.positions.len())
+        .filter(|&v| boundary_v[v] && faces_at[v] == 1)
+        .count();
+    (
+        s.faces.len() + interior_e + interior_v + wide,
+        2 * boundary_e - single,
+    )
+}
+
+fn boundary_edges(s: &PolygonSoup) -> usize {
+    let mut uses = std::collections::HashMap::new();
+    for f in &s.faces {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    uses.values().filter(|&&n| n == 1).count()
+}
+
+/// A dual scheme's point of corner `k` of a face (its corners' positions).
+type CornerRule = dyn Fn(&[DVec3], usize) -> DVec3;
+
+/// Doo-Sabin and Peters-Reif on open meshes: two steps on a quad grid
+/// (whose corners lie on one face), the triangle patch (boundary vertices
+/// on two to four faces) and a patch of a pentagon, a hexagon, quads and
+/// triangles, every point against the rules computed here from the step's
+/// input (1e-12), the faces counted, and the new boundary Chaikin's
+/// polygon of the old (its edges counted; its points are among those
+/// checked).
+#[test]
+fn vv_doo_sabin_and_peters_reif_on_open_meshes() {
+    let dir = scratch("vv");
+    let mixed = PolygonSoup {
+        positions: [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.1],
+            [2.0, 0.0, 0.0],
+            [3.0, 0.0, 0.2],
+            [0.0, 1.0, 0.1],
+            [1.0, 1.0, 0.3],
+            [2.0, 1.0, 0.2],
+            [3.0, 1.0, 0.0],
+            [0.5, 1.8, 0.0],
+            [1.5, 2.1, 0.2],
+            [2.5, 1.8, 0.1],
+            [3.6, 0.5, 0.1],
+            [1.5, 2.9, 0.0],
+            [0.3, 2.6, 0.1],
+            [-0.6, 0.5, 0.0],
+            [2.6, 2.7, 0.2],
+        ]
+        .iter()
+        .map(|&[x, y, z]| DVec3::new(x, y, z))
+        .collect(),
+        faces: vec![
+            vec![0, 1, 5, 4],
+            vec![1, 2, 6, 5],
+            vec![2, 3, 11, 7, 6],
+            vec![4, 5, 6, 10, 9, 8],
+            vec![8, 9, 12, 13],
+            vec![0, 4, 14],
+            vec![4, 8, 13, 14],
+            vec![6, 7, 10],
+            vec![9, 10, 15, 12],
+        ]
+        .into(),
+        ..PolygonSoup::default()
+    };
+    let averaging = |ps: &[DVec3], k: usize| {
+        let n = ps.len();
+        let (p, q, r) = (ps[k], ps[(k + 1) % n], ps[(k + n - 1) % n]);
+        let centroid = ps.iter().sum::<DVec3>() / n as f64;
+        0.25 * (p + 0.5 * (p + q) + 0.5 * (p + r) + centroid)
+    };
+    let mid_mid = |ps: &[DVec3], k: usize| {
+        let n = ps.len();
+        0.25 * (ps[(k + n - 1) % n] + 2.0 * ps[k] + ps[(k + 1) % n])
+    };
+    let cases = [
+        ("grid", io::read(&mesh("grid.obj")).unwrap()),
+        ("patch", io::read(&mesh("pentagon-patch.obj")).unwrap()),
+        ("mixed", mixed),
+    ];
+    for (name, soup) in cases {
+        let (path, base) = jiggled(dir.path(), name, soup, 11);
+        let rules: [(&str, &CornerRule); 2] = [
+            ("doo-sabin.lsys", &averaging),
+            ("peters-reif.lsys", &mid_mid),
+        ];
+        for (program, interior) in rules {
+            let what = format!("{program} on {name}");
+            let one = run(&vv(program), &path, 1, &[]);
+            let two = run(&vv(program), &path, 2, &[]);
+            for (input, output, step) in [(&base, &one, 1), (&one, &two, 2)] {
+                let d = match_points(&output.positions, &dual_points(input, interior));
+                assert!(d < 1e-12, "{what}, step {step}: {d}");
+                let (faces, bedges) = dual_counts(input);
+                assert_eq!(output.faces.len(), faces, "{what}, step {step}: faces");
+                assert_eq!(
+                    boundary_edges(output),
+                    bedges,
+                    "{what}, step {step}: boundary"
+                );
+            }
         }
     }
 }

@@ -103,18 +103,20 @@ impl Grammar {
     /// triangles a face split makes into quads); one that reads none takes
     /// quads as two triangles.
     fn check_blocks(&self, mesh: &mut Mesh) -> Result<(), RunError> {
-        // Pairing takes the triangles of a fanned polygon like any other.
+        // Pairing takes the triangles of a fanned polygon like any other,
+        // and a face split takes the polygon whole (Mesh::polygon_split_with).
+        let face_split = self.rules.iter().any(|r| r.op == Op::FaceSplit);
         let fanned = mesh
             .fanned_polygon()
-            .filter(|_| self.match_blocks_at.is_none());
+            .filter(|_| self.match_blocks_at.is_none() && !face_split);
         if let (Some(span), Some(fan)) = (self.block_used_at, fanned) {
             let line = fan.line.map_or(String::new(), |l| format!(" (line {l})"));
             return Err(RunError {
                 span: Some(span),
                 message: format!(
-                    "this grammar reads quads as basic blocks, but face {}{line} has {} sides; \
-                     polygons of more than four sides are not supported by such grammars yet \
-                     (split them into quads and triangles first)",
+                    "this grammar reads quads as basic blocks, but face {}{line} has {} sides, \
+                     and only a grammar with a face split (F -> V || E^3 F^3) takes a polygon \
+                     of more than four sides whole; split it into quads and triangles first",
                     fan.face + 1,
                     fan.sides
                 ),
@@ -167,7 +169,8 @@ impl Grammar {
                     span: Some(span),
                     message: format!(
                         "this grammar is a dual scheme, which runs on closed meshes only; \
-                         vertex {v} is on a boundary"
+                         vertex {v} is on a boundary (lsystems/vv/doo-sabin.lsys and \
+                         peters-reif.lsys, vv programs of the same schemes, have boundary rules)"
                     ),
                 });
             }

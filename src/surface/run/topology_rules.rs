@@ -119,9 +119,17 @@ impl Grammar {
                             let Some(f) = face_of(mesh, vs) else {
                                 return Err(fail("a face to split is gone".into()));
                             };
-                            let p = vs.iter().map(|v| mesh.position(*v)).sum::<DVec3>() / 3.0;
-                            mesh.face_split_with(f, p, &split)
-                                .map_err(|e| fail(e.message))?
+                            if let Some((k, _)) = mesh.fan_at(f) {
+                                // A polygon of five or more sides: its centre
+                                // joined to every corner.
+                                let p = mesh.fan_centroid(k);
+                                mesh.polygon_split_with(k, p, &split)
+                                    .map_err(|e| fail(e.message))?
+                            } else {
+                                let p = vs.iter().map(|v| mesh.position(*v)).sum::<DVec3>() / 3.0;
+                                mesh.face_split_with(f, p, &split)
+                                    .map_err(|e| fail(e.message))?
+                            }
                         } else if let Some((p, q)) = host::edge_vertices(val) {
                             let e = edge_id(val);
                             debug_assert!({
