@@ -299,10 +299,15 @@ impl GrammarRun<'_> {
         self.grammar.apply_all(&each, self.mesh, &mut self.state)?;
         self.state.swap_positions(self.mesh);
         // A step is one level of the scheme: semi-sharp creases and
-        // corners soften by one (OpenSubdiv's uniform rule). The rules of
-        // the step read the sharpness it started with.
+        // corners soften (OpenSubdiv's uniform rule, or its Chaikin rule
+        // at each edge's end that was there before the step). The rules
+        // of the step read the sharpness it started with.
         if self.state.creased {
-            self.mesh.decrement_sharpness();
+            let (mesh, step) = (&mut *self.mesh, self.state.step);
+            let old: Vec<bool> = (0..mesh.v_alive.len() as u32)
+                .map(|v| mesh.vertex_step(crate::mesh::VertexId(v)) < step)
+                .collect();
+            mesh.soften_sharpness(self.grammar.creasing, |v| old[v.index()]);
         }
         debug_assert!(
             self.state

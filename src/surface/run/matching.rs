@@ -105,7 +105,7 @@ impl Grammar {
         let parts: Vec<Result<(Part, Part), (bool, RuntimeError)>> = ranges
             .into_par_iter()
             .map(|(lo, hi)| {
-                let mut ev = Evaluator::new(mesh, current, step, frame_len);
+                let mut ev = Evaluator::new(mesh, current, step, frame_len, self.creasing);
                 let (mut a, mut b): (Part, Part) = Default::default();
                 match rule.op {
                     Op::FaceSplit => {

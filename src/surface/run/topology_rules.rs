@@ -52,7 +52,7 @@ impl Grammar {
             .into_par_iter()
             .with_min_len(CHUNK)
             .map_init(
-                || Evaluator::new(mesh, current, step, rule.frame),
+                || Evaluator::new(mesh, current, step, rule.frame, self.creasing),
                 |ev, k| match one(ev, k) {
                     Ok(Value::V3(p)) => p,
                     _ => DVec3::NAN,
@@ -64,7 +64,10 @@ impl Grammar {
             // Evaluate the first bad one again, to say what it gave.
             Some(k) => Err((
                 lo + k,
-                one(&mut Evaluator::new(mesh, current, step, rule.frame), lo + k),
+                one(
+                    &mut Evaluator::new(mesh, current, step, rule.frame, self.creasing),
+                    lo + k,
+                ),
             )),
         }
     }
