@@ -221,7 +221,7 @@ fn write_limit(
         return write_soup_picture(&soup, output, looks, &mut Out::Files).map(|()| Vec::new());
     }
     let dropped = format!(
-        "{}: the file does not keep the limit normals (write .obj or .ply, which keep them)",
+        "{}: warning: the file does not keep the limit normals (write .obj or .ply, which keep them)",
         output.display()
     );
     if is_glb(output) {
