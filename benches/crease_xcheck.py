@@ -27,6 +27,12 @@ Vertices are matched by position: for every vertex of one output the nearest
 vertex of the other; the largest such distance (both ways) is the error.
 The counts of vertices and faces must agree too.
 
+`--chaikin` runs the grammar with `-D CHAIKIN=1` (OpenSubdiv's Chaikin
+creasing, `creasing: chaikin;`) and only reports: Blender's modifier
+creases uniformly (it offers no creasing method), so the cases where a
+semi-sharp edge meets another of a different sharpness must differ and
+the others agree; that is how one sees which method Blender uses.
+
 `--self-test` gives Blender half of every sharpness instead (1.5 for
 `inf`): then every
 case with creases must differ (at some k), which shows that the comparison
@@ -123,11 +129,11 @@ def write_case(folder, name, vs, fs, sharp):
     return obj
 
 
-def ours(subgram, mesh, k, folder):
+def ours(subgram, mesh, k, folder, defines=()):
     out = os.path.join(folder, "out-%d.obj" % k)
     grammar = os.path.join(ROOT, "lsystems", "surfaces", "catmull-clark.lsys")
     subprocess.run([subgram, "subdivide", mesh, "--grammar", grammar, "-n", str(k), "-o", out,
-                    "--force"], check=True)
+                    "--force"] + [a for d in defines for a in ("-D", d)], check=True)
     return read_obj(out)
 
 
@@ -182,7 +188,11 @@ def main():
     ap.add_argument("--self-test", action="store_true",
                     help="give Blender half of each sharpness (1.5 for inf): every creased "
                     "case must differ")
+    ap.add_argument("--chaikin", action="store_true",
+                    help="run the grammar with -D CHAIKIN=1 (OpenSubdiv's Chaikin creasing) and "
+                    "report which cases Blender (uniform creasing) differs on; not judged")
     args = ap.parse_args()
+    defines = ("CHAIKIN=1",) if args.chaikin else ()
     cases = dict(CASES)
     # The repository's example, read from its PLY edge element.
     ply = os.path.join(ROOT, "lsystems", "meshes", "creased-cube.ply")
@@ -196,7 +206,7 @@ def main():
             mesh = ply if name.endswith(".ply") else write_case(folder, "case%d" % n, vs, fs, sharp)
             case_bad = 0
             for k in (1, 2, 3):
-                p, faces = ours(args.subgram, mesh, k, folder)
+                p, faces = ours(args.subgram, mesh, k, folder, defines)
                 given = ({e: (s / 2 if s != INF else 1.5) for e, s in sharp.items()}
                          if args.self_test else sharp)
                 q, nf = blender(vs, fs, given, k)
@@ -214,6 +224,11 @@ def main():
         print("self-test: %d results differ; every one of the %d creased cases must" % (
             bad, creased))
         return 0 if differed == creased else 1
+    if args.chaikin:
+        print("Chaikin creasing: %d of %d results differ from Blender's (uniform creasing); "
+              "only cases whose semi-sharp edges meet others of another sharpness can" % (
+                  bad, 3 * len(cases)))
+        return 0
     print("%d passed, %d failed" % (3 * len(cases) - bad, bad))
     return 1 if bad else 0
 

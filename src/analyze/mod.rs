@@ -17,6 +17,7 @@
 //! a layer above (see ARCHITECTURE.md, "Layers").
 
 pub mod curve;
+pub mod limit;
 mod num;
 pub mod surface;
 mod text;

@@ -40,6 +40,11 @@ pub(super) struct SubdivideCli {
     /// Write the output even when it is one of the inputs.
     #[arg(long)]
     force: bool,
+    /// Surface grammars (primal, on a closed mesh): move the final
+    /// vertices to their limit positions and write their limit normals
+    /// (vn in OBJ, nx ny nz in PLY), by the stencils `analyze` measures
+    #[arg(long)]
+    limit: bool,
 }
 
 impl SubdivideCli {
@@ -56,6 +61,7 @@ impl SubdivideCli {
             seed,
             timeout,
             force,
+            limit,
         } = self;
         let args = SubdivideArgs {
             mesh,
@@ -69,6 +75,7 @@ impl SubdivideCli {
             seed,
             timeout: timeout.0,
             force,
+            limit,
             program_output: subgram::ProgramOutput::new(),
         };
         let result = with_progress(|p| command::subdivide(&args, p));

@@ -343,6 +343,7 @@ pub(super) fn render_system(
             seed: a.seed,
             timeout: a.timeout,
             force: a.force,
+            limit: false,
             program_output: a.program_output.clone(),
         };
         return subdivide_in_run(&sa, progress);

@@ -37,6 +37,10 @@ pub struct SubdivideArgs {
     pub timeout: Option<Duration>,
     /// Write the output even over one of the inputs.
     pub force: bool,
+    /// `--limit`: the final vertices at their limit positions, with their
+    /// limit normals written (surface grammars; see
+    /// [`crate::analyze::limit`]).
+    pub limit: bool,
     /// What a vv program prints: the caller keeps a clone and prints it.
     pub program_output: ProgramOutput,
 }
@@ -126,6 +130,18 @@ pub(super) fn subdivide_in_run(
     } else {
         Kind::Surface
     };
+    if a.limit && kind != Kind::Surface {
+        return Err(Error::Usage(format!(
+            "--limit is for surface grammars (its stencils come from `analyze`), and `{}` is \
+             a {}",
+            grammar.display(),
+            if kind == Kind::Vv {
+                "vertex-vertex program"
+            } else {
+                "shape grammar"
+            }
+        )));
+    }
     // A shape grammar writes its terminal shapes.
     if kind == Kind::Shapes {
         let dir = grammar.parent().unwrap_or(Path::new("")).to_path_buf();
@@ -175,6 +191,9 @@ pub(super) fn subdivide_in_run(
         refuse_overwrite(&[output], &as_paths(&inputs), a.force)?;
     }
     let run = surface.subdivide(&opts, progress)?;
+    if a.limit {
+        return write_limit(&surface.grammar, &run.mesh, output, &looks);
+    }
     if Picture::from_path(output).is_ok() {
         return write_mesh_picture(&run.mesh, output, &looks, &mut Out::Files).map(|()| Vec::new());
     }
@@ -182,6 +201,45 @@ pub(super) fn subdivide_in_run(
         return write_soup_glb(&run.mesh.to_quad_soup(), &[], output).map(|()| Vec::new());
     }
     write_mesh(output, &run.mesh, false)
+}
+
+/// `--limit`: the run's mesh at its limit positions, written with its
+/// limit normals where the format keeps them (a picture is drawn from the
+/// positions; OFF and glTF get a warning that the normals are not in
+/// them).
+fn write_limit(
+    g: &crate::surface::Grammar,
+    m: &crate::mesh::Mesh,
+    output: &Path,
+    looks: &MeshLooks,
+) -> Result<Vec<String>, Error> {
+    if m.has_sharpness() {
+        return Err(Error::Failed(
+            "--limit: the mesh still has creases after the run; limit positions and normals \
+             are computed for smooth interior vertices only (the stencils `analyze` measures)"
+                .into(),
+        ));
+    }
+    let mut soup = m.to_quad_soup();
+    let deadline = crate::deadline::current()
+        .unwrap_or_else(|| crate::Deadline::after(crate::analyze::TIMEOUT));
+    let limit = crate::analyze::limit::limit_surface(g, &soup, deadline)?;
+    soup.positions = limit.positions;
+    if Picture::from_path(output).is_ok() {
+        return write_soup_picture(&soup, output, looks, &mut Out::Files).map(|()| Vec::new());
+    }
+    let dropped = format!(
+        "{}: warning: the file does not keep the limit normals (write .obj or .ply, which keep them)",
+        output.display()
+    );
+    if is_glb(output) {
+        return write_soup_glb(&soup, &[], output).map(|()| vec![dropped]);
+    }
+    mesh::io::write_with_normals(output, &soup, &limit.normals)?;
+    Ok(match mesh::io::Format::from_path(output) {
+        Some(mesh::io::Format::Off) => vec![dropped],
+        _ => Vec::new(),
+    })
 }
 
 /// The output is binary glTF (`.glb`), which meshes are exported to as a

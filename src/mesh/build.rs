@@ -111,6 +111,32 @@ impl Mesh {
     }
 
     fn build(soup: &PolygonSoup, tags: Option<&[u32]>) -> Result<Mesh, MeshError> {
+        let mut m = Mesh::build_triangles(soup, tags)?;
+        m.record_fans(soup);
+        Ok(m)
+    }
+
+    /// Records each polygon of five or more sides of `soup` as the fan of
+    /// triangles the build made of it ([`Mesh::soup_face_ranges`]), for a
+    /// face split that takes the polygon whole.
+    fn record_fans(&mut self, soup: &PolygonSoup) {
+        for (fi, range) in Mesh::soup_face_ranges(soup).into_iter().enumerate() {
+            let corners = &soup.faces[fi];
+            if corners.len() < 5 {
+                continue;
+            }
+            let k = self.fans.len() as u32;
+            for f in range.clone() {
+                self.fan_of.insert(f, k);
+            }
+            self.fans.push(super::halfedge::Fan {
+                corners: corners.iter().map(|&c| VertexId(c)).collect(),
+                faces: range.map(FaceId).collect(),
+            });
+        }
+    }
+
+    fn build_triangles(soup: &PolygonSoup, tags: Option<&[u32]>) -> Result<Mesh, MeshError> {
         let nv = soup.positions.len();
         for (i, p) in soup.positions.iter().enumerate() {
             if !p.is_finite() {
@@ -474,8 +500,11 @@ impl Mesh {
     /// Reads the mesh as plain triangles: no basic blocks, and, on a base
     /// mesh (every vertex at level 0), every edge at level 0, as if each
     /// quad had been given as two triangles. Schemes for triangle meshes
-    /// run on quad input this way.
+    /// run on quad input this way; a polygon of more than four sides is
+    /// its fan's triangles for them (a face split takes each alone).
     pub fn forget_blocks(&mut self) {
+        self.fans.clear();
+        self.fan_of.clear();
         let base = self.vertices().all(|v| self.vertex_level(v) == 0);
         let edges: Vec<EdgeId> = self.edges().collect();
         for e in edges {
@@ -1370,9 +1399,12 @@ pub(crate) mod tests {
         for base in bases() {
             for _ in 0..150 {
                 let (soup, tags) = mutate(&mut rng, &base);
-                let new = Mesh::build(&soup, Some(&tags));
+                let new = Mesh::build_triangles(&soup, Some(&tags));
                 assert_eq!(new, Mesh::build_reference(&soup, Some(&tags)));
-                assert_eq!(Mesh::build(&soup, None), Mesh::build_reference(&soup, None));
+                assert_eq!(
+                    Mesh::build_triangles(&soup, None),
+                    Mesh::build_reference(&soup, None)
+                );
                 match new {
                     Ok(m) => {
                         built += 1;

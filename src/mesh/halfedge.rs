@@ -184,6 +184,65 @@ pub struct Mesh {
     /// built from, which was fanned into triangles: where the mesh came
     /// from, so that schemes that read quads can refuse those triangles.
     pub(crate) fanned: Option<FannedPolygon>,
+    /// Every polygon of five or more sides of the soup, as its fan of
+    /// triangles, until a polygon split ([`Mesh::polygon_split_with`])
+    /// joins its corners to a centre; `fan_of` maps each of its
+    /// triangles' slots to its index here.
+    pub(crate) fans: Vec<Fan>,
+    pub(crate) fan_of: std::collections::BTreeMap<u32, u32>,
+}
+
+/// How semi-sharp creases soften from one level to the next: OpenSubdiv's
+/// creasing methods (`Sdc::Options::CreasingMethod`). A surface grammar
+/// chooses one with `creasing: chaikin;` (uniform without it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Creasing {
+    /// Every sharpness drops by one a level (`CREASE_UNIFORM`).
+    #[default]
+    Uniform,
+    /// An edge's sharpness at each end follows Chaikin's rule over the
+    /// semi-sharp edges there (`CREASE_CHAIKIN`): see [`child_sharpness`].
+    Chaikin,
+}
+
+/// The sharpness one level down of the half, at vertex `v`, of an edge of
+/// sharpness `s`, given the sharpness of every edge at `v` (`s`'s edge
+/// among them), as OpenSubdiv defines its creasing methods: smooth stays
+/// smooth and infinite infinite; [`Creasing::Uniform`] gives `s - 1`;
+/// [`Creasing::Chaikin`], where two or more of the edges at `v` are
+/// semi-sharp (above 0, finite), gives `3/4 s + 1/4 a - 1`, `a` the mean of
+/// the other semi-sharp edges' sharpness, and `s - 1` where `s`'s edge is
+/// the only one. Never below 0.
+pub fn child_sharpness(method: Creasing, s: f64, at_v: impl Iterator<Item = f64>) -> f64 {
+    if s <= 0.0 {
+        return 0.0;
+    }
+    if s.is_infinite() {
+        return s;
+    }
+    let (mut sum, mut count, mut edges) = (0.0, 0usize, 0usize);
+    for x in at_v {
+        edges += 1;
+        if x > 0.0 && x.is_finite() {
+            sum += x;
+            count += 1;
+        }
+    }
+    let s = if method == Creasing::Chaikin && edges >= 2 && count > 1 {
+        0.75 * s + 0.25 * ((sum - s) / (count - 1) as f64)
+    } else {
+        s
+    };
+    (s - 1.0).max(0.0)
+}
+
+/// A polygon of five or more sides of the soup the mesh was built from,
+/// fanned into triangles from its first corner: its corners in order and
+/// the triangles `(c0, c(i+1), c(i+2))` of its fan, first to last.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Fan {
+    pub(crate) corners: Vec<VertexId>,
+    pub(crate) faces: Vec<FaceId>,
 }
 
 /// A polygon of more than four sides that [`Mesh::from_soup`] fanned into
@@ -409,6 +468,53 @@ impl Mesh {
         self.outgoing_halfedges(v)
             .filter(|h| self.is_sharp_edge(h.edge()) && !self.is_boundary_edge(h.edge()))
             .count()
+    }
+
+    /// One level of `method`: a vertex's sharpness drops by one (both
+    /// methods); an edge's by one ([`Creasing::Uniform`]), or
+    /// ([`Creasing::Chaikin`]) by [`child_sharpness`] at its end that
+    /// `old` says was there before the step, from the sharpness of the
+    /// edges at that end as the step left them (a split edge's halves
+    /// keep their parent's, so these are the parent level's values). An
+    /// edge with both ends old or neither takes the uniform rule.
+    pub fn soften_sharpness(&mut self, method: Creasing, old: impl Fn(VertexId) -> bool) {
+        if method == Creasing::Uniform || !self.creased {
+            self.decrement_sharpness();
+            return;
+        }
+        let mut next: Vec<(EdgeId, f64)> = Vec::new();
+        for e in self.edges() {
+            let s = self.edge_sharpness(e);
+            if s <= 0.0 || s.is_infinite() {
+                continue;
+            }
+            let (a, b) = self.edge_vertices(e);
+            let at = match (old(a), old(b)) {
+                (true, false) => Some(a),
+                (false, true) => Some(b),
+                _ => None,
+            };
+            let child = match at {
+                Some(v) => child_sharpness(
+                    Creasing::Chaikin,
+                    s,
+                    self.outgoing_halfedges(v)
+                        .map(|h| self.edge_sharpness(h.edge())),
+                ),
+                None => (s - 1.0).max(0.0),
+            };
+            next.push((e, child));
+        }
+        for (e, s) in next {
+            self.e_sharp.set(e.index(), s);
+        }
+        let v = self.v_sharp.stored_mut();
+        for s in v.iter_mut() {
+            if *s > 0.0 {
+                *s = (*s - 1.0).max(0.0);
+            }
+        }
+        self.creased = self.has_sharpness();
     }
 
     /// One level of OpenSubdiv's uniform rule: every positive sharpness,

@@ -18,6 +18,8 @@ pub mod stellar;
 pub mod validate;
 
 pub use build::SoupSharpness;
-pub use halfedge::{EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId};
+pub use halfedge::{
+    child_sharpness, Creasing, EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId,
+};
 pub use soup::{Faces, MeshFileError, Place, PolygonSoup};
 pub use stellar::{BlockSplit, Split};

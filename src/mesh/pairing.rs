@@ -545,6 +545,10 @@ impl Mesh {
             )));
         }
         let base = self.vertices().all(|v| self.vertex_level(v) == 0);
+        // The fans' triangles are paired like any others: no polygon is
+        // taken whole any more.
+        self.fans.clear();
+        self.fan_of.clear();
         for &e in &pairs {
             self.e_block.set(e.index(), true);
         }

@@ -161,6 +161,100 @@ impl Mesh {
         Ok(v)
     }
 
+    /// The polygon of five or more sides whose fan of triangles holds `f`,
+    /// while the fan is as the build made it: its index, and whether `f`
+    /// is its first triangle (the one a polygon split starts from).
+    pub(crate) fn fan_at(&self, f: FaceId) -> Option<(usize, bool)> {
+        let k = *self.fan_of.get(&f.0)? as usize;
+        let fan = &self.fans[k];
+        let c = &fan.corners;
+        let whole = fan.faces.iter().enumerate().all(|(i, &t)| {
+            self.is_face(t) && {
+                let mut got = self.face_vertices(t);
+                let mut want = [c[0], c[i + 1], c[i + 2]];
+                got.sort();
+                want.sort();
+                got == want
+            }
+        });
+        whole.then_some((k, fan.faces[0] == f))
+    }
+
+    /// The centroid of fan polygon `k`'s corners.
+    pub(crate) fn fan_centroid(&self, k: usize) -> DVec3 {
+        let c = &self.fans[k].corners;
+        c.iter().map(|&v| self.position(v)).sum::<DVec3>() / c.len() as f64
+    }
+
+    /// Polygon split: a new vertex `v` inside a polygon of five or more
+    /// sides (fan `k`, see [`Mesh::fan_at`]) joined to all its corners: a
+    /// face split of the fan's first triangle, then a flip of each of the
+    /// fan's diagonals in turn, each of which becomes a spoke.
+    ///
+    /// ```text
+    ///       c3 ---- c2              c3 ---- c2
+    ///      /  ` .    \             /  \    /  \
+    ///    c4      ` .  c1    ->   c4 --- v --- c1
+    ///      \        ` |            \  /    \  /
+    ///       c5 ---- c0              c5 ---- c0
+    /// ```
+    ///
+    /// (one of the fan's diagonals drawn, c0-c3: each diagonal c0-ci
+    /// flips into the spoke v-c(i+1); v-c0, v-c1 and v-c2 come from the
+    /// face split of the triangle c0 c1 c2).
+    ///
+    /// The spokes get the level of `v`, as a face split's, and with
+    /// `policy.lone_triangles_join_blocks` become internal edges of
+    /// blocks, so that the polygon becomes as many quads as it has sides
+    /// (Catmull-Clark's first step on a polygon). Everything is checked
+    /// before the mesh changes; afterwards the polygon is no longer a fan.
+    pub(crate) fn polygon_split_with(
+        &mut self,
+        k: usize,
+        p: DVec3,
+        policy: &Split,
+    ) -> Result<VertexId, MeshError> {
+        let fan = self.fans[k].clone();
+        let first = fan.faces[0];
+        if self.fan_at(first) != Some((k, true)) {
+            return Err(MeshError::new(format!(
+                "polygon split: the polygon of {} sides on vertices {}, {}, ... was changed \
+                 since it was read",
+                fan.corners.len(),
+                fan.corners[0],
+                fan.corners[1]
+            )));
+        }
+        let c0 = fan.corners[0];
+        let mut diagonals = Vec::with_capacity(fan.corners.len() - 3);
+        for &c in &fan.corners[2..fan.corners.len() - 1] {
+            let e = self
+                .find_halfedge(c0, c)
+                .map(|h| h.edge())
+                .filter(|&e| !self.is_sharp_edge(e) && !self.is_boundary_edge(e))
+                .ok_or_else(|| {
+                    MeshError::new(format!(
+                        "polygon split: the diagonal between vertices {c0} and {c} is missing, \
+                         sharp or on the boundary"
+                    ))
+                })?;
+            diagonals.push(e);
+        }
+        let v = self.face_split_with(first, p, policy)?;
+        let lv = self.vertex_level(v);
+        for e in diagonals {
+            self.edge_flip(e)?;
+            self.e_level.set(e.index(), lv);
+            if policy.lone_triangles_join_blocks {
+                self.e_block.set(e.index(), true);
+            }
+        }
+        for f in &fan.faces {
+            self.fan_of.remove(&f.0);
+        }
+        Ok(v)
+    }
+
     /// Face weld, the inverse of face split: removes an interior vertex of
     /// valence 3 and merges its three triangles. The merged face reuses
     /// the slot, and keeps the tag, of the first face around the vertex.

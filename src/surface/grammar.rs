@@ -112,6 +112,9 @@ pub struct GrammarFile {
     /// `adaptive: incremental;`: from the second step on, split rules test
     /// only the diamonds at vertices made since the step before.
     pub incremental: bool,
+    /// `creasing: chaikin;` or `creasing: uniform;`: how semi-sharp
+    /// creases soften from step to step (OpenSubdiv's creasing methods).
+    pub creasing: Option<(crate::mesh::Creasing, Span)>,
 }
 
 type R<T> = Result<T, Diagnostic>;
@@ -205,6 +208,20 @@ pub fn parse(toks: &[Token], eof: Span, text_of: impl Fn(Span) -> String) -> R<G
             p.bump();
             p.expect_punct(";", "after the block refinement")?;
             g.block_split = Some((how, at));
+            continue;
+        }
+        if at_key(&p, "creasing") {
+            p.bump();
+            p.bump();
+            let at = p.span_here();
+            let how = match p.peek().map(|t| &t.tok) {
+                Some(Tok::Ident(w)) if w == "uniform" => crate::mesh::Creasing::Uniform,
+                Some(Tok::Ident(w)) if w == "chaikin" => crate::mesh::Creasing::Chaikin,
+                _ => return p.error("`uniform` or `chaikin` after `creasing:`"),
+            };
+            p.bump();
+            p.expect_punct(";", "after the creasing method")?;
+            g.creasing = Some((how, at));
             continue;
         }
         if p.peek_ident("adaptive") && p.peek_at(1).is_some_and(|t| t.tok.is_punct(";")) {
@@ -324,12 +341,10 @@ fn rule(p: &mut Parser, text_of: &impl Fn(Span) -> String) -> R<RuleDef> {
         Some(Tok::Ident(k)) if k == "F" => Kind::Face,
         Some(Tok::Ident(k)) if k == "E" => Kind::Edge,
         Some(Tok::Ident(k)) if k == "V" => Kind::Vertex,
-        _ => {
-            return p.error(
-                "a rule starting with F, E or V, `init:`, `define`, `mesh:`, `blocks:`, \
+        _ => return p.error(
+            "a rule starting with F, E or V, `init:`, `define`, `mesh:`, `blocks:`, `creasing:`, \
                  `adaptive;` or `derivation length:`",
-            )
-        }
+        ),
     };
     p.bump();
     p.expect_punct("(", "after the element type")?;

@@ -54,7 +54,14 @@ const ON_CREASES: &[(&str, &str)] = &[
 ];
 
 /// vv programs with boundary rules, run on the open triangle patch as well.
-const ON_PATCH: &[&str] = &["butterfly", "loop", "sqrt3"];
+const ON_PATCH: &[&str] = &[
+    "butterfly",
+    "doo-sabin",
+    "loop",
+    "modified-butterfly",
+    "peters-reif",
+    "sqrt3",
+];
 
 /// The golden files of `lsystems/REL`, with how each is compared; `None`
 /// for a file no rule covers.

@@ -21,6 +21,7 @@ mod guide;
 mod infer;
 mod lang_features;
 mod layers;
+mod limit_surface;
 mod limits;
 mod lpfg_agreement;
 mod lpfg_semantics;

@@ -493,3 +493,177 @@ fn a_crease_that_meets_the_boundary_ends_in_corners() {
         assert_ne!(m.position(VertexId(5)), base.position(VertexId(5)));
     }
 }
+
+/// OpenSubdiv's Chaikin rule for the half at `v` of an edge of sharpness
+/// `s`, written out here from its documentation: smooth stays smooth,
+/// infinite infinite; where another semi-sharp edge meets `v`, 3/4 s +
+/// 1/4 (the mean of the other semi-sharp edges' sharpness) - 1, else s -
+/// 1; never below 0.
+fn chaikin_child(s: f64, others: &[f64]) -> f64 {
+    if s <= 0.0 || s.is_infinite() {
+        return s.max(0.0);
+    }
+    let semi: Vec<f64> = others
+        .iter()
+        .copied()
+        .filter(|x| *x > 0.0 && x.is_finite())
+        .collect();
+    let s = if semi.is_empty() {
+        s
+    } else {
+        0.75 * s + 0.25 * semi.iter().sum::<f64>() / semi.len() as f64
+    };
+    (s - 1.0).max(0.0)
+}
+
+/// Every sharp edge of `after` (one step of a grammar from `before`) holds
+/// the Chaikin value of its parent at its old end: the half (x, n), n new,
+/// has parent (x, z) in `before`, z the far end of n's other sharp half.
+/// Returns how many edges were checked.
+fn check_chaikin_step(before: &Mesh, after: &Mesh, what: &str) -> usize {
+    let old = |v: VertexId| before.is_vertex(v);
+    let mut checked = 0;
+    for e in after.edges() {
+        // A quad's diagonal (Catmull-Clark's blocks) joins an old corner
+        // to a face point: not a half of an old edge.
+        if after.is_block_edge(e) {
+            continue;
+        }
+        let s = after.edge_sharpness(e);
+        let (a, b) = after.edge_vertices(e);
+        let (x, n) = match (old(a), old(b)) {
+            (true, false) => (a, b),
+            (false, true) => (b, a),
+            _ => continue,
+        };
+        // n is new on the edge x-z of `before`: its old neighbours are x
+        // and z (its other neighbours are new in both schemes).
+        let Some(z) = after
+            .outgoing_halfedges(n)
+            .map(|h| after.to(h))
+            .find(|&z| z != x && old(z))
+        else {
+            continue;
+        };
+        let parent = before.find_halfedge(x, z).unwrap().edge();
+        let ps = before.edge_sharpness(parent);
+        if ps <= 0.0 {
+            continue;
+        }
+        let others: Vec<f64> = before
+            .outgoing_halfedges(x)
+            .filter(|h| h.edge() != parent)
+            .map(|h| before.edge_sharpness(h.edge()))
+            .collect();
+        let want = chaikin_child(ps, &others);
+        assert!(
+            (s - want).abs() < 1e-12,
+            "{what}: the half at {x} of edge {x}-{z} (sharpness {ps}, others {others:?}) \
+             has {s}, Chaikin gives {want}"
+        );
+        checked += 1;
+    }
+    checked
+}
+
+/// OpenSubdiv's Chaikin creasing (`creasing: chaikin;`, which
+/// `-D CHAIKIN=1` turns on in the shipped grammars): a rim of four edges
+/// of different sharpness on the cube (Catmull-Clark) and an equator on
+/// the octahedron (Loop); after each of three steps every sharp half holds
+/// the rule's value computed here from the step before, and the two
+/// halves of one edge differ where its ends see different neighbours.
+#[test]
+fn chaikin_creasing_softens_each_half_by_its_ends_neighbours() {
+    let defines = ["CHAIKIN=1".to_string()];
+    for (file, base, ring, values) in [
+        (
+            "surfaces/catmull-clark.lsys",
+            cube(7),
+            RIM,
+            [0.8, 3.0, 2.0, 1.5],
+        ),
+        (
+            "surfaces/loop.lsys",
+            octahedron(7),
+            EQUATOR,
+            [2.5, 0.6, 1.7, 3.2],
+        ),
+    ] {
+        let g = subgram::surface::load_file(&lsys(file), &defines).unwrap();
+        let mut m = base.clone();
+        for k in 0..4 {
+            let e = edge(&m, ring[k], ring[(k + 1) % 4]);
+            m.set_edge_sharpness(e, values[k]).unwrap();
+        }
+        let mut before = m.clone();
+        let mut uneven = false;
+        for steps in 1..=3 {
+            let after = run(&g, &m, steps);
+            let n = check_chaikin_step(&before, &after, &format!("{file}, step {steps}"));
+            assert!(
+                n >= 8 || steps == 3,
+                "{file}, step {steps}: only {n} halves checked"
+            );
+            if steps == 1 {
+                // The halves of the rim's first edge, at its two ends.
+                let s: Vec<f64> = after
+                    .edges()
+                    .map(|e| after.edge_sharpness(e))
+                    .filter(|s| *s > 0.0)
+                    .collect();
+                let distinct = s
+                    .iter()
+                    .map(|x| (x * 1e9) as i64)
+                    .collect::<std::collections::BTreeSet<_>>();
+                uneven = distinct.len() > 4;
+            }
+            before = after;
+        }
+        assert!(uneven, "{file}: the halves all took the same values");
+    }
+}
+
+/// Where the methods differ, the positions follow: on the cube with a rim
+/// of sharpness 0.8 on one edge and 3 on the other three, uniform
+/// creasing blends the corner between the two (0.8 of its crease rule:
+/// the 0.8 edge dies) and the 0.8 edge's point between midpoint and
+/// smooth point (0.8), while Chaikin's keeps the edge sharp one level
+/// down at both ends (3/4 0.8 + 1/4 3 - 1 = 0.35), so the corner takes
+/// the crease rule 3/4 v + 1/8 (a + b) whole and the edge point is the
+/// midpoint: masks computed here.
+#[test]
+fn chaikin_creasing_keeps_a_weak_edge_next_to_strong_ones() {
+    let mut m = cube(3);
+    for k in 0..4 {
+        let e = edge(&m, RIM[k], RIM[(k + 1) % 4]);
+        m.set_edge_sharpness(e, if k == 0 { 0.8 } else { 3.0 })
+            .unwrap();
+    }
+    let p = |v: u32| m.position(VertexId(v));
+    let (v0, v1, v3) = (RIM[0], RIM[1], RIM[3]);
+    let crease_point = 0.75 * p(v0) + 0.125 * (p(v1) + p(v3));
+    let midpoint = 0.5 * (p(v0) + p(v1));
+    let has = |out: &Mesh, q: DVec3| out.vertices().any(|v| out.position(v).distance(q) < 1e-12);
+    let chaikin = subgram::surface::load_file(
+        &lsys("surfaces/catmull-clark.lsys"),
+        &["CHAIKIN=1".to_string()],
+    )
+    .unwrap();
+    let out = run(&chaikin, &m, 1);
+    assert!(
+        has(&out, crease_point),
+        "Chaikin: the corner takes the crease rule"
+    );
+    assert!(
+        has(&out, midpoint),
+        "Chaikin: the weak edge's point is its midpoint"
+    );
+    assert!((out.position(VertexId(v0)) - crease_point).length() < 1e-12);
+    let uniform = grammar("surfaces/catmull-clark.lsys");
+    let out = run(&uniform, &m, 1);
+    assert!(
+        !has(&out, crease_point) && !has(&out, midpoint),
+        "uniform blends both"
+    );
+    assert!((out.position(VertexId(v0)) - crease_point).length() > 1e-3);
+}

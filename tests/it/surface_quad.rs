@@ -404,11 +404,9 @@ fn parallel_evaluation_gives_the_same_bits_on_one_thread() {
     }
 }
 
-/// A pentagon is fanned into triangles on input; a grammar that reads
-/// quads would take the fan's triangles for faces, so it refuses by name.
-#[test]
-fn block_grammars_refuse_fanned_polygons() {
-    let soup = PolygonSoup {
+/// A pentagonal pyramid: a pentagon and five triangles, closed.
+fn pentagon_pyramid() -> PolygonSoup {
+    PolygonSoup {
         positions: vec![
             DVec3::new(0.0, 0.0, 0.0),
             DVec3::new(1.0, 0.0, 0.0),
@@ -418,27 +416,164 @@ fn block_grammars_refuse_fanned_polygons() {
             DVec3::new(0.5, 0.5, 1.0),
         ],
         faces: vec![
-            vec![0, 1, 2, 3, 4],
-            vec![0, 5, 1],
-            vec![1, 5, 2],
-            vec![2, 5, 3],
-            vec![3, 5, 4],
-            vec![4, 5, 0],
+            vec![0, 4, 3, 2, 1],
+            vec![0, 1, 5],
+            vec![1, 2, 5],
+            vec![2, 3, 5],
+            vec![3, 4, 5],
+            vec![4, 0, 5],
         ]
         .into(),
         ..PolygonSoup::default()
-    };
-    for file in ["surfaces/catmull-clark.lsys", "surfaces/doo-sabin.lsys"] {
-        let g = grammar(file);
-        let mut m = Mesh::from_soup(&soup).unwrap();
-        let e = g.run(&mut m, 1, |_| {}).unwrap_err();
-        let text = g.render_error(&e);
-        assert!(text.contains("face 1 has 5 sides"), "{text}");
     }
+}
+
+/// A pentagon is fanned into triangles on input; a grammar that reads
+/// quads and has no face split to take the polygon whole (4-8) would take
+/// the fan's triangles for faces, so it refuses by name.
+#[test]
+fn block_grammars_without_a_face_split_refuse_fanned_polygons() {
+    let soup = pentagon_pyramid();
+    let g = grammar("surfaces/four-eight.lsys");
+    let mut m = Mesh::from_soup(&soup).unwrap();
+    let e = g.run(&mut m, 1, |_| {}).unwrap_err();
+    let text = g.render_error(&e);
+    assert!(text.contains("face 1 has 5 sides"), "{text}");
     // Loop reads everything as triangles and runs.
     let g = grammar("surfaces/loop.lsys");
     let mut m = Mesh::from_soup(&soup).unwrap();
     g.run(&mut m, 1, |_| {}).unwrap();
+}
+
+/// Catmull and Clark's rules on any polygon, as OpenSubdiv has them,
+/// computed here from the input polygons: the face point is the centroid
+/// of the face's corners; an interior edge's point the average of its ends
+/// and its two face points, a boundary edge's its midpoint; an interior
+/// vertex of valence n goes to (n - 2)/n v + (sum of its n neighbours +
+/// sum of its n face points)/n^2, a boundary vertex to 3/4 v + 1/8 (a + b)
+/// of its boundary neighbours.
+fn catmull_clark_points(s: &PolygonSoup) -> Vec<DVec3> {
+    let p = |i: u32| s.positions[i as usize];
+    let centroid = |f: &[u32]| f.iter().map(|&i| p(i)).sum::<DVec3>() / f.len() as f64;
+    let mut out: Vec<DVec3> = s.faces.iter().map(centroid).collect();
+    // Each edge's faces (by index), in a map from (min, max).
+    let mut edges: std::collections::BTreeMap<(u32, u32), Vec<usize>> = Default::default();
+    for (k, f) in s.faces.iter().enumerate() {
+        for j in 0..f.len() {
+            let (a, b) = (f[j], f[(j + 1) % f.len()]);
+            edges.entry((a.min(b), a.max(b))).or_default().push(k);
+        }
+    }
+    for (&(a, b), fs) in &edges {
+        out.push(match fs.as_slice() {
+            [f, g] => (p(a) + p(b) + out[*f] + out[*g]) / 4.0,
+            [_] => (p(a) + p(b)) / 2.0,
+            _ => panic!("a non-manifold edge"),
+        });
+    }
+    for v in 0..s.positions.len() as u32 {
+        let nbrs: Vec<(u32, usize)> = edges
+            .iter()
+            .filter(|((a, b), _)| *a == v || *b == v)
+            .map(|(&(a, b), fs)| (if a == v { b } else { a }, fs.len()))
+            .collect();
+        let faces: Vec<usize> = (0..s.faces.len())
+            .filter(|&k| s.faces[k].contains(&v))
+            .collect();
+        let boundary: Vec<u32> = nbrs
+            .iter()
+            .filter(|(_, n)| *n == 1)
+            .map(|(w, _)| *w)
+            .collect();
+        out.push(if boundary.is_empty() {
+            let n = nbrs.len() as f64;
+            assert_eq!(nbrs.len(), faces.len());
+            let ring = nbrs.iter().map(|(w, _)| p(*w)).sum::<DVec3>()
+                + faces.iter().map(|&k| out[k]).sum::<DVec3>();
+            p(v) * ((n - 2.0) / n) + ring / (n * n)
+        } else {
+            assert_eq!(boundary.len(), 2);
+            p(v) * 0.75 + (p(boundary[0]) + p(boundary[1])) * 0.125
+        });
+    }
+    out
+}
+
+/// Catmull-Clark on polygons of 5 to 7 sides, closed (a pentagonal
+/// pyramid, a prism of two hexagons) and open (a heptagon ringed by
+/// quads), positions jittered: one step is Catmull and Clark's rules
+/// computed here (every point, 1e-12), and every polygon becomes as many
+/// quads as it has sides. `benches/ngon_xcheck.py` holds three levels to
+/// Blender's modifier.
+#[test]
+fn catmull_clark_takes_polygons_of_any_number_of_sides() {
+    let ring = |n: usize, r: f64, z: f64| -> Vec<DVec3> {
+        (0..n)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                DVec3::new(r * a.cos(), r * a.sin(), z)
+            })
+            .collect()
+    };
+    let hexagonal_prism = {
+        let mut positions = ring(6, 1.0, 0.0);
+        positions.extend(ring(6, 1.0, 1.0));
+        let mut faces = vec![vec![5, 4, 3, 2, 1, 0], vec![6, 7, 8, 9, 10, 11]];
+        faces.extend((0..6u32).map(|i| vec![i, (i + 1) % 6, 6 + (i + 1) % 6, 6 + i]));
+        PolygonSoup {
+            positions,
+            faces: faces.into(),
+            ..PolygonSoup::default()
+        }
+    };
+    let ringed_heptagon = {
+        let mut positions = ring(7, 1.0, 0.2);
+        positions.extend(ring(7, 2.0, 0.0));
+        let mut faces = vec![(0..7u32).collect::<Vec<_>>()];
+        faces.extend((0..7u32).map(|i| vec![i, 7 + i, 7 + (i + 1) % 7, (i + 1) % 7]));
+        PolygonSoup {
+            positions,
+            faces: faces.into(),
+            ..PolygonSoup::default()
+        }
+    };
+    for (name, soup) in [
+        ("pentagonal pyramid", pentagon_pyramid()),
+        ("hexagonal prism", hexagonal_prism),
+        ("ringed heptagon", ringed_heptagon),
+    ] {
+        let base = jitter(soup, 0x9E37_79B9_7F4A_7C15);
+        let one = run("surfaces/catmull-clark.lsys", &base, 1);
+        let sides: usize = base.faces.iter().map(|f| f.len()).sum();
+        assert_eq!(one.faces.len(), sides, "{name}: a quad per corner");
+        assert!(one.faces.iter().all(|f| f.len() == 4), "{name}: quads");
+        let d = match_points(&one.positions, &catmull_clark_points(&base));
+        assert!(d < 1e-12, "{name}: {d}");
+        // The next step is the quad rules on the result.
+        let two = run("surfaces/catmull-clark.lsys", &base, 2);
+        let d = match_points(&two.positions, &catmull_clark_points(&one));
+        assert!(d < 1e-12, "{name}, step 2: {d}");
+    }
+}
+
+/// The dual schemes take a polygon whole too (their `init:` face split):
+/// one step on the jittered pentagonal pyramid gives the averaging form at
+/// every corner of the pentagon and of the triangles (Doo-Sabin), and
+/// (a + 2b + c)/4 (Peters), with a polygon per face, edge and vertex.
+#[test]
+fn dual_schemes_take_polygons_of_any_number_of_sides() {
+    let base = jitter(pentagon_pyramid(), 0x2545_F491_4F6C_DD1D);
+    let ds = run("surfaces/doo-sabin.lsys", &base, 1);
+    assert_eq!(ds.faces.len(), 6 + 10 + 6);
+    let d = match_points(&ds.positions, &per_corner(&base, doo_sabin_average));
+    assert!(d < 1e-12, "{d}");
+    let pe = run("surfaces/peters.lsys", &base, 1);
+    let mid_mid = |ps: &[DVec3], k: usize| {
+        let n = ps.len();
+        (ps[(k + n - 1) % n] + ps[k] * 2.0 + ps[(k + 1) % n]) * 0.25
+    };
+    let d = match_points(&pe.positions, &per_corner(&base, mid_mid));
+    assert!(d < 1e-12, "{d}");
 }
 
 /// What an `init:` vertex rule writes is current before the first step.

@@ -30,7 +30,7 @@ fn run(file: &Path, mesh: &Path, steps: u64, defines: &[&str]) -> PolygonSoup {
     };
     match system.run(&ro).unwrap_or_else(|e| panic!("{e}")) {
         Run::Vv(v) => v.soup,
-        Run::Surface(s) => s.mesh.to_soup(),
+        Run::Surface(s) => s.mesh.to_quad_soup(),
         Run::Curve(_) | Run::Shapes(_) => panic!("{} is not a mesh program", file.display()),
     }
 }
@@ -593,6 +593,7 @@ fn triangle_schemes_refuse_quads() {
     for f in [
         "loop.lsys",
         "butterfly.lsys",
+        "modified-butterfly.lsys",
         "sqrt3.lsys",
         "polyhedral.lsys",
     ] {
@@ -622,4 +623,415 @@ fn a_vertex_without_neighbours_fails_the_check_after_a_step() {
         e.contains("after step 1") && e.contains("has no neighbours"),
         "{e}"
     );
+}
+
+/// The modified butterfly's new vertex of every edge, from the rules as
+/// `lsystems/vv/modified-butterfly.lsys` states them (Zorin, Schröder and
+/// Sweldens 1996 inside, VTK's choices at the boundary), computed here from
+/// the base mesh's triangles: Zorin's s_j from the formula, the 8-point
+/// mask, the four-point rule.
+fn modified_butterfly_masks(base: &PolygonSoup) -> Vec<((u32, u32), DVec3)> {
+    let n = base.positions.len();
+    // In triangle (a, b, c), c follows b around a.
+    let mut next: Vec<Vec<(u32, u32)>> = vec![Vec::new(); n];
+    for f in &base.faces {
+        assert_eq!(f.len(), 3);
+        for k in 0..3 {
+            next[f[k] as usize].push((f[(k + 1) % 3], f[(k + 2) % 3]));
+        }
+    }
+    let after = |a: u32, b: u32| {
+        next[a as usize]
+            .iter()
+            .find(|(x, _)| *x == b)
+            .map(|(_, c)| *c)
+    };
+    let before = |a: u32, b: u32| {
+        next[a as usize]
+            .iter()
+            .find(|(_, c)| *c == b)
+            .map(|(x, _)| *x)
+    };
+    let triangles = |v: u32| next[v as usize].len();
+    // On the boundary when some neighbour has no triangle on one side.
+    let on_boundary = |v: u32| {
+        next[v as usize]
+            .iter()
+            .any(|&(b, c)| before(v, b).is_none() || after(v, c).is_none())
+    };
+    let pos = |v: u32| base.positions[v as usize];
+    let other_boundary_end = |p: u32, q: u32| -> u32 {
+        // The boundary neighbour of p that is not q.
+        next[p as usize]
+            .iter()
+            .flat_map(|&(b, c)| [b, c])
+            .find(|&y| y != q && (after(p, y).is_none() || before(p, y).is_none()))
+            .unwrap()
+    };
+    let eight_point = |p: u32, q: u32| {
+        let r = after(p, q).unwrap();
+        let s = before(p, q).unwrap();
+        let t = [
+            after(p, r).unwrap_or(s),
+            before(q, r).unwrap_or(s),
+            before(p, s).unwrap_or(r),
+            after(q, s).unwrap_or(r),
+        ];
+        0.5 * (pos(p) + pos(q)) + 0.125 * (pos(r) + pos(s))
+            - 0.0625 * t.iter().map(|&x| pos(x)).sum::<DVec3>()
+    };
+    let zorin = |j: usize, k: usize| -> f64 {
+        let (j, k) = (j as f64, k as f64);
+        match k as usize {
+            3 => [5.0 / 12.0, -1.0 / 12.0, -1.0 / 12.0][j as usize],
+            4 => [3.0 / 8.0, 0.0, -1.0 / 8.0, 0.0][j as usize],
+            _ => {
+                let a = std::f64::consts::TAU * j / k;
+                (0.25 + a.cos() + 0.5 * (2.0 * a).cos()) / k
+            }
+        }
+    };
+    let end = |p: u32, q: u32| {
+        if on_boundary(p) {
+            return eight_point(p, q);
+        }
+        let k = triangles(p);
+        let mut sum = 0.75 * pos(p);
+        let mut x = q;
+        for j in 0..k {
+            sum += zorin(j, k) * pos(x);
+            x = after(p, x).unwrap();
+        }
+        assert_eq!(x, q, "the ring around {p} closes");
+        sum
+    };
+    let mut out = Vec::new();
+    for p in 0..n as u32 {
+        let mut nbrs: Vec<u32> = next[p as usize].iter().flat_map(|&(b, c)| [b, c]).collect();
+        nbrs.sort();
+        nbrs.dedup();
+        for q in nbrs.into_iter().filter(|&q| q > p) {
+            let x = if after(p, q).is_none() || before(p, q).is_none() {
+                9.0 / 16.0 * (pos(p) + pos(q))
+                    - 1.0 / 16.0 * (pos(other_boundary_end(p, q)) + pos(other_boundary_end(q, p)))
+            } else {
+                match (triangles(p) == 6, triangles(q) == 6) {
+                    (true, true) => eight_point(p, q),
+                    (false, true) => end(p, q),
+                    (true, false) => end(q, p),
+                    (false, false) => 0.5 * (end(p, q) + end(q, p)),
+                }
+            };
+            out.push(((p, q), x));
+        }
+    }
+    out
+}
+
+/// Modified butterfly (Zorin, Schröder and Sweldens 1996) as a vv program:
+/// one step on meshes with valences 3, 4, 5, 6 and more, closed and open,
+/// every new vertex against the mask built here from the stated rules, to
+/// 1e-12, on positions moved at random so that no weight is hidden by
+/// symmetry. VTK's filter is the peer of `benches/butterfly_xcheck.py`.
+#[test]
+fn vv_modified_butterfly_is_zorins_masks_with_vtks_boundary() {
+    let dir = scratch("vv");
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut jiggle = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut grid = shapes::triangle_grid(5, 4);
+    for p in &mut grid.positions {
+        p.z = p.x * p.y;
+    }
+    let cases = [
+        ("tetrahedron", io::read(&mesh("tetrahedron.obj")).unwrap()),
+        ("octahedron", io::read(&mesh("octahedron.obj")).unwrap()),
+        (
+            "pentagon patch",
+            io::read(&mesh("pentagon-patch.obj")).unwrap(),
+        ),
+        ("triangle grid", grid),
+        ("bunny", io::read(&mesh("bunny.obj")).unwrap()),
+    ];
+    for (name, mut base) in cases {
+        for p in &mut base.positions {
+            *p += 0.1 * DVec3::new(jiggle(), jiggle(), jiggle());
+        }
+        let path = dir.path().join(format!("{}.obj", name.replace(' ', "-")));
+        io::write(&path, &base).unwrap();
+        let base = io::read(&path).unwrap(); // what the program reads
+        let out = run(&vv("modified-butterfly.lsys"), &path, 1, &[]);
+        let n = base.positions.len();
+        assert_eq!(
+            &out.positions[..n],
+            &base.positions[..],
+            "{name}: interpolates"
+        );
+        // Each new vertex's parent edge: its two old neighbours.
+        let mut old_nbrs: Vec<Vec<u32>> = vec![Vec::new(); out.positions.len()];
+        for f in &out.faces {
+            for k in 0..f.len() {
+                let (a, b) = (f[k], f[(k + 1) % f.len()]);
+                if (a as usize) >= n && (b as usize) < n && !old_nbrs[a as usize].contains(&b) {
+                    old_nbrs[a as usize].push(b);
+                }
+                if (b as usize) >= n && (a as usize) < n && !old_nbrs[b as usize].contains(&a) {
+                    old_nbrs[b as usize].push(a);
+                }
+            }
+        }
+        let mut made = std::collections::HashMap::new();
+        for (x, nb) in old_nbrs.iter().enumerate().skip(n) {
+            assert_eq!(
+                nb.len(),
+                2,
+                "{name}: new vertex {x}'s old neighbours {nb:?}"
+            );
+            made.insert((nb[0].min(nb[1]), nb[0].max(nb[1])), out.positions[x]);
+        }
+        let masks = modified_butterfly_masks(&base);
+        assert_eq!(made.len(), masks.len(), "{name}: one new vertex an edge");
+        for (edge, expected) in masks {
+            let got = made[&edge];
+            assert!(
+                (got - expected).abs().max_element() < 1e-12,
+                "{name}: edge {edge:?}: {got} against the mask's {expected}"
+            );
+        }
+    }
+}
+
+/// `soup` with every vertex moved a little (a fixed sequence), written to
+/// `dir/name.obj` and read back as the programs read it.
+fn jiggled(dir: &Path, name: &str, mut soup: PolygonSoup, mut seed: u64) -> (PathBuf, PolygonSoup) {
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for p in &mut soup.positions {
+        *p += 0.1 * DVec3::new(next(), next(), next());
+    }
+    let path = dir.join(format!("{name}.obj"));
+    io::write(&path, &soup).unwrap();
+    let soup = io::read(&path).unwrap();
+    (path, soup)
+}
+
+/// The dual vv programs (Doo-Sabin, Peters-Reif) are the stellar grammars
+/// on closed meshes: quads, triangles, a torus, two steps, 1e-12, the
+/// same faces.
+#[test]
+fn vv_doo_sabin_and_peters_reif_are_the_grammars_on_closed_meshes() {
+    let dir = scratch("vv");
+    for m in ["cube.obj", "octahedron.obj", "torus.obj"] {
+        let (path, _) = jiggled(
+            dir.path(),
+            m.trim_end_matches(".obj"),
+            io::read(&mesh(m)).unwrap(),
+            7,
+        );
+        for (program, g) in [
+            ("doo-sabin.lsys", "doo-sabin.lsys"),
+            ("peters-reif.lsys", "peters.lsys"),
+        ] {
+            let a = run(&vv(program), &path, 2, &[]);
+            let b = run(&grammar(g), &path, 2, &[]);
+            assert_same_mesh(&a, &b, 1e-12, &format!("{program} on {m}"));
+        }
+    }
+}
+
+/// The points a dual program makes from `s`, one per face corner, by the
+/// rules its comment states: `interior(face positions, k)` at a corner
+/// with no boundary edge; at a corner p whose face has the boundary edge
+/// p-q, 3/4 p + 1/4 q; with both its edges on the boundary,
+/// 3/4 p + 1/8 (q + r).
+fn dual_points(s: &PolygonSoup, interior: impl Fn(&[DVec3], usize) -> DVec3) -> Vec<DVec3> {
+    let mut uses = std::collections::HashMap::new();
+    for f in &s.faces {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    let on_boundary = |a: u32, b: u32| uses[&(a.min(b), a.max(b))] == 1;
+    let mut out = Vec::new();
+    for f in &s.faces {
+        let n = f.len();
+        let ps: Vec<DVec3> = f.iter().map(|&i| s.positions[i as usize]).collect();
+        for k in 0..n {
+            let (p, q, r) = (f[k], f[(k + 1) % n], f[(k + n - 1) % n]);
+            let (pq, rp) = (on_boundary(p, q), on_boundary(r, p));
+            let (pp, qq, rr) = (ps[k], ps[(k + 1) % n], ps[(k + n - 1) % n]);
+            out.push(match (pq, rp) {
+                (true, true) => 0.75 * pp + 0.125 * (qq + rr),
+                (true, false) => 0.75 * pp + 0.25 * qq,
+                (false, true) => 0.75 * pp + 0.25 * rr,
+                (false, false) => interior(&ps, k),
+            });
+        }
+    }
+    out
+}
+
+/// One to one by position: every point of `want` has its own point of
+/// `got`; the largest distance.
+fn match_points(got: &[DVec3], want: &[DVec3]) -> f64 {
+    assert_eq!(got.len(), want.len(), "point counts");
+    let mut used = vec![false; got.len()];
+    let mut worst = 0.0f64;
+    for w in want {
+        let (i, d) = got
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !used[*i])
+            .map(|(i, g)| (i, g.distance(*w)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("a point left");
+        used[i] = true;
+        worst = worst.max(d);
+    }
+    worst
+}
+
+/// Faces a dual step makes from `s`: one per face, interior edge and
+/// interior vertex, and one per boundary vertex on three faces or more;
+/// and the boundary edges it has: Chaikin's polygon, two per boundary
+/// edge, less one per boundary vertex on a single face.
+fn dual_counts(s: &PolygonSoup) -> (usize, usize) {
+    let mut uses = std::collections::HashMap::new();
+    let mut faces_at = vec![0usize; s.positions.len()];
+    for f in &s.faces {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            faces_at[f[k] as usize] += 1;
+        }
+    }
+    let mut boundary_v = vec![false; s.positions.len()];
+    for (&(a, b), &n) in &uses {
+        if n == 1 {
+            boundary_v[a as usize] = true;
+            boundary_v[b as usize] = true;
+        }
+    }
+    let interior_e = uses.values().filter(|&&n| n == 2).count();
+    let boundary_e = uses.len() - interior_e;
+    let interior_v = boundary_v.iter().filter(|b| !**b).count();
+    let wide = (0..s.positions.len())
+        .filter(|&v| boundary_v[v] && faces_at[v] >= 3)
+        .count();
+    let single = (0..s.positions.len())
+        .filter(|&v| boundary_v[v] && faces_at[v] == 1)
+        .count();
+    (
+        s.faces.len() + interior_e + interior_v + wide,
+        2 * boundary_e - single,
+    )
+}
+
+fn boundary_edges(s: &PolygonSoup) -> usize {
+    let mut uses = std::collections::HashMap::new();
+    for f in &s.faces {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    uses.values().filter(|&&n| n == 1).count()
+}
+
+/// A dual scheme's point of corner `k` of a face (its corners' positions).
+type CornerRule = dyn Fn(&[DVec3], usize) -> DVec3;
+
+/// Doo-Sabin and Peters-Reif on open meshes: two steps on a quad grid
+/// (whose corners lie on one face), the triangle patch (boundary vertices
+/// on two to four faces) and a patch of a pentagon, a hexagon, quads and
+/// triangles, every point against the rules computed here from the step's
+/// input (1e-12), the faces counted, and the new boundary Chaikin's
+/// polygon of the old (its edges counted; its points are among those
+/// checked).
+#[test]
+fn vv_doo_sabin_and_peters_reif_on_open_meshes() {
+    let dir = scratch("vv");
+    let mixed = PolygonSoup {
+        positions: [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.1],
+            [2.0, 0.0, 0.0],
+            [3.0, 0.0, 0.2],
+            [0.0, 1.0, 0.1],
+            [1.0, 1.0, 0.3],
+            [2.0, 1.0, 0.2],
+            [3.0, 1.0, 0.0],
+            [0.5, 1.8, 0.0],
+            [1.5, 2.1, 0.2],
+            [2.5, 1.8, 0.1],
+            [3.6, 0.5, 0.1],
+            [1.5, 2.9, 0.0],
+            [0.3, 2.6, 0.1],
+            [-0.6, 0.5, 0.0],
+            [2.6, 2.7, 0.2],
+        ]
+        .iter()
+        .map(|&[x, y, z]| DVec3::new(x, y, z))
+        .collect(),
+        faces: vec![
+            vec![0, 1, 5, 4],
+            vec![1, 2, 6, 5],
+            vec![2, 3, 11, 7, 6],
+            vec![4, 5, 6, 10, 9, 8],
+            vec![8, 9, 12, 13],
+            vec![0, 4, 14],
+            vec![4, 8, 13, 14],
+            vec![6, 7, 10],
+            vec![9, 10, 15, 12],
+        ]
+        .into(),
+        ..PolygonSoup::default()
+    };
+    let averaging = |ps: &[DVec3], k: usize| {
+        let n = ps.len();
+        let (p, q, r) = (ps[k], ps[(k + 1) % n], ps[(k + n - 1) % n]);
+        let centroid = ps.iter().sum::<DVec3>() / n as f64;
+        0.25 * (p + 0.5 * (p + q) + 0.5 * (p + r) + centroid)
+    };
+    let mid_mid = |ps: &[DVec3], k: usize| {
+        let n = ps.len();
+        0.25 * (ps[(k + n - 1) % n] + 2.0 * ps[k] + ps[(k + 1) % n])
+    };
+    let cases = [
+        ("grid", io::read(&mesh("grid.obj")).unwrap()),
+        ("patch", io::read(&mesh("pentagon-patch.obj")).unwrap()),
+        ("mixed", mixed),
+    ];
+    for (name, soup) in cases {
+        let (path, base) = jiggled(dir.path(), name, soup, 11);
+        let rules: [(&str, &CornerRule); 2] = [
+            ("doo-sabin.lsys", &averaging),
+            ("peters-reif.lsys", &mid_mid),
+        ];
+        for (program, interior) in rules {
+            let what = format!("{program} on {name}");
+            let one = run(&vv(program), &path, 1, &[]);
+            let two = run(&vv(program), &path, 2, &[]);
+            for (input, output, step) in [(&base, &one, 1), (&one, &two, 2)] {
+                let d = match_points(&output.positions, &dual_points(input, interior));
+                assert!(d < 1e-12, "{what}, step {step}: {d}");
+                let (faces, bedges) = dual_counts(input);
+                assert_eq!(output.faces.len(), faces, "{what}, step {step}: faces");
+                assert_eq!(
+                    boundary_edges(output),
+                    bedges,
+                    "{what}, step {step}: boundary"
+                );
+            }
+        }
+    }
 }

@@ -116,6 +116,19 @@ pub(super) fn write_obj(w: &mut dyn Write, s: &dyn Polygons) -> io::Result<()> {
         w.write_all(b"v ")?;
         put_position(w, p)
     })?;
+    if let Some(normals) = s.normals() {
+        for &n in normals {
+            w.write_all(b"vn ")?;
+            put_position(w, n)?;
+        }
+        return s.each_face(&mut |f| {
+            w.write_all(b"f")?;
+            for &i in f {
+                write!(w, " {0}//{0}", u64::from(i) + 1)?;
+            }
+            w.write_all(b"\n")
+        });
+    }
     s.each_face(&mut |f| {
         w.write_all(b"f")?;
         put_indices(w, f, 1)

@@ -734,12 +734,18 @@ pub(super) fn write_ply(
     edges: &[(u32, u32, f64)],
 ) -> io::Result<()> {
     let count_type = if s.longest() <= 255 { "uchar" } else { "uint" };
+    let normals = s.normals();
     write!(
         w,
         "ply\nformat ascii 1.0\ncomment written by subgram\n\
-         element vertex {}\nproperty double x\nproperty double y\nproperty double z\n\
+         element vertex {}\nproperty double x\nproperty double y\nproperty double z\n{}\
          element face {}\nproperty list {count_type} uint vertex_indices\n",
         s.vertex_count(),
+        if normals.is_some() {
+            "property double nx\nproperty double ny\nproperty double nz\n"
+        } else {
+            ""
+        },
         s.face_count()
     )?;
     if !edges.is_empty() {
@@ -751,7 +757,21 @@ pub(super) fn write_ply(
         )?;
     }
     w.write_all(b"end_header\n")?;
-    s.each_position(&mut |p| put_position(w, p))?;
+    match normals {
+        Some(normals) => {
+            let mut k = 0;
+            s.each_position(&mut |p| {
+                let n = normals[k];
+                k += 1;
+                writeln!(
+                    w,
+                    "{:?} {:?} {:?} {:?} {:?} {:?}",
+                    p.x, p.y, p.z, n.x, n.y, n.z
+                )
+            })?
+        }
+        None => s.each_position(&mut |p| put_position(w, p))?,
+    }
     s.each_face(&mut |f| {
         write!(w, "{}", f.len())?;
         put_indices(w, f, 0)

@@ -23,6 +23,19 @@ pub fn write(path: &Path, soup: &PolygonSoup) -> Result<(), MeshFileError> {
     write_with_sharpness(path, soup, &[])
 }
 
+/// Writes `soup` to `path` as [`write()`] does, with a unit normal per
+/// vertex where the format has a place for it: `vn` lines in OBJ (each
+/// face's corners `v//v`), `nx ny nz` in PLY's vertex element. OFF has
+/// none; the caller says so.
+pub fn write_with_normals(
+    path: &Path,
+    soup: &PolygonSoup,
+    normals: &[DVec3],
+) -> Result<(), MeshFileError> {
+    assert_eq!(normals.len(), soup.positions.len(), "a normal per vertex");
+    write_streamed(path, &WithNormals { soup, normals }, &[])
+}
+
 /// Writes `soup` to `path` as [`write()`] does, with the sharp `edges` (two
 /// soup vertices, from 0, and a sharpness) where the format carries them:
 /// a PLY `edge` element with `vertex1`, `vertex2` and `crease`, which
@@ -89,6 +102,42 @@ pub(super) trait Polygons {
     fn each_position(&self, f: &mut dyn FnMut(DVec3) -> io::Result<()>) -> io::Result<()>;
     /// Calls `f` on every face's corners in order, stopping at an error.
     fn each_face(&self, f: &mut dyn FnMut(&[u32]) -> io::Result<()>) -> io::Result<()>;
+    /// A normal per vertex, in order, when there are normals.
+    fn normals(&self) -> Option<&[DVec3]> {
+        None
+    }
+}
+
+/// A soup with a normal per vertex.
+struct WithNormals<'a> {
+    soup: &'a PolygonSoup,
+    normals: &'a [DVec3],
+}
+
+impl Polygons for WithNormals<'_> {
+    fn vertex_count(&self) -> usize {
+        self.soup.vertex_count()
+    }
+
+    fn face_count(&self) -> usize {
+        self.soup.face_count()
+    }
+
+    fn longest(&self) -> usize {
+        self.soup.longest()
+    }
+
+    fn each_position(&self, f: &mut dyn FnMut(DVec3) -> io::Result<()>) -> io::Result<()> {
+        self.soup.each_position(f)
+    }
+
+    fn each_face(&self, f: &mut dyn FnMut(&[u32]) -> io::Result<()>) -> io::Result<()> {
+        self.soup.each_face(f)
+    }
+
+    fn normals(&self) -> Option<&[DVec3]> {
+        Some(self.normals)
+    }
 }
 
 impl Polygons for PolygonSoup {

@@ -232,6 +232,17 @@ static FUNCTIONS: &[Builtin] = &[
         },
     },
     Builtin {
+        name: "next_sharpness",
+        resolve: |a| match a {
+            [V, V] => Ok((Func::Host(id::NEXT_SHARPNESS), Ty::Double)),
+            _ => Err(SigError::Message(
+                "`next_sharpness(v, w)` takes two vertices: the sharpness the half at v of the \
+                 edge between them has one level down (by the grammar's `creasing:` method)"
+                    .into(),
+            )),
+        },
+    },
+    Builtin {
         name: "creases",
         resolve: |a| {
             one(

@@ -6,7 +6,7 @@ use glam::DVec3;
 
 use crate::lang::eval::Host;
 use crate::lang::value::{Elem, Value};
-use crate::mesh::{EdgeId, Mesh, VertexId};
+use crate::mesh::{child_sharpness, Creasing, EdgeId, Mesh, VertexId};
 use crate::syntax::ast::BinOp;
 
 use super::{
@@ -23,6 +23,9 @@ pub struct MeshHost<'m> {
     /// The step being run (0 in `init:` rules): `step`, and the vertices
     /// it made are `new`.
     pub step: u32,
+    /// How creases soften: `crease_weight` and `next_sharpness` read the
+    /// next level's sharpness by it.
+    pub creasing: Creasing,
 }
 
 pub(super) fn cmp(op: i64, l: u32, c: u32) -> bool {
@@ -311,6 +314,23 @@ impl Host for MeshHost<'_> {
                     .and_then(|(a, b)| m.find_halfedge(a, b));
                 Value::Float(between.map_or(0.0, |h| m.edge_sharpness(h.edge())))
             }
+            id::NEXT_SHARPNESS => {
+                let end = |x: &Value| match x {
+                    Value::Elem(e) if e.kind == VERTEX => Some(VertexId(e.ids[0])),
+                    _ => None,
+                };
+                Value::Float(match (end(&args[0]), end(&args[1])) {
+                    (Some(a), Some(b)) => match m.find_halfedge(a, b) {
+                        Some(h) => child_sharpness(
+                            self.creasing,
+                            m.edge_sharpness(h.edge()),
+                            m.outgoing_halfedges(a).map(|g| m.edge_sharpness(g.edge())),
+                        ),
+                        None => 0.0,
+                    },
+                    _ => 0.0,
+                })
+            }
             id::CREASES => Value::Int(v().map_or(0, |v| m.sharp_edge_count(v) as i64)),
             id::CREASE_RING => match v() {
                 Some(v) => Value::Elem(Elem {
@@ -320,7 +340,9 @@ impl Host for MeshHost<'_> {
                 }),
                 None => return Err("this is not a vertex of the mesh".into()),
             },
-            id::CREASE_WEIGHT => Value::Float(v().map_or(0.0, |v| crease_weight(m, v))),
+            id::CREASE_WEIGHT => {
+                Value::Float(v().map_or(0.0, |v| crease_weight(m, v, self.creasing)))
+            }
             id::CURRENT => Value::Int(self.current as i64),
             id::STEP => Value::Int(self.step as i64),
             id::LONE => Value::Bool(elem.is_some_and(|e| self.lone(&e))),
@@ -416,11 +438,15 @@ fn vertex_rule(vertex: f64, edges: impl Iterator<Item = f64>) -> u8 {
 /// that drop to 0 at this level, at most 1, so that the mask is that
 /// weight of this level's rule and the rest of the next level's. 0 for a
 /// smooth vertex.
-pub fn crease_weight(m: &Mesh, v: VertexId) -> f64 {
+///
+/// With [`Creasing::Chaikin`] the edges' next sharpness at `v` is
+/// [`child_sharpness`]'s, and the transition is the edges (and the vertex)
+/// sharp now and smooth one level down, as OpenSubdiv weighs its
+/// non-uniform methods.
+pub fn crease_weight(m: &Mesh, v: VertexId, creasing: Creasing) -> f64 {
     if !m.has_sharpness_flag() {
         return 0.0;
     }
-    let child = |s: f64| (s - 1.0).max(0.0);
     let sv = m.vertex_sharpness(v);
     // A boundary edge is sharp for ever, as in OpenSubdiv: a boundary
     // vertex is a crease, and a corner where an interior crease meets it.
@@ -437,12 +463,15 @@ pub fn crease_weight(m: &Mesh, v: VertexId) -> f64 {
     if parent == 0 {
         return 0.0;
     }
-    if vertex_rule(child(sv), edges().map(child)) == parent {
+    let child = |s: f64| child_sharpness(creasing, s, edges());
+    let vertex_child = (sv - 1.0).max(0.0);
+    if vertex_rule(vertex_child, edges().map(child)) == parent {
         return 1.0;
     }
     let (mut sum, mut n) = (0.0, 0);
-    for s in std::iter::once(sv).chain(edges()) {
-        if s > 0.0 && child(s) <= 0.0 {
+    let pairs = std::iter::once((sv, vertex_child)).chain(edges().map(|s| (s, child(s))));
+    for (s, next) in pairs {
+        if s > 0.0 && next <= 0.0 {
             sum += s;
             n += 1;
         }

@@ -78,6 +78,8 @@ pub mod id {
     /// `sharpness(v, w)`: of the edge between two vertices.
     pub const SHARPNESS_BETWEEN: u16 = 24;
     pub const LONE: u16 = 25;
+    /// `next_sharpness(v, w)`: the edge's sharpness one level down, at `v`.
+    pub const NEXT_SHARPNESS: u16 = 26;
     /// Guards of adaptive refinement: sizes and shape of the mesh now.
     pub const AREA: u16 = 30;
     pub const LENGTH: u16 = 31;

@@ -6,7 +6,7 @@ use crate::lang::compile::RuleCompiler;
 use crate::lang::eval::{Env, Interp};
 use crate::lang::ir::{Ex, Func};
 use crate::lang::value::{Ty, Value};
-use crate::mesh::{BlockSplit, Mesh};
+use crate::mesh::{BlockSplit, Creasing, Mesh};
 use crate::surface::grammar::{GrammarFile, Op};
 use crate::surface::host::{self, id, MeshHost};
 use crate::syntax::span::{Diagnostic, SourceMap, Span};
@@ -147,6 +147,7 @@ pub(crate) fn compile_with(
                     mesh: &m,
                     current: 0,
                     step: 0,
+                    creasing: Creasing::Uniform,
                 };
                 let got = Interp::new(&[]).eval(
                     &x,
@@ -239,6 +240,7 @@ pub(crate) fn compile_with(
             .map_or(BlockSplit::Quadrisection, |(b, _)| b),
         adaptive: file.adaptive,
         incremental: file.incremental,
+        creasing: file.creasing.map_or(Creasing::Uniform, |(c, _)| c),
         match_blocks_at: file.match_blocks,
         max_faces: MAX_FACES,
         max_valence: MAX_VALENCE,

@@ -39,7 +39,13 @@ impl<'m> host::Evaluate<'m> for Evaluator<'m> {
 }
 
 impl<'m> Evaluator<'m> {
-    pub(super) fn new(mesh: &'m Mesh, current: u32, step: u32, frame: usize) -> Evaluator<'m> {
+    pub(super) fn new(
+        mesh: &'m Mesh,
+        current: u32,
+        step: u32,
+        frame: usize,
+        creasing: crate::mesh::Creasing,
+    ) -> Evaluator<'m> {
         Evaluator {
             interp: Interp::new(&[]),
             env: Env::with_model(Vec::new(), crate::model::default_ref()),
@@ -47,6 +53,7 @@ impl<'m> Evaluator<'m> {
                 mesh,
                 current,
                 step,
+                creasing,
             },
             frame: vec![Value::Void; frame],
             memo: host::Memo::default(),

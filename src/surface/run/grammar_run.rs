@@ -103,18 +103,20 @@ impl Grammar {
     /// triangles a face split makes into quads); one that reads none takes
     /// quads as two triangles.
     fn check_blocks(&self, mesh: &mut Mesh) -> Result<(), RunError> {
-        // Pairing takes the triangles of a fanned polygon like any other.
+        // Pairing takes the triangles of a fanned polygon like any other,
+        // and a face split takes the polygon whole (Mesh::polygon_split_with).
+        let face_split = self.rules.iter().any(|r| r.op == Op::FaceSplit);
         let fanned = mesh
             .fanned_polygon()
-            .filter(|_| self.match_blocks_at.is_none());
+            .filter(|_| self.match_blocks_at.is_none() && !face_split);
         if let (Some(span), Some(fan)) = (self.block_used_at, fanned) {
             let line = fan.line.map_or(String::new(), |l| format!(" (line {l})"));
             return Err(RunError {
                 span: Some(span),
                 message: format!(
-                    "this grammar reads quads as basic blocks, but face {}{line} has {} sides; \
-                     polygons of more than four sides are not supported by such grammars yet \
-                     (split them into quads and triangles first)",
+                    "this grammar reads quads as basic blocks, but face {}{line} has {} sides, \
+                     and only a grammar with a face split (F -> V || E^3 F^3) takes a polygon \
+                     of more than four sides whole; split it into quads and triangles first",
                     fan.face + 1,
                     fan.sides
                 ),
@@ -167,7 +169,8 @@ impl Grammar {
                     span: Some(span),
                     message: format!(
                         "this grammar is a dual scheme, which runs on closed meshes only; \
-                         vertex {v} is on a boundary"
+                         vertex {v} is on a boundary (lsystems/vv/doo-sabin.lsys and \
+                         peters-reif.lsys, vv programs of the same schemes, have boundary rules)"
                     ),
                 });
             }
@@ -296,10 +299,15 @@ impl GrammarRun<'_> {
         self.grammar.apply_all(&each, self.mesh, &mut self.state)?;
         self.state.swap_positions(self.mesh);
         // A step is one level of the scheme: semi-sharp creases and
-        // corners soften by one (OpenSubdiv's uniform rule). The rules of
-        // the step read the sharpness it started with.
+        // corners soften (OpenSubdiv's uniform rule, or its Chaikin rule
+        // at each edge's end that was there before the step). The rules
+        // of the step read the sharpness it started with.
         if self.state.creased {
-            self.mesh.decrement_sharpness();
+            let (mesh, step) = (&mut *self.mesh, self.state.step);
+            let old: Vec<bool> = (0..mesh.v_alive.len() as u32)
+                .map(|v| mesh.vertex_step(crate::mesh::VertexId(v)) < step)
+                .collect();
+            mesh.soften_sharpness(self.grammar.creasing, |v| old[v.index()]);
         }
         debug_assert!(
             self.state

@@ -105,12 +105,17 @@ impl Grammar {
         let parts: Vec<Result<(Part, Part), (bool, RuntimeError)>> = ranges
             .into_par_iter()
             .map(|(lo, hi)| {
-                let mut ev = Evaluator::new(mesh, current, step, frame_len);
+                let mut ev = Evaluator::new(mesh, current, step, frame_len, self.creasing);
                 let (mut a, mut b): (Part, Part) = Default::default();
                 match rule.op {
                     Op::FaceSplit => {
                         for f in (lo..hi).map(|i| crate::mesh::FaceId(id_at(i))) {
-                            if mesh.is_face(f) && protect.is_none_or(|p| p.face_free(mesh, f)) {
+                            // A polygon's fan is matched once, by its first
+                            // triangle: its split takes the polygon whole.
+                            if mesh.is_face(f)
+                                && protect.is_none_or(|p| p.face_free(mesh, f))
+                                && mesh.fan_at(f).is_none_or(|(_, first)| first)
+                            {
                                 let hs = mesh.face_halfedges(f);
                                 let val = host::face(
                                     hs.map(|h| mesh.from(h)),

@@ -127,6 +127,9 @@ pub struct Grammar {
     /// before or in this one; a diamond not selected when it appeared is
     /// not tested again.
     pub incremental: bool,
+    /// `creasing:`: how semi-sharp creases soften after each step
+    /// (uniform without the declaration).
+    pub creasing: crate::mesh::Creasing,
     /// `init: match_blocks;`: triangles in no block are paired by a
     /// maximum matching before the `init:` rules.
     pub match_blocks_at: Option<Span>,

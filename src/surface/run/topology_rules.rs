@@ -52,7 +52,7 @@ impl Grammar {
             .into_par_iter()
             .with_min_len(CHUNK)
             .map_init(
-                || Evaluator::new(mesh, current, step, rule.frame),
+                || Evaluator::new(mesh, current, step, rule.frame, self.creasing),
                 |ev, k| match one(ev, k) {
                     Ok(Value::V3(p)) => p,
                     _ => DVec3::NAN,
@@ -64,7 +64,10 @@ impl Grammar {
             // Evaluate the first bad one again, to say what it gave.
             Some(k) => Err((
                 lo + k,
-                one(&mut Evaluator::new(mesh, current, step, rule.frame), lo + k),
+                one(
+                    &mut Evaluator::new(mesh, current, step, rule.frame, self.creasing),
+                    lo + k,
+                ),
             )),
         }
     }
@@ -119,9 +122,17 @@ impl Grammar {
                             let Some(f) = face_of(mesh, vs) else {
                                 return Err(fail("a face to split is gone".into()));
                             };
-                            let p = vs.iter().map(|v| mesh.position(*v)).sum::<DVec3>() / 3.0;
-                            mesh.face_split_with(f, p, &split)
-                                .map_err(|e| fail(e.message))?
+                            if let Some((k, _)) = mesh.fan_at(f) {
+                                // A polygon of five or more sides: its centre
+                                // joined to every corner.
+                                let p = mesh.fan_centroid(k);
+                                mesh.polygon_split_with(k, p, &split)
+                                    .map_err(|e| fail(e.message))?
+                            } else {
+                                let p = vs.iter().map(|v| mesh.position(*v)).sum::<DVec3>() / 3.0;
+                                mesh.face_split_with(f, p, &split)
+                                    .map_err(|e| fail(e.message))?
+                            }
                         } else if let Some((p, q)) = host::edge_vertices(val) {
                             let e = edge_id(val);
                             debug_assert!({

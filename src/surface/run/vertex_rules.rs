@@ -51,7 +51,7 @@ impl Grammar {
         // Tests and evaluates the ids at places `lo..hi`, handing each
         // point to `emit` with its place.
         let task = |lo: usize, hi: usize, emit: &mut dyn FnMut(usize, VertexId, DVec3)| {
-            let mut ev = Evaluator::new(mesh, current, state.step, rule.frame);
+            let mut ev = Evaluator::new(mesh, current, state.step, rule.frame, self.creasing);
             let mut end = VertexTask::default();
             for i in lo..hi {
                 let v = id_at(i);
@@ -143,7 +143,7 @@ impl Grammar {
         };
         // Evaluate the first bad one again, to say what it gave.
         let v = id_at(i);
-        let mut ev = Evaluator::new(mesh, current, state.step, rule.frame);
+        let mut ev = Evaluator::new(mesh, current, state.step, rule.frame, self.creasing);
         ev.frame[slot] = Value::Elem(host::vertex(v));
         Err(match ev.assign(rule, assign) {
             Ok(Value::V3(p)) => rule_error(
