@@ -67,12 +67,6 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
     let deadline = a.timeout.map(Deadline::after);
     let _deadline = crate::deadline::scope(deadline);
     let file = Path::new(&a.file);
-    let system = crate::load::load_edited(
-        file,
-        text,
-        &load_options(&a.defines, a.double, &a.environment),
-    )?;
-    let mut warnings = system.warnings();
     let mut a = a.clone();
     a.allow_writes = None;
     a.force = true;
@@ -121,6 +115,21 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
             smooth: mv.smooth,
         })))
     };
+    // A mesh file: the edited text read as the mesh (OBJ, OFF, ASCII PLY).
+    if let Some(format) = crate::mesh::io::Format::from_path(file) {
+        let soup = crate::mesh::io::read_str(&a.file, format, text.as_bytes())?;
+        let sight = mesh(&soup, Vec::new(), &looks, &[], false)?;
+        return Ok(Seen {
+            sight,
+            warnings: Vec::new(),
+        });
+    }
+    let system = crate::load::load_edited(
+        file,
+        text,
+        &load_options(&a.defines, a.double, &a.environment),
+    )?;
+    let mut warnings = system.warnings();
     let sight = match system {
         System::Surface(s) => {
             let opts = RunOptions {
@@ -227,6 +236,12 @@ pub fn frames_edited(
 ) -> Result<SeenFrames, Error> {
     let deadline = a.timeout.map(Deadline::after);
     let _deadline = crate::deadline::scope(deadline);
+    if crate::mesh::io::Format::from_path(Path::new(&a.file)).is_some() {
+        return Err(Error::Usage(
+            "a mesh file has no steps to play: serve a grammar or a vv program that subdivides it"
+                .into(),
+        ));
+    }
     let system = crate::load::load_edited(
         Path::new(&a.file),
         text,

@@ -770,7 +770,9 @@ pub fn viewer_scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<Vec<[u
     // the copies with other normals (few: along sharp edges and folds).
     let mut firsts: Vec<Vec<u32>> = Vec::new();
     let mut others: Vec<HashMap<(u32, [u32; 3]), u32>> = Vec::new();
-    let mut edges: Vec<Vec<[u32; 2]>> = Vec::new();
+    // Each polygon side: the soup's ends (so that an edge between faces
+    // whose corners are different copies is drawn once) and the copies.
+    let mut edges: Vec<Vec<([u32; 2], [u32; 2])>> = Vec::new();
     for (f, face) in soup.faces.iter().enumerate() {
         let Some(normal) = newell[f].map(DVec3::normalize) else {
             continue;
@@ -820,15 +822,22 @@ pub fn viewer_scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<Vec<[u
         for j in 1..local.len() - 1 {
             m.triangles.push([local[0], local[j], local[j + 1]]);
         }
-        for (j, &a) in local.iter().enumerate() {
-            let b = local[(j + 1) % local.len()];
-            edges[k].push([a.min(b), a.max(b)]);
+        for j in 0..local.len() {
+            let next = (j + 1) % local.len();
+            let (a, b) = (face[j], face[next]);
+            edges[k].push(([a.min(b), a.max(b)], [local[j], local[next]]));
         }
     }
-    for list in &mut edges {
-        list.sort_unstable();
-        list.dedup();
-    }
+    let edges = edges
+        .into_iter()
+        .map(|mut list| {
+            list.sort_unstable_by_key(|e| e.0);
+            list.dedup_by_key(|e| e.0);
+            list.into_iter()
+                .map(|(_, [a, b])| [a.min(b), a.max(b)])
+                .collect()
+        })
+        .collect();
     (scene, edges)
 }
 

@@ -1062,7 +1062,8 @@ pub fn messages(e: &Error, program: &Path) -> Vec<Message> {
         } => vec![Message {
             severity: "error",
             file: path.clone(),
-            program: false,
+            // A mesh file being edited is the program.
+            program: *path == program_name,
             line: Some(*line),
             col: Some(text.get(..*start).map_or(1, |t| t.chars().count() + 1)),
             end_line: None,

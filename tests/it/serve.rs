@@ -1076,3 +1076,47 @@ fn playback_derives_every_step_once_and_keeps_each_frame() {
     let (status, _) = send(addr, "GET", "/api/play/1", &[format!("Host: {addr}")], "");
     assert_eq!(status, 403);
 }
+
+/// A mesh file on the page: the edited text read as the mesh (a cube's six
+/// quads: 12 triangles, 12 polygon edges, 8 corners each with the three
+/// normals of its faces, so 24 vertices); a bad line is an error at its
+/// place in the text; it has no growth to play.
+#[test]
+fn a_mesh_file_is_shown_from_its_edited_text() {
+    let cube =
+        std::fs::read_to_string(crate::support::root().join("lsystems/meshes/cube.obj")).unwrap();
+    let dir = scratch("serve-mesh");
+    let file = dir.path().join("cube.obj");
+    std::fs::write(&file, &cube).unwrap();
+    let live = start_at(dir, file, false, Limits::default());
+    let r = render(&live, &cube, "");
+    assert_eq!(r["ok"], true, "{r}");
+    assert_eq!(r["scene"]["triangles"], 12, "{r}");
+    let (_, _, bytes) = blob(&live, &r["scene"]["blob"]);
+    let (doc, _) = glb(&bytes);
+    let prims = doc["meshes"][0]["primitives"].as_array().unwrap();
+    let lines: u64 = prims
+        .iter()
+        .filter(|p| p["mode"] == 1)
+        .map(|p| {
+            doc["accessors"][p["indices"].as_u64().unwrap() as usize]["count"]
+                .as_u64()
+                .unwrap()
+        })
+        .sum();
+    assert_eq!(lines, 2 * 12);
+    assert_eq!(r["scene"]["vertices"], 24, "{r}");
+    let broken = cube.replacen("v ", "v x", 1);
+    let r = render(&live, &broken, "");
+    assert_eq!(r["ok"], false, "{r}");
+    let m = &r["messages"][0];
+    assert_eq!(m["program"], true, "{r}");
+    let line = cube.lines().position(|l| l.starts_with("v ")).unwrap() + 1;
+    assert_eq!(m["line"], line, "{r}");
+    let failed = play(&live, &cube, "");
+    assert_eq!(failed["phase"], "failed");
+    assert!(failed["messages"][0]["message"]
+        .as_str()
+        .unwrap()
+        .contains("no steps to play"));
+}
