@@ -18,7 +18,7 @@ Stanford bunny, 4 steps: 3,674 · 4^4 = 940,544), with a release binary:
 Chromium here draws WebGL with SwiftShader, a CPU renderer: the page's
 figures are an upper bound of what a machine with a GPU takes.
 
-    python3 benches/page_3d.py [SUBGRAM_RELEASE_BINARY] [REPEAT]
+    python3 benches/page_3d.py [SUBGRAM_RELEASE_BINARY] [REPEAT] [plant|bunny|both]
 """
 
 import json
@@ -136,8 +136,11 @@ def main():
         with open(grammar, "w") as f:
             f.write(loop)
         results = {}
+        which = sys.argv[3] if len(sys.argv) > 3 else "both"
         for name, path, text in [("plant (131,071 cylinders)", plant, PLANT),
                                  ("bunny, Loop 4 steps", grammar, loop)]:
+            if which != "both" and not name.startswith(which):
+                continue
             results[name] = bench(binary, path, text, repeat, browser)
             print(name, json.dumps(results[name]), flush=True)
         print(json.dumps(results, indent=2))
