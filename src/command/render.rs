@@ -282,15 +282,21 @@ pub fn render_edited(a: &RenderArgs, text: &str) -> Result<Drawn, Error> {
     let mut a = a.clone();
     a.allow_writes = None;
     a.force = true;
+    let (picture, more) = picture_in_memory(&a, system, (&looks, format), deadline)?;
+    warnings.extend(more);
+    Ok(Drawn { picture, warnings })
+}
+
+/// The main picture `render_system` draws, in memory, and the program's
+/// warnings; an error when nothing was drawn.
+pub(super) fn picture_in_memory(
+    a: &RenderArgs,
+    system: System,
+    looks: (&MeshLooks, Picture),
+    deadline: Option<Deadline>,
+) -> Result<(Vec<u8>, Vec<String>), Error> {
     let mut out = Out::Memory(Vec::new());
-    warnings.extend(render_system(
-        &a,
-        system,
-        (&looks, format),
-        deadline,
-        |_| {},
-        &mut out,
-    )?);
+    let warnings = render_system(a, system, looks, deadline, |_| {}, &mut out)?;
     let mut files = match out {
         Out::Memory(files) => files,
         Out::Files => Vec::new(),
@@ -298,13 +304,10 @@ pub fn render_edited(a: &RenderArgs, text: &str) -> Result<Drawn, Error> {
     if files.is_empty() {
         return Err(Error::Failed("nothing was drawn".into()));
     }
-    Ok(Drawn {
-        picture: files.swap_remove(0).1,
-        warnings,
-    })
+    Ok((files.swap_remove(0).1, warnings))
 }
 
-pub(super) fn render_system(
+fn render_system(
     a: &RenderArgs,
     system: System,
     (looks, format): (&MeshLooks, Picture),

@@ -8,8 +8,10 @@
 use std::path::Path;
 
 use super::common::{load_options, write_program_files, writes_folder};
-use super::picture::{MeshLooks, Out, Picture};
-use super::render::{render_system, solid_raster_options, solid_scene, wants_solid, RenderArgs};
+use super::picture::{MeshLooks, Picture};
+use super::render::{
+    picture_in_memory, solid_raster_options, solid_scene, wants_solid, RenderArgs,
+};
 use crate::deadline::Deadline;
 use crate::error::Error;
 use crate::mesh::soup::PolygonSoup;
@@ -190,23 +192,9 @@ pub fn sight_edited(a: &RenderArgs, text: &str) -> Result<Seen, Error> {
             }))
         }
         system @ System::Curve(_) => {
-            let mut out = Out::Memory(Vec::new());
-            warnings.extend(render_system(
-                &a,
-                system,
-                (&looks, Picture::Svg),
-                deadline,
-                |_| {},
-                &mut out,
-            )?);
-            let mut files = match out {
-                Out::Memory(files) => files,
-                Out::Files => Vec::new(),
-            };
-            if files.is_empty() {
-                return Err(Error::Failed("nothing was drawn".into()));
-            }
-            Sight::Flat(String::from_utf8_lossy(&files.swap_remove(0).1).into_owned())
+            let (svg, more) = picture_in_memory(&a, system, (&looks, Picture::Svg), deadline)?;
+            warnings.extend(more);
+            Sight::Flat(String::from_utf8_lossy(&svg).into_owned())
         }
     };
     Ok(Seen { sight, warnings })
