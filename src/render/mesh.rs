@@ -479,7 +479,7 @@ fn face_look(base: Option<DVec3>, back: bool) -> Look {
     }
 }
 
-/// A colour for each face of `soup`, from [`CELL_COLOURS`]: each face the
+/// A colour for each face of `soup`, from `CELL_COLOURS` (ColorBrewer Set3): each face the
 /// first colour none of its neighbours (faces sharing an edge) took
 /// before it, in face order (greedy colouring), or by its number when
 /// its neighbours took all eight.
