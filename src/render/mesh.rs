@@ -550,7 +550,7 @@ fn corner_normals(
     soup: &PolygonSoup,
     newell: &[Option<DVec3>],
     sharp: &[(u32, u32)],
-) -> Vec<Option<Vec<DVec3>>> {
+) -> CornerNormals {
     use std::collections::HashSet;
     let sharp: HashSet<(u32, u32)> = sharp.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
     // Corners numbered face after face.
@@ -613,34 +613,46 @@ fn corner_normals(
             sum[r] += nf;
         }
     }
-    soup.faces
-        .iter()
-        .enumerate()
-        .map(|(f, face)| {
-            let own = newell[f]?.normalize();
-            Some(
-                (0..face.len())
-                    .map(|k| {
-                        let r = root(&mut parent, first[f] + k);
-                        sum[r].try_normalize().unwrap_or(own)
-                    })
-                    .collect(),
-            )
-        })
-        .collect()
+    let mut normals = vec![DVec3::ZERO; n];
+    for (f, face) in soup.faces.iter().enumerate() {
+        let Some(own) = newell[f].map(DVec3::normalize) else {
+            continue;
+        };
+        for k in 0..face.len() {
+            let r = root(&mut parent, first[f] + k);
+            normals[first[f] + k] = sum[r].try_normalize().unwrap_or(own);
+        }
+    }
+    CornerNormals { first, normals }
+}
+
+/// The normal of every corner, face after face (see [`corner_normals`]).
+struct CornerNormals {
+    /// Where each face's corners start in `normals`, and the end.
+    first: Vec<usize>,
+    normals: Vec<DVec3>,
+}
+
+impl CornerNormals {
+    /// The normals of face `f`'s corners.
+    fn of(&self, f: usize) -> &[DVec3] {
+        &self.normals[self.first[f]..self.first[f + 1]]
+    }
 }
 
 /// Each face's Newell vector (twice its vector area), or `None` for a face
 /// that cannot be drawn (fewer than three corners, an index out of range,
 /// a coordinate not finite, no area).
 fn newell_vectors(soup: &PolygonSoup) -> Vec<Option<DVec3>> {
+    // One buffer for every face's corners.
+    let mut corners: Vec<DVec3> = Vec::new();
     soup.faces
         .iter()
         .map(|face| {
-            let corners = face
-                .iter()
-                .map(|&i| soup.positions.get(i as usize).copied())
-                .collect::<Option<Vec<DVec3>>>()?;
+            corners.clear();
+            for &i in face {
+                corners.push(*soup.positions.get(i as usize)?);
+            }
             if corners.len() < 3 || corners.iter().any(|p| !p.is_finite()) {
                 return None;
             }
@@ -689,7 +701,7 @@ pub fn scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<u32>, Vec<Loo
         let m = &mut scene.meshes[k];
         let start = m.positions.len() as u32;
         m.positions.extend(corners.iter().map(|p| p.as_vec3()));
-        match smooth.as_ref().and_then(|s| s[f].as_ref()) {
+        match smooth.as_ref().map(|s| s.of(f)) {
             Some(normals) => m.normals.extend(normals.iter().map(|n| n.as_vec3())),
             None => m
                 .normals
@@ -793,7 +805,7 @@ pub fn viewer_scene3(soup: &PolygonSoup, view: &MeshView) -> (Scene3, Vec<Vec<[u
                 keys.len() - 1
             }
         };
-        let corner_normals = smooth.as_ref().and_then(|s| s[f].as_ref());
+        let corner_normals = smooth.as_ref().map(|s| s.of(f));
         let m = &mut scene.meshes[k];
         let (first, other) = (&mut firsts[k], &mut others[k]);
         let local: Vec<u32> = face
