@@ -373,6 +373,11 @@ function resetView() {
   else { state.flat2d = { zoom: 1, x: 0, y: 0 }; placeFlat(); }
 }
 
+// A file a render kept on the server (`/api/blob/ID`), with the token.
+function fetchBlob(id) {
+  return fetch(`/api/blob/${id}`, { headers: { "x-subgram-token": API_TOKEN }, cache: "no-store", credentials: "omit" });
+}
+
 // 3D geometry: the GLB fetched and drawn by the page's own viewer, or the
 // server's PNG when the geometry is too large to send.
 async function showScene(reply) {
@@ -380,7 +385,7 @@ async function showScene(reply) {
   const took = reply.seconds;
   let r;
   try {
-    r = await fetch(`/api/blob/${info.blob}`, { headers: { "x-subgram-token": API_TOKEN }, cache: "no-store", credentials: "omit" });
+    r = await fetchBlob(info.blob);
     if (!r.ok) throw new Error(`the server answered ${r.status}`);
   } catch (e) {
     status.className = "error";
@@ -394,22 +399,7 @@ async function showScene(reply) {
     shown(`drawn in ${took.toFixed(2)} s`);
     return;
   }
-  let canvas = picture.querySelector("canvas");
-  try {
-    if (!state.view3d) {
-      canvas = document.createElement("canvas");
-      canvas.className = "view3d";
-      picture.append(canvas);
-      state.view3d = new View3D(canvas);
-      state.view3d.setWireframe(wire.checked);
-    }
-  } catch (e) {
-    canvas?.remove();
-    state.view3d = null;
-    status.className = "error";
-    status.textContent = `cannot draw in 3D here: ${e.message}`;
-    return;
-  }
+  if (!ensureView3d()) return;
   const sameKind = state.scene && state.scene.turn_axis.join() === info.turn_axis.join() &&
     state.scene.projection === info.projection;
   const first = state.mode !== "3d";
@@ -500,7 +490,7 @@ async function startPlay() {
   if (job.interval_ms) play.intervalMs = job.interval_ms;
   for (const [i, f] of job.frames.entries()) {
     playMessage(`loading frame ${i + 1} of ${job.frames.length}`);
-    const r = await fetch(`/api/blob/${f.blob}`, { headers: { "x-subgram-token": API_TOKEN }, cache: "no-store", credentials: "omit" });
+    const r = await fetchBlob(f.blob);
     if (state.play !== play) return;
     if (!r.ok) { stopPlay(); playMessage(`cannot fetch frame ${i + 1}: the server answered ${r.status}`, true); return; }
     if (f.kind === "svg") {

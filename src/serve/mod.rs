@@ -175,6 +175,12 @@ pub struct App {
     jobs: Arc<std::sync::Mutex<play::Jobs>>,
 }
 
+/// `m` locked; a lock a panicking thread left is taken as it is (the
+/// kept files and the jobs' states stay readable).
+fn lock<T>(m: &std::sync::Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
 /// Files kept for the page: the newest first to stay, within
 /// [`Limits::max_kept_bytes`].
 #[derive(Default)]
@@ -796,16 +802,12 @@ impl App {
 
     /// Keeps a file for the page to fetch; its number.
     fn keep(&self, content: &'static str, bytes: Vec<u8>) -> u64 {
-        self.blobs.lock().unwrap_or_else(|p| p.into_inner()).keep(
-            content,
-            bytes,
-            self.opts.limits.max_kept_bytes,
-        )
+        lock(&self.blobs).keep(content, bytes, self.opts.limits.max_kept_bytes)
     }
 
     /// A file a render kept: `/api/blob/ID`.
     fn blob(&self, id: u64) -> Reply {
-        let found = self.blobs.lock().unwrap_or_else(|p| p.into_inner()).get(id);
+        let found = lock(&self.blobs).get(id);
         match found {
             Some((kind, bytes)) => asset(&bytes, kind),
             None => failure(

@@ -17,7 +17,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::{scene_reply, App, Blobs, Message, SceneReply, ServeOptions};
+use super::{lock, scene_reply, App, Blobs, Message, SceneReply, ServeOptions};
 use crate::command::{self, FrameGeometry, RenderArgs, Solid};
 use crate::render::raster::Shading;
 
@@ -105,7 +105,7 @@ impl App {
             );
         }
         let job = {
-            let mut jobs = self.jobs.lock().unwrap_or_else(|p| p.into_inner());
+            let mut jobs = lock(&self.jobs);
             if jobs.running >= MAX_RUNNING {
                 return super::failure(
                     503,
@@ -125,7 +125,7 @@ impl App {
             }
             job
         };
-        let id = job.lock().unwrap_or_else(|p| p.into_inner()).id;
+        let id = lock(&job).id;
         let player = Player {
             opts: self.opts.clone(),
             program: self.program.clone(),
@@ -137,10 +137,10 @@ impl App {
             .stack_size(256 << 20)
             .spawn(move || {
                 player.run_job(&job, &req);
-                jobs.lock().unwrap_or_else(|p| p.into_inner()).running -= 1;
+                lock(&jobs).running -= 1;
             });
         if spawned.is_err() {
-            self.jobs.lock().unwrap_or_else(|p| p.into_inner()).running -= 1;
+            lock(&self.jobs).running -= 1;
             return super::failure(503, "the server cannot start another thread now");
         }
         super::json_reply(200, &serde_json::json!({ "ok": true, "job": id }))
@@ -148,14 +148,11 @@ impl App {
 
     /// `GET /api/play/ID`.
     pub(super) fn job(&self, id: u64) -> super::Reply {
-        let jobs = self.jobs.lock().unwrap_or_else(|p| p.into_inner());
-        let found = jobs
-            .jobs
-            .iter()
-            .find(|j| j.lock().unwrap_or_else(|p| p.into_inner()).id == id);
+        let jobs = lock(&self.jobs);
+        let found = jobs.jobs.iter().find(|j| lock(j).id == id);
         match found {
             Some(j) => {
-                let state = j.lock().unwrap_or_else(|p| p.into_inner()).clone();
+                let state = lock(j).clone();
                 super::json_reply(200, &state)
             }
             None => super::failure(404, "no such playback: the server remembers the last 8"),
@@ -165,11 +162,7 @@ impl App {
 
 impl Player {
     fn keep(&self, content: &'static str, bytes: Vec<u8>) -> u64 {
-        self.blobs.lock().unwrap_or_else(|p| p.into_inner()).keep(
-            content,
-            bytes,
-            self.opts.limits.max_kept_bytes,
-        )
+        lock(&self.blobs).keep(content, bytes, self.opts.limits.max_kept_bytes)
     }
 
     /// Derives the frames and keeps each as a file for the page.
@@ -188,9 +181,7 @@ impl Player {
         a.double = self.opts.double;
         a.max_modules = l.max_modules;
         a.timeout = Some(l.play_timeout);
-        let set = |f: &mut dyn FnMut(&mut JobState)| {
-            f(&mut job.lock().unwrap_or_else(|p| p.into_inner()))
-        };
+        let set = |f: &mut dyn FnMut(&mut JobState)| f(&mut lock(job));
         let result = command::frames_edited(&a, &req.text, |p| {
             set(&mut |s| {
                 s.step = p.step;
