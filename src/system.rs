@@ -265,6 +265,15 @@ pub struct SurfaceRun {
     pub steps: usize,
 }
 
+/// A run's mesh as a soup of polygons with what a file keeps of it: its
+/// sharp edges and its corners' texture coordinates.
+#[derive(Debug)]
+pub struct TexturedSoup {
+    pub soup: PolygonSoup,
+    pub sharpness: crate::mesh::SoupSharpness,
+    pub uvs: crate::mesh::FaceUvs,
+}
+
 impl Surface {
     /// `grammar`, read from `file` (its `mesh:` is relative to the file's
     /// folder) or from text (relative to the current folder).
@@ -393,6 +402,73 @@ impl Surface {
     /// The base mesh a run starts from: `opts.base_mesh`, else the
     /// grammar's `mesh:` (an unreadable one shown at that line).
     fn base(&self, opts: &RunOptions) -> Result<Mesh, Error> {
+        self.base_with(opts, load_mesh)
+    }
+
+    /// Loads the base mesh (see [`Surface::subdivide`]) and runs the steps
+    /// on it and, where the file gives its corners texture coordinates, on
+    /// its UV layout too (see [`crate::surface::uvs`]): the run, and the
+    /// mesh it made as a soup with its sharpness and its corners'
+    /// coordinates. Without coordinates in the file, the second part is
+    /// `None` and the run is [`Surface::subdivide`]'s.
+    pub fn subdivide_with_uvs(
+        &self,
+        opts: &RunOptions,
+        mode: crate::surface::uvs::FvarLinear,
+        progress: impl FnMut(Progress),
+    ) -> Result<(SurfaceRun, Option<TexturedSoup>), Error> {
+        use crate::surface::uvs;
+        let (mut mesh, soup, found) =
+            self.base_with(opts, |p| Ok(crate::mesh::io::read_with_uvs(p)?))?;
+        let steps = self.steps(opts.steps)?;
+        let Some(found) = found else {
+            self.run_on(&mut mesh, steps, opts.deadline, progress)?;
+            return Ok((SurfaceRun { mesh, steps }, None));
+        };
+        let name = &self.grammar.sources.get(FileId(0)).name;
+        if mode != uvs::FvarLinear::None && !uvs::reads_sharpness(&self.grammar) {
+            return Err(Error::Usage(format!(
+                "`--fvar-linear {}` keeps some texture coordinates linear through the grammar's \
+                 crease rules, and `{name}` has none (it never reads `sharp`, `sharpness` or \
+                 `creases`): use `--fvar-linear none`, or `--no-uvs`",
+                mode.name()
+            )));
+        }
+        let mut layout = uvs::UvLayout::new(&soup, &found, &mesh, mode)
+            .map_err(|m| Error::Failed(format!("{}: {m}", self.base_name(opts))))?;
+        drop(soup);
+        mesh.track_origins(uvs::base_key);
+        self.run_on(&mut mesh, steps, opts.deadline, progress)?;
+        layout
+            .run(&self.grammar, steps, opts.deadline)
+            .map_err(|e| self.error(e))?;
+        let (soup, sharpness, uvs) = uvs::carry(&mesh, &layout.mesh).map_err(Error::Failed)?;
+        Ok((
+            SurfaceRun { mesh, steps },
+            Some(TexturedSoup {
+                soup,
+                sharpness,
+                uvs,
+            }),
+        ))
+    }
+
+    /// The base mesh's path as given, for messages.
+    fn base_name(&self, opts: &RunOptions) -> String {
+        match (&opts.base_mesh, self.base_mesh()) {
+            (Some(m), _) => m.display().to_string(),
+            (None, Some(p)) => p.display().to_string(),
+            (None, None) => "the base mesh".into(),
+        }
+    }
+
+    /// Loads the base mesh with `load`: `opts.base_mesh`, else the
+    /// grammar's `mesh:` (a problem reading it shown at that line).
+    fn base_with<T>(
+        &self,
+        opts: &RunOptions,
+        load: impl Fn(&Path) -> Result<T, Error>,
+    ) -> Result<T, Error> {
         let path = match (&opts.base_mesh, self.base_mesh()) {
             (Some(m), _) => m.clone(),
             (None, Some(p)) => p,
@@ -405,7 +481,7 @@ impl Surface {
             }
         };
         let named_here = opts.base_mesh.is_none();
-        load_mesh(&path).map_err(|e| match &self.grammar.mesh {
+        load(&path).map_err(|e| match &self.grammar.mesh {
             // A mesh the grammar names but that cannot be read at all is
             // shown at its `mesh:` line; a problem inside the mesh file
             // keeps its own place.

@@ -45,6 +45,15 @@ pub(super) struct SubdivideCli {
     /// (vn in OBJ, nx ny nz in PLY), by the stencils `analyze` measures
     #[arg(long)]
     limit: bool,
+    /// Surface grammars on a mesh with texture coordinates (OBJ vt, PLY
+    /// texcoord or u v): which are interpolated linearly, OpenSubdiv's
+    /// choices: none (smooth everywhere), corners-only, corners-plus1,
+    /// corners-plus2, boundaries (the default, as Blender's), all
+    #[arg(long, value_name = "CHOICE")]
+    fvar_linear: Option<String>,
+    /// Subdivide without the base mesh's texture coordinates.
+    #[arg(long)]
+    no_uvs: bool,
 }
 
 impl SubdivideCli {
@@ -62,6 +71,8 @@ impl SubdivideCli {
             timeout,
             force,
             limit,
+            fvar_linear,
+            no_uvs,
         } = self;
         let args = SubdivideArgs {
             mesh,
@@ -76,6 +87,8 @@ impl SubdivideCli {
             timeout: timeout.0,
             force,
             limit,
+            fvar_linear,
+            no_uvs,
             program_output: subgram::ProgramOutput::new(),
         };
         let result = with_progress(|p| command::subdivide(&args, p));

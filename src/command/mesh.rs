@@ -14,6 +14,36 @@ use crate::system::load_mesh;
 /// lost without a word.
 pub(super) fn write_mesh(output: &Path, m: &Mesh, triangles: bool) -> Result<Vec<String>, Error> {
     let sharp = mesh::io::write_mesh(output, m, triangles)?;
+    Ok(lost_in_file(output, &sharp))
+}
+
+/// Writes a run's mesh with its texture coordinates (see
+/// [`crate::system::Surface::subdivide_with_uvs`]); the warnings say what
+/// the file does not keep (OFF keeps no texture coordinates, only PLY
+/// keeps sharp edges).
+pub(super) fn write_textured(
+    output: &Path,
+    t: &crate::system::TexturedSoup,
+) -> Result<Vec<String>, Error> {
+    let off = mesh::io::Format::from_path(output) == Some(mesh::io::Format::Off);
+    mesh::io::write_with_attributes(output, &t.soup, None, Some(&t.uvs), &t.sharpness.edges)?;
+    let mut warnings = lost_in_file(output, &t.sharpness);
+    if off {
+        warnings.insert(
+            0,
+            format!(
+                "{}: warning: the file does not keep the texture coordinates of the base mesh \
+                 (write .obj or .ply, which keep them)",
+                output.display()
+            ),
+        );
+    }
+    Ok(warnings)
+}
+
+/// Warnings for what of a mesh's sharpness the file at `output` does not
+/// keep, and for a `.creases` file beside it.
+fn lost_in_file(output: &Path, sharp: &crate::mesh::SoupSharpness) -> Vec<String> {
     let ply = mesh::io::Format::from_path(output) == Some(mesh::io::Format::Ply);
     let edges = |n: usize| format!("{n} sharp edge{}", if n == 1 { "" } else { "s" });
     let mut lost = Vec::new();
@@ -55,7 +85,7 @@ pub(super) fn write_mesh(output: &Path, m: &Mesh, triangles: bool) -> Result<Vec
             side.display()
         ));
     }
-    Ok(warnings)
+    warnings
 }
 
 /// `subgram mesh info`: counts, boundary loops, Euler characteristic, genus,

@@ -347,6 +347,8 @@ fn render_system(
             timeout: a.timeout,
             force: a.force,
             limit: false,
+            fvar_linear: None,
+            no_uvs: false,
             program_output: a.program_output.clone(),
         };
         return subdivide_in_run(&sa, progress);

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use super::common::{as_paths, extension_hint, in_run, refuse_overwrite, write_files};
-use super::mesh::write_mesh;
+use super::mesh::{write_mesh, write_textured};
 use super::picture::{write_mesh_picture, write_soup_picture, MeshLooks, Out, Picture};
 use crate::error::Error;
 use crate::lang::ProgramOutput;
@@ -41,6 +41,12 @@ pub struct SubdivideArgs {
     /// limit normals written (surface grammars; see
     /// [`crate::analyze::limit`]).
     pub limit: bool,
+    /// `--fvar-linear`: how texture coordinates are interpolated (one of
+    /// [`crate::surface::uvs::FvarLinear::NAMES`]; default `boundaries`,
+    /// Blender's).
+    pub fvar_linear: Option<String>,
+    /// `--no-uvs`: subdivide without the base mesh's texture coordinates.
+    pub no_uvs: bool,
     /// What a vv program prints: the caller keeps a clone and prints it.
     pub program_output: ProgramOutput,
 }
@@ -183,12 +189,37 @@ pub(super) fn subdivide_in_run(
         mesh::io::write(output, &run.soup)?;
         return Ok(Vec::new());
     }
+    let fvar = match a.fvar_linear.as_deref() {
+        None => crate::surface::uvs::FvarLinear::default(),
+        Some(name) => crate::surface::uvs::FvarLinear::from_name(name).ok_or_else(|| {
+            Error::Usage(format!(
+                "`--fvar-linear {name}` is not a choice: use {}",
+                crate::surface::uvs::FvarLinear::NAMES.join(", ")
+            ))
+        })?,
+    };
+    if a.fvar_linear.is_some() && (kind != Kind::Surface || a.no_uvs) {
+        return Err(Error::Usage(
+            "`--fvar-linear` says how a surface grammar carries texture coordinates; it is \
+             for surface grammars, without `--no-uvs`"
+                .into(),
+        ));
+    }
     let g = crate::load::with_stack(move || crate::surface::from_front(front))?;
     let surface = Surface::new(g, Some(grammar));
     if a.mesh.is_none() {
         // The grammar's own `mesh:` is an input too.
         inputs.extend(surface.base_mesh());
         refuse_overwrite(&[output], &as_paths(&inputs), a.force)?;
+    }
+    // A mesh file gets the base mesh's texture coordinates, where it has
+    // them.
+    if mesh::io::Format::from_path(output).is_some() && !a.limit && !a.no_uvs {
+        let (run, textured) = surface.subdivide_with_uvs(&opts, fvar, progress)?;
+        return match textured {
+            Some(t) => write_textured(output, &t),
+            None => write_mesh(output, &run.mesh, false),
+        };
     }
     let run = surface.subdivide(&opts, progress)?;
     if a.limit {

@@ -595,6 +595,12 @@ impl Mesh {
         (soup, tags)
     }
 
+    /// [`Mesh::to_quad_soup`], and the mesh vertex of each soup vertex.
+    pub(crate) fn quad_soup_with_vertices(&self) -> (PolygonSoup, Vec<VertexId>) {
+        let (soup, _, vertices) = self.soup_with(|e| self.is_block_edge(e));
+        (soup, vertices)
+    }
+
     /// [`Mesh::to_quad_soup_tagged`], and the mesh vertex of each soup
     /// vertex.
     pub(crate) fn quad_soup_tagged_with_vertices(&self) -> (PolygonSoup, Vec<u32>, Vec<VertexId>) {

@@ -190,6 +190,37 @@ pub struct Mesh {
     /// triangles' slots to its index here.
     pub(crate) fans: Vec<Fan>,
     pub(crate) fan_of: std::collections::BTreeMap<u32, u32>,
+    /// Each vertex's origin key, while [`Mesh::track_origins`] is on
+    /// (empty otherwise): a base vertex's is given, a split's new vertex's
+    /// is made from the keys of the corners of what was split (see
+    /// [`origin_key`]). Two runs of one grammar on meshes of the same
+    /// faces (a mesh and its UV layout, cut open at seams) give the
+    /// vertices they make for the same element the same key.
+    pub(crate) v_key: Vec<u64>,
+}
+
+/// The origin key of a vertex made by splitting an element whose corners
+/// have the keys `parents` (two for an edge, three for a face), whatever
+/// their order.
+pub fn origin_key(parents: &[u64]) -> u64 {
+    let mut sorted = [0u64; 3];
+    let n = parents.len().min(3);
+    sorted[..n].copy_from_slice(&parents[..n]);
+    sorted[..n].sort_unstable();
+    let mut h = 0x243F_6A88_85A3_08D3 ^ n as u64;
+    for &k in &sorted[..n] {
+        h = mix64(h ^ k);
+    }
+    h
+}
+
+/// SplitMix64's finaliser: every bit of the result depends on every bit
+/// of `x`.
+pub fn mix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// How semi-sharp creases soften from one level to the next: OpenSubdiv's
@@ -534,6 +565,31 @@ impl Mesh {
         self.creased = self.has_sharpness();
     }
 
+    /// Makes every vertex, and every edge that is neither a basic block's
+    /// internal edge nor a diagonal of a fanned polygon, sharp for ever:
+    /// a crease-aware grammar's rules then interpolate linearly (corners
+    /// stay, edges split at their midpoints, faces at their centroids).
+    pub fn sharpen_everything(&mut self) {
+        let vertices: Vec<VertexId> = self.vertices().collect();
+        for v in vertices {
+            self.v_sharp.set(v.index(), f64::INFINITY);
+        }
+        let edges: Vec<EdgeId> = self.edges().collect();
+        for e in edges {
+            let inside_fan = match self.edge_faces(e) {
+                [Some(f), Some(g)] => {
+                    let k = self.fan_of.get(&f.0);
+                    k.is_some() && k == self.fan_of.get(&g.0)
+                }
+                _ => false,
+            };
+            if !self.is_block_edge(e) && !inside_fan {
+                self.e_sharp.set(e.index(), f64::INFINITY);
+            }
+        }
+        self.creased = true;
+    }
+
     /// The step of a grammar run that made the vertex (0: the base mesh).
     pub fn vertex_step(&self, v: VertexId) -> u32 {
         self.v_step.get(v.index())
@@ -830,8 +886,38 @@ impl Mesh {
         self.f_tag.reserve(faces);
     }
 
+    /// Starts giving every vertex an origin key: each vertex now in the
+    /// mesh `base(v)`, each one a split makes from then on the
+    /// [`origin_key`] of what it split.
+    pub fn track_origins(&mut self, base: impl Fn(VertexId) -> u64) {
+        self.v_key = (0..self.v_alive.len() as u32)
+            .map(|v| base(VertexId(v)))
+            .collect();
+    }
+
+    /// The vertex's origin key, while [`Mesh::track_origins`] is on.
+    pub fn origin(&self, v: VertexId) -> Option<u64> {
+        self.v_key.get(v.index()).copied()
+    }
+
+    /// Gives `v`, just made by splitting an element with `corners`, its
+    /// origin key, while keys are tracked.
+    pub(crate) fn set_origin(&mut self, v: VertexId, corners: &[VertexId]) {
+        if self.v_key.is_empty() {
+            return;
+        }
+        let mut keys = [0u64; 3];
+        for (k, c) in keys.iter_mut().zip(corners) {
+            *k = self.v_key[c.index()];
+        }
+        self.v_key[v.index()] = origin_key(&keys[..corners.len()]);
+    }
+
     /// A new vertex at `p`, made in grammar step `step`.
     pub(crate) fn new_vertex(&mut self, p: DVec3, level: u32, step: u32) -> VertexId {
+        if !self.v_key.is_empty() && self.free_v.is_empty() {
+            self.v_key.push(0);
+        }
         if let Some(i) = self.free_v.pop() {
             let k = i as usize;
             self.v_out[k] = NO_HALFEDGE;

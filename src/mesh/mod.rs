@@ -21,5 +21,5 @@ pub use build::SoupSharpness;
 pub use halfedge::{
     child_sharpness, Creasing, EdgeId, FaceId, FannedPolygon, HalfEdgeId, Mesh, MeshError, VertexId,
 };
-pub use soup::{Faces, MeshFileError, Place, PolygonSoup};
+pub use soup::{FaceUvs, Faces, MeshFileError, Place, PolygonSoup};
 pub use stellar::{BlockSplit, Split};

@@ -2,7 +2,7 @@
 //! them. Files are read into a soup, checked, then built into a half-edge
 //! mesh; a mesh is written back through a soup.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 /// Positions and polygons (counter-clockwise index lists, any size >= 3).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -14,6 +14,25 @@ pub struct PolygonSoup {
     pub face_lines: Vec<usize>,
     /// The 1-based source line of each vertex (0 when unknown).
     pub vertex_lines: Vec<usize>,
+}
+
+/// Texture coordinates of a soup's face corners (OBJ `vt` with `f v/vt`,
+/// PLY `u v` per vertex or a face's `texcoord` list): `corners` runs
+/// parallel to the soup's [`Faces::indices`], one index into `values` a
+/// corner. Two corners at one vertex with different values make a seam.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FaceUvs {
+    pub values: Vec<DVec2>,
+    pub corners: Vec<u32>,
+}
+
+impl FaceUvs {
+    /// The values of face `k` of `faces`'s corners, in order.
+    pub fn face<'a>(&'a self, faces: &Faces, k: usize) -> impl Iterator<Item = DVec2> + 'a {
+        self.corners[faces.range(k)]
+            .iter()
+            .map(|&i| self.values[i as usize])
+    }
 }
 
 /// A problem with a mesh file or with the mesh it describes.
@@ -158,7 +177,7 @@ impl Faces {
 
     /// Where face `k` lies in `indices`.
     #[inline]
-    fn range(&self, k: usize) -> std::ops::Range<usize> {
+    pub(crate) fn range(&self, k: usize) -> std::ops::Range<usize> {
         if self.ends.is_empty() {
             k * self.arity..(k + 1) * self.arity
         } else {

@@ -142,6 +142,7 @@ impl Mesh {
         let [a, b, c] = self.face_vertices(f);
         let lv = self.face_level_from_vertices([a, b, c]);
         let v = self.new_vertex(p, lv, policy.step);
+        self.set_origin(v, &[a, b, c]);
         let va = self.new_edge(v, a, lv);
         let vb = self.new_edge(v, b, lv);
         let vc = self.new_edge(v, c, lv);
@@ -386,6 +387,7 @@ impl Mesh {
             )));
         }
         let v = self.new_vertex(p, lv, policy.step);
+        self.set_origin(v, &[a, b]);
         // h becomes a -> v, t becomes v -> a.
         self.he_to[h.index()] = v;
         self.he_to[t.index()] = a;

@@ -12,6 +12,7 @@
 pub(crate) mod grammar;
 pub(crate) mod host;
 pub(crate) mod run;
+pub mod uvs;
 
 use std::path::Path;
 

@@ -54,6 +54,7 @@ mod surface_c4;
 mod surface_creases;
 mod surface_quad;
 mod threads;
+mod uvs;
 mod vv;
 mod vv_adversarial;
 mod watch;

@@ -56,8 +56,10 @@ mod text;
 mod write;
 
 pub use creases::CREASES_EXTENSION;
-pub use read::{read, read_mesh, read_str};
-pub use write::{to_bytes, write, write_mesh, write_with_normals, write_with_sharpness};
+pub use read::{read, read_mesh, read_str, read_with_uvs};
+pub use write::{
+    to_bytes, write, write_mesh, write_with_attributes, write_with_normals, write_with_sharpness,
+};
 
 use text::error;
 

@@ -1,18 +1,31 @@
-//! Wavefront OBJ: `v` and `f` statements; everything else is ignored.
+//! Wavefront OBJ: `v`, `vt` and `f` statements; everything else is
+//! ignored.
 //!
-//! The writer writes `v` lines then 1-based `f` lines.
+//! The writer writes `v` lines (and `vt`, `vn` where there are texture
+//! coordinates or normals) then 1-based `f` lines.
 
 use std::io::{self, Write};
 
-use crate::mesh::soup::{MeshFileError, PolygonSoup};
+use glam::DVec2;
 
-use super::raw::Raw;
+use crate::mesh::soup::{FaceUvs, MeshFileError, PolygonSoup};
+
+use super::raw::{Raw, NO_UV};
 use super::read::check_deadline;
-use super::text::{parse_index, parse_position, strip_comment, utf8, Line, Source};
+use super::text::{parse_index, parse_number, parse_position, strip_comment, utf8, Line, Source};
 use super::write::{put_indices, put_position, Polygons};
 
 /// Parses OBJ text into a checked soup.
 pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<PolygonSoup, MeshFileError> {
+    parse_with_uvs(name, bytes).map(|(soup, _)| soup)
+}
+
+/// Parses OBJ text into a checked soup and its corners' texture
+/// coordinates (`vt` lines and `f v/vt` corners), when it has them.
+pub(super) fn parse_with_uvs(
+    name: &str,
+    bytes: &[u8],
+) -> Result<(PolygonSoup, Option<FaceUvs>), MeshFileError> {
     let text = utf8(name, bytes, 1)?;
     let mut raw = Raw::new(1);
     let mut lines = text.lines().enumerate();
@@ -52,16 +65,42 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<PolygonSoup, MeshFileErr
                 let p = parse_position(name, &line, toks, &raw)?;
                 raw.push_vertex(p, line.no);
             }
+            Some("vt") => {
+                let uv = parse_texture(name, &line, toks)?;
+                raw.uv_values.push(uv);
+            }
             Some("f") | Some("fo") => {
                 parse_face(name, &line, toks, &mut raw)?;
                 raw.end_face(line.no, 1);
             }
-            // vt, vn, vp, o, g, s, usemtl, mtllib, l, p, free-form
+            // vn, vp, o, g, s, usemtl, mtllib, l, p, free-form
             // geometry: nothing this reader needs.
             _ => {}
         }
     }
-    raw.finish(name, Some(Source { text, first: 1 }))
+    raw.finish_with_uvs(name, Some(Source { text, first: 1 }))
+}
+
+/// A `vt` statement's `u` and `v` (`v` 0 where it is left out; a third
+/// value, `w`, is ignored).
+fn parse_texture<'a>(
+    name: &str,
+    line: &Line,
+    mut toks: impl Iterator<Item = &'a str>,
+) -> Result<DVec2, MeshFileError> {
+    let Some(u) = toks.next() else {
+        return Err(line.end(name, "a texture coordinate needs a value: `vt u v`"));
+    };
+    let u_at = u;
+    let u = parse_number(name, line, u)?;
+    let v = match toks.next() {
+        Some(v) => parse_number(name, line, v)?,
+        None => 0.0,
+    };
+    if !(u.is_finite() && v.is_finite()) {
+        return Err(line.at(name, u_at, "a texture coordinate must be finite"));
+    }
+    Ok(DVec2::new(u, v))
 }
 
 /// Pushes the 0-based vertices of an `f` statement (forms `i`, `i/t`,
@@ -75,13 +114,41 @@ fn parse_face<'a>(
 ) -> Result<(), MeshFileError> {
     let number = raw.face_count() + 1;
     let count = raw.positions.len();
+    let textures = raw.uv_values.len();
     for tok in toks {
-        let first = tok.split('/').next().unwrap_or(tok);
+        let mut parts = tok.split('/');
+        let first = parts.next().unwrap_or(tok);
         let i = parse_index(name, line, first)?;
         let i = resolve(number, count, i).map_err(|m| line.at(name, tok, m))?;
         raw.indices.push(i);
+        let uv = match parts.next().filter(|t| !t.is_empty()) {
+            Some(t) => {
+                let k = parse_index(name, line, t).map_err(|_| {
+                    line.at(
+                        name,
+                        tok,
+                        format!("expected a texture coordinate index, found `{t}`"),
+                    )
+                })?;
+                resolve_texture(number, textures, k).map_err(|m| line.at(name, tok, m))?
+            }
+            None => NO_UV,
+        };
+        raw.push_corner_uv(uv);
     }
     Ok(())
+}
+
+/// A written `vt` index as 0-based, checked against the `vt` lines so far
+/// (negative indices count back from the last).
+fn resolve_texture(face: usize, count: usize, i: i64) -> Result<i64, String> {
+    let resolved = if i > 0 { i - 1 } else { count as i64 + i };
+    if i == 0 || resolved < 0 || resolved >= count as i64 {
+        return Err(format!(
+            "face {face} refers to texture coordinate {i}, but {count} `vt` lines precede it"
+        ));
+    }
+    Ok(resolved)
 }
 
 /// A written OBJ index as 0-based, refusing 0 and indices before the
@@ -104,7 +171,9 @@ fn resolve(face: usize, count: usize, i: i64) -> Result<i64, String> {
     Ok(resolved)
 }
 
-/// OBJ: `v` lines then 1-based `f` lines.
+/// OBJ: `v` lines (then `vt` and `vn` lines where there are texture
+/// coordinates or normals), then 1-based `f` lines: `v`, `v/t`, `v//n` or
+/// `v/t/n` corners.
 pub(super) fn write_obj(w: &mut dyn Write, s: &dyn Polygons) -> io::Result<()> {
     writeln!(
         w,
@@ -116,21 +185,43 @@ pub(super) fn write_obj(w: &mut dyn Write, s: &dyn Polygons) -> io::Result<()> {
         w.write_all(b"v ")?;
         put_position(w, p)
     })?;
-    if let Some(normals) = s.normals() {
+    let uvs = s.uvs();
+    if let Some(uvs) = uvs {
+        for t in &uvs.values {
+            writeln!(w, "vt {:?} {:?}", t.x, t.y)?;
+        }
+    }
+    let normals = s.normals();
+    if let Some(normals) = normals {
         for &n in normals {
             w.write_all(b"vn ")?;
             put_position(w, n)?;
         }
+    }
+    if uvs.is_none() && normals.is_none() {
         return s.each_face(&mut |f| {
             w.write_all(b"f")?;
-            for &i in f {
-                write!(w, " {0}//{0}", u64::from(i) + 1)?;
-            }
-            w.write_all(b"\n")
+            put_indices(w, f, 1)
         });
     }
+    let mut corner = 0;
     s.each_face(&mut |f| {
         w.write_all(b"f")?;
-        put_indices(w, f, 1)
+        for &i in f {
+            let v = u64::from(i) + 1;
+            match uvs {
+                Some(uvs) => {
+                    let t = u64::from(uvs.corners[corner]) + 1;
+                    corner += 1;
+                    if normals.is_some() {
+                        write!(w, " {v}/{t}/{v}")?;
+                    } else {
+                        write!(w, " {v}/{t}")?;
+                    }
+                }
+                None => write!(w, " {v}//{v}")?,
+            }
+        }
+        w.write_all(b"\n")
     })
 }

@@ -7,9 +7,9 @@
 
 use std::io::{self, Write};
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
-use crate::mesh::soup::{MeshFileError, PolygonSoup};
+use crate::mesh::soup::{FaceUvs, MeshFileError, PolygonSoup};
 
 use super::creases::{saying, sharpness_value, Mark};
 use super::raw::Raw;
@@ -138,10 +138,13 @@ struct Header<'a> {
 /// What an element contributes to the mesh.
 #[derive(Clone, Copy)]
 enum Role {
-    /// Positions, with the indices of the x, y and z properties.
-    Vertex([usize; 3]),
-    /// Faces, with the index of the vertex list property.
-    Face(usize),
+    /// Positions, with the indices of the x, y and z properties, and of
+    /// a texture coordinate's two (`u v`, `s t` or `texture_u
+    /// texture_v`) where there are.
+    Vertex([usize; 3], Option<[usize; 2]>),
+    /// Faces, with the index of the vertex list property, and of a
+    /// `texcoord` list (u and v of each corner) where there is one.
+    Face(usize, Option<usize>),
     /// Sharp edges, with the indices of `vertex1`, `vertex2` and the
     /// sharpness (`crease` or `sharpness`).
     Edge([usize; 3]),
@@ -160,6 +163,16 @@ pub(super) fn parse_with_sharpness(
     name: &str,
     bytes: &[u8],
 ) -> Result<(PolygonSoup, Vec<Mark>), MeshFileError> {
+    parse_all(name, bytes).map(|(soup, marks, _)| (soup, marks))
+}
+
+/// Parses a PLY file into a checked soup, the sharpness of its `edge`
+/// element, and its corners' texture coordinates: a face's `texcoord`
+/// list, else a vertex's `u v` (or `s t`, `texture_u texture_v`).
+pub(super) fn parse_all(
+    name: &str,
+    bytes: &[u8],
+) -> Result<(PolygonSoup, Vec<Mark>, Option<FaceUvs>), MeshFileError> {
     let header = parse_header(name, bytes)?;
     let body = &bytes[header.body..];
     if header.binary {
@@ -169,7 +182,8 @@ pub(super) fn parse_with_sharpness(
         };
         let mut raw = read_elements(name, &header, &mut src)?;
         let marks = std::mem::take(&mut raw.marks);
-        Ok((raw.finish(name, None)?, marks))
+        let (soup, uvs) = raw.finish_with_uvs(name, None)?;
+        Ok((soup, marks, uvs))
     } else {
         let first = header.end.no + 1;
         let text = utf8(name, body, first)?;
@@ -177,7 +191,8 @@ pub(super) fn parse_with_sharpness(
         let mut raw = read_elements(name, &header, &mut src)?;
         src.check_end(name)?;
         let marks = std::mem::take(&mut raw.marks);
-        Ok((raw.finish(name, Some(Source { text, first }))?, marks))
+        let (soup, uvs) = raw.finish_with_uvs(name, Some(Source { text, first }))?;
+        Ok((soup, marks, uvs))
     }
 }
 
@@ -327,7 +342,15 @@ fn role(name: &str, el: &Element) -> Result<Role, MeshFileError> {
                     None => return fail(format!("the `vertex` element has no `{axis}` property")),
                 }
             }
-            Ok(Role::Vertex(ix))
+            let scalar = |n: &str| {
+                el.props
+                    .iter()
+                    .position(|p| p.name == n && matches!(p.kind, Kind::Scalar(_)))
+            };
+            let uv = [("u", "v"), ("s", "t"), ("texture_u", "texture_v")]
+                .into_iter()
+                .find_map(|(u, v)| Some([scalar(u)?, scalar(v)?]));
+            Ok(Role::Vertex(ix, uv))
         }
         "face" => {
             let found = el
@@ -335,7 +358,13 @@ fn role(name: &str, el: &Element) -> Result<Role, MeshFileError> {
                 .iter()
                 .position(|p| p.name == "vertex_indices" || p.name == "vertex_index");
             match found.map(|i| (i, el.props[i].kind)) {
-                Some((i, Kind::List { item, .. })) if item.is_integer() => Ok(Role::Face(i)),
+                Some((i, Kind::List { item, .. })) if item.is_integer() => {
+                    let uv = el
+                        .props
+                        .iter()
+                        .position(|p| p.name == "texcoord" && matches!(p.kind, Kind::List { .. }));
+                    Ok(Role::Face(i, uv))
+                }
                 Some(_) => {
                     fail("the face property `vertex_indices` must be a list of integers".into())
                 }
@@ -595,7 +624,7 @@ fn read_elements<V: Values>(
                 return Err(src.ended(name, el, left / least));
             }
         }
-        if let Role::Vertex(_) = role {
+        if let Role::Vertex(..) = role {
             let room = src.bytes_left().map_or(0, |left| left / least);
             raw.positions.reserve(el.count.min(room));
             raw.vertex_lines.reserve(el.count.min(room));
@@ -619,7 +648,9 @@ fn read_instance<V: Values>(
 ) -> Result<(), MeshFileError> {
     let (line, _) = src.position();
     let mut xyz = [0.0; 3];
+    let mut uv = [0.0; 2];
     let mut face_at = (line, 0);
+    let mut texcoords: Vec<f64> = Vec::new();
     let mut edge = [0.0; 3];
     let mut edge_at = Vec::new();
     for (p, prop) in el.props.iter().enumerate() {
@@ -636,17 +667,27 @@ fn read_instance<V: Values>(
                         edge_at.push((k, src.at_last(name, String::new())));
                     }
                 }
-                if let Role::Vertex(ix) = role {
+                if let Role::Vertex(ix, uv_ix) = role {
                     for k in (0..3).filter(|&k| ix[k] == p) {
                         if !v.is_finite() {
                             return Err(src.at_last(name, raw.non_finite(raw.positions.len())));
                         }
                         xyz[k] = v;
                     }
+                    for k in (0..2).filter(|&k| uv_ix.is_some_and(|t| t[k] == p)) {
+                        if !v.is_finite() {
+                            return Err(src.at_last(
+                                name,
+                                format!("vertex {i} has a non-finite texture coordinate"),
+                            ));
+                        }
+                        uv[k] = v;
+                    }
                 }
             }
             Kind::List { count, item } => {
-                let keep = matches!(role, Role::Face(fp) if fp == p);
+                let keep = matches!(role, Role::Face(fp, _) if fp == p);
+                let texture = matches!(role, Role::Face(_, Some(tp)) if tp == p);
                 if keep {
                     face_at = src.position();
                 }
@@ -668,13 +709,42 @@ fn read_instance<V: Values>(
                     if keep {
                         raw.indices.push(index(name, src, v)?);
                     }
+                    if texture {
+                        if !v.is_finite() {
+                            return Err(src.at_last(
+                                name,
+                                format!("face {i} has a non-finite texture coordinate"),
+                            ));
+                        }
+                        texcoords.push(v);
+                    }
                 }
             }
         }
     }
     match role {
-        Role::Vertex(_) => raw.push_vertex(DVec3::from(xyz), line),
-        Role::Face(_) => raw.end_face(face_at.0, face_at.1.saturating_add(1)),
+        Role::Vertex(_, uv_ix) => {
+            raw.push_vertex(DVec3::from(xyz), line);
+            if uv_ix.is_some() {
+                raw.vertex_uvs.push(DVec2::from(uv));
+            }
+        }
+        Role::Face(_, None) => raw.end_face(face_at.0, face_at.1.saturating_add(1)),
+        Role::Face(_, Some(_)) => {
+            let corners = raw.indices.len() - raw.face_start();
+            if texcoords.len() != 2 * corners {
+                return Err(src.at_last(
+                    name,
+                    format!(
+                        "face {i} has {corners} corners but {} texture coordinate values: \
+                         `texcoord` holds u and v of each corner",
+                        texcoords.len()
+                    ),
+                ));
+            }
+            raw.push_face_uvs(texcoords.chunks_exact(2).map(|t| DVec2::new(t[0], t[1])));
+            raw.end_face(face_at.0, face_at.1.saturating_add(1));
+        }
         Role::Edge(_) => {
             edge_at.sort_by_key(|(k, _)| *k);
             let at: Vec<MeshFileError> = edge_at.into_iter().map(|(_, e)| e).collect();
@@ -734,19 +804,30 @@ pub(super) fn write_ply(
     edges: &[(u32, u32, f64)],
 ) -> io::Result<()> {
     let count_type = if s.longest() <= 255 { "uchar" } else { "uint" };
+    let uv_count_type = if 2 * s.longest() <= 255 {
+        "uchar"
+    } else {
+        "uint"
+    };
     let normals = s.normals();
+    let uvs = s.uvs();
     write!(
         w,
         "ply\nformat ascii 1.0\ncomment written by subgram\n\
          element vertex {}\nproperty double x\nproperty double y\nproperty double z\n{}\
-         element face {}\nproperty list {count_type} uint vertex_indices\n",
+         element face {}\nproperty list {count_type} uint vertex_indices\n{}",
         s.vertex_count(),
         if normals.is_some() {
             "property double nx\nproperty double ny\nproperty double nz\n"
         } else {
             ""
         },
-        s.face_count()
+        s.face_count(),
+        if uvs.is_some() {
+            format!("property list {uv_count_type} double texcoord\n")
+        } else {
+            String::new()
+        }
     )?;
     if !edges.is_empty() {
         write!(
@@ -772,10 +853,28 @@ pub(super) fn write_ply(
         }
         None => s.each_position(&mut |p| put_position(w, p))?,
     }
-    s.each_face(&mut |f| {
-        write!(w, "{}", f.len())?;
-        put_indices(w, f, 0)
-    })?;
+    match uvs {
+        None => s.each_face(&mut |f| {
+            write!(w, "{}", f.len())?;
+            put_indices(w, f, 0)
+        })?,
+        Some(uvs) => {
+            let mut corner = 0;
+            s.each_face(&mut |f| {
+                write!(w, "{}", f.len())?;
+                for i in f {
+                    write!(w, " {i}")?;
+                }
+                write!(w, " {}", 2 * f.len())?;
+                for _ in f {
+                    let t = uvs.values[uvs.corners[corner] as usize];
+                    corner += 1;
+                    write!(w, " {:?} {:?}", t.x, t.y)?;
+                }
+                w.write_all(b"\n")
+            })?
+        }
+    }
     for &(a, b, sharp) in edges {
         writeln!(w, "{a} {b} {sharp:?}")?;
     }

@@ -1,9 +1,9 @@
 //! A mesh as parsed, before its faces are checked, and the check that
 //! turns it into a polygon soup.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
-use crate::mesh::soup::{first_repeat, Faces, MeshFileError, PolygonSoup};
+use crate::mesh::soup::{first_repeat, FaceUvs, Faces, MeshFileError, PolygonSoup};
 
 use super::creases::Mark;
 use super::text::{error, known, strip_comment, Source};
@@ -25,7 +25,19 @@ pub(super) struct Raw {
     base: i64,
     /// Sharpness the file gives (a PLY `edge` element's).
     pub(super) marks: Vec<Mark>,
+    /// Texture coordinates as read (OBJ `vt`, a PLY face's `texcoord`).
+    pub(super) uv_values: Vec<DVec2>,
+    /// The texture coordinate of each corner in `indices`, 0-based and
+    /// checked against `uv_values` when read, or [`NO_UV`]; empty while
+    /// no corner has one.
+    pub(super) uv_indices: Vec<i64>,
+    /// A texture coordinate per vertex (PLY `u v`), used where the faces
+    /// give none of their own.
+    pub(super) vertex_uvs: Vec<DVec2>,
 }
+
+/// A corner without a texture coordinate.
+pub(super) const NO_UV: i64 = i64::MIN;
 
 impl Raw {
     /// An empty mesh numbering from `base`.
@@ -39,7 +51,39 @@ impl Raw {
             face_words: Vec::new(),
             base,
             marks: Vec::new(),
+            uv_values: Vec::new(),
+            uv_indices: Vec::new(),
+            vertex_uvs: Vec::new(),
         }
+    }
+
+    /// Where the face being read starts in `indices`.
+    pub(super) fn face_start(&self) -> usize {
+        self.starts.last().copied().unwrap_or(0)
+    }
+
+    /// Gives the corners of the face being read their texture coordinates,
+    /// `values` in order (one a corner).
+    pub(super) fn push_face_uvs(&mut self, values: impl Iterator<Item = DVec2>) {
+        let start = self.face_start();
+        self.uv_indices.resize(start, NO_UV);
+        for v in values {
+            self.uv_indices.push(self.uv_values.len() as i64);
+            self.uv_values.push(v);
+        }
+    }
+
+    /// Records corner `indices[k]`'s texture coordinate (`NO_UV` for
+    /// none), the corners before it without one.
+    pub(super) fn push_corner_uv(&mut self, uv: i64) {
+        if uv == NO_UV && self.uv_indices.is_empty() {
+            return;
+        }
+        let k = self.indices.len() - 1;
+        if self.uv_indices.len() < k {
+            self.uv_indices.resize(k, NO_UV);
+        }
+        self.uv_indices.push(uv);
     }
 
     /// Adds a vertex read on `line`.
@@ -76,6 +120,18 @@ impl Raw {
         name: &str,
         source: Option<Source>,
     ) -> Result<PolygonSoup, MeshFileError> {
+        self.finish_with_uvs(name, source).map(|(soup, _)| soup)
+    }
+
+    /// [`Raw::finish`], and the texture coordinates of the faces' corners
+    /// where the file gives them: every corner of every face has one, or
+    /// the file is refused at the first face that lacks one.
+    pub(super) fn finish_with_uvs(
+        mut self,
+        name: &str,
+        source: Option<Source>,
+    ) -> Result<(PolygonSoup, Option<FaceUvs>), MeshFileError> {
+        let uvs = self.take_uvs(name, source)?;
         if let Some(v) = self.positions.iter().position(|p| !p.is_finite()) {
             let line = self.vertex_lines[v];
             let located = source.and_then(|s| s.line(line));
@@ -92,12 +148,57 @@ impl Raw {
         if faces.is_empty() {
             return Err(error(name, None, "the mesh has no faces"));
         }
-        Ok(PolygonSoup {
+        let soup = PolygonSoup {
             positions: self.positions,
             faces,
             face_lines: self.face_lines,
             vertex_lines: self.vertex_lines,
-        })
+        };
+        Ok((soup, uvs))
+    }
+
+    /// The corners' texture coordinates, when some corner has one: each
+    /// face's own (`uv_indices`), else each vertex's (`vertex_uvs`).
+    fn take_uvs(
+        &mut self,
+        name: &str,
+        source: Option<Source>,
+    ) -> Result<Option<FaceUvs>, MeshFileError> {
+        if self.uv_indices.is_empty() {
+            if self.vertex_uvs.is_empty() {
+                return Ok(None);
+            }
+            // One per vertex: a corner's is its vertex's (its range is
+            // checked with the face).
+            let corners = self
+                .indices
+                .iter()
+                .map(|&i| i.clamp(0, u32::MAX as i64) as u32);
+            return Ok(Some(FaceUvs {
+                corners: corners.collect(),
+                values: std::mem::take(&mut self.vertex_uvs),
+            }));
+        }
+        self.uv_indices.resize(self.indices.len(), NO_UV);
+        if let Some(k) = self.uv_indices.iter().position(|&t| t == NO_UV) {
+            let f = self.starts.partition_point(|&s| s <= k) - 1;
+            let line = self.face_lines[f];
+            let message = format!(
+                "face {} has no texture coordinate at its corner {}, but other faces have \
+                 them: give every corner one (`f v/vt`), or none",
+                f as i64 + self.base,
+                k - self.starts[f] + 1
+            );
+            return Err(match source.and_then(|s| s.line(line)) {
+                Some(l) => l.whole(name, message),
+                None => error(name, known(line), message),
+            });
+        }
+        let corners = self.uv_indices.iter().map(|&t| t as u32).collect();
+        Ok(Some(FaceUvs {
+            values: std::mem::take(&mut self.uv_values),
+            corners,
+        }))
     }
 
     /// Face `f` with at least three distinct, in-range vertices.

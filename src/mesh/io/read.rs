@@ -5,7 +5,7 @@ use std::io::Read;
 use std::path::Path;
 
 use crate::mesh::halfedge::Mesh;
-use crate::mesh::soup::{MeshFileError, PolygonSoup};
+use crate::mesh::soup::{FaceUvs, MeshFileError, PolygonSoup};
 
 use super::creases::{apply_sharpness, read_creases, CREASES_EXTENSION};
 use super::text::{error, utf8, Source};
@@ -43,10 +43,44 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, MeshFileError> {
         _ => (read_str(&name, format, &bytes)?, Vec::new()),
     };
     drop(bytes);
-    check_deadline(&name, 0)?;
-    let mut mesh = build_mesh(path, &soup)?;
-    check_deadline(&name, 0)?;
-    apply_sharpness(&mut mesh, &marks, 0)?;
+    finish_mesh(path, &name, &soup, &marks, limit)
+}
+
+/// Reads the mesh file at `path` as [`read_mesh`] does, and the texture
+/// coordinates of its faces' corners where it has them (OBJ `vt` with `f
+/// v/vt`; PLY a face's `texcoord` list or a vertex's `u v`); also the
+/// soup the mesh was built from, whose faces the coordinates follow.
+pub fn read_with_uvs(path: &Path) -> Result<(Mesh, PolygonSoup, Option<FaceUvs>), MeshFileError> {
+    let name = path.display().to_string();
+    let format = format_of(&name, path)?;
+    let limit = max_file_bytes().map_err(|m| error(&name, None, m))?;
+    let bytes = read_bounded_as(&name, path, limit, Some(format))?;
+    let (soup, marks, uvs) = match format {
+        Format::Ply => ply::parse_all(&name, &bytes)?,
+        Format::Obj => {
+            let (soup, uvs) = obj::parse_with_uvs(&name, &bytes)?;
+            (soup, Vec::new(), uvs)
+        }
+        Format::Off => (off::parse(&name, &bytes)?, Vec::new(), None),
+    };
+    drop(bytes);
+    let mesh = finish_mesh(path, &name, &soup, &marks, limit)?;
+    Ok((mesh, soup, uvs))
+}
+
+/// The half-edge mesh of `soup`, read from `path`, with the sharpness of
+/// `marks` and of the `.creases` file beside it.
+fn finish_mesh(
+    path: &Path,
+    name: &str,
+    soup: &PolygonSoup,
+    marks: &[super::creases::Mark],
+    limit: u64,
+) -> Result<Mesh, MeshFileError> {
+    check_deadline(name, 0)?;
+    let mut mesh = build_mesh(path, soup)?;
+    check_deadline(name, 0)?;
+    apply_sharpness(&mut mesh, marks, 0)?;
     let side = path.with_extension(CREASES_EXTENSION);
     if side.is_file() {
         let marks = read_creases(&side, limit)?;

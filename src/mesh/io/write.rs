@@ -9,7 +9,7 @@ use glam::DVec3;
 
 use crate::mesh::build::SoupSharpness;
 use crate::mesh::halfedge::Mesh;
-use crate::mesh::soup::{MeshFileError, PolygonSoup};
+use crate::mesh::soup::{FaceUvs, MeshFileError, PolygonSoup};
 
 use super::obj::write_obj;
 use super::off::write_off;
@@ -33,7 +33,34 @@ pub fn write_with_normals(
     normals: &[DVec3],
 ) -> Result<(), MeshFileError> {
     assert_eq!(normals.len(), soup.positions.len(), "a normal per vertex");
-    write_streamed(path, &WithNormals { soup, normals }, &[])
+    write_with_attributes(path, soup, Some(normals), None, &[])
+}
+
+/// Writes `soup` to `path` as [`write()`] does, with `normals` (one a
+/// vertex, see [`write_with_normals`]) and the corners' texture
+/// coordinates `uvs` where the format has a place for them: `vt` lines
+/// and `f v/t` corners in OBJ, a face's `texcoord` list (u and v of each
+/// corner, as MeshLab writes it) in PLY; and the sharp `edges` as
+/// [`write_with_sharpness`] writes them. OFF has no place for texture
+/// coordinates; the caller says so.
+pub fn write_with_attributes(
+    path: &Path,
+    soup: &PolygonSoup,
+    normals: Option<&[DVec3]>,
+    uvs: Option<&FaceUvs>,
+    edges: &[(u32, u32, f64)],
+) -> Result<(), MeshFileError> {
+    if let Some(n) = normals {
+        assert_eq!(n.len(), soup.positions.len(), "a normal per vertex");
+    }
+    if let Some(t) = uvs {
+        assert_eq!(
+            t.corners.len(),
+            soup.faces.indices().len(),
+            "a texture coordinate per corner"
+        );
+    }
+    write_streamed(path, &WithNormals { soup, normals, uvs }, edges)
 }
 
 /// Writes `soup` to `path` as [`write()`] does, with the sharp `edges` (two
@@ -106,12 +133,18 @@ pub(super) trait Polygons {
     fn normals(&self) -> Option<&[DVec3]> {
         None
     }
+    /// The texture coordinates of the faces' corners, when there are some.
+    fn uvs(&self) -> Option<&FaceUvs> {
+        None
+    }
 }
 
-/// A soup with a normal per vertex.
+/// A soup with a normal per vertex, or texture coordinates per corner, or
+/// both.
 struct WithNormals<'a> {
     soup: &'a PolygonSoup,
-    normals: &'a [DVec3],
+    normals: Option<&'a [DVec3]>,
+    uvs: Option<&'a FaceUvs>,
 }
 
 impl Polygons for WithNormals<'_> {
@@ -136,7 +169,11 @@ impl Polygons for WithNormals<'_> {
     }
 
     fn normals(&self) -> Option<&[DVec3]> {
-        Some(self.normals)
+        self.normals
+    }
+
+    fn uvs(&self) -> Option<&FaceUvs> {
+        self.uvs
     }
 }
 

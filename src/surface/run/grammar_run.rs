@@ -330,6 +330,14 @@ impl GrammarRun<'_> {
         self.mesh.set_position(v, p);
     }
 
+    /// Makes the mesh sharp everywhere before the next step (see
+    /// [`Mesh::sharpen_everything`]): how face-varying data is
+    /// interpolated linearly by a crease-aware grammar.
+    pub fn sharpen_everything(&mut self) {
+        self.mesh.sharpen_everything();
+        self.state.creased = true;
+    }
+
     /// Stops the run with an error once `deadline` passes: it is looked
     /// at before every rule.
     pub fn set_deadline(&mut self, deadline: Option<crate::Deadline>) {
