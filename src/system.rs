@@ -426,6 +426,21 @@ impl Surface {
             return Ok((SurfaceRun { mesh, steps }, None));
         };
         let name = &self.grammar.sources.get(FileId(0)).name;
+        let what = if self.grammar.dual_at.is_some() {
+            Some("a dual scheme, which runs on closed meshes only")
+        } else if self.grammar.adaptive.is_some() {
+            Some("adaptive, so its splits depend on the shape of what it runs on")
+        } else {
+            None
+        };
+        if let Some(what) = what {
+            return Err(Error::Usage(format!(
+                "`{}` gives its corners texture coordinates, which run through a grammar as a \
+                 layout of their own, with boundaries at the seams; `{name}` is {what}: \
+                 subdivide with `--no-uvs`",
+                self.base_name(opts)
+            )));
+        }
         if mode != uvs::FvarLinear::None && !uvs::reads_sharpness(&self.grammar) {
             return Err(Error::Usage(format!(
                 "`--fvar-linear {}` keeps some texture coordinates linear through the grammar's \

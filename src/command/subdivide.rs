@@ -173,6 +173,12 @@ pub(super) fn subdivide_in_run(
             inputs.extend(v.base_mesh());
             refuse_overwrite(&[output], &as_paths(&inputs), a.force)?;
         }
+        let dropped = dropped_uvs(
+            a.mesh.as_deref().map(PathBuf::from).or(v.base_mesh()),
+            output,
+            a.no_uvs,
+            "a vertex-vertex program carries none",
+        );
         let run = v.run(&opts, progress)?;
         if Picture::from_path(output).is_ok() {
             return write_soup_picture(
@@ -184,10 +190,10 @@ pub(super) fn subdivide_in_run(
             .map(|()| Vec::new());
         }
         if is_glb(output) {
-            return write_soup_glb(&run.soup, &[], output).map(|()| Vec::new());
+            return write_soup_glb(&run.soup, &[], output).map(|()| dropped);
         }
         mesh::io::write(output, &run.soup)?;
-        return Ok(Vec::new());
+        return Ok(dropped);
     }
     let fvar = match a.fvar_linear.as_deref() {
         None => crate::surface::uvs::FvarLinear::default(),
@@ -221,17 +227,39 @@ pub(super) fn subdivide_in_run(
             None => write_mesh(output, &run.mesh, false),
         };
     }
+    let base = a.mesh.as_deref().map(PathBuf::from).or(surface.base_mesh());
     let run = surface.subdivide(&opts, progress)?;
     if a.limit {
-        return write_limit(&surface.grammar, &run.mesh, output, &looks);
+        let mut warnings = write_limit(&surface.grammar, &run.mesh, output, &looks)?;
+        if Picture::from_path(output).is_err() {
+            warnings.extend(dropped_uvs(base, output, a.no_uvs, "`--limit` writes none"));
+        }
+        return Ok(warnings);
     }
     if Picture::from_path(output).is_ok() {
         return write_mesh_picture(&run.mesh, output, &looks, &mut Out::Files).map(|()| Vec::new());
     }
     if is_glb(output) {
-        return write_soup_glb(&run.mesh.to_quad_soup(), &[], output).map(|()| Vec::new());
+        let dropped = dropped_uvs(base, output, a.no_uvs, "glTF is written without them");
+        return write_soup_glb(&run.mesh.to_quad_soup(), &[], output).map(|()| dropped);
     }
     write_mesh(output, &run.mesh, false)
+}
+
+/// A warning that the base mesh's texture coordinates are not in the
+/// mesh file `output` (`why`), where the base mesh has some and
+/// `--no-uvs` did not ask for that; none for pictures.
+fn dropped_uvs(base: Option<PathBuf>, output: &Path, no_uvs: bool, why: &str) -> Vec<String> {
+    match base {
+        Some(b) if !no_uvs && Picture::from_path(output).is_err() && mesh::io::mentions_uvs(&b) => {
+            vec![format!(
+                "{}: warning: the texture coordinates of `{}` are not in it: {why}",
+                output.display(),
+                b.display()
+            )]
+        }
+        _ => Vec::new(),
+    }
 }
 
 /// `--limit`: the run's mesh at its limit positions, written with its

@@ -487,6 +487,31 @@ fn what_cannot_carry_coordinates_says_so() {
         warnings.iter().any(|w| w.contains("texture coordinates")),
         "{warnings:?}"
     );
+    // Where they cannot follow, the output says it lost them.
+    for (grammar, output, limit) in [
+        ("vv/loop.lsys", "vv.obj", false),
+        ("surfaces/loop.lsys", "limit.obj", true),
+        ("surfaces/loop.lsys", "scene.glb", false),
+    ] {
+        let out = dir.path().join(output);
+        let mut a = args(&mesh, grammar, 1, &out, None);
+        a.limit = limit;
+        let warnings = command::subdivide(&a, |_| {}).unwrap();
+        assert!(
+            warnings
+                .iter()
+                .any(|w| w.contains("texture coordinates of")),
+            "{grammar} -> {output}: {warnings:?}"
+        );
+    }
+    // A dual scheme is refused before it runs.
+    let e = command::subdivide(
+        &args(&mesh, "surfaces/doo-sabin.lsys", 1, &out, Some("none")),
+        |_| {},
+    )
+    .expect_err("refused")
+    .to_string();
+    assert!(e.contains("dual scheme") && e.contains("--no-uvs"), "{e}");
     // An unknown choice.
     let e = command::subdivide(
         &args(&mesh, "surfaces/loop.lsys", 1, &out, Some("smooth")),

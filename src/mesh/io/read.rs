@@ -68,6 +68,42 @@ pub fn read_with_uvs(path: &Path) -> Result<(Mesh, PolygonSoup, Option<FaceUvs>)
     Ok((mesh, soup, uvs))
 }
 
+/// True when the mesh file at `path` gives texture coordinates (an OBJ
+/// `vt` line; a PLY `texcoord` property or a vertex's `u`/`s`): a look at
+/// the text, for a command that drops them to say so. False where the
+/// file cannot be read (reading it proper reports why).
+pub fn mentions_uvs(path: &Path) -> bool {
+    let name = path.display().to_string();
+    let Ok(format) = format_of(&name, path) else {
+        return false;
+    };
+    let Ok(limit) = max_file_bytes() else {
+        return false;
+    };
+    let Ok(bytes) = read_bounded(&name, path, limit) else {
+        return false;
+    };
+    let starts = |line: &[u8], word: &[u8]| {
+        let line = line.trim_ascii_start();
+        line.starts_with(word) && line.get(word.len()).is_none_or(|c| c.is_ascii_whitespace())
+    };
+    match format {
+        Format::Obj => bytes.split(|&b| b == b'\n').any(|l| starts(l, b"vt")),
+        Format::Ply => {
+            let end = bytes
+                .windows(10)
+                .position(|w| w == b"end_header")
+                .unwrap_or(bytes.len());
+            bytes[..end].split(|&b| b == b'\n').any(|l| {
+                let words: Vec<&[u8]> = l.split(|b| b.is_ascii_whitespace()).collect();
+                words.first() == Some(&&b"property"[..])
+                    && matches!(words.last(), Some(&w) if [&b"texcoord"[..], b"u", b"s", b"texture_u"].contains(&w))
+            })
+        }
+        Format::Off => false,
+    }
+}
+
 /// The half-edge mesh of `soup`, read from `path`, with the sharpness of
 /// `marks` and of the `.creases` file beside it.
 fn finish_mesh(
