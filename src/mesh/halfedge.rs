@@ -493,7 +493,7 @@ impl Mesh {
     /// boundary is a crease of its own: the grammars' boundary rules keep
     /// it a curve).
     pub fn sharp_edge_count(&self, v: VertexId) -> usize {
-        if !self.creased {
+        if !self.creased || self.e_sharp.all_default() {
             return 0;
         }
         self.outgoing_halfedges(v)
@@ -1129,6 +1129,12 @@ impl<T: Copy + Default + PartialEq> Column<T> {
                 len,
             }
         }
+    }
+
+    /// True while every element holds the default.
+    #[inline]
+    pub(crate) fn all_default(&self) -> bool {
+        self.stored.is_empty()
     }
 
     #[inline]

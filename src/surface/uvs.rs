@@ -387,43 +387,58 @@ pub fn reads_sharpness(g: &Grammar) -> bool {
 pub fn carry(mesh: &Mesh, layout: &Mesh) -> Result<(PolygonSoup, SoupSharpness, FaceUvs), String> {
     let (soup, vertices) = mesh.quad_soup_with_vertices();
     let (uv_soup, uv_vertices) = layout.quad_soup_with_vertices();
-    let key = |m: &Mesh, v: VertexId| m.origin(v).unwrap_or(0);
-    // Each layout face by the hash of its keys from the smallest on.
-    let mut cycle = Vec::new();
-    let mut found: HashMap<u64, (u32, u32)> = HashMap::with_capacity(uv_soup.faces.len());
-    for (k, f) in uv_soup.faces.iter().enumerate() {
-        cycle.clear();
-        cycle.extend(f.iter().map(|&u| key(layout, uv_vertices[u as usize])));
-        let (h, rot) = cycle_hash(&cycle);
-        if found.insert(h, (k as u32, rot as u32)).is_some() {
-            return Err(mismatch());
-        }
-    }
     if uv_soup.faces.len() != soup.faces.len() {
         return Err(mismatch());
     }
-    let mut corners = Vec::with_capacity(soup.faces.indices().len());
-    let mut keys = Vec::new();
-    for f in soup.faces.iter() {
-        cycle.clear();
-        cycle.extend(f.iter().map(|&v| key(mesh, vertices[v as usize])));
-        let (h, rot) = cycle_hash(&cycle);
-        let &(k, uv_rot) = found.get(&h).ok_or_else(mismatch)?;
-        let g = &uv_soup.faces[k as usize];
-        if g.len() != f.len() {
+    // The soups' vertices' keys, then each face's hash of its keys from
+    // the smallest on; the two lists sorted by hash meet face to face (a
+    // sort and a walk, where a table of a million faces would miss the
+    // cache at every look-up).
+    let keys_of = |m: &Mesh, vs: &[VertexId]| -> Vec<u64> {
+        vs.iter().map(|&v| m.origin(v).unwrap_or(0)).collect()
+    };
+    let (keys, uv_keys) = (keys_of(mesh, &vertices), keys_of(layout, &uv_vertices));
+    let hashed = |s: &PolygonSoup, keys: &[u64]| -> Vec<(u64, u32, u32)> {
+        let mut cycle = Vec::new();
+        let mut out: Vec<(u64, u32, u32)> = s
+            .faces
+            .iter()
+            .enumerate()
+            .map(|(k, f)| {
+                cycle.clear();
+                cycle.extend(f.iter().map(|&v| keys[v as usize]));
+                let (h, rot) = cycle_hash(&cycle);
+                (h, k as u32, rot as u32)
+            })
+            .collect();
+        out.sort_unstable();
+        out
+    };
+    let (faces, uv_faces) = (hashed(&soup, &keys), hashed(&uv_soup, &uv_keys));
+    // The layout face and the two rotations of each face.
+    let mut partner = vec![(0u32, 0u32, 0u32); soup.faces.len()];
+    for (i, (&(h, k, rot), &(uh, uk, urot))) in faces.iter().zip(&uv_faces).enumerate() {
+        let repeated = i > 0 && faces[i - 1].0 == h;
+        if h != uh || repeated {
             return Err(mismatch());
         }
+        partner[k as usize] = (uk, rot, urot);
+    }
+    let mut corners = Vec::with_capacity(soup.faces.indices().len());
+    for (f, &(k, rot, uv_rot)) in soup.faces.iter().zip(&partner) {
+        let g = &uv_soup.faces[k as usize];
         let n = f.len();
-        keys.clear();
-        for j in 0..n {
+        if g.len() != n {
+            return Err(mismatch());
+        }
+        for (j, &v) in f.iter().enumerate() {
             // Corner j of f is corner (j - rot + uv_rot) of g.
-            let u = g[(j + n - rot + uv_rot as usize) % n];
-            if key(layout, uv_vertices[u as usize]) != cycle[j] {
+            let u = g[(j + n - rot as usize + uv_rot as usize) % n];
+            if uv_keys[u as usize] != keys[v as usize] {
                 return Err(mismatch());
             }
-            keys.push(u);
+            corners.push(u);
         }
-        corners.extend_from_slice(&keys);
     }
     let values = uv_soup
         .positions
