@@ -410,20 +410,22 @@ impl Surface {
     /// its UV layout too (see [`crate::surface::uvs`]): the run, and the
     /// mesh it made as a soup with its sharpness and its corners'
     /// coordinates. Without coordinates in the file, the second part is
-    /// `None` and the run is [`Surface::subdivide`]'s.
+    /// `None` and the run is [`Surface::subdivide`]'s; the third is a
+    /// warning where the file's coordinates are not whole and were
+    /// dropped.
     pub fn subdivide_with_uvs(
         &self,
         opts: &RunOptions,
         mode: crate::surface::uvs::FvarLinear,
         progress: impl FnMut(Progress),
-    ) -> Result<(SurfaceRun, Option<TexturedSoup>), Error> {
+    ) -> Result<(SurfaceRun, Option<TexturedSoup>, Option<String>), Error> {
         use crate::surface::uvs;
-        let (mut mesh, soup, found) =
+        let (mut mesh, soup, read) =
             self.base_with(opts, |p| Ok(crate::mesh::io::read_with_uvs(p)?))?;
         let steps = self.steps(opts.steps)?;
-        let Some(found) = found else {
+        let Some(found) = read.uvs else {
             self.run_on(&mut mesh, steps, opts.deadline, progress)?;
-            return Ok((SurfaceRun { mesh, steps }, None));
+            return Ok((SurfaceRun { mesh, steps }, None, read.warning));
         };
         let name = &self.grammar.sources.get(FileId(0)).name;
         let what = if self.grammar.dual_at.is_some() {
@@ -465,6 +467,7 @@ impl Surface {
                 sharpness,
                 uvs,
             }),
+            None,
         ))
     }
 

@@ -221,11 +221,13 @@ pub(super) fn subdivide_in_run(
     // A mesh file gets the base mesh's texture coordinates, where it has
     // them.
     if mesh::io::Format::from_path(output).is_some() && !a.limit && !a.no_uvs {
-        let (run, textured) = surface.subdivide_with_uvs(&opts, fvar, progress)?;
-        return match textured {
-            Some(t) => write_textured(output, &t),
-            None => write_mesh(output, &run.mesh, false),
+        let (run, textured, dropped) = surface.subdivide_with_uvs(&opts, fvar, progress)?;
+        let mut warnings = match textured {
+            Some(t) => write_textured(output, &t)?,
+            None => write_mesh(output, &run.mesh, false)?,
         };
+        warnings.extend(dropped);
+        return Ok(warnings);
     }
     let base = a.mesh.as_deref().map(PathBuf::from).or(surface.base_mesh());
     let run = surface.subdivide(&opts, progress)?;

@@ -72,8 +72,8 @@ fn args(mesh: &Path, grammar: &str, steps: u64, out: &Path, mode: Option<&str>) 
 /// Runs `subdivide` and reads the output back with its coordinates.
 fn subdivide(a: &SubdivideArgs) -> (PolygonSoup, FaceUvs) {
     command::subdivide(a, |_| {}).unwrap_or_else(|e| panic!("{e}"));
-    let (_, soup, uvs) = io::read_with_uvs(Path::new(&a.output)).unwrap();
-    (soup, uvs.expect("the output has texture coordinates"))
+    let (_, soup, read) = io::read_with_uvs(Path::new(&a.output)).unwrap();
+    (soup, read.uvs.expect("the output has texture coordinates"))
 }
 
 /// The mesh `soup` run `steps` steps of a grammar, as the command writes
@@ -120,7 +120,7 @@ fn texture_coordinates_read_and_write_back() {
         DVec2::new(k as f64 + 0.25 * j as f64, 0.5 - j as f64)
     });
     let (_, read, uvs) = io::read_with_uvs(&obj).unwrap();
-    let uvs = uvs.unwrap();
+    let uvs = uvs.uvs.unwrap();
     assert_eq!(read.faces, soup.faces);
     assert_eq!(
         uvs.face(&read.faces, 4).nth(3),
@@ -131,7 +131,7 @@ fn texture_coordinates_read_and_write_back() {
         let out = dir.path().join(name);
         io::write_with_attributes(&out, &read, None, Some(&uvs), &[]).unwrap();
         let (_, back, back_uvs) = io::read_with_uvs(&out).unwrap();
-        let back_uvs = back_uvs.unwrap();
+        let back_uvs = back_uvs.uvs.unwrap();
         assert_eq!(back.faces, read.faces, "{name}");
         for k in 0..read.faces.len() {
             let a: Vec<DVec2> = uvs.face(&read.faces, k).collect();
@@ -150,7 +150,7 @@ fn texture_coordinates_read_and_write_back() {
     )
     .unwrap();
     let (_, s, uvs) = io::read_with_uvs(&ply).unwrap();
-    let got: Vec<DVec2> = uvs.unwrap().face(&s.faces, 0).collect();
+    let got: Vec<DVec2> = uvs.uvs.unwrap().face(&s.faces, 0).collect();
     assert_eq!(
         got,
         [
@@ -161,6 +161,8 @@ fn texture_coordinates_read_and_write_back() {
     );
 }
 
+/// Coordinates that are not whole are dropped with a warning at their
+/// place; the mesh itself reads as before (and a plain read ignores them).
 #[test]
 fn bad_texture_coordinates_are_located() {
     let dir = scratch("uvs-bad");
@@ -184,8 +186,14 @@ fn bad_texture_coordinates_are_located() {
     for (text, at, what) in cases {
         let path = dir.path().join("bad.obj");
         std::fs::write(&path, text).unwrap();
-        let e = io::read_with_uvs(&path).expect_err("refused").to_string();
-        assert!(e.contains(at) && e.contains(what) && e.contains('^'), "{e}");
+        let (_, soup, read) = io::read_with_uvs(&path).unwrap();
+        let w = read.warning.expect("a warning");
+        assert!(read.uvs.is_none(), "{w}");
+        assert!(
+            w.contains(&format!("{at}: warning: ")) && w.contains(what) && w.contains('^'),
+            "{w}"
+        );
+        assert_eq!(io::read(&path).unwrap(), soup);
     }
 }
 
@@ -477,8 +485,8 @@ fn what_cannot_carry_coordinates_says_so() {
     let mut a = args(&mesh, "surfaces/sqrt3.lsys", 1, &out, None);
     a.no_uvs = true;
     command::subdivide(&a, |_| {}).unwrap();
-    let (_, _, uvs) = io::read_with_uvs(&out).unwrap();
-    assert!(uvs.is_none());
+    let (_, _, read) = io::read_with_uvs(&out).unwrap();
+    assert!(read.uvs.is_none() && read.warning.is_none());
     // OFF keeps none, and says so.
     let off = dir.path().join("out.off");
     let warnings =

@@ -8,16 +8,16 @@ use std::io::{self, Write};
 
 use glam::DVec2;
 
-use crate::mesh::soup::{FaceUvs, MeshFileError, PolygonSoup};
+use crate::mesh::soup::{MeshFileError, PolygonSoup};
 
-use super::raw::{Raw, NO_UV};
+use super::raw::{Raw, UvRead, NO_UV};
 use super::read::check_deadline;
 use super::text::{parse_index, parse_number, parse_position, strip_comment, utf8, Line, Source};
 use super::write::{put_indices, put_position, Polygons};
 
 /// Parses OBJ text into a checked soup.
 pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<PolygonSoup, MeshFileError> {
-    parse_with_uvs(name, bytes).map(|(soup, _)| soup)
+    parse_as(name, bytes, false).map(|(soup, _)| soup)
 }
 
 /// Parses OBJ text into a checked soup and its corners' texture
@@ -25,9 +25,16 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<PolygonSoup, MeshFileErr
 pub(super) fn parse_with_uvs(
     name: &str,
     bytes: &[u8],
-) -> Result<(PolygonSoup, Option<FaceUvs>), MeshFileError> {
+) -> Result<(PolygonSoup, UvRead), MeshFileError> {
+    parse_as(name, bytes, true)
+}
+
+/// Parses OBJ text; texture coordinates only where `uvs` asks for them
+/// (else `vt` lines and the `/t` of corners are ignored, as always).
+fn parse_as(name: &str, bytes: &[u8], uvs: bool) -> Result<(PolygonSoup, UvRead), MeshFileError> {
     let text = utf8(name, bytes, 1)?;
     let mut raw = Raw::new(1);
+    raw.want_uvs = uvs;
     let mut lines = text.lines().enumerate();
     let mut joined = String::new();
     while let Some((i, first)) = lines.next() {
@@ -65,8 +72,11 @@ pub(super) fn parse_with_uvs(
                 let p = parse_position(name, &line, toks, &raw)?;
                 raw.push_vertex(p, line.no);
             }
-            Some("vt") => {
-                let uv = parse_texture(name, &line, toks)?;
+            Some("vt") if raw.want_uvs => {
+                let uv = parse_texture(name, &line, toks).unwrap_or_else(|e| {
+                    raw.uv_problem(e);
+                    DVec2::ZERO
+                });
                 raw.uv_values.push(uv);
             }
             Some("f") | Some("fo") => {
@@ -121,16 +131,26 @@ fn parse_face<'a>(
         let i = parse_index(name, line, first)?;
         let i = resolve(number, count, i).map_err(|m| line.at(name, tok, m))?;
         raw.indices.push(i);
+        if !raw.want_uvs {
+            continue;
+        }
         let uv = match parts.next().filter(|t| !t.is_empty()) {
             Some(t) => {
-                let k = parse_index(name, line, t).map_err(|_| {
-                    line.at(
-                        name,
-                        tok,
-                        format!("expected a texture coordinate index, found `{t}`"),
-                    )
-                })?;
-                resolve_texture(number, textures, k).map_err(|m| line.at(name, tok, m))?
+                let k = parse_index(name, line, t)
+                    .map_err(|_| {
+                        line.at(
+                            name,
+                            tok,
+                            format!("expected a texture coordinate index, found `{t}`"),
+                        )
+                    })
+                    .and_then(|k| {
+                        resolve_texture(number, textures, k).map_err(|m| line.at(name, tok, m))
+                    });
+                k.unwrap_or_else(|e| {
+                    raw.uv_problem(e);
+                    NO_UV
+                })
             }
             None => NO_UV,
         };

@@ -9,10 +9,10 @@ use std::io::{self, Write};
 
 use glam::{DVec2, DVec3};
 
-use crate::mesh::soup::{FaceUvs, MeshFileError, PolygonSoup};
+use crate::mesh::soup::{MeshFileError, PolygonSoup};
 
 use super::creases::{saying, sharpness_value, Mark};
-use super::raw::Raw;
+use super::raw::{Raw, UvRead};
 use super::read::check_deadline;
 use super::text::{error, not_text, parse_count, parse_number, utf8, Line, Source};
 use super::write::{put_indices, put_position, Polygons};
@@ -163,7 +163,7 @@ pub(super) fn parse_with_sharpness(
     name: &str,
     bytes: &[u8],
 ) -> Result<(PolygonSoup, Vec<Mark>), MeshFileError> {
-    parse_all(name, bytes).map(|(soup, marks, _)| (soup, marks))
+    parse_as(name, bytes, false).map(|(soup, marks, _)| (soup, marks))
 }
 
 /// Parses a PLY file into a checked soup, the sharpness of its `edge`
@@ -172,7 +172,17 @@ pub(super) fn parse_with_sharpness(
 pub(super) fn parse_all(
     name: &str,
     bytes: &[u8],
-) -> Result<(PolygonSoup, Vec<Mark>, Option<FaceUvs>), MeshFileError> {
+) -> Result<(PolygonSoup, Vec<Mark>, UvRead), MeshFileError> {
+    parse_as(name, bytes, true)
+}
+
+/// Parses a PLY file; texture coordinates only where `uvs` asks for
+/// them (else their properties are read and dropped, as always).
+fn parse_as(
+    name: &str,
+    bytes: &[u8],
+    uvs: bool,
+) -> Result<(PolygonSoup, Vec<Mark>, UvRead), MeshFileError> {
     let header = parse_header(name, bytes)?;
     let body = &bytes[header.body..];
     if header.binary {
@@ -180,7 +190,7 @@ pub(super) fn parse_all(
             bytes: body,
             pos: 0,
         };
-        let mut raw = read_elements(name, &header, &mut src)?;
+        let mut raw = read_elements(name, &header, &mut src, uvs)?;
         let marks = std::mem::take(&mut raw.marks);
         let (soup, uvs) = raw.finish_with_uvs(name, None)?;
         Ok((soup, marks, uvs))
@@ -188,7 +198,7 @@ pub(super) fn parse_all(
         let first = header.end.no + 1;
         let text = utf8(name, body, first)?;
         let mut src = Ascii::new(text, header.end);
-        let mut raw = read_elements(name, &header, &mut src)?;
+        let mut raw = read_elements(name, &header, &mut src, uvs)?;
         src.check_end(name)?;
         let marks = std::mem::take(&mut raw.marks);
         let (soup, uvs) = raw.finish_with_uvs(name, Some(Source { text, first }))?;
@@ -595,6 +605,7 @@ fn read_elements<V: Values>(
     name: &str,
     header: &Header,
     src: &mut V,
+    uvs: bool,
 ) -> Result<Raw, MeshFileError> {
     if !header.elements.iter().any(|e| e.name == "vertex") {
         return Err(header
@@ -602,8 +613,13 @@ fn read_elements<V: Values>(
             .whole(name, "the PLY header declares no `vertex` element"));
     }
     let mut raw = Raw::new(0);
+    raw.want_uvs = uvs;
     for el in &header.elements {
-        let role = role(name, el)?;
+        let role = match role(name, el)? {
+            Role::Vertex(ix, _) if !uvs => Role::Vertex(ix, None),
+            Role::Face(ix, _) if !uvs => Role::Face(ix, None),
+            r => r,
+        };
         if el.props.is_empty() {
             if el.count > 0 {
                 return Err(el.line.at(
@@ -676,7 +692,7 @@ fn read_instance<V: Values>(
                     }
                     for k in (0..2).filter(|&k| uv_ix.is_some_and(|t| t[k] == p)) {
                         if !v.is_finite() {
-                            return Err(src.at_last(
+                            raw.uv_problem(src.at_last(
                                 name,
                                 format!("vertex {i} has a non-finite texture coordinate"),
                             ));
@@ -711,7 +727,7 @@ fn read_instance<V: Values>(
                     }
                     if texture {
                         if !v.is_finite() {
-                            return Err(src.at_last(
+                            raw.uv_problem(src.at_last(
                                 name,
                                 format!("face {i} has a non-finite texture coordinate"),
                             ));
@@ -732,8 +748,10 @@ fn read_instance<V: Values>(
         Role::Face(_, None) => raw.end_face(face_at.0, face_at.1.saturating_add(1)),
         Role::Face(_, Some(_)) => {
             let corners = raw.indices.len() - raw.face_start();
-            if texcoords.len() != 2 * corners {
-                return Err(src.at_last(
+            if texcoords.len() == 2 * corners {
+                raw.push_face_uvs(texcoords.chunks_exact(2).map(|t| DVec2::new(t[0], t[1])));
+            } else {
+                raw.uv_problem(src.at_last(
                     name,
                     format!(
                         "face {i} has {corners} corners but {} texture coordinate values: \
@@ -742,7 +760,6 @@ fn read_instance<V: Values>(
                     ),
                 ));
             }
-            raw.push_face_uvs(texcoords.chunks_exact(2).map(|t| DVec2::new(t[0], t[1])));
             raw.end_face(face_at.0, face_at.1.saturating_add(1));
         }
         Role::Edge(_) => {

@@ -34,6 +34,23 @@ pub(super) struct Raw {
     /// A texture coordinate per vertex (PLY `u v`), used where the faces
     /// give none of their own.
     pub(super) vertex_uvs: Vec<DVec2>,
+    /// Texture coordinates are read only when asked for: a reader that
+    /// wants none reads a file as it always has.
+    pub(super) want_uvs: bool,
+    /// The first problem with the texture coordinates (a `vt` line that is
+    /// not two numbers, a corner's index out of range, a face without
+    /// them where others have them): they are dropped with a warning,
+    /// since the mesh itself is good.
+    pub(super) uv_problem: Option<MeshFileError>,
+}
+
+/// What a read gave of a file's texture coordinates: the coordinates,
+/// or a warning that they were dropped and why (`path:line:col: warning:
+/// ...` with the line and a caret), or neither.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct UvRead {
+    pub uvs: Option<FaceUvs>,
+    pub warning: Option<String>,
 }
 
 /// A corner without a texture coordinate.
@@ -54,7 +71,14 @@ impl Raw {
             uv_values: Vec::new(),
             uv_indices: Vec::new(),
             vertex_uvs: Vec::new(),
+            want_uvs: false,
+            uv_problem: None,
         }
+    }
+
+    /// Keeps the first problem with the texture coordinates.
+    pub(super) fn uv_problem(&mut self, e: MeshFileError) {
+        self.uv_problem.get_or_insert(e);
     }
 
     /// Where the face being read starts in `indices`.
@@ -124,14 +148,19 @@ impl Raw {
     }
 
     /// [`Raw::finish`], and the texture coordinates of the faces' corners
-    /// where the file gives them: every corner of every face has one, or
-    /// the file is refused at the first face that lacks one.
+    /// where the reader asked for them (`want_uvs`) and the file gives
+    /// them: every corner of every face has one, else they are dropped
+    /// with a warning that points at the first face without.
     pub(super) fn finish_with_uvs(
         mut self,
         name: &str,
         source: Option<Source>,
-    ) -> Result<(PolygonSoup, Option<FaceUvs>), MeshFileError> {
-        let uvs = self.take_uvs(name, source)?;
+    ) -> Result<(PolygonSoup, UvRead), MeshFileError> {
+        let uvs = if self.want_uvs {
+            self.take_uvs(name, source)
+        } else {
+            UvRead::default()
+        };
         if let Some(v) = self.positions.iter().position(|p| !p.is_finite()) {
             let line = self.vertex_lines[v];
             let located = source.and_then(|s| s.line(line));
@@ -158,15 +187,24 @@ impl Raw {
     }
 
     /// The corners' texture coordinates, when some corner has one: each
-    /// face's own (`uv_indices`), else each vertex's (`vertex_uvs`).
-    fn take_uvs(
-        &mut self,
-        name: &str,
-        source: Option<Source>,
-    ) -> Result<Option<FaceUvs>, MeshFileError> {
+    /// face's own (`uv_indices`), else each vertex's (`vertex_uvs`); a
+    /// warning instead where they are not whole.
+    fn take_uvs(&mut self, name: &str, source: Option<Source>) -> UvRead {
+        let dropped = |e: MeshFileError| {
+            UvRead {
+            uvs: None,
+            warning: Some(format!(
+                "{}\n(the texture coordinates are not used; `--no-uvs` says so without this warning)",
+                e.to_string().replacen(": error: ", ": warning: ", 1)
+            )),
+        }
+        };
+        if let Some(e) = self.uv_problem.take() {
+            return dropped(e);
+        }
         if self.uv_indices.is_empty() {
             if self.vertex_uvs.is_empty() {
-                return Ok(None);
+                return UvRead::default();
             }
             // One per vertex: a corner's is its vertex's (its range is
             // checked with the face).
@@ -174,10 +212,13 @@ impl Raw {
                 .indices
                 .iter()
                 .map(|&i| i.clamp(0, u32::MAX as i64) as u32);
-            return Ok(Some(FaceUvs {
-                corners: corners.collect(),
-                values: std::mem::take(&mut self.vertex_uvs),
-            }));
+            return UvRead {
+                uvs: Some(FaceUvs {
+                    corners: corners.collect(),
+                    values: std::mem::take(&mut self.vertex_uvs),
+                }),
+                warning: None,
+            };
         }
         self.uv_indices.resize(self.indices.len(), NO_UV);
         if let Some(k) = self.uv_indices.iter().position(|&t| t == NO_UV) {
@@ -189,16 +230,19 @@ impl Raw {
                 f as i64 + self.base,
                 k - self.starts[f] + 1
             );
-            return Err(match source.and_then(|s| s.line(line)) {
+            return dropped(match source.and_then(|s| s.line(line)) {
                 Some(l) => l.whole(name, message),
                 None => error(name, known(line), message),
             });
         }
         let corners = self.uv_indices.iter().map(|&t| t as u32).collect();
-        Ok(Some(FaceUvs {
-            values: std::mem::take(&mut self.uv_values),
-            corners,
-        }))
+        UvRead {
+            uvs: Some(FaceUvs {
+                values: std::mem::take(&mut self.uv_values),
+                corners,
+            }),
+            warning: None,
+        }
     }
 
     /// Face `f` with at least three distinct, in-range vertices.

@@ -5,7 +5,9 @@ use std::io::Read;
 use std::path::Path;
 
 use crate::mesh::halfedge::Mesh;
-use crate::mesh::soup::{FaceUvs, MeshFileError, PolygonSoup};
+use crate::mesh::soup::{MeshFileError, PolygonSoup};
+
+use super::raw::UvRead;
 
 use super::creases::{apply_sharpness, read_creases, CREASES_EXTENSION};
 use super::text::{error, utf8, Source};
@@ -48,9 +50,10 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, MeshFileError> {
 
 /// Reads the mesh file at `path` as [`read_mesh`] does, and the texture
 /// coordinates of its faces' corners where it has them (OBJ `vt` with `f
-/// v/vt`; PLY a face's `texcoord` list or a vertex's `u v`); also the
-/// soup the mesh was built from, whose faces the coordinates follow.
-pub fn read_with_uvs(path: &Path) -> Result<(Mesh, PolygonSoup, Option<FaceUvs>), MeshFileError> {
+/// v/vt`; PLY a face's `texcoord` list or a vertex's `u v`), or a warning
+/// that they are not whole and are dropped; also the soup the mesh was
+/// built from, whose faces the coordinates follow.
+pub fn read_with_uvs(path: &Path) -> Result<(Mesh, PolygonSoup, UvRead), MeshFileError> {
     let name = path.display().to_string();
     let format = format_of(&name, path)?;
     let limit = max_file_bytes().map_err(|m| error(&name, None, m))?;
@@ -61,7 +64,7 @@ pub fn read_with_uvs(path: &Path) -> Result<(Mesh, PolygonSoup, Option<FaceUvs>)
             let (soup, uvs) = obj::parse_with_uvs(&name, &bytes)?;
             (soup, Vec::new(), uvs)
         }
-        Format::Off => (off::parse(&name, &bytes)?, Vec::new(), None),
+        Format::Off => (off::parse(&name, &bytes)?, Vec::new(), UvRead::default()),
     };
     drop(bytes);
     let mesh = finish_mesh(path, &name, &soup, &marks, limit)?;
