@@ -342,10 +342,7 @@ fn curve_frames(
 ) -> Result<Frames, Error> {
     let (selection, interval, each_fitted, notes) = curve_selection(c, opts);
     let model = c.model();
-    let model_background = model.colours.as_ref().map(|m| {
-        let [r, g, b] = m.background();
-        Rgba(r, g, b, 255)
-    });
+    let model_background = model.background().map(|[r, g, b]| Rgba(r, g, b, 255));
     let background = opts
         .background
         .or(model_background)

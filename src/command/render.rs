@@ -426,10 +426,7 @@ fn render_system(
             let palette = model
                 .palette()
                 .map(|p| std::sync::Arc::new(p.map(|[r, g, b]| Rgba(r, g, b, 255))));
-            let model_background = model.colours.as_ref().map(|m| {
-                let [r, g, b] = m.background();
-                Rgba(r, g, b, 255)
-            });
+            let model_background = model.background().map(|[r, g, b]| Rgba(r, g, b, 255));
             let figure = FigureOptions {
                 derive: opts.derive_options(),
                 each: a.each,
@@ -607,10 +604,7 @@ pub(super) fn solid_raster_options(
         camera.up = Some(y_up(u));
     }
     let mut ropts = camera.raster_options(&model.lights, scene.bounds(), w, h)?;
-    let model_background = model.colours.as_ref().map(|m| {
-        let [r, g, b] = m.background();
-        Rgba(r, g, b, 255)
-    });
+    let model_background = model.background().map(|[r, g, b]| Rgba(r, g, b, 255));
     ropts.background = a
         .background
         .or(model_background)

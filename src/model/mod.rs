@@ -42,8 +42,32 @@ impl Model {
     /// The 256 colours that colour indices choose, when the model has a
     /// colour map or materials.
     pub fn palette(&self) -> Option<[[u8; 3]; 256]> {
-        let c = self.colours.as_ref()?;
-        Some(std::array::from_fn(|i| c.colour(i as i64, &self.lights)))
+        match &self.colours {
+            Some(c) => Some(std::array::from_fn(|i| c.colour(i as i64, &self.lights))),
+            None if self.lpfg => Some(std::array::from_fn(|i| lpfg_default_colour(i as i64))),
+            None => None,
+        }
+    }
+
+    /// The background its colours give: colour 0 of the map (material 0's
+    /// emission), or black for an lpfg program without a colour file, as
+    /// lpfg draws it; `None` for subgram's own files without one.
+    pub fn background(&self) -> Option<[u8; 3]> {
+        match &self.colours {
+            Some(c) => Some(c.background()),
+            None if self.lpfg => Some(lpfg_default_colour(0)),
+            None => None,
+        }
+    }
+}
+
+/// lpfg's colour map when a model has no colour file: index 0 black,
+/// every other one white (so lpfg draws white on black).
+pub fn lpfg_default_colour(i: i64) -> [u8; 3] {
+    if i.rem_euclid(256) == 0 {
+        [0, 0, 0]
+    } else {
+        [255, 255, 255]
     }
 }
 
@@ -82,6 +106,10 @@ pub struct Model {
     /// Surfaces, numbered from 0 in the view file's order.
     pub surfaces: Vec<Surface>,
     pub colours: Option<Colours>,
+    /// Read as an lpfg program's model ([`Model::read`]: a `.l` file or a
+    /// model folder), whose colours default to lpfg's own
+    /// ([`lpfg_default_colour`]) where no colour file gives them.
+    pub lpfg: bool,
     /// The view file's `line style:` makes widths the model's units.
     pub widths_in_units: bool,
     /// The view file's `line style:`.
@@ -285,6 +313,7 @@ impl Model {
     pub fn read(files: &[PathBuf]) -> Result<Model, Error> {
         let mut m = Model {
             contours: vec![Contour::default_circle()],
+            lpfg: true,
             ..Model::default()
         };
         let by = |k: &'static str| files.iter().filter(move |p| ext(p) == k);

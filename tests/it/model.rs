@@ -555,3 +555,67 @@ fn a_program_without_lpfgall_is_run_with_a_warning() {
     let out = subgram::command::check(&tmp.display().to_string(), &[], false).unwrap();
     assert!(!out.contains("lpfgall"), "{out}");
 }
+
+/// The RGB pixels of a PNG file.
+fn rgb_pixels(path: &Path) -> Vec<[u8; 3]> {
+    let d = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut r = d.read_info().unwrap();
+    let mut buf = vec![0; r.output_buffer_size()];
+    let info = r.next_frame(&mut buf).unwrap();
+    let step = info.color_type.samples();
+    buf[..info.buffer_size()]
+        .chunks(step)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect()
+}
+
+/// Without a colour file lpfg uses its own map, index 0 black (the
+/// background) and every other index white (vlab's lpfg, colormap.h; its
+/// picture of the corpus's 03-snowflake is white lines on black): an
+/// lpfg program (`.l`) is drawn so. subgram's own files keep their white
+/// page and palette.
+#[test]
+fn an_lpfg_program_without_a_colour_file_is_white_on_black() {
+    let dir = scratch("lpfg-colours");
+    let text = "#include <lpfgall.h>\nderivation length: 2;\nAxiom: F(1);\n\
+                F(v) : { produce F(v) Left(60) F(v) Right(120) F(v) Left(60) F(v); }\n";
+    for (name, background, ink) in [
+        ("koch.l", [0u8, 0, 0], [255u8, 255, 255]),
+        ("koch.lsys", [255, 255, 255], [24, 24, 24]),
+    ] {
+        let program = dir.path().join(name);
+        std::fs::write(&program, text).unwrap();
+        let png = dir.path().join(format!("{name}.png"));
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+            .args([
+                "render",
+                program.to_str().unwrap(),
+                "-o",
+                png.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let pixels = rgb_pixels(&png);
+        assert_eq!(pixels[0], background, "{name}: the corner");
+        let near = |p: [u8; 3], c: [u8; 3]| (i32::from(p[0]) - i32::from(c[0])).abs() < 64;
+        let inked = pixels.iter().filter(|&&p| near(p, ink)).count();
+        assert!(
+            inked > 200,
+            "{name}: {inked} pixels near the line's colour {ink:?}"
+        );
+        assert!(
+            pixels.contains(&ink),
+            "{name}: no pixel of the line's colour {ink:?}"
+        );
+        // Antialiased lines: only greys between the two.
+        assert!(
+            pixels.iter().all(|p| p[0] == p[1] && p[1] == p[2]),
+            "{name}"
+        );
+    }
+}

@@ -336,6 +336,11 @@ impl<'m> Builder<'m> {
                     opacity: 1.0 - m.transparency as f32 / 255.0,
                 }
             }
+            None if self.model.lpfg => Look::colour(
+                format!("colour{k}"),
+                i,
+                crate::model::lpfg_default_colour(i),
+            ),
             None => {
                 let c = crate::colour::palette(i);
                 Look::colour(format!("colour{k}"), i, [c.0, c.1, c.2])
