@@ -19,6 +19,7 @@
 pub mod curve;
 pub mod limit;
 mod num;
+pub mod star;
 pub mod surface;
 mod text;
 
