@@ -83,6 +83,13 @@ pub fn star_stencils(
             "a dual or adaptive grammar has no stencils around a vertex".into(),
         ));
     }
+    if star.is_corner() && star.sides().len() == 1 && !star.open {
+        return Ok(Err(
+            "a sharp vertex with fewer than two sharp edges is the tip of a cone: it has no \
+             tangent plane"
+                .into(),
+        ));
+    }
     let quads = g.block_used_at.is_some();
     let f = star_fan(star, quads, FAN_RINGS, false);
     let (_, _, hoods, measured) = match measure(g, &f, false, deadline, deadline)? {
@@ -96,7 +103,9 @@ pub fn star_stencils(
     let Some(eig) = spectrum(&s) else {
         return Ok(Err("the eigenvalues did not converge".into()));
     };
-    let simple_one = eig.first().is_some_and(|l| close(l.re, 1.0) && close(l.im, 0.0))
+    let simple_one = eig
+        .first()
+        .is_some_and(|l| close(l.re, 1.0) && close(l.im, 0.0))
         && eig.get(1).is_none_or(|l| l.modulus < 1.0 - 1e-7);
     let limit = match left_null(&s, 1.0, 1).pop() {
         Some(w) if simple_one && w.iter().sum::<f64>().abs() > TOL => {
@@ -211,9 +220,7 @@ fn side(
     // The side's places must be invariant: their new positions read no
     // place of another side.
     for &r in &idx {
-        if let Some(c) =
-            (0..places.len()).find(|&c| at[c].is_none() && s[(r, c)].abs() > TOL)
-        {
+        if let Some(c) = (0..places.len()).find(|&c| at[c].is_none() && s[(r, c)].abs() > TOL) {
             let (a, b) = (places[r], places[c]);
             return Err(format!(
                 "the new vertex at ({}, {}, {}) reads the old one at ({}, {}, {}), across a \
@@ -223,9 +230,8 @@ fn side(
         }
     }
     let m = sub(s, &idx, &idx);
-    let local = |p: At| -> Vec<usize> {
-        (0..idx.len()).filter(|&a| at[idx[a]] == Some(p)).collect()
-    };
+    let local =
+        |p: At| -> Vec<usize> { (0..idx.len()).filter(|&a| at[idx[a]] == Some(p)).collect() };
     let (centre, start, end, inside) = (
         local(At::Centre),
         local(At::Start),

@@ -58,7 +58,8 @@ mod write;
 pub use creases::CREASES_EXTENSION;
 pub use read::{mentions_uvs, read, read_mesh, read_str, read_with_uvs};
 pub use write::{
-    to_bytes, write, write_mesh, write_with_attributes, write_with_normals, write_with_sharpness,
+    to_bytes, write, write_mesh, write_with_attributes, write_with_corner_normals,
+    write_with_normals, write_with_sharpness,
 };
 
 use text::error;
