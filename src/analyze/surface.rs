@@ -338,7 +338,7 @@ impl Fan {
     }
 }
 
-/// The vertex a fan is built around for [`star_stencils`]: `n` faces
+/// The vertex a fan is built around for [`super::star::star_stencils`]: `n` faces
 /// around it, the last one next to the first unless `open` (a boundary
 /// vertex: edges 0 and n are boundary edges); its edges `sharp` (indices
 /// 0..n, edge t between sectors t - 1 and t, sharp for ever), and whether

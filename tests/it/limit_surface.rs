@@ -293,8 +293,8 @@ fn fine_sides(fine: &PolygonSoup, sharp: &HashSet<(u32, u32)>, q: DVec3) -> Vec<
         }
     }
     let mut sums: HashMap<usize, DVec3> = HashMap::new();
-    for i in 0..around.len() {
-        *sums.entry(root(&mut group, i)).or_default() += around[i].0;
+    for (i, (a, _)) in around.iter().enumerate() {
+        *sums.entry(root(&mut group, i)).or_default() += *a;
     }
     sums.values().map(|n| n.normalize()).collect()
 }

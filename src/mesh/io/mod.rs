@@ -25,7 +25,7 @@
 //!   of one by extension;
 //! - `read`: [`read`], [`read_mesh`] and [`read_str`], and reading a
 //!   file's bytes within the limit;
-//! - `write`: [`write()`], [`write_with_sharpness`], [`write_mesh`] and
+//! - `write`: [`write()`], [`write_with_sharpness`], [`write_with_corner_normals`], [`write_mesh`] and
 //!   [`to_bytes`], and what the writers of every format read (a soup, or
 //!   a mesh's triangles in place);
 //! - `text`: what the readers share: errors placed on a line and a word,
