@@ -9,7 +9,8 @@
 //! Hölder estimate. Surfaces ([`surface`]): the local subdivision matrix
 //! around a vertex of each valence (around an n-sided face for dual
 //! schemes), its leading eigenvalues, Reif's check and the limit and
-//! tangent stencils. A dual scheme's centres of blocks, which its rules
+//! tangent stencils; [`star`] the same around boundary, crease and corner
+//! vertices, side by side. A dual scheme's centres of blocks, which its rules
 //! may read, are put at their polygons' centroids with each impulse.
 //!
 //! **Layer.** It uses `curve`, `deadline`, `error`, `lang`, `load`, `mesh`,
@@ -19,6 +20,7 @@
 pub mod curve;
 pub mod limit;
 mod num;
+pub mod star;
 pub mod surface;
 mod text;
 

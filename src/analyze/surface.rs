@@ -53,7 +53,7 @@ pub const FAN_RINGS: usize = 3;
 pub const MAX_RINGS: usize = 2;
 /// Eigenvalues listed per valence.
 pub const LISTED: usize = 6;
-const TOL: f64 = 1e-9;
+pub(super) const TOL: f64 = 1e-9;
 /// The time the valences of one grammar may take together; valences not
 /// reached in it are skipped with a note.
 pub const BUDGET: std::time::Duration = std::time::Duration::from_secs(60);
@@ -165,10 +165,10 @@ pub struct LabelWeight {
 /// next sector's. The centre is (0, 0, 0); a place on the edge between
 /// sectors t - 1 and t is `(t, x, 0)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Label {
-    t: usize,
-    x: f64,
-    y: f64,
+pub(super) struct Label {
+    pub(super) t: usize,
+    pub(super) x: f64,
+    pub(super) y: f64,
 }
 
 const CENTRE: Label = Label {
@@ -306,31 +306,139 @@ impl Lattice {
 }
 
 /// A fan of `n` sectors around one vertex, and for dual schemes its
-/// mirror glued along the rim (whose vertices have no label).
-struct Fan {
-    soup: PolygonSoup,
+/// mirror glued along the rim (whose vertices have no label); or the fan
+/// of a [`Star`]: open (a boundary vertex) or with sharp edges.
+pub(super) struct Fan {
+    pub(super) soup: PolygonSoup,
     labels: Vec<Option<Label>>,
     lattice: Lattice,
+    /// Edges made sharp for ever (soup vertices), and whether the centre
+    /// is a sharp vertex.
+    sharp: Vec<(u32, u32)>,
+    sharp_centre: bool,
 }
 
+impl Fan {
+    /// The mesh of `soup` (the fan's, or the fan's with other positions)
+    /// with the fan's sharpness.
+    fn mesh(&self, soup: &PolygonSoup) -> Result<Mesh, String> {
+        let mut m = Mesh::from_soup(soup).map_err(|e| e.to_string())?;
+        for &(a, b) in &self.sharp {
+            let h = m
+                .find_halfedge(VertexId(a), VertexId(b))
+                .ok_or("a sharp edge of the fan is missing")?;
+            m.set_edge_sharpness(h.edge(), f64::INFINITY)
+                .map_err(|e| e.to_string())?;
+        }
+        if self.sharp_centre {
+            m.set_vertex_sharpness(VertexId(0), f64::INFINITY)
+                .map_err(|e| e.to_string())?;
+        }
+        Ok(m)
+    }
+}
+
+/// The vertex a fan is built around for [`super::star::star_stencils`]: `n` faces
+/// around it, the last one next to the first unless `open` (a boundary
+/// vertex: edges 0 and n are boundary edges); its edges `sharp` (indices
+/// 0..n, edge t between sectors t - 1 and t, sharp for ever), and whether
+/// it is a sharp vertex (`corner`).
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Star {
+    pub n: usize,
+    pub open: bool,
+    pub sharp: Vec<usize>,
+    pub corner: bool,
+}
+
+impl Star {
+    /// The edges that part the fan into sides: the boundary's and the
+    /// sharp ones on an open fan; the sharp ones where there are two or
+    /// more on a closed one; none else (one side all round).
+    fn parting(&self) -> Vec<usize> {
+        if self.open {
+            let mut e = vec![0];
+            e.extend(self.sharp.iter().copied().filter(|&t| t > 0 && t < self.n));
+            e.push(self.n);
+            e
+        } else if self.sharp.len() >= 2 {
+            self.sharp.clone()
+        } else {
+            Vec::new()
+        }
+    }
+
+    /// True where the vertex stays (the grammars' corner rule): a sharp
+    /// vertex, three or more sharp edges, or a sharp edge that meets the
+    /// boundary.
+    pub fn is_corner(&self) -> bool {
+        self.corner
+            || if self.open {
+                self.sharp.iter().any(|&t| t > 0 && t < self.n)
+            } else {
+                self.sharp.len() >= 3
+            }
+    }
+
+    /// The sides: (first sector, number of sectors), in order.
+    pub fn sides(&self) -> Vec<(usize, usize)> {
+        let e = self.parting();
+        if e.is_empty() {
+            return vec![(0, self.n)];
+        }
+        if self.open {
+            return e.windows(2).map(|w| (w[0], w[1] - w[0])).collect();
+        }
+        (0..e.len())
+            .map(|k| {
+                let (a, b) = (e[k], e[(k + 1) % e.len()]);
+                (a, (b + self.n - a - 1) % self.n + 1)
+            })
+            .collect()
+    }
+}
+
+/// The fan of a smooth interior vertex of valence `n` (or, `closed`, the
+/// closed probe of a dual scheme).
 fn fan(n: usize, quads: bool, rings: usize, closed: bool) -> Fan {
+    let star = Star {
+        n,
+        open: false,
+        sharp: Vec::new(),
+        corner: false,
+    };
+    star_fan(&star, quads, rings, closed)
+}
+
+/// The fan of `star`: on an open star the sectors span less than half a
+/// turn, and the lattice's sectors do not wrap round (its `k` is larger
+/// than the fan's).
+pub(super) fn star_fan(star: &Star, quads: bool, rings: usize, closed: bool) -> Fan {
+    let n = star.n;
+    let (k, step) = if star.open {
+        (n + 2, std::f64::consts::PI / (n + 1) as f64)
+    } else {
+        (n, TAU / n as f64)
+    };
     let u = |t: usize| {
-        let a = TAU * (t % n) as f64 / n as f64;
+        let a = step * t as f64;
         DVec2::new(a.cos(), a.sin())
     };
-    let lattice = Lattice { k: n, quads };
+    let lattice = Lattice { k, quads };
     let mut ids: HashMap<(usize, usize, usize), u32> = HashMap::new();
     let mut f = Fan {
         soup: PolygonSoup::default(),
         labels: Vec::new(),
         lattice,
+        sharp: Vec::new(),
+        sharp_centre: star.corner,
     };
     let mut rim = Vec::new();
     let mut id = |f: &mut Fan, t: usize, i: usize, j: usize| -> u32 {
         let key = match (i, j) {
             (0, 0) => (0, 0, 0),
-            (0, _) => ((t + 1) % n, j, 0),
-            _ => (t % n, i, j),
+            (0, _) => ((t + 1) % k, j, 0),
+            _ => (t % k, i, j),
         };
         *ids.entry(key).or_insert_with(|| {
             let p = i as f64 * u(t) + j as f64 * u(t + 1);
@@ -377,6 +485,15 @@ fn fan(n: usize, quads: bool, rings: usize, closed: bool) -> Fan {
                     }
                 }
             }
+        }
+    }
+    // Sharp edges all the way to the rim, so that the vertices on them
+    // are crease vertices.
+    for &e in &star.sharp {
+        for j in 0..rings {
+            let a = id(&mut f, e, j, 0);
+            let b = id(&mut f, e, j + 1, 0);
+            f.sharp.push((a, b));
         }
     }
     if closed {
@@ -473,8 +590,8 @@ fn name_generation(
 
 /// A measured map: the old vertices (columns: their place), the new ones
 /// (rows: their place) and the matrix between them.
-struct Measured {
-    cols: Vec<Label>,
+pub(super) struct Measured {
+    pub(super) cols: Vec<Label>,
     rows: Vec<Option<Label>>,
     full: DMatrix<f64>,
     /// The old mesh's edges between columns.
@@ -508,11 +625,12 @@ fn start_error(e: crate::surface::RunError) -> String {
 /// in id order.
 fn run_primal(
     g: &Grammar,
+    f: &Fan,
     soup: &PolygonSoup,
     steps: usize,
     deadline: Deadline,
 ) -> Result<Vec<DVec3>, String> {
-    let mut m = Mesh::from_soup(soup).map_err(|e| e.to_string())?;
+    let mut m = f.mesh(soup)?;
     g.run_until(&mut m, steps, Some(deadline), |_| {})
         .map_err(start_error)?;
     Ok(m.vertices().map(|v| m.position(v)).collect())
@@ -532,7 +650,7 @@ fn measure_primal(
 ) -> Result<Measured, String> {
     let fan_vertices = f.soup.positions.len();
     // The names, step by step on one run.
-    let mut m = Mesh::from_soup(&f.soup).map_err(|e| e.to_string())?;
+    let mut m = f.mesh(&f.soup)?;
     let mut names: Vec<Option<Label>> = f.labels.clone();
     {
         let mut run = g.start(&mut m).map_err(start_error)?;
@@ -562,7 +680,7 @@ fn measure_primal(
             deadline.check()?;
             let mut soup = f.soup.clone();
             soup.positions[c].z = 1.0;
-            run_primal(g, &soup, steps, deadline)
+            run_primal(g, f, &soup, steps, deadline)
         })
         .collect::<Result<_, String>>()?;
     let mut s = DMatrix::zeros(base.len(), cols.len());
@@ -707,7 +825,7 @@ fn impulse_dual(
 
 /// A local matrix, its columns (indices into `Measured::cols`) and its
 /// ring count.
-type Hood = (DMatrix<f64>, Vec<usize>, usize);
+pub(super) type Hood = (DMatrix<f64>, Vec<usize>, usize);
 
 /// The local matrices in the invariant neighbourhoods of at most
 /// [`MAX_RINGS`] rings, smallest first, with their columns and ring
@@ -755,7 +873,7 @@ fn local(m: &Measured, lattice: Lattice, scale: usize, dual: bool) -> Option<Vec
 }
 
 /// The eigenvalues of `s`, largest modulus first.
-fn spectrum(s: &DMatrix<f64>) -> Option<Vec<Eigenvalue>> {
+pub(super) fn spectrum(s: &DMatrix<f64>) -> Option<Vec<Eigenvalue>> {
     let mut eig: Vec<Eigenvalue> = eigenvalues(s)?
         .iter()
         .map(|c| Eigenvalue {
@@ -768,7 +886,7 @@ fn spectrum(s: &DMatrix<f64>) -> Option<Vec<Eigenvalue>> {
     Some(eig)
 }
 
-fn close(a: f64, b: f64) -> bool {
+pub(super) fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-7
 }
 
@@ -843,7 +961,7 @@ fn characteristic(s: &DMatrix<f64>, set: &[usize], m: &Measured) -> Option<Chara
 }
 
 /// The left null vectors of `s - λ I` (as many as `count`), from the SVD.
-fn left_null(s: &DMatrix<f64>, lambda: f64, count: usize) -> Vec<Vec<f64>> {
+pub(super) fn left_null(s: &DMatrix<f64>, lambda: f64, count: usize) -> Vec<Vec<f64>> {
     let n = s.nrows();
     let a = s.transpose() - DMatrix::identity(n, n) * lambda;
     let svd = a.svd(false, true);
@@ -859,7 +977,7 @@ fn left_null(s: &DMatrix<f64>, lambda: f64, count: usize) -> Vec<Vec<f64>> {
         .collect()
 }
 
-fn label_weights(cols: &[Label], set: &[usize], v: &[f64]) -> Vec<LabelWeight> {
+pub(super) fn label_weights(cols: &[Label], set: &[usize], v: &[f64]) -> Vec<LabelWeight> {
     set.iter()
         .zip(v)
         .map(|(&c, &w)| {
@@ -873,6 +991,62 @@ fn label_weights(cols: &[Label], set: &[usize], v: &[f64]) -> Vec<LabelWeight> {
             }
         })
         .collect()
+}
+
+/// What [`measure`] finds: the steps and the scale of the measured map,
+/// its invariant neighbourhoods (smallest first) and the map itself.
+pub(super) type Found = (usize, usize, Vec<Hood>, Measured);
+
+/// One or two steps of `g` measured on the fan `f` by impulses, and the
+/// invariant neighbourhoods in it; `Ok(Err(why))` where there is none.
+pub(super) fn measure(
+    g: &Grammar,
+    f: &Fan,
+    dual: bool,
+    deadline: Deadline,
+    budget: Deadline,
+) -> Result<Result<Found, String>, Error> {
+    let mut why = String::new();
+    let limit = if budget.limit() < deadline.limit() {
+        budget
+    } else {
+        deadline
+    };
+    let tries: &[usize] = if dual { &[1] } else { &[1, 2] };
+    for &steps in tries {
+        let measured = if dual {
+            measure_dual(g, f, limit)
+        } else {
+            measure_primal(g, f, steps, limit)
+        };
+        match measured {
+            Ok(m) => {
+                if let Some((scale, hoods)) = [2, 3]
+                    .iter()
+                    .find_map(|&scale| Some((scale, local(&m, f.lattice, scale, dual)?)))
+                {
+                    return Ok(Ok((steps, scale, hoods, m)));
+                }
+                why = format!(
+                    "no invariant neighbourhood of at most {MAX_RINGS} rings whose new vertices \
+                     stand at a half or a third of the spacing after {}",
+                    if dual { "one step" } else { "one or two steps" }
+                );
+            }
+            Err(e) => {
+                if deadline.passed() {
+                    return Err(Error::Failed(deadline.message()));
+                }
+                if budget.passed() {
+                    why = format!("not measured within the budget of {} s", BUDGET.as_secs());
+                    break;
+                }
+                why = format!("the grammar does not run on this fan: {e}");
+                break;
+            }
+        }
+    }
+    Ok(Err(why))
 }
 
 fn valence(
@@ -901,51 +1075,12 @@ fn valence(
         wider: None,
         characteristic: None,
     };
-    let mut why = String::new();
-    let mut found = None;
-    let limit = if budget.limit() < deadline.limit() {
-        budget
-    } else {
-        deadline
-    };
-    let tries: &[usize] = if dual { &[1] } else { &[1, 2] };
-    for &steps in tries {
-        let measured = if dual {
-            measure_dual(g, &f, limit)
-        } else {
-            measure_primal(g, &f, steps, limit)
-        };
-        match measured {
-            Ok(m) => {
-                if let Some(l) = [2, 3]
-                    .iter()
-                    .find_map(|&scale| Some((scale, local(&m, f.lattice, scale, dual)?)))
-                {
-                    found = Some((steps, l, m));
-                    break;
-                }
-                why = format!(
-                    "no invariant neighbourhood of at most {MAX_RINGS} rings whose new vertices \
-                     stand at a half or a third of the spacing after {}",
-                    if dual { "one step" } else { "one or two steps" }
-                );
-            }
-            Err(e) => {
-                if deadline.passed() {
-                    return Err(Error::Failed(deadline.message()));
-                }
-                if budget.passed() {
-                    why = format!("not measured within the budget of {} s", BUDGET.as_secs());
-                    break;
-                }
-                why = format!("the grammar does not run on this fan: {e}");
-                break;
-            }
+    let (steps, scale, mut hoods, measured) = match measure(g, &f, dual, deadline, budget)? {
+        Ok(found) => found,
+        Err(why) => {
+            v.skipped = Some(why);
+            return Ok(v);
         }
-    }
-    let Some((steps, (scale, mut hoods), measured)) = found else {
-        v.skipped = Some(why);
-        return Ok(v);
     };
     let wider = (hoods.len() > 1).then(|| hoods.remove(1));
     let (s, set, rings) = hoods.swap_remove(0);

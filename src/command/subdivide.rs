@@ -265,26 +265,21 @@ fn dropped_uvs(base: Option<PathBuf>, output: &Path, no_uvs: bool, why: &str) ->
 }
 
 /// `--limit`: the run's mesh at its limit positions, written with its
-/// limit normals where the format keeps them (a picture is drawn from the
-/// positions; OFF and glTF get a warning that the normals are not in
-/// them).
+/// limit normals where the format keeps them: OBJ a normal per face
+/// corner (`v//n`; the corners of a vertex on a crease or at a corner
+/// take their side's), PLY one per vertex (there the mean of the sides',
+/// and a warning says so). A picture is drawn from the positions; OFF and
+/// glTF get a warning that the normals are not in them.
 fn write_limit(
     g: &crate::surface::Grammar,
     m: &crate::mesh::Mesh,
     output: &Path,
     looks: &MeshLooks,
 ) -> Result<Vec<String>, Error> {
-    if m.has_sharpness() {
-        return Err(Error::Failed(
-            "--limit: the mesh still has creases after the run; limit positions and normals \
-             are computed for smooth interior vertices only (the stencils `analyze` measures)"
-                .into(),
-        ));
-    }
     let mut soup = m.to_quad_soup();
     let deadline = crate::deadline::current()
         .unwrap_or_else(|| crate::Deadline::after(crate::analyze::TIMEOUT));
-    let limit = crate::analyze::limit::limit_surface(g, &soup, deadline)?;
+    let limit = crate::analyze::limit::limit_surface(g, m, deadline)?;
     soup.positions = limit.positions;
     if Picture::from_path(output).is_ok() {
         return write_soup_picture(&soup, output, looks, &mut Out::Files).map(|()| Vec::new());
@@ -296,9 +291,25 @@ fn write_limit(
     if is_glb(output) {
         return write_soup_glb(&soup, &[], output).map(|()| vec![dropped]);
     }
-    mesh::io::write_with_normals(output, &soup, &limit.normals)?;
-    Ok(match mesh::io::Format::from_path(output) {
+    let format = mesh::io::Format::from_path(output);
+    if format == Some(mesh::io::Format::Obj) {
+        mesh::io::write_with_corner_normals(
+            output,
+            &soup,
+            &limit.normal_values,
+            &limit.corner_normals,
+        )?;
+    } else {
+        mesh::io::write_with_normals(output, &soup, &limit.normals)?;
+    }
+    let two_sided = limit.normal_values.len() > limit.normals.len();
+    Ok(match format {
         Some(mesh::io::Format::Off) => vec![dropped],
+        Some(mesh::io::Format::Ply) if two_sided => vec![format!(
+            "{}: warning: PLY keeps one normal a vertex: a vertex on a crease or at a corner \
+             gets the mean of its sides' limit normals (OBJ keeps each side's)",
+            output.display()
+        )],
         _ => Vec::new(),
     })
 }

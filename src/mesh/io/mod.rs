@@ -25,7 +25,7 @@
 //!   of one by extension;
 //! - `read`: [`read`], [`read_mesh`] and [`read_str`], and reading a
 //!   file's bytes within the limit;
-//! - `write`: [`write()`], [`write_with_sharpness`], [`write_mesh`] and
+//! - `write`: [`write()`], [`write_with_sharpness`], [`write_with_corner_normals`], [`write_mesh`] and
 //!   [`to_bytes`], and what the writers of every format read (a soup, or
 //!   a mesh's triangles in place);
 //! - `text`: what the readers share: errors placed on a line and a word,
@@ -59,7 +59,8 @@ pub use creases::CREASES_EXTENSION;
 pub use raw::UvRead;
 pub use read::{mentions_uvs, read, read_mesh, read_str, read_with_uvs};
 pub use write::{
-    to_bytes, write, write_mesh, write_with_attributes, write_with_normals, write_with_sharpness,
+    to_bytes, write, write_mesh, write_with_attributes, write_with_corner_normals,
+    write_with_normals, write_with_sharpness,
 };
 
 use text::error;

@@ -224,23 +224,25 @@ pub(super) fn write_obj(w: &mut dyn Write, s: &dyn Polygons) -> io::Result<()> {
             put_indices(w, f, 1)
         });
     }
+    let normal_corners = s.normal_corners();
     let mut corner = 0;
     s.each_face(&mut |f| {
         w.write_all(b"f")?;
         for &i in f {
             let v = u64::from(i) + 1;
+            let n = normal_corners.map_or(v, |c| u64::from(c[corner]) + 1);
             match uvs {
                 Some(uvs) => {
                     let t = u64::from(uvs.corners[corner]) + 1;
-                    corner += 1;
                     if normals.is_some() {
-                        write!(w, " {v}/{t}/{v}")?;
+                        write!(w, " {v}/{t}/{n}")?;
                     } else {
                         write!(w, " {v}/{t}")?;
                     }
                 }
-                None => write!(w, " {v}//{v}")?,
+                None => write!(w, " {v}//{n}")?,
             }
+            corner += 1;
         }
         w.write_all(b"\n")
     })

@@ -36,6 +36,35 @@ pub fn write_with_normals(
     write_with_attributes(path, soup, Some(normals), None, &[])
 }
 
+/// Writes `soup` to `path` as [`write()`] does, with a unit normal per
+/// face corner: `values`, the first one a vertex (what PLY's vertex
+/// element keeps), and `corners`, an index into them for each corner of
+/// the faces in order. OBJ writes every value as a `vn` line and the
+/// corners `v//n`; PLY the first one a vertex, as [`write_with_normals`].
+pub fn write_with_corner_normals(
+    path: &Path,
+    soup: &PolygonSoup,
+    values: &[DVec3],
+    corners: &[u32],
+) -> Result<(), MeshFileError> {
+    assert!(
+        values.len() >= soup.positions.len(),
+        "a normal per vertex first"
+    );
+    assert_eq!(
+        corners.len(),
+        soup.faces.indices().len(),
+        "a normal per corner"
+    );
+    let s = WithNormals {
+        soup,
+        normals: Some(values),
+        normal_corners: Some(corners),
+        uvs: None,
+    };
+    write_streamed(path, &s, &[])
+}
+
 /// Writes `soup` to `path` as [`write()`] does, with `normals` (one a
 /// vertex, see [`write_with_normals`]) and the corners' texture
 /// coordinates `uvs` where the format has a place for them: `vt` lines
@@ -60,7 +89,16 @@ pub fn write_with_attributes(
             "a texture coordinate per corner"
         );
     }
-    write_streamed(path, &WithNormals { soup, normals, uvs }, edges)
+    write_streamed(
+        path,
+        &WithNormals {
+            soup,
+            normals,
+            normal_corners: None,
+            uvs,
+        },
+        edges,
+    )
 }
 
 /// Writes `soup` to `path` as [`write()`] does, with the sharp `edges` (two
@@ -129,8 +167,14 @@ pub(super) trait Polygons {
     fn each_position(&self, f: &mut dyn FnMut(DVec3) -> io::Result<()>) -> io::Result<()>;
     /// Calls `f` on every face's corners in order, stopping at an error.
     fn each_face(&self, f: &mut dyn FnMut(&[u32]) -> io::Result<()>) -> io::Result<()>;
-    /// A normal per vertex, in order, when there are normals.
+    /// A normal per vertex, in order, when there are normals (then, with
+    /// [`Polygons::normal_corners`], more normals that corners name).
     fn normals(&self) -> Option<&[DVec3]> {
+        None
+    }
+    /// Each face corner's normal, an index into [`Polygons::normals`];
+    /// `None`: each corner has its vertex's.
+    fn normal_corners(&self) -> Option<&[u32]> {
         None
     }
     /// The texture coordinates of the faces' corners, when there are some.
@@ -144,6 +188,9 @@ pub(super) trait Polygons {
 struct WithNormals<'a> {
     soup: &'a PolygonSoup,
     normals: Option<&'a [DVec3]>,
+    /// Each face corner's normal, an index into `normals` (else a vertex's
+    /// own).
+    normal_corners: Option<&'a [u32]>,
     uvs: Option<&'a FaceUvs>,
 }
 
@@ -170,6 +217,10 @@ impl Polygons for WithNormals<'_> {
 
     fn normals(&self) -> Option<&[DVec3]> {
         self.normals
+    }
+
+    fn normal_corners(&self) -> Option<&[u32]> {
+        self.normal_corners
     }
 
     fn uvs(&self) -> Option<&FaceUvs> {
