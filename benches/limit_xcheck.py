@@ -21,6 +21,19 @@ face normals at the nearest vertex of `subgram subdivide -n k+5` (no
 limit; the sphere k+4, the bunny, 3,674 triangles, k+4), judged at 0.1
 degree.
 
+Then open meshes and creases (the limit at boundary, crease and corner
+vertices): the cube with a face open, an open grid, the UV sphere with
+its north cap off, the bunny with a hole cut near its first vertex, the
+cube with its top rim creased for ever and the grid with a crease across
+(a `.creases` file for subgram; Blender's `crease_edge` 1.0, which it
+passes to OpenSubdiv as sharpness 10, infinite, with `use_creases`),
+positions only, at k = 1 and 2, judged at 1e-5 of the mesh's size. A
+corner of a single face is judged instead against the refinement itself,
+8 levels finer (its corner converges to the limit at 1/4 a level): there
+Blender's patches put the limit 1e-3 of the grid's size away from where
+its own refinement goes, which subgram follows; that distance is
+reported.
+
 `--self-test` compares the limit positions of level k with Blender's at
 level k+1 and its normals with those of a coarse mesh (k+1): both must be
 reported as failures.
@@ -194,6 +207,122 @@ def run(binary, out, self_test=False):
     return failed
 
 
+# -- open meshes and creases (the limit at boundary and crease vertices) --
+
+def blender_limit_creased(v, f, sharp, levels):
+    """Blender's use_limit_surface with edge creases: `sharp` maps a vertex
+    pair to infinity (crease 1.0, sharpness 10: OpenSubdiv's infinite)."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    ob = bpy_mesh(v, f)
+    me = ob.data
+    if sharp:
+        attr = me.attributes.new("crease_edge", "FLOAT", "EDGE")
+        index = {tuple(sorted(e.vertices)): e.index for e in me.edges}
+        for a, b in sharp:
+            attr.data[index[tuple(sorted((a, b)))]].value = 1.0
+    md = ob.modifiers.new("subsurf", "SUBSURF")
+    md.subdivision_type = "CATMULL_CLARK"
+    md.boundary_smooth = "ALL"
+    md.use_limit_surface = True
+    md.use_creases = bool(sharp)
+    md.levels = levels
+    md.render_levels = levels
+    dg = bpy.context.evaluated_depsgraph_get()
+    dg.update()
+    return blender_fetch(ob, dg)
+
+
+def open_cases():
+    """Open meshes and meshes with creases for ever: name, vertices, faces,
+    sharp edges (pairs of vertex indices, from 0)."""
+    cube_v, cube_f = read_obj(os.path.join(MESHES, "cube.obj"))
+    cube_j = jiggle(cube_v, 1)
+    grid = np.array([[i / 4, j / 3, 0.1 * ((i * 7 + j * 3) % 5) - 0.2]
+                     for j in range(4) for i in range(5)])
+    grid_f = [[j * 5 + i, j * 5 + i + 1, (j + 1) * 5 + i + 1, (j + 1) * 5 + i]
+              for j in range(3) for i in range(4)]
+    sv, sf = uv_sphere()
+    sv = jiggle(sv, 2, 0.01)
+    cap = [face for face in sf if 0 not in face]
+    bv, bf = read_obj(os.path.join(MESHES, "bunny.obj"))
+    centre = bv[0]
+    near = np.linalg.norm(bv - centre, axis=1) < 0.15 * np.ptp(bv, axis=0).max()
+    holed = [face for face in bf if not all(near[i] for i in face)]
+    top = [face for face in cube_f]
+    # The cube's top rim: the edges of the face whose vertices all have the largest z.
+    zmax = cube_v[:, 2].max()
+    rim = [(a, b) for face in cube_f for a, b in zip(face, face[1:] + face[:1])
+           if cube_v[a, 2] == zmax and cube_v[b, 2] == zmax and a < b]
+    row = [(5 + i, 6 + i) for i in range(4)]
+    return [
+        ("cube, a face open", cube_j, cube_f[:-1], []),
+        ("grid (open)", grid, grid_f, []),
+        ("UV sphere, cap off", sv, cap, []),
+        ("bunny, a hole", bv, holed, []),
+        ("cube, rim creased", cube_j, top, rim),
+        ("grid, a crease across", grid, grid_f, row),
+    ]
+
+
+def compact(v, f):
+    used = sorted({i for face in f for i in face})
+    new = {old: k for k, old in enumerate(used)}
+    return np.asarray(v)[used], [[new[i] for i in face] for face in f], new
+
+
+def run_open(binary, out, self_test=False):
+    print()
+    print("--limit at boundary and crease vertices, against Blender's use_limit_surface")
+    print(f"   {'mesh':<22} {'k':>2} {'vertices':>9} {'position':>10} {'':>4}")
+    failed = []
+    for n, (name, v, f, sharp) in enumerate(open_cases()):
+        v, f, new = compact(v, f)
+        sharp = [(new[a], new[b]) for a, b in sharp]
+        path = os.path.join(out, f"open{n}.obj")
+        write_obj(path, v, f, name)
+        creases = os.path.join(out, f"open{n}.creases")
+        if sharp:
+            with open(creases, "w") as c:
+                for a, b in sharp:
+                    c.write(f"e {a + 1} {b + 1} inf\n")
+        elif os.path.exists(creases):
+            os.remove(creases)
+        v, f = read_obj(path)
+        size = float(np.ptp(v, axis=0).max())
+        for k in (1, 2):
+            lim = os.path.join(out, f"open{n}-{k}-limit.obj")
+            mv, mf = subgram(binary, path, k, lim, True)
+            bv, bf = blender_limit_creased(v, f, sharp, k + 1 if self_test else k)
+            # Corners of a single face are judged against the limit of
+            # the refinement itself (8 levels more, the nearest such
+            # corner), not against Blender: its patches put them elsewhere.
+            one = valences(len(mv), mf) == 1
+            if match(bv, bf, mv, mf) is None:
+                failed.append(f"{name}, k={k}: no one-to-one match with Blender's vertices")
+                print(f"   {name:<22} {k:>2} {len(mv):>9} {'no match':>10} FAIL")
+                continue
+            d, _ = cKDTree(bv).query(mv)
+            rel = float(d[~one].max()) / size
+            mark = "ok" if rel <= POS_TOL else "FAIL"
+            if mark == "FAIL":
+                failed.append(f"{name}, k={k}: position {rel:.2e} > {POS_TOL:.0e}")
+            extra = ""
+            if one.any():
+                fk = k + 8
+                fv, ff = subgram(binary, path, fk, os.path.join(out, f"open{n}-{fk}.obj"), False)
+                fone = valences(len(fv), ff) == 1
+                dc, _ = cKDTree(fv[fone]).query(mv[one])
+                crel = float(dc.max()) / size
+                cmark = "ok" if crel <= 1e-4 else "FAIL"
+                if cmark == "FAIL":
+                    failed.append(f"{name}, k={k}: corner {crel:.2e} from the refinement's")
+                blender_off = float(d[one].max()) / size
+                extra = (f"   {int(one.sum())} corners of one face: {crel:.1e} from level {fk}'s "
+                         f"{cmark}; Blender's {blender_off:.1e} off")
+            print(f"   {name:<22} {k:>2} {len(mv):>9} {rel:>10.1e} {mark:>4}{extra}")
+    return failed
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bin", default=os.path.join(ROOT, "target", "debug", "subgram"))
@@ -208,6 +337,7 @@ def main():
         out = args.out or tmp
         os.makedirs(out, exist_ok=True)
         failed = run(binary, out, args.self_test)
+        failed += run_open(binary, out, args.self_test)
     print()
     if args.self_test:
         pos = sum("position" in x or "no one-to-one" in x for x in failed)
