@@ -131,7 +131,13 @@ mod tests {
             .collect()
     }
 
-    fn encode(w: u32, h: u32, colour: png::ColorType, depth: png::BitDepth, data: &[u8]) -> Vec<u8> {
+    fn encode(
+        w: u32,
+        h: u32,
+        colour: png::ColorType,
+        depth: png::BitDepth,
+        data: &[u8],
+    ) -> Vec<u8> {
         let mut out = Vec::new();
         let mut e = png::Encoder::new(&mut out, w, h);
         e.set_color(colour);
@@ -179,7 +185,13 @@ mod tests {
 
     #[test]
     fn a_grey_image_takes_one_byte_a_pixel() {
-        let png = encode(64, 32, png::ColorType::Grayscale, png::BitDepth::Eight, &[9; 64 * 32]);
+        let png = encode(
+            64,
+            32,
+            png::ColorType::Grayscale,
+            png::BitDepth::Eight,
+            &[9; 64 * 32],
+        );
         let img = Image::decode(&png).unwrap();
         assert_eq!(img.data.len(), 64 * 32);
         assert_eq!(img.data.capacity(), 64 * 32);
