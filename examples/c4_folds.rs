@@ -5,11 +5,9 @@
 //! `cargo run --release --example c4_folds [MESH...] [--steps 2,4,6,8]`
 //! (default: `lsystems/meshes/bunny.obj` and `lsystems/meshes/armadillo.off`)
 //!
-//! Each base triangle gets its index as a tag, which the stellar operators
-//! hand down, so each refined face is measured against the base surface
-//! where it came from ([`subgram::mesh::folds`]): a face is flipped when
-//! its normal points away from the base triangle's smoothed normal (the
-//! sum of its corners' vertex normals). Besides the largest dihedral angle
+//! A face is flipped when its normal points away from the smoothed normal
+//! (the sum of its corners' vertex normals) of the base triangle nearest
+//! to it ([`subgram::mesh::folds`]). Besides the largest dihedral angle
 //! of the whole mesh, the largest across the edges at the original
 //! interior vertices of valence 3 and 4 (which keep their numbers): where
 //! the pairing leaves one in two blocks, that angle does not fall. It
@@ -50,9 +48,8 @@ fn main() {
 
 fn measure(path: &Path, steps: &[usize]) {
     let soup = io::read(path).unwrap_or_else(|e| panic!("{e}"));
-    let tags: Vec<u32> = (0..soup.faces.len() as u32).collect();
-    let base = Mesh::from_soup_tagged(&soup, &tags).unwrap_or_else(|e| panic!("{e}"));
-    let normals = folds::base_normals(&base);
+    let base = Mesh::from_soup(&soup).unwrap_or_else(|e| panic!("{e}"));
+    let surface = folds::Base::new(&base);
     // The interior vertices of valence 3 and 4: those a pairing may leave
     // in two blocks.
     let low: Vec<_> = base
@@ -89,7 +86,7 @@ fn measure(path: &Path, steps: &[usize]) {
             let n = if scheme == "loop" { s / 2 } else { s };
             run.steps(n - done, |_| {}).unwrap_or_else(|e| fail(e));
             done = n;
-            let f = folds::folds(run.mesh(), &normals, &low);
+            let f = folds::folds(run.mesh(), &surface, &low);
             println!(
                 "  {scheme:4} {n} steps: {:>8} faces, max dihedral {:6.2}°, at valence 3 and 4 \
                  {:6.2}°, {} flipped",
