@@ -212,7 +212,9 @@ def make(kind, n, path):
 
 
 def slope(rows):
-    """Log-log slopes between consecutive finished sizes."""
+    """Log-log slopes between consecutive finished sizes (CPU time: user +
+    system, which another process on the machine disturbs less than the
+    wall time)."""
     out = []
     for (n0, t0), (n1, t1) in zip(rows, rows[1:]):
         if t0 and t1 and t0 > 0.02:
@@ -240,8 +242,8 @@ def table(title, size_name, sizes, cases, run, timeout, units=lambda n: n):
             per = rss * 2**20 / units(n)
             print(f"{name:24s} {n:>10d} {shown:>9s} {cpu:9.2f} {rss:9.1f} {per:7.1f}  {note}",
                   flush=True)
-            done.append((units(n), None if code != 0 else wall))
-        print(f"{'':24s} log-log slope of wall time against {size_name if units(2) == 2 else 'pixels'}: "
+            done.append((units(n), None if code != 0 else cpu))
+        print(f"{'':24s} log-log slope of CPU time against {size_name if units(2) == 2 else 'pixels'}: "
               f"{slope(done)}")
 
 
