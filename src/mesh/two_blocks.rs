@@ -12,22 +12,21 @@
 //! more, and no new vertex in fewer than three:
 //!
 //! ```text
-//!   quads  Q1 = v a w b  (v's edges va, vb shared with)  Q2 = v b u a
+//!   Q1 = v a w b, Q2 = v b u a: the two quads at v share its edges va
+//!   and vb; Q2's internal edge is v u (one of the two has its internal
+//!   edge at v). New points: ma on va, mb on vb (midpoints), c at the
+//!   midpoint of Q1's internal edge (v w or a b).
 //!
-//!         a ----------- w            a ----------- w
-//!        / \    Q1     /            / \  .        /
-//!       /   \         /            /  ma ---- c  /        Q1: v ma c mb,
-//!      /     \       /     ->     /  /  \     | /             ma a w c,
-//!     u  Q2   v ---- b           u ---- v --- mb-- b           c w b mb
-//!      \             |            \            \   |      Q2: v mb b u,
-//!       \____________|             \____________\__|          v u a ma
+//!   Q1 -> v ma c mb,  a w c ma,  c w b mb      (v in 3 quads,
+//!   Q2 -> mb b u v,   u a ma v                  ma, mb, c in 3 each)
 //! ```
 //!
-//! `ma` and `mb` are the midpoints of `va` and `vb`, `c` the centre of
-//! Q1: the mesh's shape stays (new points on its quads), its original
-//! vertices keep their places and numbers, and the new ones come after.
-//! The two edges split are `v`'s own, inside Q1 ∪ Q2, so nothing outside
-//! the two quads changes: no T-junction, no triangle left alone.
+//! Every new triangle lies inside an old one (each quad's internal edge
+//! is on an old edge or inside an old triangle, and Q2 keeps v u), so the
+//! mesh's shape, its area and its original vertices (places and numbers)
+//! stay; the new vertices come after them. The two edges split are `v`'s
+//! own, inside Q1 ∪ Q2, so nothing outside the two quads changes: no
+//! T-junction, no triangle left alone.
 
 use glam::DVec3;
 
