@@ -21,6 +21,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use glam::DVec3;
+use subgram::mesh::folds::TriangleIndex;
 use subgram::mesh::{io, shapes, Mesh};
 use subgram::surface::{load_file, load_str, Grammar};
 
@@ -53,129 +54,9 @@ fn adaptive_as(how: &str, guard: &str) -> Grammar {
     load_str("adaptive.lsys", &text, &[]).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Triangles in a uniform grid of cells, for nearest-point queries.
-struct Index {
-    tris: Vec<[DVec3; 3]>,
-    lo: DVec3,
-    cell: f64,
-    dims: [usize; 3],
-    cells: Vec<Vec<u32>>,
-}
-
-impl Index {
-    fn new(m: &Mesh) -> Index {
-        let tris: Vec<[DVec3; 3]> = m
-            .faces()
-            .map(|f| m.face_vertices(f).map(|v| m.position(v)))
-            .collect();
-        let (mut lo, mut hi) = (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN));
-        for t in &tris {
-            for p in t {
-                lo = lo.min(*p);
-                hi = hi.max(*p);
-            }
-        }
-        let n = (tris.len() as f64 / 2.0).cbrt().max(1.0);
-        let cell = (hi - lo).max_element() / n;
-        let dims = ((hi - lo) / cell).to_array().map(|x| x as usize + 1);
-        let mut cells = vec![Vec::new(); dims[0] * dims[1] * dims[2]];
-        for (i, t) in tris.iter().enumerate() {
-            let a = t[0].min(t[1]).min(t[2]);
-            let b = t[0].max(t[1]).max(t[2]);
-            let (ca, cb) = (((a - lo) / cell).to_array(), ((b - lo) / cell).to_array());
-            for x in ca[0] as usize..=(cb[0] as usize).min(dims[0] - 1) {
-                for y in ca[1] as usize..=(cb[1] as usize).min(dims[1] - 1) {
-                    for z in ca[2] as usize..=(cb[2] as usize).min(dims[2] - 1) {
-                        cells[(x * dims[1] + y) * dims[2] + z].push(i as u32);
-                    }
-                }
-            }
-        }
-        Index {
-            tris,
-            lo,
-            cell,
-            dims,
-            cells,
-        }
-    }
-
-    /// The distance from `p` to the nearest triangle: cells in growing
-    /// shells, until the best distance is within the shell's reach.
-    fn distance(&self, p: DVec3) -> f64 {
-        let c = ((p - self.lo) / self.cell)
-            .to_array()
-            .map(|x| x.floor() as i64);
-        let mut best = f64::MAX;
-        for k in 0i64.. {
-            for x in c[0] - k..=c[0] + k {
-                for y in c[1] - k..=c[1] + k {
-                    for z in c[2] - k..=c[2] + k {
-                        let shell = (x - c[0]).abs().max((y - c[1]).abs()).max((z - c[2]).abs());
-                        if shell != k {
-                            continue;
-                        }
-                        let ok = |v: i64, d: usize| v >= 0 && (v as usize) < d;
-                        if !(ok(x, self.dims[0]) && ok(y, self.dims[1]) && ok(z, self.dims[2])) {
-                            continue;
-                        }
-                        let cell = &self.cells
-                            [(x as usize * self.dims[1] + y as usize) * self.dims[2] + z as usize];
-                        for &i in cell {
-                            best = best.min(point_triangle(p, &self.tris[i as usize]));
-                        }
-                    }
-                }
-            }
-            if best <= k as f64 * self.cell {
-                return best;
-            }
-            if k as usize > self.dims.iter().sum::<usize>() {
-                return best;
-            }
-        }
-        best
-    }
-}
-
-/// The distance from `p` to triangle `t` (Ericson, Real-Time Collision
-/// Detection, 5.1.5: the closest point by the Voronoi regions).
-fn point_triangle(p: DVec3, t: &[DVec3; 3]) -> f64 {
-    let [a, b, c] = *t;
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return p.distance(a);
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return p.distance(b);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return p.distance(a + ab * (d1 / (d1 - d3)));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return p.distance(c);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return p.distance(a + ac * (d2 / (d2 - d6)));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
-        return p.distance(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    p.distance(a + ab * (vb * denom) + ac * (vc * denom))
-}
-
 /// The largest distance from a vertex or face centroid of `m` to `limit`,
 /// over the points within `within` of `centre` (all with `None`).
-fn error(m: &Mesh, limit: &Index, within: Option<(DVec3, f64)>) -> f64 {
+fn error(m: &Mesh, limit: &TriangleIndex, within: Option<(DVec3, f64)>) -> f64 {
     let vs = m.vertices().map(|v| m.position(v));
     let cs = m.faces().map(|f| m.face_centroid(f));
     vs.chain(cs)
@@ -203,7 +84,7 @@ fn main() {
     .unwrap_or_else(|e| panic!("{e}"));
     let t = Instant::now();
     let limit = run(&uniform, &base, reference);
-    let index = Index::new(&limit);
+    let index = TriangleIndex::new(&limit);
     println!(
         "{}: {} faces; reference: {reference} uniform bisections, {} faces ({:.1} s)",
         mesh.display(),

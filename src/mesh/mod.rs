@@ -7,6 +7,7 @@
 //! "Layers").
 
 pub mod build;
+pub mod folds;
 pub mod halfedge;
 pub mod info;
 pub mod io;
@@ -15,6 +16,7 @@ pub mod pairing;
 pub mod shapes;
 pub mod soup;
 pub mod stellar;
+mod two_blocks;
 pub mod validate;
 
 pub use build::SoupSharpness;

@@ -421,6 +421,108 @@ pub(crate) fn maximum_matching(
     mate
 }
 
+/// The matchings [`Mesh::match_blocks`] tries, each preferring edges
+/// chosen from the one before.
+const PASSES: usize = 3;
+
+/// The interior vertices that a pairing may leave in fewer than 3 blocks
+/// (valence 3 or 4), and which of their edges a pairing may take as a
+/// block's internal edge: none at valence 3; at valence 4 none at first,
+/// then two that share a face (`pick`: the first of them, in the order
+/// of [`Mesh::outgoing_halfedges`]).
+struct Few {
+    /// Per vertex slot: 0 not low (boundary or valence 5 or more), else
+    /// its valence; `u8::MAX` not yet known.
+    low: Vec<u8>,
+    pick: std::collections::HashMap<VertexId, usize>,
+}
+
+impl Few {
+    fn new(m: &Mesh) -> Few {
+        let slots = m.vertices().map(|v| v.index() + 1).max().unwrap_or(0);
+        Few {
+            low: vec![u8::MAX; slots],
+            pick: std::collections::HashMap::new(),
+        }
+    }
+
+    /// 3 or 4 for an interior vertex of that valence, else 0; once a
+    /// vertex (a fan's centre has thousands of edges).
+    fn low(&mut self, m: &Mesh, v: VertexId) -> u8 {
+        let l = &mut self.low[v.index()];
+        if *l == u8::MAX {
+            *l = if m.is_boundary_vertex(v) {
+                0
+            } else {
+                // Stops counting at 5: a fan's centre is not walked whole.
+                match m.outgoing_halfedges(v).take(5).count() {
+                    d @ (3 | 4) => d as u8,
+                    _ => 0,
+                }
+            };
+        }
+        *l
+    }
+
+    /// Whether `e` may be an internal edge as far as its ends go.
+    fn allowed(&mut self, m: &Mesh, e: EdgeId) -> bool {
+        let (p, q) = m.edge_vertices(e);
+        [p, q].into_iter().all(|v| match self.low(m, v) {
+            0 => true,
+            3 => false,
+            _ => self.pick.get(&v).is_some_and(|&i| {
+                let ring: Vec<EdgeId> = m.outgoing_halfedges(v).map(|h| h.edge()).collect();
+                ring[i] == e || ring[(i + 1) % ring.len()] == e
+            }),
+        })
+    }
+
+    /// The vertices left in fewer than 3 blocks when `taken` become
+    /// internal edges (with the blocks the mesh has already).
+    fn count(&mut self, m: &Mesh, taken: &[EdgeId]) -> usize {
+        let mut diagonals: std::collections::HashMap<VertexId, usize> =
+            std::collections::HashMap::new();
+        let lows: Vec<VertexId> = taken
+            .iter()
+            .flat_map(|&e| {
+                let (p, q) = m.edge_vertices(e);
+                [p, q]
+            })
+            .filter(|&v| self.low(m, v) != 0)
+            .collect();
+        for v in lows {
+            *diagonals.entry(v).or_default() += 1;
+        }
+        diagonals
+            .into_iter()
+            .filter(|&(v, j)| {
+                let old = m
+                    .outgoing_halfedges(v)
+                    .filter(|h| m.is_block_edge(h.edge()))
+                    .count();
+                (self.low(m, v) as usize) < 3 + j + old
+            })
+            .count()
+    }
+
+    /// At each vertex of valence 4, allows the edge `taken` has there (the
+    /// first, where two are) and the next one.
+    fn follow(&mut self, m: &Mesh, taken: &[EdgeId]) {
+        for &e in taken {
+            let (p, q) = m.edge_vertices(e);
+            for v in [p, q] {
+                if self.low(m, v) == 4 {
+                    let i = m
+                        .outgoing_halfedges(v)
+                        .position(|h| h.edge() == e)
+                        .expect("an edge at its end");
+                    self.pick.entry(v).or_insert(i);
+                }
+            }
+        }
+    }
+}
+
 /// What [`Mesh::match_blocks`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Pairing {
@@ -428,6 +530,10 @@ pub struct Pairing {
     pub pairs: usize,
     /// Triangles left alone on the boundary, for a boundary split.
     pub on_boundary: usize,
+    /// Interior vertices the matching left in two blocks, whose two quads
+    /// were cut into five (each adds 3 vertices and 3 blocks; see
+    /// `mesh/two_blocks.rs`).
+    pub split: usize,
 }
 
 impl Mesh {
@@ -486,30 +592,51 @@ impl Mesh {
             }
         }
         let g = Graph::from_edges(real + stand_ins.len(), &links);
-        // Preferred pairs: across an edge with no interior end of valence
-        // 3 or 4. A diagonal there leaves the vertex in two quads (k = 2
-        // in c4.lsys's terms), where the C4 scheme's subdominant
-        // eigenvalue 1/4 is not above the next one (see
-        // tests/it/surface_c4.rs); without one it is in 3 or 4 quads.
-        // Once a vertex: a fan's centre has thousands of edges.
-        let mut lows = std::collections::HashMap::new();
-        let mut low = |v: VertexId| {
-            *lows
-                .entry(v)
-                .or_insert_with(|| !self.is_boundary_vertex(v) && self.valence(v) <= 4)
-        };
-        let preferred: Vec<(u32, u32)> = links
-            .iter()
-            .zip(&via)
-            .filter(|&(&(_, b), &e)| {
-                let (p, q) = self.edge_vertices(e);
-                (b as usize) < real && !low(p) && !low(q)
-            })
-            .map(|(&l, _)| l)
-            .collect();
-        let preferred = Graph::from_edges(real + stand_ins.len(), &preferred);
+        // Preferred pairs: those that leave every interior vertex in 3
+        // blocks or more (`Few`). A vertex of valence d in j blocks'
+        // internal edges is in d - j blocks; C4 needs 3 (k = 2 in
+        // c4.lsys's terms, a vertex in two quads, is not C1: its
+        // subdominant eigenvalue 1/4 is not above the next one; see
+        // tests/it/surface_c4.rs). A vertex of valence 5 or more is in 3
+        // at least whatever is paired (each internal edge at it takes two
+        // of its faces); one of valence 3 may have no internal edge, and
+        // one of valence 4 at most one. The first matching prefers no edge
+        // at either; the next ones allow two edges at each vertex of
+        // valence 4 that share a face (so at most one is taken), the two
+        // at the edge the matching before took there, and keep the
+        // matching that leaves the fewest vertices in two blocks.
+        let mut few = Few::new(self);
         let mut left = budget;
-        let mate = maximum_matching(&g, &preferred, real, &mut left);
+        let mut best: Option<(usize, Vec<u32>)> = None;
+        for pass in 0..PASSES {
+            let preferred: Vec<(u32, u32)> = links
+                .iter()
+                .zip(&via)
+                .filter(|&(&(_, b), &e)| (b as usize) < real && few.allowed(self, e))
+                .map(|(&l, _)| l)
+                .collect();
+            let preferred = Graph::from_edges(real + stand_ins.len(), &preferred);
+            let mate = maximum_matching(&g, &preferred, real, &mut left);
+            if left == 0 || crate::deadline::current().is_some_and(|d| d.passed()) {
+                best = Some((0, mate));
+                break;
+            }
+            let taken: Vec<EdgeId> = links
+                .iter()
+                .zip(&via)
+                .filter(|&(&(a, b), _)| (b as usize) < real && mate[a as usize] == b)
+                .map(|(_, &e)| e)
+                .collect();
+            let bad = few.count(self, &taken);
+            if best.as_ref().is_none_or(|(b, _)| bad < *b) {
+                best = Some((bad, mate));
+            }
+            if bad == 0 || pass + 1 == PASSES {
+                break;
+            }
+            few.follow(self, &taken);
+        }
+        let (_, mate) = best.expect("one pass at least");
         if let Some(d) = crate::deadline::current().filter(|d| d.passed()) {
             return Err(MeshError::new(format!(
                 "pairing triangles into blocks: {}",
@@ -552,6 +679,17 @@ impl Mesh {
         for &e in &pairs {
             self.e_block.set(e.index(), true);
         }
+        // What the matching left in two blocks, cut into three (a base
+        // mesh's: the cut rebuilds it).
+        let split = if base {
+            self.split_two_block_vertices().inspect_err(|_| {
+                for &e in &pairs {
+                    self.e_block.set(e.index(), false);
+                }
+            })?
+        } else {
+            0
+        };
         if base {
             let edges: Vec<EdgeId> = self.edges().collect();
             for e in edges {
@@ -560,8 +698,9 @@ impl Mesh {
             }
         }
         Ok(Pairing {
-            pairs: pairs.len(),
+            pairs: pairs.len() + 3 * split,
             on_boundary,
+            split,
         })
     }
 }

@@ -22,7 +22,8 @@ use crate::error::Error;
 pub const MAX_INPUT_BYTES: u64 = 64 << 20;
 
 /// The largest PNG silhouette traced, in pixels (8192 × 8192): tracing
-/// needs about 12 bytes a pixel.
+/// needs the image's bytes (one a pixel for a grey image, up to four for
+/// colour with alpha) and about 1.3 bytes a pixel more.
 pub const MAX_IMAGE_PIXELS: u64 = 8192 * 8192;
 
 /// The option of the binary that raises [`MAX_INPUT_BYTES`], for messages.
@@ -625,24 +626,11 @@ pub fn read_png_with(name: &str, bytes: &[u8], silhouette: &Silhouette) -> Resul
             ));
         }
     }
-    let pm = tiny_skia::Pixmap::decode_png(bytes)
+    let img = super::image::Image::decode(bytes)
         .map_err(|e| Error::file(name, format!("cannot read the PNG image: {e}")))?;
-    let (w, h) = (pm.width() as usize, pm.height() as usize);
-    // The image's one copy: its colours demultiplied in place.
-    let mut rgba = pm.take();
-    for px in rgba.chunks_exact_mut(4) {
-        if let Some(p) = tiny_skia::PremultipliedColorU8::from_rgba(px[0], px[1], px[2], px[3]) {
-            let c = p.demultiply();
-            px.copy_from_slice(&[c.red(), c.green(), c.blue(), c.alpha()]);
-        }
-    }
+    let (w, h) = (img.w, img.h);
     // A pixel's colour over white, then its luminance in 0..1.
-    let grey = |x: usize, y: usize| -> f64 {
-        let p = &rgba[(y * w + x) * 4..][..4];
-        let a = p[3] as f64 / 255.0;
-        let lum = (0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64) / 255.0;
-        a * lum + (1.0 - a)
-    };
+    let grey = |x: usize, y: usize| img.grey(x, y);
     let light = match silhouette.side {
         Side::Dark => false,
         Side::Light => true,

@@ -9,6 +9,7 @@
 //! above (see ARCHITECTURE.md, "Layers").
 
 pub mod details;
+mod image;
 pub mod input;
 pub mod metric;
 pub mod trace;

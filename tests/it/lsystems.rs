@@ -80,7 +80,7 @@ fn goldens(rel: &Path) -> Option<Vec<(PathBuf, Kind)>> {
         });
     }
     match (folder, ext) {
-        ("meshes", "obj" | "ply") => Some(vec![(with(".txt"), Kind::Exact)]),
+        ("meshes", "obj" | "ply" | "off") => Some(vec![(with(".txt"), Kind::Exact)]),
         // The sharpness of the mesh beside it: read with it.
         ("meshes", "creases") => Some(vec![]),
         ("shapes", "lsys") => Some(vec![

@@ -119,25 +119,43 @@ fn a_pipe_with_a_writer_is_read() {
     assert_eq!(word.matches('F').count(), 48, "{word}");
 }
 
+/// A fan of `n` triangles around one vertex, as OBJ text.
+fn fan_obj(n: usize) -> String {
+    let mut obj = String::from("v 0 0 0\n");
+    for k in 0..n {
+        let a = k as f64 / n as f64 * std::f64::consts::TAU;
+        obj.push_str(&format!("v {} {} 0\n", a.cos(), a.sin()));
+    }
+    for k in 0..n {
+        obj.push_str(&format!("f 1 {} {}\n", k + 2, (k + 1) % n + 2));
+    }
+    obj
+}
+
+/// A `side`² PNG of black and white 2-pixel squares in a white frame of 4
+/// pixels: a segment in every cell for the tracer.
+fn checkerboard(path: &Path, side: u32) {
+    let mut pm = tiny_skia::Pixmap::new(side, side).unwrap();
+    pm.fill(tiny_skia::Color::WHITE);
+    let black = tiny_skia::PremultipliedColorU8::from_rgba(0, 0, 0, 255).unwrap();
+    let px = pm.pixels_mut();
+    for y in 4..side - 4 {
+        for x in 4..side - 4 {
+            if (x / 2 + y / 2) % 2 == 0 {
+                px[(y * side + x) as usize] = black;
+            }
+        }
+    }
+    pm.save_png(path).unwrap();
+}
+
 /// A PNG of 2-pixel squares makes the tracer follow a loop in every
 /// other cell: `--timeout 1` ends it within a second, and writes nothing.
 #[test]
 fn tracing_stops_at_the_timeout() {
     let tmp = scratch("nohang-trace");
     let dir = tmp.path();
-    let n = 2048u32;
-    let mut pm = tiny_skia::Pixmap::new(n, n).unwrap();
-    pm.fill(tiny_skia::Color::WHITE);
-    let black = tiny_skia::PremultipliedColorU8::from_rgba(0, 0, 0, 255).unwrap();
-    let px = pm.pixels_mut();
-    for y in 4..n - 4 {
-        for x in 4..n - 4 {
-            if (x / 2 + y / 2) % 2 == 0 {
-                px[(y * n + x) as usize] = black;
-            }
-        }
-    }
-    pm.save_png(dir.join("board.png")).unwrap();
+    checkerboard(&dir.join("board.png"), 2048);
     let (o, took) = bin(
         dir,
         &[
@@ -168,16 +186,7 @@ fn tracing_stops_at_the_timeout() {
 fn pairing_stops_at_the_timeout() {
     let tmp = scratch("nohang-pairing");
     let dir = tmp.path();
-    let n = 20_001;
-    let mut obj = String::from("v 0 0 0\n");
-    for k in 0..n {
-        let a = k as f64 / n as f64 * std::f64::consts::TAU;
-        obj.push_str(&format!("v {} {} 0\n", a.cos(), a.sin()));
-    }
-    for k in 0..n {
-        obj.push_str(&format!("f 1 {} {}\n", k + 2, (k + 1) % n + 2));
-    }
-    std::fs::write(dir.join("fan.obj"), obj).unwrap();
+    std::fs::write(dir.join("fan.obj"), fan_obj(20_001)).unwrap();
     std::fs::copy(
         root().join("lsystems/surfaces/c4.lsys"),
         dir.join("c4.lsys"),
@@ -425,4 +434,81 @@ fn serve_analyze_and_two_outputs_of_one_name() {
         "{:?}",
         names(&dir.join("w"))
     );
+}
+
+/// Issue 42, item 4: every path whose cost grows with the input looks at
+/// the deadline. A limit of a millisecond on inputs that take far longer
+/// (the pairing of a 20,000-triangle fan, adaptive 4-8 refinement of a
+/// 20,000-triangle grid, with `adaptive;` and `adaptive: incremental;`,
+/// and the trace of a 1024² checkerboard): each command fails with the
+/// limit's message and writes nothing. Untimed: what is asserted is that
+/// the limit is looked at, not how soon (benches/growth.py measures that).
+#[test]
+fn growing_paths_stop_at_a_tiny_timeout() {
+    let tmp = scratch("nohang-growth");
+    let dir = tmp.path();
+    std::fs::write(dir.join("fan.obj"), fan_obj(20_000)).unwrap();
+    // A 100 × 100 grid of quads in [-1, 1]^2 (its quads are the blocks).
+    let k = 100;
+    let mut grid = String::new();
+    for j in 0..=k {
+        for i in 0..=k {
+            let (x, y) = (
+                -1.0 + 2.0 * i as f64 / k as f64,
+                -1.0 + 2.0 * j as f64 / k as f64,
+            );
+            grid.push_str(&format!("v {x} {y} 0\n"));
+        }
+    }
+    for j in 0..k {
+        for i in 0..k {
+            let a = j * (k + 1) + i + 1;
+            grid.push_str(&format!("f {a} {} {} {}\n", a + 1, a + k + 2, a + k + 1));
+        }
+    }
+    std::fs::write(dir.join("grid.obj"), grid).unwrap();
+    let adaptive =
+        std::fs::read_to_string(root().join("lsystems/surfaces/four-eight-adaptive.lsys")).unwrap();
+    std::fs::write(dir.join("adaptive.lsys"), &adaptive).unwrap();
+    std::fs::write(
+        dir.join("incremental.lsys"),
+        adaptive.replace("\nadaptive;\n", "\nadaptive: incremental;\n"),
+    )
+    .unwrap();
+    std::fs::copy(
+        root().join("lsystems/surfaces/c4.lsys"),
+        dir.join("c4.lsys"),
+    )
+    .unwrap();
+    checkerboard(&dir.join("board.png"), 1024);
+    let before = names(dir);
+    let sub = |mesh: &'static str, grammar: &'static str, steps: &'static str| {
+        vec![
+            "subdivide",
+            mesh,
+            "--grammar",
+            grammar,
+            "-n",
+            steps,
+            "-o",
+            "out.obj",
+        ]
+    };
+    let runs: Vec<Vec<&str>> = vec![
+        sub("fan.obj", "c4.lsys", "0"),
+        sub("grid.obj", "adaptive.lsys", "4"),
+        sub("grid.obj", "incremental.lsys", "4"),
+        vec!["reverse", "board.png", "-n", "1", "-o", "out.csv"],
+    ];
+    for mut args in runs {
+        args.extend(["--timeout", "0.001", "-D", "PX=0", "-D", "R=0.5"]);
+        if args[0] == "reverse" {
+            args.truncate(args.len() - 4);
+        }
+        let (o, _) = bin(dir, &args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("time limit of 0.001 s"), "{args:?}: {err}");
+        assert_eq!(names(dir), before, "{args:?}");
+    }
 }
