@@ -57,7 +57,7 @@ import bpy  # noqa: E402  (before anything that loads another Embree)
 from scipy.spatial import cKDTree  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from xcheck import blender_fetch, bpy_mesh, read_obj, write_obj  # noqa: E402
+from xcheck import blender_fetch, bpy_mesh, read_obj, subsurf, write_obj  # noqa: E402
 
 
 def read_obj_normals(path):
@@ -66,18 +66,7 @@ def read_obj_normals(path):
 
 
 def blender_limit(v, f, levels):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    ob = bpy_mesh(v, f)
-    md = ob.modifiers.new("subsurf", "SUBSURF")
-    md.subdivision_type = "CATMULL_CLARK"
-    md.boundary_smooth = "ALL"
-    md.use_limit_surface = True
-    md.use_creases = False
-    md.levels = levels
-    md.render_levels = levels
-    dg = bpy.context.evaluated_depsgraph_get()
-    dg.update()
-    return blender_fetch(ob, dg)
+    return blender_limit_creased(v, f, [], levels)
 
 
 def uv_sphere(segments=12, rings=8):
@@ -220,15 +209,7 @@ def blender_limit_creased(v, f, sharp, levels):
         index = {tuple(sorted(e.vertices)): e.index for e in me.edges}
         for a, b in sharp:
             attr.data[index[tuple(sorted((a, b)))]].value = 1.0
-    md = ob.modifiers.new("subsurf", "SUBSURF")
-    md.subdivision_type = "CATMULL_CLARK"
-    md.boundary_smooth = "ALL"
-    md.use_limit_surface = True
-    md.use_creases = bool(sharp)
-    md.levels = levels
-    md.render_levels = levels
-    dg = bpy.context.evaluated_depsgraph_get()
-    dg.update()
+    dg = subsurf(ob, levels, use_limit_surface=True, use_creases=bool(sharp))
     return blender_fetch(ob, dg)
 
 
@@ -248,7 +229,6 @@ def open_cases():
     centre = bv[0]
     near = np.linalg.norm(bv - centre, axis=1) < 0.15 * np.ptp(bv, axis=0).max()
     holed = [face for face in bf if not all(near[i] for i in face)]
-    top = [face for face in cube_f]
     # The cube's top rim: the edges of the face whose vertices all have the largest z.
     zmax = cube_v[:, 2].max()
     rim = [(a, b) for face in cube_f for a, b in zip(face, face[1:] + face[:1])
@@ -259,7 +239,7 @@ def open_cases():
         ("grid (open)", grid, grid_f, []),
         ("UV sphere, cap off", sv, cap, []),
         ("bunny, a hole", bv, holed, []),
-        ("cube, rim creased", cube_j, top, rim),
+        ("cube, rim creased", cube_j, cube_f, rim),
         ("grid, a crease across", grid, grid_f, row),
     ]
 

@@ -43,7 +43,7 @@ import bpy  # noqa: E402
 from scipy.spatial import cKDTree  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from xcheck import bpy_mesh, read_obj  # noqa: E402
+from xcheck import blender_fetch, bpy_mesh, read_obj, subsurf  # noqa: E402
 
 # Blender's uv_smooth choice -> OpenSubdiv's face-varying linear
 # interpolation, as subgram names it.
@@ -215,34 +215,16 @@ def read_uv_obj(path):
 def blender_uv(v, f, uv, levels, smooth):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     ob = bpy_mesh(v, f)
-    me = ob.data
-    layer = me.uv_layers.new(name="UV")
+    layer = ob.data.uv_layers.new(name="UV")
     layer.data.foreach_set("uv", np.asarray([c for t in uv for c in t], np.float32).ravel())
-    md = ob.modifiers.new("subsurf", "SUBSURF")
-    md.subdivision_type = "CATMULL_CLARK"
-    md.boundary_smooth = "ALL"
-    md.uv_smooth = smooth
-    md.use_limit_surface = False
-    md.use_creases = False
-    md.levels = levels
-    md.render_levels = levels
-    dg = bpy.context.evaluated_depsgraph_get()
-    dg.update()
+    dg = subsurf(ob, levels, uv_smooth=smooth)
+    co, faces = blender_fetch(ob, dg)
     ev = ob.evaluated_get(dg).data
-    co = np.empty(len(ev.vertices) * 3, np.float32)
-    ev.vertices.foreach_get("co", co)
-    n = len(ev.polygons)
-    start, total = np.empty(n, np.int32), np.empty(n, np.int32)
-    ev.polygons.foreach_get("loop_start", start)
-    ev.polygons.foreach_get("loop_total", total)
-    lv = np.empty(len(ev.loops), np.int32)
-    ev.loops.foreach_get("vertex_index", lv)
     luv = np.empty(len(ev.loops) * 2, np.float32)
     ev.uv_layers.active.data.foreach_get("uv", luv)
     luv = luv.reshape(-1, 2).astype(np.float64)
-    faces = [lv[s:s + t].tolist() for s, t in zip(start, total)]
-    uvs = [luv[s:s + t] for s, t in zip(start, total)]
-    return co.reshape(-1, 3).astype(np.float64), faces, uvs
+    ends = np.cumsum([len(face) for face in faces])
+    return co, faces, np.split(luv, ends[:-1])
 
 
 def subgram(binary, mesh, levels, out, choice):

@@ -206,20 +206,30 @@ def blender_fetch(ob, dg, faces=True):
     return co.reshape(-1, 3).astype(np.float64), f
 
 
-def blender_cc(v, f, levels, boundary="ALL"):
+def subsurf(ob, levels, **settings):
+    """A Catmull-Clark Subdivision Surface modifier of `levels` on `ob`
+    (`boundary_smooth='ALL'`, no limit surface, no creases unless
+    `settings` say otherwise), evaluated: the depsgraph to read it from."""
     import bpy
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    ob = bpy_mesh(v, f)
     md = ob.modifiers.new("subsurf", "SUBSURF")
     md.subdivision_type = "CATMULL_CLARK"
-    md.boundary_smooth = boundary
+    md.boundary_smooth = "ALL"
     md.use_limit_surface = False
     md.use_creases = False
+    for name, value in settings.items():
+        setattr(md, name, value)
     md.levels = levels
     md.render_levels = levels
     dg = bpy.context.evaluated_depsgraph_get()
     dg.update()
-    return blender_fetch(ob, dg)
+    return dg
+
+
+def blender_cc(v, f, levels, boundary="ALL"):
+    import bpy
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    ob = bpy_mesh(v, f)
+    return blender_fetch(ob, subsurf(ob, levels, boundary_smooth=boundary))
 
 
 def blender_timing(path, runs=3):
