@@ -619,3 +619,47 @@ fn an_lpfg_program_without_a_colour_file_is_white_on_black() {
         );
     }
 }
+
+/// In lpfg's shaded modes a pixel-wide line keeps its colour-map entry
+/// (lpfg's picture of such a model: 255,191,0 exactly, made with
+/// ../shared/tools/lpfg); subgram lit it like a tube facing the viewer
+/// (255,255,0).
+#[test]
+fn a_line_in_shaded_mode_keeps_its_map_colour() {
+    let dir = scratch("shaded-lines");
+    let mut map = vec![255u8; 768];
+    map[..6].copy_from_slice(&[0, 0, 0, 255, 191, 0]);
+    std::fs::write(dir.path().join("color.map"), &map).unwrap();
+    std::fs::write(dir.path().join("view.v"), "render mode: shaded\n").unwrap();
+    let program = dir.path().join("plant.l");
+    std::fs::write(
+        &program,
+        "#include <lpfgall.h>\nderivation length: 3;\nmodule A();\n\
+         Axiom: SetColor(1) SetWidth(3) A();\n\
+         A() : { produce F(1) SB() Left(30) A() EB() SB() Right(30) A() EB() F(1) A(); }\n",
+    )
+    .unwrap();
+    let png = dir.path().join("plant.png");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .args([
+            "render",
+            program.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let pixels = rgb_pixels(&png);
+    let mut counts: std::collections::HashMap<[u8; 3], usize> = Default::default();
+    for p in pixels.iter().filter(|p| **p != [0, 0, 0]) {
+        *counts.entry(*p).or_default() += 1;
+    }
+    let (&most, _) = counts.iter().max_by_key(|(_, n)| **n).unwrap();
+    assert_eq!(most, [255, 191, 0], "{counts:?}");
+    assert!(!counts.contains_key(&[255, 255, 0]), "a lit line");
+}

@@ -236,8 +236,15 @@ struct Builder<'m> {
     sides: u32,
     capped: bool,
     scene: Scene3,
-    /// The mesh of each colour index (mod 256), `u32::MAX` until used.
+    /// The mesh of each colour index (mod 256), `u32::MAX` until used;
+    /// from 256 on, the unlit look of each for pixel-wide lines.
     mesh_of: Vec<u32>,
+    /// Pixel-wide lines keep their colour-map entry's colour unlit, as
+    /// lpfg draws lines in its shaded modes: an lpfg model with a colour
+    /// map (or lpfg's default map), not materials.
+    unlit_lines: bool,
+    /// A pixel-wide line is being made: its tube takes the unlit look.
+    in_line: bool,
     triangles: usize,
     vertices: usize,
     max_triangles: usize,
@@ -292,7 +299,9 @@ impl<'m> Builder<'m> {
             sides,
             capped: model.capped_cylinders,
             scene: Scene3::default(),
-            mesh_of: vec![u32::MAX; 256],
+            mesh_of: vec![u32::MAX; 512],
+            unlit_lines: model.lpfg && !matches!(model.colours, Some(Colours::Materials(_))),
+            in_line: false,
             triangles: 0,
             vertices: 0,
             max_triangles: sopts.max_triangles,
@@ -350,9 +359,22 @@ impl<'m> Builder<'m> {
 
     /// The mesh of colour index `color`, made on first use.
     fn mesh(&mut self, color: i64) -> u32 {
-        let k = color.rem_euclid(256) as usize;
+        let c = color.rem_euclid(256) as usize;
+        let unlit = self.in_line && self.unlit_lines;
+        let k = c + if unlit { 256 } else { 0 };
         if self.mesh_of[k] == u32::MAX {
-            let look = self.look(k);
+            let mut look = self.look(c);
+            if unlit {
+                // Emission alone: every light leaves it its colour.
+                look = Look {
+                    name: format!("{}-line", look.name),
+                    emission: look.diffuse,
+                    ambient: [0.0; 3],
+                    diffuse: [0.0; 3],
+                    specular: [0.0; 3],
+                    ..look
+                };
+            }
             self.scene.looks.push(look);
             self.scene.meshes.push(TriMesh::default());
             self.mesh_of[k] = (self.scene.meshes.len() - 1) as u32;

@@ -19,7 +19,9 @@ impl Sink for Builder<'_> {
                 Some(k) => {
                     let scale = self.cur.scale;
                     self.cur.scale = (scale.0 * k, scale.1 * k);
+                    self.in_line = true;
                     let made = self.tube(t, a, b);
+                    self.in_line = false;
                     self.cur.scale = scale;
                     made
                 }
