@@ -556,6 +556,26 @@ fn a_program_without_lpfgall_is_run_with_a_warning() {
     assert!(!out.contains("lpfgall"), "{out}");
 }
 
+/// The RGB pixels of `subgram render PROGRAM -o PROGRAM.png`.
+fn rendered(program: &Path) -> Vec<[u8; 3]> {
+    let png = program.with_extension("png");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
+        .args([
+            "render",
+            program.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    rgb_pixels(&png)
+}
+
 /// The RGB pixels of a PNG file.
 fn rgb_pixels(path: &Path) -> Vec<[u8; 3]> {
     let d = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
@@ -585,22 +605,7 @@ fn an_lpfg_program_without_a_colour_file_is_white_on_black() {
     ] {
         let program = dir.path().join(name);
         std::fs::write(&program, text).unwrap();
-        let png = dir.path().join(format!("{name}.png"));
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
-            .args([
-                "render",
-                program.to_str().unwrap(),
-                "-o",
-                png.to_str().unwrap(),
-            ])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let pixels = rgb_pixels(&png);
+        let pixels = rendered(&program);
         assert_eq!(pixels[0], background, "{name}: the corner");
         let near = |p: [u8; 3], c: [u8; 3]| (i32::from(p[0]) - i32::from(c[0])).abs() < 64;
         let inked = pixels.iter().filter(|&&p| near(p, ink)).count();
@@ -639,22 +644,7 @@ fn a_line_in_shaded_mode_keeps_its_map_colour() {
          A() : { produce F(1) SB() Left(30) A() EB() SB() Right(30) A() EB() F(1) A(); }\n",
     )
     .unwrap();
-    let png = dir.path().join("plant.png");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_subgram"))
-        .args([
-            "render",
-            program.to_str().unwrap(),
-            "-o",
-            png.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let pixels = rgb_pixels(&png);
+    let pixels = rendered(&program);
     let mut counts: std::collections::HashMap<[u8; 3], usize> = Default::default();
     for p in pixels.iter().filter(|p| **p != [0, 0, 0]) {
         *counts.entry(*p).or_default() += 1;
