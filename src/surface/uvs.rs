@@ -126,9 +126,9 @@ impl UvLayout {
     ) -> Result<UvLayout, String> {
         // A layout vertex for each (mesh vertex, value) pair, or one for
         // each fan of faces around the vertex that hold the value where
-        // the fans are separate: two values that happen to be equal, as
-        // Blender hands them to OpenSubdiv (a bow-tie would not be a
-        // manifold layout).
+        // the fans are separate (a bow-tie would not be a manifold
+        // layout); such a value is kept a corner below, as OpenSubdiv
+        // keeps a non-manifold value.
         let corner_of = fans_of_values(soup, uvs);
         let mut index: HashMap<u32, u32> = HashMap::new();
         let mut groups: HashMap<(u32, u32), u32> = HashMap::new();
